@@ -1,0 +1,12 @@
+//! rover, the application: headless runs, teleop, scripts and traces.
+//!
+//! The binary `rover` is a thin command line over this library, so tests drive exactly what
+//! users run.
+
+pub mod bench;
+pub mod headless;
+pub mod paths;
+pub mod pilot;
+pub mod script;
+pub mod teleop;
+pub mod trace;

@@ -1,0 +1,224 @@
+//! The `rover` command line.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use rover::bench;
+use rover::headless::{self, RunConfig};
+use rover_sim::SimOptions;
+
+/// rover: a desktop robot simulator for learning robot perception.
+///
+/// A URDF differential-drive car with a camera, in a world from worlds/, stepped with rapier3d
+/// physics and driven like Gazebo's diff_drive plugin (cmd_vel: linear.x m/s, angular.z rad/s;
+/// REP-103 frames: x forward, y left, z up).
+///
+/// Without a subcommand rover runs the simulation. This version runs it headless: give a script
+/// of timed commands and a trace file to record what the robot did.
+#[derive(Debug, Parser)]
+#[command(version, about, long_about, after_help = EXAMPLES)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+const EXAMPLES: &str = "\
+Examples:
+  rover --headless                                  default world and robot for 10 s, print a summary
+  rover --headless --script drive.toml --trace out.csv
+  rover --headless --world worlds/playground.toml --robot assets/robots/my_robot.urdf --duration 30 --seed 7
+  rover bench                                       physics-only real-time factor
+
+Script format (TOML, times in sim seconds):
+  steps = [
+    { at = 0.0, cmd_vel = [0.5, 0.0] },   # linear.x m/s, angular.z rad/s
+    { at = 2.0, key = \"j\" },              # teleop_twist_keyboard key: u i o j k l m , . q z w x e c space
+    { at = 3.0, toggle = \"follow\" },      # flip manual/follow
+  ]
+
+Trace CSV columns (one row per diff-drive control update):
+  sim_time_s,x_m,y_m,yaw_rad,odom_x_m,odom_y_m,odom_yaw_rad,cmd_linear_mps,cmd_angular_radps,mode";
+
+#[derive(Debug, Args)]
+struct WorldArgs {
+    /// World file (TOML, see docs/WORLDS.md) [default: worlds/playground.toml]
+    #[arg(long, value_name = "FILE")]
+    world: Option<PathBuf>,
+
+    /// Robot URDF [default: the world's [robot] urdf, else assets/robots/my_robot.urdf]
+    #[arg(long, value_name = "FILE")]
+    robot: Option<PathBuf>,
+
+    /// Physics step rate in Hz, overriding the world's [physics] step_hz
+    #[arg(long, value_name = "HZ")]
+    physics_hz: Option<f64>,
+
+    /// Seed for everything random; the same seed gives the same run
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+#[derive(Debug, Args)]
+struct RunArgs {
+    /// Run without a window, as fast as the CPU allows (the only mode in this version)
+    #[arg(long)]
+    headless: bool,
+
+    #[command(flatten)]
+    world: WorldArgs,
+
+    /// Input script: timed cmd_vel / key / toggle steps on sim time (TOML)
+    #[arg(long, value_name = "FILE")]
+    script: Option<PathBuf>,
+
+    /// Sim seconds to run [default: last script step + 1 s, or 10 s]
+    #[arg(long, value_name = "SECS")]
+    duration: Option<f64>,
+
+    /// Write a CSV trace, one row per control update
+    #[arg(long, value_name = "FILE")]
+    trace: Option<PathBuf>,
+
+    /// Stop the robot when no cmd_vel arrived for SECS (off by default, like Gazebo; 0 = off)
+    #[arg(long, value_name = "SECS")]
+    cmd_timeout: Option<f64>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Measure the physics-only real-time factor (single thread) on a world
+    Bench {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per measurement
+        #[arg(long, default_value_t = 60.0, value_name = "SECS")]
+        sim_seconds: f64,
+
+        /// Repeats per measurement (the fastest counts)
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
+
+        /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
+        #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
+        rates: Vec<f64>,
+    },
+}
+
+fn options(w: &WorldArgs, cmd_timeout_s: Option<f64>) -> SimOptions {
+    SimOptions {
+        seed: w.seed,
+        cmd_timeout_s,
+        step_hz: w.physics_hz,
+    }
+}
+
+fn run(args: RunArgs) -> Result<()> {
+    if !args.headless {
+        tracing::info!(
+            "the interactive window is not part of this version yet; running headless (pass --headless to skip this note)"
+        );
+    }
+    let config = RunConfig {
+        world: args.world.world.clone(),
+        robot: args.world.robot.clone(),
+        script: args.script,
+        duration_s: args.duration,
+        trace: args.trace.clone(),
+        options: options(&args.world, args.cmd_timeout),
+        progress_every: Some(Duration::from_secs(5)),
+    };
+    let summary = headless::run(&config)?;
+    println!(
+        "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.0}x real time)",
+        summary.world,
+        summary.robot,
+        summary.sim_time_s,
+        summary.steps,
+        summary.wall_s,
+        summary.real_time_factor()
+    );
+    if let Some(last) = summary.last {
+        let g = last.ground_truth;
+        let o = last.odometry;
+        println!(
+            "final pose: x {:.3} m, y {:.3} m, yaw {:.1} deg (odometry: x {:.3} m, y {:.3} m, yaw {:.1} deg); mode {}",
+            g.x_m,
+            g.y_m,
+            g.yaw_rad.to_degrees(),
+            o.x_m,
+            o.y_m,
+            o.yaw_rad.to_degrees(),
+            summary.mode.as_str()
+        );
+    }
+    if let Some(path) = &args.trace {
+        println!("trace: {} ({} rows)", path.display(), summary.rows);
+    }
+    Ok(())
+}
+
+fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) -> Result<()> {
+    anyhow::ensure!(
+        sim_seconds.is_finite() && sim_seconds > 0.0,
+        "--sim-seconds must be positive, found {sim_seconds}"
+    );
+    let config = RunConfig {
+        world: world.world.clone(),
+        robot: world.robot.clone(),
+        options: options(&world, None),
+        ..RunConfig::default()
+    };
+    let mut plan: Vec<Option<f64>> = vec![world.physics_hz];
+    plan.extend(rates.into_iter().map(Some));
+    println!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
+    println!(
+        "{:>10} {:>12} {:>12} {:>14}",
+        "step_hz", "wall_s", "us/step", "real-time x"
+    );
+    for step_hz in plan {
+        let b = bench::physics(&config, step_hz, sim_seconds, repeats)?;
+        println!(
+            "{:>10.0} {:>12.3} {:>12.1} {:>14.0}",
+            b.step_hz,
+            b.wall_s,
+            b.us_per_step(),
+            b.real_time_factor()
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Bench {
+            world,
+            sim_seconds,
+            repeats,
+            rates,
+        }) => bench_cmd(world, sim_seconds, repeats, rates),
+        None => run(cli.run),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("rover: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! The trace CSV: one row per diff-drive control update.
+
+use std::io::Write;
+
+use rover_sim::ControlSample;
+
+use crate::pilot::Mode;
+
+/// Column header of the trace CSV.
+pub const TRACE_HEADER: &str = "sim_time_s,x_m,y_m,yaw_rad,odom_x_m,odom_y_m,odom_yaw_rad,cmd_linear_mps,cmd_angular_radps,mode";
+
+/// Writes trace rows with fixed formatting, so identical runs give identical bytes.
+#[derive(Debug)]
+pub struct TraceWriter<W: Write> {
+    out: W,
+    rows: u64,
+}
+
+impl<W: Write> TraceWriter<W> {
+    /// Starts a trace, writing the header.
+    pub fn new(mut out: W) -> std::io::Result<Self> {
+        writeln!(out, "{TRACE_HEADER}")?;
+        Ok(Self { out, rows: 0 })
+    }
+
+    /// Appends one row.
+    pub fn row(&mut self, s: &ControlSample, mode: Mode) -> std::io::Result<()> {
+        let g = &s.ground_truth;
+        let o = &s.odometry;
+        writeln!(
+            self.out,
+            "{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{}",
+            s.sim_time_s,
+            g.x_m,
+            g.y_m,
+            g.yaw_rad,
+            o.x_m,
+            o.y_m,
+            o.yaw_rad,
+            s.cmd.linear_mps,
+            s.cmd.angular_radps,
+            mode.as_str()
+        )?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Flushes and returns the writer.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+/// One parsed trace row (for tests and tools that read traces back).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceRow {
+    /// Sim time (s).
+    pub sim_time_s: f64,
+    /// Ground-truth x (m).
+    pub x_m: f64,
+    /// Ground-truth y (m).
+    pub y_m: f64,
+    /// Ground-truth yaw (rad).
+    pub yaw_rad: f64,
+    /// Odometry x (m).
+    pub odom_x_m: f64,
+    /// Odometry y (m).
+    pub odom_y_m: f64,
+    /// Odometry yaw (rad).
+    pub odom_yaw_rad: f64,
+    /// Commanded linear.x (m/s).
+    pub cmd_linear_mps: f64,
+    /// Commanded angular.z (rad/s).
+    pub cmd_angular_radps: f64,
+    /// `manual` or `follow`.
+    pub mode: String,
+}
+
+/// Parses a trace CSV produced by [`TraceWriter`].
+pub fn parse_trace(text: &str) -> anyhow::Result<Vec<TraceRow>> {
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or("");
+    anyhow::ensure!(header == TRACE_HEADER, "unexpected trace header: {header}");
+    let mut rows = Vec::new();
+    for (n, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        anyhow::ensure!(
+            f.len() == 10,
+            "trace line {}: expected 10 fields, found {}",
+            n + 2,
+            f.len()
+        );
+        let num = |i: usize| -> anyhow::Result<f64> {
+            f[i].parse()
+                .map_err(|e| anyhow::anyhow!("trace line {}, field {}: {e}", n + 2, i + 1))
+        };
+        rows.push(TraceRow {
+            sim_time_s: num(0)?,
+            x_m: num(1)?,
+            y_m: num(2)?,
+            yaw_rad: num(3)?,
+            odom_x_m: num(4)?,
+            odom_y_m: num(5)?,
+            odom_yaw_rad: num(6)?,
+            cmd_linear_mps: num(7)?,
+            cmd_angular_radps: num(8)?,
+            mode: f[9].to_owned(),
+        });
+    }
+    Ok(rows)
+}

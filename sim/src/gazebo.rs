@@ -1,0 +1,549 @@
+//! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
+//! `<sensor>` blocks (with `libgazebo_ros_camera.so`), and per-link friction (`mu1`/`mu2`).
+//!
+//! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
+//! file, line and element.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::error::{Result, SimError};
+use crate::robot::line_of;
+
+/// Where the diff drive takes its odometry from (`<odometrySource>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OdometrySource {
+    /// Ground truth from the simulator (`world`, Gazebo's default).
+    World,
+    /// Integrated from the wheel joints' measured speeds (`encoder`).
+    Encoder,
+}
+
+/// gazebo_ros_diff_drive's parameters, Gazebo's defaults where the URDF is silent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiffDriveConfig {
+    /// Plugin `name` attribute.
+    pub name: String,
+    /// `<commandTopic>` (default `cmd_vel`).
+    pub command_topic: String,
+    /// `<odometryTopic>` (default `odom`).
+    pub odometry_topic: String,
+    /// `<odometryFrame>` (default `odom`).
+    pub odometry_frame: String,
+    /// `<robotBaseFrame>` (default `base_footprint`).
+    pub robot_base_frame: String,
+    /// `<leftJoint>` (default `left_joint`).
+    pub left_joint: String,
+    /// `<rightJoint>` (default `right_joint`).
+    pub right_joint: String,
+    /// `<wheelSeparation>` (m, default 0.34).
+    pub wheel_separation_m: f64,
+    /// `<wheelDiameter>` (m, default 0.15).
+    pub wheel_diameter_m: f64,
+    /// `<wheelTorque>` (N m, default 5): the wheel motors' maximum torque.
+    pub wheel_torque_nm: f64,
+    /// `<wheelAcceleration>` (rad/s^2 on the commanded wheel speed, default 0 = unlimited).
+    pub wheel_acceleration_radps2: f64,
+    /// `<updateRate>` (Hz, default 100): the control loop on sim time; 0 means every physics step.
+    pub update_rate_hz: f64,
+    /// `<odometrySource>` (default `world`).
+    pub odometry_source: OdometrySource,
+    /// `<publishWheelTF>` (default false).
+    pub publish_wheel_tf: bool,
+    /// `<publishOdomTF>` (default true).
+    pub publish_odom_tf: bool,
+    /// `<publishWheelJointState>` (default false).
+    pub publish_wheel_joint_state: bool,
+    /// rover's opt-in `<cmdTimeout>` (s): stop when no command arrived for this long. Gazebo has
+    /// none (the last command applies forever), so the default is off.
+    pub cmd_timeout_s: Option<f64>,
+    /// Line of the `<plugin>` element, for messages.
+    pub line: Option<u32>,
+}
+
+impl Default for DiffDriveConfig {
+    fn default() -> Self {
+        Self {
+            name: "differential_drive_controller".to_owned(),
+            command_topic: "cmd_vel".to_owned(),
+            odometry_topic: "odom".to_owned(),
+            odometry_frame: "odom".to_owned(),
+            robot_base_frame: "base_footprint".to_owned(),
+            left_joint: "left_joint".to_owned(),
+            right_joint: "right_joint".to_owned(),
+            wheel_separation_m: 0.34,
+            wheel_diameter_m: 0.15,
+            wheel_torque_nm: 5.0,
+            wheel_acceleration_radps2: 0.0,
+            update_rate_hz: 100.0,
+            odometry_source: OdometrySource::World,
+            publish_wheel_tf: false,
+            publish_odom_tf: true,
+            publish_wheel_joint_state: false,
+            cmd_timeout_s: None,
+            line: None,
+        }
+    }
+}
+
+/// Pixel format of a camera image (`<image><format>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelFormat {
+    /// `R8G8B8` (ROS encoding `rgb8`).
+    Rgb8,
+    /// `B8G8R8` (ROS encoding `bgr8`).
+    Bgr8,
+    /// `L8` (ROS encoding `mono8`).
+    Mono8,
+}
+
+/// Gaussian pixel noise (`<noise type="gaussian">`), on the 0..1 scale per channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GaussianNoise {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub stddev: f64,
+}
+
+/// Brown-Conrady lens distortion (`<distortion>` or the camera plugin's `distortionK1`...).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Distortion {
+    /// Radial k1.
+    pub k1: f64,
+    /// Radial k2.
+    pub k2: f64,
+    /// Radial k3.
+    pub k3: f64,
+    /// Tangential p1 (Gazebo's t1).
+    pub p1: f64,
+    /// Tangential p2 (Gazebo's t2).
+    pub p2: f64,
+}
+
+impl Distortion {
+    /// True when every coefficient is zero.
+    pub fn is_zero(&self) -> bool {
+        [self.k1, self.k2, self.k3, self.p1, self.p2]
+            .iter()
+            .all(|c| *c == 0.0)
+    }
+}
+
+/// A `<sensor type="camera">` attached to a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraConfig {
+    /// Sensor `name`.
+    pub name: String,
+    /// Link the sensor is attached to (`<gazebo reference>`).
+    pub link: String,
+    /// `<update_rate>` (Hz, sim time).
+    pub update_rate_hz: f64,
+    /// `<horizontal_fov>` (rad).
+    pub horizontal_fov_rad: f64,
+    /// `<image><width>` (px).
+    pub width_px: u32,
+    /// `<image><height>` (px).
+    pub height_px: u32,
+    /// `<image><format>`.
+    pub format: PixelFormat,
+    /// `<clip><near>` (m).
+    pub clip_near_m: f64,
+    /// `<clip><far>` (m).
+    pub clip_far_m: f64,
+    /// Optional gaussian noise.
+    pub noise: Option<GaussianNoise>,
+    /// Lens distortion (zero when absent).
+    pub distortion: Distortion,
+    /// The camera plugin's `<cameraName>` (default: the sensor name).
+    pub camera_name: String,
+    /// The camera plugin's `<frameName>` (default: the link).
+    pub frame_name: String,
+    /// The camera plugin's `<imageTopicName>` (default `image_raw`).
+    pub image_topic: String,
+    /// The camera plugin's `<cameraInfoTopicName>` (default `camera_info`).
+    pub info_topic: String,
+    /// Line of the `<sensor>` element, for messages.
+    pub line: Option<u32>,
+}
+
+/// Everything read from `<gazebo>` elements.
+#[derive(Debug, Default)]
+pub(crate) struct Extensions {
+    pub diff_drive: Option<DiffDriveConfig>,
+    pub cameras: Vec<CameraConfig>,
+    /// Link name -> friction coefficient (min of mu1 and mu2).
+    pub friction: BTreeMap<String, f32>,
+}
+
+type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
+
+struct Ctx<'a, 'input> {
+    doc: &'a roxmltree::Document<'input>,
+    path: &'a Path,
+}
+
+impl<'a, 'input> Ctx<'a, 'input> {
+    fn err(&self, node: Node<'_, '_>, message: String) -> SimError {
+        SimError::invalid(self.path, Some(line_of(self.doc, node)), message)
+    }
+
+    fn number(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let text = node.text().map(str::trim).unwrap_or("");
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a number ({unit}), found '{text}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+
+    fn positive(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let v = self.number(node, what, unit)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a positive number ({unit}), found {v}",
+                    node.tag_name().name()
+                ),
+            ))
+        }
+    }
+
+    fn non_negative(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let v = self.number(node, what, unit)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected zero or a positive number ({unit}), found {v}",
+                    node.tag_name().name()
+                ),
+            ))
+        }
+    }
+
+    fn boolean(&self, node: Node<'_, '_>, what: &str) -> Result<bool> {
+        match node.text().map(str::trim).unwrap_or("") {
+            "true" | "1" => Ok(true),
+            "false" | "0" => Ok(false),
+            other => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected true or false, found '{other}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+
+    fn pixels(&self, node: Node<'_, '_>, what: &str) -> Result<u32> {
+        let text = node.text().map(str::trim).unwrap_or("");
+        match text.parse::<u32>() {
+            Ok(v) if (1..=16384).contains(&v) => Ok(v),
+            _ => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a whole number of pixels between 1 and 16384, found '{text}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+}
+
+/// Trimmed text content of an element ("" when empty).
+fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
+    node.text().map(str::trim).unwrap_or("")
+}
+
+fn elements<'a, 'input>(node: Node<'a, 'input>) -> impl Iterator<Item = Node<'a, 'input>> {
+    node.children().filter(|n| n.is_element())
+}
+
+/// Reads every `<gazebo>` element under `<robot>`.
+pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extensions> {
+    let ctx = Ctx { doc, path };
+    let mut ext = Extensions::default();
+    for gz in elements(doc.root_element()).filter(|n| n.has_tag_name("gazebo")) {
+        let reference = gz.attribute("reference");
+        let mut mu: [Option<f64>; 2] = [None, None];
+        for child in elements(gz) {
+            match child.tag_name().name() {
+                "plugin" => {
+                    let file = child.attribute("filename").unwrap_or("");
+                    if file.contains("gazebo_ros_diff_drive") {
+                        if let Some(first) = &ext.diff_drive {
+                            return Err(ctx.err(
+                                child,
+                                format!(
+                                    "a second libgazebo_ros_diff_drive.so plugin (the first is at line {}); expected one",
+                                    first.line.unwrap_or(0)
+                                ),
+                            ));
+                        }
+                        ext.diff_drive = Some(parse_diff_drive(&ctx, child)?);
+                    } else {
+                        tracing::debug!(
+                            "{}: ignoring Gazebo plugin {file}: rover does not simulate it",
+                            path.display()
+                        );
+                    }
+                }
+                "sensor" if child.attribute("type") == Some("camera") => {
+                    let Some(link) = reference else {
+                        return Err(ctx.err(
+                            child,
+                            "<sensor type=\"camera\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
+                        ));
+                    };
+                    ext.cameras.push(parse_camera(&ctx, child, link)?);
+                }
+                "mu1" => {
+                    mu[0] = Some(ctx.non_negative(
+                        child,
+                        "<gazebo reference>",
+                        "friction coefficient",
+                    )?)
+                }
+                "mu2" => {
+                    mu[1] = Some(ctx.non_negative(
+                        child,
+                        "<gazebo reference>",
+                        "friction coefficient",
+                    )?)
+                }
+                _ => {}
+            }
+        }
+        if let (Some(link), [Some(_), _] | [_, Some(_)]) = (reference, mu) {
+            let friction = mu.iter().flatten().fold(f64::INFINITY, |a, &b| a.min(b));
+            ext.friction.insert(link.to_owned(), friction as f32);
+        }
+    }
+    Ok(ext)
+}
+
+fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDriveConfig> {
+    let what = "the libgazebo_ros_diff_drive.so plugin";
+    let mut c = DiffDriveConfig {
+        name: plugin
+            .attribute("name")
+            .unwrap_or("differential_drive_controller")
+            .to_owned(),
+        line: Some(line_of(ctx.doc, plugin)),
+        ..DiffDriveConfig::default()
+    };
+    for p in elements(plugin) {
+        let text = || text_of(p).to_owned();
+        match p.tag_name().name() {
+            "commandTopic" => c.command_topic = text(),
+            "odometryTopic" => c.odometry_topic = text(),
+            "odometryFrame" => c.odometry_frame = text(),
+            "robotBaseFrame" => c.robot_base_frame = text(),
+            "leftJoint" => c.left_joint = text(),
+            "rightJoint" => c.right_joint = text(),
+            "wheelSeparation" => c.wheel_separation_m = ctx.positive(p, what, "metres")?,
+            "wheelDiameter" => c.wheel_diameter_m = ctx.positive(p, what, "metres")?,
+            "wheelTorque" | "torque" => c.wheel_torque_nm = ctx.positive(p, what, "N m")?,
+            "wheelAcceleration" => {
+                c.wheel_acceleration_radps2 = ctx.non_negative(p, what, "rad/s^2, 0 = unlimited")?
+            }
+            "updateRate" => c.update_rate_hz = ctx.non_negative(p, what, "Hz")?,
+            "odometrySource" => {
+                c.odometry_source = match text_of(p) {
+                    "world" | "1" => OdometrySource::World,
+                    "encoder" | "0" => OdometrySource::Encoder,
+                    other => {
+                        return Err(ctx.err(
+                            p,
+                            format!("<odometrySource> in {what}: expected world or encoder, found '{other}'"),
+                        ));
+                    }
+                }
+            }
+            "publishWheelTF" => c.publish_wheel_tf = ctx.boolean(p, what)?,
+            "publishOdomTF" | "publishTf" => c.publish_odom_tf = ctx.boolean(p, what)?,
+            "publishWheelJointState" => c.publish_wheel_joint_state = ctx.boolean(p, what)?,
+            "cmdTimeout" => {
+                let t = ctx.non_negative(p, what, "seconds, 0 = off")?;
+                c.cmd_timeout_s = (t > 0.0).then_some(t);
+            }
+            "alwaysOn" | "legacyMode" | "rosDebugLevel" | "robotNamespace" | "odometryRate"
+            | "publishOdom" => {}
+            other => tracing::warn!(
+                "{}:{}: <{other}> in {what}: unknown parameter, ignored",
+                ctx.path.display(),
+                line_of(ctx.doc, p)
+            ),
+        }
+    }
+    Ok(c)
+}
+
+fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<CameraConfig> {
+    let name = sensor.attribute("name").unwrap_or("camera").to_owned();
+    let what = format!("<sensor name=\"{name}\">");
+    let what = what.as_str();
+    let mut c = CameraConfig {
+        name: name.clone(),
+        link: link.to_owned(),
+        update_rate_hz: 30.0,
+        horizontal_fov_rad: 1.047,
+        width_px: 320,
+        height_px: 240,
+        format: PixelFormat::Rgb8,
+        clip_near_m: 0.1,
+        clip_far_m: 100.0,
+        noise: None,
+        distortion: Distortion::default(),
+        camera_name: name,
+        frame_name: link.to_owned(),
+        image_topic: "image_raw".to_owned(),
+        info_topic: "camera_info".to_owned(),
+        line: Some(line_of(ctx.doc, sensor)),
+    };
+    let mut plugin_distortion = Distortion::default();
+    let mut sdf_distortion = None;
+    for s in elements(sensor) {
+        match s.tag_name().name() {
+            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "camera" => {
+                for cam in elements(s) {
+                    match cam.tag_name().name() {
+                        "horizontal_fov" => {
+                            let fov = ctx.positive(cam, what, "radians")?;
+                            if fov >= std::f64::consts::PI {
+                                return Err(ctx.err(
+                                    cam,
+                                    format!("<horizontal_fov> in {what}: expected less than pi radians for a pinhole camera, found {fov}"),
+                                ));
+                            }
+                            c.horizontal_fov_rad = fov;
+                        }
+                        "image" => {
+                            for img in elements(cam) {
+                                match img.tag_name().name() {
+                                    "width" => c.width_px = ctx.pixels(img, what)?,
+                                    "height" => c.height_px = ctx.pixels(img, what)?,
+                                    "format" => {
+                                        c.format = match text_of(img) {
+                                            "R8G8B8" | "RGB_INT8" => PixelFormat::Rgb8,
+                                            "B8G8R8" | "BGR_INT8" => PixelFormat::Bgr8,
+                                            "L8" | "L_INT8" => PixelFormat::Mono8,
+                                            other => {
+                                                return Err(ctx.err(
+                                                    img,
+                                                    format!("<format> in {what}: expected R8G8B8, B8G8R8 or L8, found '{other}'"),
+                                                ));
+                                            }
+                                        }
+                                    }
+                                    _ => {}
+                                }
+                            }
+                        }
+                        "clip" => {
+                            for clip in elements(cam) {
+                                match clip.tag_name().name() {
+                                    "near" => c.clip_near_m = ctx.positive(clip, what, "metres")?,
+                                    "far" => c.clip_far_m = ctx.positive(clip, what, "metres")?,
+                                    _ => {}
+                                }
+                            }
+                            if c.clip_near_m >= c.clip_far_m {
+                                return Err(ctx.err(
+                                    cam,
+                                    format!(
+                                        "<clip> in {what}: expected near < far, found near {} and far {}",
+                                        c.clip_near_m, c.clip_far_m
+                                    ),
+                                ));
+                            }
+                        }
+                        "noise" => c.noise = parse_noise(ctx, cam, what)?,
+                        "distortion" => {
+                            let mut d = Distortion::default();
+                            for k in elements(cam) {
+                                let slot = match k.tag_name().name() {
+                                    "k1" => &mut d.k1,
+                                    "k2" => &mut d.k2,
+                                    "k3" => &mut d.k3,
+                                    "p1" => &mut d.p1,
+                                    "p2" => &mut d.p2,
+                                    _ => continue,
+                                };
+                                *slot = ctx.number(k, what, "coefficient")?;
+                            }
+                            sdf_distortion = Some(d);
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            "plugin" => {
+                for p in elements(s) {
+                    let text = || text_of(p).to_owned();
+                    match p.tag_name().name() {
+                        "cameraName" => c.camera_name = text(),
+                        "frameName" => c.frame_name = text(),
+                        "imageTopicName" => c.image_topic = text(),
+                        "cameraInfoTopicName" => c.info_topic = text(),
+                        "distortionK1" => {
+                            plugin_distortion.k1 = ctx.number(p, what, "coefficient")?
+                        }
+                        "distortionK2" => {
+                            plugin_distortion.k2 = ctx.number(p, what, "coefficient")?
+                        }
+                        "distortionK3" => {
+                            plugin_distortion.k3 = ctx.number(p, what, "coefficient")?
+                        }
+                        "distortionT1" => {
+                            plugin_distortion.p1 = ctx.number(p, what, "coefficient")?
+                        }
+                        "distortionT2" => {
+                            plugin_distortion.p2 = ctx.number(p, what, "coefficient")?
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    c.distortion = sdf_distortion.unwrap_or(plugin_distortion);
+    Ok(c)
+}
+
+fn parse_noise(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str) -> Result<Option<GaussianNoise>> {
+    let mut kind = "gaussian".to_owned();
+    let mut noise = GaussianNoise {
+        mean: 0.0,
+        stddev: 0.0,
+    };
+    for n in elements(node) {
+        match n.tag_name().name() {
+            "type" => kind = text_of(n).to_owned(),
+            "mean" => noise.mean = ctx.number(n, what, "0..1 intensity")?,
+            "stddev" => noise.stddev = ctx.non_negative(n, what, "0..1 intensity")?,
+            _ => {}
+        }
+    }
+    match kind.as_str() {
+        "gaussian" => Ok((noise.stddev > 0.0 || noise.mean != 0.0).then_some(noise)),
+        "none" => Ok(None),
+        other => Err(ctx.err(
+            node,
+            format!("<noise><type> in {what}: expected gaussian or none, found '{other}'"),
+        )),
+    }
+}

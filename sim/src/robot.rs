@@ -1,0 +1,713 @@
+//! Robot descriptions loaded from URDF, with the `<gazebo>` extensions rover honours.
+//!
+//! `urdf-rs` parses the standard URDF elements; rover reads the `<gazebo>` elements itself
+//! (urdf-rs drops them) and validates the file first with `roxmltree`, so that every error names
+//! the file, the line and the element.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::error::{Result, SimError};
+use crate::gazebo::{self, CameraConfig, DiffDriveConfig};
+use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, vec3};
+
+/// Mass properties of a link, from its `<inertial>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inertial {
+    /// Mass (kg).
+    pub mass_kg: f32,
+    /// Pose of the centre of mass and inertia frame in the link frame.
+    pub link_from_inertial: Pose,
+    /// Inertia tensor about the centre of mass, in the inertial frame: ixx, ixy, ixz, iyy, iyz, izz (kg m^2).
+    pub inertia: [f32; 6],
+}
+
+/// Something drawn for a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Visual {
+    /// Pose of the shape in the link frame.
+    pub link_from_shape: Pose,
+    /// The shape.
+    pub shape: Shape,
+    /// Colour from the URDF material (grey when none is given).
+    pub color: Rgba,
+}
+
+/// A collision shape of a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collision {
+    /// Pose of the shape in the link frame.
+    pub link_from_shape: Pose,
+    /// The shape.
+    pub shape: Shape,
+}
+
+/// A URDF link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    /// Link name.
+    pub name: String,
+    /// Mass properties; `None` when the URDF gives no `<inertial>`.
+    pub inertial: Option<Inertial>,
+    /// Visual shapes.
+    pub visuals: Vec<Visual>,
+    /// Collision shapes.
+    pub collisions: Vec<Collision>,
+    /// Friction coefficient from `<gazebo reference="link"><mu1>`/`<mu2>` (the smaller one).
+    pub friction: Option<f32>,
+}
+
+/// Kind of a URDF joint that rover simulates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JointKind {
+    /// Rigidly welded.
+    Fixed,
+    /// Rotation about the axis without limits.
+    Continuous,
+    /// Rotation about the axis between limits (rad).
+    Revolute {
+        /// Lower limit (rad).
+        lower_rad: f32,
+        /// Upper limit (rad).
+        upper_rad: f32,
+    },
+    /// Translation along the axis between limits (m).
+    Prismatic {
+        /// Lower limit (m).
+        lower_m: f32,
+        /// Upper limit (m).
+        upper_m: f32,
+    },
+    /// No constraint: the child moves freely.
+    Floating,
+}
+
+/// A URDF joint, with links referred to by index into [`RobotModel::links`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Joint name.
+    pub name: String,
+    /// Kind and limits.
+    pub kind: JointKind,
+    /// Parent link index.
+    pub parent: usize,
+    /// Child link index.
+    pub child: usize,
+    /// Joint origin: the child link frame expressed in the parent link frame at zero position.
+    pub parent_from_child: Pose,
+    /// Unit axis in the joint (= child link) frame.
+    pub axis: Vec3,
+    /// Viscous damping from `<dynamics damping>` (N m s/rad).
+    pub damping: f32,
+}
+
+/// A robot loaded from URDF.
+#[derive(Debug, Clone)]
+pub struct RobotModel {
+    /// `<robot name>`.
+    pub name: String,
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Links in file order.
+    pub links: Vec<Link>,
+    /// Joints in file order.
+    pub joints: Vec<Joint>,
+    /// Index of the root link (the one that is no joint's child).
+    pub root: usize,
+    /// The `libgazebo_ros_diff_drive.so` plugin, if present.
+    pub diff_drive: Option<DiffDriveConfig>,
+    /// Camera sensors (`<sensor type="camera">`).
+    pub cameras: Vec<CameraConfig>,
+}
+
+impl RobotModel {
+    /// Loads and validates a URDF file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_str(&text, path)
+    }
+
+    /// Parses URDF text; `path` is used for messages and to resolve relative mesh files.
+    pub fn from_str(text: &str, path: &Path) -> Result<Self> {
+        let doc = roxmltree::Document::parse(text).map_err(|e| {
+            let pos = e.pos();
+            SimError::invalid(
+                path,
+                Some(pos.row),
+                format!("malformed XML (column {}): {e}", pos.col),
+            )
+        })?;
+        let root = doc.root_element();
+        if root.tag_name().name() != "robot" {
+            return Err(SimError::invalid(
+                path,
+                Some(line_of(&doc, root)),
+                format!(
+                    "expected a <robot> root element, found <{}>",
+                    root.tag_name().name()
+                ),
+            ));
+        }
+        validate_numbers(&doc, path)?;
+        let lines = ElementLines::collect(&doc);
+
+        let urdf = urdf_rs::read_from_string(text)
+            .map_err(|e| SimError::invalid(path, None, format!("not a valid URDF robot: {e}")))?;
+
+        let base_dir = path.parent().unwrap_or(Path::new("."));
+        let materials: HashMap<&str, Rgba> = urdf
+            .materials
+            .iter()
+            .filter_map(|m| m.color.as_ref().map(|c| (m.name.as_str(), rgba(c.rgba.0))))
+            .collect();
+
+        let mut link_index: BTreeMap<String, usize> = BTreeMap::new();
+        let mut links = Vec::with_capacity(urdf.links.len());
+        for link in &urdf.links {
+            if link_index.insert(link.name.clone(), links.len()).is_some() {
+                return Err(SimError::invalid(
+                    path,
+                    lines.link(&link.name),
+                    format!("<link name=\"{}\"> is defined twice", link.name),
+                ));
+            }
+            links.push(convert_link(link, &materials, base_dir, path, &lines)?);
+        }
+        if links.is_empty() {
+            return Err(SimError::invalid(
+                path,
+                Some(line_of(&doc, root)),
+                "<robot> has no <link>: expected at least one",
+            ));
+        }
+
+        let mut joints = Vec::with_capacity(urdf.joints.len());
+        let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
+        let mut joint_names = BTreeMap::new();
+        for joint in &urdf.joints {
+            let line = lines.joint(&joint.name);
+            if joint_names.insert(joint.name.clone(), ()).is_some() {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!("<joint name=\"{}\"> is defined twice", joint.name),
+                ));
+            }
+            let find = |role: &str, name: &str| {
+                link_index.get(name).copied().ok_or_else(|| {
+                    SimError::invalid(
+                        path,
+                        line,
+                        format!(
+                            "<joint name=\"{}\"> <{role} link=\"{name}\">: no such link; links in this robot: {}",
+                            joint.name,
+                            names(link_index.keys())
+                        ),
+                    )
+                })
+            };
+            let parent = find("parent", &joint.parent.link)?;
+            let child = find("child", &joint.child.link)?;
+            if let Some(previous) = parent_of[child] {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "<joint name=\"{}\">: link \"{}\" already has a parent joint \"{}\"; a URDF must be a tree",
+                        joint.name, joint.child.link, urdf.joints[previous].name
+                    ),
+                ));
+            }
+            parent_of[child] = Some(joints.len());
+            joints.push(convert_joint(joint, parent, child, path, line)?);
+        }
+
+        let roots: Vec<usize> = (0..links.len())
+            .filter(|&i| parent_of[i].is_none())
+            .collect();
+        let root = match roots.as_slice() {
+            [single] => *single,
+            [] => {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    "every link is some joint's child (a cycle): expected exactly one root link",
+                ));
+            }
+            many => {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    format!(
+                        "the links {} are not connected by joints: expected exactly one root link",
+                        names(many.iter().map(|&i| &links[i].name))
+                    ),
+                ));
+            }
+        };
+        // A cycle that does not touch the root leaves some link unreachable from it.
+        let mut reachable = vec![false; links.len()];
+        reachable[root] = true;
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for j in &joints {
+                if reachable[j.parent] && !reachable[j.child] {
+                    reachable[j.child] = true;
+                    changed = true;
+                }
+            }
+        }
+        if let Some(lost) = (0..links.len()).find(|&i| !reachable[i]) {
+            return Err(SimError::invalid(
+                path,
+                lines.link(&links[lost].name),
+                format!(
+                    "link \"{}\" is part of a joint cycle: a URDF must be a tree",
+                    links[lost].name
+                ),
+            ));
+        }
+
+        let extensions = gazebo::parse(&doc, path)?;
+        for (reference, friction) in &extensions.friction {
+            match link_index.get(reference) {
+                Some(&i) => links[i].friction = Some(*friction),
+                None => tracing::warn!(
+                    "{}: <gazebo reference=\"{reference}\">: no link of that name; ignored",
+                    path.display()
+                ),
+            }
+        }
+
+        let model = Self {
+            name: urdf.name.clone(),
+            source: path.to_path_buf(),
+            links,
+            joints,
+            root,
+            diff_drive: extensions.diff_drive,
+            cameras: extensions.cameras,
+        };
+        model.validate_plugins(path)?;
+        Ok(model)
+    }
+
+    /// Index of the link called `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.name == name)
+    }
+
+    /// Index of the joint called `name`.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// Pose of every link in the root link's frame with all joints at zero.
+    pub fn root_from_links(&self) -> Vec<Pose> {
+        let mut poses = vec![None; self.links.len()];
+        poses[self.root] = Some(Pose::IDENTITY);
+        let mut pending = true;
+        while pending {
+            pending = false;
+            for j in &self.joints {
+                if let (Some(parent), None) = (poses[j.parent], poses[j.child]) {
+                    poses[j.child] = Some(parent * j.parent_from_child);
+                    pending = true;
+                }
+            }
+        }
+        poses.into_iter().map(|p| p.unwrap_or_default()).collect()
+    }
+
+    fn validate_plugins(&self, path: &Path) -> Result<()> {
+        if let Some(dd) = &self.diff_drive {
+            for (role, name) in [
+                ("leftJoint", &dd.left_joint),
+                ("rightJoint", &dd.right_joint),
+            ] {
+                let Some(index) = self.joint_index(name) else {
+                    return Err(SimError::invalid(
+                        path,
+                        dd.line,
+                        format!(
+                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: no such joint; joints in this robot: {}",
+                            names(self.joints.iter().map(|j| &j.name))
+                        ),
+                    ));
+                };
+                let joint = &self.joints[index];
+                if !matches!(
+                    joint.kind,
+                    JointKind::Continuous | JointKind::Revolute { .. }
+                ) {
+                    return Err(SimError::invalid(
+                        path,
+                        dd.line,
+                        format!(
+                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: the joint is {}, expected a continuous or revolute wheel joint",
+                            kind_name(&joint.kind)
+                        ),
+                    ));
+                }
+            }
+            if dd.left_joint == dd.right_joint {
+                return Err(SimError::invalid(
+                    path,
+                    dd.line,
+                    format!(
+                        "<plugin filename=\"libgazebo_ros_diff_drive.so\">: leftJoint and rightJoint are both \"{}\"; expected two different wheel joints",
+                        dd.left_joint
+                    ),
+                ));
+            }
+        }
+        for camera in &self.cameras {
+            if self.link_index(&camera.link).is_none() {
+                return Err(SimError::invalid(
+                    path,
+                    camera.line,
+                    format!(
+                        "<gazebo reference=\"{}\"> <sensor type=\"camera\">: no such link; links in this robot: {}",
+                        camera.link,
+                        names(self.links.iter().map(|l| &l.name))
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn kind_name(kind: &JointKind) -> &'static str {
+    match kind {
+        JointKind::Fixed => "fixed",
+        JointKind::Continuous => "continuous",
+        JointKind::Revolute { .. } => "revolute",
+        JointKind::Prismatic { .. } => "prismatic",
+        JointKind::Floating => "floating",
+    }
+}
+
+/// `"a", "b", "c"` for messages.
+fn names<'a>(items: impl Iterator<Item = &'a String>) -> String {
+    let list: Vec<String> = items.map(|n| format!("\"{n}\"")).collect();
+    if list.is_empty() {
+        "(none)".to_owned()
+    } else {
+        list.join(", ")
+    }
+}
+
+fn rgba(c: [f64; 4]) -> Rgba {
+    Rgba(c.map(|v| v.clamp(0.0, 1.0) as f32))
+}
+
+/// 1-based line of an element.
+pub(crate) fn line_of(doc: &roxmltree::Document<'_>, node: roxmltree::Node<'_, '_>) -> u32 {
+    doc.text_pos_at(node.range().start).row
+}
+
+/// Lines of `<link>` and `<joint>` elements by name, for messages about them.
+struct ElementLines {
+    links: HashMap<String, u32>,
+    joints: HashMap<String, u32>,
+}
+
+impl ElementLines {
+    fn collect(doc: &roxmltree::Document<'_>) -> Self {
+        let mut links = HashMap::new();
+        let mut joints = HashMap::new();
+        for node in doc.root_element().children().filter(|n| n.is_element()) {
+            let Some(name) = node.attribute("name") else {
+                continue;
+            };
+            match node.tag_name().name() {
+                "link" => {
+                    links.entry(name.to_owned()).or_insert(line_of(doc, node));
+                }
+                "joint" => {
+                    joints.entry(name.to_owned()).or_insert(line_of(doc, node));
+                }
+                _ => {}
+            }
+        }
+        Self { links, joints }
+    }
+
+    fn link(&self, name: &str) -> Option<u32> {
+        self.links.get(name).copied()
+    }
+
+    fn joint(&self, name: &str) -> Option<u32> {
+        self.joints.get(name).copied()
+    }
+}
+
+/// Checks every numeric URDF attribute before urdf-rs sees it, so a typo is reported with its
+/// line and element instead of a bare deserialisation message.
+fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
+    for node in doc.descendants().filter(|n| n.is_element()) {
+        let element = node.tag_name().name();
+        for attr in node.attributes() {
+            let expected = match (element, attr.name()) {
+                (_, "xyz" | "rpy") | ("box", "size") | ("mesh", "scale") => 3,
+                ("color", "rgba") => 4,
+                ("mass", "value")
+                | ("cylinder" | "sphere" | "capsule", "radius")
+                | ("cylinder" | "capsule", "length")
+                | ("inertia", "ixx" | "ixy" | "ixz" | "iyy" | "iyz" | "izz")
+                | ("limit", "lower" | "upper" | "effort" | "velocity")
+                | ("dynamics", "damping" | "friction") => 1,
+                _ => continue,
+            };
+            let tokens: Vec<&str> = attr.value().split_whitespace().collect();
+            let bad = tokens
+                .iter()
+                .find(|t| t.parse::<f64>().map(|v| !v.is_finite()).unwrap_or(true));
+            let unit = if expected == 1 { "number" } else { "numbers" };
+            if tokens.len() != expected || bad.is_some() {
+                let found = match bad {
+                    Some(token) => format!("'{token}' is not a finite number"),
+                    None => format!("found {} value(s)", tokens.len()),
+                };
+                return Err(SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!(
+                        "<{element} {}=\"{}\">: expected {expected} {unit}; {found}",
+                        attr.name(),
+                        attr.value()
+                    ),
+                ));
+            }
+            if matches!(attr.name(), "radius" | "length" | "value" | "size") {
+                if let Some(neg) = tokens
+                    .iter()
+                    .find(|t| t.parse::<f64>().is_ok_and(|v| v < 0.0))
+                {
+                    return Err(SimError::invalid(
+                        path,
+                        Some(line_of(doc, node)),
+                        format!(
+                            "<{element} {}=\"{}\">: expected non-negative values, found {neg}",
+                            attr.name(),
+                            attr.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn convert_link(
+    link: &urdf_rs::Link,
+    materials: &HashMap<&str, Rgba>,
+    base_dir: &Path,
+    path: &Path,
+    lines: &ElementLines,
+) -> Result<Link> {
+    let line = lines.link(&link.name);
+    let geometry = |g: &urdf_rs::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
+    let inertial = (link.inertial.mass.value > 0.0).then(|| {
+        let i = &link.inertial.inertia;
+        Inertial {
+            mass_kg: link.inertial.mass.value as f32,
+            link_from_inertial: pose_from_xyz_rpy(
+                link.inertial.origin.xyz.0,
+                link.inertial.origin.rpy.0,
+            ),
+            inertia: [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz].map(|v| v as f32),
+        }
+    });
+    let mut visuals = Vec::with_capacity(link.visual.len());
+    for v in &link.visual {
+        let color = v
+            .material
+            .as_ref()
+            .and_then(|m| {
+                m.color
+                    .as_ref()
+                    .map(|c| rgba(c.rgba.0))
+                    .or_else(|| materials.get(m.name.as_str()).copied())
+            })
+            .unwrap_or(Rgba::rgb(0.7, 0.7, 0.7));
+        visuals.push(Visual {
+            link_from_shape: pose_from_xyz_rpy(v.origin.xyz.0, v.origin.rpy.0),
+            shape: geometry(&v.geometry)?,
+            color,
+        });
+    }
+    let mut collisions = Vec::with_capacity(link.collision.len());
+    for c in &link.collision {
+        collisions.push(Collision {
+            link_from_shape: pose_from_xyz_rpy(c.origin.xyz.0, c.origin.rpy.0),
+            shape: geometry(&c.geometry)?,
+        });
+    }
+    Ok(Link {
+        name: link.name.clone(),
+        inertial,
+        visuals,
+        collisions,
+        friction: None,
+    })
+}
+
+fn convert_geometry(
+    g: &urdf_rs::Geometry,
+    base_dir: &Path,
+    path: &Path,
+    line: Option<u32>,
+    link: &str,
+) -> Result<Shape> {
+    Ok(match g {
+        urdf_rs::Geometry::Box { size } => Shape::Box {
+            size_m: vec3(size.0),
+        },
+        urdf_rs::Geometry::Cylinder { radius, length } => Shape::Cylinder {
+            radius_m: *radius as f32,
+            length_m: *length as f32,
+        },
+        urdf_rs::Geometry::Capsule { radius, length } => Shape::Capsule {
+            radius_m: *radius as f32,
+            length_m: *length as f32,
+        },
+        urdf_rs::Geometry::Sphere { radius } => Shape::Sphere {
+            radius_m: *radius as f32,
+        },
+        urdf_rs::Geometry::Mesh { filename, scale } => {
+            let resolved = resolve_mesh(filename, base_dir).ok_or_else(|| {
+                SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: file not found (relative paths are resolved against {}; package://NAME/... against the folders above it)",
+                        base_dir.display()
+                    ),
+                )
+            })?;
+            let ext = resolved
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            if !matches!(ext.as_deref(), Some("stl" | "obj")) {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: unsupported mesh format; expected .stl or .obj"
+                    ),
+                ));
+            }
+            Shape::Mesh {
+                path: resolved,
+                scale: scale.as_ref().map(|s| vec3(s.0)).unwrap_or(Vec3::ONE),
+            }
+        }
+    })
+}
+
+/// Resolves `package://pkg/rel`, `file://abs` and relative mesh paths.
+fn resolve_mesh(filename: &str, base_dir: &Path) -> Option<PathBuf> {
+    if let Some(abs) = filename.strip_prefix("file://") {
+        let p = PathBuf::from(abs);
+        return p.is_file().then_some(p);
+    }
+    if let Some(rest) = filename.strip_prefix("package://") {
+        let (package, rel) = rest.split_once('/')?;
+        // Look for a folder named like the package, or for the relative path itself, in the
+        // URDF's folder and each folder above it.
+        for dir in base_dir.ancestors() {
+            for candidate in [dir.join(package).join(rel), dir.join(rel)] {
+                if candidate.is_file() {
+                    return Some(candidate);
+                }
+            }
+        }
+        return None;
+    }
+    let p = base_dir.join(filename);
+    p.is_file().then_some(p)
+}
+
+fn convert_joint(
+    joint: &urdf_rs::Joint,
+    parent: usize,
+    child: usize,
+    path: &Path,
+    line: Option<u32>,
+) -> Result<Joint> {
+    let limit = &joint.limit;
+    let limits_ok = || {
+        if limit.lower > limit.upper {
+            Err(SimError::invalid(
+                path,
+                line,
+                format!(
+                    "<joint name=\"{}\"> <limit lower=\"{}\" upper=\"{}\">: expected lower <= upper",
+                    joint.name, limit.lower, limit.upper
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    let kind = match joint.joint_type {
+        urdf_rs::JointType::Fixed => JointKind::Fixed,
+        urdf_rs::JointType::Continuous => JointKind::Continuous,
+        urdf_rs::JointType::Revolute => {
+            limits_ok()?;
+            JointKind::Revolute {
+                lower_rad: limit.lower as f32,
+                upper_rad: limit.upper as f32,
+            }
+        }
+        urdf_rs::JointType::Prismatic => {
+            limits_ok()?;
+            JointKind::Prismatic {
+                lower_m: limit.lower as f32,
+                upper_m: limit.upper as f32,
+            }
+        }
+        urdf_rs::JointType::Floating => JointKind::Floating,
+        urdf_rs::JointType::Planar | urdf_rs::JointType::Spherical => {
+            return Err(SimError::invalid(
+                path,
+                line,
+                format!(
+                    "<joint name=\"{}\" type=\"{:?}\">: unsupported joint type; expected fixed, continuous, revolute, prismatic or floating",
+                    joint.name, joint.joint_type
+                ),
+            ));
+        }
+    };
+    let axis = vec3(joint.axis.xyz.0);
+    let needs_axis = !matches!(kind, JointKind::Fixed | JointKind::Floating);
+    if needs_axis && axis.length() < 1e-6 {
+        return Err(SimError::invalid(
+            path,
+            line,
+            format!(
+                "<joint name=\"{}\"> <axis xyz=\"0 0 0\">: expected a non-zero axis",
+                joint.name
+            ),
+        ));
+    }
+    Ok(Joint {
+        name: joint.name.clone(),
+        kind,
+        parent,
+        child,
+        parent_from_child: pose_from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0),
+        axis: axis.normalize_or(Vec3::X),
+        damping: joint.dynamics.as_ref().map_or(0.0, |d| d.damping as f32),
+    })
+}

@@ -1,0 +1,592 @@
+//! The simulation: a world and a URDF robot in rapier3d, stepped at a fixed rate, driven by the
+//! Gazebo-style diff drive.
+
+use glam::{Mat3, Quat, Vec3};
+use rapier3d::prelude::*;
+
+use crate::diff_drive::{
+    DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
+};
+use crate::error::{Result, SimError};
+use crate::gazebo::OdometrySource;
+use crate::geometry::{Pose, Shape, yaw_of};
+use crate::mesh::load_mesh;
+use crate::robot::{JointKind, RobotModel};
+use crate::world::{ObjectShape, World};
+
+/// Collision group of the robot's own colliders (the robot does not collide with itself,
+/// like Gazebo's default `self_collide = false`).
+const ROBOT_GROUP: Group = Group::GROUP_1;
+/// Collision group of everything else.
+const WORLD_GROUP: Group = Group::GROUP_2;
+
+/// Options that are not part of the world or robot files.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimOptions {
+    /// Seed for every random process (sensor noise, ...). Same seed, same run.
+    pub seed: u64,
+    /// Overrides the diff drive's `cmd_timeout_s` (`Some(0.0)` turns it off).
+    pub cmd_timeout_s: Option<f64>,
+    /// Overrides the world's physics step rate (Hz).
+    pub step_hz: Option<f64>,
+}
+
+/// The robot's state at one diff-drive control update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlSample {
+    /// Sim time of the update (s).
+    pub sim_time_s: f64,
+    /// Ground-truth planar pose and velocity of the base link (world frame).
+    pub ground_truth: Odometry,
+    /// Odometry from the plugin's configured `odometrySource`.
+    pub odometry: Odometry,
+    /// The cmd_vel in force (zero after a command timeout).
+    pub cmd: Twist,
+    /// Wheel joint speed targets sent to the motors (rad/s).
+    pub wheel_targets_radps: WheelSpeeds,
+    /// Measured wheel joint speeds (rad/s).
+    pub wheel_measured_radps: WheelSpeeds,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct WheelJoint {
+    joint: ImpulseJointHandle,
+    parent: RigidBodyHandle,
+    child: RigidBodyHandle,
+    /// Joint axis in the child body's frame.
+    axis_child: Vec3,
+}
+
+/// A running simulation.
+pub struct Simulation {
+    physics: PhysicsWorld,
+    robot: RobotModel,
+    world: World,
+    link_body: Vec<RigidBodyHandle>,
+    body_from_link: Vec<Pose>,
+    base: RigidBodyHandle,
+    wheels: [WheelJoint; 2],
+    drive: DiffDriveController,
+    encoder: EncoderOdometry,
+    step_index: u64,
+    dt_s: f64,
+    seed: u64,
+}
+
+impl std::fmt::Debug for Simulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Simulation")
+            .field("world", &self.world.name)
+            .field("robot", &self.robot.name)
+            .field("sim_time_s", &self.sim_time_s())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Simulation {
+    /// Builds the physics scene for `robot` in `world`.
+    pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
+        let mut drive_config = robot.diff_drive.clone().ok_or_else(|| {
+            SimError::Setup(format!(
+                "{}: the robot has no <gazebo><plugin filename=\"libgazebo_ros_diff_drive.so\">; rover needs it to drive the robot",
+                robot.source.display()
+            ))
+        })?;
+        if let Some(timeout) = options.cmd_timeout_s {
+            if !(timeout.is_finite() && timeout >= 0.0) {
+                return Err(SimError::Setup(format!(
+                    "cmd timeout must be zero (off) or a positive number of seconds, found {timeout}"
+                )));
+            }
+            drive_config.cmd_timeout_s = (timeout > 0.0).then_some(timeout);
+        }
+        let step_hz = options.step_hz.unwrap_or(world.physics.step_hz);
+        if !(step_hz.is_finite() && (50.0..=10_000.0).contains(&step_hz)) {
+            return Err(SimError::Setup(format!(
+                "physics step rate must be 50..=10000 Hz, found {step_hz}"
+            )));
+        }
+        let dt_s = 1.0 / step_hz;
+
+        let mut physics = PhysicsWorld::new();
+        let g = world.physics.gravity_mps2;
+        physics.gravity = Vec3::new(g[0] as f32, g[1] as f32, g[2] as f32);
+        physics.integration_parameters.dt = dt_s as f32;
+        physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
+
+        add_world(&mut physics, &world);
+        let robot_bodies = add_robot(&mut physics, &world, &robot)?;
+
+        let wheel = |name: &str| -> Result<WheelJoint> {
+            let index = robot.joint_index(name).ok_or_else(|| {
+                SimError::Setup(format!(
+                    "diff drive joint \"{name}\" missing from the robot"
+                ))
+            })?;
+            let joint = &robot.joints[index];
+            let handle = robot_bodies.joints[index].ok_or_else(|| {
+                SimError::Setup(format!("diff drive joint \"{name}\" is not a wheel joint"))
+            })?;
+            let child_from_link = robot_bodies.body_from_link[joint.child];
+            Ok(WheelJoint {
+                joint: handle,
+                parent: robot_bodies.link_body[joint.parent],
+                child: robot_bodies.link_body[joint.child],
+                axis_child: child_from_link.rotation * joint.axis,
+            })
+        };
+        let wheels = [
+            wheel(&drive_config.left_joint)?,
+            wheel(&drive_config.right_joint)?,
+        ];
+        for w in &wheels {
+            if let Some(j) = physics.impulse_joints.get_mut(w.joint, true) {
+                j.data
+                    .set_motor_model(JointAxis::AngX, MotorModel::ForceBased)
+                    .set_motor_velocity(JointAxis::AngX, 0.0, WHEEL_MOTOR_GAIN)
+                    .set_motor_max_force(JointAxis::AngX, drive_config.wheel_torque_nm as f32);
+            }
+        }
+
+        let base = robot_bodies.link_body[robot.root];
+        let start = planar(
+            physics
+                .bodies
+                .get(base)
+                .map(|b| *b.position())
+                .unwrap_or_default(),
+        );
+        let encoder = EncoderOdometry::new(start, &drive_config);
+        Ok(Self {
+            physics,
+            link_body: robot_bodies.link_body,
+            body_from_link: robot_bodies.body_from_link,
+            base,
+            wheels,
+            drive: DiffDriveController::new(drive_config),
+            encoder,
+            step_index: 0,
+            dt_s,
+            seed: options.seed,
+            robot,
+            world,
+        })
+    }
+
+    /// Sets cmd_vel (takes effect at the next control update). Non-finite values are rejected and
+    /// the last valid command stays in force.
+    pub fn set_cmd_vel(&mut self, cmd: Twist) -> Result<()> {
+        let now = self.sim_time_s();
+        self.drive.set_command(cmd, now)
+    }
+
+    /// Advances one physics step. When the diff drive's control loop ran at the start of this
+    /// step, returns the robot's state at that moment.
+    pub fn step(&mut self) -> Option<ControlSample> {
+        let now = self.sim_time_s();
+        let sample = if self.drive.update(now) {
+            let targets = self.drive.wheel_targets_radps();
+            for (wheel, target) in self.wheels.iter().zip(targets) {
+                if let Some(j) = self.physics.impulse_joints.get_mut(wheel.joint, true) {
+                    j.data
+                        .set_motor_velocity(JointAxis::AngX, target as f32, WHEEL_MOTOR_GAIN);
+                }
+            }
+            Some(self.sample(now))
+        } else {
+            None
+        };
+        self.physics.step();
+        self.step_index += 1;
+        let measured = self.wheel_speeds_radps();
+        self.encoder.integrate(measured, self.dt_s);
+        sample
+    }
+
+    fn sample(&self, now: f64) -> ControlSample {
+        ControlSample {
+            sim_time_s: now,
+            ground_truth: self.ground_truth(),
+            odometry: self.odometry(),
+            cmd: self.drive.command(),
+            wheel_targets_radps: self.drive.wheel_targets_radps(),
+            wheel_measured_radps: self.wheel_speeds_radps(),
+        }
+    }
+
+    /// Sim time (s): physics steps taken times the step length.
+    pub fn sim_time_s(&self) -> f64 {
+        self.step_index as f64 * self.dt_s
+    }
+
+    /// Physics steps taken so far.
+    pub fn step_index(&self) -> u64 {
+        self.step_index
+    }
+
+    /// The fixed physics step (s).
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// The seed this run was built with.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The robot being simulated.
+    pub fn robot(&self) -> &RobotModel {
+        &self.robot
+    }
+
+    /// The world being simulated.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The diff drive controller (configuration, command in force).
+    pub fn drive(&self) -> &DiffDriveController {
+        &self.drive
+    }
+
+    /// Pose of the robot's root (base) link in the world.
+    pub fn world_from_base(&self) -> Pose {
+        self.world_from_link(self.robot.root)
+    }
+
+    /// Pose of URDF link `index` in the world.
+    pub fn world_from_link(&self, index: usize) -> Pose {
+        let body = self
+            .physics
+            .bodies
+            .get(self.link_body[index])
+            .map(|b| *b.position())
+            .unwrap_or_default();
+        body * self.body_from_link[index]
+    }
+
+    /// Ground-truth planar pose and velocity of the base link.
+    pub fn ground_truth(&self) -> Odometry {
+        let Some(body) = self.physics.bodies.get(self.base) else {
+            return Odometry::default();
+        };
+        let mut odo = planar(*body.position());
+        let forward = body.rotation() * Vec3::X;
+        odo.linear_mps = f64::from(body.linvel().dot(forward));
+        odo.angular_radps = f64::from(body.angvel().z);
+        odo
+    }
+
+    /// Odometry from the configured source (`world` = ground truth, `encoder` = integrated wheels).
+    pub fn odometry(&self) -> Odometry {
+        match self.drive.config().odometry_source {
+            OdometrySource::World => self.ground_truth(),
+            OdometrySource::Encoder => self.encoder.odometry(),
+        }
+    }
+
+    /// Encoder odometry, whatever the configured source.
+    pub fn encoder_odometry(&self) -> Odometry {
+        self.encoder.odometry()
+    }
+
+    /// Measured left/right wheel joint speeds (rad/s): the child's angular velocity relative to
+    /// its parent, about the joint axis.
+    pub fn wheel_speeds_radps(&self) -> WheelSpeeds {
+        let mut out = [0.0; 2];
+        for (slot, w) in [LEFT, RIGHT].into_iter().zip(&self.wheels) {
+            let (Some(parent), Some(child)) = (
+                self.physics.bodies.get(w.parent),
+                self.physics.bodies.get(w.child),
+            ) else {
+                continue;
+            };
+            let axis_world = child.rotation() * w.axis_child;
+            out[slot] = f64::from((child.angvel() - parent.angvel()).dot(axis_world));
+        }
+        out
+    }
+}
+
+/// Velocity motor gain (N m s/rad): high enough that the motor holds the target speed until it
+/// saturates at `wheelTorque`, like Gazebo's joint velocity constraint with `fmax`.
+const WHEEL_MOTOR_GAIN: f32 = 50.0;
+
+fn planar(pose: Pose) -> Odometry {
+    Odometry {
+        x_m: f64::from(pose.translation.x),
+        y_m: f64::from(pose.translation.y),
+        yaw_rad: wrap_angle(yaw_of(pose.rotation)),
+        linear_mps: 0.0,
+        angular_radps: 0.0,
+    }
+}
+
+fn world_groups() -> InteractionGroups {
+    InteractionGroups::new(WORLD_GROUP, Group::ALL, InteractionTestMode::And)
+}
+
+fn add_world(physics: &mut PhysicsWorld, world: &World) {
+    let ground =
+        physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
+    let [sx, sy] = world.ground.size_m;
+    physics.insert_collider(
+        ColliderBuilder::cuboid(sx as f32 / 2.0, sy as f32 / 2.0, 0.5)
+            .friction(world.ground.friction)
+            .friction_combine_rule(CoefficientCombineRule::Min)
+            .collision_groups(world_groups()),
+        Some(ground),
+    );
+    for object in &world.objects {
+        let p = object.position_m;
+        let pose = Pose::from_parts(
+            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
+            Quat::from_rotation_z(object.yaw_rad as f32),
+        );
+        let builder = match object.mass_kg {
+            Some(_) => RigidBodyBuilder::dynamic(),
+            None => RigidBodyBuilder::fixed(),
+        };
+        let body = physics.insert_body(builder.pose(pose));
+        let shape = match object.shape {
+            ObjectShape::Box { size_m } => ColliderBuilder::cuboid(
+                size_m[0] as f32 / 2.0,
+                size_m[1] as f32 / 2.0,
+                size_m[2] as f32 / 2.0,
+            ),
+            ObjectShape::Cylinder { radius_m, length_m } => {
+                ColliderBuilder::cylinder(length_m as f32 / 2.0, radius_m as f32)
+                    .rotation(Vec3::X * std::f32::consts::FRAC_PI_2)
+            }
+            ObjectShape::Sphere { radius_m } => ColliderBuilder::ball(radius_m as f32),
+        };
+        let shape = match object.mass_kg {
+            Some(mass) => shape.mass(mass as f32),
+            None => shape,
+        };
+        physics.insert_collider(
+            shape
+                .friction(object.friction)
+                .friction_combine_rule(CoefficientCombineRule::Min)
+                .collision_groups(world_groups()),
+            Some(body),
+        );
+    }
+    for person in &world.people {
+        let radius = person.body_radius_m() as f32;
+        let height = person.height_m as f32;
+        let half_segment = (height / 2.0 - radius).max(0.0);
+        let body = physics.insert_body(RigidBodyBuilder::kinematic_position_based().pose(
+            Pose::from_parts(
+                Vec3::new(
+                    person.position_m[0] as f32,
+                    person.position_m[1] as f32,
+                    height / 2.0,
+                ),
+                Quat::from_rotation_z(person.heading_rad as f32),
+            ),
+        ));
+        physics.insert_collider(
+            ColliderBuilder::capsule_z(half_segment, radius).collision_groups(world_groups()),
+            Some(body),
+        );
+    }
+}
+
+struct RobotBodies {
+    link_body: Vec<RigidBodyHandle>,
+    body_from_link: Vec<Pose>,
+    joints: Vec<Option<ImpulseJointHandle>>,
+}
+
+/// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
+fn collider_shape(shape: &Shape, robot: &RobotModel, link: &str) -> Result<(SharedShape, Pose)> {
+    // URDF cylinders run along z, rapier's along y: rotate y onto z.
+    let y_to_z = Pose::from_rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2));
+    Ok(match shape {
+        Shape::Box { size_m } => (
+            SharedShape::cuboid(size_m.x / 2.0, size_m.y / 2.0, size_m.z / 2.0),
+            Pose::IDENTITY,
+        ),
+        Shape::Cylinder { radius_m, length_m } => {
+            (SharedShape::cylinder(length_m / 2.0, *radius_m), y_to_z)
+        }
+        Shape::Sphere { radius_m } => (SharedShape::ball(*radius_m), Pose::IDENTITY),
+        Shape::Capsule { radius_m, length_m } => (
+            SharedShape::capsule_z(length_m / 2.0, *radius_m),
+            Pose::IDENTITY,
+        ),
+        Shape::Mesh { path, scale } => {
+            let mesh = load_mesh(path, *scale)?;
+            let hull = SharedShape::convex_hull(&mesh.positions).ok_or_else(|| {
+                SimError::invalid(
+                    &robot.source,
+                    None,
+                    format!(
+                        "link \"{link}\": collision mesh {} is degenerate (flat or a single point); expected a solid",
+                        path.display()
+                    ),
+                )
+            })?;
+            (hull, Pose::IDENTITY)
+        }
+    })
+}
+
+fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> Result<RobotBodies> {
+    let n = robot.links.len();
+    // Links welded by fixed joints share a rigid body: find each link's body root.
+    let mut body_root: Vec<usize> = (0..n).collect();
+    let mut body_from_link = vec![Pose::IDENTITY; n];
+    let mut settled = vec![false; n];
+    settled[robot.root] = true;
+    let mut progress = true;
+    while progress {
+        progress = false;
+        for joint in &robot.joints {
+            if settled[joint.parent] && !settled[joint.child] {
+                if joint.kind == JointKind::Fixed {
+                    body_root[joint.child] = body_root[joint.parent];
+                    body_from_link[joint.child] =
+                        body_from_link[joint.parent] * joint.parent_from_child;
+                }
+                settled[joint.child] = true;
+                progress = true;
+            }
+        }
+    }
+
+    // Rest the robot on the ground: lowest collision point just above z = 0.
+    let root_from_links = robot.root_from_links();
+    let mut shapes = Vec::new();
+    let mut min_z = f32::INFINITY;
+    for (i, link) in robot.links.iter().enumerate() {
+        for c in &link.collisions {
+            let (shape, fix) = collider_shape(&c.shape, robot, &link.name)?;
+            let root_from_shape = root_from_links[i] * c.link_from_shape * fix;
+            min_z = min_z.min(shape.compute_aabb(&root_from_shape).mins.z);
+            shapes.push((i, shape, c.link_from_shape * fix));
+        }
+    }
+    if shapes.is_empty() {
+        return Err(SimError::Setup(format!(
+            "{}: the robot has no <collision> shapes, so it would fall through the ground; give its wheels and base collision geometry",
+            robot.source.display()
+        )));
+    }
+    let spawn = &world.robot;
+    let world_from_root = Pose::from_parts(
+        Vec3::new(
+            spawn.position_m[0] as f32,
+            spawn.position_m[1] as f32,
+            -min_z + SPAWN_CLEARANCE_M,
+        ),
+        Quat::from_rotation_z(spawn.yaw_rad as f32),
+    );
+
+    // One rigid body per body root, carrying the summed inertials of its links.
+    let mut link_body = vec![RigidBodyHandle::invalid(); n];
+    for root in 0..n {
+        if body_root[root] != root {
+            continue;
+        }
+        let mut mass = MassProperties::default();
+        for (i, link) in robot.links.iter().enumerate() {
+            if body_root[i] != root {
+                continue;
+            }
+            if let Some(inertial) = &link.inertial {
+                let [ixx, ixy, ixz, iyy, iyz, izz] = inertial.inertia;
+                let local = Mat3::from_cols(
+                    Vec3::new(ixx, ixy, ixz),
+                    Vec3::new(ixy, iyy, iyz),
+                    Vec3::new(ixz, iyz, izz),
+                );
+                let r = Mat3::from_quat(inertial.link_from_inertial.rotation);
+                let props = MassProperties::with_inertia_matrix(
+                    inertial.link_from_inertial.translation,
+                    inertial.mass_kg,
+                    r * local * r.transpose(),
+                );
+                mass += props.transform_by(&body_from_link[i]);
+            }
+        }
+        if mass.mass() <= 0.0 {
+            tracing::warn!(
+                "{}: link \"{}\" moves on its own but has no <inertial>; giving it 10 g",
+                robot.source.display(),
+                robot.links[root].name
+            );
+            mass = MassProperties::new(Vec3::ZERO, 0.01, Vec3::splat(1e-6));
+        }
+        let pose = world_from_root * root_from_links[root];
+        let body = physics.insert_body(
+            RigidBodyBuilder::dynamic()
+                .pose(pose)
+                .additional_mass_properties(mass)
+                .can_sleep(false),
+        );
+        for (i, slot) in link_body.iter_mut().enumerate() {
+            if body_root[i] == root {
+                *slot = body;
+            }
+        }
+    }
+
+    let robot_groups = InteractionGroups::new(ROBOT_GROUP, !ROBOT_GROUP, InteractionTestMode::And);
+    for (i, shape, link_from_shape) in shapes {
+        physics.insert_collider(
+            ColliderBuilder::new(shape)
+                .position(body_from_link[i] * link_from_shape)
+                .density(0.0)
+                .friction(robot.links[i].friction.unwrap_or(1.0))
+                .friction_combine_rule(CoefficientCombineRule::Min)
+                .collision_groups(robot_groups),
+            Some(link_body[i]),
+        );
+    }
+
+    let mut joints = vec![None; robot.joints.len()];
+    for (index, joint) in robot.joints.iter().enumerate() {
+        let (parent, child) = (link_body[joint.parent], link_body[joint.child]);
+        let axis_frame = Pose::from_rotation(Quat::from_rotation_arc(Vec3::X, joint.axis));
+        let frame1 = body_from_link[joint.parent] * joint.parent_from_child * axis_frame;
+        let frame2 = body_from_link[joint.child] * axis_frame;
+        let builder = match joint.kind {
+            JointKind::Fixed | JointKind::Floating => continue,
+            JointKind::Continuous => GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES),
+            JointKind::Revolute {
+                lower_rad,
+                upper_rad,
+            } => GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+                .limits(JointAxis::AngX, [lower_rad, upper_rad]),
+            JointKind::Prismatic { lower_m, upper_m } => {
+                GenericJointBuilder::new(JointAxesMask::LOCKED_PRISMATIC_AXES)
+                    .limits(JointAxis::LinX, [lower_m, upper_m])
+            }
+        };
+        let free_axis = match joint.kind {
+            JointKind::Prismatic { .. } => JointAxis::LinX,
+            _ => JointAxis::AngX,
+        };
+        let mut builder = builder
+            .local_frame1(frame1)
+            .local_frame2(frame2)
+            .contacts_enabled(false);
+        if joint.damping > 0.0 {
+            builder = builder
+                .motor_model(free_axis, MotorModel::ForceBased)
+                .motor_velocity(free_axis, 0.0, joint.damping);
+        }
+        joints[index] = Some(physics.insert_impulse_joint(parent, child, builder.build()));
+    }
+
+    Ok(RobotBodies {
+        link_body,
+        body_from_link,
+        joints,
+    })
+}
+
+/// Gap between the robot's lowest collision point and the ground at spawn (m).
+const SPAWN_CLEARANCE_M: f32 = 0.0;

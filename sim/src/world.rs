@@ -1,0 +1,617 @@
+//! World files: a small, strict TOML format (documented in docs/WORLDS.md).
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{Result, SimError};
+use crate::geometry::Rgba;
+use crate::tomlfile;
+
+/// Default physics step rate (Hz); see docs/WORLDS.md for why.
+pub const DEFAULT_STEP_HZ: f64 = 500.0;
+
+/// A loaded and validated world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct World {
+    /// World name (defaults to the file stem).
+    pub name: String,
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Free-text description.
+    pub description: String,
+    /// Where and which robot to spawn.
+    pub robot: RobotSpawn,
+    /// Physics settings.
+    pub physics: Physics,
+    /// The ground plane.
+    pub ground: Ground,
+    /// Boxes, cylinders, spheres and walls.
+    pub objects: Vec<Object>,
+    /// People standing in the world.
+    pub people: Vec<Person>,
+}
+
+/// Robot spawn settings (`[robot]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotSpawn {
+    /// URDF file, resolved against the world file's folder; `None` = the app's default robot.
+    pub urdf: Option<PathBuf>,
+    /// Spawn position on the ground (x, y in m).
+    pub position_m: [f64; 2],
+    /// Spawn heading (rad, counter-clockwise from +x).
+    pub yaw_rad: f64,
+}
+
+/// Physics settings (`[physics]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Physics {
+    /// Fixed step rate (Hz).
+    pub step_hz: f64,
+    /// Gravity (m/s^2, world frame).
+    pub gravity_mps2: [f64; 3],
+    /// Solver iterations per step.
+    pub solver_iterations: usize,
+}
+
+/// The ground (`[ground]`): a flat square centred on the origin, top at z = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ground {
+    /// Side lengths along x and y (m).
+    pub size_m: [f64; 2],
+    /// Friction coefficient.
+    pub friction: f32,
+    /// Main colour.
+    pub color: Rgba,
+    /// Second colour of the checker texture.
+    pub checker_color: Rgba,
+    /// Checker square size (m).
+    pub checker_size_m: f64,
+}
+
+/// Shape of a world object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ObjectShape {
+    /// Box with full side lengths (m).
+    Box {
+        /// Side lengths along the object's x, y, z (m).
+        size_m: [f64; 3],
+    },
+    /// Upright cylinder.
+    Cylinder {
+        /// Radius (m).
+        radius_m: f64,
+        /// Height (m).
+        length_m: f64,
+    },
+    /// Sphere.
+    Sphere {
+        /// Radius (m).
+        radius_m: f64,
+    },
+}
+
+/// A static or dynamic object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    /// Name (unique within the world).
+    pub name: String,
+    /// Shape.
+    pub shape: ObjectShape,
+    /// Centre position (m, world frame).
+    pub position_m: [f64; 3],
+    /// Heading about +z (rad).
+    pub yaw_rad: f64,
+    /// Colour.
+    pub color: Rgba,
+    /// Mass (kg); `None` for a static object.
+    pub mass_kg: Option<f64>,
+    /// Friction coefficient.
+    pub friction: f32,
+}
+
+/// A person (`[[person]]`): a standing human figure, an obstacle for physics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Person {
+    /// Name (unique within the world).
+    pub name: String,
+    /// Position of the feet on the ground (x, y in m).
+    pub position_m: [f64; 2],
+    /// Facing direction (rad, counter-clockwise from +x).
+    pub heading_rad: f64,
+    /// Standing height (m).
+    pub height_m: f64,
+    /// Shirt colour.
+    pub shirt_color: Rgba,
+    /// Trousers colour.
+    pub trousers_color: Rgba,
+    /// Skin colour.
+    pub skin_color: Rgba,
+    /// Hair colour.
+    pub hair_color: Rgba,
+}
+
+impl Person {
+    /// Radius of the upright capsule that stands in for the person in physics (m).
+    pub fn body_radius_m(&self) -> f64 {
+        0.13 * self.height_m / 1.75
+    }
+}
+
+impl World {
+    /// Loads and validates a world file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let raw: RawWorld = tomlfile::load_toml(path)?;
+        raw.into_world(path)
+    }
+
+    /// Parses world TOML text; `path` is used in messages and to resolve the robot's URDF.
+    pub fn from_str(text: &str, path: &Path) -> Result<Self> {
+        let raw: RawWorld = tomlfile::parse_toml(text, path)?;
+        raw.into_world(path)
+    }
+
+    /// An empty flat world (ground only, every setting at its default), for tests and calibration.
+    pub fn flat() -> Result<Self> {
+        Self::from_str("name = \"flat\"\n", Path::new("<built-in flat world>"))
+    }
+}
+
+// ---- Raw (file) representation -------------------------------------------------------------
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWorld {
+    name: Option<String>,
+    #[serde(default)]
+    description: String,
+    #[serde(default)]
+    robot: RawRobot,
+    #[serde(default)]
+    physics: RawPhysics,
+    #[serde(default)]
+    ground: RawGround,
+    #[serde(default, rename = "box")]
+    boxes: Vec<RawBox>,
+    #[serde(default, rename = "cylinder")]
+    cylinders: Vec<RawCylinder>,
+    #[serde(default, rename = "sphere")]
+    spheres: Vec<RawSphere>,
+    #[serde(default, rename = "wall")]
+    walls: Vec<RawWall>,
+    #[serde(default, rename = "person")]
+    people: Vec<RawPerson>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRobot {
+    urdf: Option<PathBuf>,
+    #[serde(default)]
+    position_m: [f64; 2],
+    #[serde(default)]
+    yaw_deg: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RawPhysics {
+    step_hz: f64,
+    gravity_mps2: [f64; 3],
+    solver_iterations: usize,
+}
+
+impl Default for RawPhysics {
+    fn default() -> Self {
+        Self {
+            step_hz: DEFAULT_STEP_HZ,
+            gravity_mps2: [0.0, 0.0, -9.81],
+            solver_iterations: 4,
+        }
+    }
+}
+
+impl From<RawPhysics> for Physics {
+    fn from(p: RawPhysics) -> Self {
+        Self {
+            step_hz: p.step_hz,
+            gravity_mps2: p.gravity_mps2,
+            solver_iterations: p.solver_iterations,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RawGround {
+    size_m: [f64; 2],
+    friction: f64,
+    color: String,
+    checker_color: String,
+    checker_size_m: f64,
+}
+
+impl Default for RawGround {
+    fn default() -> Self {
+        Self {
+            size_m: [60.0, 60.0],
+            friction: 1.0,
+            color: "#7d8a6a".to_owned(),
+            checker_color: "#6f7c5d".to_owned(),
+            checker_size_m: 1.0,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBox {
+    name: Option<String>,
+    size_m: [f64; 3],
+    position_m: Vec<f64>,
+    #[serde(default)]
+    yaw_deg: f64,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCylinder {
+    name: Option<String>,
+    radius_m: f64,
+    length_m: f64,
+    position_m: Vec<f64>,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSphere {
+    name: Option<String>,
+    radius_m: f64,
+    position_m: Vec<f64>,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWall {
+    name: Option<String>,
+    from_m: [f64; 2],
+    to_m: [f64; 2],
+    #[serde(default = "default_wall_height")]
+    height_m: f64,
+    #[serde(default = "default_wall_thickness")]
+    thickness_m: f64,
+    color: Option<String>,
+    friction: Option<f64>,
+}
+
+fn default_wall_height() -> f64 {
+    1.0
+}
+
+fn default_wall_thickness() -> f64 {
+    0.1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPerson {
+    name: Option<String>,
+    position_m: [f64; 2],
+    #[serde(default)]
+    heading_deg: f64,
+    #[serde(default = "default_person_height")]
+    height_m: f64,
+    shirt_color: Option<String>,
+    trousers_color: Option<String>,
+    skin_color: Option<String>,
+    hair_color: Option<String>,
+}
+
+fn default_person_height() -> f64 {
+    1.75
+}
+
+/// Collects validation problems as `key: message` pairs.
+struct Checker<'a> {
+    path: &'a Path,
+}
+
+impl Checker<'_> {
+    fn fail(&self, key: &str, message: impl std::fmt::Display) -> SimError {
+        SimError::invalid(self.path, None, format!("at `{key}`: {message}"))
+    }
+
+    fn finite(&self, key: &str, values: &[f64]) -> Result<()> {
+        if values.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.fail(key, format!("expected finite numbers, found {values:?}")))
+        }
+    }
+
+    fn positive(&self, key: &str, values: &[f64], unit: &str) -> Result<()> {
+        self.finite(key, values)?;
+        if values.iter().all(|v| *v > 0.0) {
+            Ok(())
+        } else {
+            Err(self.fail(
+                key,
+                format!("expected positive numbers ({unit}), found {values:?}"),
+            ))
+        }
+    }
+
+    fn color(&self, key: &str, text: Option<&str>, default: Rgba) -> Result<Rgba> {
+        match text {
+            None => Ok(default),
+            Some(t) => Rgba::from_hex(t).ok_or_else(|| {
+                self.fail(
+                    key,
+                    format!(
+                        "expected a colour like \"#a0522d\" (#rrggbb or #rrggbbaa), found \"{t}\""
+                    ),
+                )
+            }),
+        }
+    }
+
+    fn friction(&self, key: &str, value: Option<f64>) -> Result<f32> {
+        let f = value.unwrap_or(0.8);
+        if f.is_finite() && f >= 0.0 {
+            Ok(f as f32)
+        } else {
+            Err(self.fail(
+                key,
+                format!("expected a friction coefficient >= 0, found {f}"),
+            ))
+        }
+    }
+
+    fn mass(&self, key: &str, value: Option<f64>) -> Result<Option<f64>> {
+        match value {
+            Some(m) if !(m.is_finite() && m > 0.0) => Err(self.fail(
+                key,
+                format!("expected a positive mass in kg (omit it for a static object), found {m}"),
+            )),
+            other => Ok(other),
+        }
+    }
+
+    /// `[x, y]` (resting on the ground, z = `half_height`) or `[x, y, z]`.
+    fn position(&self, key: &str, values: &[f64], half_height: f64) -> Result<[f64; 3]> {
+        self.finite(key, values)?;
+        match *values {
+            [x, y] => Ok([x, y, half_height]),
+            [x, y, z] => Ok([x, y, z]),
+            _ => Err(self.fail(
+                key,
+                format!(
+                    "expected [x, y] (resting on the ground) or [x, y, z] in metres, found {} values",
+                    values.len()
+                ),
+            )),
+        }
+    }
+}
+
+impl RawGround {
+    fn into_ground(self, path: &Path) -> Result<Ground> {
+        let c = Checker { path };
+        c.positive("ground.size_m", &self.size_m, "m")?;
+        c.positive("ground.checker_size_m", &[self.checker_size_m], "m")?;
+        let color = c.color("ground.color", Some(&self.color), Rgba::rgb(0.5, 0.5, 0.5))?;
+        Ok(Ground {
+            size_m: self.size_m,
+            friction: c.friction("ground.friction", Some(self.friction))?,
+            color,
+            checker_color: c.color("ground.checker_color", Some(&self.checker_color), color)?,
+            checker_size_m: self.checker_size_m,
+        })
+    }
+}
+
+impl RawWorld {
+    fn into_world(self, path: &Path) -> Result<World> {
+        let c = Checker { path };
+        let base_dir = path.parent().unwrap_or(Path::new("."));
+
+        c.finite("robot.position_m", &self.robot.position_m)?;
+        c.finite("robot.yaw_deg", &[self.robot.yaw_deg])?;
+        let robot = RobotSpawn {
+            urdf: self.robot.urdf.map(|u| base_dir.join(u)),
+            position_m: self.robot.position_m,
+            yaw_rad: self.robot.yaw_deg.to_radians(),
+        };
+
+        c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;
+        if !(50.0..=10_000.0).contains(&self.physics.step_hz) {
+            return Err(c.fail(
+                "physics.step_hz",
+                format!(
+                    "expected 50..=10000 Hz (default {DEFAULT_STEP_HZ}), found {}",
+                    self.physics.step_hz
+                ),
+            ));
+        }
+        c.finite("physics.gravity_mps2", &self.physics.gravity_mps2)?;
+        if !(1..=100).contains(&self.physics.solver_iterations) {
+            return Err(c.fail(
+                "physics.solver_iterations",
+                format!("expected 1..=100, found {}", self.physics.solver_iterations),
+            ));
+        }
+
+        let ground = self.ground.into_ground(path)?;
+
+        let mut objects = Vec::new();
+        for (i, b) in self.boxes.into_iter().enumerate() {
+            let key = |field: &str| format!("box[{i}].{field}");
+            c.positive(&key("size_m"), &b.size_m, "m")?;
+            c.finite(&key("yaw_deg"), &[b.yaw_deg])?;
+            objects.push(Object {
+                name: b.name.unwrap_or_else(|| format!("box_{i}")),
+                position_m: c.position(&key("position_m"), &b.position_m, b.size_m[2] / 2.0)?,
+                shape: ObjectShape::Box { size_m: b.size_m },
+                yaw_rad: b.yaw_deg.to_radians(),
+                color: c.color(
+                    &key("color"),
+                    b.color.as_deref(),
+                    Rgba::rgb(0.63, 0.42, 0.25),
+                )?,
+                mass_kg: c.mass(&key("mass_kg"), b.mass_kg)?,
+                friction: c.friction(&key("friction"), b.friction)?,
+            });
+        }
+        for (i, cy) in self.cylinders.into_iter().enumerate() {
+            let key = |field: &str| format!("cylinder[{i}].{field}");
+            c.positive(&key("radius_m"), &[cy.radius_m], "m")?;
+            c.positive(&key("length_m"), &[cy.length_m], "m")?;
+            objects.push(Object {
+                name: cy.name.unwrap_or_else(|| format!("cylinder_{i}")),
+                position_m: c.position(&key("position_m"), &cy.position_m, cy.length_m / 2.0)?,
+                shape: ObjectShape::Cylinder {
+                    radius_m: cy.radius_m,
+                    length_m: cy.length_m,
+                },
+                yaw_rad: 0.0,
+                color: c.color(
+                    &key("color"),
+                    cy.color.as_deref(),
+                    Rgba::rgb(0.8, 0.45, 0.1),
+                )?,
+                mass_kg: c.mass(&key("mass_kg"), cy.mass_kg)?,
+                friction: c.friction(&key("friction"), cy.friction)?,
+            });
+        }
+        for (i, s) in self.spheres.into_iter().enumerate() {
+            let key = |field: &str| format!("sphere[{i}].{field}");
+            c.positive(&key("radius_m"), &[s.radius_m], "m")?;
+            objects.push(Object {
+                name: s.name.unwrap_or_else(|| format!("sphere_{i}")),
+                position_m: c.position(&key("position_m"), &s.position_m, s.radius_m)?,
+                shape: ObjectShape::Sphere {
+                    radius_m: s.radius_m,
+                },
+                yaw_rad: 0.0,
+                color: c.color(&key("color"), s.color.as_deref(), Rgba::rgb(0.85, 0.2, 0.2))?,
+                mass_kg: c.mass(&key("mass_kg"), s.mass_kg)?,
+                friction: c.friction(&key("friction"), s.friction)?,
+            });
+        }
+        for (i, w) in self.walls.into_iter().enumerate() {
+            let key = |field: &str| format!("wall[{i}].{field}");
+            c.finite(&key("from_m"), &w.from_m)?;
+            c.finite(&key("to_m"), &w.to_m)?;
+            c.positive(&key("height_m"), &[w.height_m], "m")?;
+            c.positive(&key("thickness_m"), &[w.thickness_m], "m")?;
+            let (dx, dy) = (w.to_m[0] - w.from_m[0], w.to_m[1] - w.from_m[1]);
+            let length = dx.hypot(dy);
+            if length < 1e-3 {
+                return Err(c.fail(
+                    &key("to_m"),
+                    "expected a wall end point different from from_m",
+                ));
+            }
+            objects.push(Object {
+                name: w.name.unwrap_or_else(|| format!("wall_{i}")),
+                shape: ObjectShape::Box {
+                    size_m: [length, w.thickness_m, w.height_m],
+                },
+                position_m: [
+                    (w.from_m[0] + w.to_m[0]) / 2.0,
+                    (w.from_m[1] + w.to_m[1]) / 2.0,
+                    w.height_m / 2.0,
+                ],
+                yaw_rad: dy.atan2(dx),
+                color: c.color(
+                    &key("color"),
+                    w.color.as_deref(),
+                    Rgba::rgb(0.85, 0.83, 0.78),
+                )?,
+                mass_kg: None,
+                friction: c.friction(&key("friction"), w.friction)?,
+            });
+        }
+
+        let mut people = Vec::new();
+        for (i, p) in self.people.into_iter().enumerate() {
+            let key = |field: &str| format!("person[{i}].{field}");
+            c.finite(&key("position_m"), &p.position_m)?;
+            c.finite(&key("heading_deg"), &[p.heading_deg])?;
+            if !(p.height_m.is_finite() && (0.5..=2.5).contains(&p.height_m)) {
+                return Err(c.fail(
+                    &key("height_m"),
+                    format!(
+                        "expected a height between 0.5 and 2.5 m, found {}",
+                        p.height_m
+                    ),
+                ));
+            }
+            people.push(Person {
+                name: p.name.unwrap_or_else(|| format!("person_{i}")),
+                position_m: p.position_m,
+                heading_rad: p.heading_deg.to_radians(),
+                height_m: p.height_m,
+                shirt_color: c.color(
+                    &key("shirt_color"),
+                    p.shirt_color.as_deref(),
+                    Rgba::rgb(0.75, 0.15, 0.12),
+                )?,
+                trousers_color: c.color(
+                    &key("trousers_color"),
+                    p.trousers_color.as_deref(),
+                    Rgba::rgb(0.15, 0.2, 0.35),
+                )?,
+                skin_color: c.color(
+                    &key("skin_color"),
+                    p.skin_color.as_deref(),
+                    Rgba::rgb(0.87, 0.67, 0.53),
+                )?,
+                hair_color: c.color(
+                    &key("hair_color"),
+                    p.hair_color.as_deref(),
+                    Rgba::rgb(0.2, 0.13, 0.08),
+                )?,
+            });
+        }
+
+        let mut seen = std::collections::BTreeSet::new();
+        for name in objects
+            .iter()
+            .map(|o| &o.name)
+            .chain(people.iter().map(|p| &p.name))
+        {
+            if !seen.insert(name.clone()) {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    format!("two entries are named \"{name}\": names must be unique"),
+                ));
+            }
+        }
+
+        Ok(World {
+            name: self.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "world".to_owned())
+            }),
+            source: path.to_path_buf(),
+            description: self.description,
+            robot,
+            physics: self.physics.into(),
+            ground,
+            objects,
+            people,
+        })
+    }
+}

@@ -1,0 +1,53 @@
+//! Helpers for rover's end-to-end tests (the tests themselves are in `tests/`).
+
+use std::path::{Path, PathBuf};
+
+use rover_sim::{ControlSample, RobotModel, SimOptions, Simulation, Twist, World};
+
+/// Path of a file in the repository.
+pub fn repo(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(|p| p.join(relative))
+        .unwrap_or_else(|| PathBuf::from(relative))
+}
+
+/// The bundled tutorial car.
+pub fn my_robot() -> anyhow::Result<RobotModel> {
+    Ok(RobotModel::load(&repo("assets/robots/my_robot.urdf"))?)
+}
+
+/// The tutorial car with extra elements spliced into its diff_drive plugin.
+pub fn my_robot_with_plugin_params(extra: &str) -> anyhow::Result<RobotModel> {
+    let path = repo("assets/robots/my_robot.urdf");
+    let text = std::fs::read_to_string(&path)?;
+    let marker = "<wheelSeparation>";
+    anyhow::ensure!(
+        text.contains(marker),
+        "my_robot.urdf lost its diff_drive plugin"
+    );
+    let text = text.replacen(marker, &format!("{extra}\n      {marker}"), 1);
+    Ok(RobotModel::from_str(&text, &path)?)
+}
+
+/// Runs `sim` under a constant command for `seconds`, returning every control sample.
+pub fn drive(sim: &mut Simulation, cmd: Twist, seconds: f64) -> anyhow::Result<Vec<ControlSample>> {
+    sim.set_cmd_vel(cmd)?;
+    let end = sim.sim_time_s() + seconds;
+    let mut samples = Vec::new();
+    while sim.sim_time_s() < end - sim.dt_s() / 2.0 {
+        if let Some(s) = sim.step() {
+            samples.push(s);
+        }
+    }
+    Ok(samples)
+}
+
+/// A simulation of `robot` on flat, empty ground with default settings.
+pub fn flat_sim(robot: RobotModel) -> anyhow::Result<Simulation> {
+    Ok(Simulation::new(
+        World::flat()?,
+        robot,
+        &SimOptions::default(),
+    )?)
+}
