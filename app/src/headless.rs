@@ -118,10 +118,10 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
             if step.at_s > now + sim.dt_s() / 2.0 {
                 break;
             }
-            if let Some(cmd) = pilot.apply(step.action) {
-                if let Err(e) = sim.set_cmd_vel(cmd) {
-                    tracing::warn!("script step at {} s: {e}", step.at_s);
-                }
+            if let Some(cmd) = pilot.apply(step.action)
+                && let Err(e) = sim.set_cmd_vel(cmd)
+            {
+                tracing::warn!("script step at {} s: {e}", step.at_s);
             }
             next_step += 1;
         }
@@ -131,16 +131,16 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
             }
             last = Some(sample);
         }
-        if let Some(every) = config.progress_every {
-            if last_report.elapsed() >= every {
-                last_report = Instant::now();
-                tracing::info!(
-                    "sim time {:.1} / {:.1} s ({:.0}x real time)",
-                    sim.sim_time_s(),
-                    duration_s,
-                    sim.sim_time_s() / started.elapsed().as_secs_f64()
-                );
-            }
+        if let Some(every) = config.progress_every
+            && last_report.elapsed() >= every
+        {
+            last_report = Instant::now();
+            tracing::info!(
+                "sim time {:.1} / {:.1} s ({:.0}x real time)",
+                sim.sim_time_s(),
+                duration_s,
+                sim.sim_time_s() / started.elapsed().as_secs_f64()
+            );
         }
     }
     let wall_s = started.elapsed().as_secs_f64();

@@ -151,13 +151,14 @@ impl DiffDriveController {
     /// Runs the control loop at sim time `now_s` (call once per physics step, before stepping).
     /// Returns true when a control update happened, i.e. the wheel targets were recomputed.
     pub fn update(&mut self, now_s: f64) -> bool {
-        if let Some(timeout) = self.config.cmd_timeout_s {
-            if !self.timed_out && now_s - self.cmd_stamp_s > timeout {
-                tracing::warn!(
-                    "no cmd_vel for {timeout} s (cmd_timeout_s): stopping the robot until the next command"
-                );
-                self.timed_out = true;
-            }
+        if let Some(timeout) = self.config.cmd_timeout_s
+            && !self.timed_out
+            && now_s - self.cmd_stamp_s > timeout
+        {
+            tracing::warn!(
+                "no cmd_vel for {timeout} s (cmd_timeout_s): stopping the robot until the next command"
+            );
+            self.timed_out = true;
         }
         // Tolerance against floating-point drift of the accumulated schedule.
         if now_s + 1e-9 < self.next_update_s {

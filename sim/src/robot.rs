@@ -486,21 +486,20 @@ fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
                     ),
                 ));
             }
-            if matches!(attr.name(), "radius" | "length" | "value" | "size") {
-                if let Some(neg) = tokens
+            if matches!(attr.name(), "radius" | "length" | "value" | "size")
+                && let Some(neg) = tokens
                     .iter()
                     .find(|t| t.parse::<f64>().is_ok_and(|v| v < 0.0))
-                {
-                    return Err(SimError::invalid(
-                        path,
-                        Some(line_of(doc, node)),
-                        format!(
-                            "<{element} {}=\"{}\">: expected non-negative values, found {neg}",
-                            attr.name(),
-                            attr.value()
-                        ),
-                    ));
-                }
+            {
+                return Err(SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!(
+                        "<{element} {}=\"{}\">: expected non-negative values, found {neg}",
+                        attr.name(),
+                        attr.value()
+                    ),
+                ));
             }
         }
     }

@@ -9,7 +9,7 @@ use crate::geometry::Rgba;
 use crate::tomlfile;
 
 /// Default physics step rate (Hz); see docs/WORLDS.md for why.
-pub const DEFAULT_STEP_HZ: f64 = 500.0;
+pub const DEFAULT_STEP_HZ: f64 = 200.0;
 
 /// A loaded and validated world.
 #[derive(Debug, Clone, PartialEq)]

@@ -17,16 +17,32 @@ pub fn my_robot() -> anyhow::Result<RobotModel> {
     Ok(RobotModel::load(&repo("assets/robots/my_robot.urdf"))?)
 }
 
-/// The tutorial car with extra elements spliced into its diff_drive plugin.
-pub fn my_robot_with_plugin_params(extra: &str) -> anyhow::Result<RobotModel> {
+/// The tutorial car with one diff_drive plugin parameter set to `value` (replacing the
+/// file's own value, or added when the file has none).
+pub fn my_robot_with_plugin_param(name: &str, value: &str) -> anyhow::Result<RobotModel> {
     let path = repo("assets/robots/my_robot.urdf");
     let text = std::fs::read_to_string(&path)?;
-    let marker = "<wheelSeparation>";
-    anyhow::ensure!(
-        text.contains(marker),
-        "my_robot.urdf lost its diff_drive plugin"
-    );
-    let text = text.replacen(marker, &format!("{extra}\n      {marker}"), 1);
+    let element = format!("<{name}>{value}</{name}>");
+    let text = match (
+        text.find(&format!("<{name}>")),
+        text.find(&format!("</{name}>")),
+    ) {
+        (Some(start), Some(end)) => {
+            format!(
+                "{}{element}{}",
+                &text[..start],
+                &text[end + name.len() + 3..]
+            )
+        }
+        _ => {
+            let marker = "<wheelSeparation>";
+            anyhow::ensure!(
+                text.contains(marker),
+                "my_robot.urdf lost its diff_drive plugin"
+            );
+            text.replacen(marker, &format!("{element}\n      {marker}"), 1)
+        }
+    };
     Ok(RobotModel::from_str(&text, &path)?)
 }
 

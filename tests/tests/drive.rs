@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use anyhow::Result;
 use rover_sim::diff_drive::wrap_angle;
 use rover_sim::{SimOptions, Simulation, Twist, World};
-use rover_tests::{drive, flat_sim, my_robot, my_robot_with_plugin_params};
+use rover_tests::{drive, flat_sim, my_robot, my_robot_with_plugin_param};
 
 #[test]
 fn straight_line_half_a_metre_per_second_for_four_seconds() -> Result<()> {
@@ -42,9 +42,7 @@ fn turn_in_place_half_a_turn() -> Result<()> {
 #[test]
 fn wheel_acceleration_ramp_is_honoured() -> Result<()> {
     let accel_radps2 = 5.0;
-    let robot = my_robot_with_plugin_params(&format!(
-        "<wheelAcceleration>{accel_radps2}</wheelAcceleration>"
-    ))?;
+    let robot = my_robot_with_plugin_param("wheelAcceleration", &accel_radps2.to_string())?;
     let mut sim = flat_sim(robot)?;
     let samples = drive(&mut sim, Twist::new(0.5, 0.0), 3.0)?;
     let target = 0.5 / 0.05;
@@ -89,7 +87,7 @@ fn wheel_acceleration_ramp_is_honoured() -> Result<()> {
 
 #[test]
 fn encoder_odometry_matches_ground_truth_on_a_straight_run() -> Result<()> {
-    let robot = my_robot_with_plugin_params("<odometrySource>encoder</odometrySource>")?;
+    let robot = my_robot_with_plugin_param("odometrySource", "encoder")?;
     let mut sim = flat_sim(robot)?;
     drive(&mut sim, Twist::new(0.5, 0.0), 4.0)?;
     drive(&mut sim, Twist::ZERO, 1.0)?;
