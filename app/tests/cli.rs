@@ -1,0 +1,143 @@
+//! The real `rover` binary, as users run it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use anyhow::Result;
+
+fn repo(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative)
+}
+
+fn rover(args: &[&str], cwd: &Path) -> Result<Output> {
+    Ok(Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(args)
+        .current_dir(cwd)
+        .env("RUST_LOG", "warn")
+        .output()?)
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn plain_headless_run_uses_the_default_world_and_robot_from_anywhere() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let out = rover(&["--headless", "--duration", "1"], dir.path())?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", text(&out.stderr));
+    assert!(
+        stdout.contains("world \"playground\", robot \"my_robot\""),
+        "{stdout}"
+    );
+    assert!(stdout.contains("1.00 s sim time"), "{stdout}");
+    Ok(())
+}
+
+#[test]
+fn scripted_run_writes_the_trace() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let script = dir.path().join("drive.toml");
+    std::fs::write(
+        &script,
+        "steps = [ { at = 0.0, cmd_vel = [0.5, 0.0] }, { at = 1.0, key = \"k\" } ]\n",
+    )?;
+    let trace = dir.path().join("out.csv");
+    let args = [
+        "--headless",
+        "--world",
+        &repo("worlds/playground.toml").display().to_string(),
+        "--robot",
+        &repo("assets/robots/my_robot.urdf").display().to_string(),
+        "--script",
+        &script.display().to_string(),
+        "--trace",
+        &trace.display().to_string(),
+        "--seed",
+        "3",
+    ]
+    .map(String::from);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = rover(&args, dir.path())?;
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Duration defaults to the last step + 1 s: 2 s at 100 Hz control.
+    let csv = std::fs::read_to_string(&trace)?;
+    let rows = rover::trace::parse_trace(&csv)?;
+    assert_eq!(rows.len(), 200);
+    let moved = rows.last().map(|r| r.x_m).unwrap_or_default();
+    assert!(moved > 0.3, "the car drove forward, x = {moved}");
+    assert!(text(&out.stdout).contains("(200 rows)"));
+    Ok(())
+}
+
+#[test]
+fn bad_input_exits_with_a_located_error() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let world = dir.path().join("w.toml");
+    std::fs::write(
+        &world,
+        "[[box]]\nsize_m = [1.0, 1.0, 1.0]\nposition_m = [1.0, 0.0]\nmas_kg = 3.0\n",
+    )?;
+    let out = rover(
+        &["--headless", "--world", &world.display().to_string()],
+        dir.path(),
+    )?;
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("w.toml:4: at `box[0].mas_kg`: unknown field `mas_kg`"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    let out = rover(&["--headless", "--script", "missing.toml"], dir.path())?;
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("cannot read missing.toml"),
+        "{}",
+        text(&out.stderr)
+    );
+    Ok(())
+}
+
+#[test]
+fn help_explains_the_interface() -> Result<()> {
+    let out = rover(&["--help"], &repo(""))?;
+    let help = text(&out.stdout);
+    for needle in [
+        "--headless",
+        "--world",
+        "--robot",
+        "--script",
+        "--duration",
+        "--trace",
+        "--seed",
+        "cmd_vel",
+        "sim_time_s,x_m",
+        "bench",
+    ] {
+        assert!(help.contains(needle), "--help lacks {needle}:\n{help}");
+    }
+    Ok(())
+}
+
+#[test]
+fn bench_prints_a_real_time_factor() -> Result<()> {
+    let out = rover(
+        &["bench", "--sim-seconds", "0.5", "--repeats", "1"],
+        &repo(""),
+    )?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("real-time x"), "{stdout}");
+    let figure = stdout
+        .lines()
+        .last()
+        .and_then(|l| l.split_whitespace().last())
+        .and_then(|v| v.parse::<f64>().ok());
+    assert!(figure.is_some_and(|rtf| rtf > 0.0), "{stdout}");
+    Ok(())
+}
