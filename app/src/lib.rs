@@ -4,6 +4,7 @@
 //! users run.
 
 pub mod bench;
+pub mod detect;
 pub mod headless;
 pub mod paths;
 pub mod pilot;

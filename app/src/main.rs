@@ -7,7 +7,9 @@ use std::time::Duration;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use rover::bench;
+use rover::detect::{self, DetectOptions};
 use rover::headless::{self, RunConfig};
+use rover_perception::{DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig};
 use rover_sim::SimOptions;
 
 /// rover: a desktop robot simulator for learning robot perception.
@@ -34,6 +36,7 @@ Examples:
   rover --headless --script drive.toml --trace out.csv
   rover --headless --world worlds/playground.toml --robot assets/robots/my_robot.urdf --duration 30 --seed 7
   rover bench                                       physics-only real-time factor
+  rover detect photo.jpg --out boxes.png            YOLO boxes on an image (the model's quick check)
 
 Script format (TOML, times in sim seconds):
   steps = [
@@ -90,8 +93,92 @@ struct RunArgs {
     cmd_timeout: Option<f64>,
 }
 
+/// Detector options shared by the commands that run YOLO.
+#[derive(Debug, Args)]
+struct DetectorArgs {
+    /// YOLO ONNX model [default: YOLOv12n from the crates.io package easy-yolo 0.1.3, fetched
+    /// into ~/.cache/rover on first use; its weights are AGPL-3.0]. Heads: YOLOv5 [1,N,5+C],
+    /// YOLOv8/11/12 [1,4+C,N], YOLOv10 [1,K,6]
+    #[arg(long, value_name = "FILE")]
+    model: Option<PathBuf>,
+
+    /// Class names, one per line (darknet's coco.names format) [default: the model's `names`
+    /// metadata, else COCO's 80]
+    #[arg(long, value_name = "FILE")]
+    labels: Option<PathBuf>,
+
+    /// Confidence threshold (darknet_ros's default)
+    #[arg(long, default_value_t = DEFAULT_THRESHOLD, value_name = "T")]
+    threshold: f32,
+
+    /// Class-wise NMS IoU threshold (darknet_ros's default)
+    #[arg(long, default_value_t = DEFAULT_NMS_IOU, value_name = "IOU")]
+    nms: f32,
+
+    /// Network input size WIDTHxHEIGHT, multiples of 32 [default: 640x480 for the default model
+    /// (the camera's size), the model's own size otherwise]
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    input_size: Option<(usize, usize)>,
+}
+
+fn parse_size(text: &str) -> Result<(usize, usize), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 640x480, found '{text}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("'{v}' is not a whole number of pixels"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+impl DetectorArgs {
+    fn config(&self) -> anyhow::Result<DetectorConfig> {
+        anyhow::ensure!(
+            (0.0..=1.0).contains(&self.threshold),
+            "--threshold must be between 0 and 1, found {}",
+            self.threshold
+        );
+        anyhow::ensure!(
+            (0.0..=1.0).contains(&self.nms),
+            "--nms must be between 0 and 1, found {}",
+            self.nms
+        );
+        Ok(DetectorConfig {
+            model: self.model.clone(),
+            labels: self.labels.clone(),
+            input_size: self.input_size,
+            threshold: self.threshold,
+            nms_iou: self.nms,
+            ..DetectorConfig::default()
+        })
+    }
+}
+
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Run the YOLO detector on image files and print the boxes
+    ///
+    /// One line per box: `class probability xmin ymin xmax ymax` (source-image pixels), or with
+    /// --json one darknet_ros-shaped object per image.
+    Detect {
+        /// Image files (PNG, JPEG)
+        #[arg(required = true, value_name = "IMAGE")]
+        images: Vec<PathBuf>,
+
+        #[command(flatten)]
+        detector: DetectorArgs,
+
+        /// Print darknet_ros-shaped JSON, one object per image per line
+        #[arg(long)]
+        json: bool,
+
+        /// Write the image with boxes drawn (a folder when several images are given)
+        #[arg(long, value_name = "PATH")]
+        out: Option<PathBuf>,
+    },
+
     /// Measure the physics-only real-time factor (single thread) on a world
     Bench {
         #[command(flatten)]
@@ -198,8 +285,11 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
 fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
+                tracing_subscriber::EnvFilter::new(
+                    "info,tract_onnx=error,tract_hir=error,tract_core=error",
+                )
+            }),
         )
         .with_writer(std::io::stderr)
         .with_target(false)
@@ -212,6 +302,19 @@ fn main() -> ExitCode {
             repeats,
             rates,
         }) => bench_cmd(world, sim_seconds, repeats, rates),
+        Some(Command::Detect {
+            images,
+            detector,
+            json,
+            out,
+        }) => detector.config().and_then(|config| {
+            detect::run(&DetectOptions {
+                images,
+                detector: config,
+                json,
+                out,
+            })
+        }),
         None => run(cli.run),
     };
     match result {

@@ -1,1 +1,29 @@
-//! placeholder
+//! rover-perception: YOLO object detection on tract-onnx with darknet_ros-shaped results.
+//!
+//! * [`Detector`] loads any YOLO ONNX export (YOLOv5 `[1,N,5+C]`, YOLOv8/11/12 `[1,4+C,N]`,
+//!   YOLOv10 `[1,K,6]`), letterboxes RGB8 images into it, decodes the head and runs class-wise
+//!   NMS. Ultralytics exports get load-time surgery ([`graph`]) that makes tract ~3x faster and
+//!   lets them run at the camera's 640x480.
+//! * [`DetectorWorker`] runs it on its own thread, always on the newest frame.
+//! * The default model is YOLOv12n from the crates.io package easy-yolo 0.1.3 ([`fetch`]); its
+//!   weights are AGPL-3.0 and are fetched at set-up, never shipped.
+//!
+//! No UI or viewer code: everything runs headless in tests.
+
+pub mod detector;
+pub mod error;
+pub mod fetch;
+mod graph;
+pub mod head;
+pub mod labels;
+pub mod messages;
+pub mod preprocess;
+pub mod worker;
+
+pub use detector::{
+    DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, StageTimes,
+};
+pub use error::{PerceptionError, Result};
+pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
+pub use preprocess::{Letterbox, RgbView};
+pub use worker::{DetectorWorker, Frame, WorkerStats};

@@ -1,0 +1,362 @@
+//! The YOLO detector on tract-onnx: loaded and optimised once, reused for every frame.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use tract_onnx::prelude::*;
+
+use crate::error::{PerceptionError, Result};
+use crate::fetch;
+use crate::graph;
+use crate::head::{self, Candidate, Head};
+use crate::labels::{COCO80, read_labels_file};
+use crate::messages::{BoundingBox, BoundingBoxes, FrameStamp};
+use crate::preprocess::{RgbView, letterbox_into};
+
+/// Input size the default model runs at: the camera's own 640x480, so camera frames need no
+/// letterbox and the network does 25% less work than at its native 640x640.
+pub const DEFAULT_INPUT_SIZE: (usize, usize) = (640, 480);
+/// darknet_ros's default confidence threshold.
+pub const DEFAULT_THRESHOLD: f32 = 0.3;
+/// darknet_ros's default NMS IoU threshold.
+pub const DEFAULT_NMS_IOU: f32 = 0.4;
+
+/// How to build a [`Detector`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectorConfig {
+    /// ONNX model file; `None` = the default YOLOv12n (fetched on first use).
+    pub model: Option<PathBuf>,
+    /// Class names file (one per line); default: the model's `names` metadata, else COCO's 80.
+    pub labels: Option<PathBuf>,
+    /// Input size (width, height), multiples of 32; default: [`DEFAULT_INPUT_SIZE`] for the
+    /// default model, the model's own size for others.
+    pub input_size: Option<(usize, usize)>,
+    /// Confidence threshold.
+    pub threshold: f32,
+    /// Class-wise NMS IoU threshold.
+    pub nms_iou: f32,
+    /// At most this many boxes per image.
+    pub max_boxes: usize,
+    /// `frame_id` stamped on results.
+    pub frame_id: String,
+}
+
+impl Default for DetectorConfig {
+    fn default() -> Self {
+        Self {
+            model: None,
+            labels: None,
+            input_size: None,
+            threshold: DEFAULT_THRESHOLD,
+            nms_iou: DEFAULT_NMS_IOU,
+            max_boxes: 100,
+            frame_id: "camera_optical_frame".to_owned(),
+        }
+    }
+}
+
+fn f32_slice(t: &Tensor) -> Result<&[f32]> {
+    t.try_as_plain_ram()
+        .and_then(|v| v.as_slice::<f32>())
+        .map_err(|e| PerceptionError::Inference(format!("model output is not f32: {e}")))
+}
+
+/// Time spent in each stage of the last detection (ms).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StageTimes {
+    /// Letterbox and normalisation.
+    pub preprocess_ms: f64,
+    /// The network.
+    pub inference_ms: f64,
+    /// Head decoding and NMS.
+    pub decode_ms: f64,
+}
+
+/// A loaded YOLO model.
+pub struct Detector {
+    plan: Arc<TypedRunnableModel>,
+    head: Head,
+    labels: Vec<String>,
+    num_classes: usize,
+    input_w: usize,
+    input_h: usize,
+    input: Arc<Tensor>,
+    candidates: Vec<Candidate>,
+    kept: Vec<Candidate>,
+    config: DetectorConfig,
+    model_path: PathBuf,
+    proto: tract_onnx::pb::ModelProto,
+    last_times: StageTimes,
+}
+
+impl std::fmt::Debug for Detector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Detector")
+            .field("model", &self.model_path)
+            .field("head", &self.head)
+            .field("input", &(self.input_w, self.input_h))
+            .field("classes", &self.num_classes)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Detector {
+    /// Loads, checks and optimises the model (once; detection reuses everything).
+    pub fn load(config: DetectorConfig) -> Result<Self> {
+        let (model_path, requested) = match &config.model {
+            Some(p) => (p.clone(), config.input_size),
+            None => (
+                fetch::ensure_default_model()?,
+                Some(config.input_size.unwrap_or(DEFAULT_INPUT_SIZE)),
+            ),
+        };
+        if !model_path.is_file() {
+            return Err(PerceptionError::model(&model_path, "no such model file"));
+        }
+        let prepared = graph::prepare(&model_path, requested)?;
+        let (input_w, input_h) = prepared.input_size;
+        let fail = |stage: &str, e: TractError| {
+            PerceptionError::model(&model_path, format!("{stage}: {e:#}"))
+        };
+        let plan = tract_onnx::onnx()
+            .model_for_proto_model(&prepared.proto)
+            .map_err(|e| fail("tract cannot load it", e))?
+            .with_input_fact(0, f32::fact([1, 3, input_h, input_w]).into())
+            .map_err(|e| fail("setting the input shape", e))?
+            .into_optimized()
+            .map_err(|e| fail("tract cannot optimise it", e))?
+            .into_runnable()
+            .map_err(|e| fail("tract cannot plan it", e))?;
+        let output_shape: Vec<usize> = plan
+            .model()
+            .output_fact(0)
+            .ok()
+            .and_then(|f| f.shape.as_concrete().map(|s| s.to_vec()))
+            .ok_or_else(|| {
+                PerceptionError::model(&model_path, "the model's output shape is not fixed")
+            })?;
+
+        let labels = match &config.labels {
+            Some(file) => read_labels_file(file)?,
+            None => prepared
+                .metadata_names
+                .clone()
+                .unwrap_or_else(|| COCO80.iter().map(|s| (*s).to_owned()).collect()),
+        };
+        let (head, num_classes) = match prepared.head.clone() {
+            Some(Head::Dfl { reg_max, strides }) => {
+                let classes = output_shape
+                    .get(1)
+                    .copied()
+                    .unwrap_or(0)
+                    .saturating_sub(4 * reg_max);
+                (Head::Dfl { reg_max, strides }, classes)
+            }
+            Some(other) => (other, labels.len()),
+            None => match Head::from_shape(&output_shape) {
+                Some((head, Some(classes))) => (head, classes),
+                Some((head, None)) => (head, labels.len()),
+                None => {
+                    return Err(PerceptionError::UnknownHead {
+                        path: model_path,
+                        shape: output_shape,
+                    });
+                }
+            },
+        };
+        if labels.len() != num_classes {
+            return Err(PerceptionError::Labels(format!(
+                "{}: the model predicts {num_classes} classes but {} class names were found ({}); pass --labels with one name per line",
+                model_path.display(),
+                labels.len(),
+                match &config.labels {
+                    Some(f) => format!("from {}", f.display()),
+                    None if prepared.metadata_names.is_some() =>
+                        "from the model's metadata".to_owned(),
+                    None => "COCO's default 80".to_owned(),
+                }
+            )));
+        }
+        tracing::debug!(
+            "detector: {} at {input_w}x{input_h}, head {}, {num_classes} classes",
+            model_path.display(),
+            head.name()
+        );
+        Ok(Self {
+            plan,
+            head,
+            num_classes,
+            labels,
+            input_w,
+            input_h,
+            input: Arc::new(Tensor::zero::<f32>(&[1, 3, input_h, input_w]).map_err(|e| {
+                PerceptionError::Inference(format!("allocating the input tensor: {e}"))
+            })?),
+            candidates: Vec::with_capacity(1024),
+            kept: Vec::with_capacity(128),
+            config,
+            model_path,
+            proto: prepared.proto,
+            last_times: StageTimes::default(),
+        })
+    }
+
+    /// Class names, indexed by class id.
+    pub fn labels(&self) -> &[String] {
+        &self.labels
+    }
+
+    /// Model input size (width, height).
+    pub fn input_size(&self) -> (usize, usize) {
+        (self.input_w, self.input_h)
+    }
+
+    /// The head format being decoded.
+    pub fn head(&self) -> &Head {
+        &self.head
+    }
+
+    /// The model file.
+    pub fn model_path(&self) -> &std::path::Path {
+        &self.model_path
+    }
+
+    /// The configuration it was built with.
+    pub fn config(&self) -> &DetectorConfig {
+        &self.config
+    }
+
+    /// Stage timings of the last [`Detector::detect`].
+    pub fn last_times(&self) -> StageTimes {
+        self.last_times
+    }
+
+    /// Writes the model as rover runs it (after surgery) to an ONNX file, so other runtimes can
+    /// be compared on exactly the same graph.
+    pub fn export_onnx(&self, path: &std::path::Path) -> Result<()> {
+        use prost::Message as _;
+        std::fs::write(path, self.proto.encode_to_vec()).map_err(|e| PerceptionError::io(path, e))
+    }
+
+    /// Letterboxes `image` into the reused input tensor and returns a view of it (for comparing
+    /// runtimes on the same input).
+    pub fn preprocess(
+        &mut self,
+        image: RgbView<'_>,
+    ) -> Result<(&[f32], crate::preprocess::Letterbox)> {
+        let (w, h) = (self.input_w, self.input_h);
+        let tensor = Arc::make_mut(&mut self.input);
+        let mut plain = tensor
+            .try_as_plain_ram_mut()
+            .map_err(|e| PerceptionError::Inference(e.to_string()))?;
+        let slice = plain
+            .as_slice_mut::<f32>()
+            .map_err(|e| PerceptionError::Inference(e.to_string()))?;
+        let lb = letterbox_into(image, slice, w, h)?;
+        Ok((f32_slice(&self.input)?, lb))
+    }
+
+    /// Runs the network on the current input tensor; returns the raw output and its shape.
+    pub fn infer_raw(&mut self) -> Result<(Vec<f32>, Vec<usize>)> {
+        let outputs = self.run_network()?;
+        let out = &outputs[0];
+        let data = f32_slice(out)?.to_vec();
+        Ok((data, out.shape().to_vec()))
+    }
+
+    fn run_network(&mut self) -> Result<TVec<TValue>> {
+        self.plan
+            .run(tvec!(TValue::from_const(self.input.clone())))
+            .map_err(|e| PerceptionError::Inference(format!("{e:#}")))
+    }
+
+    /// Decodes a raw output (as from [`Detector::infer_raw`], or another runtime given the same
+    /// input) into boxes in source-image pixels.
+    pub fn decode_raw(
+        &mut self,
+        output: &[f32],
+        shape: &[usize],
+        letterbox: crate::preprocess::Letterbox,
+        stamp: FrameStamp,
+    ) -> Result<BoundingBoxes> {
+        let mut result = BoundingBoxes {
+            image_stamp: stamp,
+            frame_id: self.config.frame_id.clone(),
+            ..BoundingBoxes::default()
+        };
+        self.decode_into(output, shape, letterbox, &mut result)?;
+        Ok(result)
+    }
+
+    fn decode_into(
+        &mut self,
+        output: &[f32],
+        shape: &[usize],
+        lb: crate::preprocess::Letterbox,
+        result: &mut BoundingBoxes,
+    ) -> Result<()> {
+        head::decode(
+            &self.head,
+            output,
+            shape,
+            self.input_w,
+            self.input_h,
+            self.num_classes,
+            self.config.threshold,
+            &mut self.candidates,
+        )?;
+        head::nms(
+            &mut self.candidates,
+            self.config.nms_iou,
+            self.config.max_boxes,
+            &mut self.kept,
+        );
+        result.bounding_boxes.clear();
+        for c in &self.kept {
+            let (x1, y1) = lb.to_source(c.x1, c.y1);
+            let (x2, y2) = lb.to_source(c.x2, c.y2);
+            if x2 - x1 < 1.0 || y2 - y1 < 1.0 {
+                continue;
+            }
+            result.bounding_boxes.push(BoundingBox {
+                class: self.labels[c.class].clone(),
+                probability: f64::from(c.score),
+                xmin: x1.round() as i64,
+                ymin: y1.round() as i64,
+                xmax: x2.round() as i64,
+                ymax: y2.round() as i64,
+                id: c.class as i16,
+            });
+        }
+        Ok(())
+    }
+
+    /// Detects objects in an RGB8 image. Boxes are in the image's pixels; the result carries
+    /// `stamp` (the frame it came from).
+    pub fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes> {
+        let start = Instant::now();
+        let (_, lb) = self.preprocess(image)?;
+        let preprocessed = Instant::now();
+        let outputs = self.run_network()?;
+        let inferred = Instant::now();
+        let out = &outputs[0];
+        let data = f32_slice(out)?;
+        let mut result = BoundingBoxes {
+            image_stamp: stamp,
+            frame_id: self.config.frame_id.clone(),
+            ..BoundingBoxes::default()
+        };
+        let shape: TVec<usize> = out.shape().into();
+        self.decode_into(data, &shape, lb, &mut result)?;
+        drop(outputs);
+        let done = Instant::now();
+        self.last_times = StageTimes {
+            preprocess_ms: (preprocessed - start).as_secs_f64() * 1e3,
+            inference_ms: (inferred - preprocessed).as_secs_f64() * 1e3,
+            decode_ms: (done - inferred).as_secs_f64() * 1e3,
+        };
+        result.latency_ms = (done - start).as_secs_f64() * 1e3;
+        Ok(result)
+    }
+}
