@@ -296,16 +296,13 @@ impl Detector {
         lb: crate::preprocess::Letterbox,
         result: &mut BoundingBoxes,
     ) -> Result<()> {
-        head::decode(
-            &self.head,
-            output,
-            shape,
-            self.input_w,
-            self.input_h,
-            self.num_classes,
-            self.config.threshold,
-            &mut self.candidates,
-        )?;
+        let spec = head::DecodeSpec {
+            input_w: self.input_w,
+            input_h: self.input_h,
+            num_classes: self.num_classes,
+            threshold: self.config.threshold,
+        };
+        head::decode(&self.head, output, shape, spec, &mut self.candidates)?;
         head::nms(
             &mut self.candidates,
             self.config.nms_iou,

@@ -11,7 +11,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use tract_onnx::pb::{
-    ModelProto, NodeProto, TensorProto, ValueInfoProto, tensor_shape_proto, type_proto,
+    ModelProto, NodeProto, TensorProto, TypeProto, ValueInfoProto, tensor_shape_proto, type_proto,
 };
 
 use crate::error::{PerceptionError, Result};
@@ -71,7 +71,9 @@ pub(crate) fn prepare(path: &Path, requested: Option<(usize, usize)>) -> Result<
         .graph
         .as_mut()
         .ok_or_else(|| PerceptionError::model(path, "the ONNX file has no graph"))?;
-    let initializers: HashSet<&str> = graph.initializer.iter().map(|t| t.name.as_str()).collect();
+    let initializers_owned: HashSet<String> =
+        graph.initializer.iter().map(|t| t.name.clone()).collect();
+    let initializers: HashSet<&str> = initializers_owned.iter().map(String::as_str).collect();
     let inputs: Vec<&ValueInfoProto> = graph
         .input
         .iter()
@@ -100,7 +102,11 @@ pub(crate) fn prepare(path: &Path, requested: Option<(usize, usize)>) -> Result<
         }
     };
     let input_size = requested.or(native_size).unwrap_or((640, 640));
-    if input_size.0 % 32 != 0 || input_size.1 % 32 != 0 || input_size.0 == 0 || input_size.1 == 0 {
+    if !input_size.0.is_multiple_of(32)
+        || !input_size.1.is_multiple_of(32)
+        || input_size.0 == 0
+        || input_size.1 == 0
+    {
         return Err(PerceptionError::model(
             path,
             format!(
@@ -133,12 +139,37 @@ pub(crate) fn prepare(path: &Path, requested: Option<(usize, usize)>) -> Result<
             )
         })?;
     }
+    set_input_size(graph, &initializers_owned, input_size);
     Ok(Prepared {
         proto,
         head,
         input_size,
         metadata_names,
     })
+}
+
+/// Declares the image input as `[1, 3, height, width]`, so the exported graph is consistent for
+/// other runtimes too.
+fn set_input_size(
+    graph: &mut tract_onnx::pb::GraphProto,
+    initializers: &HashSet<String>,
+    (w, h): (usize, usize),
+) {
+    for input in graph
+        .input
+        .iter_mut()
+        .filter(|i| !initializers.contains(&i.name))
+    {
+        if let Some(type_proto::Value::TensorType(t)) =
+            input.r#type.as_mut().and_then(|t| t.value.as_mut())
+            && let Some(shape) = t.shape.as_mut()
+            && shape.dim.len() == 4
+        {
+            for (dim, value) in shape.dim.iter_mut().zip([1, 3, h, w]) {
+                dim.value = Some(tensor_shape_proto::dimension::Value::DimValue(value as i64));
+            }
+        }
+    }
 }
 
 /// Finds Ultralytics' decode tail `output0 = Concat(boxes, Sigmoid(Split(raw)[1]))` and makes
@@ -173,6 +204,13 @@ fn cut_ultralytics_head(
     let raw = split.input.first()?.clone();
     graph.output = vec![ValueInfoProto {
         name: raw,
+        r#type: Some(TypeProto {
+            value: Some(type_proto::Value::TensorType(type_proto::Tensor {
+                elem_type: 1, // FLOAT
+                shape: None,
+            })),
+            ..TypeProto::default()
+        }),
         ..ValueInfoProto::default()
     }];
     Some(Head::Dfl {
@@ -208,7 +246,7 @@ fn tensor_i64(t: &TensorProto) -> Option<Vec<i64>> {
     if !t.int64_data.is_empty() {
         return Some(t.int64_data.clone());
     }
-    if t.raw_data.len() % 8 != 0 {
+    if !t.raw_data.len().is_multiple_of(8) {
         return None;
     }
     Some(

@@ -76,18 +76,33 @@ impl Candidate {
     }
 }
 
-/// Decodes `output` (row-major, `shape`) into `out` (cleared first), keeping candidates whose
-/// score is at least `threshold`. `input_w`/`input_h` are the model input size (px).
+/// What decoding needs besides the output itself.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DecodeSpec {
+    /// Model input width (px).
+    pub input_w: usize,
+    /// Model input height (px).
+    pub input_h: usize,
+    /// Number of classes the model predicts.
+    pub num_classes: usize,
+    /// Keep candidates scoring at least this.
+    pub threshold: f32,
+}
+
+/// Decodes `output` (row-major, `shape`) into `out` (cleared first).
 pub fn decode(
     head: &Head,
     output: &[f32],
     shape: &[usize],
-    input_w: usize,
-    input_h: usize,
-    num_classes: usize,
-    threshold: f32,
+    spec: DecodeSpec,
     out: &mut Vec<Candidate>,
 ) -> Result<()> {
+    let DecodeSpec {
+        input_w,
+        input_h,
+        num_classes,
+        threshold,
+    } = spec;
     out.clear();
     let bad = |expected: String| {
         PerceptionError::Inference(format!(
@@ -313,10 +328,12 @@ mod tests {
             &Head::AnchorFree,
             &out,
             &[1, 6, 2],
-            640,
-            640,
-            2,
-            0.3,
+            DecodeSpec {
+                input_w: 640,
+                input_h: 640,
+                num_classes: 2,
+                threshold: 0.3,
+            },
             &mut c,
         )?;
         assert_eq!(
@@ -345,10 +362,12 @@ mod tests {
             &Head::Objectness,
             &out,
             &[1, 2, 7],
-            640,
-            640,
-            2,
-            0.3,
+            DecodeSpec {
+                input_w: 640,
+                input_h: 640,
+                num_classes: 2,
+                threshold: 0.3,
+            },
             &mut c,
         )?;
         assert_eq!(c.len(), 1);
@@ -364,7 +383,18 @@ mod tests {
             1.0, 2.0, 30.0, 40.0, 0.95, 0.0, 5.0, 5.0, 6.0, 6.0, 0.1, 1.0,
         ];
         let mut c = Vec::new();
-        decode(&Head::EndToEnd, &out, &[1, 2, 6], 640, 640, 80, 0.3, &mut c)?;
+        decode(
+            &Head::EndToEnd,
+            &out,
+            &[1, 2, 6],
+            DecodeSpec {
+                input_w: 640,
+                input_h: 640,
+                num_classes: 80,
+                threshold: 0.3,
+            },
+            &mut c,
+        )?;
         assert_eq!(
             c,
             vec![Candidate {
@@ -396,7 +426,18 @@ mod tests {
             reg_max,
             strides: vec![32],
         };
-        decode(&head, &out, &[1, channels, n], 64, 32, 1, 0.3, &mut c)?;
+        decode(
+            &head,
+            &out,
+            &[1, channels, n],
+            DecodeSpec {
+                input_w: 64,
+                input_h: 32,
+                num_classes: 1,
+                threshold: 0.3,
+            },
+            &mut c,
+        )?;
         assert_eq!(c.len(), 1, "anchor 0's score is far below threshold");
         let b = c[0];
         assert!((b.score - 0.952_574).abs() < 1e-4);
@@ -404,7 +445,21 @@ mod tests {
             assert!((got - want).abs() < 1e-3, "{b:?}");
         }
         // Wrong shapes are errors, not garbage.
-        assert!(decode(&head, &out, &[1, channels, 3], 64, 32, 1, 0.3, &mut c).is_err());
+        assert!(
+            decode(
+                &head,
+                &out,
+                &[1, channels, 3],
+                DecodeSpec {
+                    input_w: 64,
+                    input_h: 32,
+                    num_classes: 1,
+                    threshold: 0.3
+                },
+                &mut c
+            )
+            .is_err()
+        );
         Ok(())
     }
 

@@ -146,6 +146,15 @@ pub fn letterbox_into(
     Ok(lb)
 }
 
+/// Reads an image file (PNG, JPEG) as RGB8: (width, height, pixels).
+pub fn load_rgb(path: &std::path::Path) -> Result<(usize, usize, Vec<u8>)> {
+    let image = image::open(path)
+        .map_err(|e| PerceptionError::Image(format!("{}: {e}", path.display())))?
+        .into_rgb8();
+    let (w, h) = image.dimensions();
+    Ok((w as usize, h as usize, image.into_raw()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -188,13 +197,4 @@ mod tests {
         assert!(RgbView::new(4, 4, &flat).is_err());
         Ok(())
     }
-}
-
-/// Reads an image file (PNG, JPEG) as RGB8: (width, height, pixels).
-pub fn load_rgb(path: &std::path::Path) -> Result<(usize, usize, Vec<u8>)> {
-    let image = image::open(path)
-        .map_err(|e| PerceptionError::Image(format!("{}: {e}", path.display())))?
-        .into_rgb8();
-    let (w, h) = image.dimensions();
-    Ok((w as usize, h as usize, image.into_raw()))
 }

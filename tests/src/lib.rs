@@ -67,3 +67,104 @@ pub fn flat_sim(robot: RobotModel) -> anyhow::Result<Simulation> {
         &SimOptions::default(),
     )?)
 }
+
+/// A real test photo: scikit-image's `astronaut`/`camera`/`chelsea`/`coffee` (written as PNG
+/// into `dir` by scripts/test_photos.py) or Debian darknet's `person`/`dog`/`horses`/... from
+/// /usr/share/darknet/data. Errors say what to install (.ci/run installs both).
+pub fn photo(name: &str, dir: &Path) -> anyhow::Result<PathBuf> {
+    let darknet = Path::new("/usr/share/darknet/data").join(format!("{name}.jpg"));
+    if darknet.is_file() {
+        return Ok(darknet);
+    }
+    if ["astronaut", "camera", "chelsea", "coffee"].contains(&name) {
+        let status = std::process::Command::new("python3")
+            .arg(repo("scripts/test_photos.py"))
+            .arg(dir)
+            .arg(name)
+            .status()?;
+        let png = dir.join(format!("{name}.png"));
+        anyhow::ensure!(
+            status.success() && png.is_file(),
+            "scripts/test_photos.py failed: pip install scikit-image"
+        );
+        return Ok(png);
+    }
+    anyhow::bail!(
+        "test photo {name} not found: apt-get install darknet (it ships /usr/share/darknet/data)"
+    )
+}
+
+/// Output of the onnxruntime reference (scripts/ort_reference.py).
+#[derive(Debug, Clone)]
+pub struct OrtRun {
+    /// Raw first output.
+    pub output: Vec<f32>,
+    /// Its shape.
+    pub shape: Vec<usize>,
+    /// Median latency (ms).
+    pub median_ms: f64,
+}
+
+/// Runs `model` with onnxruntime (Python) on `input` of `shape`.
+pub fn ort_reference(
+    model: &Path,
+    input: &[f32],
+    shape: &[usize],
+    dir: &Path,
+    threads: usize,
+    runs: usize,
+) -> anyhow::Result<OrtRun> {
+    let input_path = dir.join("input.f32");
+    let output_path = dir.join("output.f32");
+    let bytes: Vec<u8> = input.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(&input_path, bytes)?;
+    let shape_arg = shape
+        .iter()
+        .map(|d| d.to_string())
+        .collect::<Vec<_>>()
+        .join(",");
+    let out = std::process::Command::new("python3")
+        .arg(repo("scripts/ort_reference.py"))
+        .arg(model)
+        .arg(&input_path)
+        .arg(shape_arg)
+        .arg(&output_path)
+        .args([
+            "--threads",
+            &threads.to_string(),
+            "--runs",
+            &runs.to_string(),
+        ])
+        .output()?;
+    anyhow::ensure!(
+        out.status.success(),
+        "onnxruntime reference failed (pip install onnxruntime): {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let shape_text = text
+        .split("\"shape\": [")
+        .nth(1)
+        .and_then(|s| s.split(']').next())
+        .ok_or_else(|| anyhow::anyhow!("unexpected reference output: {text}"))?;
+    let shape: Vec<usize> = shape_text
+        .split(',')
+        .map(|v| v.trim().parse())
+        .collect::<Result<_, _>>()?;
+    let median_ms = text
+        .split("\"median_ms\": ")
+        .nth(1)
+        .and_then(|s| s.split([',', '}']).next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or(f64::NAN);
+    let raw = std::fs::read(&output_path)?;
+    let output = raw
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    Ok(OrtRun {
+        output,
+        shape,
+        median_ms,
+    })
+}

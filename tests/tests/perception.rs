@@ -1,0 +1,170 @@
+//! The real default model on real photos, checked against onnxruntime on the same graph, input
+//! and decoding.
+
+use anyhow::Result;
+use rover_perception::preprocess::load_rgb;
+use rover_perception::{Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView};
+use rover_tests::{ort_reference, photo};
+
+const CASES: [(&str, &[&str]); 3] = [
+    ("astronaut", &["person"]),
+    ("person", &["person", "horse", "dog"]),
+    ("dog", &["bicycle", "dog", "car"]),
+];
+
+#[test]
+fn default_model_finds_the_expected_objects_like_onnxruntime() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let mut detector = Detector::load(DetectorConfig::default())?;
+    let model = dir.path().join("model.onnx");
+    detector.export_onnx(&model)?;
+    let (w, h) = detector.input_size();
+    for (name, expected) in CASES {
+        let path = photo(name, dir.path())?;
+        let (width, height, pixels) = load_rgb(&path)?;
+        let view = RgbView::new(width, height, &pixels)?;
+        let stamp = FrameStamp {
+            sim_time_s: 1.5,
+            frame: 7,
+        };
+        let ours = detector.detect(view, stamp)?;
+        assert_eq!(ours.image_stamp, stamp, "results carry their image's stamp");
+        for class in expected {
+            assert!(
+                ours.bounding_boxes.iter().any(|b| b.class == *class),
+                "{name}: expected a {class}, got {:?}",
+                ours.bounding_boxes
+            );
+        }
+        // onnxruntime on exactly the graph, input tensor and decoder rover uses.
+        let (input, letterbox) = detector.preprocess(view)?;
+        let input = input.to_vec();
+        let reference = ort_reference(&model, &input, &[1, 3, h, w], dir.path(), 1, 1)?;
+        let theirs = detector.decode_raw(&reference.output, &reference.shape, letterbox, stamp)?;
+        assert!(
+            !theirs.bounding_boxes.is_empty(),
+            "{name}: reference found nothing"
+        );
+        for r in &theirs.bounding_boxes {
+            let best = ours
+                .bounding_boxes
+                .iter()
+                .filter(|b| b.class == r.class)
+                .map(|b| b.iou(r))
+                .fold(0.0, f64::max);
+            assert!(
+                best >= 0.9,
+                "{name}: onnxruntime's {r:?} has no tract box with IoU >= 0.9 (best {best})"
+            );
+        }
+        eprintln!(
+            "{name}: {:?}",
+            ours.bounding_boxes
+                .iter()
+                .map(|b| (&b.class, b.probability))
+                .collect::<Vec<_>>()
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn the_worker_always_finishes_on_the_newest_frame() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let (width, height, pixels) = load_rgb(&photo("person", dir.path())?)?;
+    let worker = DetectorWorker::spawn(Detector::load(DetectorConfig::default())?)?;
+    let frames = 6u64;
+    for frame in 0..frames {
+        let mut buffer = worker.buffer();
+        buffer.clear();
+        buffer.extend_from_slice(&pixels);
+        worker.submit(Frame {
+            pixels: buffer,
+            width,
+            height,
+            stamp: FrameStamp {
+                sim_time_s: frame as f64 / 30.0,
+                frame,
+            },
+        });
+    }
+    let mut last_seen = None;
+    loop {
+        let result = worker.wait()?;
+        if let Some(prev) = last_seen {
+            assert!(
+                result.image_stamp.frame > prev,
+                "results come in frame order"
+            );
+        }
+        last_seen = Some(result.image_stamp.frame);
+        assert!(result.bounding_boxes.iter().any(|b| b.class == "person"));
+        if result.image_stamp.frame == frames - 1 {
+            break;
+        }
+    }
+    let stats = worker.stats();
+    assert_eq!(stats.submitted, frames);
+    assert_eq!(
+        stats.processed + stats.dropped,
+        frames,
+        "every frame is either detected or dropped as stale: {stats:?}"
+    );
+    assert!(
+        stats.dropped >= 1,
+        "six frames submitted at once cannot all be detected: {stats:?}"
+    );
+    Ok(())
+}
+
+#[test]
+fn bad_models_and_labels_are_clear_errors() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let junk = dir.path().join("junk.onnx");
+    std::fs::write(&junk, b"definitely not protobuf")?;
+    let err = Detector::load(DetectorConfig {
+        model: Some(junk.clone()),
+        ..DetectorConfig::default()
+    })
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(
+        err.starts_with(&format!("{}: not a readable ONNX model", junk.display())),
+        "{err}"
+    );
+
+    let missing = dir.path().join("missing.onnx");
+    let err = Detector::load(DetectorConfig {
+        model: Some(missing),
+        ..DetectorConfig::default()
+    })
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(err.contains("no such model file"), "{err}");
+
+    let labels = dir.path().join("three.names");
+    std::fs::write(&labels, "cat\ndog\nbird\n")?;
+    let err = Detector::load(DetectorConfig {
+        labels: Some(labels),
+        ..DetectorConfig::default()
+    })
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(
+        err.contains("the model predicts 80 classes but 3 class names were found"),
+        "{err}"
+    );
+
+    let err = Detector::load(DetectorConfig {
+        input_size: Some((600, 480)),
+        ..DetectorConfig::default()
+    })
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(err.contains("multiples of 32"), "{err}");
+    Ok(())
+}
