@@ -68,3 +68,100 @@ pub fn physics(
         wall_s: best,
     })
 }
+
+/// Result of the detector benchmark.
+#[derive(Debug, Clone)]
+pub struct DetectorBench {
+    /// Model input size (width, height).
+    pub input_size: (usize, usize),
+    /// Median letterbox + normalisation (ms).
+    pub preprocess_ms: f64,
+    /// Median tract inference (ms).
+    pub inference_ms: f64,
+    /// Median decode + NMS (ms).
+    pub decode_ms: f64,
+    /// Median end to end (ms).
+    pub total_ms: f64,
+    /// onnxruntime's median on the same graph and input, one thread, when it could run.
+    pub onnxruntime_ms: Result<f64, String>,
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Times the detector (single thread, `runs` frames after one warm-up) on `image`, then
+/// onnxruntime (Python, scripts/ort_reference.py) on exactly the same graph and input tensor.
+pub fn detector(
+    config: rover_perception::DetectorConfig,
+    image: &std::path::Path,
+    runs: usize,
+) -> Result<DetectorBench> {
+    use rover_perception::preprocess::load_rgb;
+    use rover_perception::{Detector, FrameStamp, RgbView};
+
+    let mut detector = Detector::load(config)?;
+    let (w, h, pixels) = load_rgb(image)?;
+    let view = RgbView::new(w, h, &pixels)?;
+    detector.detect(view, FrameStamp::default())?;
+    let (mut pre, mut inf, mut dec, mut total) = (vec![], vec![], vec![], vec![]);
+    for frame in 0..runs.max(1) {
+        let r = detector.detect(view, FrameStamp { sim_time_s: 0.0, frame: frame as u64 })?;
+        let t = detector.last_times();
+        pre.push(t.preprocess_ms);
+        inf.push(t.inference_ms);
+        dec.push(t.decode_ms);
+        total.push(r.latency_ms);
+    }
+    let input_size = detector.input_size();
+    let onnxruntime_ms = onnxruntime_median(&mut detector, view, runs);
+    Ok(DetectorBench {
+        input_size,
+        preprocess_ms: median(&mut pre),
+        inference_ms: median(&mut inf),
+        decode_ms: median(&mut dec),
+        total_ms: median(&mut total),
+        onnxruntime_ms,
+    })
+}
+
+fn onnxruntime_median(
+    detector: &mut rover_perception::Detector,
+    view: rover_perception::RgbView<'_>,
+    runs: usize,
+) -> Result<f64, String> {
+    let dir = std::env::temp_dir().join(format!("rover-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let model = dir.join("model.onnx");
+    let input_path = dir.join("input.f32");
+    let output_path = dir.join("output.f32");
+    let (w, h) = detector.input_size();
+    let result = (|| {
+        detector.export_onnx(&model).map_err(|e| e.to_string())?;
+        let (input, _) = detector.preprocess(view).map_err(|e| e.to_string())?;
+        let bytes: Vec<u8> = input.iter().flat_map(|v| v.to_le_bytes()).collect();
+        std::fs::write(&input_path, bytes).map_err(|e| e.to_string())?;
+        let script = crate::paths::bundled("scripts/ort_reference.py");
+        let out = std::process::Command::new("python3")
+            .arg(&script)
+            .arg(&model)
+            .arg(&input_path)
+            .arg(format!("1,3,{h},{w}"))
+            .arg(&output_path)
+            .args(["--threads", "1", "--runs", &(runs.max(1) + 1).to_string()])
+            .output()
+            .map_err(|e| format!("cannot run python3: {e}"))?;
+        if !out.status.success() {
+            return Err(String::from_utf8_lossy(&out.stderr).trim().to_owned());
+        }
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        text.split("\"median_ms\": ")
+            .nth(1)
+            .and_then(|s| s.split([',', '}']).next())
+            .and_then(|s| s.trim().parse::<f64>().ok())
+            .ok_or_else(|| format!("unexpected output from {}: {text}", script.display()))
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}

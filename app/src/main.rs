@@ -115,8 +115,8 @@ struct DetectorArgs {
     #[arg(long, default_value_t = DEFAULT_NMS_IOU, value_name = "IOU")]
     nms: f32,
 
-    /// Network input size WIDTHxHEIGHT, multiples of 32 [default: 640x480 for the default model
-    /// (the camera's size), the model's own size otherwise]
+    /// Network input size WIDTHxHEIGHT, multiples of 32 [default: 512x384 for the default model
+    /// (the camera's 4:3 aspect), the model's own size otherwise]
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     input_size: Option<(usize, usize)>,
 }
@@ -157,6 +157,23 @@ impl DetectorArgs {
 }
 
 #[derive(Debug, Subcommand)]
+enum BenchKind {
+    /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
+    Detect {
+        #[command(flatten)]
+        detector: DetectorArgs,
+
+        /// Image to detect on [default: darknet's person.jpg if installed, else a test pattern]
+        #[arg(long, value_name = "FILE")]
+        image: Option<PathBuf>,
+
+        /// Timed runs (after one warm-up)
+        #[arg(long, default_value_t = 15)]
+        runs: usize,
+    },
+}
+
+#[derive(Debug, Subcommand)]
 enum Command {
     /// Run the YOLO detector on image files and print the boxes
     ///
@@ -179,8 +196,11 @@ enum Command {
         out: Option<PathBuf>,
     },
 
-    /// Measure the physics-only real-time factor (single thread) on a world
+    /// Benchmarks: physics-only real-time factor (default), or `bench detect`
     Bench {
+        #[command(subcommand)]
+        kind: Option<BenchKind>,
+
         #[command(flatten)]
         world: WorldArgs,
 
@@ -282,6 +302,39 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
     Ok(())
 }
 
+fn bench_detect(config: DetectorConfig, image: Option<PathBuf>, runs: usize) -> Result<()> {
+    let image = match image {
+        Some(path) => path,
+        None => {
+            let darknet = PathBuf::from("/usr/share/darknet/data/person.jpg");
+            if darknet.is_file() {
+                darknet
+            } else {
+                let path = std::env::temp_dir().join("rover-bench-pattern.png");
+                let pattern = image::RgbImage::from_fn(640, 480, |x, y| image::Rgb([(x % 256) as u8, (y % 256) as u8, ((x + y) % 256) as u8]));
+                pattern.save(&path)?;
+                path
+            }
+        }
+    };
+    println!("detector benchmark on {}: {runs} runs after a warm-up, one thread", image.display());
+    let b = bench::detector(config, &image, runs)?;
+    println!("input {}x{}", b.input_size.0, b.input_size.1);
+    println!("{:<28} {:>10}", "stage (median)", "ms");
+    println!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
+    println!("{:<28} {:>10.1}", "tract inference", b.inference_ms);
+    println!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
+    println!("{:<28} {:>10.1}   ({:.1} Hz)", "end to end", b.total_ms, 1000.0 / b.total_ms);
+    match b.onnxruntime_ms {
+        Ok(ort) => {
+            println!("{:<28} {:>10.1}", "onnxruntime inference", ort);
+            println!("{:<28} {:>10.2}x", "tract / onnxruntime", b.inference_ms / ort);
+        }
+        Err(e) => println!("onnxruntime: not measured ({e}); pip install onnxruntime"),
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -297,6 +350,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Bench {
+            kind: Some(BenchKind::Detect { detector, image, runs }),
+            ..
+        }) => detector.config().and_then(|config| bench_detect(config, image, runs)),
+        Some(Command::Bench {
+            kind: None,
             world,
             sim_seconds,
             repeats,
