@@ -107,7 +107,13 @@ pub fn detector(
     detector.detect(view, FrameStamp::default())?;
     let (mut pre, mut inf, mut dec, mut total) = (vec![], vec![], vec![], vec![]);
     for frame in 0..runs.max(1) {
-        let r = detector.detect(view, FrameStamp { sim_time_s: 0.0, frame: frame as u64 })?;
+        let r = detector.detect(
+            view,
+            FrameStamp {
+                sim_time_s: 0.0,
+                frame: frame as u64,
+            },
+        )?;
         let t = detector.last_times();
         pre.push(t.preprocess_ms);
         inf.push(t.inference_ms);

@@ -311,24 +311,38 @@ fn bench_detect(config: DetectorConfig, image: Option<PathBuf>, runs: usize) -> 
                 darknet
             } else {
                 let path = std::env::temp_dir().join("rover-bench-pattern.png");
-                let pattern = image::RgbImage::from_fn(640, 480, |x, y| image::Rgb([(x % 256) as u8, (y % 256) as u8, ((x + y) % 256) as u8]));
+                let pattern = image::RgbImage::from_fn(640, 480, |x, y| {
+                    image::Rgb([(x % 256) as u8, (y % 256) as u8, ((x + y) % 256) as u8])
+                });
                 pattern.save(&path)?;
                 path
             }
         }
     };
-    println!("detector benchmark on {}: {runs} runs after a warm-up, one thread", image.display());
+    println!(
+        "detector benchmark on {}: {runs} runs after a warm-up, one thread",
+        image.display()
+    );
     let b = bench::detector(config, &image, runs)?;
     println!("input {}x{}", b.input_size.0, b.input_size.1);
     println!("{:<28} {:>10}", "stage (median)", "ms");
     println!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
     println!("{:<28} {:>10.1}", "tract inference", b.inference_ms);
     println!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
-    println!("{:<28} {:>10.1}   ({:.1} Hz)", "end to end", b.total_ms, 1000.0 / b.total_ms);
+    println!(
+        "{:<28} {:>10.1}   ({:.1} Hz)",
+        "end to end",
+        b.total_ms,
+        1000.0 / b.total_ms
+    );
     match b.onnxruntime_ms {
         Ok(ort) => {
             println!("{:<28} {:>10.1}", "onnxruntime inference", ort);
-            println!("{:<28} {:>10.2}x", "tract / onnxruntime", b.inference_ms / ort);
+            println!(
+                "{:<28} {:>10.2}x",
+                "tract / onnxruntime",
+                b.inference_ms / ort
+            );
         }
         Err(e) => println!("onnxruntime: not measured ({e}); pip install onnxruntime"),
     }
@@ -350,9 +364,16 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Bench {
-            kind: Some(BenchKind::Detect { detector, image, runs }),
+            kind:
+                Some(BenchKind::Detect {
+                    detector,
+                    image,
+                    runs,
+                }),
             ..
-        }) => detector.config().and_then(|config| bench_detect(config, image, runs)),
+        }) => detector
+            .config()
+            .and_then(|config| bench_detect(config, image, runs)),
         Some(Command::Bench {
             kind: None,
             world,

@@ -16,6 +16,7 @@ pub mod fetch;
 mod graph;
 pub mod head;
 pub mod labels;
+pub mod lockstep;
 pub mod messages;
 pub mod preprocess;
 pub mod worker;
@@ -24,6 +25,7 @@ pub use detector::{
     DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, StageTimes,
 };
 pub use error::{PerceptionError, Result};
+pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
 pub use preprocess::{Letterbox, RgbView};
 pub use worker::{DetectorWorker, Frame, WorkerStats};

@@ -168,3 +168,32 @@ fn bad_models_and_labels_are_clear_errors() -> Result<()> {
     assert!(err.contains("multiples of 32"), "{err}");
     Ok(())
 }
+
+#[test]
+fn lockstep_detection_runs_at_its_sim_rate_and_repeats_exactly() -> Result<()> {
+    use rover_perception::LockstepDetector;
+    let dir = tempfile::tempdir()?;
+    let (width, height, pixels) = load_rgb(&photo("person", dir.path())?)?;
+    let view = RgbView::new(width, height, &pixels)?;
+    let mut runs = Vec::new();
+    for _ in 0..2 {
+        let mut lockstep = LockstepDetector::new(Detector::load(DetectorConfig::default())?, 5.0)?;
+        let mut results = Vec::new();
+        // One second of 30 Hz camera frames.
+        for frame in 0..30u64 {
+            let stamp = FrameStamp {
+                sim_time_s: frame as f64 / 30.0,
+                frame,
+            };
+            if let Some(r) = lockstep.detect_if_due(view, stamp)? {
+                results.push((r.image_stamp.frame, r.bounding_boxes));
+            }
+        }
+        runs.push(results);
+    }
+    let frames: Vec<u64> = runs[0].iter().map(|(f, _)| *f).collect();
+    assert_eq!(frames, vec![0, 6, 12, 18, 24], "5 Hz on sim time");
+    assert_eq!(runs[0], runs[1], "same inputs, same boxes");
+    assert!(LockstepDetector::new(Detector::load(DetectorConfig::default())?, 0.0).is_err());
+    Ok(())
+}
