@@ -141,3 +141,61 @@ fn bench_prints_a_real_time_factor() -> Result<()> {
     assert!(figure.is_some_and(|rtf| rtf > 0.0), "{stdout}");
     Ok(())
 }
+
+#[test]
+fn detect_prints_boxes_json_and_draws_them() -> Result<()> {
+    let photo = Path::new("/usr/share/darknet/data/person.jpg");
+    anyhow::ensure!(
+        photo.is_file(),
+        "apt-get install darknet (its sample photos)"
+    );
+    let dir = tempfile::tempdir()?;
+    let out_png = dir.path().join("boxes.png");
+    let photo_arg = photo.display().to_string();
+    let out_arg = out_png.display().to_string();
+    let out = rover(&["detect", &photo_arg, "--out", &out_arg], dir.path())?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let person = stdout
+        .lines()
+        .find(|l| l.starts_with("person "))
+        .ok_or_else(|| anyhow::anyhow!("no person line in {stdout}"))?;
+    let fields: Vec<&str> = person.split_whitespace().collect();
+    assert_eq!(
+        fields.len(),
+        6,
+        "class probability xmin ymin xmax ymax: {person}"
+    );
+    assert!(fields[1].parse::<f64>()? > 0.5);
+    let drawn = image::open(&out_png)?.into_rgb8();
+    let original = image::open(photo)?.into_rgb8();
+    assert_eq!(drawn.dimensions(), original.dimensions());
+    assert_ne!(drawn.as_raw(), original.as_raw(), "boxes were drawn");
+
+    let out = rover(
+        &["detect", &photo_arg, "--json", "--threshold", "0.5"],
+        dir.path(),
+    )?;
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_str(text(&out.stdout).trim())?;
+    let boxes = json["bounding_boxes"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    assert!(boxes.iter().any(|b| b["Class"] == "horse"), "{json}");
+    assert!(
+        boxes
+            .iter()
+            .all(|b| b["probability"].as_f64().unwrap_or(0.0) >= 0.5)
+    );
+    assert_eq!(json["image_stamp"]["frame"], 0);
+
+    let out = rover(&["detect", "missing.jpg"], dir.path())?;
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("missing.jpg"),
+        "{}",
+        text(&out.stderr)
+    );
+    Ok(())
+}
