@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use rover_sim::{ControlSample, RobotModel, SimOptions, Simulation, World};
+use rover_sim::{CameraSensor, ControlSample, RobotModel, SimOptions, Simulation, World};
 
 use crate::paths;
 use crate::pilot::{Mode, Pilot};
@@ -30,6 +30,10 @@ pub struct RunConfig {
     pub options: SimOptions,
     /// Log progress to stderr about every this many wall seconds (None = quiet).
     pub progress_every: Option<Duration>,
+    /// Write camera images as PNG into this folder.
+    pub save_frames: Option<PathBuf>,
+    /// Write every Nth camera image (1 = all).
+    pub frame_every: u64,
 }
 
 /// What a headless run did.
@@ -103,6 +107,27 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
     let world_name = world.name.clone();
     let robot_name = robot.name.clone();
     let mut sim = Simulation::new(world, robot, &config.options)?;
+    let mut camera = match &config.save_frames {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            let sensor = CameraSensor::new(&sim)?;
+            tracing::info!(
+                "camera: {}x{} at {} Hz, rendering on {}",
+                sensor.info().width,
+                sensor.info().height,
+                sim.robot()
+                    .cameras
+                    .first()
+                    .map_or(0.0, |c| c.update_rate_hz),
+                sensor.renderer().adapter()
+            );
+            Some((sensor, dir.clone()))
+        }
+        None => None,
+    };
+    let frame_every = config.frame_every.max(1);
+    let mut frames_written = 0u64;
     let mut pilot = Pilot::default();
     let mut next_step = 0;
     let total_steps = (duration_s / sim.dt_s()).round() as u64;
@@ -124,6 +149,21 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
                 tracing::warn!("script step at {} s: {e}", step.at_s);
             }
             next_step += 1;
+        }
+        if let Some((sensor, dir)) = camera.as_mut()
+            && let Some(frame) = sensor.capture_if_due(&sim)?
+            && frame.seq % frame_every == 0
+        {
+            let path = dir.join(format!("frame_{:06}.png", frame.seq));
+            image::save_buffer(
+                &path,
+                frame.rgb,
+                frame.width,
+                frame.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
+            frames_written += 1;
         }
         if let Some(sample) = sim.step() {
             if let Some(t) = trace.as_mut() {
@@ -152,6 +192,9 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
         }
         None => 0,
     };
+    if let Some((_, dir)) = &camera {
+        tracing::info!("wrote {frames_written} camera frames to {}", dir.display());
+    }
     Ok(RunSummary {
         world: world_name,
         robot: robot_name,

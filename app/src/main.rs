@@ -88,6 +88,15 @@ struct RunArgs {
     #[arg(long, value_name = "FILE")]
     trace: Option<PathBuf>,
 
+    /// Write the robot camera's images as PNG files into DIR (rendered with wgpu: a GPU, or
+    /// Mesa's software Vulkan)
+    #[arg(long, value_name = "DIR")]
+    save_frames: Option<PathBuf>,
+
+    /// With --save-frames: write every Nth camera image
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    frame_every: u64,
+
     /// Stop the robot when no cmd_vel arrived for SECS (off by default, like Gazebo; 0 = off)
     #[arg(long, value_name = "SECS")]
     cmd_timeout: Option<f64>,
@@ -240,6 +249,8 @@ fn run(args: RunArgs) -> Result<()> {
         trace: args.trace.clone(),
         options: options(&args.world, args.cmd_timeout),
         progress_every: Some(Duration::from_secs(5)),
+        save_frames: args.save_frames,
+        frame_every: args.frame_every,
     };
     let summary = headless::run(&config)?;
     println!(

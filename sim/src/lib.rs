@@ -7,20 +7,26 @@
 //!
 //! Frames follow REP-103: x forward, y left, z up.
 
+pub mod camera;
 pub mod diff_drive;
 pub mod error;
 pub mod gazebo;
 pub mod geometry;
 pub mod mesh;
+pub mod render;
 pub mod robot;
+pub mod sensor;
 pub mod simulation;
 pub mod tomlfile;
 pub mod world;
 
+pub use camera::CameraInfo;
 pub use diff_drive::{DiffDriveController, Odometry, Twist, WheelSpeeds};
 pub use error::{Location, Result, SimError};
 pub use gazebo::{CameraConfig, DiffDriveConfig, OdometrySource};
 pub use geometry::{Pose, Rgba, Shape};
+pub use render::{CameraRenderer, RenderError};
 pub use robot::RobotModel;
+pub use sensor::{CameraFrame, CameraSensor};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use world::World;

@@ -265,6 +265,13 @@ impl Simulation {
         body * self.body_from_link[index]
     }
 
+    /// Every link's world pose, in URDF order, into `out` (cleared first; no allocation once
+    /// `out` has the capacity).
+    pub fn link_poses_into(&self, out: &mut Vec<Pose>) {
+        out.clear();
+        out.extend((0..self.robot.links.len()).map(|i| self.world_from_link(i)));
+    }
+
     /// Ground-truth planar pose and velocity of the base link.
     pub fn ground_truth(&self) -> Odometry {
         let Some(body) = self.physics.bodies.get(self.base) else {

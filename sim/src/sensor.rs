@@ -1,0 +1,112 @@
+//! The camera as a sensor: renders the robot's camera at its `update_rate` on sim time.
+
+use crate::camera::CameraInfo;
+use crate::error::SimError;
+use crate::geometry::Pose;
+use crate::render::{CameraRenderer, RenderError};
+use crate::simulation::Simulation;
+
+/// One camera image.
+#[derive(Debug, Clone, Copy)]
+pub struct CameraFrame<'a> {
+    /// Sim time the image was taken (s).
+    pub sim_time_s: f64,
+    /// Sequence number, from 0.
+    pub seq: u64,
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// RGB8 pixels, rows top to bottom.
+    pub rgb: &'a [u8],
+}
+
+/// A robot camera rendering at its update rate.
+#[derive(Debug)]
+pub struct CameraSensor {
+    renderer: CameraRenderer,
+    link: usize,
+    period_s: f64,
+    next_s: f64,
+    seq: u64,
+    link_poses: Vec<Pose>,
+}
+
+impl CameraSensor {
+    /// The robot's first camera (`<sensor type="camera">`), rendered with the sim's seed.
+    pub fn new(sim: &Simulation) -> Result<Self, RenderError> {
+        let robot = sim.robot();
+        let config = robot.cameras.first().ok_or_else(|| {
+            RenderError::Scene(SimError::Setup(format!(
+                "{}: the robot has no <sensor type=\"camera\">",
+                robot.source.display()
+            )))
+        })?;
+        let link = robot.link_index(&config.link).ok_or_else(|| {
+            RenderError::Scene(SimError::Setup(format!(
+                "camera link {} missing",
+                config.link
+            )))
+        })?;
+        let renderer = CameraRenderer::new(sim.world(), robot, config, sim.seed())?;
+        Ok(Self {
+            renderer,
+            link,
+            period_s: if config.update_rate_hz > 0.0 {
+                1.0 / config.update_rate_hz
+            } else {
+                0.0
+            },
+            next_s: 0.0,
+            seq: 0,
+            link_poses: Vec::with_capacity(robot.links.len()),
+        })
+    }
+
+    /// The intrinsics.
+    pub fn info(&self) -> &CameraInfo {
+        self.renderer.info()
+    }
+
+    /// The renderer (adapter name, ...).
+    pub fn renderer(&self) -> &CameraRenderer {
+        &self.renderer
+    }
+
+    /// True when an image is due at the sim's current time.
+    pub fn due(&self, sim: &Simulation) -> bool {
+        sim.sim_time_s() + 1e-9 >= self.next_s
+    }
+
+    /// Renders an image if one is due (schedule accumulated like Gazebo's sensors).
+    pub fn capture_if_due(
+        &mut self,
+        sim: &Simulation,
+    ) -> Result<Option<CameraFrame<'_>>, RenderError> {
+        if !self.due(sim) {
+            return Ok(None);
+        }
+        self.next_s += self.period_s;
+        if self.next_s + 1e-9 < sim.sim_time_s() {
+            self.next_s = sim.sim_time_s() + self.period_s;
+        }
+        self.capture(sim).map(Some)
+    }
+
+    /// Renders an image now.
+    pub fn capture(&mut self, sim: &Simulation) -> Result<CameraFrame<'_>, RenderError> {
+        sim.link_poses_into(&mut self.link_poses);
+        let camera = self.link_poses[self.link];
+        let seq = self.seq;
+        self.seq += 1;
+        let (width, height) = (self.renderer.info().width, self.renderer.info().height);
+        let rgb = self.renderer.render(&self.link_poses, camera)?;
+        Ok(CameraFrame {
+            sim_time_s: sim.sim_time_s(),
+            seq,
+            width,
+            height,
+            rgb,
+        })
+    }
+}
