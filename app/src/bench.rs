@@ -171,3 +171,42 @@ fn onnxruntime_median(
     let _ = std::fs::remove_dir_all(&dir);
     result
 }
+
+/// Result of the camera benchmark.
+#[derive(Debug, Clone)]
+pub struct CameraBench {
+    /// Graphics adapter used.
+    pub adapter: String,
+    /// Image size (px).
+    pub size: (u32, u32),
+    /// Median render + readback (ms).
+    pub median_ms: f64,
+    /// Fastest frame (ms).
+    pub best_ms: f64,
+}
+
+/// Renders `frames` camera images of the world from the robot's camera while it drives a
+/// circle (render + readback + post-processing per frame, after one warm-up).
+pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
+    let (world, robot) = headless::load(config)?;
+    let mut sim = Simulation::new(world, robot, &config.options)?;
+    let mut sensor = rover_sim::CameraSensor::new(&sim)?;
+    sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
+    sensor.capture(&sim)?;
+    let mut times = Vec::with_capacity(frames);
+    for _ in 0..frames.max(1) {
+        for _ in 0..5 {
+            sim.step();
+        }
+        let start = Instant::now();
+        sensor.capture(&sim)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok(CameraBench {
+        adapter: sensor.renderer().adapter().to_owned(),
+        size: (sensor.info().width, sensor.info().height),
+        median_ms: median(&mut times),
+        best_ms,
+    })
+}

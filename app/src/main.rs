@@ -167,6 +167,15 @@ impl DetectorArgs {
 
 #[derive(Debug, Subcommand)]
 enum BenchKind {
+    /// Camera: ms per image (render + readback) on this machine's GPU or software Vulkan
+    Camera {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Frames to time (after one warm-up)
+        #[arg(long, default_value_t = 60)]
+        frames: usize,
+    },
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]
@@ -313,6 +322,21 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
     Ok(())
 }
 
+fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
+    let config = RunConfig {
+        world: world.world.clone(),
+        robot: world.robot.clone(),
+        options: options(&world, None),
+        ..RunConfig::default()
+    };
+    let b = bench::camera(&config, frames)?;
+    println!(
+        "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",
+        b.size.0, b.size.1, b.adapter, b.median_ms, b.best_ms
+    );
+    Ok(())
+}
+
 fn bench_detect(config: DetectorConfig, image: Option<PathBuf>, runs: usize) -> Result<()> {
     let image = match image {
         Some(path) => path,
@@ -385,6 +409,10 @@ fn main() -> ExitCode {
         }) => detector
             .config()
             .and_then(|config| bench_detect(config, image, runs)),
+        Some(Command::Bench {
+            kind: Some(BenchKind::Camera { world, frames }),
+            ..
+        }) => bench_camera(world, frames),
         Some(Command::Bench {
             kind: None,
             world,

@@ -199,3 +199,42 @@ fn detect_prints_boxes_json_and_draws_them() -> Result<()> {
     );
     Ok(())
 }
+
+#[test]
+fn save_frames_writes_the_camera_images() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let frames = dir.path().join("frames");
+    let frames_arg = frames.display().to_string();
+    // 0.5 s at 30 Hz = 15 images; every 5th is written: 0, 5, 10.
+    let out = rover(
+        &[
+            "--headless",
+            "--duration",
+            "0.5",
+            "--save-frames",
+            &frames_arg,
+            "--frame-every",
+            "5",
+        ],
+        dir.path(),
+    )?;
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(&frames)?
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_000000.png", "frame_000005.png", "frame_000010.png"]
+    );
+    let image = image::open(frames.join("frame_000000.png"))?.into_rgb8();
+    assert_eq!(image.dimensions(), (640, 480));
+    // Sky above, ground below: the image is not blank.
+    let sky = image.get_pixel(320, 10);
+    let ground = image.get_pixel(320, 470);
+    assert!(
+        sky[2] > sky[0] && sky != ground,
+        "sky {sky:?} ground {ground:?}"
+    );
+    Ok(())
+}

@@ -185,82 +185,88 @@ pub struct Part {
     pub color: Rgba,
 }
 
-/// A standing person in its own frame: feet on z = 0, facing +x, proportioned to `height_m`.
+/// A standing person in its own frame: feet on z = 0, facing +x, proportioned to `height_m`
+/// (a head about 1/7.5 of the height, shoulders about a quarter of it wide).
 pub fn person_parts(person: &Person) -> Vec<Part> {
     let s = (person.height_m / 1.75) as f32;
     let at = |x: f32, y: f32, z: f32| Pose::from_translation(Vec3::new(x, y, z) * s);
     let tilt = |x: f32, y: f32, z: f32, roll: f32| {
         Pose::from_parts(Vec3::new(x, y, z) * s, Quat::from_rotation_x(roll))
     };
-    let shoe = Rgba::rgb(0.12, 0.1, 0.09);
+    let shoe = Rgba::rgb(0.1, 0.08, 0.07);
     let mut parts = Vec::new();
     let mut add = |mesh: MeshData, pose: Pose, color: Rgba| parts.push(Part { mesh, pose, color });
     for side in [-1.0f32, 1.0] {
-        let y = 0.1 * side;
+        let y = 0.095 * side;
         add(
-            cuboid(Vec3::new(0.27, 0.11, 0.08) * s),
+            ellipsoid(0.1 * s, Vec3::new(1.3, 0.5, 0.45), 8, 12),
             at(0.04, y, 0.04),
             shoe,
         );
-        // Legs: thigh and shin, slightly apart at the feet.
+        // Shin and thigh, a little thicker towards the hip.
         add(
-            capsule(0.07 * s, 0.36 * s),
+            capsule(0.058 * s, 0.38 * s),
             at(0.0, y, 0.3),
             person.trousers_color,
         );
         add(
-            capsule(0.08 * s, 0.34 * s),
-            at(0.0, y * 0.95, 0.68),
+            capsule(0.075 * s, 0.33 * s),
+            at(0.0, y * 0.95, 0.7),
             person.trousers_color,
         );
-        // Arms hang a little away from the body: upper arm in the sleeve, forearm skin.
-        let ay = 0.255 * side;
+        // Arms hang close to the body: short sleeve, bare forearm, hand.
+        let ay = 0.225 * side;
         add(
-            capsule(0.052 * s, 0.24 * s),
-            tilt(0.0, ay, 1.28, -0.08 * side),
+            capsule(0.048 * s, 0.2 * s),
+            tilt(0.0, ay, 1.3, -0.12 * side),
             person.shirt_color,
         );
         add(
-            capsule(0.045 * s, 0.22 * s),
-            tilt(0.02, ay + 0.025 * side, 0.98, -0.1 * side),
+            capsule(0.036 * s, 0.24 * s),
+            tilt(0.015, ay + 0.035 * side, 1.02, -0.06 * side),
             person.skin_color,
         );
         add(
-            ellipsoid(0.05 * s, Vec3::new(0.8, 0.6, 1.3), 8, 12),
-            at(0.03, ay + 0.04 * side, 0.8),
+            ellipsoid(0.045 * s, Vec3::new(0.7, 0.55, 1.3), 8, 12),
+            at(0.02, ay + 0.045 * side, 0.83),
             person.skin_color,
         );
     }
-    // Pelvis and torso (a rounded box: an ellipsoid-ish chest over a box).
+    // Hips, then a torso that narrows from the shoulders to the waist.
     add(
-        cuboid(Vec3::new(0.22, 0.36, 0.16) * s),
-        at(0.0, 0.0, 0.9),
+        ellipsoid(0.2 * s, Vec3::new(0.5, 0.85, 0.5), 10, 16),
+        at(0.0, 0.0, 0.93),
         person.trousers_color,
     );
     add(
-        cuboid(Vec3::new(0.22, 0.38, 0.42) * s),
-        at(0.0, 0.0, 1.17),
+        ellipsoid(0.2 * s, Vec3::new(0.6, 0.92, 1.25), 12, 18),
+        at(0.0, 0.0, 1.2),
         person.shirt_color,
     );
     add(
-        ellipsoid(0.2 * s, Vec3::new(0.6, 1.12, 0.45), 10, 16),
+        ellipsoid(0.2 * s, Vec3::new(0.58, 1.1, 0.5), 10, 18),
         at(0.0, 0.0, 1.38),
         person.shirt_color,
     );
     add(
-        cylinder(0.05 * s, 0.12 * s, 12),
+        cylinder(0.045 * s, 0.12 * s, 12),
         at(0.0, 0.0, 1.5),
         person.skin_color,
     );
-    // Head: face skin, hair over the back and top.
+    // Head: the face in skin, hair over the top and back.
     add(
-        ellipsoid(0.105 * s, Vec3::new(0.95, 0.85, 1.1), 12, 18),
-        at(0.0, 0.0, 1.64),
+        ellipsoid(0.1 * s, Vec3::new(0.95, 0.82, 1.15), 12, 18),
+        at(0.005, 0.0, 1.635),
         person.skin_color,
     );
     add(
-        ellipsoid(0.11 * s, Vec3::new(0.95, 0.9, 0.9), 10, 16),
-        at(-0.025, 0.0, 1.675),
+        ellipsoid(0.104 * s, Vec3::new(0.98, 0.88, 0.7), 10, 16),
+        at(-0.006, 0.0, 1.7),
+        person.hair_color,
+    );
+    add(
+        ellipsoid(0.09 * s, Vec3::new(0.7, 0.9, 1.0), 8, 12),
+        at(-0.045, 0.0, 1.62),
         person.hair_color,
     );
     parts
