@@ -256,10 +256,22 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
     // Eyes, brows and mouth on the face (the face's front is at x ~ 0.1).
     let dark = Rgba::rgb(0.08, 0.06, 0.05);
     for side in [-1.0f32, 1.0] {
-        add(ellipsoid(0.012 * s, Vec3::new(0.6, 1.2, 0.8), 6, 8), at(0.093, 0.032 * side, 1.655), dark);
-        add(ellipsoid(0.016 * s, Vec3::new(0.4, 1.6, 0.35), 6, 8), at(0.092, 0.034 * side, 1.682), person.hair_color);
+        add(
+            ellipsoid(0.012 * s, Vec3::new(0.6, 1.2, 0.8), 6, 8),
+            at(0.093, 0.032 * side, 1.655),
+            dark,
+        );
+        add(
+            ellipsoid(0.016 * s, Vec3::new(0.4, 1.6, 0.35), 6, 8),
+            at(0.092, 0.034 * side, 1.682),
+            person.hair_color,
+        );
     }
-    add(ellipsoid(0.018 * s, Vec3::new(0.4, 1.5, 0.35), 6, 8), at(0.09, 0.0, 1.585), Rgba::rgb(0.55, 0.25, 0.22));
+    add(
+        ellipsoid(0.018 * s, Vec3::new(0.4, 1.5, 0.35), 6, 8),
+        at(0.09, 0.0, 1.585),
+        Rgba::rgb(0.55, 0.25, 0.22),
+    );
     // Head: the face in skin, hair over the top and back.
     add(
         ellipsoid(0.1 * s, Vec3::new(0.95, 0.82, 1.15), 12, 18),
