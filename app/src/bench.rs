@@ -137,38 +137,18 @@ fn onnxruntime_median(
     view: rover_perception::RgbView<'_>,
     runs: usize,
 ) -> Result<f64, String> {
-    let dir = std::env::temp_dir().join(format!("rover-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let model = dir.join("model.onnx");
-    let input_path = dir.join("input.f32");
-    let output_path = dir.join("output.f32");
+    let model = std::env::temp_dir().join(format!("rover-bench-{}.onnx", std::process::id()));
     let (w, h) = detector.input_size();
-    let result = (|| {
-        detector.export_onnx(&model).map_err(|e| e.to_string())?;
-        let (input, _) = detector.preprocess(view).map_err(|e| e.to_string())?;
-        let bytes: Vec<u8> = input.iter().flat_map(|v| v.to_le_bytes()).collect();
-        std::fs::write(&input_path, bytes).map_err(|e| e.to_string())?;
-        let script = crate::paths::bundled("scripts/ort_reference.py");
-        let out = std::process::Command::new("python3")
-            .arg(&script)
-            .arg(&model)
-            .arg(&input_path)
-            .arg(format!("1,3,{h},{w}"))
-            .arg(&output_path)
-            .args(["--threads", "1", "--runs", &(runs.max(1) + 1).to_string()])
-            .output()
-            .map_err(|e| format!("cannot run python3: {e}"))?;
-        if !out.status.success() {
-            return Err(String::from_utf8_lossy(&out.stderr).trim().to_owned());
-        }
-        let text = String::from_utf8_lossy(&out.stdout).into_owned();
-        text.split("\"median_ms\": ")
-            .nth(1)
-            .and_then(|s| s.split([',', '}']).next())
-            .and_then(|s| s.trim().parse::<f64>().ok())
-            .ok_or_else(|| format!("unexpected output from {}: {text}", script.display()))
-    })();
-    let _ = std::fs::remove_dir_all(&dir);
+    let result = detector
+        .export_onnx(&model)
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            let (input, _) = detector.preprocess(view).map_err(|e| e.to_string())?;
+            crate::reference::onnxruntime(&model, input, &[1, 3, h, w], 1, runs.max(1) + 1)
+                .map(|r| r.median_ms)
+                .map_err(|e| format!("{e:#}"))
+        });
+    let _ = std::fs::remove_file(&model);
     result
 }
 

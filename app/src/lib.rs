@@ -8,6 +8,7 @@ pub mod detect;
 pub mod headless;
 pub mod paths;
 pub mod pilot;
+pub mod reference;
 pub mod script;
 pub mod teleop;
 pub mod trace;

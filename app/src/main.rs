@@ -236,11 +236,19 @@ enum Command {
     },
 }
 
-fn options(w: &WorldArgs, cmd_timeout_s: Option<f64>) -> SimOptions {
-    SimOptions {
-        seed: w.seed,
-        cmd_timeout_s,
-        step_hz: w.physics_hz,
+impl WorldArgs {
+    /// A run of this world and robot; the rest at its defaults.
+    fn run_config(&self, cmd_timeout_s: Option<f64>) -> RunConfig {
+        RunConfig {
+            world: self.world.clone(),
+            robot: self.robot.clone(),
+            options: SimOptions {
+                seed: self.seed,
+                cmd_timeout_s,
+                step_hz: self.physics_hz,
+            },
+            ..RunConfig::default()
+        }
     }
 }
 
@@ -251,15 +259,13 @@ fn run(args: RunArgs) -> Result<()> {
         );
     }
     let config = RunConfig {
-        world: args.world.world.clone(),
-        robot: args.world.robot.clone(),
         script: args.script,
         duration_s: args.duration,
         trace: args.trace.clone(),
-        options: options(&args.world, args.cmd_timeout),
         progress_every: Some(Duration::from_secs(5)),
         save_frames: args.save_frames,
         frame_every: args.frame_every,
+        ..args.world.run_config(args.cmd_timeout)
     };
     let summary = headless::run(&config)?;
     println!(
@@ -296,12 +302,7 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
         sim_seconds.is_finite() && sim_seconds > 0.0,
         "--sim-seconds must be positive, found {sim_seconds}"
     );
-    let config = RunConfig {
-        world: world.world.clone(),
-        robot: world.robot.clone(),
-        options: options(&world, None),
-        ..RunConfig::default()
-    };
+    let config = world.run_config(None);
     let mut plan: Vec<Option<f64>> = vec![world.physics_hz];
     plan.extend(rates.into_iter().map(Some));
     println!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
@@ -323,12 +324,7 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
 }
 
 fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
-    let config = RunConfig {
-        world: world.world.clone(),
-        robot: world.robot.clone(),
-        options: options(&world, None),
-        ..RunConfig::default()
-    };
+    let config = world.run_config(None);
     let b = bench::camera(&config, frames)?;
     println!(
         "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",

@@ -53,7 +53,7 @@ impl Default for DetectorConfig {
             threshold: DEFAULT_THRESHOLD,
             nms_iou: DEFAULT_NMS_IOU,
             max_boxes: 100,
-            frame_id: "camera_optical_frame".to_owned(),
+            frame_id: "camera_link_optical".to_owned(),
         }
     }
 }

@@ -71,13 +71,11 @@ pub(crate) fn prepare(path: &Path, requested: Option<(usize, usize)>) -> Result<
         .graph
         .as_mut()
         .ok_or_else(|| PerceptionError::model(path, "the ONNX file has no graph"))?;
-    let initializers_owned: HashSet<String> =
-        graph.initializer.iter().map(|t| t.name.clone()).collect();
-    let initializers: HashSet<&str> = initializers_owned.iter().map(String::as_str).collect();
+    let initializers: HashSet<String> = graph.initializer.iter().map(|t| t.name.clone()).collect();
     let inputs: Vec<&ValueInfoProto> = graph
         .input
         .iter()
-        .filter(|i| !initializers.contains(i.name.as_str()))
+        .filter(|i| !initializers.contains(&i.name))
         .collect();
     let [input] = inputs.as_slice() else {
         return Err(PerceptionError::model(
@@ -139,7 +137,7 @@ pub(crate) fn prepare(path: &Path, requested: Option<(usize, usize)>) -> Result<
             )
         })?;
     }
-    set_input_size(graph, &initializers_owned, input_size);
+    set_input_size(graph, &initializers, input_size);
     Ok(Prepared {
         proto,
         head,

@@ -2,9 +2,10 @@
 //! and decoding.
 
 use anyhow::Result;
+use rover::reference::onnxruntime;
 use rover_perception::preprocess::load_rgb;
 use rover_perception::{Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView};
-use rover_tests::{ort_reference, photo};
+use rover_tests::photo;
 
 const CASES: [(&str, &[&str]); 3] = [
     ("astronaut", &["person"]),
@@ -39,7 +40,7 @@ fn default_model_finds_the_expected_objects_like_onnxruntime() -> Result<()> {
         // onnxruntime on exactly the graph, input tensor and decoder rover uses.
         let (input, letterbox) = detector.preprocess(view)?;
         let input = input.to_vec();
-        let reference = ort_reference(&model, &input, &[1, 3, h, w], dir.path(), 1, 1)?;
+        let reference = onnxruntime(&model, &input, &[1, 3, h, w], 1, 1)?;
         let theirs = detector.decode_raw(&reference.output, &reference.shape, letterbox, stamp)?;
         assert!(
             !theirs.bounding_boxes.is_empty(),

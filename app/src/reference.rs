@@ -1,0 +1,102 @@
+//! onnxruntime as the reference runtime (Python, `scripts/ort_reference.py`): the detector tests
+//! and `rover bench detect` run it on exactly the graph and input tensor rover uses.
+
+use std::path::Path;
+use std::process::Command;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anyhow::{Context, Result, bail};
+
+/// What onnxruntime produced.
+#[derive(Debug, Clone)]
+pub struct OrtRun {
+    /// The first output, raw.
+    pub output: Vec<f32>,
+    /// Its shape.
+    pub shape: Vec<usize>,
+    /// Median latency over the runs (ms).
+    pub median_ms: f64,
+    /// onnxruntime's version.
+    pub version: String,
+}
+
+/// Runs `model` on `input` (`shape`, f32) with onnxruntime, `threads` intra-op threads,
+/// `runs` times. Needs `python3` with `onnxruntime` and `numpy`.
+pub fn onnxruntime(
+    model: &Path,
+    input: &[f32],
+    shape: &[usize],
+    threads: usize,
+    runs: usize,
+) -> Result<OrtRun> {
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "rover-ort-{}-{}",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let result = run_in(&dir, model, input, shape, threads, runs);
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
+fn run_in(
+    dir: &Path,
+    model: &Path,
+    input: &[f32],
+    shape: &[usize],
+    threads: usize,
+    runs: usize,
+) -> Result<OrtRun> {
+    let input_path = dir.join("input.f32");
+    let output_path = dir.join("output.f32");
+    let bytes: Vec<u8> = input.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(&input_path, bytes)?;
+    let script = crate::paths::bundled("scripts/ort_reference.py");
+    let shape_arg = shape
+        .iter()
+        .map(usize::to_string)
+        .collect::<Vec<_>>()
+        .join(",");
+    let out = Command::new("python3")
+        .arg(&script)
+        .arg(model)
+        .arg(&input_path)
+        .arg(shape_arg)
+        .arg(&output_path)
+        .args([
+            "--threads",
+            &threads.to_string(),
+            "--runs",
+            &runs.max(1).to_string(),
+        ])
+        .output()
+        .context("cannot run python3")?;
+    if !out.status.success() {
+        bail!(
+            "onnxruntime reference failed (pip install onnxruntime numpy): {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .with_context(|| format!("unexpected output from {}", script.display()))?;
+    let shape = report["shape"]
+        .as_array()
+        .map(|dims| {
+            dims.iter()
+                .filter_map(|d| d.as_u64().map(|d| d as usize))
+                .collect()
+        })
+        .unwrap_or_default();
+    let raw = std::fs::read(&output_path)?;
+    Ok(OrtRun {
+        output: raw
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+        shape,
+        median_ms: report["median_ms"].as_f64().unwrap_or(f64::NAN),
+        version: report["onnxruntime"].as_str().unwrap_or("?").to_owned(),
+    })
+}
