@@ -1,5 +1,7 @@
 //! Helpers for rover's end-to-end tests (the tests themselves are in `tests/`).
 
+pub mod sweep;
+
 use std::path::{Path, PathBuf};
 
 use rover_sim::{ControlSample, RobotModel, SimOptions, Simulation, Twist, World};

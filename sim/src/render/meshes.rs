@@ -185,74 +185,204 @@ pub struct Part {
     pub color: Rgba,
 }
 
+/// One cross-section of a [`loft`]: at height `z`, a rounded rectangle with half sizes
+/// `half_x` (front-back) and `half_y` (side to side), centred at (`x`, `y`).
+#[derive(Debug, Clone, Copy)]
+pub struct Section {
+    /// Height (m).
+    pub z: f32,
+    /// Centre, front-back (m).
+    pub x: f32,
+    /// Centre, side to side (m).
+    pub y: f32,
+    /// Half depth (m).
+    pub half_x: f32,
+    /// Half width (m).
+    pub half_y: f32,
+}
+
+impl Section {
+    /// A section centred on the axis.
+    pub const fn new(z: f32, half_x: f32, half_y: f32) -> Self {
+        Self {
+            z,
+            x: 0.0,
+            y: 0.0,
+            half_x,
+            half_y,
+        }
+    }
+
+    /// The same section moved by (`x`, `y`).
+    pub const fn at(self, x: f32, y: f32) -> Self {
+        Self { x, y, ..self }
+    }
+}
+
+/// A smooth closed body through `sections` (bottom to top): each section is a superellipse
+/// with exponent `squareness` (2 = ellipse, larger = boxier); the ends are capped. Normals are
+/// averaged over the faces around each vertex, so the surface shades smoothly.
+pub fn loft(sections: &[Section], squareness: f32, segments: u32) -> MeshData {
+    let mut m = MeshData::default();
+    if sections.len() < 2 {
+        return m;
+    }
+    let e = 2.0 / squareness.max(0.1);
+    let ring_point = |s: &Section, i: u32| {
+        let a = i as f32 / segments as f32 * std::f32::consts::TAU;
+        let (c, sn) = (a.cos(), a.sin());
+        let sx = c.signum() * c.abs().powf(e);
+        let sy = sn.signum() * sn.abs().powf(e);
+        Vec3::new(s.x + sx * s.half_x, s.y + sy * s.half_y, s.z)
+    };
+    let mut positions = Vec::new();
+    for s in sections {
+        for i in 0..segments {
+            positions.push(ring_point(s, i));
+        }
+    }
+    let first = sections[0];
+    let last = sections[sections.len() - 1];
+    let bottom = positions.len() as u32;
+    positions.push(Vec3::new(first.x, first.y, first.z));
+    let top = bottom + 1;
+    positions.push(Vec3::new(last.x, last.y, last.z));
+    let mut tris = Vec::new();
+    for r in 0..sections.len() as u32 - 1 {
+        for i in 0..segments {
+            let j = (i + 1) % segments;
+            let (a, b) = (r * segments + i, r * segments + j);
+            let (c, d) = (a + segments, b + segments);
+            tris.push([a, b, d]);
+            tris.push([a, d, c]);
+        }
+    }
+    let top_ring = (sections.len() as u32 - 1) * segments;
+    for i in 0..segments {
+        let j = (i + 1) % segments;
+        tris.push([bottom, j, i]);
+        tris.push([top, top_ring + i, top_ring + j]);
+    }
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in &tris {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for i in t {
+            normals[*i as usize] += n;
+        }
+    }
+    // The caps get their own flat-ish normals so the ring edge stays rounded.
+    normals[bottom as usize] = Vec3::NEG_Z;
+    normals[top as usize] = Vec3::Z;
+    for (p, n) in positions.iter().zip(&normals) {
+        m.push(*p, *n);
+    }
+    for t in tris {
+        m.indices.extend_from_slice(&t);
+    }
+    m
+}
+
+/// A limb from `from` to `to` (figure frame): a loft with radius `r_from` at `from` and `r_to`
+/// at `to`, rounded ends.
+fn limb(from: Vec3, to: Vec3, r_from: f32, r_to: f32) -> (MeshData, Pose) {
+    let axis = to - from;
+    let len = axis.length().max(1e-4);
+    let mut sections = Vec::new();
+    // Rounded ends: a few shrinking rings beyond each end.
+    for k in [0.0f32, 0.5, 0.8, 1.0] {
+        let r = r_from * (1.0 - k * k).sqrt().max(0.05);
+        sections.push(Section::new(-r_from * k, r, r));
+    }
+    sections.reverse();
+    for t in [0.25f32, 0.5, 0.75] {
+        let r = r_from + (r_to - r_from) * t;
+        sections.push(Section::new(len * t, r, r));
+    }
+    for k in [0.0f32, 0.5, 0.8, 1.0] {
+        let r = r_to * (1.0 - k * k).sqrt().max(0.05);
+        sections.push(Section::new(len + r_to * k, r, r));
+    }
+    let rotation = Quat::from_rotation_arc(Vec3::Z, axis / len);
+    (loft(&sections, 2.0, 14), Pose::from_parts(from, rotation))
+}
+
 /// A standing person in its own frame: feet on z = 0, facing +x, proportioned to `height_m`
 /// (a head about 1/7.5 of the height, shoulders about a quarter of it wide).
 pub fn person_parts(person: &Person) -> Vec<Part> {
     let s = (person.height_m / 1.75) as f32;
-    let at = |x: f32, y: f32, z: f32| Pose::from_translation(Vec3::new(x, y, z) * s);
-    let tilt = |x: f32, y: f32, z: f32, roll: f32| {
-        Pose::from_parts(Vec3::new(x, y, z) * s, Quat::from_rotation_x(roll))
+    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * s;
+    let at = |x: f32, y: f32, z: f32| Pose::from_translation(v(x, y, z));
+    let scaled = |sections: &[Section]| -> Vec<Section> {
+        sections
+            .iter()
+            .map(|c| Section {
+                z: c.z * s,
+                x: c.x * s,
+                y: c.y * s,
+                half_x: c.half_x * s,
+                half_y: c.half_y * s,
+            })
+            .collect()
     };
     let shoe = Rgba::rgb(0.1, 0.08, 0.07);
     let mut parts = Vec::new();
     let mut add = |mesh: MeshData, pose: Pose, color: Rgba| parts.push(Part { mesh, pose, color });
     for side in [-1.0f32, 1.0] {
-        let y = 0.095 * side;
+        let y = 0.09 * side;
         add(
-            ellipsoid(0.1 * s, Vec3::new(1.3, 0.5, 0.45), 8, 12),
-            at(0.04, y, 0.04),
+            ellipsoid(0.1 * s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
+            at(0.035, y, 0.045),
             shoe,
         );
-        // Shin and thigh, a little thicker towards the hip.
+        // Leg: ankle, calf, knee, thigh, hip.
+        let leg = scaled(&[
+            Section::new(0.06, 0.045, 0.042).at(0.0, y),
+            Section::new(0.2, 0.05, 0.045).at(0.0, y),
+            Section::new(0.36, 0.06, 0.055).at(0.0, y),
+            Section::new(0.5, 0.052, 0.05).at(0.0, y),
+            Section::new(0.7, 0.07, 0.068).at(0.0, y * 0.97),
+            Section::new(0.86, 0.08, 0.08).at(0.0, y * 0.9),
+            Section::new(0.9, 0.07, 0.07).at(0.0, y * 0.85),
+        ]);
+        add(loft(&leg, 2.0, 16), Pose::IDENTITY, person.trousers_color);
+        // Arm: shoulder, elbow, wrist hanging just off the body.
+        let shoulder = v(0.0, 0.185 * side, 1.42);
+        let elbow = v(-0.03, 0.225 * side, 1.14);
+        let wrist = v(0.07, 0.24 * side, 0.9);
+        let (mesh, pose) = limb(shoulder, elbow, 0.052 * s, 0.042 * s);
+        add(mesh, pose, person.shirt_color);
+        let (mesh, pose) = limb(elbow, wrist, 0.036 * s, 0.027 * s);
+        add(mesh, pose, person.skin_color);
         add(
-            capsule(0.058 * s, 0.38 * s),
-            at(0.0, y, 0.3),
-            person.trousers_color,
-        );
-        add(
-            capsule(0.075 * s, 0.33 * s),
-            at(0.0, y * 0.95, 0.7),
-            person.trousers_color,
-        );
-        // Arms hang close to the body: short sleeve, bare forearm, hand.
-        let ay = 0.225 * side;
-        add(
-            capsule(0.048 * s, 0.2 * s),
-            tilt(0.0, ay, 1.3, -0.12 * side),
-            person.shirt_color,
-        );
-        add(
-            capsule(0.036 * s, 0.24 * s),
-            tilt(0.015, ay + 0.035 * side, 1.02, -0.06 * side),
-            person.skin_color,
-        );
-        add(
-            ellipsoid(0.045 * s, Vec3::new(0.7, 0.55, 1.3), 8, 12),
-            at(0.02, ay + 0.045 * side, 0.83),
+            ellipsoid(0.045 * s, Vec3::new(0.65, 0.5, 1.3), 8, 12),
+            Pose::from_parts(v(0.09, 0.243 * side, 0.84), Quat::from_rotation_y(-0.35)),
             person.skin_color,
         );
     }
-    // Hips, then a torso that narrows from the shoulders to the waist.
-    add(
-        ellipsoid(0.2 * s, Vec3::new(0.5, 0.85, 0.5), 10, 16),
-        at(0.0, 0.0, 0.93),
-        person.trousers_color,
-    );
-    add(
-        ellipsoid(0.2 * s, Vec3::new(0.6, 0.92, 1.25), 12, 18),
-        at(0.0, 0.0, 1.2),
-        person.shirt_color,
-    );
-    add(
-        ellipsoid(0.2 * s, Vec3::new(0.58, 1.1, 0.5), 10, 18),
-        at(0.0, 0.0, 1.38),
-        person.shirt_color,
-    );
-    add(
-        cylinder(0.045 * s, 0.12 * s, 12),
-        at(0.0, 0.0, 1.5),
-        person.skin_color,
-    );
+    // Pelvis in trousers, torso in the shirt: shoulders broad, waist narrower.
+    let pelvis = scaled(&[
+        Section::new(0.8, 0.06, 0.1),
+        Section::new(0.86, 0.1, 0.165),
+        Section::new(0.95, 0.11, 0.175),
+        Section::new(1.03, 0.105, 0.165),
+    ]);
+    add(loft(&pelvis, 2.6, 24), Pose::IDENTITY, person.trousers_color);
+    let torso = scaled(&[
+        Section::new(0.98, 0.1, 0.16),
+        Section::new(1.1, 0.1, 0.155),
+        Section::new(1.22, 0.11, 0.165),
+        Section::new(1.33, 0.115, 0.18),
+        Section::new(1.41, 0.1, 0.19),
+        Section::new(1.46, 0.07, 0.14),
+        Section::new(1.48, 0.04, 0.06),
+    ]);
+    add(loft(&torso, 2.6, 24), Pose::IDENTITY, person.shirt_color);
+    let neck = scaled(&[
+        Section::new(1.42, 0.048, 0.048),
+        Section::new(1.58, 0.045, 0.045),
+    ]);
+    add(loft(&neck, 2.0, 12), at(-0.01, 0.0, 0.0), person.skin_color);
     // Eyes, brows and mouth on the face (the face's front is at x ~ 0.1).
     let dark = Rgba::rgb(0.08, 0.06, 0.05);
     for side in [-1.0f32, 1.0] {
@@ -266,25 +396,37 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
             at(0.092, 0.034 * side, 1.682),
             person.hair_color,
         );
+        // Ears.
+        add(
+            ellipsoid(0.03 * s, Vec3::new(0.6, 0.35, 1.0), 6, 8),
+            at(0.0, 0.08 * side, 1.64),
+            person.skin_color,
+        );
     }
     add(
         ellipsoid(0.018 * s, Vec3::new(0.4, 1.5, 0.35), 6, 8),
         at(0.09, 0.0, 1.585),
         Rgba::rgb(0.55, 0.25, 0.22),
     );
+    // Nose.
+    add(
+        ellipsoid(0.016 * s, Vec3::new(0.9, 0.8, 1.3), 6, 8),
+        at(0.1, 0.0, 1.625),
+        person.skin_color,
+    );
     // Head: the face in skin, hair over the top and back.
     add(
-        ellipsoid(0.1 * s, Vec3::new(0.95, 0.82, 1.15), 12, 18),
+        ellipsoid(0.1 * s, Vec3::new(0.95, 0.8, 1.15), 12, 18),
         at(0.005, 0.0, 1.635),
         person.skin_color,
     );
     add(
-        ellipsoid(0.104 * s, Vec3::new(0.98, 0.88, 0.7), 10, 16),
+        ellipsoid(0.104 * s, Vec3::new(0.98, 0.86, 0.7), 10, 16),
         at(-0.006, 0.0, 1.7),
         person.hair_color,
     );
     add(
-        ellipsoid(0.09 * s, Vec3::new(0.7, 0.9, 1.0), 8, 12),
+        ellipsoid(0.09 * s, Vec3::new(0.7, 0.88, 1.0), 8, 12),
         at(-0.045, 0.0, 1.62),
         person.hair_color,
     );
