@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod detect;
+pub mod follower;
 pub mod headless;
 pub mod paths;
 pub mod pilot;

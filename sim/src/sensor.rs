@@ -100,6 +100,12 @@ impl CameraSensor {
         let seq = self.seq;
         self.seq += 1;
         let (width, height) = (self.renderer.info().width, self.renderer.info().height);
+        for (index, person) in sim.world().people.iter().enumerate() {
+            if person.walk.is_some() {
+                self.renderer
+                    .set_person_pose(index, sim.world_from_person(index));
+            }
+        }
         let rgb = self.renderer.render(&self.link_poses, camera)?;
         Ok(CameraFrame {
             sim_time_s: sim.sim_time_s(),

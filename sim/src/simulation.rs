@@ -71,6 +71,8 @@ pub struct Simulation {
     step_index: u64,
     dt_s: f64,
     seed: u64,
+    /// Kinematic bodies of the people, in world order.
+    people: Vec<RigidBodyHandle>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -114,7 +116,7 @@ impl Simulation {
         physics.integration_parameters.dt = dt_s as f32;
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
 
-        add_world(&mut physics, &world);
+        let people = add_world(&mut physics, &world);
         let robot_bodies = add_robot(&mut physics, &world, &robot)?;
 
         let wheel = |name: &str| -> Result<WheelJoint> {
@@ -168,6 +170,7 @@ impl Simulation {
             step_index: 0,
             dt_s,
             seed: options.seed,
+            people,
             robot,
             world,
         })
@@ -196,6 +199,16 @@ impl Simulation {
         } else {
             None
         };
+        // Walking people: their kinematic bodies move to where their path puts them at the end
+        // of this step (rapier derives their velocity, so contacts push correctly).
+        let next_t = (self.step_index + 1) as f64 * self.dt_s;
+        for (person, handle) in self.world.people.iter().zip(&self.people) {
+            if person.walk.is_some()
+                && let Some(body) = self.physics.bodies.get_mut(*handle)
+            {
+                body.set_next_kinematic_position(person_body_pose(person, next_t));
+            }
+        }
         self.physics.step();
         self.step_index += 1;
         let measured = self.wheel_speeds_radps();
@@ -212,6 +225,17 @@ impl Simulation {
             wheel_targets_radps: self.drive.wheel_targets_radps(),
             wheel_measured_radps: self.wheel_speeds_radps(),
         }
+    }
+
+    /// Pose of person `index` (world order) now: feet on the ground, x facing where they look.
+    pub fn world_from_person(&self, index: usize) -> Pose {
+        self.world.people.get(index).map_or(Pose::IDENTITY, |p| {
+            let (x, y, heading) = p.pose_at(self.sim_time_s());
+            Pose::from_parts(
+                Vec3::new(x as f32, y as f32, 0.0),
+                Quat::from_rotation_z(heading as f32),
+            )
+        })
     }
 
     /// Sim time (s): physics steps taken times the step length.
@@ -333,7 +357,17 @@ fn world_groups() -> InteractionGroups {
     InteractionGroups::new(WORLD_GROUP, Group::ALL, InteractionTestMode::And)
 }
 
-fn add_world(physics: &mut PhysicsWorld, world: &World) {
+/// The pose of a person's physics capsule at sim time `t_s` (its centre at half height).
+fn person_body_pose(person: &crate::world::Person, t_s: f64) -> Pose {
+    let (x, y, heading) = person.pose_at(t_s);
+    Pose::from_parts(
+        Vec3::new(x as f32, y as f32, person.height_m as f32 / 2.0),
+        Quat::from_rotation_z(heading as f32),
+    )
+}
+
+/// Adds the ground, objects, walls and people; returns the people's bodies.
+fn add_world(physics: &mut PhysicsWorld, world: &World) -> Vec<RigidBodyHandle> {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
     let [sx, sy] = world.ground.size_m;
@@ -379,25 +413,21 @@ fn add_world(physics: &mut PhysicsWorld, world: &World) {
             Some(body),
         );
     }
+    let mut people = Vec::with_capacity(world.people.len());
     for person in &world.people {
         let radius = person.body_radius_m() as f32;
         let height = person.height_m as f32;
         let half_segment = (height / 2.0 - radius).max(0.0);
-        let body = physics.insert_body(RigidBodyBuilder::kinematic_position_based().pose(
-            Pose::from_parts(
-                Vec3::new(
-                    person.position_m[0] as f32,
-                    person.position_m[1] as f32,
-                    height / 2.0,
-                ),
-                Quat::from_rotation_z(person.heading_rad as f32),
-            ),
-        ));
+        let body = physics.insert_body(
+            RigidBodyBuilder::kinematic_position_based().pose(person_body_pose(person, 0.0)),
+        );
         physics.insert_collider(
             ColliderBuilder::capsule_z(half_segment, radius).collision_groups(world_groups()),
             Some(body),
         );
+        people.push(body);
     }
+    people
 }
 
 struct RobotBodies {

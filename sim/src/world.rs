@@ -129,9 +129,52 @@ pub struct Person {
     pub skin_color: Rgba,
     /// Hair colour.
     pub hair_color: Rgba,
+    /// A walk: `position_m`, then each waypoint, then back to `position_m`, repeated.
+    pub walk: Option<Walk>,
+}
+
+/// A person's walk: a closed path at a constant speed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Walk {
+    /// Waypoints after the start position (m, world frame).
+    pub waypoints_m: Vec<[f64; 2]>,
+    /// Walking speed (m/s).
+    pub speed_mps: f64,
 }
 
 impl Person {
+    /// Where the person is at sim time `t_s`: (x m, y m, heading rad). Standing people stay
+    /// put; walking people follow their closed path at their speed, facing where they go.
+    pub fn pose_at(&self, t_s: f64) -> (f64, f64, f64) {
+        let [x0, y0] = self.position_m;
+        let Some(walk) = &self.walk else {
+            return (x0, y0, self.heading_rad);
+        };
+        let corners: Vec<[f64; 2]> = std::iter::once(self.position_m)
+            .chain(walk.waypoints_m.iter().copied())
+            .collect();
+        let leg = |i: usize| {
+            let a = corners[i];
+            let b = corners[(i + 1) % corners.len()];
+            (a, b, (b[0] - a[0]).hypot(b[1] - a[1]))
+        };
+        let length: f64 = (0..corners.len()).map(|i| leg(i).2).sum();
+        if length <= 1e-9 {
+            return (x0, y0, self.heading_rad);
+        }
+        let mut s = (walk.speed_mps * t_s.max(0.0)).rem_euclid(length);
+        for i in 0..corners.len() {
+            let (a, b, l) = leg(i);
+            if s <= l || i + 1 == corners.len() {
+                let f = if l > 0.0 { (s / l).min(1.0) } else { 0.0 };
+                let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+                return (a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f, heading);
+            }
+            s -= l;
+        }
+        (x0, y0, self.heading_rad)
+    }
+
     /// Radius of the upright capsule that stands in for the person in physics (m).
     pub fn body_radius_m(&self) -> f64 {
         0.13 * self.height_m / 1.75
@@ -314,6 +357,9 @@ struct RawPerson {
     trousers_color: Option<String>,
     skin_color: Option<String>,
     hair_color: Option<String>,
+    #[serde(default)]
+    waypoints_m: Vec<[f64; 2]>,
+    speed_mps: Option<f64>,
 }
 
 fn default_person_height() -> f64 {
@@ -556,8 +602,34 @@ impl RawWorld {
                     ),
                 ));
             }
+            for (j, w) in p.waypoints_m.iter().enumerate() {
+                c.finite(&format!("person[{i}].waypoints_m[{j}]"), w)?;
+            }
+            let walk = match (p.waypoints_m.is_empty(), p.speed_mps) {
+                (true, None) => None,
+                (true, Some(_)) => {
+                    return Err(c.fail(
+                        &key("speed_mps"),
+                        "a walking speed needs `waypoints_m = [[x, y], ...]` to walk through",
+                    ));
+                }
+                (false, speed) => {
+                    let speed = speed.unwrap_or(0.8);
+                    if !(speed.is_finite() && speed > 0.0 && speed <= 3.0) {
+                        return Err(c.fail(
+                            &key("speed_mps"),
+                            format!("expected a walking speed in (0, 3] m/s, found {speed}"),
+                        ));
+                    }
+                    Some(Walk {
+                        waypoints_m: p.waypoints_m,
+                        speed_mps: speed,
+                    })
+                }
+            };
             people.push(Person {
                 name: p.name.unwrap_or_else(|| format!("person_{i}")),
+                walk,
                 position_m: p.position_m,
                 heading_rad: p.heading_deg.to_radians(),
                 height_m: p.height_m,
@@ -613,5 +685,46 @@ impl RawWorld {
             objects,
             people,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn world(person: &str) -> Result<World> {
+        World::from_str(
+            &format!("name = \"t\"\n[[person]]\n{person}\n"),
+            Path::new("t.toml"),
+        )
+    }
+
+    #[test]
+    fn a_walking_person_follows_the_closed_path_facing_ahead() -> Result<()> {
+        let w = world("position_m = [0.0, 0.0]\nwaypoints_m = [[2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]\nspeed_mps = 0.5")?;
+        let p = &w.people[0];
+        let close = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+            (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9
+        };
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        assert!(close(p.pose_at(0.0), (0.0, 0.0, 0.0)));
+        assert!(close(p.pose_at(2.0), (1.0, 0.0, 0.0)));
+        assert!(close(p.pose_at(6.0), (2.0, 1.0, half_pi)));
+        // Last leg back to the start, then around again (16 s per lap).
+        assert!(close(p.pose_at(14.0), (0.0, 1.0, -half_pi)));
+        assert!(close(p.pose_at(18.0), (1.0, 0.0, 0.0)));
+        Ok(())
+    }
+
+    #[test]
+    fn a_speed_without_waypoints_or_a_bad_speed_is_an_error() {
+        let e = world("position_m = [0.0, 0.0]\nspeed_mps = 0.5").err();
+        assert!(
+            e.is_some_and(|e| e.to_string().contains("waypoints_m")),
+            "speed without a path"
+        );
+        let e = world("position_m = [0.0, 0.0]\nwaypoints_m = [[1.0, 0.0]]\nspeed_mps = -1.0")
+            .err();
+        assert!(e.is_some_and(|e| e.to_string().contains("person[0].speed_mps")));
     }
 }

@@ -118,6 +118,8 @@ pub struct CameraRenderer {
     instances: Vec<Instance>,
     instance_buffer: wgpu::Buffer,
     attached: Vec<Attached>,
+    /// Parts of the people (`link` = person index, `link_from_shape` = person_from_part).
+    people: Vec<Attached>,
     info: CameraInfo,
     checker: Rgba,
     checker_size_m: f32,
@@ -350,20 +352,23 @@ impl CameraRenderer {
             );
             add(&mesh, instance(pose, object.color));
         }
-        for person in &world.people {
+        let mut person_parts_at = Vec::new();
+        for (person_index, person) in world.people.iter().enumerate() {
+            let (x, y, heading) = person.pose_at(0.0);
             let world_from_person = Pose::from_parts(
-                Vec3::new(
-                    person.position_m[0] as f32,
-                    person.position_m[1] as f32,
-                    0.0,
-                ),
-                glam::Quat::from_rotation_z(person.heading_rad as f32),
+                Vec3::new(x as f32, y as f32, 0.0),
+                glam::Quat::from_rotation_z(heading as f32),
             );
             for part in person_parts(person) {
-                add(
+                let index = add(
                     &part.mesh,
                     instance(world_from_person * part.pose, part.color),
                 );
+                person_parts_at.push(Attached {
+                    instance: index,
+                    link: person_index,
+                    link_from_shape: part.pose,
+                });
             }
         }
         for (link_index, link) in robot.links.iter().enumerate() {
@@ -399,6 +404,7 @@ impl CameraRenderer {
             instances,
             instance_buffer,
             attached,
+            people: person_parts_at,
             checker: world.ground.checker_color,
             checker_size_m: world.ground.checker_size_m as f32,
             near_m: camera.clip_near_m as f32,
@@ -445,6 +451,16 @@ impl CameraRenderer {
             ),
             Vec4::new(0.0, 0.0, -f * n / (f - n), 0.0),
         )
+    }
+
+    /// Moves person `index` (world order) to `world_from_person` for the following renders.
+    pub fn set_person_pose(&mut self, index: usize, world_from_person: Pose) {
+        for a in self.people.iter().filter(|a| a.link == index) {
+            let pose = world_from_person * a.link_from_shape;
+            self.instances[a.instance].model =
+                Mat4::from_rotation_translation(pose.rotation, pose.translation)
+                    .to_cols_array_2d();
+        }
     }
 
     /// Renders one image: `world_from_links` are the robot's link poses (URDF order),
