@@ -337,11 +337,10 @@ impl Follower {
         cmd
     }
 
+    /// Range (m) and bearing (rad) of the target from the robot's base now: the standoff is
+    /// the distance between the car and the person, as a user would measure it.
     fn relative(&self, t: &Target, odom: Odometry) -> (f64, f64) {
-        let (sin, cos) = odom.yaw_rad.sin_cos();
-        let camera_x = odom.x_m + cos * self.camera.forward_m;
-        let camera_y = odom.y_m + sin * self.camera.forward_m;
-        let (dx, dy) = (t.x_m - camera_x, t.y_m - camera_y);
+        let (dx, dy) = (t.x_m - odom.x_m, t.y_m - odom.y_m);
         (dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad))
     }
 
@@ -480,7 +479,7 @@ mod tests {
         // At the standoff it holds still.
         let mut f = Follower::new(FollowerConfig::default(), camera());
         f.command(0.0, odom, true);
-        f.observe(&message(0.0, vec![person_box(1.5 + 0.15, 0.0)]));
+        f.observe(&message(0.0, vec![person_box(1.5 - 0.15, 0.0)]));
         let cmd = f.command(0.01, odom, true);
         assert!(cmd.linear_mps.abs() < 0.01, "{cmd:?}");
     }

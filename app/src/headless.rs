@@ -6,11 +6,14 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use rover_sim::{CameraSensor, ControlSample, RobotModel, SimOptions, Simulation, World};
+use rover_perception::DetectorConfig;
+use rover_sim::{ControlSample, RobotModel, SimOptions, World};
 
+use crate::follower::FollowerConfig;
 use crate::paths;
-use crate::pilot::{Mode, Pilot};
-use crate::script::Script;
+use crate::pilot::Mode;
+use crate::script::{Action, Script};
+use crate::session::{DetectorMode, NoObserver, Observer, Session, SessionOptions};
 use crate::trace::TraceWriter;
 
 /// Everything a headless run needs.
@@ -34,7 +37,32 @@ pub struct RunConfig {
     pub save_frames: Option<PathBuf>,
     /// Write every Nth camera image (1 = all).
     pub frame_every: u64,
+    /// Camera + detector: `Auto` runs them when the script switches to follow mode or an
+    /// observer wants images.
+    pub perception: Perception,
+    /// Lockstep detection rate on sim time (Hz; default [`DEFAULT_DETECT_HZ`]).
+    pub detect_hz: Option<f64>,
+    /// Detector settings.
+    pub detector: DetectorConfig,
+    /// Follower settings.
+    pub follower: FollowerConfig,
 }
+
+/// Whether a headless run renders the camera and runs the detector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Perception {
+    /// When the script toggles follow mode, or something watches the camera.
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never (the follower holds still).
+    Off,
+}
+
+/// Default lockstep detection rate of headless runs (Hz of sim time): about what the default
+/// model reaches on two CPU cores in real time.
+pub const DEFAULT_DETECT_HZ: f64 = 5.0;
 
 /// What a headless run did.
 #[derive(Debug, Clone)]
@@ -82,8 +110,18 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
 }
 
 /// Runs headless and writes the trace, if asked. Deterministic: the same world, robot, script
-/// and seed give a byte-identical trace.
+/// and seed give a byte-identical trace (detection runs in lockstep on sim time).
 pub fn run(config: &RunConfig) -> Result<RunSummary> {
+    run_observed(config, &mut NoObserver, false)
+}
+
+/// [`run`] with an observer (the Rerun recorder). `observer_wants_camera` turns the camera and
+/// detector on under [`Perception::Auto`].
+pub fn run_observed(
+    config: &RunConfig,
+    observer: &mut dyn Observer,
+    observer_wants_camera: bool,
+) -> Result<RunSummary> {
     let (world, robot) = load(config)?;
     let script = match &config.script {
         Some(path) => Script::load(path)?,
@@ -94,6 +132,20 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
         Some(d) => anyhow::bail!("--duration must be a number of seconds >= 0, found {d}"),
         None if config.script.is_some() => script.end_s() + 1.0,
         None => 10.0,
+    };
+    let detect_hz = config.detect_hz.unwrap_or(DEFAULT_DETECT_HZ);
+    anyhow::ensure!(
+        detect_hz.is_finite() && detect_hz > 0.0,
+        "--detect-hz must be a positive number, found {detect_hz}"
+    );
+    let follows = script
+        .steps
+        .iter()
+        .any(|s| matches!(s.action, Action::ToggleFollow));
+    let perceive = match config.perception {
+        Perception::On => true,
+        Perception::Off => false,
+        Perception::Auto => follows || observer_wants_camera,
     };
     let mut trace = match &config.trace {
         Some(path) => {
@@ -106,68 +158,41 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
 
     let world_name = world.name.clone();
     let robot_name = robot.name.clone();
-    let mut sim = Simulation::new(world, robot, &config.options)?;
-    let mut camera = match &config.save_frames {
-        Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-            let sensor = CameraSensor::new(&sim)?;
-            tracing::info!(
-                "camera: {}x{} at {} Hz, rendering on {}",
-                sensor.info().width,
-                sensor.info().height,
-                sim.robot()
-                    .cameras
-                    .first()
-                    .map_or(0.0, |c| c.update_rate_hz),
-                sensor.renderer().adapter()
-            );
-            Some((sensor, dir.clone()))
-        }
-        None => None,
+    let options = SessionOptions {
+        sim: config.options.clone(),
+        camera: perceive,
+        detector: if perceive {
+            DetectorMode::Lockstep { rate_hz: detect_hz }
+        } else {
+            DetectorMode::Off
+        },
+        detector_config: config.detector.clone(),
+        follower: config.follower.clone(),
+        save_frames: config.save_frames.clone(),
+        frame_every: config.frame_every,
     };
-    let frame_every = config.frame_every.max(1);
-    let mut frames_written = 0u64;
-    let mut pilot = Pilot::default();
+    let mut session = Session::new(world, robot, &options, observer)?;
+    let dt_s = session.sim().dt_s();
     let mut next_step = 0;
-    let total_steps = (duration_s / sim.dt_s()).round() as u64;
+    let total_steps = (duration_s / dt_s).round() as u64;
     let mut last = None;
     let started = Instant::now();
     let mut last_report = started;
 
-    while sim.step_index() < total_steps {
-        let now = sim.sim_time_s();
+    while session.sim().step_index() < total_steps {
+        let now = session.sim().sim_time_s();
         while let Some(step) = script.steps.get(next_step) {
             // Half a physics step of tolerance: a step applies at the first physics step at or
             // after its time.
-            if step.at_s > now + sim.dt_s() / 2.0 {
+            if step.at_s > now + dt_s / 2.0 {
                 break;
             }
-            if let Some(cmd) = pilot.apply(step.action)
-                && let Err(e) = sim.set_cmd_vel(cmd)
-            {
-                tracing::warn!("script step at {} s: {e}", step.at_s);
-            }
+            session.input(step.action, observer);
             next_step += 1;
         }
-        if let Some((sensor, dir)) = camera.as_mut()
-            && let Some(frame) = sensor.capture_if_due(&sim)?
-            && frame.seq % frame_every == 0
-        {
-            let path = dir.join(format!("frame_{:06}.png", frame.seq));
-            image::save_buffer(
-                &path,
-                frame.rgb,
-                frame.width,
-                frame.height,
-                image::ExtendedColorType::Rgb8,
-            )
-            .with_context(|| format!("cannot write {}", path.display()))?;
-            frames_written += 1;
-        }
-        if let Some(sample) = sim.step() {
+        if let Some(sample) = session.step(observer)? {
             if let Some(t) = trace.as_mut() {
-                t.row(&sample, pilot.mode())?;
+                t.row(&sample, session.pilot().mode())?;
             }
             last = Some(sample);
         }
@@ -176,10 +201,10 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
         {
             last_report = Instant::now();
             tracing::info!(
-                "sim time {:.1} / {:.1} s ({:.0}x real time)",
-                sim.sim_time_s(),
+                "sim time {:.1} / {:.1} s ({:.1}x real time)",
+                session.sim().sim_time_s(),
                 duration_s,
-                sim.sim_time_s() / started.elapsed().as_secs_f64()
+                session.sim().sim_time_s() / started.elapsed().as_secs_f64()
             );
         }
     }
@@ -192,17 +217,21 @@ pub fn run(config: &RunConfig) -> Result<RunSummary> {
         }
         None => 0,
     };
-    if let Some((_, dir)) = &camera {
-        tracing::info!("wrote {frames_written} camera frames to {}", dir.display());
+    if let Some(dir) = &config.save_frames {
+        tracing::info!(
+            "wrote {} camera frames to {}",
+            session.frames_written(),
+            dir.display()
+        );
     }
     Ok(RunSummary {
         world: world_name,
         robot: robot_name,
-        sim_time_s: sim.sim_time_s(),
-        steps: sim.step_index(),
+        sim_time_s: session.sim().sim_time_s(),
+        steps: session.sim().step_index(),
         wall_s,
         rows,
         last,
-        mode: pilot.mode(),
+        mode: session.pilot().mode(),
     })
 }

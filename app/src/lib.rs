@@ -11,5 +11,6 @@ pub mod paths;
 pub mod pilot;
 pub mod reference;
 pub mod script;
+pub mod session;
 pub mod teleop;
 pub mod trace;

@@ -8,7 +8,8 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use rover::bench;
 use rover::detect::{self, DetectOptions};
-use rover::headless::{self, RunConfig};
+use rover::follower::FollowerConfig;
+use rover::headless::{self, Perception, RunConfig};
 use rover_perception::{DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig};
 use rover_sim::SimOptions;
 
@@ -100,6 +101,70 @@ struct RunArgs {
     /// Stop the robot when no cmd_vel arrived for SECS (off by default, like Gazebo; 0 = off)
     #[arg(long, value_name = "SECS")]
     cmd_timeout: Option<f64>,
+
+    #[command(flatten)]
+    follow: FollowArgs,
+
+    #[command(flatten)]
+    detector: DetectorArgs,
+}
+
+/// Camera, detector and follower options of a run.
+#[derive(Debug, Args)]
+struct FollowArgs {
+    /// Headless: run the camera and detector even when the script never switches to follow
+    /// (they always run when it does)
+    #[arg(long, conflicts_with = "no_detector")]
+    detect: bool,
+
+    /// Never run the detector (the follower then holds still)
+    #[arg(long)]
+    no_detector: bool,
+
+    /// Headless: detections per sim second, in lockstep with the simulation (deterministic)
+    #[arg(long, value_name = "HZ", default_value_t = headless::DEFAULT_DETECT_HZ)]
+    detect_hz: f64,
+
+    /// Follower: class to follow (a darknet_ros `Class`, e.g. person, dog)
+    #[arg(long, default_value = "person", value_name = "CLASS")]
+    target_class: String,
+
+    /// Follower: distance to keep from the target (m)
+    #[arg(long, default_value_t = 1.5, value_name = "M")]
+    standoff: f64,
+
+    /// Follower: speed limit (m/s)
+    #[arg(long, default_value_t = 0.5, value_name = "MPS")]
+    follow_speed: f64,
+}
+
+impl FollowArgs {
+    fn follower(&self) -> anyhow::Result<FollowerConfig> {
+        anyhow::ensure!(
+            self.standoff.is_finite() && self.standoff > 0.3,
+            "--standoff must be more than 0.3 m, found {}",
+            self.standoff
+        );
+        anyhow::ensure!(
+            self.follow_speed.is_finite() && self.follow_speed > 0.0,
+            "--follow-speed must be a positive speed in m/s, found {}",
+            self.follow_speed
+        );
+        Ok(FollowerConfig {
+            target_class: self.target_class.clone(),
+            standoff_m: self.standoff,
+            max_speed_mps: self.follow_speed,
+            ..FollowerConfig::default()
+        })
+    }
+
+    fn perception(&self) -> Perception {
+        match (self.detect, self.no_detector) {
+            (_, true) => Perception::Off,
+            (true, _) => Perception::On,
+            _ => Perception::Auto,
+        }
+    }
 }
 
 /// Detector options shared by the commands that run YOLO.
@@ -265,6 +330,10 @@ fn run(args: RunArgs) -> Result<()> {
         progress_every: Some(Duration::from_secs(5)),
         save_frames: args.save_frames,
         frame_every: args.frame_every,
+        perception: args.follow.perception(),
+        detect_hz: Some(args.follow.detect_hz),
+        detector: args.detector.config()?,
+        follower: args.follow.follower()?,
         ..args.world.run_config(args.cmd_timeout)
     };
     let summary = headless::run(&config)?;

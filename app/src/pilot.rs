@@ -63,7 +63,6 @@ impl Pilot {
                     Mode::Manual => Mode::Follow,
                     Mode::Follow => Mode::Manual,
                 };
-                tracing::info!("mode: {}", self.mode.as_str());
                 // Either way the robot stops: the teleop direction is cleared so that leaving
                 // follow mode does not resume an old key press.
                 self.teleop.press(crate::teleop::KeyAction::Stop);

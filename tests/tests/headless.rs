@@ -74,10 +74,12 @@ fn script_keys_and_toggle_drive_the_robot() -> Result<()> {
         (row(3.2)?.cmd_linear_mps + 0.55).abs() < 1e-6,
         ", drives back"
     );
-    // Toggle to follow: the mode column changes and, with no detector, the robot holds still.
+    // Toggle to follow: the mode column changes and the follower takes over from the reverse
+    // key (it never reverses faster than a third of its speed limit; tests/follow.rs checks
+    // what it does).
     assert_eq!(row(3.2)?.mode, "manual");
     assert_eq!(row(4.0)?.mode, "follow");
-    assert_eq!(row(4.0)?.cmd_linear_mps, 0.0);
+    assert!(row(4.0)?.cmd_linear_mps > -0.2);
     // A manual key takes control back.
     assert_eq!(row(4.7)?.mode, "manual");
     assert!((row(4.7)?.cmd_linear_mps - 0.55).abs() < 1e-6);

@@ -1,0 +1,475 @@
+//! One run of the robot: simulation, camera, detector, pilot and follower, advanced one physics
+//! step at a time. Headless runs and the window use the same [`Session`]; they differ only in
+//! who paces it (as fast as possible vs real time) and which detector drives it (lockstep on sim
+//! time for determinism vs a worker thread that always takes the newest frame).
+//!
+//! Data flows one way: world + URDF -> sim -> camera -> detector -> pilot (teleop | follower)
+//! -> cmd_vel -> sim. Observers (the Rerun recorder, the window's HUD) only watch.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use rover_perception::{
+    BoundingBoxes, Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, LockstepDetector,
+    RgbView, WorkerStats,
+};
+use rover_sim::{
+    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, Twist,
+    World,
+};
+
+use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig};
+use crate::pilot::{Mode, Pilot};
+use crate::script::Action;
+
+/// How detection runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DetectorMode {
+    /// No camera processing: the follower holds still.
+    Off,
+    /// Synchronously on the loop's thread at this rate on sim time (deterministic).
+    Lockstep {
+        /// Detections per sim second.
+        rate_hz: f64,
+    },
+    /// On its own thread, always on the newest frame (interactive, real time).
+    Worker,
+}
+
+/// Everything a session needs besides the world and the robot.
+#[derive(Debug, Clone)]
+pub struct SessionOptions {
+    /// Simulation options (seed, overrides).
+    pub sim: SimOptions,
+    /// Whether to render the camera at all.
+    pub camera: bool,
+    /// How detection runs (needs the camera).
+    pub detector: DetectorMode,
+    /// Detector settings (model, input size, thresholds).
+    pub detector_config: DetectorConfig,
+    /// Follower settings.
+    pub follower: FollowerConfig,
+    /// Write camera images as PNG into this folder.
+    pub save_frames: Option<PathBuf>,
+    /// Write every Nth camera image (1 = all).
+    pub frame_every: u64,
+}
+
+impl Default for SessionOptions {
+    fn default() -> Self {
+        Self {
+            sim: SimOptions::default(),
+            camera: false,
+            detector: DetectorMode::Off,
+            detector_config: DetectorConfig::default(),
+            follower: FollowerConfig::default(),
+            save_frames: None,
+            frame_every: 1,
+        }
+    }
+}
+
+/// How bad an [`Observer::event`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventLevel {
+    /// Information (mode changes).
+    Info,
+    /// Something the user should know (no detector, viewer gone).
+    Warn,
+}
+
+/// Loop figures for HUDs and recorders.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LoopStats {
+    /// Control mode.
+    pub mode: Mode,
+    /// What the follower is doing.
+    pub follow_state: FollowState,
+    /// Detector results per wall second (worker) or per sim second (lockstep).
+    pub detector_hz: f64,
+    /// Latency of the newest detection (ms, from frame submission to result).
+    pub detector_latency_ms: f64,
+    /// Frames the detector skipped because a newer one arrived.
+    pub frames_dropped: u64,
+    /// Camera frames rendered.
+    pub frames: u64,
+    /// Whether a detector is running.
+    pub detector_ok: bool,
+}
+
+/// Watches a session without influencing it (the Rerun recorder, the window).
+pub trait Observer {
+    /// After every control update (100 Hz for the tutorial car).
+    fn control(&mut self, _sim: &Simulation, _sample: &ControlSample, _stats: &LoopStats) {}
+    /// A camera image, taken at `frame.sim_time_s` from `world_from_camera` (the camera link).
+    fn camera_frame(&mut self, _frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {}
+    /// Detections of an earlier camera image (see their `image_stamp`).
+    fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
+    /// A mode change, a warning.
+    fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
+}
+
+/// Sends an event to the observer and to the log.
+fn emit(observer: &mut dyn Observer, sim_time_s: f64, level: EventLevel, text: &str) {
+    match level {
+        EventLevel::Info => tracing::info!("{text}"),
+        EventLevel::Warn => tracing::warn!("{text}"),
+    }
+    observer.event(sim_time_s, level, text);
+}
+
+/// An observer that ignores everything.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {}
+
+enum Detection {
+    Off,
+    Lockstep(Box<LockstepDetector>),
+    Worker(DetectorWorker),
+}
+
+/// A running session.
+pub struct Session {
+    sim: Simulation,
+    camera: Option<CameraSensor>,
+    camera_link: usize,
+    detection: Detection,
+    labels: Vec<String>,
+    pilot: Pilot,
+    follower: Follower,
+    stats: LoopStats,
+    save_frames: Option<PathBuf>,
+    frame_every: u64,
+    frames_written: u64,
+    last_boxes: Option<BoundingBoxes>,
+    detections_done: u64,
+    detector_started: Option<Instant>,
+}
+
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session")
+            .field("sim", &self.sim)
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Session {
+    /// Builds the simulation, and the camera and detector when asked. A detector that cannot
+    /// be loaded (no model, bad model) is reported through `observer` as a warning: the session
+    /// still runs, manual driving works and the follower holds still.
+    pub fn new(
+        world: World,
+        robot: RobotModel,
+        options: &SessionOptions,
+        observer: &mut dyn Observer,
+    ) -> Result<Self> {
+        let sim = Simulation::new(world, robot, &options.sim)?;
+        let camera_config = sim.robot().cameras.first().cloned();
+        let wants_camera = options.camera
+            || options.save_frames.is_some()
+            || options.detector != DetectorMode::Off;
+        let camera = match (&camera_config, wants_camera) {
+            (Some(_), true) => {
+                let sensor = CameraSensor::new(&sim).context("cannot start the camera")?;
+                tracing::info!(
+                    "camera: {}x{}, rendering on {}",
+                    sensor.info().width,
+                    sensor.info().height,
+                    sensor.renderer().adapter()
+                );
+                Some(sensor)
+            }
+            (None, true) => {
+                emit(observer, 
+                    0.0,
+                    EventLevel::Warn,
+                    "the robot has no camera: no images, no detections, the follower holds still",
+                );
+                None
+            }
+            _ => None,
+        };
+        if let Some(dir) = &options.save_frames {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+        }
+        let camera_link = camera_config
+            .as_ref()
+            .and_then(|c| sim.robot().link_index(&c.link))
+            .unwrap_or(0);
+        let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
+        let mut labels = Vec::new();
+        let detection = match (options.detector, camera.is_some()) {
+            (DetectorMode::Off, _) | (_, false) => Detection::Off,
+            (mode, true) => match Detector::load(options.detector_config.clone()) {
+                Ok(detector) => {
+                    labels = detector.labels().to_vec();
+                    tracing::info!(
+                        "detector: {} at {}x{}",
+                        detector.model_path().display(),
+                        detector.input_size().0,
+                        detector.input_size().1
+                    );
+                    match mode {
+                        DetectorMode::Lockstep { rate_hz } => {
+                            Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
+                        }
+                        _ => Detection::Worker(DetectorWorker::spawn(detector)?),
+                    }
+                }
+                Err(e) => {
+                    emit(observer, 
+                        0.0,
+                        EventLevel::Warn,
+                        &format!(
+                            "no detector ({e}); manual driving works, the follower holds still"
+                        ),
+                    );
+                    Detection::Off
+                }
+            },
+        };
+        let stats = LoopStats {
+            detector_ok: !matches!(detection, Detection::Off),
+            ..LoopStats::default()
+        };
+        Ok(Self {
+            follower: Follower::new(options.follower.clone(), geometry),
+            sim,
+            camera,
+            camera_link,
+            detection,
+            labels,
+            pilot: Pilot::default(),
+            stats,
+            save_frames: options.save_frames.clone(),
+            frame_every: options.frame_every.max(1),
+            frames_written: 0,
+            last_boxes: None,
+            detections_done: 0,
+            detector_started: None,
+        })
+    }
+
+    /// The simulation.
+    pub fn sim(&self) -> &Simulation {
+        &self.sim
+    }
+
+    /// The pilot (mode, teleop limits).
+    pub fn pilot(&self) -> &Pilot {
+        &self.pilot
+    }
+
+    /// The follower.
+    pub fn follower(&self) -> &Follower {
+        &self.follower
+    }
+
+    /// The camera's intrinsics, when the camera runs.
+    pub fn camera_info(&self) -> Option<&CameraInfo> {
+        self.camera.as_ref().map(|c| c.info())
+    }
+
+    /// Class names of the detector (empty without one).
+    pub fn labels(&self) -> &[String] {
+        &self.labels
+    }
+
+    /// The newest detections.
+    pub fn last_boxes(&self) -> Option<&BoundingBoxes> {
+        self.last_boxes.as_ref()
+    }
+
+    /// Loop figures.
+    pub fn stats(&self) -> LoopStats {
+        self.stats
+    }
+
+    /// Camera images written by `save_frames`.
+    pub fn frames_written(&self) -> u64 {
+        self.frames_written
+    }
+
+    /// Applies a user input (script step, key, gamepad). Manual input while following takes
+    /// control back at once.
+    pub fn input(&mut self, action: Action, observer: &mut dyn Observer) {
+        let before = self.pilot.mode();
+        let cmd = self.pilot.apply(action);
+        let after = self.pilot.mode();
+        if before != after {
+            self.follower.reset();
+            let text = match after {
+                Mode::Follow if matches!(self.detection, Detection::Off) => {
+                    "mode: follow (no detector: holding still)"
+                }
+                Mode::Follow => "mode: follow",
+                Mode::Manual => "mode: manual",
+            };
+            emit(observer, self.sim.sim_time_s(), EventLevel::Info, text);
+        }
+        if let Some(cmd) = cmd
+            && let Err(e) = self.sim.set_cmd_vel(cmd)
+        {
+            emit(observer, self.sim.sim_time_s(), EventLevel::Warn, &e.to_string());
+        }
+        self.stats.mode = after;
+    }
+
+    /// Sets cmd_vel directly (gamepad axes); manual mode.
+    pub fn manual_cmd(&mut self, cmd: Twist, observer: &mut dyn Observer) {
+        self.input(Action::CmdVel(cmd), observer);
+    }
+
+    /// Advances one physics step: camera (when due), detector, follower, physics. Returns the
+    /// control sample when the diff drive's control loop ran.
+    pub fn step(&mut self, observer: &mut dyn Observer) -> Result<Option<ControlSample>> {
+        self.camera_and_detection(observer)?;
+        let sample = self.sim.step();
+        if let Some(sample) = &sample {
+            if self.pilot.mode() == Mode::Follow {
+                let cmd = self.follower.command(
+                    sample.sim_time_s,
+                    sample.odometry,
+                    self.stats.detector_ok,
+                );
+                self.sim.set_cmd_vel(cmd)?;
+            }
+            self.stats.mode = self.pilot.mode();
+            self.stats.follow_state = self.follower.state();
+            observer.control(&self.sim, sample, &self.stats);
+        }
+        Ok(sample)
+    }
+
+    fn camera_and_detection(&mut self, observer: &mut dyn Observer) -> Result<()> {
+        // Results from the worker thread arrive whenever they are ready.
+        if let Detection::Worker(worker) = &self.detection
+            && let Some(result) = worker.latest()
+        {
+            match result {
+                Ok(boxes) => {
+                    let stats = worker.stats();
+                    self.accept(boxes, Some(stats), observer);
+                }
+                Err(e) => {
+                    emit(observer, 
+                        self.sim.sim_time_s(),
+                        EventLevel::Warn,
+                        &format!("detector failed: {e}; the follower holds still"),
+                    );
+                    self.detection = Detection::Off;
+                    self.stats.detector_ok = false;
+                }
+            }
+        }
+        let Some(camera) = self.camera.as_mut() else {
+            return Ok(());
+        };
+        let world_from_camera = self.sim.world_from_link(self.camera_link);
+        let Some(frame) = camera.capture_if_due(&self.sim)? else {
+            return Ok(());
+        };
+        self.stats.frames += 1;
+        observer.camera_frame(&frame, world_from_camera);
+        if let Some(dir) = &self.save_frames
+            && frame.seq % self.frame_every == 0
+        {
+            let path = dir.join(format!("frame_{:06}.png", frame.seq));
+            image::save_buffer(
+                &path,
+                frame.rgb,
+                frame.width,
+                frame.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
+            self.frames_written += 1;
+        }
+        let stamp = FrameStamp {
+            sim_time_s: frame.sim_time_s,
+            frame: frame.seq,
+        };
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let detected = match &mut self.detection {
+            Detection::Off => None,
+            Detection::Lockstep(detector) => {
+                detector.detect_if_due(RgbView::new(w, h, frame.rgb)?, stamp)?
+            }
+            Detection::Worker(worker) => {
+                let mut pixels = worker.buffer();
+                pixels.clear();
+                pixels.extend_from_slice(frame.rgb);
+                self.detector_started.get_or_insert_with(Instant::now);
+                worker.submit(Frame {
+                    pixels,
+                    width: w,
+                    height: h,
+                    stamp,
+                });
+                None
+            }
+        };
+        if let Some(boxes) = detected {
+            self.accept(boxes, None, observer);
+        }
+        Ok(())
+    }
+
+    fn accept(
+        &mut self,
+        boxes: BoundingBoxes,
+        worker: Option<WorkerStats>,
+        observer: &mut dyn Observer,
+    ) {
+        self.detections_done += 1;
+        self.stats.detector_latency_ms = boxes.latency_ms;
+        match worker {
+            Some(w) => {
+                self.stats.frames_dropped = w.dropped;
+                let wall = self
+                    .detector_started
+                    .map_or(0.0, |t| t.elapsed().as_secs_f64());
+                if wall > 0.0 {
+                    self.stats.detector_hz = w.processed as f64 / wall;
+                }
+            }
+            None => {
+                let t = self.sim.sim_time_s();
+                if t > 0.0 {
+                    self.stats.detector_hz = self.detections_done as f64 / t;
+                }
+            }
+        }
+        self.follower.observe(&boxes);
+        observer.detections(&boxes, &self.labels);
+        self.last_boxes = Some(boxes);
+    }
+}
+
+/// The follower's view of the camera: intrinsics, and where the camera sits on the robot as
+/// it rests at the start. Without a camera the follower never sees anything, so any geometry
+/// will do.
+fn camera_geometry(sim: &Simulation, info: Option<&CameraInfo>, camera_link: usize) -> CameraGeometry {
+    let world_from_camera = sim.world_from_link(camera_link);
+    let base_from_camera = sim.world_from_base().inverse() * world_from_camera;
+    let height_m = f64::from(world_from_camera.translation.z);
+    let forward_m = f64::from(base_from_camera.translation.x);
+    match info {
+        Some(info) => CameraGeometry::new(info, height_m, forward_m),
+        None => CameraGeometry {
+            fx: 1.0,
+            fy: 1.0,
+            cx: 0.0,
+            cy: 0.0,
+            height_px: 1.0,
+            height_m,
+            forward_m,
+        },
+    }
+}
