@@ -190,3 +190,64 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         best_ms,
     })
 }
+
+/// Recording overhead: the same headless run (camera and lockstep detector on) without and
+/// with `--record`.
+#[derive(Debug, Clone)]
+pub struct RecordBench {
+    /// Wall seconds without recording (best of the repeats).
+    pub plain_s: f64,
+    /// Wall seconds with recording to an .rrd file (best of the repeats).
+    pub recorded_s: f64,
+    /// Size of the recording (bytes).
+    pub rrd_bytes: u64,
+}
+
+impl RecordBench {
+    /// recorded / plain.
+    pub fn ratio(&self) -> f64 {
+        self.recorded_s / self.plain_s
+    }
+}
+
+/// Runs `config` `repeats` times each without and with a recorder writing into `dir`.
+pub fn record(
+    config: &RunConfig,
+    images: crate::recorder::ImageOptions,
+    repeats: u32,
+    dir: &std::path::Path,
+) -> Result<RecordBench> {
+    use crate::recorder::{Recorder, RecorderOptions, Viewer};
+    let config = RunConfig {
+        perception: headless::Perception::On,
+        ..config.clone()
+    };
+    let mut plain = f64::INFINITY;
+    let mut recorded = f64::INFINITY;
+    let mut rrd_bytes = 0;
+    for i in 0..repeats.max(1) {
+        let started = Instant::now();
+        headless::run(&config)?;
+        plain = plain.min(started.elapsed().as_secs_f64());
+        let path = dir.join(format!("bench-{i}.rrd"));
+        let started = Instant::now();
+        let options = RecorderOptions {
+            viewer: Viewer::Save(path.clone()),
+            images,
+            ..RecorderOptions::default()
+        };
+        let mut rec = Recorder::start(&options)?
+            .ok_or_else(|| anyhow::anyhow!("the recorder did not start"))?;
+        headless::run_observed(&config, &mut rec, true)?;
+        rec.finish();
+        drop(rec);
+        recorded = recorded.min(started.elapsed().as_secs_f64());
+        rrd_bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        let _ = std::fs::remove_file(&path);
+    }
+    Ok(RecordBench {
+        plain_s: plain,
+        recorded_s: recorded,
+        rrd_bytes,
+    })
+}

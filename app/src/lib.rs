@@ -6,11 +6,15 @@
 pub mod bench;
 pub mod detect;
 pub mod follower;
+pub mod font;
+pub mod gamepad;
 pub mod headless;
 pub mod paths;
 pub mod pilot;
+pub mod recorder;
 pub mod reference;
 pub mod script;
 pub mod session;
 pub mod teleop;
 pub mod trace;
+pub mod window;

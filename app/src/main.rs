@@ -4,12 +4,17 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use rover::bench;
 use rover::detect::{self, DetectOptions};
 use rover::follower::FollowerConfig;
 use rover::headless::{self, Perception, RunConfig};
+use rover::recorder::{self, ImageOptions, Recorder, RecorderOptions, Viewer};
+use rover::script::Script;
+use rover::session::{DetectorMode, NoObserver, Observer, Session, SessionOptions};
+use rover::trace::TraceWriter;
+use rover::window::{self, WindowOptions};
 use rover_perception::{DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig};
 use rover_sim::SimOptions;
 
@@ -19,8 +24,10 @@ use rover_sim::SimOptions;
 /// physics and driven like Gazebo's diff_drive plugin (cmd_vel: linear.x m/s, angular.z rad/s;
 /// REP-103 frames: x forward, y left, z up).
 ///
-/// Without a subcommand rover runs the simulation. This version runs it headless: give a script
-/// of timed commands and a trace file to record what the robot did.
+/// Without a subcommand rover opens the driver's station: a window with the car's camera, boxes
+/// and a HUD; drive with teleop_twist_keyboard's keys (hold to drive) or a gamepad, press `f` to
+/// let the follower drive toward the person, and watch everything in the Rerun viewer. With
+/// --headless it runs as fast as the CPU allows from a script of timed inputs, deterministically.
 #[derive(Debug, Parser)]
 #[command(version, about, long_about, after_help = EXAMPLES)]
 struct Cli {
@@ -33,11 +40,19 @@ struct Cli {
 
 const EXAMPLES: &str = "\
 Examples:
+  rover                                             window + Rerun viewer on the default world
+  rover --world worlds/walking.toml --viewer web    a walking person; viewer in the browser
   rover --headless                                  default world and robot for 10 s, print a summary
+  rover --headless --record run.rrd                 the same, recorded for `rerun run.rrd`
   rover --headless --script drive.toml --trace out.csv
   rover --headless --world worlds/playground.toml --robot assets/robots/my_robot.urdf --duration 30 --seed 7
   rover bench                                       physics-only real-time factor
   rover detect photo.jpg --out boxes.png            YOLO boxes on an image (the model's quick check)
+
+Window keys (teleop_twist_keyboard layout; hold to drive, release to stop; --latched to keep going):
+  u i o / j k l / m , .   drive       k, space  stop      q/z w/x e/c  speed/turn x1.1 / x0.9
+  arrows                  drive       f  follow on/off    p  pause, n  single step    Esc  quit
+Gamepad: hold LB (deadman) + left stick forward/back, right stick turn; A toggles follow.
 
 Script format (TOML, times in sim seconds):
   steps = [
@@ -107,6 +122,107 @@ struct RunArgs {
 
     #[command(flatten)]
     detector: DetectorArgs,
+
+    #[command(flatten)]
+    viewer: ViewerArgs,
+
+    #[command(flatten)]
+    window: WindowArgs,
+}
+
+/// Window options.
+#[derive(Debug, Args)]
+struct WindowArgs {
+    /// Window: sim seconds per wall second
+    #[arg(long, default_value_t = 1.0, value_name = "X")]
+    rtf: f64,
+
+    /// Window: keep driving after a key is released, like the terminal teleop_twist_keyboard
+    /// (default: hold a key to drive, release to stop)
+    #[arg(long)]
+    latched: bool,
+
+    /// Window: W/A/S/D drive too (teleop's w/x/e/c speed keys are then off; q/z still scale)
+    #[arg(long)]
+    wasd: bool,
+
+    /// Window: start paused (p resumes, n steps one control update)
+    #[arg(long)]
+    paused: bool,
+
+    /// Window: write the window's image (camera, boxes, HUD) as PNG when quitting
+    #[arg(long, value_name = "FILE.png")]
+    screenshot: Option<PathBuf>,
+}
+
+/// Rerun viewer and recording options.
+#[derive(Debug, Args)]
+struct ViewerArgs {
+    /// Rerun viewer: `spawn` (native viewer, `pip install rerun-sdk==0.36.3`), `connect [URL]`
+    /// (a running viewer, default rerun+http://127.0.0.1:9876/proxy), `web` (rover serves the
+    /// web viewer and prints its URL), `save FILE.rrd`, or `none` [default: none when headless;
+    /// in the window: spawn when a matching `rerun` is on PATH, else web]
+    #[arg(long, num_args = 1..=2, value_names = ["MODE", "ARG"])]
+    viewer: Vec<String>,
+
+    /// Also record the run to this .rrd file (works with any --viewer)
+    #[arg(long, value_name = "FILE.rrd")]
+    record: Option<PathBuf>,
+
+    /// Camera images sent to Rerun per sim second [default: every camera frame]
+    #[arg(long, value_name = "HZ")]
+    image_hz: Option<f64>,
+
+    /// Send camera images to Rerun at 1/N of their width and height (long runs)
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    image_downscale: u32,
+
+    /// Send camera images to Rerun as JPEG of this quality (1-100) instead of raw RGB
+    #[arg(long, value_name = "Q", value_parser = clap::value_parser!(u8).range(1..=100))]
+    image_jpeg: Option<u8>,
+
+    /// Port of the web viewer (`--viewer web`)
+    #[arg(long, default_value_t = 9090, value_name = "PORT")]
+    web_port: u16,
+
+    /// Port of the Rerun data server behind the web viewer (`--viewer web`)
+    #[arg(long, default_value_t = 9876, value_name = "PORT")]
+    grpc_port: u16,
+}
+
+impl ViewerArgs {
+    fn options(&self, interactive: bool) -> Result<RecorderOptions> {
+        let viewer = if self.viewer.is_empty() {
+            if interactive {
+                let (viewer, why) = recorder::default_viewer();
+                tracing::info!("viewer: {why}");
+                viewer
+            } else {
+                Viewer::None
+            }
+        } else {
+            Viewer::parse(&self.viewer)?
+        };
+        if let Some(hz) = self.image_hz {
+            anyhow::ensure!(hz.is_finite() && hz > 0.0, "--image-hz must be positive, found {hz}");
+        }
+        anyhow::ensure!(
+            (1..=16).contains(&self.image_downscale),
+            "--image-downscale must be 1..=16, found {}",
+            self.image_downscale
+        );
+        Ok(RecorderOptions {
+            viewer,
+            record: self.record.clone(),
+            images: ImageOptions {
+                rate_hz: self.image_hz,
+                downscale: self.image_downscale,
+                jpeg_quality: self.image_jpeg,
+            },
+            web_port: self.web_port,
+            grpc_port: self.grpc_port,
+        })
+    }
 }
 
 /// Camera, detector and follower options of a run.
@@ -232,6 +348,24 @@ impl DetectorArgs {
 
 #[derive(Debug, Subcommand)]
 enum BenchKind {
+    /// Rerun recording overhead: the same headless run (camera + detector) without and with
+    /// --record
+    Record {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per run
+        #[arg(long, default_value_t = 10.0, value_name = "SECS")]
+        duration: f64,
+
+        /// Repeats (the fastest of each counts)
+        #[arg(long, default_value_t = 2)]
+        repeats: u32,
+
+        /// Send camera images as JPEG of this quality instead of raw RGB
+        #[arg(long, value_name = "Q")]
+        image_jpeg: Option<u8>,
+    },
     /// Camera: ms per image (render + readback) on this machine's GPU or software Vulkan
     Camera {
         #[command(flatten)]
@@ -319,9 +453,7 @@ impl WorldArgs {
 
 fn run(args: RunArgs) -> Result<()> {
     if !args.headless {
-        tracing::info!(
-            "the interactive window is not part of this version yet; running headless (pass --headless to skip this note)"
-        );
+        return run_window(args);
     }
     let config = RunConfig {
         script: args.script,
@@ -336,7 +468,27 @@ fn run(args: RunArgs) -> Result<()> {
         follower: args.follow.follower()?,
         ..args.world.run_config(args.cmd_timeout)
     };
-    let summary = headless::run(&config)?;
+    let recorder_options = args.viewer.options(false)?;
+    let summary = match Recorder::start(&recorder_options)? {
+        Some(mut rec) => {
+            if let Some(url) = &rec.web_url {
+                println!("Rerun web viewer: {url}");
+            }
+            let summary = headless::run_observed(&config, &mut rec, true);
+            rec.finish();
+            if let Some(path) = &recorder_options.record {
+                println!("recording: {}", recorder::describe_file(path));
+            }
+            if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
+                println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
+                loop {
+                    std::thread::sleep(Duration::from_secs(3600));
+                }
+            }
+            summary?
+        }
+        None => headless::run(&config)?,
+    };
     println!(
         "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.0}x real time)",
         summary.world,
@@ -366,6 +518,86 @@ fn run(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_window(args: RunArgs) -> Result<()> {
+    window::check_display()?;
+    anyhow::ensure!(
+        args.window.rtf.is_finite() && args.window.rtf > 0.0,
+        "--rtf must be a positive factor, found {}",
+        args.window.rtf
+    );
+    let config = args.world.run_config(args.cmd_timeout);
+    let (world, robot) = headless::load(&config)?;
+    let script = match &args.script {
+        Some(path) => Script::load(path)?,
+        None => Script::default(),
+    };
+    let recorder_options = args.viewer.options(true)?;
+    let mut recorder = match Recorder::start(&recorder_options) {
+        Ok(r) => r,
+        Err(e) => {
+            tracing::warn!("{e:#}; going on without a viewer");
+            None
+        }
+    };
+    if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.clone()) {
+        println!("Rerun web viewer: {url}");
+    }
+    let mut none = NoObserver;
+    let observer: &mut dyn Observer = match recorder.as_mut() {
+        Some(r) => r,
+        None => &mut none,
+    };
+    let options = SessionOptions {
+        sim: config.options.clone(),
+        camera: true,
+        detector: if args.follow.no_detector {
+            DetectorMode::Off
+        } else {
+            DetectorMode::Worker
+        },
+        detector_config: args.detector.config()?,
+        follower: args.follow.follower()?,
+        save_frames: args.save_frames.clone(),
+        frame_every: args.frame_every,
+    };
+    let session = Session::new(world, robot, &options, observer)?;
+    let trace = match &args.trace {
+        Some(path) => {
+            let file = std::fs::File::create(path)
+                .with_context(|| format!("cannot create trace file {}", path.display()))?;
+            Some(TraceWriter::new(std::io::BufWriter::new(file))?)
+        }
+        None => None,
+    };
+    let summary = window::run(
+        session,
+        observer,
+        WindowOptions {
+            real_time_factor: args.window.rtf,
+            latched: args.window.latched,
+            wasd: args.window.wasd,
+            duration_s: args.duration,
+            paused: args.window.paused,
+            script,
+            screenshot: args.window.screenshot.clone(),
+        },
+        trace,
+    )?;
+    if let Some(r) = recorder.as_mut() {
+        r.finish();
+    }
+    println!(
+        "rover: {:.1} s sim time in {:.1} s wall; mode {}",
+        summary.sim_time_s,
+        summary.wall_s,
+        summary.mode.as_str()
+    );
+    if let Some(path) = &recorder_options.record {
+        println!("recording: {}", recorder::describe_file(path));
+    }
+    Ok(())
+}
+
 fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) -> Result<()> {
     anyhow::ensure!(
         sim_seconds.is_finite() && sim_seconds > 0.0,
@@ -389,6 +621,37 @@ fn bench_cmd(world: WorldArgs, sim_seconds: f64, repeats: u32, rates: Vec<f64>) 
             b.real_time_factor()
         );
     }
+    Ok(())
+}
+
+fn bench_record(world: WorldArgs, duration: f64, repeats: u32, jpeg: Option<u8>) -> Result<()> {
+    let config = RunConfig {
+        duration_s: Some(duration),
+        ..world.run_config(None)
+    };
+    let dir = std::env::temp_dir().join(format!("rover-bench-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    println!(
+        "recording overhead: {duration} sim s headless, camera + lockstep detector on, best of {repeats}"
+    );
+    let b = bench::record(
+        &config,
+        ImageOptions {
+            jpeg_quality: jpeg,
+            ..ImageOptions::default()
+        },
+        repeats,
+        &dir,
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    let b = b?;
+    println!("without --record: {:.2} s wall", b.plain_s);
+    println!(
+        "with --record:    {:.2} s wall ({:.1} MB .rrd)",
+        b.recorded_s,
+        b.rrd_bytes as f64 / 1e6
+    );
+    println!("ratio: {:.2}x (goal <= 1.3x)", b.ratio());
     Ok(())
 }
 
@@ -478,6 +741,16 @@ fn main() -> ExitCode {
             kind: Some(BenchKind::Camera { world, frames }),
             ..
         }) => bench_camera(world, frames),
+        Some(Command::Bench {
+            kind:
+                Some(BenchKind::Record {
+                    world,
+                    duration,
+                    repeats,
+                    image_jpeg,
+                }),
+            ..
+        }) => bench_record(world, duration, repeats, image_jpeg),
         Some(Command::Bench {
             kind: None,
             world,

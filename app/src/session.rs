@@ -100,6 +100,9 @@ pub struct LoopStats {
 
 /// Watches a session without influencing it (the Rerun recorder, the window).
 pub trait Observer {
+    /// Once, when the session is set up: the scene, the camera's intrinsics and the detector's
+    /// class names.
+    fn start(&mut self, _sim: &Simulation, _camera: Option<&CameraInfo>, _labels: &[String]) {}
     /// After every control update (100 Hz for the tutorial car).
     fn control(&mut self, _sim: &Simulation, _sample: &ControlSample, _stats: &LoopStats) {}
     /// A camera image, taken at `frame.sim_time_s` from `world_from_camera` (the camera link).
@@ -238,6 +241,7 @@ impl Session {
             detector_ok: !matches!(detection, Detection::Off),
             ..LoopStats::default()
         };
+        observer.start(&sim, camera.as_ref().map(|c| c.info()), &labels);
         Ok(Self {
             follower: Follower::new(options.follower.clone(), geometry),
             sim,

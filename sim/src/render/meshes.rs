@@ -174,6 +174,22 @@ pub fn shape_mesh(shape: &Shape) -> Result<MeshData> {
     })
 }
 
+/// The mesh of a world object (box, cylinder, sphere), centred on its position.
+pub fn object_mesh(shape: &crate::world::ObjectShape) -> MeshData {
+    use crate::world::ObjectShape;
+    match *shape {
+        ObjectShape::Box { size_m } => cuboid(Vec3::new(
+            size_m[0] as f32,
+            size_m[1] as f32,
+            size_m[2] as f32,
+        )),
+        ObjectShape::Cylinder { radius_m, length_m } => {
+            cylinder(radius_m as f32, length_m as f32, 32)
+        }
+        ObjectShape::Sphere { radius_m } => sphere(radius_m as f32),
+    }
+}
+
 /// A coloured part of a figure, in the figure's frame.
 #[derive(Debug, Clone)]
 pub struct Part {

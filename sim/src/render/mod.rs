@@ -13,8 +13,8 @@ use crate::error::SimError;
 use crate::gazebo::{CameraConfig, GaussianNoise};
 use crate::geometry::{Pose, Rgba};
 use crate::robot::RobotModel;
-use crate::world::{ObjectShape, World};
-use meshes::{MeshData, Vertex, cuboid, cylinder, person_parts, shape_mesh, sphere};
+use crate::world::World;
+use meshes::{MeshData, Vertex, cuboid, object_mesh, person_parts, shape_mesh};
 
 /// Why the camera cannot render.
 #[derive(Debug, thiserror::Error)]
@@ -334,17 +334,7 @@ impl CameraRenderer {
             ),
         );
         for object in &world.objects {
-            let mesh = match object.shape {
-                ObjectShape::Box { size_m } => cuboid(Vec3::new(
-                    size_m[0] as f32,
-                    size_m[1] as f32,
-                    size_m[2] as f32,
-                )),
-                ObjectShape::Cylinder { radius_m, length_m } => {
-                    cylinder(radius_m as f32, length_m as f32, 32)
-                }
-                ObjectShape::Sphere { radius_m } => sphere(radius_m as f32),
-            };
+            let mesh = object_mesh(&object.shape);
             let p = object.position_m;
             let pose = Pose::from_parts(
                 Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
