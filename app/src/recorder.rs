@@ -584,7 +584,7 @@ impl Observer for Recorder {
         let m = sample.wheel_measured_radps;
         self.log(
             "plots/wheels",
-            &rerun::Scalars::new([t.left, t.right, m.left, m.right]),
+            &rerun::Scalars::new([t[0], t[1], m[0], m[1]]),
         );
         self.log(
             "plots/mode",

@@ -312,7 +312,7 @@ impl Gpu {
             pass.draw(0..3, 0..1);
         }
         self.queue.submit([encoder.finish()]);
-        frame.present();
+        self.queue.present(frame);
     }
 }
 

@@ -83,7 +83,7 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
     assert!(get("/world")?.components.iter().any(|c| c.contains("ViewCoordinates")));
     assert!(get("/world/people/alice/body")?.static_rows > 0);
     assert!(get("/world/objects/crate")?.static_rows > 0);
-    assert!(get("/world/robot/chassis/visual_0")?.static_rows > 0);
+    assert!(get("/world/robot/base_link/visual_0")?.static_rows > 0);
     assert!(get("/world/robot/camera")?.static_rows > 0);
     let image = get("/world/robot/camera/image")?;
     assert!(image.components.iter().any(|c| c.starts_with("Pinhole:")), "{:?}", image.components);
