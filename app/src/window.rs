@@ -519,43 +519,54 @@ impl App<'_> {
             ),
         };
         let x = canvas.text(8, y0, &mode_text, 3, mode_color);
-        if self.paused {
-            canvas.text(x + 16, y0, "PAUSED (p: resume, n: step)", 3, [255, 230, 80]);
+        let right = if self.paused {
+            "PAUSED".to_owned()
+        } else {
+            format!("t {:.1} s", self.session.sim().sim_time_s())
+        };
+        let rx = w as i64 - 8 - right.len() as i64 * 12;
+        if rx > x + 12 {
+            canvas.text(rx, y0 + 4, &right, 2, [255, 230, 80]);
         }
+        // Lines of at most 52 characters (12 px each at scale 2 in 640 px).
         let line2 = format!(
-            "speed {:.2} m/s  turn {:.2} rad/s   cmd {:+.2} m/s {:+.2} rad/s   t {:.1} s",
-            teleop.speed_mps,
-            teleop.turn_radps,
-            cmd.linear_mps,
-            cmd.angular_radps,
-            self.session.sim().sim_time_s()
+            "cmd {:+.2} m/s {:+.2} rad/s  max {:.2} m/s {:.2} rad/s",
+            cmd.linear_mps, cmd.angular_radps, teleop.speed_mps, teleop.turn_radps
         );
         canvas.text(8, y0 + 28, &line2, 2, [230, 230, 230]);
         let line3 = if stats.detector_ok {
             format!(
-                "detector {:.1} Hz  latency {:.0} ms  dropped {}   sim {:.2}x real time",
+                "yolo {:.1} Hz {:.0} ms  dropped {}  sim {:.2}x",
                 stats.detector_hz, stats.detector_latency_ms, stats.frames_dropped, self.rtf
             )
         } else {
-            format!("detector OFF   sim {:.2}x real time", self.rtf)
+            format!("detector OFF  sim {:.2}x real time", self.rtf)
         };
         canvas.text(8, y0 + 48, &line3, 2, [230, 230, 230]);
-        let help = match &self.tap.warning {
-            Some(w) => (format!("! {w}"), [255, 120, 90]),
-            None => (
-                "i , j l u o m . drive  k/space stop  q/z w/x e/c speeds  f follow  p pause  esc quit"
-                    .to_owned(),
-                [160, 170, 180],
-            ),
-        };
-        canvas.text(8, y0 + 72, &help.0, 2, help.1);
-        canvas.text(
-            8,
-            y0 + 90,
-            "gamepad: hold LB + left stick drive, right stick turn, A follow",
-            2,
-            [160, 170, 180],
-        );
+        match &self.tap.warning {
+            Some(warning) => {
+                let text: String = warning.chars().take(104).collect();
+                let (a, b) = text.split_at(text.char_indices().nth(52).map_or(text.len(), |(i, _)| i));
+                canvas.text(8, y0 + 72, &format!("! {a}"), 2, [255, 120, 90]);
+                canvas.text(8, y0 + 90, b, 2, [255, 120, 90]);
+            }
+            None => {
+                canvas.text(
+                    8,
+                    y0 + 72,
+                    "i,jluom. drive k stop q/z speed f follow p pause",
+                    2,
+                    [160, 170, 180],
+                );
+                canvas.text(
+                    8,
+                    y0 + 90,
+                    "pad: hold LB + sticks, A follow    esc quit",
+                    2,
+                    [160, 170, 180],
+                );
+            }
+        }
     }
 }
 
