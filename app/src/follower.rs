@@ -246,8 +246,7 @@ impl Follower {
         let camera_y = pose.y_m + sin * self.camera.forward_m;
         let mut best: Option<(f64, Target)> = None;
         for b in &message.bounding_boxes {
-            if b.class != self.config.target_class || b.probability < self.config.min_probability
-            {
+            if b.class != self.config.target_class || b.probability < self.config.min_probability {
                 continue;
             }
             let (range_m, bearing_rad) = self.range_bearing(b);
@@ -306,9 +305,7 @@ impl Follower {
             self.poses.pop_front();
         }
         self.poses.push_back((now_s, odom));
-        let dt = self
-            .last_cmd_s
-            .map_or(0.0, |t| (now_s - t).clamp(0.0, 0.1));
+        let dt = self.last_cmd_s.map_or(0.0, |t| (now_s - t).clamp(0.0, 0.1));
         let fresh = self
             .last_message_s
             .is_some_and(|t| now_s - t <= self.config.stale_after_s);
@@ -402,6 +399,7 @@ impl Follower {
 }
 
 #[cfg(test)]
+#[allow(clippy::expect_used)]
 mod tests {
     use super::*;
     use rover_perception::FrameStamp;

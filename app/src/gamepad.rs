@@ -37,8 +37,19 @@ pub struct PadTeleop {
 impl PadTeleop {
     /// The command for the current state, given teleop's speed and turn limits. Returns `None`
     /// when the pad is idle and was idle (so the keyboard keeps control).
-    pub fn update(&mut self, state: PadState, speed_mps: f64, turn_radps: f64) -> Option<PadCommand> {
-        let dz = |v: f32| if v.abs() < DEADZONE { 0.0 } else { f64::from(v) };
+    pub fn update(
+        &mut self,
+        state: PadState,
+        speed_mps: f64,
+        turn_radps: f64,
+    ) -> Option<PadCommand> {
+        let dz = |v: f32| {
+            if v.abs() < DEADZONE {
+                0.0
+            } else {
+                f64::from(v)
+            }
+        };
         if state.deadman {
             self.driving = true;
             Some(PadCommand::Drive(Twist::new(
@@ -67,7 +78,9 @@ pub struct Gamepads {
 
 impl std::fmt::Debug for Gamepads {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Gamepads").field("active", &self.active).finish()
+        f.debug_struct("Gamepads")
+            .field("active", &self.active)
+            .finish()
     }
 }
 
@@ -152,7 +165,10 @@ mod tests {
             left_y: 0.05,
             right_x: 0.0,
         };
-        assert_eq!(pad.update(small, 0.5, 1.0), Some(PadCommand::Drive(Twist::ZERO)));
+        assert_eq!(
+            pad.update(small, 0.5, 1.0),
+            Some(PadCommand::Drive(Twist::ZERO))
+        );
         assert_eq!(pad.update(idle, 0.5, 1.0), Some(PadCommand::Stop));
         assert_eq!(pad.update(idle, 0.5, 1.0), None);
         pad.update(held, 0.5, 1.0);

@@ -204,7 +204,10 @@ impl ViewerArgs {
             Viewer::parse(&self.viewer)?
         };
         if let Some(hz) = self.image_hz {
-            anyhow::ensure!(hz.is_finite() && hz > 0.0, "--image-hz must be positive, found {hz}");
+            anyhow::ensure!(
+                hz.is_finite() && hz > 0.0,
+                "--image-hz must be positive, found {hz}"
+            );
         }
         anyhow::ensure!(
             (1..=16).contains(&self.image_downscale),

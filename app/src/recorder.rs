@@ -63,7 +63,9 @@ impl Viewer {
             ("spawn", None) => Viewer::Spawn,
             ("web", None) => Viewer::Web,
             ("none", None) => Viewer::None,
-            ("connect", url) => Viewer::Connect(url.unwrap_or_else(|| rerun::DEFAULT_CONNECT_URL.to_owned())),
+            ("connect", url) => {
+                Viewer::Connect(url.unwrap_or_else(|| rerun::DEFAULT_CONNECT_URL.to_owned()))
+            }
             ("save", Some(path)) => Viewer::Save(PathBuf::from(path)),
             ("save", None) => anyhow::bail!("--viewer save needs a file: --viewer save run.rrd"),
             (m @ ("spawn" | "web" | "none"), Some(extra)) => {
@@ -149,10 +151,9 @@ pub fn pip_command() -> String {
 /// viewer. Returns the choice and why.
 pub fn default_viewer() -> (Viewer, String) {
     match viewer_on_path() {
-        Some(v) if v == RERUN_VERSION => (
-            Viewer::Spawn,
-            format!("found the Rerun viewer {v} on PATH"),
-        ),
+        Some(v) if v == RERUN_VERSION => {
+            (Viewer::Spawn, format!("found the Rerun viewer {v} on PATH"))
+        }
         Some(v) => (
             Viewer::Web,
             format!(
@@ -206,8 +207,12 @@ impl std::fmt::Debug for Recorder {
 }
 
 fn proxy_uri(url: &str) -> Result<ProxyUri> {
-    url.parse::<ProxyUri>()
-        .map_err(|e| anyhow::anyhow!("'{url}' is not a Rerun gRPC URL ({e}); expected e.g. {}", rerun::DEFAULT_CONNECT_URL))
+    url.parse::<ProxyUri>().map_err(|e| {
+        anyhow::anyhow!(
+            "'{url}' is not a Rerun gRPC URL ({e}); expected e.g. {}",
+            rerun::DEFAULT_CONNECT_URL
+        )
+    })
 }
 
 /// True when something accepts TCP connections on 127.0.0.1:`port`.
@@ -255,11 +260,15 @@ impl Recorder {
                     ..rerun::SpawnOptions::default()
                 };
                 let info = rerun::spawn(&spawn).with_context(|| {
-                    format!("cannot start the Rerun viewer (`{}` installs it; or use --viewer web)", pip_command())
+                    format!(
+                        "cannot start the Rerun viewer (`{}` installs it; or use --viewer web)",
+                        pip_command()
+                    )
                 })?;
                 tracing::info!(
                     "Rerun viewer started (pid {}, port {})",
-                    info.child_pid.map_or_else(|| "?".to_owned(), |p| p.to_string()),
+                    info.child_pid
+                        .map_or_else(|| "?".to_owned(), |p| p.to_string()),
                     info.port
                 );
                 let url = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
@@ -268,7 +277,8 @@ impl Recorder {
             }
             Viewer::Connect(url) => {
                 let uri = proxy_uri(url)?;
-                let (host, port) = host_port(url).unwrap_or(("127.0.0.1".into(), rerun::DEFAULT_SERVER_PORT));
+                let (host, port) =
+                    host_port(url).unwrap_or(("127.0.0.1".into(), rerun::DEFAULT_SERVER_PORT));
                 if !port_open(&host, port) {
                     anyhow::bail!(
                         "no Rerun viewer answers at {url}: start one with `rerun` (`{}`), or use --viewer web",
@@ -297,7 +307,9 @@ impl Recorder {
                     open_browser: false,
                     ..Default::default()
                 })
-                .with_context(|| format!("cannot serve the web viewer on port {}", options.web_port))?;
+                .with_context(|| {
+                    format!("cannot serve the web viewer on port {}", options.web_port)
+                })?;
                 let url = format!(
                     "{}/?url={}",
                     server.server_url(),
@@ -361,9 +373,12 @@ impl Recorder {
         let [gx, gy] = world.ground.size_m;
         self.log_static(
             "world/ground",
-            &rerun::Boxes3D::from_centers_and_sizes([[0.0f32, 0.0, -0.01]], [[gx as f32, gy as f32, 0.02]])
-                .with_colors([color(world.ground.color)])
-                .with_fill_mode(rerun::FillMode::Solid),
+            &rerun::Boxes3D::from_centers_and_sizes(
+                [[0.0f32, 0.0, -0.01]],
+                [[gx as f32, gy as f32, 0.02]],
+            )
+            .with_colors([color(world.ground.color)])
+            .with_fill_mode(rerun::FillMode::Solid),
         );
         for object in &world.objects {
             let p = object.position_m;
@@ -386,7 +401,8 @@ impl Recorder {
                 let base = positions.len() as u32;
                 for v in &part.mesh.vertices {
                     positions.push((part.pose * glam::Vec3::from_array(v.position)).to_array());
-                    normals.push((part.pose.rotation * glam::Vec3::from_array(v.normal)).to_array());
+                    normals
+                        .push((part.pose.rotation * glam::Vec3::from_array(v.normal)).to_array());
                     colors.push(color(part.color));
                 }
                 triangles.extend(
@@ -423,7 +439,9 @@ impl Recorder {
         }
         if let Some(info) = camera {
             let config = robot.cameras.first();
-            let link = config.and_then(|c| robot.link_index(&c.link)).unwrap_or(robot.root);
+            let link = config
+                .and_then(|c| robot.link_index(&c.link))
+                .unwrap_or(robot.root);
             let base_from_link = sim.world_from_base().inverse() * sim.world_from_link(link);
             let base_from_optical =
                 base_from_link * Pose::from_rotation(rover_sim::camera::link_from_optical());
@@ -548,7 +566,10 @@ impl Observer for Recorder {
         }
         let o = sample.odometry;
         let here = [o.x_m as f32, o.y_m as f32, 0.02];
-        self.log("world/odometry", &rerun::Points3D::new([here]).with_radii([0.04f32]));
+        self.log(
+            "world/odometry",
+            &rerun::Points3D::new([here]).with_radii([0.04f32]),
+        );
         if self.trail.last() != Some(&here) {
             if self.trail.len() == self.trail.capacity() {
                 // Keep the trail bounded: drop every other point of the older half.
@@ -591,13 +612,25 @@ impl Observer for Recorder {
             &rerun::Scalars::single(if stats.mode == Mode::Follow { 1.0 } else { 0.0 }),
         );
         if stats.detector_ok {
-            self.log("plots/detector/latency_ms", &rerun::Scalars::single(stats.detector_latency_ms));
-            self.log("plots/detector/hz", &rerun::Scalars::single(stats.detector_hz));
-            self.log("plots/detector/dropped", &rerun::Scalars::single(stats.frames_dropped as f64));
+            self.log(
+                "plots/detector/latency_ms",
+                &rerun::Scalars::single(stats.detector_latency_ms),
+            );
+            self.log(
+                "plots/detector/hz",
+                &rerun::Scalars::single(stats.detector_hz),
+            );
+            self.log(
+                "plots/detector/dropped",
+                &rerun::Scalars::single(stats.frames_dropped as f64),
+            );
         }
         let wall = self.started.elapsed().as_secs_f64();
         if wall > 0.5 {
-            self.log("plots/real_time_factor", &rerun::Scalars::single(sample.sim_time_s / wall));
+            self.log(
+                "plots/real_time_factor",
+                &rerun::Scalars::single(sample.sim_time_s / wall),
+            );
         }
     }
 
@@ -615,7 +648,13 @@ impl Observer for Recorder {
         let pixels: &[u8] = if factor == 1 {
             frame.rgb
         } else {
-            downscale_into(frame.rgb, frame.width, frame.height, factor, &mut self.scaled);
+            downscale_into(
+                frame.rgb,
+                frame.width,
+                frame.height,
+                factor,
+                &mut self.scaled,
+            );
             &self.scaled
         };
         match self.images.jpeg_quality {
@@ -632,7 +671,8 @@ impl Observer for Recorder {
                         let bytes = self.jpeg.clone();
                         self.log(
                             "world/robot/camera/image",
-                            &rerun::EncodedImage::new(bytes).with_media_type(rerun::MediaType::JPEG),
+                            &rerun::EncodedImage::new(bytes)
+                                .with_media_type(rerun::MediaType::JPEG),
                         );
                     }
                     Err(e) => tracing::warn!("rerun: JPEG encoding failed: {e}"),
@@ -652,14 +692,20 @@ impl Observer for Recorder {
         self.boxes_ids.clear();
         for b in &boxes.bounding_boxes {
             self.boxes_mins.push([b.xmin as f32 / k, b.ymin as f32 / k]);
-            self.boxes_sizes.push([b.width() as f32 / k, b.height() as f32 / k]);
-            self.boxes_labels.push(format!("{} {:.2}", b.class, b.probability));
-            let id = labels.iter().position(|l| *l == b.class).unwrap_or(usize::from(u16::MAX));
+            self.boxes_sizes
+                .push([b.width() as f32 / k, b.height() as f32 / k]);
+            self.boxes_labels
+                .push(format!("{} {:.2}", b.class, b.probability));
+            let id = labels
+                .iter()
+                .position(|l| *l == b.class)
+                .unwrap_or(usize::from(u16::MAX));
             self.boxes_ids.push(id as u16);
         }
-        let data = rerun::Boxes2D::from_mins_and_sizes(self.boxes_mins.clone(), self.boxes_sizes.clone())
-            .with_labels(self.boxes_labels.clone())
-            .with_class_ids(self.boxes_ids.clone());
+        let data =
+            rerun::Boxes2D::from_mins_and_sizes(self.boxes_mins.clone(), self.boxes_sizes.clone())
+                .with_labels(self.boxes_labels.clone())
+                .with_class_ids(self.boxes_ids.clone());
         self.log("world/robot/camera/image/detections", &data);
         self.set_time(stamp.sim_time_s);
     }
@@ -734,14 +780,16 @@ fn downscale_into(rgb: &[u8], w: u32, h: u32, factor: u32, out: &mut Vec<u8>) {
                 let row = (y * f + dy) * w;
                 for dx in 0..f {
                     let i = (row + x * f + dx) * 3;
-                    for c in 0..3 {
-                        sum[c] += u32::from(rgb.get(i + c).copied().unwrap_or(0));
+                    if let Some(px) = rgb.get(i..i + 3) {
+                        for (s, v) in sum.iter_mut().zip(px) {
+                            *s += u32::from(*v);
+                        }
                     }
                 }
             }
             let o = (y * ow + x) * 3;
-            for c in 0..3 {
-                out[o + c] = (sum[c] / (f * f) as u32) as u8;
+            for (dst, s) in out[o..o + 3].iter_mut().zip(sum) {
+                *dst = (s / (f * f) as u32) as u8;
             }
         }
     }
@@ -757,10 +805,18 @@ pub fn blueprint() -> Blueprint {
         .with_row_shares([4.0f32, 1.0])
         .into(),
         Vertical::new([
-            Spatial2DView::new("Camera").with_origin("world/robot/camera/image").into(),
-            TimeSeriesView::new("Linear velocity").with_origin("plots/velocity/linear").into(),
-            TimeSeriesView::new("Angular velocity").with_origin("plots/velocity/angular").into(),
-            TimeSeriesView::new("Detector").with_origin("plots/detector").into(),
+            Spatial2DView::new("Camera")
+                .with_origin("world/robot/camera/image")
+                .into(),
+            TimeSeriesView::new("Linear velocity")
+                .with_origin("plots/velocity/linear")
+                .into(),
+            TimeSeriesView::new("Angular velocity")
+                .with_origin("plots/velocity/angular")
+                .into(),
+            TimeSeriesView::new("Detector")
+                .with_origin("plots/detector")
+                .into(),
         ])
         .with_row_shares([3.0f32, 1.0, 1.0, 1.0])
         .into(),
@@ -773,5 +829,54 @@ pub fn describe_file(path: &Path) -> String {
     match std::fs::metadata(path) {
         Ok(m) => format!("{} ({:.1} MB)", path.display(), m.len() as f64 / 1e6),
         Err(_) => path.display().to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viewer_modes_parse_with_their_arguments() -> Result<()> {
+        let p = |w: &[&str]| Viewer::parse(&w.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        assert_eq!(p(&["spawn"])?, Viewer::Spawn);
+        assert_eq!(p(&["web"])?, Viewer::Web);
+        assert_eq!(
+            p(&["connect"])?,
+            Viewer::Connect(rerun::DEFAULT_CONNECT_URL.to_owned())
+        );
+        assert_eq!(p(&["save", "a.rrd"])?, Viewer::Save(PathBuf::from("a.rrd")));
+        assert!(p(&["save"]).is_err());
+        assert!(p(&["spawn", "x"]).is_err());
+        let e = p(&["native"])
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.contains("spawn, connect [URL], web, save FILE.rrd or none"),
+            "{e}"
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn downscale_averages_blocks() {
+        // 4x2 image, two 2x2 blocks: black/white checker -> grey, all 100 -> 100.
+        let rgb: Vec<u8> = [0u8, 255, 100, 100, 255, 0, 100, 100]
+            .iter()
+            .flat_map(|v| [*v, *v, *v])
+            .collect();
+        let mut out = Vec::new();
+        downscale_into(&rgb, 4, 2, 2, &mut out);
+        assert_eq!(out, vec![127, 127, 127, 100, 100, 100]);
+    }
+
+    #[test]
+    fn grpc_urls_give_host_and_port() {
+        assert_eq!(
+            host_port("rerun+http://127.0.0.1:9876/proxy"),
+            Some(("127.0.0.1".to_owned(), 9876))
+        );
+        assert!(proxy_uri("http://localhost:9876").is_err());
     }
 }

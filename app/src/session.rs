@@ -15,8 +15,7 @@ use rover_perception::{
     RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, Twist,
-    World,
+    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, Twist, World,
 };
 
 use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig};
@@ -188,7 +187,8 @@ impl Session {
                 Some(sensor)
             }
             (None, true) => {
-                emit(observer, 
+                emit(
+                    observer,
                     0.0,
                     EventLevel::Warn,
                     "the robot has no camera: no images, no detections, the follower holds still",
@@ -226,7 +226,8 @@ impl Session {
                     }
                 }
                 Err(e) => {
-                    emit(observer, 
+                    emit(
+                        observer,
                         0.0,
                         EventLevel::Warn,
                         &format!(
@@ -320,7 +321,12 @@ impl Session {
         if let Some(cmd) = cmd
             && let Err(e) = self.sim.set_cmd_vel(cmd)
         {
-            emit(observer, self.sim.sim_time_s(), EventLevel::Warn, &e.to_string());
+            emit(
+                observer,
+                self.sim.sim_time_s(),
+                EventLevel::Warn,
+                &e.to_string(),
+            );
         }
         self.stats.mode = after;
     }
@@ -362,7 +368,8 @@ impl Session {
                     self.accept(boxes, Some(stats), observer);
                 }
                 Err(e) => {
-                    emit(observer, 
+                    emit(
+                        observer,
                         self.sim.sim_time_s(),
                         EventLevel::Warn,
                         &format!("detector failed: {e}; the follower holds still"),
@@ -459,7 +466,11 @@ impl Session {
 /// The follower's view of the camera: intrinsics, and where the camera sits on the robot as
 /// it rests at the start. Without a camera the follower never sees anything, so any geometry
 /// will do.
-fn camera_geometry(sim: &Simulation, info: Option<&CameraInfo>, camera_link: usize) -> CameraGeometry {
+fn camera_geometry(
+    sim: &Simulation,
+    info: Option<&CameraInfo>,
+    camera_link: usize,
+) -> CameraGeometry {
     let world_from_camera = sim.world_from_link(camera_link);
     let base_from_camera = sim.world_from_base().inverse() * world_from_camera;
     let height_m = f64::from(world_from_camera.translation.z);

@@ -132,10 +132,11 @@ impl Gpu {
             "no GPU or software Vulkan for the window (apt-get install mesa-vulkan-drivers)",
         )?;
         tracing::info!("window: drawing with {}", adapter.get_info().name);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("rover window"),
-            ..Default::default()
-        }))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("rover window"),
+                ..Default::default()
+            }))?;
         let config = surface
             .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
             .context("the window surface is not supported by this adapter")?;
@@ -272,7 +273,8 @@ impl Gpu {
             },
         );
         let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.device, &self.config);
                 return;
@@ -412,12 +414,10 @@ impl App<'_> {
                 Some(PadCommand::ToggleFollow) => {
                     self.session.input(Action::ToggleFollow, &mut self.tap);
                 }
-                Some(PadCommand::Stop) => {
-                    if self.session.pilot().mode() == Mode::Manual {
-                        self.session.manual_cmd(Twist::ZERO, &mut self.tap);
-                    }
+                Some(PadCommand::Stop) if self.session.pilot().mode() == Mode::Manual => {
+                    self.session.manual_cmd(Twist::ZERO, &mut self.tap);
                 }
-                None => {}
+                Some(PadCommand::Stop) | None => {}
             }
         }
         let target = if self.paused {
@@ -546,7 +546,8 @@ impl App<'_> {
         match &self.tap.warning {
             Some(warning) => {
                 let text: String = warning.chars().take(104).collect();
-                let (a, b) = text.split_at(text.char_indices().nth(52).map_or(text.len(), |(i, _)| i));
+                let (a, b) =
+                    text.split_at(text.char_indices().nth(52).map_or(text.len(), |(i, _)| i));
                 canvas.text(8, y0 + 72, &format!("! {a}"), 2, [255, 120, 90]);
                 canvas.text(8, y0 + 90, b, 2, [255, 120, 90]);
             }
@@ -734,8 +735,14 @@ pub fn run(
     if let Some(path) = app.options.screenshot.clone() {
         app.compose();
         let (w, h) = app.canvas_size;
-        image::save_buffer(&path, &app.canvas, w as u32, h as u32, image::ExtendedColorType::Rgba8)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        image::save_buffer(
+            &path,
+            &app.canvas,
+            w as u32,
+            h as u32,
+            image::ExtendedColorType::Rgba8,
+        )
+        .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let _ = app.tap.image_stamp;
     Ok(WindowSummary {

@@ -80,14 +80,28 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
             .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
     };
     // Static scene.
-    assert!(get("/world")?.components.iter().any(|c| c.contains("ViewCoordinates")));
+    assert!(
+        get("/world")?
+            .components
+            .iter()
+            .any(|c| c.contains("ViewCoordinates"))
+    );
     assert!(get("/world/people/alice/body")?.static_rows > 0);
     assert!(get("/world/objects/crate")?.static_rows > 0);
     assert!(get("/world/robot/base_link/visual_0")?.static_rows > 0);
     assert!(get("/world/robot/camera")?.static_rows > 0);
     let image = get("/world/robot/camera/image")?;
-    assert!(image.components.iter().any(|c| c.starts_with("Pinhole:")), "{:?}", image.components);
-    assert!(image.components.iter().any(|c| c.starts_with("AnnotationContext:")));
+    assert!(
+        image.components.iter().any(|c| c.starts_with("Pinhole:")),
+        "{:?}",
+        image.components
+    );
+    assert!(
+        image
+            .components
+            .iter()
+            .any(|c| c.starts_with("AnnotationContext:"))
+    );
     // Per control update (100 Hz for 2 s): base pose, wheels, plots; rows match the trace.
     let control_rows = std::fs::read_to_string(&trace)?.lines().count() - 1;
     assert_eq!(control_rows, 200);

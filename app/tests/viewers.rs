@@ -81,7 +81,10 @@ fn the_served_web_viewer_renders_the_run_in_chromium() -> Result<()> {
     if let Ok(keep) = std::env::var("ROVER_KEEP_SCREENSHOT") {
         std::fs::copy(&shot, keep)?;
     }
-    assert!(json["colourFrac"].as_f64().unwrap_or(0.0) > 0.01, "{report}");
+    assert!(
+        json["colourFrac"].as_f64().unwrap_or(0.0) > 0.01,
+        "{report}"
+    );
     Ok(())
 }
 
@@ -105,7 +108,9 @@ fn killing_the_spawned_viewer_mid_run_does_not_stop_the_run() -> Result<()> {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| anyhow::anyhow!("cannot run xvfb-run ({e}): apt-get install xvfb xauth"))?,
+            .map_err(|e| {
+                anyhow::anyhow!("cannot run xvfb-run ({e}): apt-get install xvfb xauth")
+            })?,
     );
     let stderr = child
         .0
@@ -145,15 +150,24 @@ fn killing_the_spawned_viewer_mid_run_does_not_stop_the_run() -> Result<()> {
     let _ = Command::new("pkill")
         .args(["-KILL", "-P", &pid.to_string()])
         .status()?;
-    let killed = Command::new("kill").arg("-9").arg(pid.to_string()).status()?;
+    let killed = Command::new("kill")
+        .arg("-9")
+        .arg(pid.to_string())
+        .status()?;
     assert!(killed.success(), "could not kill the viewer (pid {pid})");
     let status = child.0.wait()?;
     let _ = reader.join();
     let log = lines.lock().map(|l| l.join("\n")).unwrap_or_default();
-    assert!(status.success(), "rover failed after the viewer was killed:\n{log}");
+    assert!(
+        status.success(),
+        "rover failed after the viewer was killed:\n{log}"
+    );
     assert!(log.contains("viewer has gone away"), "no warning:\n{log}");
     let rows = parse_trace(&std::fs::read_to_string(&trace)?)?;
     assert_eq!(rows.len(), 1200, "the trace is complete");
-    assert!(std::fs::metadata(&rrd)?.len() > 100_000, "the recording went on");
+    assert!(
+        std::fs::metadata(&rrd)?.len() > 100_000,
+        "the recording went on"
+    );
     Ok(())
 }

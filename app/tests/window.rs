@@ -41,7 +41,9 @@ wait "$pid"
         .env("SHOT", &shot)
         .env("LOG", dir.path().join("rover.log"))
         .output()
-        .map_err(|e| anyhow::anyhow!("cannot run xvfb-run ({e}): apt-get install xvfb xauth xdotool"))?;
+        .map_err(|e| {
+            anyhow::anyhow!("cannot run xvfb-run ({e}): apt-get install xvfb xauth xdotool")
+        })?;
     let log = std::fs::read_to_string(dir.path().join("rover.log")).unwrap_or_default();
     assert!(
         out.status.success(),
@@ -54,14 +56,29 @@ wait "$pid"
     // While `i` was held the car drove forward at teleop's 0.5 m/s...
     let driving: Vec<_> = rows.iter().filter(|r| r.cmd_linear_mps == 0.5).collect();
     let (first, last) = (
-        driving.first().ok_or_else(|| anyhow::anyhow!("never drove; log:\n{log}"))?,
-        driving.last().ok_or_else(|| anyhow::anyhow!("never drove"))?,
+        driving
+            .first()
+            .ok_or_else(|| anyhow::anyhow!("never drove; log:\n{log}"))?,
+        driving
+            .last()
+            .ok_or_else(|| anyhow::anyhow!("never drove"))?,
     );
     let held_s = last.sim_time_s - first.sim_time_s;
-    assert!((1.0..3.5).contains(&held_s), "held for {held_s:.2} s of sim time");
-    assert!(last.x_m - first.x_m > 0.4, "x {:.3} -> {:.3}", first.x_m, last.x_m);
+    assert!(
+        (1.0..3.5).contains(&held_s),
+        "held for {held_s:.2} s of sim time"
+    );
+    assert!(
+        last.x_m - first.x_m > 0.4,
+        "x {:.3} -> {:.3}",
+        first.x_m,
+        last.x_m
+    );
     // ...and releasing it stopped the car.
-    let after: Vec<_> = rows.iter().filter(|r| r.sim_time_s > last.sim_time_s + 0.05).collect();
+    let after: Vec<_> = rows
+        .iter()
+        .filter(|r| r.sim_time_s > last.sim_time_s + 0.05)
+        .collect();
     assert!(after.iter().all(|r| r.cmd_linear_mps == 0.0));
     let end = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
     assert!(end.x_m - last.x_m < 0.1, "rolled on after release");

@@ -701,7 +701,9 @@ mod tests {
 
     #[test]
     fn a_walking_person_follows_the_closed_path_facing_ahead() -> Result<()> {
-        let w = world("position_m = [0.0, 0.0]\nwaypoints_m = [[2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]\nspeed_mps = 0.5")?;
+        let w = world(
+            "position_m = [0.0, 0.0]\nwaypoints_m = [[2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]\nspeed_mps = 0.5",
+        )?;
         let p = &w.people[0];
         let close = |a: (f64, f64, f64), b: (f64, f64, f64)| {
             (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9
@@ -723,8 +725,8 @@ mod tests {
             e.is_some_and(|e| e.to_string().contains("waypoints_m")),
             "speed without a path"
         );
-        let e = world("position_m = [0.0, 0.0]\nwaypoints_m = [[1.0, 0.0]]\nspeed_mps = -1.0")
-            .err();
+        let e =
+            world("position_m = [0.0, 0.0]\nwaypoints_m = [[1.0, 0.0]]\nspeed_mps = -1.0").err();
         assert!(e.is_some_and(|e| e.to_string().contains("person[0].speed_mps")));
     }
 }

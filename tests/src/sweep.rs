@@ -36,7 +36,11 @@ impl Sweep {
     /// (frames with the person fully in view and labelled >= [`PASS_CONFIDENCE`],
     /// frames with the person fully in view).
     pub fn score(&self) -> (usize, usize) {
-        let cells = self.rows.iter().flat_map(|(_, c)| c).filter(|c| c.fully_in_view);
+        let cells = self
+            .rows
+            .iter()
+            .flat_map(|(_, c)| c)
+            .filter(|c| c.fully_in_view);
         let counted: Vec<_> = cells.collect();
         let ok = counted
             .iter()
@@ -123,7 +127,10 @@ pub fn person_sweep(
                 Quat::from_rotation_z(yaw as f32),
             );
             let rgb = renderer.render(&parked, world_from_camera)?;
-            let boxes = detector.detect(RgbView::new(w as usize, h as usize, rgb)?, FrameStamp::default())?;
+            let boxes = detector.detect(
+                RgbView::new(w as usize, h as usize, rgb)?,
+                FrameStamp::default(),
+            )?;
             let confidence = boxes
                 .bounding_boxes
                 .iter()
@@ -174,7 +181,10 @@ fn person_in_view(
                 // Camera link (x forward, y left, z up) -> optical (x right, y down, z forward).
                 let projected = info.project(f64::from(-p.y), f64::from(-p.z), f64::from(p.x));
                 inside &= projected.is_some_and(|(u, v)| {
-                    u >= 0.0 && v >= 0.0 && u <= f64::from(info.width) && v <= f64::from(info.height)
+                    u >= 0.0
+                        && v >= 0.0
+                        && u <= f64::from(info.width)
+                        && v <= f64::from(info.height)
                 });
             }
         }

@@ -17,12 +17,8 @@ fn playground_with(dir: &std::path::Path, person: &str) -> Result<std::path::Pat
         + text[start..]
             .find("\n\n")
             .ok_or_else(|| anyhow::anyhow!("person block not closed"))?;
-    let text = format!(
-        "{}{person}{}",
-        &text[..start],
-        &text[end..]
-    )
-    .replace("urdf = \"../assets/robots/my_robot.urdf\"\n", "");
+    let text = format!("{}{person}{}", &text[..start], &text[end..])
+        .replace("urdf = \"../assets/robots/my_robot.urdf\"\n", "");
     let path = dir.join("world.toml");
     std::fs::write(&path, text)?;
     Ok(path)
@@ -64,7 +60,10 @@ fn follows_a_person_ahead_and_to_the_side_to_the_standoff() -> Result<()> {
     let (range, facing) = range_and_facing(last, (4.0, 1.0));
     println!("after 20 s: range {range:.2} m, facing off by {facing:.1} deg");
     assert_eq!(last.mode, "follow");
-    assert!((range - 1.5).abs() <= 0.3, "range {range:.2} m, want 1.5 +- 0.3");
+    assert!(
+        (range - 1.5).abs() <= 0.3,
+        "range {range:.2} m, want 1.5 +- 0.3"
+    );
     assert!(facing <= 10.0, "facing off by {facing:.1} deg");
     Ok(())
 }
@@ -107,7 +106,10 @@ fn with_nobody_in_view_it_searches_on_the_spot() -> Result<()> {
         .windows(2)
         .map(|w| rover_sim::diff_drive::wrap_angle(w[1].yaw_rad - w[0].yaw_rad).abs())
         .sum();
-    println!("searching: moved {moved:.3} m, turned {:.0} deg", turned.to_degrees());
+    println!(
+        "searching: moved {moved:.3} m, turned {:.0} deg",
+        turned.to_degrees()
+    );
     assert!(rows.iter().all(|r| r.cmd_linear_mps == 0.0), "never drives");
     assert!(moved < 0.1, "stayed in place (moved {moved:.3} m)");
     assert!(turned > std::f64::consts::PI, "searched around");

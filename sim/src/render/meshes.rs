@@ -383,7 +383,11 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
         Section::new(0.95, 0.11, 0.175),
         Section::new(1.03, 0.105, 0.165),
     ]);
-    add(loft(&pelvis, 2.6, 24), Pose::IDENTITY, person.trousers_color);
+    add(
+        loft(&pelvis, 2.6, 24),
+        Pose::IDENTITY,
+        person.trousers_color,
+    );
     let torso = scaled(&[
         Section::new(0.98, 0.1, 0.16),
         Section::new(1.1, 0.1, 0.155),

@@ -448,8 +448,7 @@ impl CameraRenderer {
         for a in self.people.iter().filter(|a| a.link == index) {
             let pose = world_from_person * a.link_from_shape;
             self.instances[a.instance].model =
-                Mat4::from_rotation_translation(pose.rotation, pose.translation)
-                    .to_cols_array_2d();
+                Mat4::from_rotation_translation(pose.rotation, pose.translation).to_cols_array_2d();
         }
     }
 
