@@ -745,19 +745,9 @@ fn mesh(m: &MeshData, c: Rgba) -> rerun::Mesh3D {
         .with_albedo_factor(color(c))
 }
 
-/// A distinct colour per class id (person stands out in red).
+/// The class's colour, the same as `rover detect --out` draws.
 fn class_color(i: usize) -> rerun::Rgba32 {
-    const PALETTE: [[u8; 3]; 8] = [
-        [230, 57, 70],
-        [42, 157, 143],
-        [233, 196, 106],
-        [69, 123, 157],
-        [244, 162, 97],
-        [131, 56, 236],
-        [58, 134, 255],
-        [255, 0, 110],
-    ];
-    let [r, g, b] = PALETTE[i % PALETTE.len()];
+    let image::Rgb([r, g, b]) = crate::detect::class_color(i16::try_from(i).unwrap_or(i16::MAX));
     rerun::Rgba32::from_rgb(r, g, b)
 }
 

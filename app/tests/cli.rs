@@ -238,3 +238,59 @@ fn save_frames_writes_the_camera_images() -> Result<()> {
     );
     Ok(())
 }
+
+#[test]
+fn a_missing_model_warns_and_manual_driving_still_works() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let script = dir.path().join("s.toml");
+    std::fs::write(
+        &script,
+        "steps = [ { at = 0.0, toggle = \"follow\" }, { at = 0.5, cmd_vel = [0.5, 0.0] } ]\n",
+    )?;
+    let trace = dir.path().join("t.csv");
+    let out = rover(
+        &[
+            "--headless",
+            "--duration",
+            "1.5",
+            "--model",
+            "/nonexistent/model.onnx",
+            "--script",
+            &script.display().to_string(),
+            "--trace",
+            &trace.display().to_string(),
+        ],
+        dir.path(),
+    )?;
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("no detector"), "{stderr}");
+    assert!(stderr.contains("/nonexistent/model.onnx"), "{stderr}");
+    let rows = rover::trace::parse_trace(&std::fs::read_to_string(&trace)?)?;
+    // Follow mode without a detector holds still; the manual command then drives.
+    assert!(
+        rows.iter()
+            .take(50)
+            .all(|r| r.cmd_linear_mps == 0.0 && r.mode == "follow")
+    );
+    let last = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
+    assert_eq!((last.mode.as_str(), last.cmd_linear_mps), ("manual", 0.5));
+    assert!(last.x_m > 0.3);
+    Ok(())
+}
+
+#[test]
+fn no_display_is_said_plainly() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(["--duration", "1"])
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()?;
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("no display"), "{stderr}");
+    assert!(stderr.contains("--headless"), "{stderr}");
+    Ok(())
+}
