@@ -85,7 +85,8 @@ struct WorldArgs {
 
 #[derive(Debug, Args)]
 struct RunArgs {
-    /// Run without a window, as fast as the CPU allows (the only mode in this version)
+    /// Run without a window, as fast as the CPU allows, deterministically (detector in lockstep
+    /// on sim time)
     #[arg(long)]
     headless: bool,
 
