@@ -177,15 +177,10 @@ pub struct Recorder {
     images: ImageOptions,
     next_image_s: f64,
     frame: i64,
-    camera: Option<CameraInfo>,
     trail: Vec<[f32; 3]>,
     trail_logged_s: f64,
     scaled: Vec<u8>,
     jpeg: Vec<u8>,
-    boxes_mins: Vec<[f32; 2]>,
-    boxes_sizes: Vec<[f32; 2]>,
-    boxes_labels: Vec<String>,
-    boxes_ids: Vec<u16>,
     link_paths: Vec<String>,
     people_paths: Vec<String>,
     /// Port of a viewer we stream to, probed now and then to notice it has gone.
@@ -339,15 +334,10 @@ impl Recorder {
             images: options.images,
             next_image_s: 0.0,
             frame: 0,
-            camera: None,
             trail: Vec::with_capacity(4096),
             trail_logged_s: f64::NEG_INFINITY,
             scaled: Vec::new(),
             jpeg: Vec::new(),
-            boxes_mins: Vec::new(),
-            boxes_sizes: Vec::new(),
-            boxes_labels: Vec::new(),
-            boxes_ids: Vec::new(),
             link_paths: Vec::new(),
             people_paths: Vec::new(),
             watch_port,
@@ -359,14 +349,8 @@ impl Recorder {
         }))
     }
 
-    /// The recording stream (for tests).
-    pub fn stream(&self) -> &RecordingStream {
-        &self.rec
-    }
-
     /// Logs the static scene: world, robot visuals, camera intrinsics, class names.
     fn scene(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
-        let rec = &self.rec;
         let world = sim.world();
         let robot = sim.robot();
         self.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
@@ -458,7 +442,6 @@ impl Recorder {
                     .with_resolution([w as f32, h as f32])
                     .with_image_plane_distance(0.5f32),
             );
-            self.camera = Some(info.clone());
         }
         if !labels.is_empty() {
             self.log_static(
@@ -488,7 +471,6 @@ impl Recorder {
                 "right measured (rad/s)",
             ]),
         );
-        let _ = rec;
     }
 
     fn log_static(&self, path: &str, data: &dyn rerun::AsComponents) {
@@ -681,31 +663,22 @@ impl Observer for Recorder {
         }
     }
 
-    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
+    fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
         let stamp = boxes.image_stamp;
         self.rec.set_duration_secs("sim_time", stamp.sim_time_s);
         self.rec.set_time_sequence("frame", stamp.frame as i64);
         let k = self.images.downscale.max(1) as f32;
-        self.boxes_mins.clear();
-        self.boxes_sizes.clear();
-        self.boxes_labels.clear();
-        self.boxes_ids.clear();
-        for b in &boxes.bounding_boxes {
-            self.boxes_mins.push([b.xmin as f32 / k, b.ymin as f32 / k]);
-            self.boxes_sizes
-                .push([b.width() as f32 / k, b.height() as f32 / k]);
-            self.boxes_labels
-                .push(format!("{} {:.2}", b.class, b.probability));
-            let id = labels
-                .iter()
-                .position(|l| *l == b.class)
-                .unwrap_or(usize::from(u16::MAX));
-            self.boxes_ids.push(id as u16);
-        }
-        let data =
-            rerun::Boxes2D::from_mins_and_sizes(self.boxes_mins.clone(), self.boxes_sizes.clone())
-                .with_labels(self.boxes_labels.clone())
-                .with_class_ids(self.boxes_ids.clone());
+        let b = &boxes.bounding_boxes;
+        let data = rerun::Boxes2D::from_mins_and_sizes(
+            b.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
+            b.iter()
+                .map(|b| [b.width() as f32 / k, b.height() as f32 / k]),
+        )
+        .with_labels(
+            b.iter()
+                .map(|b| format!("{} {:.2}", b.class, b.probability)),
+        )
+        .with_class_ids(b.iter().map(|b| u16::try_from(b.id).unwrap_or(u16::MAX)));
         self.log("world/robot/camera/image/detections", &data);
         self.set_time(stamp.sim_time_s);
     }
@@ -814,7 +787,7 @@ pub fn blueprint() -> Blueprint {
     .with_time_panel(TimePanel::new().with_timeline("sim_time"))
 }
 
-/// Checks that an .rrd file exists and is readable (used by `rover` after a run).
+/// The recording's path and size, for the summary `rover` prints after a run.
 pub fn describe_file(path: &Path) -> String {
     match std::fs::metadata(path) {
         Ok(m) => format!("{} ({:.1} MB)", path.display(), m.len() as f64 / 1e6),

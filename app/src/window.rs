@@ -64,7 +64,6 @@ struct Tap<'a> {
     warning: Option<String>,
     image: Vec<u8>,
     image_size: (usize, usize),
-    image_stamp: u64,
     trace: Option<TraceWriter<std::io::BufWriter<std::fs::File>>>,
     mode: Mode,
 }
@@ -87,7 +86,6 @@ impl Observer for Tap<'_> {
         self.image.clear();
         self.image.extend_from_slice(frame.rgb);
         self.image_size = (frame.width as usize, frame.height as usize);
-        self.image_stamp = frame.seq;
         self.inner.camera_frame(frame, world_from_camera);
     }
     fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
@@ -703,7 +701,6 @@ pub fn run(
             warning: None,
             image: Vec::with_capacity(w * h * 3),
             image_size: (0, 0),
-            image_stamp: 0,
             trace,
             mode: Mode::Manual,
         },
@@ -744,7 +741,6 @@ pub fn run(
         )
         .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let _ = app.tap.image_stamp;
     Ok(WindowSummary {
         sim_time_s: app.session.sim().sim_time_s(),
         wall_s: app.started.elapsed().as_secs_f64(),
