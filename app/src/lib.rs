@@ -1,20 +1,14 @@
-//! rover, the application: headless runs, teleop, scripts and traces.
+//! rover, the application: adapters at the edge of the loop in `rover-core`.
 //!
-//! The binary `rover` is a thin command line over this library, so tests drive exactly what
-//! users run.
+//! * [`cli`] — the command line (`rover`, `rover --headless`, `rover bench`, `rover detect`).
+//! * [`viewer`] — the Rerun recorder: viewer modes, the static scene, per-tick logging, images,
+//!   the blueprint.
+//! * [`station`] — the driver's station: the window, its HUD, keyboard and gamepad teleop.
+//!
+//! The binary `rover` is a thin `main` over [`cli::main`], so tests drive exactly what users
+//! run.
 
-pub mod bench;
-pub mod detect;
-pub mod follower;
-pub mod font;
-pub mod gamepad;
-pub mod headless;
-pub mod paths;
-pub mod pilot;
-pub mod recorder;
-pub mod reference;
-pub mod script;
-pub mod session;
-pub mod teleop;
-pub mod trace;
-pub mod window;
+pub mod cli;
+pub mod palette;
+pub mod station;
+pub mod viewer;

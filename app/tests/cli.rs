@@ -65,7 +65,7 @@ fn scripted_run_writes_the_trace() -> Result<()> {
     assert!(out.status.success(), "{}", text(&out.stderr));
     // Duration defaults to the last step + 1 s: 2 s at 100 Hz control.
     let csv = std::fs::read_to_string(&trace)?;
-    let rows = rover::trace::parse_trace(&csv)?;
+    let rows = rover_core::parse_trace(&csv)?;
     assert_eq!(rows.len(), 200);
     let moved = rows.last().map(|r| r.x_m).unwrap_or_default();
     assert!(moved > 0.3, "the car drove forward, x = {moved}");
@@ -266,7 +266,7 @@ fn a_missing_model_warns_and_manual_driving_still_works() -> Result<()> {
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("no detector"), "{stderr}");
     assert!(stderr.contains("/nonexistent/model.onnx"), "{stderr}");
-    let rows = rover::trace::parse_trace(&std::fs::read_to_string(&trace)?)?;
+    let rows = rover_core::parse_trace(&std::fs::read_to_string(&trace)?)?;
     // Follow mode without a detector holds still; the manual command then drives.
     assert!(
         rows.iter()

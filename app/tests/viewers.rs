@@ -7,10 +7,17 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use rover::trace::parse_trace;
+use rover_core::parse_trace;
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// A port nothing listens on now (the OS picks it), so parallel runs never collide.
+fn free_port() -> Result<u16> {
+    Ok(std::net::TcpListener::bind("127.0.0.1:0")?
+        .local_addr()?
+        .port())
 }
 
 /// Kills the child when dropped (a failing assertion must not leave a server running).
@@ -26,19 +33,12 @@ impl Drop for Reaper {
 #[test]
 fn the_served_web_viewer_renders_the_run_in_chromium() -> Result<()> {
     let dir = tempfile::tempdir()?;
+    let (web_port, grpc_port) = (free_port()?, free_port()?);
     let mut child = Reaper(
         Command::new(env!("CARGO_BIN_EXE_rover"))
-            .args([
-                "--headless",
-                "--duration",
-                "3",
-                "--viewer",
-                "web",
-                "--web-port",
-                "19090",
-                "--grpc-port",
-                "19876",
-            ])
+            .args(["--headless", "--duration", "3", "--viewer", "web"])
+            .args(["--web-port", &web_port.to_string()])
+            .args(["--grpc-port", &grpc_port.to_string()])
             .current_dir(repo())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -59,7 +59,10 @@ fn the_served_web_viewer_renders_the_run_in_chromium() -> Result<()> {
         }
     }
     let url = url.ok_or_else(|| anyhow::anyhow!("rover never said it was serving"))?;
-    assert!(url.starts_with("http://127.0.0.1:19090"), "{url}");
+    assert!(
+        url.starts_with(&format!("http://127.0.0.1:{web_port}")),
+        "{url}"
+    );
     let shot = dir.path().join("web.png");
     let out = Command::new("node")
         .arg(repo().join("scripts/webview/screenshot.mjs"))
@@ -98,7 +101,17 @@ fn killing_the_spawned_viewer_mid_run_does_not_stop_the_run() -> Result<()> {
         Command::new("xvfb-run")
             .args(["-a", "-s", "-screen 0 1280x800x24"])
             .arg(env!("CARGO_BIN_EXE_rover"))
-            .args(["--headless", "--duration", "12", "--viewer", "spawn"])
+            // Paced to real time: the run lasts at least 12 s of wall time however fast this
+            // machine is, so it is still running when the viewer is killed 4 s in.
+            .args([
+                "--headless",
+                "--duration",
+                "12",
+                "--rtf",
+                "1",
+                "--viewer",
+                "spawn",
+            ])
             .arg("--trace")
             .arg(&trace)
             .arg("--record")

@@ -248,7 +248,14 @@ impl Detector {
         image: RgbView<'_>,
     ) -> Result<(&[f32], crate::preprocess::Letterbox)> {
         let (w, h) = (self.input_w, self.input_h);
-        let tensor = Arc::make_mut(&mut self.input);
+        // The tensor is shared with tract only during a run; were it still shared here,
+        // `make_mut` would silently copy 2.4 MB per frame. Refuse instead.
+        let tensor = Arc::get_mut(&mut self.input).ok_or_else(|| {
+            PerceptionError::Inference(
+                "the input tensor is still held by the previous run (it would be copied every frame)"
+                    .into(),
+            )
+        })?;
         let mut plain = tensor
             .try_as_plain_ram_mut()
             .map_err(|e| PerceptionError::Inference(e.to_string()))?;

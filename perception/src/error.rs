@@ -45,6 +45,12 @@ pub enum PerceptionError {
     /// The detector worker thread is gone.
     #[error("the detector thread stopped: {0}")]
     WorkerGone(String),
+    /// The detector panicked (a bug in rover or tract, or a model it cannot run).
+    #[error("the detector crashed: {0}")]
+    Panicked(String),
+    /// The onnxruntime reference (tests and benchmarks) could not run.
+    #[error("{0}")]
+    Reference(String),
 }
 
 impl PerceptionError {

@@ -134,9 +134,18 @@ fn unzip_model(zip_path: &Path, target: &Path) -> Result<()> {
         .map_err(|e| PerceptionError::io(zip_path, e))?;
     let parent = target.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(|e| PerceptionError::io(parent, e))?;
-    // Write beside the target and rename, so an interrupted unpack never leaves half a model.
-    let partial = target.with_extension("onnx.partial");
-    std::fs::write(&partial, &bytes).map_err(|e| PerceptionError::io(&partial, e))?;
-    std::fs::rename(&partial, target).map_err(|e| PerceptionError::io(target, e))?;
+    // Write to a temporary file of this process's own beside the target and rename it into
+    // place: an interrupted unpack never leaves half a model, and two processes unpacking at
+    // once each rename a whole model (the last one wins; both are the same bytes).
+    let mut partial = tempfile::Builder::new()
+        .prefix(".yolov12n-")
+        .suffix(".partial")
+        .tempfile_in(parent)
+        .map_err(|e| PerceptionError::io(parent, e))?;
+    std::io::Write::write_all(&mut partial, &bytes)
+        .map_err(|e| PerceptionError::io(partial.path(), e))?;
+    partial
+        .persist(target)
+        .map_err(|e| PerceptionError::io(target, e.error))?;
     Ok(())
 }

@@ -19,6 +19,7 @@ pub mod labels;
 pub mod lockstep;
 pub mod messages;
 pub mod preprocess;
+pub mod reference;
 pub mod worker;
 
 pub use detector::{

@@ -68,6 +68,14 @@ fn lock(shared: &Shared) -> std::sync::MutexGuard<'_, Slot> {
 impl DetectorWorker {
     /// Moves `detector` onto a new thread.
     pub fn spawn(mut detector: Detector) -> Result<Self> {
+        Self::spawn_with(move |view, stamp| detector.detect(view, stamp))
+    }
+
+    /// Runs any detection function on a new thread (a [`Detector`], or a stand-in in tests).
+    pub fn spawn_with<F>(mut detect: F) -> Result<Self>
+    where
+        F: FnMut(RgbView<'_>, FrameStamp) -> Result<BoundingBoxes> + Send + 'static,
+    {
         let shared: Shared = Arc::default();
         let (result_tx, results) = mpsc::channel();
         let (recycle, recycled) = mpsc::channel::<Vec<u8>>();
@@ -92,11 +100,18 @@ impl DetectorWorker {
                                 .unwrap_or_else(PoisonError::into_inner);
                         }
                     };
-                    let result = RgbView::new(frame.width, frame.height, &frame.pixels)
-                        .and_then(|view| detector.detect(view, frame.stamp));
+                    // A panic in the detector (rover, tract or the model) must not end the
+                    // thread silently: it becomes an error the session reports, and the
+                    // thread stops, since the detector's state is no longer trustworthy.
+                    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        RgbView::new(frame.width, frame.height, &frame.pixels)
+                            .and_then(|view| detect(view, frame.stamp))
+                    }))
+                    .unwrap_or_else(|payload| Err(PerceptionError::Panicked(panic_text(&payload))));
+                    let panicked = matches!(result, Err(PerceptionError::Panicked(_)));
                     lock(&thread_shared).stats.processed += 1;
                     // Receivers gone means the worker is being dropped: just stop.
-                    if result_tx.send(result).is_err() {
+                    if result_tx.send(result).is_err() || panicked {
                         return;
                     }
                     let _ = thread_recycle.send(frame.pixels);
@@ -136,9 +151,24 @@ impl DetectorWorker {
         }
     }
 
-    /// The newest result since the last call, if any (older ones are skipped).
+    /// The newest result since the last call, if any (older boxes are skipped; an error is
+    /// never skipped). A worker thread that has stopped reports [`PerceptionError::WorkerGone`].
     pub fn latest(&self) -> Option<Result<BoundingBoxes>> {
-        self.results.try_iter().last()
+        let mut newest = None;
+        loop {
+            match self.results.try_recv() {
+                Ok(Ok(boxes)) => newest = Some(Ok(boxes)),
+                Ok(Err(e)) => return Some(Err(e)),
+                Err(mpsc::TryRecvError::Empty) => return newest,
+                Err(mpsc::TryRecvError::Disconnected) => {
+                    return Some(newest.unwrap_or_else(|| {
+                        Err(PerceptionError::WorkerGone(
+                            "the detector thread ended unexpectedly".into(),
+                        ))
+                    }));
+                }
+            }
+        }
     }
 
     /// Waits for the next result (for tools and tests).
@@ -154,6 +184,15 @@ impl DetectorWorker {
     }
 }
 
+/// The message of a caught panic.
+fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "panic without a message".to_owned())
+}
+
 impl Drop for DetectorWorker {
     fn drop(&mut self) {
         lock(&self.shared).shutdown = true;
@@ -161,5 +200,85 @@ impl Drop for DetectorWorker {
         if let Some(handle) = self.handle.take() {
             let _ = handle.join();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(n: u64) -> Frame {
+        Frame {
+            pixels: vec![0; 4 * 4 * 3],
+            width: 4,
+            height: 4,
+            stamp: FrameStamp {
+                sim_time_s: n as f64,
+                frame: n,
+            },
+        }
+    }
+
+    fn empty(stamp: FrameStamp) -> BoundingBoxes {
+        BoundingBoxes {
+            image_stamp: stamp,
+            frame_id: "camera".into(),
+            bounding_boxes: Vec::new(),
+            latency_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_panic_in_the_detector_becomes_an_error_not_silence() -> Result<()> {
+        let worker = DetectorWorker::spawn_with(|_view, stamp| {
+            if stamp.frame == 2 {
+                panic!("index out of bounds in a test detector");
+            }
+            Ok(empty(stamp))
+        })?;
+        worker.submit(frame(1));
+        assert_eq!(worker.wait()?.image_stamp.frame, 1);
+        worker.submit(frame(2));
+        let err = worker
+            .wait()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            err.contains("crashed") && err.contains("index out of bounds"),
+            "{err}"
+        );
+        // The thread has stopped: later calls say so instead of waiting forever.
+        worker.submit(frame(3));
+        match worker.latest() {
+            Some(Err(PerceptionError::WorkerGone(_))) => {}
+            other => panic!("expected WorkerGone, got {other:?}"),
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn latest_never_skips_an_error() -> Result<()> {
+        let worker = DetectorWorker::spawn_with(|_view, stamp| {
+            if stamp.frame == 1 {
+                Err(PerceptionError::Inference("bad frame".into()))
+            } else {
+                Ok(empty(stamp))
+            }
+        })?;
+        worker.submit(frame(1));
+        // Wait until both results are queued, then ask once.
+        while worker.stats().processed < 1 {
+            std::thread::yield_now();
+        }
+        worker.submit(frame(2));
+        while worker.stats().processed < 2 {
+            std::thread::yield_now();
+        }
+        assert!(matches!(
+            worker.latest(),
+            Some(Err(PerceptionError::Inference(_)))
+        ));
+        Ok(())
     }
 }

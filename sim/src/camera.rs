@@ -75,12 +75,12 @@ pub fn link_from_optical() -> Quat {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    #[test]
-    fn seed_camera_intrinsics() {
-        let config = CameraConfig {
+    /// The seed tutorial's camera: 640x480, hfov 1.3962634, 30 Hz.
+    pub(crate) fn seed_config() -> CameraConfig {
+        CameraConfig {
             name: "camera1".into(),
             link: "camera_link".into(),
             update_rate_hz: 30.0,
@@ -97,8 +97,12 @@ mod tests {
             image_topic: "image_raw".into(),
             info_topic: "camera_info".into(),
             line: None,
-        };
-        let info = CameraInfo::from_config(&config);
+        }
+    }
+
+    #[test]
+    fn seed_camera_intrinsics() {
+        let info = CameraInfo::from_config(&seed_config());
         assert!((info.fx() - 381.36).abs() < 0.01, "{}", info.fx());
         assert_eq!(info.principal_point(), (320.5, 240.5));
         assert_eq!(info.p[0], info.k[0]);

@@ -23,6 +23,19 @@ pub fn vec3(v: [f64; 3]) -> Vec3 {
 }
 
 /// Heading (rotation about +z) of a rotation, in radians in (-pi, pi].
+/// A pose at `position_m` (world frame) turned `yaw_rad` about +z: how world files place
+/// objects, people and the robot.
+pub fn pose_from_position_yaw(position_m: [f64; 3], yaw_rad: f64) -> Pose {
+    Pose::from_parts(
+        glam::Vec3::new(
+            position_m[0] as f32,
+            position_m[1] as f32,
+            position_m[2] as f32,
+        ),
+        glam::Quat::from_rotation_z(yaw_rad as f32),
+    )
+}
+
 pub fn yaw_of(rotation: Quat) -> f64 {
     let forward = rotation * Vec3::X;
     f64::from(forward.y).atan2(f64::from(forward.x))

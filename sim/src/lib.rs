@@ -2,31 +2,50 @@
 //!
 //! Loads a robot from URDF ([`RobotModel`], honouring the `<gazebo>` diff_drive and camera
 //! extensions) and a world from TOML ([`World`]), steps rapier3d physics at a fixed rate and drives
-//! the wheels like gazebo_ros_diff_drive ([`Simulation`]). Free of UI and viewer code, so it runs
-//! headless in tests.
+//! the wheels like gazebo_ros_diff_drive ([`Simulation`]), and renders the robot's camera
+//! offscreen with wgpu ([`CameraSensor`], [`CameraRenderer`]). Free of UI and viewer code, so it
+//! runs headless in tests.
 //!
-//! Frames follow REP-103: x forward, y left, z up.
+//! Frames follow REP-103: x forward, y left, z up; camera images are in the optical frame
+//! (z forward, x right, y down).
+//!
+//! The modules are private; this page lists the API. Viewers that draw the scene use the same
+//! triangles the camera renders: [`shape_mesh`], [`object_mesh`] and [`person_parts`] give
+//! [`MeshData`] in each thing's own frame.
 
-pub mod camera;
-pub mod diff_drive;
-pub mod error;
-pub mod gazebo;
-pub mod geometry;
-pub mod mesh;
-pub mod render;
-pub mod robot;
-pub mod sensor;
-pub mod simulation;
-pub mod tomlfile;
-pub mod world;
+mod camera;
+mod diff_drive;
+mod error;
+mod gazebo;
+mod geometry;
+mod mesh;
+mod render;
+mod robot;
+mod sensor;
+mod simulation;
+mod tomlfile;
+mod world;
 
-pub use camera::CameraInfo;
-pub use diff_drive::{DiffDriveController, Odometry, Twist, WheelSpeeds};
+pub use camera::{CameraInfo, link_from_optical};
+pub use diff_drive::{
+    DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
+    WheelSpeeds, wrap_angle,
+};
 pub use error::{Location, Result, SimError};
-pub use gazebo::{CameraConfig, DiffDriveConfig, OdometrySource};
-pub use geometry::{Pose, Rgba, Shape};
+pub use gazebo::{
+    CameraConfig, DiffDriveConfig, Distortion, GaussianNoise, OdometrySource, PixelFormat,
+};
+pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
+pub use mesh::{TriMesh, load_mesh};
+pub use render::meshes::{
+    MeshData, Part as PersonPart, Vertex as MeshVertex, object_mesh, person_parts, shape_mesh,
+};
 pub use render::{CameraRenderer, RenderError};
-pub use robot::RobotModel;
+pub use robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
 pub use sensor::{CameraFrame, CameraSensor};
 pub use simulation::{ControlSample, SimOptions, Simulation};
-pub use world::World;
+pub use tomlfile::{load_toml, parse_toml};
+pub use world::{
+    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Person, Physics, RobotSpawn, STEP_HZ_RANGE, Walk,
+    World, check_step_hz,
+};

@@ -9,7 +9,7 @@ use crate::diff_drive::{
 };
 use crate::error::{Result, SimError};
 use crate::gazebo::OdometrySource;
-use crate::geometry::{Pose, Shape, yaw_of};
+use crate::geometry::{Pose, Shape, pose_from_position_yaw, yaw_of};
 use crate::mesh::load_mesh;
 use crate::robot::{JointKind, RobotModel};
 use crate::world::{ObjectShape, World};
@@ -103,11 +103,7 @@ impl Simulation {
             drive_config.cmd_timeout_s = (timeout > 0.0).then_some(timeout);
         }
         let step_hz = options.step_hz.unwrap_or(world.physics.step_hz);
-        if !(step_hz.is_finite() && (50.0..=10_000.0).contains(&step_hz)) {
-            return Err(SimError::Setup(format!(
-                "physics step rate must be 50..=10000 Hz, found {step_hz}"
-            )));
-        }
+        crate::world::check_step_hz(step_hz).map_err(SimError::Setup)?;
         let dt_s = 1.0 / step_hz;
 
         let mut physics = PhysicsWorld::new();
@@ -229,13 +225,10 @@ impl Simulation {
 
     /// Pose of person `index` (world order) now: feet on the ground, x facing where they look.
     pub fn world_from_person(&self, index: usize) -> Pose {
-        self.world.people.get(index).map_or(Pose::IDENTITY, |p| {
-            let (x, y, heading) = p.pose_at(self.sim_time_s());
-            Pose::from_parts(
-                Vec3::new(x as f32, y as f32, 0.0),
-                Quat::from_rotation_z(heading as f32),
-            )
-        })
+        self.world
+            .people
+            .get(index)
+            .map_or(Pose::IDENTITY, |p| p.world_from_person(self.sim_time_s()))
     }
 
     /// Sim time (s): physics steps taken times the step length.
@@ -360,10 +353,7 @@ fn world_groups() -> InteractionGroups {
 /// The pose of a person's physics capsule at sim time `t_s` (its centre at half height).
 fn person_body_pose(person: &crate::world::Person, t_s: f64) -> Pose {
     let (x, y, heading) = person.pose_at(t_s);
-    Pose::from_parts(
-        Vec3::new(x as f32, y as f32, person.height_m as f32 / 2.0),
-        Quat::from_rotation_z(heading as f32),
-    )
+    pose_from_position_yaw([x, y, person.height_m / 2.0], heading)
 }
 
 /// Adds the ground, objects, walls and people; returns the people's bodies.
@@ -379,11 +369,7 @@ fn add_world(physics: &mut PhysicsWorld, world: &World) -> Vec<RigidBodyHandle> 
         Some(ground),
     );
     for object in &world.objects {
-        let p = object.position_m;
-        let pose = Pose::from_parts(
-            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
-            Quat::from_rotation_z(object.yaw_rad as f32),
-        );
+        let pose = object.world_from_object();
         let builder = match object.mass_kg {
             Some(_) => RigidBodyBuilder::dynamic(),
             None => RigidBodyBuilder::fixed(),
@@ -512,13 +498,13 @@ fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> R
         )));
     }
     let spawn = &world.robot;
-    let world_from_root = Pose::from_parts(
-        Vec3::new(
-            spawn.position_m[0] as f32,
-            spawn.position_m[1] as f32,
-            -min_z + SPAWN_CLEARANCE_M,
-        ),
-        Quat::from_rotation_z(spawn.yaw_rad as f32),
+    let world_from_root = pose_from_position_yaw(
+        [
+            spawn.position_m[0],
+            spawn.position_m[1],
+            f64::from(SPAWN_CLEARANCE_M - min_z),
+        ],
+        spawn.yaw_rad,
     );
 
     // One rigid body per body root, carrying the summed inertials of its links.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::error::{Result, SimError};
-use crate::geometry::Rgba;
+use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
 use crate::tomlfile;
 
 /// Default physics step rate (Hz); see docs/WORLDS.md for why.
@@ -110,6 +110,22 @@ pub struct Object {
     pub friction: f32,
 }
 
+/// Physics step rates rover accepts (Hz), from world files and `--physics-hz` alike.
+pub const STEP_HZ_RANGE: std::ops::RangeInclusive<f64> = 50.0..=10_000.0;
+
+/// Checks a physics step rate against [`STEP_HZ_RANGE`]; the error says what was expected.
+pub fn check_step_hz(step_hz: f64) -> std::result::Result<(), String> {
+    if step_hz.is_finite() && STEP_HZ_RANGE.contains(&step_hz) {
+        Ok(())
+    } else {
+        Err(format!(
+            "expected a physics step rate of {}..={} Hz (default {DEFAULT_STEP_HZ}), found {step_hz}",
+            STEP_HZ_RANGE.start(),
+            STEP_HZ_RANGE.end()
+        ))
+    }
+}
+
 /// A person (`[[person]]`): a standing human figure, an obstacle for physics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Person {
@@ -142,7 +158,20 @@ pub struct Walk {
     pub speed_mps: f64,
 }
 
+impl Object {
+    /// Where the object's centre is, turned by its yaw.
+    pub fn world_from_object(&self) -> Pose {
+        pose_from_position_yaw(self.position_m, self.yaw_rad)
+    }
+}
+
 impl Person {
+    /// The person's pose at sim time `t_s`: feet on the ground, x facing where they look.
+    pub fn world_from_person(&self, t_s: f64) -> Pose {
+        let (x, y, heading) = self.pose_at(t_s);
+        pose_from_position_yaw([x, y, 0.0], heading)
+    }
+
     /// Where the person is at sim time `t_s`: (x m, y m, heading rad). Standing people stay
     /// put; walking people follow their closed path at their speed, facing where they go.
     pub fn pose_at(&self, t_s: f64) -> (f64, f64, f64) {
@@ -479,14 +508,8 @@ impl RawWorld {
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;
-        if !(50.0..=10_000.0).contains(&self.physics.step_hz) {
-            return Err(c.fail(
-                "physics.step_hz",
-                format!(
-                    "expected 50..=10000 Hz (default {DEFAULT_STEP_HZ}), found {}",
-                    self.physics.step_hz
-                ),
-            ));
+        if let Err(message) = check_step_hz(self.physics.step_hz) {
+            return Err(c.fail("physics.step_hz", message));
         }
         c.finite("physics.gravity_mps2", &self.physics.gravity_mps2)?;
         if !(1..=100).contains(&self.physics.solver_iterations) {

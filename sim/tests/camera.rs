@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use rover_sim::gazebo::GaussianNoise;
+use rover_sim::GaussianNoise;
 use rover_sim::{CameraInfo, CameraRenderer, Pose, RobotModel, World};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;

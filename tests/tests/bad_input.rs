@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use rover::script::Script;
+use rover_core::Script;
 use rover_sim::{RobotModel, World};
 use rover_tests::repo;
 

@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use anyhow::Result;
-use rover_sim::diff_drive::wrap_angle;
+use rover_sim::wrap_angle;
 use rover_sim::{SimOptions, Simulation, Twist, World};
 use rover_tests::{drive, flat_sim, my_robot, my_robot_with_plugin_param};
 

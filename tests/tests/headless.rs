@@ -1,8 +1,8 @@
 //! Headless scripted runs through the app library: traces, determinism, scripts with keys.
 
 use anyhow::Result;
-use rover::headless::{self, RunConfig};
-use rover::trace::{TRACE_HEADER, parse_trace};
+use rover_core::{RunConfig, headless};
+use rover_core::{TRACE_HEADER, parse_trace};
 use rover_sim::SimOptions;
 use rover_tests::repo;
 

@@ -2,8 +2,8 @@
 //! and decoding.
 
 use anyhow::Result;
-use rover::reference::onnxruntime;
 use rover_perception::preprocess::load_rgb;
+use rover_perception::reference::onnxruntime;
 use rover_perception::{Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView};
 use rover_tests::photo;
 

@@ -5,12 +5,15 @@
 
 pub mod meshes;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
 use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use crate::camera::{CameraInfo, link_from_optical};
 use crate::error::SimError;
-use crate::gazebo::{CameraConfig, GaussianNoise};
+use crate::gazebo::{CameraConfig, Distortion, GaussianNoise};
 use crate::geometry::{Pose, Rgba};
 use crate::robot::RobotModel;
 use crate::world::World;
@@ -130,7 +133,12 @@ pub struct CameraRenderer {
     noise: Option<(GaussianNoise, Rng)>,
     distortion_map: Option<Vec<[f32; 2]>>,
     adapter: String,
+    mapped: Arc<AtomicU8>,
 }
+
+const MAP_PENDING: u8 = 0;
+const MAP_OK: u8 = 1;
+const MAP_FAILED: u8 = 2;
 
 impl std::fmt::Debug for CameraRenderer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -335,20 +343,11 @@ impl CameraRenderer {
         );
         for object in &world.objects {
             let mesh = object_mesh(&object.shape);
-            let p = object.position_m;
-            let pose = Pose::from_parts(
-                Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
-                glam::Quat::from_rotation_z(object.yaw_rad as f32),
-            );
-            add(&mesh, instance(pose, object.color));
+            add(&mesh, instance(object.world_from_object(), object.color));
         }
         let mut person_parts_at = Vec::new();
         for (person_index, person) in world.people.iter().enumerate() {
-            let (x, y, heading) = person.pose_at(0.0);
-            let world_from_person = Pose::from_parts(
-                Vec3::new(x as f32, y as f32, 0.0),
-                glam::Quat::from_rotation_z(heading as f32),
-            );
+            let world_from_person = person.world_from_person(0.0);
             for part in person_parts(person) {
                 let index = add(
                     &part.mesh,
@@ -404,10 +403,11 @@ impl CameraRenderer {
             noise: camera.noise.map(|n| (n, Rng(seed ^ 0x5EED_CA3E_5EED_CA3E))),
             distortion_map: None,
             adapter: adapter_name,
+            mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
             info,
         };
         if !camera.distortion.is_zero() {
-            renderer.distortion_map = Some(renderer.build_distortion_map(camera));
+            renderer.distortion_map = Some(distortion_map(&renderer.info, &camera.distortion));
         }
         Ok(renderer)
     }
@@ -548,16 +548,32 @@ impl CameraRenderer {
         );
         self.queue.submit([encoder.finish()]);
         let slice = self.readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
+        // One flag for the renderer's life (no channel per frame): the callback has run once
+        // the blocking poll below returns.
+        self.mapped.store(MAP_PENDING, Ordering::Release);
+        let mapped = Arc::clone(&self.mapped);
         slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
+            mapped.store(
+                if r.is_ok() { MAP_OK } else { MAP_FAILED },
+                Ordering::Release,
+            );
         });
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| RenderError::Readback(e.to_string()))?
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        match self.mapped.load(Ordering::Acquire) {
+            MAP_OK => {}
+            MAP_FAILED => {
+                return Err(RenderError::Readback(
+                    "the readback buffer could not be mapped".into(),
+                ));
+            }
+            _ => {
+                return Err(RenderError::Readback(
+                    "the GPU finished without mapping the readback buffer".into(),
+                ));
+            }
+        }
         {
             let data = slice
                 .get_mapped_range()
@@ -616,29 +632,98 @@ impl CameraRenderer {
             }
         }
     }
+}
 
-    /// For each output (distorted) pixel, where to sample the ideal pinhole render: Brown-Conrady
-    /// inverted by fixed-point iteration, once.
-    fn build_distortion_map(&self, camera: &CameraConfig) -> Vec<[f32; 2]> {
-        let d = camera.distortion;
-        let (fx, cx, cy) = (self.info.k[0], self.info.k[2], self.info.k[5]);
-        let (w, h) = (self.info.width as usize, self.info.height as usize);
-        let mut map = Vec::with_capacity(w * h);
-        for v in 0..h {
-            for u in 0..w {
-                let (xd, yd) = ((u as f64 - cx) / fx, (v as f64 - cy) / fx);
-                let (mut x, mut y) = (xd, yd);
-                for _ in 0..20 {
-                    let r2 = x * x + y * y;
-                    let radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
-                    let dx = 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
-                    let dy = d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
-                    x = (xd - dx) / radial;
-                    y = (yd - dy) / radial;
-                }
-                map.push([(x * fx + cx) as f32, (y * fx + cy) as f32]);
+/// Brown-Conrady lens distortion as gazebo_ros_camera applies it, on normalised image
+/// coordinates (x = (u - cx) / fx, y = (v - cy) / fy): the distorted point of an ideal one.
+pub(crate) fn distort(d: &Distortion, x: f64, y: f64) -> (f64, f64) {
+    let r2 = x * x + y * y;
+    let radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
+    let dx = 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
+    let dy = d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+    (x * radial + dx, y * radial + dy)
+}
+
+/// For each output (distorted) pixel, where to sample the ideal pinhole render: [`distort`]
+/// inverted by fixed-point iteration, computed once per camera.
+pub(crate) fn distortion_map(info: &CameraInfo, d: &Distortion) -> Vec<[f32; 2]> {
+    let (fx, cx, cy) = (info.k[0], info.k[2], info.k[5]);
+    let (w, h) = (info.width as usize, info.height as usize);
+    let mut map = Vec::with_capacity(w * h);
+    for v in 0..h {
+        for u in 0..w {
+            let (xd, yd) = ((u as f64 - cx) / fx, (v as f64 - cy) / fx);
+            let (mut x, mut y) = (xd, yd);
+            for _ in 0..20 {
+                let r2 = x * x + y * y;
+                let radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
+                let dx = 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
+                let dy = d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+                x = (xd - dx) / radial;
+                y = (yd - dy) / radial;
             }
+            map.push([(x * fx + cx) as f32, (y * fx + cy) as f32]);
         }
-        map
+    }
+    map
+}
+
+#[cfg(test)]
+mod distortion_tests {
+    use super::*;
+
+    fn info() -> CameraInfo {
+        CameraInfo::from_config(&crate::camera::tests::seed_config())
+    }
+
+    #[test]
+    fn no_distortion_samples_every_pixel_where_it_is() {
+        let info = info();
+        let map = distortion_map(&info, &Distortion::default());
+        let w = info.width as usize;
+        for (u, v) in [(0usize, 0usize), (320, 240), (639, 479), (17, 401)] {
+            let [sx, sy] = map[v * w + u];
+            assert!(
+                (sx - u as f32).abs() < 1e-3 && (sy - v as f32).abs() < 1e-3,
+                "{u},{v}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_map_inverts_brown_conrady() {
+        let info = info();
+        let d = Distortion {
+            k1: -0.25,
+            k2: 0.12,
+            k3: -0.02,
+            p1: 0.001,
+            p2: -0.0015,
+        };
+        let map = distortion_map(&info, &d);
+        let (fx, cx, cy) = (info.k[0], info.k[2], info.k[5]);
+        let w = info.width as usize;
+        for (u, v) in [
+            (0usize, 0usize),
+            (320, 240),
+            (639, 479),
+            (100, 400),
+            (600, 30),
+        ] {
+            let [sx, sy] = map[v * w + u];
+            // Distorting the ideal point we sample must land back on the output pixel.
+            let (xd, yd) = distort(&d, (f64::from(sx) - cx) / fx, (f64::from(sy) - cy) / fx);
+            let (ud, vd) = (xd * fx + cx, yd * fx + cy);
+            assert!(
+                (ud - u as f64).abs() < 0.01 && (vd - v as f64).abs() < 0.01,
+                "{u},{v}: {ud},{vd}"
+            );
+        }
+        // Barrel distortion (k1 < 0): a corner of the image sees further out than a pinhole.
+        let [sx, sy] = map[0];
+        assert!(
+            sx < 0.0 && sy < 0.0,
+            "corner samples outside the ideal image: {sx},{sy}"
+        );
     }
 }

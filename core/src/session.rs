@@ -6,18 +6,17 @@
 //! Data flows one way: world + URDF -> sim -> camera -> detector -> pilot (teleop | follower)
 //! -> cmd_vel -> sim. Observers (the Rerun recorder, the window's HUD) only watch.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
 use rover_perception::{
     BoundingBoxes, Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, LockstepDetector,
-    RgbView, WorkerStats,
+    PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
     CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, Twist, World,
 };
 
+use crate::error::{CoreError, Result};
 use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig};
 use crate::pilot::{Mode, Pilot};
 use crate::script::Action;
@@ -49,10 +48,6 @@ pub struct SessionOptions {
     pub detector_config: DetectorConfig,
     /// Follower settings.
     pub follower: FollowerConfig,
-    /// Write camera images as PNG into this folder.
-    pub save_frames: Option<PathBuf>,
-    /// Write every Nth camera image (1 = all).
-    pub frame_every: u64,
 }
 
 impl Default for SessionOptions {
@@ -63,8 +58,6 @@ impl Default for SessionOptions {
             detector: DetectorMode::Off,
             detector_config: DetectorConfig::default(),
             follower: FollowerConfig::default(),
-            save_frames: None,
-            frame_every: 1,
         }
     }
 }
@@ -95,6 +88,8 @@ pub struct LoopStats {
     pub frames: u64,
     /// Whether a detector is running.
     pub detector_ok: bool,
+    /// Whether the detector failed during the run (an error or a panic in it); it stays off.
+    pub detector_failed: bool,
 }
 
 /// Watches a session without influencing it (the Rerun recorder, the window).
@@ -110,6 +105,39 @@ pub trait Observer {
     fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
+    /// An observer that can no longer do its job (a trace or frame it cannot write) says so
+    /// here, once; the runner decides whether the run stops.
+    fn failure(&mut self) -> Option<CoreError> {
+        None
+    }
+}
+
+/// Two observers side by side, built on the stack where one is added for a moment (the
+/// window's HUD beside the fan-out): no allocation.
+impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        self.0.start(sim, camera, labels);
+        self.1.start(sim, camera, labels);
+    }
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        self.0.control(sim, sample, stats);
+        self.1.control(sim, sample, stats);
+    }
+    fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, world_from_camera: Pose) {
+        self.0.camera_frame(frame, world_from_camera);
+        self.1.camera_frame(frame, world_from_camera);
+    }
+    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
+        self.0.detections(boxes, labels);
+        self.1.detections(boxes, labels);
+    }
+    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
+        self.0.event(sim_time_s, level, text);
+        self.1.event(sim_time_s, level, text);
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.0.failure().or_else(|| self.1.failure())
+    }
 }
 
 /// Sends an event to the observer and to the log.
@@ -143,9 +171,6 @@ pub struct Session {
     pilot: Pilot,
     follower: Follower,
     stats: LoopStats,
-    save_frames: Option<PathBuf>,
-    frame_every: u64,
-    frames_written: u64,
     last_boxes: Option<BoundingBoxes>,
     detections_done: u64,
     detector_started: Option<Instant>,
@@ -163,7 +188,8 @@ impl std::fmt::Debug for Session {
 impl Session {
     /// Builds the simulation, and the camera and detector when asked. A detector that cannot
     /// be loaded (no model, bad model) is reported through `observer` as a warning: the session
-    /// still runs, manual driving works and the follower holds still.
+    /// still runs, manual driving works and the follower holds still. The same policy holds
+    /// when the detector fails later (an error or a panic in it), headless or in the window.
     pub fn new(
         world: World,
         robot: RobotModel,
@@ -172,12 +198,10 @@ impl Session {
     ) -> Result<Self> {
         let sim = Simulation::new(world, robot, &options.sim)?;
         let camera_config = sim.robot().cameras.first().cloned();
-        let wants_camera = options.camera
-            || options.save_frames.is_some()
-            || options.detector != DetectorMode::Off;
+        let wants_camera = options.camera || options.detector != DetectorMode::Off;
         let camera = match (&camera_config, wants_camera) {
             (Some(_), true) => {
-                let sensor = CameraSensor::new(&sim).context("cannot start the camera")?;
+                let sensor = CameraSensor::new(&sim).map_err(CoreError::Camera)?;
                 tracing::info!(
                     "camera: {}x{}, rendering on {}",
                     sensor.info().width,
@@ -197,10 +221,6 @@ impl Session {
             }
             _ => None,
         };
-        if let Some(dir) = &options.save_frames {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-        }
         let camera_link = camera_config
             .as_ref()
             .and_then(|c| sim.robot().link_index(&c.link))
@@ -252,9 +272,6 @@ impl Session {
             labels,
             pilot: Pilot::default(),
             stats,
-            save_frames: options.save_frames.clone(),
-            frame_every: options.frame_every.max(1),
-            frames_written: 0,
             last_boxes: None,
             detections_done: 0,
             detector_started: None,
@@ -294,11 +311,6 @@ impl Session {
     /// Loop figures.
     pub fn stats(&self) -> LoopStats {
         self.stats
-    }
-
-    /// Camera images written by `save_frames`.
-    pub fn frames_written(&self) -> u64 {
-        self.frames_written
     }
 
     /// Applies a user input (script step, key, gamepad). Manual input while following takes
@@ -367,41 +379,21 @@ impl Session {
                     let stats = worker.stats();
                     self.accept(boxes, Some(stats), observer);
                 }
-                Err(e) => {
-                    emit(
-                        observer,
-                        self.sim.sim_time_s(),
-                        EventLevel::Warn,
-                        &format!("detector failed: {e}; the follower holds still"),
-                    );
-                    self.detection = Detection::Off;
-                    self.stats.detector_ok = false;
-                }
+                Err(e) => self.detector_failed(&e, observer),
             }
         }
         let Some(camera) = self.camera.as_mut() else {
             return Ok(());
         };
         let world_from_camera = self.sim.world_from_link(self.camera_link);
-        let Some(frame) = camera.capture_if_due(&self.sim)? else {
+        let Some(frame) = camera
+            .capture_if_due(&self.sim)
+            .map_err(CoreError::Camera)?
+        else {
             return Ok(());
         };
         self.stats.frames += 1;
         observer.camera_frame(&frame, world_from_camera);
-        if let Some(dir) = &self.save_frames
-            && frame.seq % self.frame_every == 0
-        {
-            let path = dir.join(format!("frame_{:06}.png", frame.seq));
-            image::save_buffer(
-                &path,
-                frame.rgb,
-                frame.width,
-                frame.height,
-                image::ExtendedColorType::Rgb8,
-            )
-            .with_context(|| format!("cannot write {}", path.display()))?;
-            self.frames_written += 1;
-        }
         let stamp = FrameStamp {
             sim_time_s: frame.sim_time_s,
             frame: frame.seq,
@@ -410,7 +402,15 @@ impl Session {
         let detected = match &mut self.detection {
             Detection::Off => None,
             Detection::Lockstep(detector) => {
-                detector.detect_if_due(RgbView::new(w, h, frame.rgb)?, stamp)?
+                match RgbView::new(w, h, frame.rgb)
+                    .and_then(|view| detector.detect_if_due(view, stamp))
+                {
+                    Ok(boxes) => boxes,
+                    Err(e) => {
+                        self.detector_failed(&e, observer);
+                        None
+                    }
+                }
             }
             Detection::Worker(worker) => {
                 let mut pixels = worker.buffer();
@@ -430,6 +430,20 @@ impl Session {
             self.accept(boxes, None, observer);
         }
         Ok(())
+    }
+
+    /// One policy for a detector that fails mid-run, headless or in the window: say so (log,
+    /// observers, HUD), turn detection off, keep manual driving; the follower holds still.
+    fn detector_failed(&mut self, error: &PerceptionError, observer: &mut dyn Observer) {
+        emit(
+            observer,
+            self.sim.sim_time_s(),
+            EventLevel::Warn,
+            &format!("detector failed: {error}; manual driving works, the follower holds still"),
+        );
+        self.detection = Detection::Off;
+        self.stats.detector_ok = false;
+        self.stats.detector_failed = true;
     }
 
     fn accept(

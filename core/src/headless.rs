@@ -1,20 +1,18 @@
 //! Headless runs: a world, a robot and an input script, stepped as fast as the CPU allows.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
 use rover_perception::DetectorConfig;
 use rover_sim::{ControlSample, RobotModel, SimOptions, World};
 
+use crate::error::{CoreError, Result};
 use crate::follower::FollowerConfig;
+use crate::observers::{Fanout, RunFiles};
 use crate::paths;
 use crate::pilot::Mode;
-use crate::script::{Action, Script};
+use crate::script::{Script, ScriptPlayer};
 use crate::session::{DetectorMode, NoObserver, Observer, Session, SessionOptions};
-use crate::trace::TraceWriter;
 
 /// Everything a headless run needs.
 #[derive(Debug, Clone, Default)]
@@ -46,6 +44,9 @@ pub struct RunConfig {
     pub detector: DetectorConfig,
     /// Follower settings.
     pub follower: FollowerConfig,
+    /// Pace the run to this many sim seconds per wall second (None = as fast as the CPU
+    /// allows). Pacing never changes the trace: it only waits.
+    pub real_time_factor: Option<f64>,
 }
 
 /// Whether a headless run renders the camera and runs the detector.
@@ -109,6 +110,14 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
     Ok((world, robot))
 }
 
+/// Loads the script a [`RunConfig`] names (an empty one without).
+pub fn load_script(config: &RunConfig) -> Result<Script> {
+    match &config.script {
+        Some(path) => Script::load(path),
+        None => Ok(Script::default()),
+    }
+}
+
 /// Runs headless and writes the trace, if asked. Deterministic: the same world, robot, script
 /// and seed give a byte-identical trace (detection runs in lockstep on sim time).
 pub fn run(config: &RunConfig) -> Result<RunSummary> {
@@ -123,44 +132,47 @@ pub fn run_observed(
     observer_wants_camera: bool,
 ) -> Result<RunSummary> {
     let (world, robot) = load(config)?;
-    let script = match &config.script {
-        Some(path) => Script::load(path)?,
-        None => Script::default(),
-    };
+    let script = load_script(config)?;
     let duration_s = match config.duration_s {
         Some(d) if d.is_finite() && d >= 0.0 => d,
-        Some(d) => anyhow::bail!("--duration must be a number of seconds >= 0, found {d}"),
+        Some(d) => {
+            return Err(CoreError::Option(format!(
+                "--duration must be a number of seconds >= 0, found {d}"
+            )));
+        }
         None if config.script.is_some() => script.end_s() + 1.0,
         None => 10.0,
     };
     let detect_hz = config.detect_hz.unwrap_or(DEFAULT_DETECT_HZ);
-    anyhow::ensure!(
-        detect_hz.is_finite() && detect_hz > 0.0,
-        "--detect-hz must be a positive number, found {detect_hz}"
-    );
-    let follows = script
-        .steps
-        .iter()
-        .any(|s| matches!(s.action, Action::ToggleFollow));
+    if !(detect_hz.is_finite() && detect_hz > 0.0) {
+        return Err(CoreError::Option(format!(
+            "--detect-hz must be a positive number, found {detect_hz}"
+        )));
+    }
+    if let Some(rtf) = config.real_time_factor
+        && !(rtf.is_finite() && rtf > 0.0)
+    {
+        return Err(CoreError::Option(format!(
+            "--rtf must be a positive factor, found {rtf}"
+        )));
+    }
+    let mut player = ScriptPlayer::new(script);
     let perceive = match config.perception {
         Perception::On => true,
         Perception::Off => false,
-        Perception::Auto => follows || observer_wants_camera,
+        Perception::Auto => player.toggles_follow() || observer_wants_camera,
     };
-    let mut trace = match &config.trace {
-        Some(path) => {
-            let file = File::create(path)
-                .with_context(|| format!("cannot create trace file {}", path.display()))?;
-            Some(TraceWriter::new(BufWriter::new(file))?)
-        }
-        None => None,
-    };
+    let mut files = RunFiles::open(
+        config.trace.as_deref(),
+        config.save_frames.as_deref(),
+        config.frame_every,
+    )?;
 
     let world_name = world.name.clone();
     let robot_name = robot.name.clone();
     let options = SessionOptions {
         sim: config.options.clone(),
-        camera: perceive,
+        camera: perceive || files.frames.is_some(),
         detector: if perceive {
             DetectorMode::Lockstep { rate_hz: detect_hz }
         } else {
@@ -168,33 +180,29 @@ pub fn run_observed(
         },
         detector_config: config.detector.clone(),
         follower: config.follower.clone(),
-        save_frames: config.save_frames.clone(),
-        frame_every: config.frame_every,
     };
-    let mut session = Session::new(world, robot, &options, observer)?;
-    let dt_s = session.sim().dt_s();
-    let mut next_step = 0;
-    let total_steps = (duration_s / dt_s).round() as u64;
+    let mut fan = Fanout::default();
+    fan.push(&mut files);
+    fan.push(observer);
+    let mut session = Session::new(world, robot, &options, &mut fan)?;
+    let total_steps = (duration_s / session.sim().dt_s()).round() as u64;
     let mut last = None;
     let started = Instant::now();
     let mut last_report = started;
 
     while session.sim().step_index() < total_steps {
-        let now = session.sim().sim_time_s();
-        while let Some(step) = script.steps.get(next_step) {
-            // Half a physics step of tolerance: a step applies at the first physics step at or
-            // after its time.
-            if step.at_s > now + dt_s / 2.0 {
-                break;
-            }
-            session.input(step.action, observer);
-            next_step += 1;
-        }
-        if let Some(sample) = session.step(observer)? {
-            if let Some(t) = trace.as_mut() {
-                t.row(&sample, session.pilot().mode())?;
-            }
+        if let Some(sample) = player.step(&mut session, &mut fan)? {
             last = Some(sample);
+        }
+        if let Some(failure) = fan.failure() {
+            return Err(failure);
+        }
+        if let Some(rtf) = config.real_time_factor {
+            // Ahead of the wall clock: wait (in steps of a few ms, so sleeping stays coarse).
+            let ahead_s = session.sim().sim_time_s() / rtf - started.elapsed().as_secs_f64();
+            if ahead_s > 0.005 {
+                std::thread::sleep(Duration::from_secs_f64(ahead_s));
+            }
         }
         if let Some(every) = config.progress_every
             && last_report.elapsed() >= every
@@ -209,28 +217,16 @@ pub fn run_observed(
         }
     }
     let wall_s = started.elapsed().as_secs_f64();
-    let rows = match trace {
-        Some(t) => {
-            let rows = t.rows();
-            t.finish()?;
-            rows
-        }
-        None => 0,
-    };
-    if let Some(dir) = &config.save_frames {
-        tracing::info!(
-            "wrote {} camera frames to {}",
-            session.frames_written(),
-            dir.display()
-        );
-    }
+    drop(fan);
+    let written = files.finish()?;
     Ok(RunSummary {
         world: world_name,
         robot: robot_name,
         sim_time_s: session.sim().sim_time_s(),
         steps: session.sim().step_index(),
         wall_s,
-        rows,
+        rows: written.rows,
+        frames_written: written.frames,
         last,
         mode: session.pilot().mode(),
     })

@@ -19,7 +19,7 @@
 use std::collections::VecDeque;
 
 use rover_perception::{BoundingBox, BoundingBoxes};
-use rover_sim::diff_drive::wrap_angle;
+use rover_sim::wrap_angle;
 use rover_sim::{CameraInfo, Odometry, Twist};
 
 /// Follower settings.

@@ -1,11 +1,16 @@
 //! onnxruntime as the reference runtime (Python, `scripts/ort_reference.py`): the detector tests
-//! and `rover bench detect` run it on exactly the graph and input tensor rover uses.
+//! and `rover bench detect` run it on exactly the graph and input tensor rover uses. A tool for
+//! tests and benchmarks; the detector never needs Python.
 
 use std::path::Path;
 use std::process::Command;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use anyhow::{Context, Result, bail};
+use crate::error::{PerceptionError, Result};
+
+/// The onnxruntime script, written next to its input for each call (so it is found however
+/// rover is run).
+const SCRIPT: &str = include_str!("../../scripts/ort_reference.py");
 
 /// What onnxruntime produced.
 #[derive(Debug, Clone)]
@@ -35,7 +40,7 @@ pub fn onnxruntime(
         std::process::id(),
         CALLS.fetch_add(1, Ordering::Relaxed)
     ));
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| PerceptionError::io(&dir, e))?;
     let result = run_in(&dir, model, input, shape, threads, runs);
     let _ = std::fs::remove_dir_all(&dir);
     result
@@ -52,8 +57,9 @@ fn run_in(
     let input_path = dir.join("input.f32");
     let output_path = dir.join("output.f32");
     let bytes: Vec<u8> = input.iter().flat_map(|v| v.to_le_bytes()).collect();
-    std::fs::write(&input_path, bytes)?;
-    let script = crate::paths::bundled("scripts/ort_reference.py");
+    std::fs::write(&input_path, bytes).map_err(|e| PerceptionError::io(&input_path, e))?;
+    let script = dir.join("ort_reference.py");
+    std::fs::write(&script, SCRIPT).map_err(|e| PerceptionError::io(&script, e))?;
     let shape_arg = shape
         .iter()
         .map(usize::to_string)
@@ -72,15 +78,18 @@ fn run_in(
             &runs.max(1).to_string(),
         ])
         .output()
-        .context("cannot run python3")?;
+        .map_err(|e| PerceptionError::Reference(format!("cannot run python3: {e}")))?;
     if !out.status.success() {
-        bail!(
+        return Err(PerceptionError::Reference(format!(
             "onnxruntime reference failed (pip install onnxruntime numpy): {}",
             String::from_utf8_lossy(&out.stderr).trim()
-        );
+        )));
     }
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout)
-        .with_context(|| format!("unexpected output from {}", script.display()))?;
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).map_err(|e| {
+        PerceptionError::Reference(format!(
+            "unexpected output from the onnxruntime script: {e}"
+        ))
+    })?;
     let shape = report["shape"]
         .as_array()
         .map(|dims| {
@@ -89,7 +98,7 @@ fn run_in(
                 .collect()
         })
         .unwrap_or_default();
-    let raw = std::fs::read(&output_path)?;
+    let raw = std::fs::read(&output_path).map_err(|e| PerceptionError::io(&output_path, e))?;
     Ok(OrtRun {
         output: raw
             .chunks_exact(4)

@@ -1,11 +1,17 @@
-//! `rover bench`: physics-only real-time factor on a world, single-threaded.
+//! `rover bench`: physics-only real-time factor on a world (single-threaded), camera frame
+//! time, recording overhead and detector stages (beside onnxruntime).
 
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
+use rover_core::headless;
+use rover_core::{Perception, RunConfig};
+use rover_perception::DetectorConfig;
 use rover_sim::{SimOptions, Simulation, Twist};
 
-use crate::headless::{self, RunConfig};
+use super::args::WorldArgs;
+use crate::viewer::{ImageOptions, Recorder, RecorderOptions, Viewer};
 
 /// One benchmark measurement.
 #[derive(Debug, Clone, Copy)]
@@ -144,9 +150,15 @@ fn onnxruntime_median(
         .map_err(|e| e.to_string())
         .and_then(|()| {
             let (input, _) = detector.preprocess(view).map_err(|e| e.to_string())?;
-            crate::reference::onnxruntime(&model, input, &[1, 3, h, w], 1, runs.max(1) + 1)
-                .map(|r| r.median_ms)
-                .map_err(|e| format!("{e:#}"))
+            rover_perception::reference::onnxruntime(
+                &model,
+                input,
+                &[1, 3, h, w],
+                1,
+                runs.max(1) + 1,
+            )
+            .map(|r| r.median_ms)
+            .map_err(|e| format!("{e:#}"))
         });
     let _ = std::fs::remove_file(&model);
     result
@@ -213,13 +225,12 @@ impl RecordBench {
 /// Runs `config` `repeats` times each without and with a recorder writing into `dir`.
 pub fn record(
     config: &RunConfig,
-    images: crate::recorder::ImageOptions,
+    images: ImageOptions,
     repeats: u32,
     dir: &std::path::Path,
 ) -> Result<RecordBench> {
-    use crate::recorder::{Recorder, RecorderOptions, Viewer};
     let config = RunConfig {
-        perception: headless::Perception::On,
+        perception: Perception::On,
         ..config.clone()
     };
     let mut plain = f64::INFINITY;
@@ -250,4 +261,132 @@ pub fn record(
         recorded_s: recorded,
         rrd_bytes,
     })
+}
+
+pub(crate) fn bench_cmd(
+    world: WorldArgs,
+    sim_seconds: f64,
+    repeats: u32,
+    rates: Vec<f64>,
+) -> Result<()> {
+    anyhow::ensure!(
+        sim_seconds.is_finite() && sim_seconds > 0.0,
+        "--sim-seconds must be positive, found {sim_seconds}"
+    );
+    let config = world.run_config(None);
+    let mut plan: Vec<Option<f64>> = vec![world.physics_hz];
+    plan.extend(rates.into_iter().map(Some));
+    println!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
+    println!(
+        "{:>10} {:>12} {:>12} {:>14}",
+        "step_hz", "wall_s", "us/step", "real-time x"
+    );
+    for step_hz in plan {
+        let b = physics(&config, step_hz, sim_seconds, repeats)?;
+        println!(
+            "{:>10.0} {:>12.3} {:>12.1} {:>14.0}",
+            b.step_hz,
+            b.wall_s,
+            b.us_per_step(),
+            b.real_time_factor()
+        );
+    }
+    Ok(())
+}
+
+pub(crate) fn bench_record(
+    world: WorldArgs,
+    duration: f64,
+    repeats: u32,
+    jpeg: Option<u8>,
+) -> Result<()> {
+    let config = RunConfig {
+        duration_s: Some(duration),
+        ..world.run_config(None)
+    };
+    let dir = std::env::temp_dir().join(format!("rover-bench-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    println!(
+        "recording overhead: {duration} sim s headless, camera + lockstep detector on, best of {repeats}"
+    );
+    let b = record(
+        &config,
+        ImageOptions {
+            jpeg_quality: jpeg,
+            ..ImageOptions::default()
+        },
+        repeats,
+        &dir,
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    let b = b?;
+    println!("without --record: {:.2} s wall", b.plain_s);
+    println!(
+        "with --record:    {:.2} s wall ({:.1} MB .rrd)",
+        b.recorded_s,
+        b.rrd_bytes as f64 / 1e6
+    );
+    println!("ratio: {:.2}x (goal <= 1.3x)", b.ratio());
+    Ok(())
+}
+
+pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
+    let config = world.run_config(None);
+    let b = camera(&config, frames)?;
+    println!(
+        "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",
+        b.size.0, b.size.1, b.adapter, b.median_ms, b.best_ms
+    );
+    Ok(())
+}
+
+pub(crate) fn bench_detect(
+    config: DetectorConfig,
+    image: Option<PathBuf>,
+    runs: usize,
+) -> Result<()> {
+    let image = match image {
+        Some(path) => path,
+        None => {
+            let darknet = PathBuf::from("/usr/share/darknet/data/person.jpg");
+            if darknet.is_file() {
+                darknet
+            } else {
+                let path = std::env::temp_dir().join("rover-bench-pattern.png");
+                let pattern = image::RgbImage::from_fn(640, 480, |x, y| {
+                    image::Rgb([(x % 256) as u8, (y % 256) as u8, ((x + y) % 256) as u8])
+                });
+                pattern.save(&path)?;
+                path
+            }
+        }
+    };
+    println!(
+        "detector benchmark on {}: {runs} runs after a warm-up, one thread",
+        image.display()
+    );
+    let b = detector(config, &image, runs)?;
+    println!("input {}x{}", b.input_size.0, b.input_size.1);
+    println!("{:<28} {:>10}", "stage (median)", "ms");
+    println!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
+    println!("{:<28} {:>10.1}", "tract inference", b.inference_ms);
+    println!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
+    println!(
+        "{:<28} {:>10.1}   ({:.1} Hz)",
+        "end to end",
+        b.total_ms,
+        1000.0 / b.total_ms
+    );
+    match b.onnxruntime_ms {
+        Ok(ort) => {
+            println!("{:<28} {:>10.1}", "onnxruntime inference", ort);
+            println!(
+                "{:<28} {:>10.2}x",
+                "tract / onnxruntime",
+                b.inference_ms / ort
+            );
+        }
+        Err(e) => println!("onnxruntime: not measured ({e}); pip install onnxruntime"),
+    }
+    Ok(())
 }

@@ -104,26 +104,11 @@ pub fn run(options: &DetectOptions) -> Result<()> {
     Ok(())
 }
 
-/// A distinct, stable colour per class id.
-pub fn class_color(id: i16) -> Rgb<u8> {
-    const PALETTE: [[u8; 3]; 8] = [
-        [255, 56, 56],
-        [255, 157, 151],
-        [255, 112, 31],
-        [255, 178, 29],
-        [207, 210, 49],
-        [72, 249, 10],
-        [26, 147, 52],
-        [0, 212, 187],
-    ];
-    Rgb(PALETTE[(id.unsigned_abs() as usize) % PALETTE.len()])
-}
-
 /// Draws 2-px box outlines.
 pub fn draw_boxes(canvas: &mut RgbImage, boxes: &[BoundingBox]) {
     let (w, h) = (i64::from(canvas.width()), i64::from(canvas.height()));
     for b in boxes {
-        let color = class_color(b.id);
+        let color = crate::palette::class_color(b.id);
         for t in 0..2 {
             let (x0, y0) = ((b.xmin + t).clamp(0, w - 1), (b.ymin + t).clamp(0, h - 1));
             let (x1, y1) = (

@@ -82,23 +82,40 @@ pub struct TraceRow {
     pub mode: String,
 }
 
+/// A trace CSV that is not what [`TraceWriter`] writes.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("trace line {line}: {message}")]
+pub struct TraceParseError {
+    /// 1-based line.
+    pub line: usize,
+    /// What was wrong.
+    pub message: String,
+}
+
 /// Parses a trace CSV produced by [`TraceWriter`].
-pub fn parse_trace(text: &str) -> anyhow::Result<Vec<TraceRow>> {
+pub fn parse_trace(text: &str) -> Result<Vec<TraceRow>, TraceParseError> {
     let mut lines = text.lines();
     let header = lines.next().unwrap_or("");
-    anyhow::ensure!(header == TRACE_HEADER, "unexpected trace header: {header}");
+    if header != TRACE_HEADER {
+        return Err(TraceParseError {
+            line: 1,
+            message: format!("unexpected header: {header}; expected {TRACE_HEADER}"),
+        });
+    }
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
         let f: Vec<&str> = line.split(',').collect();
-        anyhow::ensure!(
-            f.len() == 10,
-            "trace line {}: expected 10 fields, found {}",
-            n + 2,
-            f.len()
-        );
-        let num = |i: usize| -> anyhow::Result<f64> {
-            f[i].parse()
-                .map_err(|e| anyhow::anyhow!("trace line {}, field {}: {e}", n + 2, i + 1))
+        if f.len() != 10 {
+            return Err(TraceParseError {
+                line: n + 2,
+                message: format!("expected 10 fields, found {}", f.len()),
+            });
+        }
+        let num = |i: usize| -> Result<f64, TraceParseError> {
+            f[i].parse().map_err(|e| TraceParseError {
+                line: n + 2,
+                message: format!("field {}: {e}", i + 1),
+            })
         };
         rows.push(TraceRow {
             sim_time_s: num(0)?,

@@ -10,11 +10,12 @@
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
+use rover_sim::{ControlSample, SimError, Twist};
 use serde::Deserialize;
 
+use crate::error::Result;
+use crate::session::{Observer, Session};
 use crate::teleop::{KeyAction, TELEOP_KEYS, key_action};
-use rover_sim::Twist;
 
 /// What a step does.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,49 +63,59 @@ struct RawStep {
 impl Script {
     /// Loads and validates a script file.
     pub fn load(path: &Path) -> Result<Self> {
-        let raw: RawScript = rover_sim::tomlfile::load_toml(path)?;
+        let raw: RawScript = rover_sim::load_toml(path)?;
         Self::from_raw(raw, path)
     }
 
     /// Parses script text; `path` is used in messages.
     pub fn from_str(text: &str, path: &Path) -> Result<Self> {
-        let raw: RawScript = rover_sim::tomlfile::parse_toml(text, path)?;
+        let raw: RawScript = rover_sim::parse_toml(text, path)?;
         Self::from_raw(raw, path)
     }
 
     fn from_raw(raw: RawScript, path: &Path) -> Result<Self> {
         let mut steps = Vec::with_capacity(raw.steps.len());
         for (i, s) in raw.steps.into_iter().enumerate() {
-            let here = format!("{}: at `steps[{i}]`", path.display());
+            let bail = |message: String| -> Result<Self> {
+                Err(SimError::invalid(path, None, format!("at `steps[{i}]`: {message}")).into())
+            };
             if !(s.at.is_finite() && s.at >= 0.0) {
-                bail!(
-                    "{here}: `at` must be a sim time in seconds >= 0, found {}",
+                return bail(format!(
+                    "`at` must be a sim time in seconds >= 0, found {}",
                     s.at
-                );
+                ));
             }
             let action = match (s.cmd_vel, s.key, s.toggle) {
                 (Some([linear, angular]), None, None) => {
                     let twist = Twist::new(linear, angular);
                     if !twist.is_finite() {
-                        bail!(
-                            "{here}: cmd_vel must be two finite numbers [linear.x m/s, angular.z rad/s], found [{linear}, {angular}]"
-                        );
+                        return bail(format!(
+                            "cmd_vel must be two finite numbers [linear.x m/s, angular.z rad/s], found [{linear}, {angular}]"
+                        ));
                     }
                     Action::CmdVel(twist)
                 }
                 (None, Some(key), None) => match key_action(&key) {
                     Some(a) => Action::Key(a),
-                    None => bail!(
-                        "{here}: key \"{key}\" is not a teleop key; expected one of: {TELEOP_KEYS}"
-                    ),
+                    None => {
+                        return bail(format!(
+                            "key \"{key}\" is not a teleop key; expected one of: {TELEOP_KEYS}"
+                        ));
+                    }
                 },
                 (None, None, Some(mode)) => match mode.as_str() {
                     "follow" => Action::ToggleFollow,
-                    other => bail!("{here}: toggle \"{other}\" is unknown; expected \"follow\""),
+                    other => {
+                        return bail(format!(
+                            "toggle \"{other}\" is unknown; expected \"follow\""
+                        ));
+                    }
                 },
-                _ => bail!(
-                    "{here}: expected exactly one of `cmd_vel`, `key` or `toggle` besides `at`"
-                ),
+                _ => {
+                    return bail(
+                        "expected exactly one of `cmd_vel`, `key` or `toggle` besides `at`".into(),
+                    );
+                }
             };
             steps.push(Step { at_s: s.at, action });
         }
@@ -118,16 +129,68 @@ impl Script {
     }
 }
 
+/// Plays a script into a session: every step applies at the first physics step at or after its
+/// sim time. The one player for headless runs and the window.
+#[derive(Debug, Clone, Default)]
+pub struct ScriptPlayer {
+    script: Script,
+    next: usize,
+}
+
+impl ScriptPlayer {
+    /// A player at the script's start.
+    pub fn new(script: Script) -> Self {
+        Self { script, next: 0 }
+    }
+
+    /// The script.
+    pub fn script(&self) -> &Script {
+        &self.script
+    }
+
+    /// True when the script switches the follower on or off somewhere.
+    pub fn toggles_follow(&self) -> bool {
+        self.script
+            .steps
+            .iter()
+            .any(|s| matches!(s.action, Action::ToggleFollow))
+    }
+
+    /// Applies the steps due at the session's sim time (half a physics step of tolerance).
+    pub fn play(&mut self, session: &mut Session, observer: &mut dyn Observer) {
+        let now = session.sim().sim_time_s();
+        let half_step_s = session.sim().dt_s() / 2.0;
+        while let Some(step) = self.script.steps.get(self.next) {
+            if step.at_s > now + half_step_s {
+                break;
+            }
+            session.input(step.action, observer);
+            self.next += 1;
+        }
+    }
+
+    /// Plays the due steps, then advances the session one physics step. Returns the control
+    /// sample when the diff drive's control loop ran.
+    pub fn step(
+        &mut self,
+        session: &mut Session,
+        observer: &mut dyn Observer,
+    ) -> Result<Option<ControlSample>> {
+        self.play(session, observer);
+        session.step(observer)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn parse(text: &str) -> Result<Script> {
+    fn parse(text: &str) -> crate::Result<Script> {
         Script::from_str(text, Path::new("s.toml"))
     }
 
     #[test]
-    fn parses_and_sorts_steps() -> Result<()> {
+    fn parses_and_sorts_steps() -> crate::Result<()> {
         let s = parse(
             "steps = [ { at = 2.0, key = \"j\" }, { at = 0.0, cmd_vel = [0.5, 0.0] }, { at = 3.0, toggle = \"follow\" } ]",
         )?;

@@ -1,0 +1,449 @@
+//! The command line: every option and subcommand, with their checks.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use rover_core::{FollowerConfig, Perception, RunConfig};
+use rover_perception::{DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig};
+use rover_sim::SimOptions;
+
+use crate::viewer::{ImageOptions, RecorderOptions, Viewer};
+
+/// rover: a desktop robot simulator for learning robot perception.
+///
+/// A URDF differential-drive car with a camera, in a world from worlds/, stepped with rapier3d
+/// physics and driven like Gazebo's diff_drive plugin (cmd_vel: linear.x m/s, angular.z rad/s;
+/// REP-103 frames: x forward, y left, z up).
+///
+/// Without a subcommand rover opens the driver's station: a window with the car's camera, boxes
+/// and a HUD; drive with teleop_twist_keyboard's keys (hold to drive) or a gamepad, press `f` to
+/// let the follower drive toward the person, and watch everything in the Rerun viewer. With
+/// --headless it runs as fast as the CPU allows from a script of timed inputs, deterministically.
+#[derive(Debug, Parser)]
+#[command(version, about, long_about, after_help = EXAMPLES)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) command: Option<Command>,
+
+    #[command(flatten)]
+    pub(crate) run: RunArgs,
+}
+
+const EXAMPLES: &str = "\
+Examples:
+  rover                                             window + Rerun viewer on the default world
+  rover --world worlds/walking.toml --viewer web    a walking person; viewer in the browser
+  rover --headless                                  default world and robot for 10 s, print a summary
+  rover --headless --record run.rrd                 the same, recorded for `rerun run.rrd`
+  rover --headless --script drive.toml --trace out.csv
+  rover --headless --world worlds/playground.toml --robot assets/robots/my_robot.urdf --duration 30 --seed 7
+  rover bench                                       physics-only real-time factor
+  rover detect photo.jpg --out boxes.png            YOLO boxes on an image (the model's quick check)
+
+Window keys (teleop_twist_keyboard layout; hold to drive, release to stop; --latched to keep going):
+  u i o / j k l / m , .   drive       k, space  stop      q/z w/x e/c  speed/turn x1.1 / x0.9
+  arrows                  drive       f  follow on/off    p  pause, n  single step    Esc  quit
+Gamepad: hold LB (deadman) + left stick forward/back, right stick turn; A toggles follow.
+
+Script format (TOML, times in sim seconds):
+  steps = [
+    { at = 0.0, cmd_vel = [0.5, 0.0] },   # linear.x m/s, angular.z rad/s
+    { at = 2.0, key = \"j\" },              # teleop_twist_keyboard key: u i o j k l m , . q z w x e c space
+    { at = 3.0, toggle = \"follow\" },      # flip manual/follow
+  ]
+
+Trace CSV columns (one row per diff-drive control update):
+  sim_time_s,x_m,y_m,yaw_rad,odom_x_m,odom_y_m,odom_yaw_rad,cmd_linear_mps,cmd_angular_radps,mode";
+
+#[derive(Debug, Args)]
+pub(crate) struct WorldArgs {
+    /// World file (TOML, see docs/WORLDS.md) [default: worlds/playground.toml]
+    #[arg(long, value_name = "FILE")]
+    pub(crate) world: Option<PathBuf>,
+
+    /// Robot URDF [default: the world's [robot] urdf, else assets/robots/my_robot.urdf]
+    #[arg(long, value_name = "FILE")]
+    pub(crate) robot: Option<PathBuf>,
+
+    /// Physics step rate in Hz, overriding the world's [physics] step_hz
+    #[arg(long, value_name = "HZ")]
+    pub(crate) physics_hz: Option<f64>,
+
+    /// Seed for everything random; the same seed gives the same run
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RunArgs {
+    /// Run without a window, as fast as the CPU allows, deterministically (detector in lockstep
+    /// on sim time)
+    #[arg(long)]
+    pub(crate) headless: bool,
+
+    #[command(flatten)]
+    pub(crate) world: WorldArgs,
+
+    /// Input script: timed cmd_vel / key / toggle steps on sim time (TOML)
+    #[arg(long, value_name = "FILE")]
+    pub(crate) script: Option<PathBuf>,
+
+    /// Sim seconds to run [default: last script step + 1 s, or 10 s]
+    #[arg(long, value_name = "SECS")]
+    pub(crate) duration: Option<f64>,
+
+    /// Write a CSV trace, one row per control update
+    #[arg(long, value_name = "FILE")]
+    pub(crate) trace: Option<PathBuf>,
+
+    /// Write the robot camera's images as PNG files into DIR (rendered with wgpu: a GPU, or
+    /// Mesa's software Vulkan)
+    #[arg(long, value_name = "DIR")]
+    pub(crate) save_frames: Option<PathBuf>,
+
+    /// With --save-frames: write every Nth camera image
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub(crate) frame_every: u64,
+
+    /// Stop the robot when no cmd_vel arrived for SECS (off by default, like Gazebo; 0 = off)
+    #[arg(long, value_name = "SECS")]
+    pub(crate) cmd_timeout: Option<f64>,
+
+    #[command(flatten)]
+    pub(crate) follow: FollowArgs,
+
+    #[command(flatten)]
+    pub(crate) detector: DetectorArgs,
+
+    #[command(flatten)]
+    pub(crate) viewer: ViewerArgs,
+
+    #[command(flatten)]
+    pub(crate) window: WindowArgs,
+}
+
+/// Window options.
+#[derive(Debug, Args)]
+pub(crate) struct WindowArgs {
+    /// Sim seconds per wall second [default: 1 in the window; headless runs go as fast as the
+    /// CPU allows unless given, e.g. --rtf 1 for a live viewer or ROS peers]
+    #[arg(long, value_name = "X")]
+    pub(crate) rtf: Option<f64>,
+
+    /// Window: keep driving after a key is released, like the terminal teleop_twist_keyboard
+    /// (default: hold a key to drive, release to stop)
+    #[arg(long)]
+    pub(crate) latched: bool,
+
+    /// Window: W/A/S/D drive too (teleop's w/x/e/c speed keys are then off; q/z still scale)
+    #[arg(long)]
+    pub(crate) wasd: bool,
+
+    /// Window: start paused (p resumes, n steps one control update)
+    #[arg(long)]
+    pub(crate) paused: bool,
+
+    /// Window: write the window's image (camera, boxes, HUD) as PNG when quitting
+    #[arg(long, value_name = "FILE.png")]
+    pub(crate) screenshot: Option<PathBuf>,
+}
+
+/// Rerun viewer and recording options.
+#[derive(Debug, Args)]
+pub(crate) struct ViewerArgs {
+    /// Rerun viewer: `spawn` (native viewer, `pip install rerun-sdk==0.36.3`), `connect [URL]`
+    /// (a running viewer, default rerun+http://127.0.0.1:9876/proxy), `web` (rover serves the
+    /// web viewer and prints its URL), `save FILE.rrd`, or `none` [default: none when headless;
+    /// in the window: spawn when a matching `rerun` is on PATH, else web]
+    #[arg(long, num_args = 1..=2, value_names = ["MODE", "ARG"])]
+    pub(crate) viewer: Vec<String>,
+
+    /// Also record the run to this .rrd file (works with any --viewer)
+    #[arg(long, value_name = "FILE.rrd")]
+    pub(crate) record: Option<PathBuf>,
+
+    /// Camera images sent to Rerun per sim second [default: every camera frame]
+    #[arg(long, value_name = "HZ")]
+    pub(crate) image_hz: Option<f64>,
+
+    /// Send camera images to Rerun at 1/N of their width and height (long runs)
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub(crate) image_downscale: u32,
+
+    /// Send camera images to Rerun as JPEG of this quality (1-100) instead of raw RGB
+    #[arg(long, value_name = "Q", value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub(crate) image_jpeg: Option<u8>,
+
+    /// Port of the web viewer (`--viewer web`)
+    #[arg(long, default_value_t = 9090, value_name = "PORT")]
+    pub(crate) web_port: u16,
+
+    /// Port of the Rerun data server behind the web viewer (`--viewer web`)
+    #[arg(long, default_value_t = 9876, value_name = "PORT")]
+    pub(crate) grpc_port: u16,
+}
+
+impl ViewerArgs {
+    pub(crate) fn options(&self, interactive: bool) -> Result<RecorderOptions> {
+        let viewer = if self.viewer.is_empty() {
+            if interactive {
+                let (viewer, why) = crate::viewer::default_viewer();
+                tracing::info!("viewer: {why}");
+                viewer
+            } else {
+                Viewer::None
+            }
+        } else {
+            Viewer::parse(&self.viewer)?
+        };
+        if let Some(hz) = self.image_hz {
+            anyhow::ensure!(
+                hz.is_finite() && hz > 0.0,
+                "--image-hz must be positive, found {hz}"
+            );
+        }
+        anyhow::ensure!(
+            (1..=16).contains(&self.image_downscale),
+            "--image-downscale must be 1..=16, found {}",
+            self.image_downscale
+        );
+        Ok(RecorderOptions {
+            viewer,
+            record: self.record.clone(),
+            images: ImageOptions {
+                rate_hz: self.image_hz,
+                downscale: self.image_downscale,
+                jpeg_quality: self.image_jpeg,
+            },
+            web_port: self.web_port,
+            grpc_port: self.grpc_port,
+        })
+    }
+}
+
+/// Camera, detector and follower options of a run.
+#[derive(Debug, Args)]
+pub(crate) struct FollowArgs {
+    /// Headless: run the camera and detector even when the script never switches to follow
+    /// (they always run when it does)
+    #[arg(long, conflicts_with = "no_detector")]
+    pub(crate) detect: bool,
+
+    /// Never run the detector (the follower then holds still)
+    #[arg(long)]
+    pub(crate) no_detector: bool,
+
+    /// Headless: detections per sim second, in lockstep with the simulation (deterministic)
+    #[arg(long, value_name = "HZ", default_value_t = rover_core::DEFAULT_DETECT_HZ)]
+    pub(crate) detect_hz: f64,
+
+    /// Follower: class to follow (a darknet_ros `Class`, e.g. person, dog)
+    #[arg(long, default_value = "person", value_name = "CLASS")]
+    pub(crate) target_class: String,
+
+    /// Follower: distance to keep from the target (m)
+    #[arg(long, default_value_t = 1.5, value_name = "M")]
+    pub(crate) standoff: f64,
+
+    /// Follower: speed limit (m/s)
+    #[arg(long, default_value_t = 0.5, value_name = "MPS")]
+    pub(crate) follow_speed: f64,
+}
+
+impl FollowArgs {
+    pub(crate) fn follower(&self) -> anyhow::Result<FollowerConfig> {
+        anyhow::ensure!(
+            self.standoff.is_finite() && self.standoff > 0.3,
+            "--standoff must be more than 0.3 m, found {}",
+            self.standoff
+        );
+        anyhow::ensure!(
+            self.follow_speed.is_finite() && self.follow_speed > 0.0,
+            "--follow-speed must be a positive speed in m/s, found {}",
+            self.follow_speed
+        );
+        Ok(FollowerConfig {
+            target_class: self.target_class.clone(),
+            standoff_m: self.standoff,
+            max_speed_mps: self.follow_speed,
+            ..FollowerConfig::default()
+        })
+    }
+
+    pub(crate) fn perception(&self) -> Perception {
+        match (self.detect, self.no_detector) {
+            (_, true) => Perception::Off,
+            (true, _) => Perception::On,
+            _ => Perception::Auto,
+        }
+    }
+}
+
+/// Detector options shared by the commands that run YOLO.
+#[derive(Debug, Args)]
+pub(crate) struct DetectorArgs {
+    /// YOLO ONNX model [default: YOLOv12n from the crates.io package easy-yolo 0.1.3, fetched
+    /// into ~/.cache/rover on first use; its weights are AGPL-3.0]. Heads: YOLOv5 [1,N,5+C],
+    /// YOLOv8/11/12 [1,4+C,N], YOLOv10 [1,K,6]
+    #[arg(long, value_name = "FILE")]
+    pub(crate) model: Option<PathBuf>,
+
+    /// Class names, one per line (darknet's coco.names format) [default: the model's `names`
+    /// metadata, else COCO's 80]
+    #[arg(long, value_name = "FILE")]
+    pub(crate) labels: Option<PathBuf>,
+
+    /// Confidence threshold (darknet_ros's default)
+    #[arg(long, default_value_t = DEFAULT_THRESHOLD, value_name = "T")]
+    pub(crate) threshold: f32,
+
+    /// Class-wise NMS IoU threshold (darknet_ros's default)
+    #[arg(long, default_value_t = DEFAULT_NMS_IOU, value_name = "IOU")]
+    pub(crate) nms: f32,
+
+    /// Network input size WIDTHxHEIGHT, multiples of 32 [default: 512x384 for the default model
+    /// (the camera's 4:3 aspect), the model's own size otherwise]
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub(crate) input_size: Option<(usize, usize)>,
+}
+
+fn parse_size(text: &str) -> Result<(usize, usize), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 640x480, found '{text}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("'{v}' is not a whole number of pixels"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+impl DetectorArgs {
+    pub(crate) fn config(&self) -> anyhow::Result<DetectorConfig> {
+        anyhow::ensure!(
+            (0.0..=1.0).contains(&self.threshold),
+            "--threshold must be between 0 and 1, found {}",
+            self.threshold
+        );
+        anyhow::ensure!(
+            (0.0..=1.0).contains(&self.nms),
+            "--nms must be between 0 and 1, found {}",
+            self.nms
+        );
+        Ok(DetectorConfig {
+            model: self.model.clone(),
+            labels: self.labels.clone(),
+            input_size: self.input_size,
+            threshold: self.threshold,
+            nms_iou: self.nms,
+            ..DetectorConfig::default()
+        })
+    }
+}
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum BenchKind {
+    /// Rerun recording overhead: the same headless run (camera + detector) without and with
+    /// --record
+    Record {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per run
+        #[arg(long, default_value_t = 10.0, value_name = "SECS")]
+        duration: f64,
+
+        /// Repeats (the fastest of each counts)
+        #[arg(long, default_value_t = 2)]
+        repeats: u32,
+
+        /// Send camera images as JPEG of this quality instead of raw RGB
+        #[arg(long, value_name = "Q")]
+        image_jpeg: Option<u8>,
+    },
+    /// Camera: ms per image (render + readback) on this machine's GPU or software Vulkan
+    Camera {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Frames to time (after one warm-up)
+        #[arg(long, default_value_t = 60)]
+        frames: usize,
+    },
+    /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
+    Detect {
+        #[command(flatten)]
+        detector: DetectorArgs,
+
+        /// Image to detect on [default: darknet's person.jpg if installed, else a test pattern]
+        #[arg(long, value_name = "FILE")]
+        image: Option<PathBuf>,
+
+        /// Timed runs (after one warm-up)
+        #[arg(long, default_value_t = 15)]
+        runs: usize,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum Command {
+    /// Run the YOLO detector on image files and print the boxes
+    ///
+    /// One line per box: `class probability xmin ymin xmax ymax` (source-image pixels), or with
+    /// --json one darknet_ros-shaped object per image.
+    Detect {
+        /// Image files (PNG, JPEG)
+        #[arg(required = true, value_name = "IMAGE")]
+        images: Vec<PathBuf>,
+
+        #[command(flatten)]
+        detector: DetectorArgs,
+
+        /// Print darknet_ros-shaped JSON, one object per image per line
+        #[arg(long)]
+        json: bool,
+
+        /// Write the image with boxes drawn (a folder when several images are given)
+        #[arg(long, value_name = "PATH")]
+        out: Option<PathBuf>,
+    },
+
+    /// Benchmarks: physics-only real-time factor (default), or `bench detect`
+    Bench {
+        #[command(subcommand)]
+        kind: Option<BenchKind>,
+
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per measurement
+        #[arg(long, default_value_t = 60.0, value_name = "SECS")]
+        sim_seconds: f64,
+
+        /// Repeats per measurement (the fastest counts)
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
+
+        /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
+        #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
+        rates: Vec<f64>,
+    },
+}
+
+impl WorldArgs {
+    /// A run of this world and robot; the rest at its defaults.
+    pub(crate) fn run_config(&self, cmd_timeout_s: Option<f64>) -> RunConfig {
+        RunConfig {
+            world: self.world.clone(),
+            robot: self.robot.clone(),
+            options: SimOptions {
+                seed: self.seed,
+                cmd_timeout_s,
+                step_hz: self.physics_hz,
+            },
+            ..RunConfig::default()
+        }
+    }
+}

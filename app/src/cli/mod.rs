@@ -1,0 +1,86 @@
+//! The `rover` command line: clap arguments ([`args`]), runs in the window or headless
+//! ([`run`]), `rover bench` ([`bench`]) and `rover detect` ([`detect`]). `anyhow` errors, `tracing`
+//! logs; the binary's `main` only calls [`main`].
+
+mod args;
+pub mod bench;
+pub mod detect;
+mod run;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use args::{BenchKind, Cli, Command};
+use detect::DetectOptions;
+
+/// Parses the command line, runs it and turns errors into `rover: error: ...` and exit code 1.
+pub fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
+                tracing_subscriber::EnvFilter::new(
+                    "info,tract_onnx=error,tract_hir=error,tract_core=error",
+                )
+            }),
+        )
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Bench {
+            kind:
+                Some(BenchKind::Detect {
+                    detector,
+                    image,
+                    runs,
+                }),
+            ..
+        }) => detector
+            .config()
+            .and_then(|config| bench::bench_detect(config, image, runs)),
+        Some(Command::Bench {
+            kind: Some(BenchKind::Camera { world, frames }),
+            ..
+        }) => bench::bench_camera(world, frames),
+        Some(Command::Bench {
+            kind:
+                Some(BenchKind::Record {
+                    world,
+                    duration,
+                    repeats,
+                    image_jpeg,
+                }),
+            ..
+        }) => bench::bench_record(world, duration, repeats, image_jpeg),
+        Some(Command::Bench {
+            kind: None,
+            world,
+            sim_seconds,
+            repeats,
+            rates,
+        }) => bench::bench_cmd(world, sim_seconds, repeats, rates),
+        Some(Command::Detect {
+            images,
+            detector,
+            json,
+            out,
+        }) => detector.config().and_then(|config| {
+            detect::run(&DetectOptions {
+                images,
+                detector: config,
+                json,
+                out,
+            })
+        }),
+        None => run::run(cli.run),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("rover: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

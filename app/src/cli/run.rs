@@ -1,0 +1,157 @@
+//! `rover` and `rover --headless`: a run in the window (the driver's station) or headless.
+
+use std::time::Duration;
+
+use anyhow::Result;
+use rover_core::headless;
+use rover_core::{DetectorMode, Fanout, RunConfig, RunFiles, Session, SessionOptions};
+
+use super::args::RunArgs;
+use crate::station::{self, WindowOptions};
+use crate::viewer::{self, Recorder};
+
+pub(crate) fn run(args: RunArgs) -> Result<()> {
+    if !args.headless {
+        return run_window(args);
+    }
+    let config = RunConfig {
+        script: args.script,
+        duration_s: args.duration,
+        trace: args.trace.clone(),
+        progress_every: Some(Duration::from_secs(5)),
+        save_frames: args.save_frames,
+        frame_every: args.frame_every,
+        perception: args.follow.perception(),
+        detect_hz: Some(args.follow.detect_hz),
+        detector: args.detector.config()?,
+        follower: args.follow.follower()?,
+        real_time_factor: args.window.rtf,
+        ..args.world.run_config(args.cmd_timeout)
+    };
+    let recorder_options = args.viewer.options(false)?;
+    let summary = match Recorder::start(&recorder_options)? {
+        Some(mut rec) => {
+            if let Some(url) = &rec.web_url {
+                println!("Rerun web viewer: {url}");
+            }
+            let summary = headless::run_observed(&config, &mut rec, true);
+            rec.finish();
+            if let Some(path) = &recorder_options.record {
+                println!("recording: {}", viewer::describe_file(path));
+            }
+            if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
+                println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
+                loop {
+                    std::thread::sleep(Duration::from_secs(3600));
+                }
+            }
+            summary?
+        }
+        None => headless::run(&config)?,
+    };
+    println!(
+        "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.0}x real time)",
+        summary.world,
+        summary.robot,
+        summary.sim_time_s,
+        summary.steps,
+        summary.wall_s,
+        summary.real_time_factor()
+    );
+    if let Some(last) = summary.last {
+        let g = last.ground_truth;
+        let o = last.odometry;
+        println!(
+            "final pose: x {:.3} m, y {:.3} m, yaw {:.1} deg (odometry: x {:.3} m, y {:.3} m, yaw {:.1} deg); mode {}",
+            g.x_m,
+            g.y_m,
+            g.yaw_rad.to_degrees(),
+            o.x_m,
+            o.y_m,
+            o.yaw_rad.to_degrees(),
+            summary.mode.as_str()
+        );
+    }
+    if let Some(path) = &args.trace {
+        println!("trace: {} ({} rows)", path.display(), summary.rows);
+    }
+    Ok(())
+}
+
+fn run_window(args: RunArgs) -> Result<()> {
+    station::check_display()?;
+    let rtf = args.window.rtf.unwrap_or(1.0);
+    anyhow::ensure!(
+        rtf.is_finite() && rtf > 0.0,
+        "--rtf must be a positive factor, found {rtf}"
+    );
+    let config = RunConfig {
+        script: args.script.clone(),
+        ..args.world.run_config(args.cmd_timeout)
+    };
+    let (world, robot) = headless::load(&config)?;
+    let script = headless::load_script(&config)?;
+    let recorder_options = args.viewer.options(true)?;
+    let mut recorder = match Recorder::start(&recorder_options) {
+        Ok(r) => r,
+        Err(e) => {
+            tracing::warn!("{e:#}; going on without a viewer");
+            None
+        }
+    };
+    if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.clone()) {
+        println!("Rerun web viewer: {url}");
+    }
+    let mut files = RunFiles::open(
+        args.trace.as_deref(),
+        args.save_frames.as_deref(),
+        args.frame_every,
+    )?;
+    let options = SessionOptions {
+        sim: config.options.clone(),
+        camera: true,
+        detector: if args.follow.no_detector {
+            DetectorMode::Off
+        } else {
+            DetectorMode::Worker
+        },
+        detector_config: args.detector.config()?,
+        follower: args.follow.follower()?,
+    };
+    let summary = {
+        let mut fan = Fanout::default();
+        fan.push(&mut files);
+        fan.push_some(recorder.as_mut());
+        let session = Session::new(world, robot, &options, &mut fan)?;
+        station::run(
+            session,
+            &mut fan,
+            WindowOptions {
+                real_time_factor: rtf,
+                latched: args.window.latched,
+                wasd: args.window.wasd,
+                duration_s: args.duration,
+                paused: args.window.paused,
+                script,
+                screenshot: args.window.screenshot.clone(),
+            },
+        )?
+    };
+    if let Some(r) = recorder.as_mut() {
+        r.finish();
+    }
+    println!(
+        "rover: {:.1} s sim time in {:.1} s wall; mode {}",
+        summary.sim_time_s,
+        summary.wall_s,
+        summary.mode.as_str()
+    );
+    let written = files.finish()?;
+    if let Some(path) = &args.trace {
+        println!("trace: {} ({} rows)", path.display(), written.rows);
+    }
+    if let Some(path) = &recorder_options.record {
+        println!("recording: {}", viewer::describe_file(path));
+    }
+    Ok(())
+}

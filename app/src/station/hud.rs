@@ -1,0 +1,157 @@
+//! The station's picture: the camera image, its boxes and the HUD under it.
+
+use rover_core::{Mode, Session};
+
+use super::canvas::{CHAR_W, Canvas, Rgb};
+
+/// Height of the HUD strip under the camera image (px).
+pub(super) const HUD_H: usize = 112;
+
+/// The HUD's background, also the margin colour when the window is scaled.
+pub(super) const BACKGROUND: Rgb = [24, 26, 30];
+
+/// Characters per HUD line at 640 px.
+const LINE_CHARS: usize = 64;
+
+/// What the HUD shows.
+pub(super) struct HudState<'a> {
+    /// The newest camera image, packed.
+    pub image: &'a [u32],
+    /// Its size (px).
+    pub image_size: (usize, usize),
+    /// The newest warning.
+    pub warning: Option<&'a str>,
+    /// The session (mode, commands, detections, follower).
+    pub session: &'a Session,
+    /// Whether the loop is paused.
+    pub paused: bool,
+    /// Measured sim seconds per wall second.
+    pub real_time_factor: f64,
+}
+
+/// Composes camera image, boxes and HUD into `canvas`.
+pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
+    let (w, h) = (canvas.width, canvas.height);
+    let img_h = h - HUD_H;
+    let (iw, ih) = hud.image_size;
+    if iw == w && ih == img_h && hud.image.len() == iw * ih {
+        canvas.pixels[..w * img_h].copy_from_slice(hud.image);
+        canvas.fill(0, img_h as i64, w as i64, HUD_H as i64, BACKGROUND);
+    } else {
+        canvas.fill(0, 0, w as i64, h as i64, BACKGROUND);
+        canvas.text(20, 20, "waiting for the camera...", [200, 200, 200]);
+    }
+    let session = hud.session;
+    if let Some(boxes) = session.last_boxes() {
+        for b in &boxes.bounding_boxes {
+            let color = if b.class == session.follower().config().target_class {
+                [255, 70, 70]
+            } else {
+                [80, 200, 255]
+            };
+            canvas.rect(b.xmin, b.ymin, b.xmax, b.ymax, 2, color);
+            let label = format!("{} {:.2}", b.class, b.probability);
+            let lw = label.len() as i64 * CHAR_W + 4;
+            let ly = (b.ymin - 20).max(0);
+            canvas.fill(b.xmin, ly, lw, 20, color);
+            canvas.text(b.xmin + 2, ly, &label, [0, 0, 0]);
+        }
+    }
+    let stats = session.stats();
+    let teleop = session.pilot().teleop();
+    let cmd = session.sim().drive().command();
+    let y0 = img_h as i64 + 4;
+    let (mode_text, mode_color) = match stats.mode {
+        Mode::Manual => ("MANUAL".to_owned(), [120, 220, 120]),
+        Mode::Follow => (
+            format!("FOLLOW ({})", stats.follow_state.as_str()),
+            [255, 170, 60],
+        ),
+    };
+    let x = canvas.text(8, y0, &mode_text, mode_color);
+    let right = if hud.paused {
+        "PAUSED (p resumes, n steps)".to_owned()
+    } else {
+        format!("t {:.1} s", session.sim().sim_time_s())
+    };
+    let rx = w as i64 - 8 - right.len() as i64 * CHAR_W;
+    if rx > x + CHAR_W {
+        canvas.text(rx, y0, &right, [255, 230, 80]);
+    }
+    let line2 = format!(
+        "cmd {:+.2} m/s {:+.2} rad/s   max {:.2} m/s {:.2} rad/s",
+        cmd.linear_mps, cmd.angular_radps, teleop.speed_mps, teleop.turn_radps
+    );
+    canvas.text(8, y0 + 22, &line2, [230, 230, 230]);
+    let line3 = if stats.detector_ok {
+        format!(
+            "yolo {:.1} Hz {:.0} ms  dropped {}  sim {:.2}x real time",
+            stats.detector_hz,
+            stats.detector_latency_ms,
+            stats.frames_dropped,
+            hud.real_time_factor
+        )
+    } else if stats.detector_failed {
+        format!(
+            "detector FAILED  sim {:.2}x real time",
+            hud.real_time_factor
+        )
+    } else {
+        format!("detector off  sim {:.2}x real time", hud.real_time_factor)
+    };
+    let detector_color = if stats.detector_failed {
+        [255, 120, 90]
+    } else {
+        [230, 230, 230]
+    };
+    canvas.text(8, y0 + 44, &line3, detector_color);
+    match hud.warning {
+        Some(warning) => {
+            let (a, b) = split_line(warning, LINE_CHARS - 2);
+            canvas.text(8, y0 + 66, &format!("! {a}"), [255, 120, 90]);
+            let (b, _) = split_line(b, LINE_CHARS);
+            canvas.text(8, y0 + 86, b, [255, 120, 90]);
+        }
+        None => {
+            canvas.text(
+                8,
+                y0 + 66,
+                "i , j l u o m . drive   k stop   q/z speed   f follow",
+                [160, 170, 180],
+            );
+            canvas.text(
+                8,
+                y0 + 86,
+                "p pause   pad: hold LB + sticks, A follow   Esc quit",
+                [160, 170, 180],
+            );
+        }
+    }
+}
+
+/// Splits `text` after at most `chars` characters, at a space when there is one.
+fn split_line(text: &str, chars: usize) -> (&str, &str) {
+    let Some((cut, _)) = text.char_indices().nth(chars) else {
+        return (text, "");
+    };
+    let at = text[..cut]
+        .rfind(' ')
+        .filter(|&i| i > cut / 2)
+        .unwrap_or(cut);
+    (&text[..at], text[at..].trim_start())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warnings_wrap_at_a_space() {
+        assert_eq!(split_line("short", 10), ("short", ""));
+        assert_eq!(
+            split_line("no detector (model missing); manual driving works", 20),
+            ("no detector (model", "missing); manual driving works")
+        );
+        assert_eq!(split_line("abcdefghij", 4), ("abcd", "efghij"));
+    }
+}

@@ -1,0 +1,277 @@
+//! The Rerun recorder: an [`Observer`] that streams a run to a Rerun viewer and/or an .rrd file.
+//! It only watches the loop; nothing in the simulation depends on it.
+//!
+//! * [`sinks`] — viewer modes, `--record` files, the web viewer server, the viewer-gone watch;
+//! * [`scene`] — the static scene logged once;
+//! * this module — per-tick logging (poses, plots, boxes, events);
+//! * [`images`] — camera images (rate, downscale, JPEG);
+//! * [`blueprint`] — the layout the viewer opens with.
+//!
+//! Entity paths (docs/RERUN.md):
+//! ```text
+//! world                                  ViewCoordinates RIGHT_HAND_Z_UP (REP-103), static
+//! world/ground, world/objects/<name>     Mesh3D, static
+//! world/people/<name>                    Transform3D (per control update when walking) + Mesh3D
+//! world/robot                            Transform3D world_from_base, per control update
+//! world/robot/<link>                     Transform3D base_from_link (wheels turn) + Mesh3D visuals
+//! world/robot/camera                     Transform3D base_from_camera_optical, static
+//! world/robot/camera/image               Pinhole (Gazebo's K), Image, AnnotationContext
+//! world/robot/camera/image/detections    Boxes2D "person 0.87" with class ids
+//! world/odometry                         Points3D (odometry position) + trail LineStrips3D
+//! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
+//!                                        detector latency/Hz/dropped, real-time factor
+//! log                                    TextLog: mode changes, warnings
+//! ```
+//! Timelines: `sim_time` (seconds of simulated time) and `frame` (camera frame number).
+
+mod blueprint;
+mod images;
+mod scene;
+mod sinks;
+
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use rerun::{RecordingStream, RecordingStreamBuilder};
+use rover_core::{EventLevel, LoopStats, Mode, Observer};
+use rover_perception::BoundingBoxes;
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
+
+pub use blueprint::blueprint;
+pub use images::ImageOptions;
+pub use sinks::{
+    RERUN_VERSION, RecorderOptions, Viewer, default_viewer, describe_file, pip_command,
+    viewer_on_path,
+};
+
+use images::ImageLogger;
+use scene::{ScenePaths, transform};
+use sinks::ViewerWatch;
+
+/// The Rerun recorder.
+pub struct Recorder {
+    rec: RecordingStream,
+    image_options: ImageOptions,
+    images: ImageLogger,
+    frame: i64,
+    trail: Vec<[f32; 3]>,
+    trail_logged_s: f64,
+    paths: ScenePaths,
+    watch: Option<ViewerWatch>,
+    viewer_gone: bool,
+    started: Instant,
+    /// Where the web viewer is, when serving it.
+    pub web_url: Option<String>,
+    _web: Option<Box<dyn std::any::Any>>,
+}
+
+impl std::fmt::Debug for Recorder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder")
+            .field("web_url", &self.web_url)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Recorder {
+    /// Opens the viewer/file sinks. Returns `Ok(None)` when there is nothing to record to.
+    pub fn start(options: &RecorderOptions) -> Result<Option<Self>> {
+        let Some(sinks) = sinks::open(options)? else {
+            return Ok(None);
+        };
+        let rec = RecordingStreamBuilder::new("rover")
+            .batcher_config(rerun::log::ChunkBatcherConfig::LOW_LATENCY)
+            .with_blueprint(blueprint())
+            .set_sinks(sinks.sinks)
+            .context("cannot start the Rerun recording")?;
+        rec.set_log_time_enabled(false);
+        Ok(Some(Self {
+            rec,
+            image_options: options.images,
+            images: ImageLogger::new(options.images),
+            frame: 0,
+            trail: Vec::with_capacity(4096),
+            trail_logged_s: f64::NEG_INFINITY,
+            paths: ScenePaths::default(),
+            watch: sinks.watch,
+            viewer_gone: false,
+            started: Instant::now(),
+            web_url: sinks.web_url,
+            _web: sinks.web_server,
+        }))
+    }
+
+    fn log(&self, path: &str, data: &dyn rerun::AsComponents) {
+        if let Err(e) = self.rec.log(path, data) {
+            tracing::warn!("rerun: {path}: {e}");
+        }
+    }
+
+    fn set_time(&self, sim_time_s: f64) {
+        self.rec.set_duration_secs("sim_time", sim_time_s);
+        self.rec.set_time_sequence("frame", self.frame);
+    }
+
+    /// Notices (once) that a streamed-to viewer has gone; the run goes on. The probing runs
+    /// on the watch's own thread: here it is one atomic load.
+    fn watch_viewer(&mut self) {
+        if !self.viewer_gone && self.watch.as_ref().is_some_and(ViewerWatch::gone) {
+            self.viewer_gone = true;
+            tracing::warn!(
+                "the Rerun viewer has gone away; the run goes on (a --record file keeps recording)"
+            );
+        }
+    }
+
+    /// Flushes the recording and closes its files (writes the .rrd footer); a web viewer
+    /// server keeps serving until the recorder is dropped.
+    pub fn finish(&mut self) {
+        if let Err(e) = self.rec.flush_with_timeout(Duration::from_secs(5))
+            && !self.viewer_gone
+        {
+            tracing::warn!("rerun: could not flush everything: {e}");
+        }
+        self.rec.finalize_deferred_sinks();
+        tracing::debug!("recorder ran {:.1} s", self.started.elapsed().as_secs_f64());
+    }
+
+    /// Appends the odometry position to the trail, keeping it bounded.
+    fn extend_trail(&mut self, here: [f32; 3]) {
+        if self.trail.last() == Some(&here) {
+            return;
+        }
+        if self.trail.len() == self.trail.capacity() {
+            // Drop every other point of the older half.
+            let half = self.trail.len() / 2;
+            let mut k = 0;
+            for j in 0..self.trail.len() {
+                if j >= half || j % 2 == 0 {
+                    self.trail[k] = self.trail[j];
+                    k += 1;
+                }
+            }
+            self.trail.truncate(k);
+        }
+        self.trail.push(here);
+    }
+}
+
+impl Observer for Recorder {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        self.paths = scene::log_scene(&self.rec, sim, camera, labels, &self.image_options);
+    }
+
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        self.watch_viewer();
+        self.set_time(sample.sim_time_s);
+        self.log("world/robot", &transform(sim.world_from_base()));
+        let base_from_world = sim.world_from_base().inverse();
+        for (i, path) in self
+            .paths
+            .links
+            .iter()
+            .enumerate()
+            .take(sim.robot().links.len())
+        {
+            if i != sim.robot().root {
+                self.log(path, &transform(base_from_world * sim.world_from_link(i)));
+            }
+        }
+        for (i, path) in self.paths.people.iter().enumerate() {
+            if sim.world().people[i].walk.is_some() {
+                self.log(path, &transform(sim.world_from_person(i)));
+            }
+        }
+        let o = sample.odometry;
+        let here = [o.x_m as f32, o.y_m as f32, 0.02];
+        self.log(
+            "world/odometry",
+            &rerun::Points3D::new([here]).with_radii([0.04f32]),
+        );
+        self.extend_trail(here);
+        if sample.sim_time_s - self.trail_logged_s >= 0.5 {
+            self.trail_logged_s = sample.sim_time_s;
+            self.log(
+                "world/odometry/trail",
+                &rerun::LineStrips3D::new([self.trail.as_slice()]).with_radii([0.01f32]),
+            );
+        }
+        let gt = sample.ground_truth;
+        self.log(
+            "plots/velocity/linear",
+            &rerun::Scalars::new([sample.cmd.linear_mps, gt.linear_mps]),
+        );
+        self.log(
+            "plots/velocity/angular",
+            &rerun::Scalars::new([sample.cmd.angular_radps, gt.angular_radps]),
+        );
+        let t = sample.wheel_targets_radps;
+        let m = sample.wheel_measured_radps;
+        self.log(
+            "plots/wheels",
+            &rerun::Scalars::new([t[0], t[1], m[0], m[1]]),
+        );
+        self.log(
+            "plots/mode",
+            &rerun::Scalars::single(if stats.mode == Mode::Follow { 1.0 } else { 0.0 }),
+        );
+        if stats.detector_ok {
+            self.log(
+                "plots/detector/latency_ms",
+                &rerun::Scalars::single(stats.detector_latency_ms),
+            );
+            self.log(
+                "plots/detector/hz",
+                &rerun::Scalars::single(stats.detector_hz),
+            );
+            self.log(
+                "plots/detector/dropped",
+                &rerun::Scalars::single(stats.frames_dropped as f64),
+            );
+        }
+        let wall = self.started.elapsed().as_secs_f64();
+        if wall > 0.5 {
+            self.log(
+                "plots/real_time_factor",
+                &rerun::Scalars::single(sample.sim_time_s / wall),
+            );
+        }
+    }
+
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, _world_from_camera: Pose) {
+        self.frame = frame.seq as i64;
+        if self.images.due(frame.sim_time_s) {
+            self.set_time(frame.sim_time_s);
+            self.images.log(&self.rec, frame);
+        }
+    }
+
+    fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
+        let stamp = boxes.image_stamp;
+        self.rec.set_duration_secs("sim_time", stamp.sim_time_s);
+        self.rec.set_time_sequence("frame", stamp.frame as i64);
+        let k = self.image_options.scale();
+        let b = &boxes.bounding_boxes;
+        let data = rerun::Boxes2D::from_mins_and_sizes(
+            b.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
+            b.iter()
+                .map(|b| [b.width() as f32 / k, b.height() as f32 / k]),
+        )
+        .with_labels(
+            b.iter()
+                .map(|b| format!("{} {:.2}", b.class, b.probability)),
+        )
+        .with_class_ids(b.iter().map(|b| u16::try_from(b.id).unwrap_or(u16::MAX)));
+        self.log("world/robot/camera/image/detections", &data);
+        self.set_time(stamp.sim_time_s);
+    }
+
+    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
+        self.rec.set_duration_secs("sim_time", sim_time_s);
+        let level = match level {
+            EventLevel::Info => rerun::TextLogLevel::INFO,
+            EventLevel::Warn => rerun::TextLogLevel::WARN,
+        };
+        self.log("log", &rerun::TextLog::new(text).with_level(level));
+    }
+}

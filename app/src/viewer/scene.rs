@@ -1,0 +1,168 @@
+//! The static scene, logged once when a run starts: world, robot visuals, camera intrinsics,
+//! class names, plot series names. Meshes are the same triangles the camera renders.
+
+use rerun::RecordingStream;
+use rover_sim::{
+    CameraInfo, MeshData, Pose, Rgba, Simulation, link_from_optical, object_mesh, person_parts,
+    shape_mesh,
+};
+
+use super::images::{IMAGE_PATH, ImageOptions};
+
+/// Entity paths of the things that move, in the simulation's order.
+#[derive(Debug, Default)]
+pub(super) struct ScenePaths {
+    /// `world/robot/<link>` per robot link.
+    pub links: Vec<String>,
+    /// `world/people/<name>` per person.
+    pub people: Vec<String>,
+}
+
+/// Logs the static scene and returns the paths per-tick logging uses.
+pub(super) fn log_scene(
+    rec: &RecordingStream,
+    sim: &Simulation,
+    camera: Option<&CameraInfo>,
+    labels: &[String],
+    images: &ImageOptions,
+) -> ScenePaths {
+    let log = |path: &str, data: &dyn rerun::AsComponents| {
+        if let Err(e) = rec.log_static(path, data) {
+            tracing::warn!("rerun: {path}: {e}");
+        }
+    };
+    let world = sim.world();
+    let robot = sim.robot();
+    log("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
+    // The 3D view's origin is the robot (see blueprint.rs): it needs the up axis too.
+    log("world/robot", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
+    let [gx, gy] = world.ground.size_m;
+    log(
+        "world/ground",
+        &rerun::Boxes3D::from_centers_and_sizes(
+            [[0.0f32, 0.0, -0.01]],
+            [[gx as f32, gy as f32, 0.02]],
+        )
+        .with_colors([color(world.ground.color)])
+        .with_fill_mode(rerun::FillMode::Solid),
+    );
+    for object in &world.objects {
+        let path = format!("world/objects/{}", object.name);
+        log(&path, &transform(object.world_from_object()));
+        log(&path, &mesh(&object_mesh(&object.shape), object.color));
+    }
+    let mut paths = ScenePaths::default();
+    for (i, person) in world.people.iter().enumerate() {
+        let path = format!("world/people/{}", person.name);
+        let mut positions = Vec::new();
+        let mut normals = Vec::new();
+        let mut colors = Vec::new();
+        let mut triangles = Vec::new();
+        for part in person_parts(person) {
+            let base = positions.len() as u32;
+            for v in &part.mesh.vertices {
+                positions.push((part.pose * glam::Vec3::from_array(v.position)).to_array());
+                normals.push((part.pose.rotation * glam::Vec3::from_array(v.normal)).to_array());
+                colors.push(color(part.color));
+            }
+            triangles.extend(
+                part.mesh
+                    .indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+            );
+        }
+        log(
+            &format!("{path}/body"),
+            &rerun::Mesh3D::new(positions)
+                .with_vertex_normals(normals)
+                .with_vertex_colors(colors)
+                .with_triangle_indices(triangles),
+        );
+        if person.walk.is_none() {
+            log(&path, &transform(sim.world_from_person(i)));
+        }
+        paths.people.push(path);
+    }
+    // The robot: one entity per link under world/robot, visuals as meshes.
+    for link in &robot.links {
+        let path = format!("world/robot/{}", link.name);
+        for (v, visual) in link.visuals.iter().enumerate() {
+            let vpath = format!("{path}/visual_{v}");
+            if let Ok(m) = shape_mesh(&visual.shape) {
+                log(&vpath, &transform(visual.link_from_shape));
+                log(&vpath, &mesh(&m, visual.color));
+            }
+        }
+        paths.links.push(path);
+    }
+    if let Some(info) = camera {
+        let link = robot
+            .cameras
+            .first()
+            .and_then(|c| robot.link_index(&c.link))
+            .unwrap_or(robot.root);
+        let base_from_link = sim.world_from_base().inverse() * sim.world_from_link(link);
+        let base_from_optical = base_from_link * Pose::from_rotation(link_from_optical());
+        log("world/robot/camera", &transform(base_from_optical));
+        let k = images.scale();
+        let proj = rerun::components::PinholeProjection::from_focal_length_and_principal_point(
+            [info.k[0] as f32 / k, info.k[4] as f32 / k],
+            [info.k[2] as f32 / k, info.k[5] as f32 / k],
+        );
+        let (w, h) = images.scaled_size(info.width, info.height);
+        log(
+            IMAGE_PATH,
+            &rerun::Pinhole::new(proj)
+                .with_resolution([w as f32, h as f32])
+                .with_image_plane_distance(0.5f32),
+        );
+    }
+    if !labels.is_empty() {
+        log(
+            IMAGE_PATH,
+            &rerun::AnnotationContext::new(labels.iter().enumerate().map(|(i, name)| {
+                let image::Rgb([r, g, b]) =
+                    crate::palette::class_color(i16::try_from(i).unwrap_or(i16::MAX));
+                (i as u16, name.as_str(), rerun::Rgba32::from_rgb(r, g, b))
+            })),
+        );
+    }
+    log(
+        "plots/velocity/linear",
+        &rerun::SeriesLines::new().with_names(["cmd linear.x (m/s)", "measured (m/s)"]),
+    );
+    log(
+        "plots/velocity/angular",
+        &rerun::SeriesLines::new().with_names(["cmd angular.z (rad/s)", "measured (rad/s)"]),
+    );
+    log(
+        "plots/wheels",
+        &rerun::SeriesLines::new().with_names([
+            "left target (rad/s)",
+            "right target (rad/s)",
+            "left measured (rad/s)",
+            "right measured (rad/s)",
+        ]),
+    );
+    paths
+}
+
+/// A pose as a Rerun transform.
+pub(super) fn transform(pose: Pose) -> rerun::Transform3D {
+    rerun::Transform3D::from_translation_rotation(
+        pose.translation.to_array(),
+        rerun::Quaternion::from_xyzw(pose.rotation.to_array()),
+    )
+}
+
+fn color(c: Rgba) -> [u8; 4] {
+    c.0.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+}
+
+fn mesh(m: &MeshData, c: Rgba) -> rerun::Mesh3D {
+    rerun::Mesh3D::new(m.vertices.iter().map(|v| v.position))
+        .with_vertex_normals(m.vertices.iter().map(|v| v.normal))
+        .with_triangle_indices(m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]))
+        .with_albedo_factor(color(c))
+}

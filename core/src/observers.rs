@@ -1,0 +1,258 @@
+//! Observers every runner composes: the trace writer and the frame saver, and the [`Fanout`]
+//! that hands one session's events to several observers. Headless runs and the window use the
+//! same ones; they differ only in pacing and detector mode.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use rover_perception::BoundingBoxes;
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
+
+use crate::error::{CoreError, Result};
+use crate::session::{EventLevel, LoopStats, Observer};
+use crate::trace::TraceWriter;
+
+/// Hands every event to each of its observers, in the order they were added.
+#[derive(Default)]
+pub struct Fanout<'a> {
+    observers: Vec<&'a mut dyn Observer>,
+}
+
+impl std::fmt::Debug for Fanout<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Fanout")
+            .field("observers", &self.observers.len())
+            .finish()
+    }
+}
+
+impl<'a> Fanout<'a> {
+    /// Adds an observer.
+    pub fn push(&mut self, observer: &'a mut dyn Observer) {
+        self.observers.push(observer);
+    }
+
+    /// Adds an observer if there is one.
+    pub fn push_some<O: Observer>(&mut self, observer: Option<&'a mut O>) {
+        if let Some(o) = observer {
+            self.observers.push(o);
+        }
+    }
+}
+
+impl Observer for Fanout<'_> {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        for o in &mut self.observers {
+            o.start(sim, camera, labels);
+        }
+    }
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        for o in &mut self.observers {
+            o.control(sim, sample, stats);
+        }
+    }
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
+        for o in &mut self.observers {
+            o.camera_frame(frame, world_from_camera);
+        }
+    }
+    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
+        for o in &mut self.observers {
+            o.detections(boxes, labels);
+        }
+    }
+    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
+        for o in &mut self.observers {
+            o.event(sim_time_s, level, text);
+        }
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.observers.iter_mut().find_map(|o| o.failure())
+    }
+}
+
+/// Writes the trace CSV: one row per control update ([`crate::trace::TRACE_HEADER`]).
+#[derive(Debug)]
+pub struct TraceObserver {
+    path: PathBuf,
+    writer: Option<TraceWriter<BufWriter<File>>>,
+    failed: Option<std::io::Error>,
+    rows: u64,
+}
+
+impl TraceObserver {
+    /// Creates (truncates) the trace file and writes its header.
+    pub fn create(path: &Path) -> Result<Self> {
+        let file = File::create(path).map_err(|e| CoreError::write(path, e))?;
+        let writer =
+            TraceWriter::new(BufWriter::new(file)).map_err(|e| CoreError::write(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            writer: Some(writer),
+            failed: None,
+            rows: 0,
+        })
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Flushes the file; returns the number of rows.
+    pub fn finish(mut self) -> Result<u64> {
+        if let Some(w) = self.writer.take() {
+            w.finish().map_err(|e| CoreError::write(&self.path, e))?;
+        }
+        Ok(self.rows)
+    }
+}
+
+impl Observer for TraceObserver {
+    fn control(&mut self, _sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        if let Some(w) = self.writer.as_mut() {
+            match w.row(sample, stats.mode) {
+                Ok(()) => self.rows += 1,
+                Err(e) => {
+                    self.writer = None;
+                    self.failed = Some(e);
+                }
+            }
+        }
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.failed.take().map(|e| CoreError::write(&self.path, e))
+    }
+}
+
+/// Writes the robot camera's images as PNG (`frame_NNNNNN.png`, by frame number), every Nth.
+#[derive(Debug)]
+pub struct FrameSaver {
+    dir: PathBuf,
+    every: u64,
+    written: u64,
+    failed: Option<CoreError>,
+    stopped: bool,
+}
+
+impl FrameSaver {
+    /// Creates `dir` if needed; `every` = 1 writes every image.
+    pub fn new(dir: &Path, every: u64) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| CoreError::write(dir, e))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            every: every.max(1),
+            written: 0,
+            failed: None,
+            stopped: false,
+        })
+    }
+
+    /// Images written so far.
+    pub fn written(&self) -> u64 {
+        self.written
+    }
+
+    /// The folder images go to.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
+impl Observer for FrameSaver {
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, _world_from_camera: Pose) {
+        if self.stopped || frame.seq % self.every != 0 {
+            return;
+        }
+        let path = self.dir.join(format!("frame_{:06}.png", frame.seq));
+        match image::save_buffer(
+            &path,
+            frame.rgb,
+            frame.width,
+            frame.height,
+            image::ExtendedColorType::Rgb8,
+        ) {
+            Ok(()) => self.written += 1,
+            Err(e) => {
+                self.stopped = true;
+                self.failed = Some(CoreError::write(&path, std::io::Error::other(e)));
+            }
+        }
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.failed.take()
+    }
+}
+
+/// The files a run writes besides a recording: the trace and the camera frames, as one
+/// observer. Headless runs and the window open them the same way.
+#[derive(Debug, Default)]
+pub struct RunFiles {
+    /// `--trace`.
+    pub trace: Option<TraceObserver>,
+    /// `--save-frames`.
+    pub frames: Option<FrameSaver>,
+}
+
+/// What [`RunFiles`] wrote.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunFilesWritten {
+    /// Trace rows.
+    pub rows: u64,
+    /// Camera images.
+    pub frames: u64,
+}
+
+impl RunFiles {
+    /// Creates the trace file (with its header) and the frames folder, as asked.
+    pub fn open(
+        trace: Option<&Path>,
+        save_frames: Option<&Path>,
+        frame_every: u64,
+    ) -> Result<Self> {
+        Ok(Self {
+            trace: trace.map(TraceObserver::create).transpose()?,
+            frames: save_frames
+                .map(|dir| FrameSaver::new(dir, frame_every))
+                .transpose()?,
+        })
+    }
+
+    /// Flushes the trace; says where the frames went.
+    pub fn finish(self) -> Result<RunFilesWritten> {
+        let rows = self
+            .trace
+            .map(TraceObserver::finish)
+            .transpose()?
+            .unwrap_or(0);
+        let frames = self.frames.as_ref().map_or(0, FrameSaver::written);
+        if let Some(f) = &self.frames {
+            tracing::info!(
+                "wrote {} camera frames to {}",
+                f.written(),
+                f.dir().display()
+            );
+        }
+        Ok(RunFilesWritten { rows, frames })
+    }
+}
+
+impl Observer for RunFiles {
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        if let Some(t) = self.trace.as_mut() {
+            t.control(sim, sample, stats);
+        }
+    }
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
+        if let Some(f) = self.frames.as_mut() {
+            f.camera_frame(frame, world_from_camera);
+        }
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.trace
+            .as_mut()
+            .and_then(Observer::failure)
+            .or_else(|| self.frames.as_mut().and_then(Observer::failure))
+    }
+}

@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# Installs what a fresh Debian/Ubuntu machine lacks to build and run rover (`setup.sh run`) or
+# to run its whole test suite (`setup.sh test`). Only missing things are installed, and the
+# script says what before it does; sudo is used only when not root. Sourced by ./run and
+# ./test (which then export PATH for the Python tools); safe to run again.
+set -euo pipefail
+
+purpose="${1:-run}"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cache="${XDG_CACHE_HOME:-$HOME/.cache}/rover"
+
+say() { printf 'rover setup: %s\n' "$*" >&2; }
+
+if ! command -v cargo >/dev/null 2>&1; then
+  say "cargo not found: install Rust 1.95 first (https://rustup.rs), then run this again"
+  exit 1
+fi
+
+# --- Debian packages -------------------------------------------------------------------------
+#   build: a C compiler and pkg-config; libudev-dev for gilrs (the gamepad library)
+#   run:   mesa-vulkan-drivers (software Vulkan: the camera renders without a GPU), the X11
+#          keyboard/cursor libraries winit loads for the window
+#   test:  darknet (its sample photos), xvfb/xauth/xdotool (the window test), chromium (the web
+#          viewer test), python3 with venv and pip (onnxruntime and scikit-image references)
+packages=(gcc libc6-dev pkg-config libudev-dev mesa-vulkan-drivers libxkbcommon-x11-0 libxcursor1 libxi6)
+if [ "$purpose" = test ]; then
+  packages+=(darknet xvfb xauth xdotool chromium python3 python3-venv python3-pip npm)
+fi
+missing=()
+if command -v dpkg-query >/dev/null 2>&1; then
+  for p in "${packages[@]}"; do
+    case "$p" in
+      # Any working python3/npm will do (pyenv, nvm, ...): only ask apt when there is none.
+      python3|python3-venv|python3-pip) command -v python3 >/dev/null 2>&1 && python3 -m venv --help >/dev/null 2>&1 && continue ;;
+      npm) command -v npm >/dev/null 2>&1 && continue ;;
+      gcc|libc6-dev) command -v cc >/dev/null 2>&1 && continue ;;
+    esac
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+else
+  say "not a Debian/Ubuntu system: install the equivalents of ${packages[*]} yourself"
+fi
+if [ ${#missing[@]} -gt 0 ]; then
+  say "installing Debian packages: ${missing[*]}"
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then
+    say "(this needs sudo)"
+    sudo_cmd=(sudo)
+  fi
+  "${sudo_cmd[@]}" apt-get update -q
+  if ! "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${missing[@]}"; then
+    "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get --fix-broken install -y -q
+    "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${missing[@]}"
+  fi
+fi
+
+# --- Python tools for the tests: onnxruntime, numpy, scikit-image, the Rerun viewer ------------
+# The system python3 when it already has them, else a virtual environment in rover's cache
+# (no sudo, nothing installed into the system's Python). Its bin/ goes first on PATH.
+if [ "$purpose" = test ]; then
+  rerun_ok() { "$1" --version 2>/dev/null | grep -q " 0\.36\.3"; }
+  if python3 -c "import onnxruntime, numpy, skimage" 2>/dev/null && rerun_ok rerun; then
+    :
+  else
+    venv="$cache/venv"
+    if [ ! -x "$venv/bin/python3" ]; then
+      say "creating a Python environment for the test references in $venv"
+      python3 -m venv "$venv"
+    fi
+    if ! "$venv/bin/python3" -c "import onnxruntime, numpy, skimage" 2>/dev/null || ! rerun_ok "$venv/bin/rerun"; then
+      say "installing onnxruntime, numpy, scikit-image, rerun-sdk==0.36.3 from PyPI into $venv"
+      "$venv/bin/python3" -m pip install --quiet --disable-pip-version-check \
+        onnxruntime numpy scikit-image rerun-sdk==0.36.3
+    fi
+    export PATH="$venv/bin:$PATH"
+  fi
+  rerun analytics disable >/dev/null 2>&1 || true
+  if [ ! -d "$root/scripts/webview/node_modules/playwright-core" ]; then
+    say "installing playwright-core (npm) for the web viewer test"
+    (cd "$root/scripts/webview" && npm ci --no-audit --no-fund --silent)
+  fi
+fi
+
+# One build folder outside the clone, shared by ./run, ./test and CI (incremental rebuilds).
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$cache/target}"
+mkdir -p "$CARGO_TARGET_DIR"

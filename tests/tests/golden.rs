@@ -1,0 +1,111 @@
+//! Golden traces: scripted headless runs whose traces were recorded before the loop moved into
+//! rover-core (app/src, commit bc11d80). The refactor and anything after it must reproduce them
+//! byte for byte: same physics, same script timing, same detector schedule, same follower.
+//!
+//! Regenerate (only when a change is meant to alter behaviour, and say so in the commit):
+//! `ROVER_BLESS=1 cargo test -p rover-tests --test golden`.
+
+use std::path::Path;
+
+use anyhow::Result;
+use rover_core::{RunConfig, headless};
+use rover_sim::{CameraSensor, SimOptions, Simulation};
+use rover_tests::repo;
+
+/// Runs `world` with `script` for `duration_s` and compares the trace with `golden`.
+fn check(world: &str, script: &str, duration_s: f64, golden: &str) -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("trace.csv");
+    headless::run(&RunConfig {
+        world: Some(repo(world)),
+        script: Some(repo(script)),
+        duration_s: Some(duration_s),
+        trace: Some(trace.clone()),
+        ..RunConfig::default()
+    })?;
+    let got = std::fs::read_to_string(&trace)?;
+    let golden_path = repo(golden);
+    if std::env::var_os("ROVER_BLESS").is_some() {
+        std::fs::write(&golden_path, &got)?;
+        return Ok(());
+    }
+    let want = std::fs::read_to_string(&golden_path)?;
+    if got != want {
+        let line = got
+            .lines()
+            .zip(want.lines())
+            .position(|(a, b)| a != b)
+            .map_or_else(|| "length".to_owned(), |i| format!("line {}", i + 1));
+        let kept = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(Path::new(golden).file_name().unwrap_or_default());
+        let _ = std::fs::write(&kept, &got);
+        anyhow::bail!(
+            "trace differs from {golden} at {line} ({} vs {} rows); this run's trace: {}",
+            got.lines().count(),
+            want.lines().count(),
+            kept.display()
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn manual_driving_reproduces_the_golden_trace() -> Result<()> {
+    check(
+        "worlds/playground.toml",
+        "tests/golden/drive.toml",
+        9.0,
+        "tests/golden/drive.csv",
+    )
+}
+
+/// What the follow trace depends on beyond rover: the CPU features tract's kernels pick and
+/// the renderer (llvmpipe's JIT). The golden trace was recorded on `follow.machine`.
+fn machine() -> Result<String> {
+    let sim = Simulation::new(
+        rover_sim::World::load(&repo("worlds/walking.toml"))?,
+        rover_sim::RobotModel::load(&repo("assets/robots/my_robot.urdf"))?,
+        &SimOptions::default(),
+    )?;
+    let adapter = CameraSensor::new(&sim)?.renderer().adapter().to_owned();
+    #[cfg(target_arch = "x86_64")]
+    let features = ["avx512f", "avx512vnni", "avx2", "fma"]
+        .into_iter()
+        .filter(|f| match *f {
+            "avx512f" => std::arch::is_x86_feature_detected!("avx512f"),
+            "avx512vnni" => std::arch::is_x86_feature_detected!("avx512vnni"),
+            "avx2" => std::arch::is_x86_feature_detected!("avx2"),
+            _ => std::arch::is_x86_feature_detected!("fma"),
+        })
+        .collect::<Vec<_>>()
+        .join(",");
+    #[cfg(not(target_arch = "x86_64"))]
+    let features = String::new();
+    Ok(format!("{} [{features}] {adapter}", std::env::consts::ARCH))
+}
+
+#[test]
+fn following_a_walking_person_reproduces_the_golden_trace() -> Result<()> {
+    let here = machine()?;
+    let machine_file = repo("tests/golden/follow.machine");
+    if std::env::var_os("ROVER_BLESS").is_some() {
+        std::fs::write(&machine_file, format!("{here}\n"))?;
+    } else {
+        let recorded = std::fs::read_to_string(&machine_file)?;
+        if recorded.trim() != here {
+            eprintln!(
+                "skipped: the golden follow trace was recorded on `{}`, this machine is `{here}` \
+                 (detector and renderer floating point differ across CPUs); the manual golden \
+                 trace and the determinism tests still run",
+                recorded.trim()
+            );
+            return Ok(());
+        }
+    }
+    check(
+        "worlds/walking.toml",
+        "tests/golden/follow.toml",
+        12.0,
+        "tests/golden/follow.csv",
+    )
+}
