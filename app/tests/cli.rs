@@ -104,6 +104,26 @@ fn bad_input_exits_with_a_located_error() -> Result<()> {
 }
 
 #[test]
+fn headless_rtf_paces_the_run_to_the_wall_clock() -> Result<()> {
+    // Pacing can only slow a run down, so this holds on any machine: 2 sim seconds at 1x take
+    // at least 2 wall seconds (unpaced, this run takes a small fraction of that).
+    let out = rover(&["--headless", "--duration", "2", "--rtf", "1"], &repo(""))?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", text(&out.stderr));
+    let wall_s = stdout
+        .split(" s wall")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|v| v.parse::<f64>().ok())
+        .ok_or_else(|| anyhow::anyhow!("no wall time in {stdout}"))?;
+    assert!(wall_s >= 1.99, "2 s of sim time at 1x took {wall_s} s");
+    let out = rover(&["--headless", "--rtf", "0"], &repo(""))?;
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("--rtf must be a positive factor"));
+    Ok(())
+}
+
+#[test]
 fn help_explains_the_interface() -> Result<()> {
     let out = rover(&["--help"], &repo(""))?;
     let help = text(&out.stdout);

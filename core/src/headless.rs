@@ -80,6 +80,8 @@ pub struct RunSummary {
     pub wall_s: f64,
     /// Trace rows written (= control updates).
     pub rows: u64,
+    /// Camera images written by `save_frames`.
+    pub frames_written: u64,
     /// The last control sample.
     pub last: Option<ControlSample>,
     /// Mode at the end.

@@ -22,7 +22,6 @@ pub fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
-/// Heading (rotation about +z) of a rotation, in radians in (-pi, pi].
 /// A pose at `position_m` (world frame) turned `yaw_rad` about +z: how world files place
 /// objects, people and the robot.
 pub fn pose_from_position_yaw(position_m: [f64; 3], yaw_rad: f64) -> Pose {
@@ -36,6 +35,7 @@ pub fn pose_from_position_yaw(position_m: [f64; 3], yaw_rad: f64) -> Pose {
     )
 }
 
+/// Heading (rotation about +z) of a rotation, in radians in (-pi, pi].
 pub fn yaw_of(rotation: Quat) -> f64 {
     let forward = rotation * Vec3::X;
     f64::from(forward.y).atan2(f64::from(forward.x))

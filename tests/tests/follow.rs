@@ -37,7 +37,7 @@ fn follow(dir: &std::path::Path, world: &std::path::Path, seconds: f64) -> Resul
         trace: Some(trace.clone()),
         ..RunConfig::default()
     })?;
-    parse_trace(&std::fs::read_to_string(trace)?)
+    Ok(parse_trace(&std::fs::read_to_string(trace)?)?)
 }
 
 /// Distance (m) from the car's base to the person, and how far (deg) the car's heading is

@@ -91,7 +91,9 @@ fn following_a_walking_person_reproduces_the_golden_trace() -> Result<()> {
     if std::env::var_os("ROVER_BLESS").is_some() {
         std::fs::write(&machine_file, format!("{here}\n"))?;
     } else {
-        let recorded = std::fs::read_to_string(&machine_file)?;
+        let recorded = std::fs::read_to_string(&machine_file).map_err(|e| {
+            anyhow::anyhow!("{}: {e}; this machine is `{here}`", machine_file.display())
+        })?;
         if recorded.trim() != here {
             eprintln!(
                 "skipped: the golden follow trace was recorded on `{}`, this machine is `{here}` \

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use image::{Rgb, RgbImage};
+use image::RgbImage;
 use rover_perception::preprocess::load_rgb;
 use rover_perception::{BoundingBox, Detector, DetectorConfig, FrameStamp, RgbView};
 use serde::Serialize;

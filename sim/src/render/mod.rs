@@ -636,6 +636,9 @@ impl CameraRenderer {
 
 /// Brown-Conrady lens distortion as gazebo_ros_camera applies it, on normalised image
 /// coordinates (x = (u - cx) / fx, y = (v - cy) / fy): the distorted point of an ideal one.
+/// The renderer needs only its inverse ([`distortion_map`]); the tests check one against the
+/// other.
+#[cfg(test)]
 pub(crate) fn distort(d: &Distortion, x: f64, y: f64) -> (f64, f64) {
     let r2 = x * x + y * y;
     let radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
