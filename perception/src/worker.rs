@@ -107,7 +107,9 @@ impl DetectorWorker {
                         RgbView::new(frame.width, frame.height, &frame.pixels)
                             .and_then(|view| detect(view, frame.stamp))
                     }))
-                    .unwrap_or_else(|payload| Err(PerceptionError::Panicked(panic_text(&payload))));
+                    .unwrap_or_else(|payload| {
+                        Err(PerceptionError::Panicked(panic_text(payload.as_ref())))
+                    });
                     let panicked = matches!(result, Err(PerceptionError::Panicked(_)));
                     lock(&thread_shared).stats.processed += 1;
                     // Receivers gone means the worker is being dropped: just stop.
