@@ -162,7 +162,7 @@ impl FrameSaver {
 
 impl Observer for FrameSaver {
     fn camera_frame(&mut self, frame: &CameraFrame<'_>, _world_from_camera: Pose) {
-        if self.stopped || frame.seq % self.every != 0 {
+        if self.stopped || !frame.seq.is_multiple_of(self.every) {
             return;
         }
         let path = self.dir.join(format!("frame_{:06}.png", frame.seq));

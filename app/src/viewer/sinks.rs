@@ -193,7 +193,7 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
             let (host, port) =
                 host_port(url).unwrap_or(("127.0.0.1".into(), rerun::DEFAULT_SERVER_PORT));
             // Resolved once, here, not on the loop thread: the watch then only dials an address.
-            let addr = resolve(&host, port).filter(|addr| connects(addr));
+            let addr = resolve(&host, port).filter(connects);
             let Some(addr) = addr else {
                 anyhow::bail!(
                     "no Rerun viewer answers at {url}: start one with `rerun` (`{}`), or use --viewer web",
