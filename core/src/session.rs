@@ -13,7 +13,7 @@ use rover_perception::{
     PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, Twist, World,
+    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, World,
 };
 
 use crate::error::{CoreError, Result};
@@ -341,11 +341,6 @@ impl Session {
             );
         }
         self.stats.mode = after;
-    }
-
-    /// Sets cmd_vel directly (gamepad axes); manual mode.
-    pub fn manual_cmd(&mut self, cmd: Twist, observer: &mut dyn Observer) {
-        self.input(Action::CmdVel(cmd), observer);
     }
 
     /// Advances one physics step: camera (when due), detector, follower, physics. Returns the

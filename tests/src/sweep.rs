@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use rover_perception::{Detector, DetectorConfig, FrameStamp, RgbView};
 use rover_sim::{CameraInfo, CameraRenderer, Pose, SimOptions, Simulation, World};
 
@@ -122,10 +122,8 @@ pub fn person_sweep(
             let cam = [px + d * heading.cos(), py + d * heading.sin()];
             let look_yaw = (py - cam[1]).atan2(px - cam[0]);
             let yaw = look_yaw - bearing.to_radians();
-            let world_from_camera = Pose::from_parts(
-                Vec3::new(cam[0] as f32, cam[1] as f32, camera_height_m as f32),
-                Quat::from_rotation_z(yaw as f32),
-            );
+            let world_from_camera =
+                rover_sim::pose_from_position_yaw([cam[0], cam[1], camera_height_m], yaw);
             let rgb = renderer.render(&parked, world_from_camera)?;
             let boxes = detector.detect(
                 RgbView::new(w as usize, h as usize, rgb)?,

@@ -4,6 +4,7 @@
 
 use std::collections::BTreeSet;
 
+use rover_core::teleop::TELEOP_KEYS;
 use rover_core::{Action, KeyAction, Mode, key_action};
 
 /// Keyboard settings.
@@ -50,12 +51,11 @@ fn teleop_name(name: &str, wasd: bool) -> Option<&'static str> {
         (_, "<") => ",",
         (_, ">") => ".",
         (_, "space" | " ") => "space",
-        (_, other) => [
-            "u", "i", "o", "j", "k", "l", "m", ",", ".", "q", "z", "w", "x", "e", "c", "f", "p",
-            "n",
-        ]
-        .into_iter()
-        .find(|k| *k == other)?,
+        // The station's own keys: follow, pause, single step.
+        (_, "f") => "f",
+        (_, "p") => "p",
+        (_, "n") => "n",
+        (_, other) => TELEOP_KEYS.split(' ').find(|k| *k == other)?,
     })
 }
 

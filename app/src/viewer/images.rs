@@ -60,6 +60,11 @@ impl ImageLogger {
         }
     }
 
+    /// The options it logs with.
+    pub fn options(&self) -> &ImageOptions {
+        &self.options
+    }
+
     /// True when `frame` is due under the image rate; advances the schedule.
     pub fn due(&mut self, sim_time_s: f64) -> bool {
         if sim_time_s + 1e-9 < self.next_image_s {

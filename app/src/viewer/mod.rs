@@ -51,7 +51,6 @@ use sinks::ViewerWatch;
 /// The Rerun recorder.
 pub struct Recorder {
     rec: RecordingStream,
-    image_options: ImageOptions,
     images: ImageLogger,
     frame: i64,
     trail: Vec<[f32; 3]>,
@@ -87,7 +86,6 @@ impl Recorder {
         rec.set_log_time_enabled(false);
         Ok(Some(Self {
             rec,
-            image_options: options.images,
             images: ImageLogger::new(options.images),
             frame: 0,
             trail: Vec::with_capacity(4096),
@@ -158,7 +156,7 @@ impl Recorder {
 
 impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
-        self.paths = scene::log_scene(&self.rec, sim, camera, labels, &self.image_options);
+        self.paths = scene::log_scene(&self.rec, sim, camera, labels, self.images.options());
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
@@ -250,7 +248,7 @@ impl Observer for Recorder {
         let stamp = boxes.image_stamp;
         self.rec.set_duration_secs("sim_time", stamp.sim_time_s);
         self.rec.set_time_sequence("frame", stamp.frame as i64);
-        let k = self.image_options.scale();
+        let k = self.images.options().scale();
         let b = &boxes.bounding_boxes;
         let data = rerun::Boxes2D::from_mins_and_sizes(
             b.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
