@@ -20,11 +20,13 @@ mod gazebo;
 mod geometry;
 mod mesh;
 mod render;
+mod resource;
 mod robot;
 mod sensor;
 mod simulation;
 mod tomlfile;
 mod world;
+mod xacro;
 
 pub use camera::{CameraInfo, link_from_optical};
 pub use diff_drive::{
@@ -41,7 +43,8 @@ pub use render::meshes::{
     MeshData, Part as PersonPart, Vertex as MeshVertex, object_mesh, person_parts, shape_mesh,
 };
 pub use render::{CameraRenderer, RenderError};
-pub use robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
+pub use resource::{NotFound, ResourcePaths};
+pub use robot::{Collision, Inertial, Joint, JointKind, Link, LoadOptions, RobotModel, Visual};
 pub use sensor::{CameraFrame, CameraSensor};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use tomlfile::{load_toml, parse_toml};
@@ -49,3 +52,4 @@ pub use world::{
     DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Person, Physics, RobotSpawn, STEP_HZ_RANGE, Walk,
     World, check_step_hz,
 };
+pub use xacro::{Expanded, expand_file as expand_xacro, uses_xacro};

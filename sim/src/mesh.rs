@@ -1,178 +1,107 @@
-//! Triangle meshes from STL (binary or ASCII) and Wavefront OBJ files, as URDF `<mesh>` uses them.
+//! Triangle meshes from STL (binary or ASCII), Wavefront OBJ and COLLADA (`.dae`) files, as
+//! URDF `<mesh>` and SDF `<mesh><uri>` use them.
+//!
+//! Parsing is OpenRR's `mesh-loader` (what urdf-viz uses): it applies COLLADA's `<unit>` and node
+//! transforms and tells binary STL files that begin with "solid" from ASCII ones. rover adds the
+//! URDF `scale`, merges the file's meshes and checks the result.
 
 use std::path::Path;
 
 use glam::Vec3;
 
 use crate::error::{Result, SimError};
+use crate::geometry::Rgba;
 
-/// An indexed triangle mesh in the file's own units, scaled.
+/// Largest mesh file accepted (a 231k-triangle COLLADA file is ~20 MB).
+const MAX_MESH_BYTES: u64 = 512 << 20;
+
+/// An indexed triangle mesh in metres (the file's unit and the URDF scale applied).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Vertex positions.
     pub positions: Vec<Vec3>,
     /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
+    /// The diffuse colour of the file's first material, when it names one.
+    pub color: Option<Rgba>,
 }
 
-/// Loads an STL or OBJ file and applies a per-axis scale.
+/// Loads an STL, OBJ or COLLADA file and applies a per-axis scale.
 pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
-    let bytes = std::fs::read(path).map_err(|source| SimError::Io {
+    let io = |source| SimError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    if size > MAX_MESH_BYTES {
+        return Err(SimError::invalid(
+            path,
+            None,
+            format!("mesh file is {size} bytes; expected at most {MAX_MESH_BYTES}"),
+        ));
+    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let mut mesh = match ext.as_deref() {
-        Some("stl") => parse_stl(&bytes, path)?,
-        Some("obj") => parse_obj(&String::from_utf8_lossy(&bytes), path)?,
+    let loader = mesh_loader::Loader::default();
+    let bytes = std::fs::read(path).map_err(io)?;
+    let scene = match ext.as_deref() {
+        Some("stl") => loader.load_stl_from_slice(&bytes, path),
+        Some("obj") => loader.load_obj_from_slice(&bytes, path),
+        Some("dae") => loader.load_collada_from_slice(&bytes, path),
         _ => {
             return Err(SimError::invalid(
                 path,
                 None,
-                "unsupported mesh format: expected .stl or .obj",
+                "unsupported mesh format: expected .stl, .obj or .dae (COLLADA)",
             ));
         }
-    };
-    if mesh.triangles.is_empty() {
-        return Err(SimError::invalid(path, None, "mesh has no triangles"));
     }
-    for p in &mut mesh.positions {
-        *p *= scale;
-    }
-    Ok(mesh)
-}
+    .map_err(|e| SimError::invalid(path, None, format!("cannot read mesh: {e}")))?;
 
-fn parse_stl(bytes: &[u8], path: &Path) -> Result<TriMesh> {
-    // Binary STL: 80-byte header, u32 count, 50 bytes per triangle. ASCII files start with
-    // "solid" but so do some binary ones, so trust the size arithmetic first.
-    if bytes.len() >= 84 {
-        let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
-        if bytes.len() == 84 + count * 50 {
-            let mut mesh = TriMesh::default();
-            for t in 0..count {
-                let base = 84 + t * 50 + 12;
-                let mut tri = [0u32; 3];
-                for (v, slot) in tri.iter_mut().enumerate() {
-                    let mut xyz = [0f32; 3];
-                    for (k, c) in xyz.iter_mut().enumerate() {
-                        let o = base + v * 12 + k * 4;
-                        *c = f32::from_le_bytes([
-                            bytes[o],
-                            bytes[o + 1],
-                            bytes[o + 2],
-                            bytes[o + 3],
-                        ]);
-                    }
-                    *slot = mesh.positions.len() as u32;
-                    mesh.positions.push(Vec3::from_array(xyz));
-                }
-                mesh.triangles.push(tri);
+    let mut mesh = TriMesh {
+        color: scene
+            .materials
+            .iter()
+            .find_map(|m| m.color.diffuse)
+            .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
+        ..TriMesh::default()
+    };
+    for part in &scene.meshes {
+        let offset = u32::try_from(mesh.positions.len())
+            .map_err(|_| SimError::invalid(path, None, "mesh has more than 2^32 vertices"))?;
+        let count = part.vertices.len() as u32;
+        for f in &part.faces {
+            if f.iter().any(|&i| i >= count) {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    format!("mesh \"{}\" has a face index past its {count} vertices", part.name),
+                ));
             }
-            return Ok(mesh);
+            mesh.triangles.push(f.map(|i| i + offset));
+        }
+        for v in &part.vertices {
+            let p = Vec3::from_array(*v) * scale;
+            if !p.is_finite() {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    format!("mesh \"{}\" has a vertex that is not a finite number", part.name),
+                ));
+            }
+            mesh.positions.push(p);
         }
     }
-    let text = std::str::from_utf8(bytes).map_err(|_| {
-        SimError::invalid(
+    if mesh.triangles.is_empty() {
+        return Err(SimError::invalid(
             path,
             None,
-            "not a valid STL file: binary size does not match its triangle count and it is not ASCII",
-        )
-    })?;
-    let mut mesh = TriMesh::default();
-    let mut pending = Vec::with_capacity(3);
-    for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        if words.next() != Some("vertex") {
-            continue;
-        }
-        let xyz = parse_floats::<3>(words, path, n + 1, "vertex x y z")?;
-        pending.push(mesh.positions.len() as u32);
-        mesh.positions.push(Vec3::from_array(xyz));
-        if pending.len() == 3 {
-            mesh.triangles.push([pending[0], pending[1], pending[2]]);
-            pending.clear();
-        }
+            "mesh has no triangles: expected at least one",
+        ));
     }
     Ok(mesh)
-}
-
-fn parse_obj(text: &str, path: &Path) -> Result<TriMesh> {
-    let mut mesh = TriMesh::default();
-    for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let xyz = parse_floats::<3>(words, path, n + 1, "v x y z")?;
-                mesh.positions.push(Vec3::from_array(xyz));
-            }
-            Some("f") => {
-                let mut corners = Vec::with_capacity(4);
-                for w in words {
-                    let first = w.split('/').next().unwrap_or("");
-                    let index: i64 = first.parse().map_err(|_| {
-                        SimError::invalid(
-                            path,
-                            Some(n as u32 + 1),
-                            format!("face corner '{w}': expected a vertex index"),
-                        )
-                    })?;
-                    // OBJ indices are 1-based; negative ones count back from the newest vertex.
-                    let count = mesh.positions.len() as i64;
-                    let resolved = if index < 0 { count + index } else { index - 1 };
-                    if !(0..count).contains(&resolved) {
-                        return Err(SimError::invalid(
-                            path,
-                            Some(n as u32 + 1),
-                            format!(
-                                "face refers to vertex {index}, but only {count} vertices are defined so far"
-                            ),
-                        ));
-                    }
-                    corners.push(resolved as u32);
-                }
-                if corners.len() < 3 {
-                    return Err(SimError::invalid(
-                        path,
-                        Some(n as u32 + 1),
-                        "face with fewer than 3 corners",
-                    ));
-                }
-                for i in 1..corners.len() - 1 {
-                    mesh.triangles
-                        .push([corners[0], corners[i], corners[i + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(mesh)
-}
-
-fn parse_floats<'a, const N: usize>(
-    mut words: impl Iterator<Item = &'a str>,
-    path: &Path,
-    line: usize,
-    what: &str,
-) -> Result<[f32; N]> {
-    let mut out = [0f32; N];
-    for slot in &mut out {
-        let w = words.next().unwrap_or("");
-        *slot = w
-            .parse::<f32>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                SimError::invalid(
-                    path,
-                    Some(line as u32),
-                    format!("'{w}': expected {what} as numbers"),
-                )
-            })?;
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
@@ -195,8 +124,9 @@ mod tests {
             source,
         })?;
         let m = load_mesh(&p, Vec3::splat(2.0))?;
-        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
-        assert_eq!(m.positions[2], Vec3::new(2.0, 2.0, 0.0));
+        assert_eq!(m.triangles.len(), 2);
+        let max = m.positions.iter().fold(Vec3::ZERO, |a, p| a.max(*p));
+        assert_eq!(max, Vec3::new(2.0, 2.0, 0.0));
         Ok(())
     }
 
@@ -238,7 +168,16 @@ mod tests {
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(err.contains(":2: 'zero'"), "{err}");
+        assert!(err.contains("a.stl") && err.contains("cannot read mesh"), "{err}");
+
+        // A binary file whose 80-byte header begins with "solid" is still binary.
+        bin[..6].copy_from_slice(b"solid ");
+        let p = dir.path().join("solid_binary.stl");
+        std::fs::write(&p, &bin).map_err(|source| SimError::Io {
+            path: p.clone(),
+            source,
+        })?;
+        assert_eq!(load_mesh(&p, Vec3::ONE)?.triangles.len(), 1);
         Ok(())
     }
 }

@@ -12,6 +12,27 @@ use glam::Vec3;
 use crate::error::{Result, SimError};
 use crate::gazebo::{self, CameraConfig, DiffDriveConfig};
 use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, vec3};
+use crate::resource::ResourcePaths;
+use crate::xacro::{self, Expanded};
+
+/// How to read a robot description: xacro arguments and where ROS packages are.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LoadOptions {
+    /// `name:=value` arguments for `$(arg name)` in xacro files.
+    pub xacro_args: BTreeMap<String, String>,
+    /// Where `package://` and `$(find)` look.
+    pub resources: ResourcePaths,
+}
+
+impl LoadOptions {
+    /// No xacro arguments; packages from `ROS_PACKAGE_PATH`.
+    pub fn from_env() -> Self {
+        Self {
+            xacro_args: BTreeMap::new(),
+            resources: ResourcePaths::from_env(),
+        }
+    }
+}
 
 /// Mass properties of a link, from its `<inertial>`.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,20 +141,44 @@ pub struct RobotModel {
     pub diff_drive: Option<DiffDriveConfig>,
     /// Camera sensors (`<sensor type="camera">`).
     pub cameras: Vec<CameraConfig>,
+    /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
+    /// `/robot_description`.
+    pub description: String,
 }
 
 impl RobotModel {
-    /// Loads and validates a URDF file.
+    /// Loads and validates a URDF or xacro file, with packages from `ROS_PACKAGE_PATH`.
     pub fn load(path: &Path) -> Result<Self> {
+        Self::load_with(path, &LoadOptions::from_env())
+    }
+
+    /// Loads and validates a URDF file, or expands a xacro file (a `.xacro` name, or a file
+    /// that declares the xacro namespace) and loads the result. Errors in an expanded file name
+    /// the xacro file and line the element came from.
+    pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_str(&text, path)
+        let is_xacro = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.ends_with(".xacro"))
+            || xacro::uses_xacro(&text);
+        if is_xacro {
+            let expanded = xacro::expand_file(path, &options.xacro_args, &options.resources)?;
+            return Self::parse(&expanded.text, path, &options.resources)
+                .map_err(|e| remap(e, &expanded));
+        }
+        Self::parse(&text, path, &options.resources)
     }
 
     /// Parses URDF text; `path` is used for messages and to resolve relative mesh files.
     pub fn from_str(text: &str, path: &Path) -> Result<Self> {
+        Self::parse(text, path, &ResourcePaths::from_env())
+    }
+
+    fn parse(text: &str, path: &Path, resources: &ResourcePaths) -> Result<Self> {
         let doc = roxmltree::Document::parse(text).map_err(|e| {
             let pos = e.pos();
             SimError::invalid(
@@ -176,7 +221,7 @@ impl RobotModel {
                     format!("<link name=\"{}\"> is defined twice", link.name),
                 ));
             }
-            links.push(convert_link(link, &materials, base_dir, path, &lines)?);
+            links.push(convert_link(link, &materials, (base_dir, resources), path, &lines)?);
         }
         if links.is_empty() {
             return Err(SimError::invalid(
@@ -293,6 +338,7 @@ impl RobotModel {
             root,
             diff_drive: extensions.diff_drive,
             cameras: extensions.cameras,
+            description: text.to_owned(),
         };
         model.validate_plugins(path)?;
         Ok(model)
@@ -506,10 +552,24 @@ fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Points an error in expanded text back at the xacro file and line it came from.
+fn remap(e: SimError, expanded: &Expanded) -> SimError {
+    match e {
+        SimError::Invalid { location, message } => {
+            let location = location
+                .line
+                .and_then(|line| expanded.source_of(line))
+                .unwrap_or(location);
+            SimError::Invalid { location, message }
+        }
+        other => other,
+    }
+}
+
 fn convert_link(
     link: &urdf_rs::Link,
     materials: &HashMap<&str, Rgba>,
-    base_dir: &Path,
+    base_dir: (&Path, &ResourcePaths),
     path: &Path,
     lines: &ElementLines,
 ) -> Result<Link> {
@@ -562,7 +622,7 @@ fn convert_link(
 
 fn convert_geometry(
     g: &urdf_rs::Geometry,
-    base_dir: &Path,
+    (base_dir, resources): (&Path, &ResourcePaths),
     path: &Path,
     line: Option<u32>,
     link: &str,
@@ -583,26 +643,19 @@ fn convert_geometry(
             radius_m: *radius as f32,
         },
         urdf_rs::Geometry::Mesh { filename, scale } => {
-            let resolved = resolve_mesh(filename, base_dir).ok_or_else(|| {
-                SimError::invalid(
-                    path,
-                    line,
-                    format!(
-                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: file not found (relative paths are resolved against {}; package://NAME/... against the folders above it)",
-                        base_dir.display()
-                    ),
-                )
+            let resolved = resources.resolve(filename, base_dir).map_err(|e| {
+                SimError::invalid(path, line, format!("<link name=\"{link}\"> <mesh>: {e}"))
             })?;
             let ext = resolved
                 .extension()
                 .and_then(|e| e.to_str())
                 .map(str::to_ascii_lowercase);
-            if !matches!(ext.as_deref(), Some("stl" | "obj")) {
+            if !matches!(ext.as_deref(), Some("stl" | "obj" | "dae")) {
                 return Err(SimError::invalid(
                     path,
                     line,
                     format!(
-                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: unsupported mesh format; expected .stl or .obj"
+                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: unsupported mesh format; expected .stl, .obj or .dae (COLLADA)"
                     ),
                 ));
             }
@@ -612,29 +665,6 @@ fn convert_geometry(
             }
         }
     })
-}
-
-/// Resolves `package://pkg/rel`, `file://abs` and relative mesh paths.
-fn resolve_mesh(filename: &str, base_dir: &Path) -> Option<PathBuf> {
-    if let Some(abs) = filename.strip_prefix("file://") {
-        let p = PathBuf::from(abs);
-        return p.is_file().then_some(p);
-    }
-    if let Some(rest) = filename.strip_prefix("package://") {
-        let (package, rel) = rest.split_once('/')?;
-        // Look for a folder named like the package, or for the relative path itself, in the
-        // URDF's folder and each folder above it.
-        for dir in base_dir.ancestors() {
-            for candidate in [dir.join(package).join(rel), dir.join(rel)] {
-                if candidate.is_file() {
-                    return Some(candidate);
-                }
-            }
-        }
-        return None;
-    }
-    let p = base_dir.join(filename);
-    p.is_file().then_some(p)
 }
 
 fn convert_joint(
