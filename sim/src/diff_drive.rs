@@ -175,9 +175,11 @@ impl DiffDriveController {
         }
 
         let target = self.wheel_speeds_for(self.command());
-        let max_delta = self.config.wheel_acceleration_radps2 * dt;
+        // gazebo_ros_diff_drive ramps the rim speed (m/s) by wheelAcceleration * dt.
+        let radius_m = self.config.wheel_diameter_m / 2.0;
+        let max_delta = self.config.wheel_acceleration_mps2 / radius_m * dt;
         for (cmd, goal) in self.wheel_cmd_radps.iter_mut().zip(target) {
-            *cmd = if self.config.wheel_acceleration_radps2 > 0.0 {
+            *cmd = if self.config.wheel_acceleration_mps2 > 0.0 {
                 *cmd + (goal - *cmd).clamp(-max_delta, max_delta)
             } else {
                 goal
@@ -246,7 +248,7 @@ mod tests {
         DiffDriveConfig {
             wheel_separation_m: 0.3,
             wheel_diameter_m: 0.1,
-            wheel_acceleration_radps2: accel,
+            wheel_acceleration_mps2: accel * 0.05,
             ..DiffDriveConfig::default()
         }
     }

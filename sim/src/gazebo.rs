@@ -42,8 +42,9 @@ pub struct DiffDriveConfig {
     pub wheel_diameter_m: f64,
     /// `<wheelTorque>` (N m, default 5): the wheel motors' maximum torque.
     pub wheel_torque_nm: f64,
-    /// `<wheelAcceleration>` (rad/s^2 on the commanded wheel speed, default 0 = unlimited).
-    pub wheel_acceleration_radps2: f64,
+    /// `<wheelAcceleration>` (m/s^2 on the commanded wheel rim speed, as gazebo_ros_diff_drive
+    /// applies it; default 0 = unlimited).
+    pub wheel_acceleration_mps2: f64,
     /// `<updateRate>` (Hz, default 100): the control loop on sim time; 0 means every physics step.
     pub update_rate_hz: f64,
     /// `<odometrySource>` (default `world`).
@@ -74,7 +75,7 @@ impl Default for DiffDriveConfig {
             wheel_separation_m: 0.34,
             wheel_diameter_m: 0.15,
             wheel_torque_nm: 5.0,
-            wheel_acceleration_radps2: 0.0,
+            wheel_acceleration_mps2: 0.0,
             update_rate_hz: 100.0,
             odometry_source: OdometrySource::World,
             publish_wheel_tf: false,
@@ -356,7 +357,8 @@ fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDrive
             "wheelDiameter" => c.wheel_diameter_m = ctx.positive(p, what, "metres")?,
             "wheelTorque" | "torque" => c.wheel_torque_nm = ctx.positive(p, what, "N m")?,
             "wheelAcceleration" => {
-                c.wheel_acceleration_radps2 = ctx.non_negative(p, what, "rad/s^2, 0 = unlimited")?
+                c.wheel_acceleration_mps2 =
+                    ctx.non_negative(p, what, "m/s^2 of rim speed, 0 = unlimited")?
             }
             "updateRate" => c.update_rate_hz = ctx.non_negative(p, what, "Hz")?,
             "odometrySource" => {

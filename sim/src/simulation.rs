@@ -114,6 +114,19 @@ impl Simulation {
 
         let people = add_world(&mut physics, &world);
         let robot_bodies = add_robot(&mut physics, &world, &robot)?;
+        let ratio = joint_mass_ratio(&robot, &robot_bodies);
+        if ratio > STIFF_MASS_RATIO
+            && physics.integration_parameters.num_solver_iterations < STIFF_SOLVER_ITERATIONS
+        {
+            // Light wheels on a heavy body (a TurtleBot3's 28 g wheels carry 30x their mass)
+            // need more solver iterations, or the joints stretch and the robot rocks.
+            tracing::info!(
+                "{}: joints connect bodies with a {ratio:.0}:1 mass ratio; using {STIFF_SOLVER_ITERATIONS} solver iterations (world: {})",
+                robot.name,
+                physics.integration_parameters.num_solver_iterations
+            );
+            physics.integration_parameters.num_solver_iterations = STIFF_SOLVER_ITERATIONS;
+        }
 
         let wheel = |name: &str| -> Result<WheelJoint> {
             let index = robot.joint_index(name).ok_or_else(|| {
@@ -420,6 +433,8 @@ struct RobotBodies {
     link_body: Vec<RigidBodyHandle>,
     body_from_link: Vec<Pose>,
     joints: Vec<Option<ImpulseJointHandle>>,
+    /// Mass of each link's rigid body (kg).
+    link_mass_kg: Vec<f32>,
 }
 
 /// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
@@ -509,6 +524,7 @@ fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> R
 
     // One rigid body per body root, carrying the summed inertials of its links.
     let mut link_body = vec![RigidBodyHandle::invalid(); n];
+    let mut link_mass_kg = vec![0.0f32; n];
     for root in 0..n {
         if body_root[root] != root {
             continue;
@@ -552,6 +568,7 @@ fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> R
         for (i, slot) in link_body.iter_mut().enumerate() {
             if body_root[i] == root {
                 *slot = body;
+                link_mass_kg[i] = mass.mass();
             }
         }
     }
@@ -606,9 +623,29 @@ fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> R
 
     Ok(RobotBodies {
         link_body,
+        link_mass_kg,
         body_from_link,
         joints,
     })
+}
+
+/// Above this mass ratio between jointed bodies the solver gets [`STIFF_SOLVER_ITERATIONS`].
+const STIFF_MASS_RATIO: f32 = 15.0;
+/// Solver iterations for robots with light links on heavy ones.
+const STIFF_SOLVER_ITERATIONS: usize = 16;
+
+/// The largest mass ratio between two bodies connected by a moving joint.
+fn joint_mass_ratio(robot: &RobotModel, bodies: &RobotBodies) -> f32 {
+    let mass = |link: usize| bodies.link_mass_kg[link];
+    robot
+        .joints
+        .iter()
+        .filter(|j| bodies.link_body[j.parent] != bodies.link_body[j.child])
+        .map(|j| {
+            let (a, b) = (mass(j.parent), mass(j.child));
+            if a.min(b) > 0.0 { a.max(b) / a.min(b) } else { 1.0 }
+        })
+        .fold(1.0, f32::max)
 }
 
 /// Gap between the robot's lowest collision point and the ground at spawn (m).

@@ -95,3 +95,18 @@ pub fn photo(name: &str, dir: &Path) -> anyhow::Result<PathBuf> {
         "test photo {name} not found: apt-get install darknet (it ships /usr/share/darknet/data)"
     )
 }
+
+/// A folder of `../shared` (test material beside the repository: real robots and worlds, ROS
+/// clients). `None`, with the reason printed, when it is absent, so tests can skip.
+pub fn shared(relative: &str) -> Option<PathBuf> {
+    let path = repo("../shared").join(relative);
+    if path.exists() {
+        Some(path)
+    } else {
+        eprintln!(
+            "SKIP: {} is absent (../shared beside the repository holds the third-party test files)",
+            path.display()
+        );
+        None
+    }
+}
