@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use rover_perception::DetectorConfig;
-use rover_sim::{ControlSample, RobotModel, SimOptions, World};
+use rover_sim::{ControlSample, LoadOptions, RobotModel, SimOptions, World};
 
 use crate::error::{CoreError, Result};
 use crate::follower::FollowerConfig;
@@ -19,8 +19,11 @@ use crate::session::{DetectorMode, NoObserver, Observer, Session, SessionOptions
 pub struct RunConfig {
     /// World file (default: worlds/playground.toml).
     pub world: Option<PathBuf>,
-    /// URDF file (default: the world's `[robot] urdf`, else assets/robots/my_robot.urdf).
+    /// URDF or xacro file (default: the world's `[robot] urdf`, else assets/robots/my_robot.urdf).
     pub robot: Option<PathBuf>,
+    /// xacro arguments (over the world's `[robot] xacro_args`) and package folders (over
+    /// `ROS_PACKAGE_PATH`) for the robot description.
+    pub robot_options: LoadOptions,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -108,8 +111,31 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
         .clone()
         .or_else(|| world.robot.urdf.clone())
         .unwrap_or_else(paths::default_robot);
-    let robot = RobotModel::load(&robot_path)?;
+    let robot = RobotModel::load_with(&robot_path, &robot_load_options(config, &world))?;
     Ok((world, robot))
+}
+
+/// How the robot is read: packages from `ROS_PACKAGE_PATH`, then the config's; xacro arguments
+/// from the world's `[robot]`, then the config's.
+pub fn robot_load_options(config: &RunConfig, world: &World) -> LoadOptions {
+    let mut options = LoadOptions::from_env();
+    options
+        .resources
+        .packages
+        .extend(config.robot_options.resources.packages.clone());
+    options.resources.package_search.splice(
+        0..0,
+        config.robot_options.resources.package_search.iter().cloned(),
+    );
+    options.resources.model_search.splice(
+        0..0,
+        config.robot_options.resources.model_search.iter().cloned(),
+    );
+    options.xacro_args = world.robot.xacro_args.clone();
+    options
+        .xacro_args
+        .extend(config.robot_options.xacro_args.clone());
+    options
 }
 
 /// Loads the script a [`RunConfig`] names (an empty one without).

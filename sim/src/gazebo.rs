@@ -175,6 +175,8 @@ pub(crate) struct Extensions {
     pub cameras: Vec<CameraConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
+    /// Sensors and plugins rover does not simulate, for one summary line.
+    pub ignored: Vec<String>,
 }
 
 type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
@@ -294,13 +296,13 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         }
                         ext.diff_drive = Some(parse_diff_drive(&ctx, child)?);
                     } else {
-                        tracing::debug!(
-                            "{}: ignoring Gazebo plugin {file}: rover does not simulate it",
-                            path.display()
-                        );
+                        ext.ignored.push(format!(
+                            "plugin {}",
+                            if file.is_empty() { "(no filename)" } else { file }
+                        ));
                     }
                 }
-                "sensor" if child.attribute("type") == Some("camera") => {
+                "sensor" if matches!(child.attribute("type"), Some("camera" | "depth")) => {
                     let Some(link) = reference else {
                         return Err(ctx.err(
                             child,
@@ -309,6 +311,11 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                     };
                     ext.cameras.push(parse_camera(&ctx, child, link)?);
                 }
+                "sensor" => ext.ignored.push(format!(
+                    "sensor \"{}\" (type {})",
+                    child.attribute("name").unwrap_or("?"),
+                    child.attribute("type").unwrap_or("?")
+                )),
                 "mu1" => {
                     mu[0] = Some(ctx.non_negative(
                         child,

@@ -141,6 +141,8 @@ pub struct RobotModel {
     pub diff_drive: Option<DiffDriveConfig>,
     /// Camera sensors (`<sensor type="camera">`).
     pub cameras: Vec<CameraConfig>,
+    /// Gazebo sensors and plugins in the file that rover does not simulate (IMU, GPS, ...).
+    pub not_simulated: Vec<String>,
     /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
     /// `/robot_description`.
     pub description: String,
@@ -339,7 +341,15 @@ impl RobotModel {
             diff_drive: extensions.diff_drive,
             cameras: extensions.cameras,
             description: text.to_owned(),
+            not_simulated: extensions.ignored,
         };
+        if !model.not_simulated.is_empty() {
+            tracing::info!(
+                "{}: not simulated (rover has no model for them): {}",
+                path.display(),
+                model.not_simulated.join(", ")
+            );
+        }
         model.validate_plugins(path)?;
         Ok(model)
     }

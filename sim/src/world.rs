@@ -41,6 +41,8 @@ pub struct RobotSpawn {
     pub position_m: [f64; 2],
     /// Spawn heading (rad, counter-clockwise from +x).
     pub yaw_rad: f64,
+    /// `xacro_args`: `$(arg NAME)` values when the robot is a xacro file.
+    pub xacro_args: std::collections::BTreeMap<String, String>,
 }
 
 /// Physics settings (`[physics]`).
@@ -263,6 +265,8 @@ struct RawRobot {
     position_m: [f64; 2],
     #[serde(default)]
     yaw_deg: f64,
+    #[serde(default)]
+    xacro_args: std::collections::BTreeMap<String, String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -505,6 +509,7 @@ impl RawWorld {
             urdf: self.robot.urdf.map(|u| base_dir.join(u)),
             position_m: self.robot.position_m,
             yaw_rad: self.robot.yaw_deg.to_radians(),
+            xacro_args: self.robot.xacro_args,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

@@ -62,9 +62,21 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
 
-    /// Robot URDF [default: the world's [robot] urdf, else assets/robots/my_robot.urdf]
+    /// Robot URDF or xacro (.urdf.xacro, .xacro; expanded in-process, no ROS needed)
+    /// [default: the world's [robot] urdf, else assets/robots/my_robot.urdf]
     #[arg(long, value_name = "FILE")]
     pub(crate) robot: Option<PathBuf>,
+
+    /// A xacro argument, NAME:=VALUE, for $(arg NAME) in the robot's xacro (repeatable;
+    /// overrides the world's [robot] xacro_args)
+    #[arg(long = "xacro-arg", value_name = "NAME:=VALUE", value_parser = parse_xacro_arg)]
+    pub(crate) xacro_args: Vec<(String, String)>,
+
+    /// Where ROS package NAME is, for package://NAME/... and $(find NAME) (repeatable). Without
+    /// it packages are found upward from the robot file (package.xml <name>) and in
+    /// ROS_PACKAGE_PATH
+    #[arg(long = "package-path", value_name = "NAME=DIR", value_parser = parse_package_path)]
+    pub(crate) package_paths: Vec<(String, PathBuf)>,
 
     /// Physics step rate in Hz, overriding the world's [physics] step_hz
     #[arg(long, value_name = "HZ")]
@@ -432,12 +444,50 @@ pub(crate) enum Command {
     },
 }
 
+/// `NAME:=VALUE` (xacro's own spelling; `NAME=VALUE` is accepted too).
+fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s
+        .split_once(":=")
+        .or_else(|| s.split_once('='))
+        .ok_or_else(|| format!("expected NAME:=VALUE, found \"{s}\""))?;
+    if name.is_empty() {
+        return Err(format!("expected NAME:=VALUE with a non-empty NAME, found \"{s}\""));
+    }
+    Ok((name.to_owned(), value.to_owned()))
+}
+
+/// `NAME=DIR` for a ROS package folder.
+fn parse_package_path(s: &str) -> Result<(String, PathBuf), String> {
+    let (name, dir) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=DIR, found \"{s}\""))?;
+    let dir = PathBuf::from(dir);
+    if name.is_empty() || !dir.is_dir() {
+        return Err(format!(
+            "expected NAME=DIR naming an existing folder, found \"{s}\""
+        ));
+    }
+    Ok((name.to_owned(), dir))
+}
+
 impl WorldArgs {
+    /// The robot-loading options these arguments give.
+    pub(crate) fn robot_options(&self) -> rover_sim::LoadOptions {
+        let mut options = rover_sim::LoadOptions::default();
+        options.xacro_args.extend(self.xacro_args.iter().cloned());
+        options
+            .resources
+            .packages
+            .extend(self.package_paths.iter().cloned());
+        options
+    }
+
     /// A run of this world and robot; the rest at its defaults.
     pub(crate) fn run_config(&self, cmd_timeout_s: Option<f64>) -> RunConfig {
         RunConfig {
             world: self.world.clone(),
             robot: self.robot.clone(),
+            robot_options: self.robot_options(),
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,
