@@ -90,6 +90,8 @@ pub struct CameraGeometry {
     pub height_m: f64,
     /// Camera position ahead of the base origin (m).
     pub forward_m: f64,
+    /// How far the optical axis looks below the horizon (rad; a TurtleBot3's camera: 0.174).
+    pub pitch_down_rad: f64,
 }
 
 impl CameraGeometry {
@@ -103,6 +105,7 @@ impl CameraGeometry {
             height_px: f64::from(info.height),
             height_m,
             forward_m,
+            pitch_down_rad: 0.0,
         }
     }
 }
@@ -223,9 +226,11 @@ impl Follower {
         // A box cut off at the top underestimates the height (overestimates the range): use
         // where the feet meet the ground instead, when they are below the horizon.
         let clipped_top = b.ymin <= 2;
-        let feet_below_horizon = b.ymax as f64 - c.cy;
-        let from_feet = (feet_below_horizon > 1.0 && (b.ymax as f64) < c.height_px - 2.0)
-            .then(|| c.fy * c.height_m / feet_below_horizon);
+        // The feet's ray dips below the horizon by the camera's pitch plus its angle below the
+        // optical axis.
+        let feet_dip_rad = ((b.ymax as f64 - c.cy) / c.fy).atan() + c.pitch_down_rad;
+        let from_feet = (feet_dip_rad > (1.0 / c.fy).atan() && (b.ymax as f64) < c.height_px - 2.0)
+            .then(|| c.height_m / feet_dip_rad.tan());
         let along_axis = match (clipped_top, from_feet) {
             (true, Some(d)) => d,
             (true, None) => from_height.min(self.config.standoff_m),
@@ -413,6 +418,7 @@ mod tests {
             height_px: 480.0,
             height_m: 0.18,
             forward_m: 0.15,
+            pitch_down_rad: 0.0,
         }
     }
 

@@ -484,8 +484,14 @@ fn camera_geometry(
     let base_from_camera = sim.world_from_base().inverse() * world_from_camera;
     let height_m = f64::from(world_from_camera.translation.z);
     let forward_m = f64::from(base_from_camera.translation.x);
+    // Gazebo cameras look along their link's +x.
+    let look = world_from_camera.rotation * glam::Vec3::X;
+    let pitch_down_rad = f64::from((-look.z).clamp(-1.0, 1.0).asin());
     match info {
-        Some(info) => CameraGeometry::new(info, height_m, forward_m),
+        Some(info) => CameraGeometry {
+            pitch_down_rad,
+            ..CameraGeometry::new(info, height_m, forward_m)
+        },
         None => CameraGeometry {
             fx: 1.0,
             fy: 1.0,
@@ -494,6 +500,7 @@ fn camera_geometry(
             height_px: 1.0,
             height_m,
             forward_m,
+            pitch_down_rad,
         },
     }
 }

@@ -113,3 +113,23 @@ fn turtlebot3_burger_rests_drives_a_metre_and_turns_half_a_turn() -> Result<()> 
     );
     Ok(())
 }
+
+#[test]
+fn turtlebot3_autorace_camera_has_gazebos_intrinsics() -> Result<()> {
+    let Some(robot) = turtlebot3("turtlebot3_burger_for_autorace.urdf.xacro")? else {
+        return Ok(());
+    };
+    let camera = robot
+        .cameras
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("the autorace burger's camera was not found"))?;
+    assert_eq!(camera.link, "camera_rgb_frame");
+    assert_eq!((camera.width_px, camera.height_px), (320, 240));
+    let info = rover_sim::CameraInfo::from_config(camera);
+    // gazebo_ros_camera: f = W / (2 tan(hfov / 2)), c = (W + 1) / 2, (H + 1) / 2.
+    let f = 320.0 / (2.0 * (1.085595f64 / 2.0).tan());
+    assert!((info.k[0] - f).abs() < 1e-9 && (info.k[4] - f).abs() < 1e-9);
+    assert_eq!((info.k[2], info.k[5]), (160.5, 120.5));
+    assert_eq!((info.width, info.height), (320, 240));
+    Ok(())
+}
