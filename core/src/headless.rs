@@ -24,6 +24,8 @@ pub struct RunConfig {
     /// xacro arguments (over the world's `[robot] xacro_args`) and package folders (over
     /// `ROS_PACKAGE_PATH`) for the robot description.
     pub robot_options: LoadOptions,
+    /// Where the robot spawns: x m, y m, yaw deg (overrides the world's `[robot]`).
+    pub spawn: Option<[f64; 3]>,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -105,7 +107,12 @@ impl RunSummary {
 /// Loads the world and robot a [`RunConfig`] names.
 pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
     let world_path = config.world.clone().unwrap_or_else(paths::default_world);
-    let world = World::load(&world_path)?;
+    let resources = robot_load_options(config, &World::flat()?).resources;
+    let mut world = World::load_with(&world_path, &resources)?;
+    if let Some([x, y, yaw_deg]) = config.spawn {
+        world.robot.position_m = [x, y];
+        world.robot.yaw_rad = yaw_deg.to_radians();
+    }
     let robot_path = config
         .robot
         .clone()

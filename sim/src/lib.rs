@@ -22,6 +22,7 @@ mod mesh;
 mod render;
 mod resource;
 mod robot;
+mod sdf;
 mod sensor;
 mod simulation;
 mod tomlfile;
@@ -45,6 +46,7 @@ pub use render::meshes::{
 pub use render::{CameraRenderer, RenderError};
 pub use resource::{NotFound, ResourcePaths};
 pub use robot::{Collision, Inertial, Joint, JointKind, Link, LoadOptions, RobotModel, Visual};
+pub use sdf::{Model, ModelLink};
 pub use sensor::{CameraFrame, CameraSensor};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use tomlfile::{load_toml, parse_toml};

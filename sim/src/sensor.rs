@@ -30,6 +30,7 @@ pub struct CameraSensor {
     next_s: f64,
     seq: u64,
     link_poses: Vec<Pose>,
+    model_poses: Vec<Pose>,
 }
 
 impl CameraSensor {
@@ -60,6 +61,7 @@ impl CameraSensor {
             next_s: 0.0,
             seq: 0,
             link_poses: Vec::with_capacity(robot.links.len()),
+            model_poses: Vec::new(),
         })
     }
 
@@ -105,6 +107,10 @@ impl CameraSensor {
                 self.renderer
                     .set_person_pose(index, sim.world_from_person(index));
             }
+        }
+        if self.renderer.has_moving_models() {
+            sim.model_link_poses_into(&mut self.model_poses);
+            self.renderer.set_model_link_poses(&self.model_poses);
         }
         let rgb = self.renderer.render(&self.link_poses, camera)?;
         Ok(CameraFrame {

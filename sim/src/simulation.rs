@@ -73,6 +73,8 @@ pub struct Simulation {
     seed: u64,
     /// Kinematic bodies of the people, in world order.
     people: Vec<RigidBodyHandle>,
+    /// Bodies of the SDF models' links, in model then link order.
+    model_links: Vec<RigidBodyHandle>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -113,6 +115,7 @@ impl Simulation {
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
 
         let people = add_world(&mut physics, &world);
+        let model_links = add_models(&mut physics, &world)?;
         let robot_bodies = add_robot(&mut physics, &world, &robot)?;
         let ratio = joint_mass_ratio(&robot, &robot_bodies);
         if ratio > STIFF_MASS_RATIO
@@ -180,6 +183,7 @@ impl Simulation {
             dt_s,
             seed: options.seed,
             people,
+            model_links,
             robot,
             world,
         })
@@ -302,6 +306,18 @@ impl Simulation {
         out.extend((0..self.robot.links.len()).map(|i| self.world_from_link(i)));
     }
 
+    /// World pose of every SDF model link (models in world order, then their links) into
+    /// `out` (cleared first; no allocation once `out` has the capacity).
+    pub fn model_link_poses_into(&self, out: &mut Vec<Pose>) {
+        out.clear();
+        out.extend(self.model_links.iter().map(|h| {
+            self.physics
+                .bodies
+                .get(*h)
+                .map_or(Pose::IDENTITY, |b| *b.position())
+        }));
+    }
+
     /// Ground-truth planar pose and velocity of the base link.
     pub fn ground_truth(&self) -> Odometry {
         let Some(body) = self.physics.bodies.get(self.base) else {
@@ -370,6 +386,44 @@ fn person_body_pose(person: &crate::world::Person, t_s: f64) -> Pose {
 }
 
 /// Adds the ground, objects, walls and people; returns the people's bodies.
+/// Adds the SDF models' links, one rigid body each; returns the bodies in model/link order.
+fn add_models(physics: &mut PhysicsWorld, world: &World) -> Result<Vec<RigidBodyHandle>> {
+    let mut bodies = Vec::new();
+    for model in &world.models {
+        for link in &model.links {
+            let dynamic = link.is_dynamic(model);
+            let builder = if dynamic {
+                RigidBodyBuilder::dynamic()
+            } else {
+                RigidBodyBuilder::fixed()
+            };
+            let body = physics.insert_body(builder.pose(link.world_from_link));
+            let count = link.collisions.len().max(1) as f32;
+            let mass = link.mass_kg.unwrap_or(0.0) as f32;
+            let name = format!("{}::{}", model.name, link.name);
+            for c in &link.collisions {
+                let (shape, fix) = collider_shape(&c.shape, &world.source, &name, !dynamic)?;
+                let mut collider = ColliderBuilder::new(shape)
+                    .position(c.link_from_shape * fix)
+                    .friction(1.0)
+                    .friction_combine_rule(CoefficientCombineRule::Min)
+                    .collision_groups(world_groups());
+                if dynamic {
+                    collider = collider.mass(mass / count);
+                }
+                physics.insert_collider(collider, Some(body));
+            }
+            if dynamic && link.collisions.is_empty() {
+                if let Some(b) = physics.bodies.get_mut(body) {
+                    b.set_additional_mass(mass, true);
+                }
+            }
+            bodies.push(body);
+        }
+    }
+    Ok(bodies)
+}
+
 fn add_world(physics: &mut PhysicsWorld, world: &World) -> Vec<RigidBodyHandle> {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
@@ -438,7 +492,14 @@ struct RobotBodies {
 }
 
 /// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
-fn collider_shape(shape: &Shape, robot: &RobotModel, link: &str) -> Result<(SharedShape, Pose)> {
+/// Meshes of static bodies keep their triangles (a concave arch stays passable); moving ones
+/// become their convex hull. `source` and `link` name the owner in messages.
+fn collider_shape(
+    shape: &Shape,
+    source: &std::path::Path,
+    link: &str,
+    fixed: bool,
+) -> Result<(SharedShape, Pose)> {
     // URDF cylinders run along z, rapier's along y: rotate y onto z.
     let y_to_z = Pose::from_rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2));
     Ok(match shape {
@@ -456,9 +517,22 @@ fn collider_shape(shape: &Shape, robot: &RobotModel, link: &str) -> Result<(Shar
         ),
         Shape::Mesh { path, scale } => {
             let mesh = load_mesh(path, *scale)?;
+            if fixed {
+                let tri = SharedShape::trimesh(mesh.positions, mesh.triangles).map_err(|e| {
+                    SimError::invalid(
+                        source,
+                        None,
+                        format!(
+                            "link \"{link}\": collision mesh {}: {e}",
+                            path.display()
+                        ),
+                    )
+                })?;
+                return Ok((tri, Pose::IDENTITY));
+            }
             let hull = SharedShape::convex_hull(&mesh.positions).ok_or_else(|| {
                 SimError::invalid(
-                    &robot.source,
+                    source,
                     None,
                     format!(
                         "link \"{link}\": collision mesh {} is degenerate (flat or a single point); expected a solid",
@@ -500,7 +574,7 @@ fn add_robot(physics: &mut PhysicsWorld, world: &World, robot: &RobotModel) -> R
     let mut min_z = f32::INFINITY;
     for (i, link) in robot.links.iter().enumerate() {
         for c in &link.collisions {
-            let (shape, fix) = collider_shape(&c.shape, robot, &link.name)?;
+            let (shape, fix) = collider_shape(&c.shape, &robot.source, &link.name, false)?;
             let root_from_shape = root_from_links[i] * c.link_from_shape * fix;
             min_z = min_z.min(shape.compute_aabb(&root_from_shape).mins.z);
             shapes.push((i, shape, c.link_from_shape * fix));

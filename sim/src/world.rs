@@ -30,6 +30,8 @@ pub struct World {
     pub objects: Vec<Object>,
     /// People standing in the world.
     pub people: Vec<Person>,
+    /// Models of a Gazebo SDF world (empty for TOML worlds).
+    pub models: Vec<crate::sdf::Model>,
 }
 
 /// Robot spawn settings (`[robot]`).
@@ -213,8 +215,21 @@ impl Person {
 }
 
 impl World {
-    /// Loads and validates a world file.
+    /// Loads a world file: TOML, or a Gazebo SDF world (`.world`, `.sdf`) with `model://`
+    /// models found through `GAZEBO_MODEL_PATH`.
     pub fn load(path: &Path) -> Result<Self> {
+        Self::load_with(path, &crate::resource::ResourcePaths::from_env())
+    }
+
+    /// Loads a world file; `resources` finds an SDF world's `model://` models and meshes.
+    pub fn load_with(path: &Path, resources: &crate::resource::ResourcePaths) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if matches!(ext.as_deref(), Some("world" | "sdf")) {
+            return crate::sdf::load_world(path, resources);
+        }
         let raw: RawWorld = tomlfile::load_toml(path)?;
         raw.into_world(path)
     }
@@ -712,6 +727,7 @@ impl RawWorld {
             ground,
             objects,
             people,
+            models: Vec::new(),
         })
     }
 }

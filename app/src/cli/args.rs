@@ -58,7 +58,8 @@ Trace CSV columns (one row per diff-drive control update):
 
 #[derive(Debug, Args)]
 pub(crate) struct WorldArgs {
-    /// World file (TOML, see docs/WORLDS.md) [default: worlds/playground.toml]
+    /// World file: TOML (see docs/WORLDS.md) or a Gazebo SDF world (.world, .sdf)
+    /// [default: worlds/playground.toml]
     #[arg(long, value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
 
@@ -77,6 +78,16 @@ pub(crate) struct WorldArgs {
     /// ROS_PACKAGE_PATH
     #[arg(long = "package-path", value_name = "NAME=DIR", value_parser = parse_package_path)]
     pub(crate) package_paths: Vec<(String, PathBuf)>,
+
+    /// Where the robot spawns: X,Y in metres and an optional heading in degrees
+    /// (counter-clockwise from +x), overriding the world's [robot]
+    #[arg(long, value_name = "X,Y[,YAW_DEG]", value_parser = parse_spawn)]
+    pub(crate) spawn: Option<[f64; 3]>,
+
+    /// A folder of Gazebo models, for model://NAME in SDF worlds (repeatable; searched before
+    /// GAZEBO_MODEL_PATH)
+    #[arg(long = "model-path", value_name = "DIR")]
+    pub(crate) model_paths: Vec<PathBuf>,
 
     /// Physics step rate in Hz, overriding the world's [physics] step_hz
     #[arg(long, value_name = "HZ")]
@@ -456,6 +467,20 @@ fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
     Ok((name.to_owned(), value.to_owned()))
 }
 
+/// `X,Y` or `X,Y,YAW_DEG`.
+fn parse_spawn(s: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("expected X,Y[,YAW_DEG] as finite numbers, found \"{s}\""))?;
+    match values.as_slice() {
+        [x, y] => Ok([*x, *y, 0.0]),
+        [x, y, yaw] => Ok([*x, *y, *yaw]),
+        _ => Err(format!("expected X,Y[,YAW_DEG], found \"{s}\"")),
+    }
+}
+
 /// `NAME=DIR` for a ROS package folder.
 fn parse_package_path(s: &str) -> Result<(String, PathBuf), String> {
     let (name, dir) = s
@@ -480,6 +505,10 @@ impl WorldArgs {
             .packages
             .extend(self.package_paths.iter().cloned());
         options
+            .resources
+            .model_search
+            .extend(self.model_paths.iter().cloned());
+        options
     }
 
     /// A run of this world and robot; the rest at its defaults.
@@ -488,6 +517,7 @@ impl WorldArgs {
             world: self.world.clone(),
             robot: self.robot.clone(),
             robot_options: self.robot_options(),
+            spawn: self.spawn,
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,

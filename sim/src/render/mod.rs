@@ -123,6 +123,8 @@ pub struct CameraRenderer {
     attached: Vec<Attached>,
     /// Parts of the people (`link` = person index, `link_from_shape` = person_from_part).
     people: Vec<Attached>,
+    /// Visuals of moving SDF model links (`link` indexes model links in world order).
+    models: Vec<Attached>,
     info: CameraInfo,
     checker: Rgba,
     checker_size_m: f32,
@@ -345,6 +347,22 @@ impl CameraRenderer {
             let mesh = object_mesh(&object.shape);
             add(&mesh, instance(object.world_from_object(), object.color));
         }
+        let mut model_parts_at = Vec::new();
+        let model_links = world.models.iter().flat_map(|m| m.links.iter().map(move |l| (m, l)));
+        for (link_index, (model, link)) in model_links.enumerate() {
+            for visual in &link.visuals {
+                let mesh = shape_mesh(&visual.shape)?;
+                let pose = link.world_from_link * visual.link_from_shape;
+                let index = add(&mesh, instance(pose, visual.color));
+                if link.is_dynamic(model) {
+                    model_parts_at.push(Attached {
+                        instance: index,
+                        link: link_index,
+                        link_from_shape: visual.link_from_shape,
+                    });
+                }
+            }
+        }
         let mut person_parts_at = Vec::new();
         for (person_index, person) in world.people.iter().enumerate() {
             let world_from_person = person.world_from_person(0.0);
@@ -394,6 +412,7 @@ impl CameraRenderer {
             instance_buffer,
             attached,
             people: person_parts_at,
+            models: model_parts_at,
             checker: world.ground.checker_color,
             checker_size_m: world.ground.checker_size_m as f32,
             near_m: camera.clip_near_m as f32,
@@ -441,6 +460,24 @@ impl CameraRenderer {
             ),
             Vec4::new(0.0, 0.0, -f * n / (f - n), 0.0),
         )
+    }
+
+    /// Whether some SDF model link can move (so [`Self::set_model_link_poses`] matters).
+    pub fn has_moving_models(&self) -> bool {
+        !self.models.is_empty()
+    }
+
+    /// Moves the visuals of moving SDF model links to `world_from_model_links` (every model
+    /// link in world order, as [`crate::Simulation::model_link_poses_into`] gives them).
+    pub fn set_model_link_poses(&mut self, world_from_model_links: &[Pose]) {
+        for a in &self.models {
+            if let Some(link) = world_from_model_links.get(a.link) {
+                let pose = *link * a.link_from_shape;
+                self.instances[a.instance].model =
+                    Mat4::from_rotation_translation(pose.rotation, pose.translation)
+                        .to_cols_array_2d();
+            }
+        }
     }
 
     /// Moves person `index` (world order) to `world_from_person` for the following renders.

@@ -1,0 +1,618 @@
+//! Gazebo SDF worlds (`.world`, `.sdf`; SDF 1.4 to 1.9): models with their links, poses,
+//! static flags, primitive and mesh visuals and collisions with colours, `<include>` of
+//! `model://` models (model.config -> model.sdf, nested includes), `<state>` poses overriding the
+//! models', the physics step and gravity. Anything else is skipped with one summary line.
+//!
+//! SDF is read with roxmltree (already a dependency); the subset rover simulates is small and no
+//! maintained Rust SDF crate builds without libsdformat.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use roxmltree::Node;
+
+use crate::error::{Result, SimError};
+use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy};
+use crate::resource::ResourcePaths;
+use crate::robot::{Collision, Visual};
+use crate::world::{DEFAULT_STEP_HZ, STEP_HZ_RANGE, World};
+
+/// Deepest `<include>` nesting followed (models including models).
+const MAX_INCLUDE_DEPTH: usize = 16;
+
+/// A model of an SDF world: rigid links with their shapes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Model name (`<model name>` or the `<include><name>`).
+    pub name: String,
+    /// `<static>`: fixed in the world whatever its links' masses.
+    pub is_static: bool,
+    /// Where the model's frame is (world frame).
+    pub world_from_model: Pose,
+    /// Links, each a rigid body.
+    pub links: Vec<ModelLink>,
+}
+
+/// One link of a [`Model`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelLink {
+    /// Link name.
+    pub name: String,
+    /// Where the link starts (world frame).
+    pub world_from_link: Pose,
+    /// `<inertial><mass>` (kg); `None` when the link gives none.
+    pub mass_kg: Option<f64>,
+    /// Visual shapes in the link frame.
+    pub visuals: Vec<Visual>,
+    /// Collision shapes in the link frame.
+    pub collisions: Vec<Collision>,
+}
+
+impl ModelLink {
+    /// Whether physics moves this link (its model is not static and it has a mass).
+    pub fn is_dynamic(&self, model: &Model) -> bool {
+        !model.is_static && self.mass_kg.is_some_and(|m| m > 0.0)
+    }
+}
+
+/// Loads an SDF world file; `resources` finds `model://` models and meshes.
+pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
+    let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let doc = parse_xml(&text, path)?;
+    let root = doc.root_element();
+    let ctx = Ctx { path, doc: &doc };
+    if !root.has_tag_name("sdf") {
+        return Err(ctx.err(
+            root,
+            format!("expected an <sdf> root element, found <{}>", root.tag_name().name()),
+        ));
+    }
+    let world_el = child(root, "world")
+        .ok_or_else(|| ctx.err(root, "<sdf> has no <world>: expected a world file"))?;
+    let mut loader = Loader {
+        resources,
+        skipped: BTreeSet::new(),
+    };
+
+    let mut world = World::flat()?;
+    let physics = &mut world.physics;
+    if let Some(p) = child(world_el, "physics") {
+        if let Some(step) = child(p, "max_step_size") {
+            let dt = ctx.number(step)?;
+            let hz = 1.0 / dt;
+            physics.step_hz = if dt > 0.0 && STEP_HZ_RANGE.contains(&hz) {
+                hz
+            } else {
+                tracing::warn!(
+                    "{}: <max_step_size>{dt}</max_step_size> is outside rover's {}..={} Hz; using {DEFAULT_STEP_HZ} Hz",
+                    path.display(),
+                    STEP_HZ_RANGE.start(),
+                    STEP_HZ_RANGE.end()
+                );
+                DEFAULT_STEP_HZ
+            };
+        }
+        if let Some(g) = child(p, "gravity") {
+            physics.gravity_mps2 = ctx.numbers::<3>(g)?;
+        }
+    }
+    if let Some(g) = child(world_el, "gravity") {
+        physics.gravity_mps2 = ctx.numbers::<3>(g)?;
+    }
+
+    // <state> poses override the models' own (Gazebo saves the world's last state there).
+    let mut state_models: BTreeMap<String, (Option<Pose>, BTreeMap<String, Pose>)> =
+        BTreeMap::new();
+    for state in children(world_el, "state") {
+        for m in children(state, "model") {
+            let name = m.attribute("name").unwrap_or_default().to_owned();
+            let pose = child(m, "pose").map(|p| ctx.pose(p)).transpose()?;
+            let mut links = BTreeMap::new();
+            for l in children(m, "link") {
+                if let Some(p) = child(l, "pose") {
+                    links.insert(l.attribute("name").unwrap_or_default().to_owned(), ctx.pose(p)?);
+                }
+            }
+            state_models.insert(name, (pose, links));
+        }
+    }
+
+    let mut models = Vec::new();
+    for node in world_el.children().filter(Node::is_element) {
+        match node.tag_name().name() {
+            "model" => loader.model(&ctx, node, Pose::IDENTITY, None, &mut models, 0)?,
+            "include" => loader.include(&ctx, node, Pose::IDENTITY, &mut models, 0)?,
+            "physics" | "gravity" | "state" => {}
+            other => {
+                loader.skipped.insert(format!("<{other}>"));
+            }
+        }
+    }
+    let mut names = BTreeSet::new();
+    for model in &mut models {
+        if !names.insert(model.name.clone()) {
+            return Err(SimError::invalid(
+                path,
+                None,
+                format!("two models are named \"{}\"; expected unique names", model.name),
+            ));
+        }
+        if let Some((pose, links)) = state_models.get(&model.name) {
+            // Links keep their place in the model; a <state> link pose wins over both.
+            let old_from_world = model.world_from_model.inverse();
+            if let Some(p) = pose {
+                model.world_from_model = *p;
+            }
+            for link in &mut model.links {
+                link.world_from_link = match links.get(&link.name) {
+                    Some(world_from_link) => *world_from_link,
+                    None => model.world_from_model * old_from_world * link.world_from_link,
+                };
+            }
+        }
+    }
+    if !loader.skipped.is_empty() {
+        tracing::info!(
+            "{}: not simulated (rover has no model for them): {}",
+            path.display(),
+            loader.skipped.iter().cloned().collect::<Vec<_>>().join(", ")
+        );
+    }
+    world.name = world_el.attribute("name").unwrap_or("default").to_owned();
+    world.source = path.to_path_buf();
+    world.description = format!("Gazebo SDF world {}", path.display());
+    // Gazebo's ground_plane is 100 m x 100 m.
+    world.ground.size_m = [100.0, 100.0];
+    world.models = models;
+    Ok(world)
+}
+
+fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Document<'a>> {
+    roxmltree::Document::parse_with_options(
+        text,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| {
+        let pos = e.pos();
+        SimError::invalid(
+            path,
+            Some(pos.row),
+            format!("malformed XML (column {}): {e}", pos.col),
+        )
+    })
+}
+
+struct Ctx<'a, 'input> {
+    path: &'a Path,
+    doc: &'a roxmltree::Document<'input>,
+}
+
+impl Ctx<'_, '_> {
+    fn err(&self, node: Node<'_, '_>, message: impl Into<String>) -> SimError {
+        SimError::invalid(
+            self.path,
+            Some(self.doc.text_pos_at(node.range().start).row),
+            message,
+        )
+    }
+
+    fn number(&self, node: Node<'_, '_>) -> Result<f64> {
+        let text = node.text().unwrap_or("").trim();
+        text.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                self.err(
+                    node,
+                    format!(
+                        "<{}>{text}</{}>: expected a finite number",
+                        node.tag_name().name(),
+                        node.tag_name().name()
+                    ),
+                )
+            })
+    }
+
+    fn numbers<const N: usize>(&self, node: Node<'_, '_>) -> Result<[f64; N]> {
+        let text = node.text().unwrap_or("");
+        let values: Vec<f64> = text
+            .split_whitespace()
+            .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<Vec<_>>>()
+            .unwrap_or_default();
+        values.try_into().map_err(|_| {
+            self.err(
+                node,
+                format!(
+                    "<{}>{}</{}>: expected {N} finite numbers",
+                    node.tag_name().name(),
+                    text.trim(),
+                    node.tag_name().name()
+                ),
+            )
+        })
+    }
+
+    fn pose(&self, node: Node<'_, '_>) -> Result<Pose> {
+        let [x, y, z, roll, pitch, yaw] = self.numbers::<6>(node)?;
+        Ok(pose_from_xyz_rpy([x, y, z], [roll, pitch, yaw]))
+    }
+
+    fn local_pose(&self, node: Node<'_, '_>) -> Result<Pose> {
+        child(node, "pose").map_or(Ok(Pose::IDENTITY), |p| self.pose(p))
+    }
+
+    fn flag(&self, node: Node<'_, '_>) -> bool {
+        matches!(node.text().map(str::trim), Some("1" | "true"))
+    }
+}
+
+fn child<'a, 'input>(node: Node<'a, 'input>, name: &str) -> Option<Node<'a, 'input>> {
+    node.children().find(|n| n.has_tag_name(name))
+}
+
+fn children<'a, 'input>(
+    node: Node<'a, 'input>,
+    name: &'static str,
+) -> impl Iterator<Item = Node<'a, 'input>> {
+    node.children().filter(move |n| n.has_tag_name(name))
+}
+
+struct Loader<'r> {
+    resources: &'r ResourcePaths,
+    skipped: BTreeSet<String>,
+}
+
+/// Overrides an `<include>` applies to the model it brings in.
+struct Overrides {
+    name: Option<String>,
+    is_static: Option<bool>,
+}
+
+impl Loader<'_> {
+    fn model(
+        &mut self,
+        ctx: &Ctx<'_, '_>,
+        node: Node<'_, '_>,
+        parent: Pose,
+        overrides: Option<Overrides>,
+        out: &mut Vec<Model>,
+        depth: usize,
+    ) -> Result<()> {
+        let own_name = node.attribute("name").unwrap_or("model").to_owned();
+        let (name, static_override) = match overrides {
+            Some(o) => (o.name.unwrap_or(own_name), o.is_static),
+            None => (own_name, None),
+        };
+        let world_from_model = parent * ctx.local_pose(node)?;
+        let is_static =
+            static_override.unwrap_or_else(|| child(node, "static").is_some_and(|s| ctx.flag(s)));
+        let mut model = Model {
+            name: name.clone(),
+            is_static,
+            world_from_model,
+            links: Vec::new(),
+        };
+        let base = ctx.path.parent().unwrap_or(Path::new("."));
+        for item in node.children().filter(Node::is_element) {
+            match item.tag_name().name() {
+                "link" => {
+                    model
+                        .links
+                        .push(self.link(ctx, item, world_from_model, base)?);
+                }
+                "model" => {
+                    // A nested model: its own entry, named parent::child as Gazebo does.
+                    let nested_name = format!("{name}::{}", item.attribute("name").unwrap_or("model"));
+                    self.model(
+                        ctx,
+                        item,
+                        world_from_model,
+                        Some(Overrides {
+                            name: Some(nested_name),
+                            is_static: is_static.then_some(true),
+                        }),
+                        out,
+                        depth + 1,
+                    )?;
+                }
+                "include" => self.include(ctx, item, world_from_model, out, depth + 1)?,
+                "pose" | "static" | "self_collide" | "allow_auto_disable" | "enable_wind" => {}
+                "joint" | "plugin" => {
+                    self.skipped.insert(format!("model <{}>", item.tag_name().name()));
+                }
+                other => {
+                    self.skipped.insert(format!("model <{other}>"));
+                }
+            }
+        }
+        out.push(model);
+        Ok(())
+    }
+
+    fn link(
+        &mut self,
+        ctx: &Ctx<'_, '_>,
+        node: Node<'_, '_>,
+        world_from_model: Pose,
+        base: &Path,
+    ) -> Result<ModelLink> {
+        let mut link = ModelLink {
+            name: node.attribute("name").unwrap_or("link").to_owned(),
+            world_from_link: world_from_model * ctx.local_pose(node)?,
+            mass_kg: None,
+            visuals: Vec::new(),
+            collisions: Vec::new(),
+        };
+        if let Some(mass) = child(node, "inertial").and_then(|i| child(i, "mass")) {
+            let m = ctx.number(mass)?;
+            if m < 0.0 {
+                return Err(ctx.err(mass, format!("<mass>{m}</mass>: expected a non-negative mass")));
+            }
+            link.mass_kg = Some(m);
+        }
+        for item in node.children().filter(Node::is_element) {
+            match item.tag_name().name() {
+                "visual" => {
+                    let Some(shape) = self.geometry(ctx, item, base)? else {
+                        continue;
+                    };
+                    link.visuals.push(Visual {
+                        link_from_shape: ctx.local_pose(item)?,
+                        shape,
+                        color: material_color(ctx, item)?,
+                    });
+                }
+                "collision" => {
+                    let Some(shape) = self.geometry(ctx, item, base)? else {
+                        continue;
+                    };
+                    link.collisions.push(Collision {
+                        link_from_shape: ctx.local_pose(item)?,
+                        shape,
+                    });
+                }
+                "sensor" => {
+                    self.skipped.insert(format!(
+                        "sensor type {}",
+                        item.attribute("type").unwrap_or("?")
+                    ));
+                }
+                _ => {}
+            }
+        }
+        Ok(link)
+    }
+
+    /// The shape of a `<visual>` or `<collision>`; `None` for a plane (the ground stands in
+    /// for it) and for geometry rover does not simulate.
+    fn geometry(
+        &mut self,
+        ctx: &Ctx<'_, '_>,
+        item: Node<'_, '_>,
+        base: &Path,
+    ) -> Result<Option<Shape>> {
+        let Some(g) = child(item, "geometry") else {
+            return Err(ctx.err(
+                item,
+                format!("<{}> has no <geometry>", item.tag_name().name()),
+            ));
+        };
+        let Some(shape) = g.children().find(Node::is_element) else {
+            return Ok(None);
+        };
+        let need = |name: &str| {
+            child(shape, name).ok_or_else(|| {
+                ctx.err(
+                    shape,
+                    format!("<{}> needs a <{name}>", shape.tag_name().name()),
+                )
+            })
+        };
+        let positive = |node: Node<'_, '_>| -> Result<f32> {
+            let v = ctx.number(node)?;
+            if v < 0.0 {
+                return Err(ctx.err(
+                    node,
+                    format!("<{}>{v}: expected a non-negative size", node.tag_name().name()),
+                ));
+            }
+            Ok(v as f32)
+        };
+        Ok(Some(match shape.tag_name().name() {
+            "box" => {
+                let size = ctx.numbers::<3>(need("size")?)?;
+                if size.iter().any(|v| *v < 0.0) {
+                    return Err(ctx.err(shape, "<box><size>: expected non-negative sizes"));
+                }
+                Shape::Box {
+                    size_m: Vec3::new(size[0] as f32, size[1] as f32, size[2] as f32),
+                }
+            }
+            "cylinder" => Shape::Cylinder {
+                radius_m: positive(need("radius")?)?,
+                length_m: positive(need("length")?)?,
+            },
+            "sphere" => Shape::Sphere {
+                radius_m: positive(need("radius")?)?,
+            },
+            "capsule" => Shape::Capsule {
+                radius_m: positive(need("radius")?)?,
+                length_m: positive(need("length")?)?,
+            },
+            "mesh" => {
+                let uri_node = need("uri")?;
+                let uri = uri_node.text().unwrap_or("").trim();
+                let path = self
+                    .resources
+                    .resolve(uri, base)
+                    .map_err(|e| ctx.err(uri_node, format!("<mesh>: {e}")))?;
+                let scale = match child(shape, "scale") {
+                    Some(s) => {
+                        let [x, y, z] = ctx.numbers::<3>(s)?;
+                        Vec3::new(x as f32, y as f32, z as f32)
+                    }
+                    None => Vec3::ONE,
+                };
+                if child(shape, "submesh").is_some() {
+                    self.skipped.insert("mesh <submesh> (the whole mesh is used)".into());
+                }
+                Shape::Mesh { path, scale }
+            }
+            "plane" | "empty" => return Ok(None),
+            other => {
+                self.skipped.insert(format!("geometry <{other}>"));
+                return Ok(None);
+            }
+        }))
+    }
+
+    fn include(
+        &mut self,
+        ctx: &Ctx<'_, '_>,
+        node: Node<'_, '_>,
+        parent: Pose,
+        out: &mut Vec<Model>,
+        depth: usize,
+    ) -> Result<()> {
+        if depth > MAX_INCLUDE_DEPTH {
+            return Err(ctx.err(
+                node,
+                format!("<include> nested deeper than {MAX_INCLUDE_DEPTH}: does a model include itself?"),
+            ));
+        }
+        let uri_node = child(node, "uri").ok_or_else(|| ctx.err(node, "<include> needs a <uri>"))?;
+        let uri = uri_node.text().unwrap_or("").trim();
+        let dir = if let Some(name) = uri.strip_prefix("model://") {
+            self.resources
+                .find_model(name.trim_end_matches('/'))
+                .map_err(|e| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {e}")))?
+        } else {
+            let p = PathBuf::from(uri.strip_prefix("file://").unwrap_or(uri));
+            let base = ctx.path.parent().unwrap_or(Path::new("."));
+            let p = if p.is_absolute() { p } else { base.join(p) };
+            if !p.is_dir() {
+                return Err(ctx.err(
+                    uri_node,
+                    format!("<include><uri>{uri}</uri>: no model folder at {}", p.display()),
+                ));
+            }
+            p
+        };
+        let file = model_file(&dir).map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
+        let text = std::fs::read_to_string(&file).map_err(|source| SimError::Io {
+            path: file.clone(),
+            source,
+        })?;
+        let doc = parse_xml(&text, &file)?;
+        let inner = Ctx {
+            path: &file,
+            doc: &doc,
+        };
+        let root = doc.root_element();
+        let model = if root.has_tag_name("model") {
+            Some(root)
+        } else {
+            child(root, "model")
+        };
+        let model = model.ok_or_else(|| inner.err(root, "expected an <sdf> with a <model>"))?;
+        // The include's <pose> places the model's frame (its own <pose> is relative to it).
+        let placed = parent * ctx.local_pose(node)?;
+        let overrides = Overrides {
+            name: child(node, "name").and_then(|n| n.text()).map(|s| s.trim().to_owned()),
+            is_static: child(node, "static").map(|s| ctx.flag(s)),
+        };
+        self.model(&inner, model, placed, Some(overrides), out, depth)
+    }
+}
+
+/// The SDF file of a model folder: the newest `<sdf>` model.config names, else model.sdf.
+fn model_file(dir: &Path) -> std::result::Result<PathBuf, String> {
+    let config = dir.join("model.config");
+    if let Ok(text) = std::fs::read_to_string(&config)
+        && let Ok(doc) = roxmltree::Document::parse(&text)
+    {
+        let best = doc
+            .root_element()
+            .children()
+            .filter(|n| n.has_tag_name("sdf"))
+            .filter_map(|n| {
+                let version: f64 = n.attribute("version")?.trim().parse().ok()?;
+                Some((version, n.text()?.trim().to_owned()))
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((_, file)) = best {
+            let p = dir.join(file);
+            if p.is_file() {
+                return Ok(p);
+            }
+        }
+    }
+    let p = dir.join("model.sdf");
+    if p.is_file() {
+        Ok(p)
+    } else {
+        Err(format!(
+            "{} has neither a model.config naming an SDF file nor a model.sdf",
+            dir.display()
+        ))
+    }
+}
+
+/// A visual's colour: `<material><diffuse>` (else `<ambient>`), else a known Gazebo material
+/// script name, else grey.
+fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Rgba> {
+    let Some(material) = child(visual, "material") else {
+        return Ok(Rgba::rgb(0.7, 0.7, 0.7));
+    };
+    for tag in ["diffuse", "ambient"] {
+        if let Some(c) = child(material, tag) {
+            let text = c.text().unwrap_or("");
+            let values: Vec<f32> = text
+                .split_whitespace()
+                .filter_map(|t| t.parse::<f32>().ok())
+                .collect();
+            return match values.as_slice() {
+                [r, g, b] => Ok(Rgba::rgb(*r, *g, *b)),
+                [r, g, b, a] => Ok(Rgba([*r, *g, *b, *a].map(|v| v.clamp(0.0, 1.0)))),
+                _ => Err(ctx.err(c, format!("<{tag}>{}</{tag}>: expected 3 or 4 numbers", text.trim()))),
+            };
+        }
+    }
+    let script = child(material, "script")
+        .and_then(|s| child(s, "name"))
+        .and_then(|n| n.text())
+        .unwrap_or("")
+        .trim();
+    Ok(gazebo_material(script).unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)))
+}
+
+/// Colours of the common `Gazebo/*` material scripts (gazebo.material).
+fn gazebo_material(name: &str) -> Option<Rgba> {
+    let rgb = match name.strip_prefix("Gazebo/")? {
+        "White" | "WhiteGlow" => [1.0, 1.0, 1.0],
+        "Grey" | "Gray" => [0.7, 0.7, 0.7],
+        "DarkGrey" | "DarkGray" => [0.35, 0.35, 0.35],
+        "Black" | "FlatBlack" => [0.1, 0.1, 0.1],
+        "Red" | "RedBright" => [0.8, 0.1, 0.1],
+        "Green" => [0.1, 0.8, 0.1],
+        "Blue" => [0.1, 0.1, 0.8],
+        "Yellow" => [0.9, 0.9, 0.1],
+        "Orange" => [1.0, 0.5, 0.05],
+        "Purple" => [0.6, 0.1, 0.7],
+        "Turquoise" => [0.1, 0.8, 0.8],
+        "Wood" => [0.65, 0.45, 0.25],
+        "Bricks" => [0.6, 0.3, 0.2],
+        "WoodFloor" => [0.7, 0.55, 0.35],
+        "Gold" => [0.85, 0.7, 0.2],
+        _ => return None,
+    };
+    Some(Rgba::rgb(rgb[0], rgb[1], rgb[2]))
+}
