@@ -132,7 +132,12 @@ pub fn robot_load_options(config: &RunConfig, world: &World) -> LoadOptions {
         .extend(config.robot_options.resources.packages.clone());
     options.resources.package_search.splice(
         0..0,
-        config.robot_options.resources.package_search.iter().cloned(),
+        config
+            .robot_options
+            .resources
+            .package_search
+            .iter()
+            .cloned(),
     );
     options.resources.model_search.splice(
         0..0,

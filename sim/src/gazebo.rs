@@ -298,7 +298,11 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",
-                            if file.is_empty() { "(no filename)" } else { file }
+                            if file.is_empty() {
+                                "(no filename)"
+                            } else {
+                                file
+                            }
                         ));
                     }
                 }

@@ -77,7 +77,10 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
                 return Err(SimError::invalid(
                     path,
                     None,
-                    format!("mesh \"{}\" has a face index past its {count} vertices", part.name),
+                    format!(
+                        "mesh \"{}\" has a face index past its {count} vertices",
+                        part.name
+                    ),
                 ));
             }
             mesh.triangles.push(f.map(|i| i + offset));
@@ -88,7 +91,10 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
                 return Err(SimError::invalid(
                     path,
                     None,
-                    format!("mesh \"{}\" has a vertex that is not a finite number", part.name),
+                    format!(
+                        "mesh \"{}\" has a vertex that is not a finite number",
+                        part.name
+                    ),
                 ));
             }
             mesh.positions.push(p);
@@ -168,7 +174,10 @@ mod tests {
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(err.contains("a.stl") && err.contains("cannot read mesh"), "{err}");
+        assert!(
+            err.contains("a.stl") && err.contains("cannot read mesh"),
+            "{err}"
+        );
 
         // A binary file whose 80-byte header begins with "solid" is still binary.
         bin[..6].copy_from_slice(b"solid ");

@@ -223,7 +223,13 @@ impl RobotModel {
                     format!("<link name=\"{}\"> is defined twice", link.name),
                 ));
             }
-            links.push(convert_link(link, &materials, (base_dir, resources), path, &lines)?);
+            links.push(convert_link(
+                link,
+                &materials,
+                (base_dir, resources),
+                path,
+                &lines,
+            )?);
         }
         if links.is_empty() {
             return Err(SimError::invalid(

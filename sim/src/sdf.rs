@@ -68,7 +68,10 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     if !root.has_tag_name("sdf") {
         return Err(ctx.err(
             root,
-            format!("expected an <sdf> root element, found <{}>", root.tag_name().name()),
+            format!(
+                "expected an <sdf> root element, found <{}>",
+                root.tag_name().name()
+            ),
         ));
     }
     let world_el = child(root, "world")
@@ -114,7 +117,10 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
             let mut links = BTreeMap::new();
             for l in children(m, "link") {
                 if let Some(p) = child(l, "pose") {
-                    links.insert(l.attribute("name").unwrap_or_default().to_owned(), ctx.pose(p)?);
+                    links.insert(
+                        l.attribute("name").unwrap_or_default().to_owned(),
+                        ctx.pose(p)?,
+                    );
                 }
             }
             state_models.insert(name, (pose, links));
@@ -138,7 +144,10 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
             return Err(SimError::invalid(
                 path,
                 None,
-                format!("two models are named \"{}\"; expected unique names", model.name),
+                format!(
+                    "two models are named \"{}\"; expected unique names",
+                    model.name
+                ),
             ));
         }
         if let Some((pose, links)) = state_models.get(&model.name) {
@@ -159,7 +168,12 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
         tracing::info!(
             "{}: not simulated (rover has no model for them): {}",
             path.display(),
-            loader.skipped.iter().cloned().collect::<Vec<_>>().join(", ")
+            loader
+                .skipped
+                .iter()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     world.name = world_el.attribute("name").unwrap_or("default").to_owned();
@@ -310,7 +324,8 @@ impl Loader<'_> {
                 }
                 "model" => {
                     // A nested model: its own entry, named parent::child as Gazebo does.
-                    let nested_name = format!("{name}::{}", item.attribute("name").unwrap_or("model"));
+                    let nested_name =
+                        format!("{name}::{}", item.attribute("name").unwrap_or("model"));
                     self.model(
                         ctx,
                         item,
@@ -326,7 +341,8 @@ impl Loader<'_> {
                 "include" => self.include(ctx, item, world_from_model, out, depth + 1)?,
                 "pose" | "static" | "self_collide" | "allow_auto_disable" | "enable_wind" => {}
                 "joint" | "plugin" => {
-                    self.skipped.insert(format!("model <{}>", item.tag_name().name()));
+                    self.skipped
+                        .insert(format!("model <{}>", item.tag_name().name()));
                 }
                 other => {
                     self.skipped.insert(format!("model <{other}>"));
@@ -354,7 +370,10 @@ impl Loader<'_> {
         if let Some(mass) = child(node, "inertial").and_then(|i| child(i, "mass")) {
             let m = ctx.number(mass)?;
             if m < 0.0 {
-                return Err(ctx.err(mass, format!("<mass>{m}</mass>: expected a non-negative mass")));
+                return Err(ctx.err(
+                    mass,
+                    format!("<mass>{m}</mass>: expected a non-negative mass"),
+                ));
             }
             link.mass_kg = Some(m);
         }
@@ -421,7 +440,10 @@ impl Loader<'_> {
             if v < 0.0 {
                 return Err(ctx.err(
                     node,
-                    format!("<{}>{v}: expected a non-negative size", node.tag_name().name()),
+                    format!(
+                        "<{}>{v}: expected a non-negative size",
+                        node.tag_name().name()
+                    ),
                 ));
             }
             Ok(v as f32)
@@ -462,7 +484,8 @@ impl Loader<'_> {
                     None => Vec3::ONE,
                 };
                 if child(shape, "submesh").is_some() {
-                    self.skipped.insert("mesh <submesh> (the whole mesh is used)".into());
+                    self.skipped
+                        .insert("mesh <submesh> (the whole mesh is used)".into());
                 }
                 Shape::Mesh { path, scale }
             }
@@ -485,10 +508,13 @@ impl Loader<'_> {
         if depth > MAX_INCLUDE_DEPTH {
             return Err(ctx.err(
                 node,
-                format!("<include> nested deeper than {MAX_INCLUDE_DEPTH}: does a model include itself?"),
+                format!(
+                    "<include> nested deeper than {MAX_INCLUDE_DEPTH}: does a model include itself?"
+                ),
             ));
         }
-        let uri_node = child(node, "uri").ok_or_else(|| ctx.err(node, "<include> needs a <uri>"))?;
+        let uri_node =
+            child(node, "uri").ok_or_else(|| ctx.err(node, "<include> needs a <uri>"))?;
         let uri = uri_node.text().unwrap_or("").trim();
         let dir = if let Some(name) = uri.strip_prefix("model://") {
             self.resources
@@ -501,12 +527,16 @@ impl Loader<'_> {
             if !p.is_dir() {
                 return Err(ctx.err(
                     uri_node,
-                    format!("<include><uri>{uri}</uri>: no model folder at {}", p.display()),
+                    format!(
+                        "<include><uri>{uri}</uri>: no model folder at {}",
+                        p.display()
+                    ),
                 ));
             }
             p
         };
-        let file = model_file(&dir).map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
+        let file = model_file(&dir)
+            .map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
         let text = std::fs::read_to_string(&file).map_err(|source| SimError::Io {
             path: file.clone(),
             source,
@@ -526,7 +556,9 @@ impl Loader<'_> {
         // The include's <pose> places the model's frame (its own <pose> is relative to it).
         let placed = parent * ctx.local_pose(node)?;
         let overrides = Overrides {
-            name: child(node, "name").and_then(|n| n.text()).map(|s| s.trim().to_owned()),
+            name: child(node, "name")
+                .and_then(|n| n.text())
+                .map(|s| s.trim().to_owned()),
             is_static: child(node, "static").map(|s| ctx.flag(s)),
         };
         self.model(&inner, model, placed, Some(overrides), out, depth)
@@ -582,7 +614,10 @@ fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Rgba> {
             return match values.as_slice() {
                 [r, g, b] => Ok(Rgba::rgb(*r, *g, *b)),
                 [r, g, b, a] => Ok(Rgba([*r, *g, *b, *a].map(|v| v.clamp(0.0, 1.0)))),
-                _ => Err(ctx.err(c, format!("<{tag}>{}</{tag}>: expected 3 or 4 numbers", text.trim()))),
+                _ => Err(ctx.err(
+                    c,
+                    format!("<{tag}>{}</{tag}>: expected 3 or 4 numbers", text.trim()),
+                )),
             };
         }
     }

@@ -413,10 +413,11 @@ fn add_models(physics: &mut PhysicsWorld, world: &World) -> Result<Vec<RigidBody
                 }
                 physics.insert_collider(collider, Some(body));
             }
-            if dynamic && link.collisions.is_empty() {
-                if let Some(b) = physics.bodies.get_mut(body) {
-                    b.set_additional_mass(mass, true);
-                }
+            if dynamic
+                && link.collisions.is_empty()
+                && let Some(b) = physics.bodies.get_mut(body)
+            {
+                b.set_additional_mass(mass, true);
             }
             bodies.push(body);
         }
@@ -522,10 +523,7 @@ fn collider_shape(
                     SimError::invalid(
                         source,
                         None,
-                        format!(
-                            "link \"{link}\": collision mesh {}: {e}",
-                            path.display()
-                        ),
+                        format!("link \"{link}\": collision mesh {}: {e}", path.display()),
                     )
                 })?;
                 return Ok((tri, Pose::IDENTITY));
@@ -717,7 +715,11 @@ fn joint_mass_ratio(robot: &RobotModel, bodies: &RobotBodies) -> f32 {
         .filter(|j| bodies.link_body[j.parent] != bodies.link_body[j.child])
         .map(|j| {
             let (a, b) = (mass(j.parent), mass(j.child));
-            if a.min(b) > 0.0 { a.max(b) / a.min(b) } else { 1.0 }
+            if a.min(b) > 0.0 {
+                a.max(b) / a.min(b)
+            } else {
+                1.0
+            }
         })
         .fold(1.0, f32::max)
 }

@@ -52,7 +52,10 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
         .link_index("base_link")
         .ok_or_else(|| anyhow::anyhow!("no base_link"))?];
     let Shape::Mesh { path, scale } = &base.visuals[0].shape else {
-        anyhow::bail!("base_link visual is not a mesh: {:?}", base.visuals[0].shape);
+        anyhow::bail!(
+            "base_link visual is not a mesh: {:?}",
+            base.visuals[0].shape
+        );
     };
     let mesh = load_mesh(path, *scale)?;
     let (lo, hi) = mesh.positions.iter().fold(
@@ -65,7 +68,11 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
         "burger base is {size:?} m; expected ~0.14 m across"
     );
     // The expanded URDF is kept for ROS's /robot_description.
-    assert!(robot.description.contains("<wheelSeparation>0.160</wheelSeparation>"));
+    assert!(
+        robot
+            .description
+            .contains("<wheelSeparation>0.160</wheelSeparation>")
+    );
     assert!(!robot.description.contains("xacro:"));
     Ok(())
 }

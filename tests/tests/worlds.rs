@@ -32,7 +32,10 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
             "cube_20k"
         ]
     );
-    assert_eq!(world.physics.step_hz, 100.0, "<max_step_size>0.01</max_step_size>");
+    assert_eq!(
+        world.physics.step_hz, 100.0,
+        "<max_step_size>0.01</max_step_size>"
+    );
     assert_eq!(world.physics.gravity_mps2, [0.0, 0.0, -9.8]);
     let link = |model: &str| {
         world
@@ -45,7 +48,10 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
     // <state> poses win over the models' own.
     let cube = link("cube_20k")?;
     let t = cube.world_from_link.translation;
-    assert!((t - glam::Vec3::new(1.41131, -1.0, 0.5)).length() < 1e-5, "cube at {t}");
+    assert!(
+        (t - glam::Vec3::new(1.41131, -1.0, 0.5)).length() < 1e-5,
+        "cube at {t}"
+    );
     let yaw = rover_sim::yaw_of(cube.world_from_link.rotation);
     assert!((yaw - 0.9).abs() < 1e-5, "cube yaw {yaw}");
     let dumpster = link("Dumpster")?;
@@ -68,7 +74,10 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
     );
     // The COLLADA file's unit and up axis applied: a 4 m long, ~1.1 m high barrier.
     let size = hi - lo;
-    assert!((size.x - 4.06).abs() < 0.2 && (size.z - 1.14).abs() < 0.2, "barrier {size}");
+    assert!(
+        (size.x - 4.06).abs() < 0.2 && (size.z - 1.14).abs() < 0.2,
+        "barrier {size}"
+    );
     Ok(())
 }
 

@@ -411,6 +411,8 @@ pub(crate) enum BenchKind {
 }
 
 #[derive(Debug, Subcommand)]
+// Parsed once per process: the variants' size difference costs nothing worth boxing for.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum Command {
     /// Run the YOLO detector on image files and print the boxes
     ///
@@ -462,7 +464,9 @@ fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
         .or_else(|| s.split_once('='))
         .ok_or_else(|| format!("expected NAME:=VALUE, found \"{s}\""))?;
     if name.is_empty() {
-        return Err(format!("expected NAME:=VALUE with a non-empty NAME, found \"{s}\""));
+        return Err(format!(
+            "expected NAME:=VALUE with a non-empty NAME, found \"{s}\""
+        ));
     }
     Ok((name.to_owned(), value.to_owned()))
 }

@@ -348,7 +348,10 @@ impl CameraRenderer {
             add(&mesh, instance(object.world_from_object(), object.color));
         }
         let mut model_parts_at = Vec::new();
-        let model_links = world.models.iter().flat_map(|m| m.links.iter().map(move |l| (m, l)));
+        let model_links = world
+            .models
+            .iter()
+            .flat_map(|m| m.links.iter().map(move |l| (m, l)));
         for (link_index, (model, link)) in model_links.enumerate() {
             for visual in &link.visuals {
                 let mesh = shape_mesh(&visual.shape)?;

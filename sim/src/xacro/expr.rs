@@ -195,8 +195,8 @@ enum Token {
 }
 
 const OPS: [&str; 22] = [
-    "**", "//", "==", "!=", "<=", ">=", "+", "-", "*", "/", "%", "<", ">", "(", ")", ",", "[",
-    "]", ":", "{", "}", ".",
+    "**", "//", "==", "!=", "<=", ">=", "+", "-", "*", "/", "%", "<", ">", "(", ")", ",", "[", "]",
+    ":", "{", "}", ".",
 ];
 
 fn tokenize(src: &str) -> R<Vec<Token>> {
@@ -207,7 +207,9 @@ fn tokenize(src: &str) -> R<Vec<Token>> {
         let c = bytes[i];
         if c.is_ascii_whitespace() {
             i += 1;
-        } else if c.is_ascii_digit() || (c == b'.' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit)) {
+        } else if c.is_ascii_digit()
+            || (c == b'.' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit))
+        {
             let start = i;
             let mut float = false;
             while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
@@ -408,8 +410,7 @@ impl Parser {
                 Some(Token::Op(o)) if matches!(*o, "==" | "!=" | "<" | "<=" | ">" | ">=") => *o,
                 Some(Token::Name(n)) if n == "in" => "in",
                 Some(Token::Name(n)) if n == "not" => {
-                    if matches!(self.tokens.get(self.pos + 1), Some(Token::Name(m)) if m == "in")
-                    {
+                    if matches!(self.tokens.get(self.pos + 1), Some(Token::Name(m)) if m == "in") {
                         self.pos += 1;
                         "not in"
                     } else {
@@ -636,7 +637,10 @@ fn eval(e: &Expr, names: &mut dyn Names) -> R<Value> {
                 ("-", Value::Float(x)) => Ok(Value::Float(-x)),
                 ("+", Value::Int(_) | Value::Float(_)) => Ok(v),
                 ("+", Value::Bool(b)) => Ok(Value::Int(i64::from(*b))),
-                _ => err(format!("bad operand type for unary {op}: '{}'", v.type_name())),
+                _ => err(format!(
+                    "bad operand type for unary {op}: '{}'",
+                    v.type_name()
+                )),
             }
         }
         Expr::Binary(op, a, b) => binary(op, eval(a, names)?, eval(b, names)?),
@@ -653,11 +657,19 @@ fn eval(e: &Expr, names: &mut dyn Names) -> R<Value> {
         }
         Expr::And(a, b) => {
             let left = eval(a, names)?;
-            if left.truthy() { eval(b, names) } else { Ok(left) }
+            if left.truthy() {
+                eval(b, names)
+            } else {
+                Ok(left)
+            }
         }
         Expr::Or(a, b) => {
             let left = eval(a, names)?;
-            if left.truthy() { Ok(left) } else { eval(b, names) }
+            if left.truthy() {
+                Ok(left)
+            } else {
+                eval(b, names)
+            }
         }
         Expr::Not(inner) => Ok(Value::Bool(!eval(inner, names)?.truthy())),
         Expr::IfElse {
@@ -681,7 +693,10 @@ fn eval(e: &Expr, names: &mut dyn Names) -> R<Value> {
             let target = eval(target, names)?;
             let index = eval(index, names)?;
             let Some(i) = index.int() else {
-                return err(format!("indices must be integers, not {}", index.type_name()));
+                return err(format!(
+                    "indices must be integers, not {}",
+                    index.type_name()
+                ));
             };
             let pick = |len: usize| -> R<usize> {
                 let len = len as i64;
@@ -698,14 +713,14 @@ fn eval(e: &Expr, names: &mut dyn Names) -> R<Value> {
                     let chars: Vec<char> = s.chars().collect();
                     Ok(Value::Str(chars[pick(chars.len())?].to_string()))
                 }
-                other => err(format!("'{}' object is not subscriptable", other.type_name())),
+                other => err(format!(
+                    "'{}' object is not subscriptable",
+                    other.type_name()
+                )),
             }
         }
         Expr::Call(name, args) => {
-            let values = args
-                .iter()
-                .map(|a| eval(a, names))
-                .collect::<R<Vec<_>>>()?;
+            let values = args.iter().map(|a| eval(a, names)).collect::<R<Vec<_>>>()?;
             call(name, values, names)
         }
     }
@@ -738,7 +753,9 @@ fn binary(op: &str, a: Value, b: Value) -> R<Value> {
             "/" if y == 0 => err("division by zero"),
             "/" => Ok(Float(x as f64 / y as f64)),
             "//" | "%" if y == 0 => err("integer division or modulo by zero"),
-            "//" => Ok(Int(x.div_euclid(y) - i64::from(y < 0 && x.rem_euclid(y) != 0))),
+            "//" => Ok(Int(
+                x.div_euclid(y) - i64::from(y < 0 && x.rem_euclid(y) != 0)
+            )),
             "%" => {
                 let r = x.rem_euclid(y);
                 Ok(Int(if y < 0 && r != 0 { r + y } else { r }))
@@ -825,15 +842,18 @@ fn call(name: &str, args: Vec<Value>, names: &mut dyn Names) -> R<Value> {
         .or_else(|| name.strip_prefix("xacro."))
         .unwrap_or(name);
     let num = |i: usize| -> R<f64> {
-        args.get(i)
-            .and_then(Value::number)
-            .ok_or_else(|| ExprError::Other(format!("{name}() expects a number as argument {}", i + 1)))
+        args.get(i).and_then(Value::number).ok_or_else(|| {
+            ExprError::Other(format!("{name}() expects a number as argument {}", i + 1))
+        })
     };
     let arity = |n: usize| -> R<()> {
         if args.len() == n {
             Ok(())
         } else {
-            err(format!("{name}() takes {n} argument(s), {} given", args.len()))
+            err(format!(
+                "{name}() takes {n} argument(s), {} given",
+                args.len()
+            ))
         }
     };
     let float1 = |f: fn(f64) -> f64| -> R<Value> {
@@ -987,11 +1007,9 @@ fn call(name: &str, args: Vec<Value>, names: &mut dyn Names) -> R<Value> {
                 Value::Str(s) => parse_python_float(s.trim())
                     .map(Value::Float)
                     .ok_or_else(|| ExprError::Other(format!("float(): invalid literal '{s}'"))),
-                other => Ok(Value::Float(
-                    other
-                        .number()
-                        .ok_or_else(|| ExprError::Other("float() expects a number".into()))?,
-                )),
+                other => Ok(Value::Float(other.number().ok_or_else(|| {
+                    ExprError::Other("float() expects a number".into())
+                })?)),
             }
         }
         "str" => {
@@ -1007,7 +1025,10 @@ fn call(name: &str, args: Vec<Value>, names: &mut dyn Names) -> R<Value> {
             match &args[0] {
                 Value::Str(s) => Ok(Value::Int(s.chars().count() as i64)),
                 Value::List(l) => Ok(Value::Int(l.len() as i64)),
-                other => err(format!("object of type '{}' has no len()", other.type_name())),
+                other => err(format!(
+                    "object of type '{}' has no len()",
+                    other.type_name()
+                )),
             }
         }
         "arg" => {

@@ -279,7 +279,10 @@ impl Expander<'_> {
                             self.count_element()?;
                             let mut elem_attrs = Vec::with_capacity(e.attrs.len());
                             for (name, value) in &e.attrs {
-                                elem_attrs.push((name.clone(), self.eval_text(value, scope)?.to_string()));
+                                elem_attrs.push((
+                                    name.clone(),
+                                    self.eval_text(value, scope)?.to_string(),
+                                ));
                             }
                             let mut children = Vec::new();
                             let mut extra = Vec::new();
@@ -318,12 +321,8 @@ impl Expander<'_> {
     }
 
     fn required<'e>(&self, e: &'e XElem, name: &str) -> Result<&'e str> {
-        self.attr(e, name).ok_or_else(|| {
-            self.error(format!(
-                "<{}> needs a {name}=\"...\" attribute",
-                e.name
-            ))
-        })
+        self.attr(e, name)
+            .ok_or_else(|| self.error(format!("<{}> needs a {name}=\"...\" attribute", e.name)))
     }
 
     fn xacro_element(
@@ -369,7 +368,9 @@ impl Expander<'_> {
                 Ok(())
             }
             "insert_block" => {
-                let name = self.eval_text(self.required(e, "name")?, scope)?.to_string();
+                let name = self
+                    .eval_text(self.required(e, "name")?, scope)?
+                    .to_string();
                 match self.lookup(&name, scope) {
                     Some((_, Prop::Block(nodes))) => {
                         out.extend(nodes);
@@ -407,13 +408,19 @@ impl Expander<'_> {
                 Ok(())
             }
             "attribute" => {
-                let name = self.eval_text(self.required(e, "name")?, scope)?.to_string();
-                let value = self.eval_text(self.required(e, "value")?, scope)?.to_string();
+                let name = self
+                    .eval_text(self.required(e, "name")?, scope)?
+                    .to_string();
+                let value = self
+                    .eval_text(self.required(e, "value")?, scope)?
+                    .to_string();
                 attrs.push((name, value));
                 Ok(())
             }
             "call" => {
-                let name = self.eval_text(self.required(e, "macro")?, scope)?.to_string();
+                let name = self
+                    .eval_text(self.required(e, "macro")?, scope)?
+                    .to_string();
                 let m = self.find_macro(&name, scope)?;
                 self.call_macro(&m, e, scope, out, &["macro"])
             }
@@ -512,7 +519,9 @@ impl Expander<'_> {
     }
 
     fn include(&mut self, e: &XElem, scope: usize, out: &mut Vec<ONode>) -> Result<()> {
-        let spec = self.eval_text(self.required(e, "filename")?, scope)?.to_string();
+        let spec = self
+            .eval_text(self.required(e, "filename")?, scope)?
+            .to_string();
         let here = self.files[e.file]
             .parent()
             .map(Path::to_path_buf)
@@ -530,7 +539,10 @@ impl Expander<'_> {
         }
         let canonical = path.canonicalize().unwrap_or_else(|_| path.clone());
         let cycle_start = self.include_stack.iter().position(|&f| {
-            self.files[f].canonicalize().unwrap_or_else(|_| self.files[f].clone()) == canonical
+            self.files[f]
+                .canonicalize()
+                .unwrap_or_else(|_| self.files[f].clone())
+                == canonical
         });
         if let Some(start) = cycle_start {
             let mut chain: Vec<String> = self.include_stack[start..]
@@ -567,7 +579,9 @@ impl Expander<'_> {
                     Prop::Lazy(text) => Prop::Value(literal(self.eval_text(&text, scope)?)),
                     other => other,
                 };
-                self.scopes[scope].props.insert(format!("{ns}.{name}"), prop);
+                self.scopes[scope]
+                    .props
+                    .insert(format!("{ns}.{name}"), prop);
             }
             for (name, m) in inner.macros {
                 self.scopes[scope].macros.insert(format!("{ns}.{name}"), m);
@@ -584,7 +598,8 @@ impl Expander<'_> {
             } else if let Some(name) = token.strip_prefix('*') {
                 params.push(Param::Block(name.to_owned()));
             } else {
-                let (name, default) = match token.split_once(":=").or_else(|| token.split_once('=')) {
+                let (name, default) = match token.split_once(":=").or_else(|| token.split_once('='))
+                {
                     Some((name, d)) => {
                         let d = unquote(d);
                         let default = if let Some(rest) = d.strip_prefix('^') {
@@ -597,7 +612,9 @@ impl Expander<'_> {
                     None => (token.as_str(), None),
                 };
                 if name.is_empty() {
-                    return Err(self.error(format!("macro params=\"{text}\": empty parameter name")));
+                    return Err(
+                        self.error(format!("macro params=\"{text}\": empty parameter name"))
+                    );
                 }
                 params.push(Param::Plain {
                     name: name.to_owned(),
@@ -677,7 +694,9 @@ impl Expander<'_> {
                     let prop = match default {
                         Some(ParamDefault::Text(text)) => Prop::Lazy(text.clone()),
                         Some(ParamDefault::Inherit(fallback)) => match self.lookup(name, scope) {
-                            Some((_, Prop::Lazy(text))) => Prop::Value(literal(self.eval_text(&text, scope)?)),
+                            Some((_, Prop::Lazy(text))) => {
+                                Prop::Value(literal(self.eval_text(&text, scope)?))
+                            }
                             Some((_, prop)) => prop,
                             None => match fallback {
                                 Some(text) => Prop::Lazy(text.clone()),
@@ -752,7 +771,11 @@ impl Expander<'_> {
     }
 
     /// The value of a property, evaluating lazy text in the scope that defined it.
-    fn property_value(&mut self, name: &str, scope: usize) -> std::result::Result<Option<Value>, ExprError> {
+    fn property_value(
+        &mut self,
+        name: &str,
+        scope: usize,
+    ) -> std::result::Result<Option<Value>, ExprError> {
         let Some((holder, prop)) = self.lookup(name, scope) else {
             return Ok(None);
         };
@@ -762,7 +785,11 @@ impl Expander<'_> {
                 "\"{name}\" is a block (of elements), not a value"
             ))),
             Prop::Lazy(text) => {
-                if self.evaluating.iter().any(|(s, n)| *s == holder && n == name) {
+                if self
+                    .evaluating
+                    .iter()
+                    .any(|(s, n)| *s == holder && n == name)
+                {
                     return Err(ExprError::Other(format!(
                         "property \"{name}\" is defined in terms of itself"
                     )));
@@ -806,7 +833,11 @@ impl Expander<'_> {
 
     /// Evaluates `${...}` and `$(...)` in `text`. A text that is exactly one `${}` keeps the
     /// expression's type.
-    fn eval_text_inner(&mut self, text: &str, scope: usize) -> std::result::Result<Value, ExprError> {
+    fn eval_text_inner(
+        &mut self,
+        text: &str,
+        scope: usize,
+    ) -> std::result::Result<Value, ExprError> {
         if !text.contains('$') {
             return Ok(Value::Str(text.to_owned()));
         }
@@ -816,7 +847,10 @@ impl Expander<'_> {
         while let Some(pos) = rest.find('$') {
             literal_buf.push_str(&rest[..pos]);
             let after = &rest[pos + 1..];
-            if let Some(stripped) = after.strip_prefix("${").or_else(|| after.strip_prefix("$(")) {
+            if let Some(stripped) = after
+                .strip_prefix("${")
+                .or_else(|| after.strip_prefix("$("))
+            {
                 // `$${` and `$$(` escape to a literal `${` / `$(`.
                 literal_buf.push('$');
                 literal_buf.push_str(&after[..1]);
@@ -865,7 +899,11 @@ impl Expander<'_> {
     }
 
     /// `$(command args)`.
-    fn substitution(&mut self, inner: &str, scope: usize) -> std::result::Result<String, ExprError> {
+    fn substitution(
+        &mut self,
+        inner: &str,
+        scope: usize,
+    ) -> std::result::Result<String, ExprError> {
         let inner = inner.trim();
         let (command, rest) = inner.split_once(char::is_whitespace).unwrap_or((inner, ""));
         let rest = rest.trim();
@@ -1025,8 +1063,8 @@ fn convert(
 ) -> Rc<XElem> {
     let tag = node.tag_name();
     let xacro = is_xacro_ns(tag.namespace()).then(|| tag.name().to_owned());
-    let qualify = |ns: Option<&str>, local: &str, namespaces: &mut BTreeMap<String, String>| {
-        match ns {
+    let qualify =
+        |ns: Option<&str>, local: &str, namespaces: &mut BTreeMap<String, String>| match ns {
             Some(uri) if is_xacro_ns(Some(uri)) => format!("xacro:{local}"),
             Some(uri) => match node.lookup_prefix(uri) {
                 Some(prefix) if !prefix.is_empty() => {
@@ -1036,8 +1074,7 @@ fn convert(
                 _ => local.to_owned(),
             },
             None => local.to_owned(),
-        }
-    };
+        };
     let name = qualify(tag.namespace(), tag.name(), namespaces);
     let attrs = node
         .attributes()
@@ -1155,13 +1192,20 @@ mod tests {
             if let Some(parent) = p.parent() {
                 let _ = std::fs::create_dir_all(parent);
             }
-            std::fs::write(&p, text).map_err(|source| SimError::Io { path: p.clone(), source })?;
+            std::fs::write(&p, text).map_err(|source| SimError::Io {
+                path: p.clone(),
+                source,
+            })?;
         }
         let args = args
             .iter()
             .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
             .collect();
-        let out = expand_file(&dir.path().join(files[0].0), &args, &ResourcePaths::default())?;
+        let out = expand_file(
+            &dir.path().join(files[0].0),
+            &args,
+            &ResourcePaths::default(),
+        )?;
         Ok(out.text)
     }
 
@@ -1200,7 +1244,10 @@ mod tests {
         assert!(out.contains("<mu1>0.5</mu1>"), "{out}");
         assert!(out.contains(r#"<link name="camera"/>"#), "{out}");
         assert!(out.contains(r#"<link name="small"/>"#), "{out}");
-        assert!(out.contains("<wheelDiameter>0.066</wheelDiameter>"), "{out}");
+        assert!(
+            out.contains("<wheelDiameter>0.066</wheelDiameter>"),
+            "{out}"
+        );
         assert!(!out.contains("xacro"), "{out}");
         let off = expand(&[("r.urdf.xacro", &text)], &[("use_cam", "false")])?;
         assert!(!off.contains("camera"), "{off}");
@@ -1221,7 +1268,10 @@ mod tests {
             r#"{HEAD}<xacro:property name="base" value="base_link"/>
 <xacro:macro name="box_link" params="name"><link name="${{name}}"/></xacro:macro></robot>"#
         );
-        let out = expand(&[("main.xacro", &main), ("parts/common.xacro", &common)], &[])?;
+        let out = expand(
+            &[("main.xacro", &main), ("parts/common.xacro", &common)],
+            &[],
+        )?;
         for name in ["base_link", "base_link_2", "b", "b2"] {
             assert!(out.contains(&format!(r#"<link name="{name}"/>"#)), "{out}");
         }
@@ -1239,20 +1289,32 @@ mod tests {
     fn errors_name_file_line_and_what_is_undefined() {
         let undefined = format!("{HEAD}\n<link name=\"${{nope}}\"/></robot>");
         let m = message(expand(&[("a.xacro", &undefined)], &[]));
-        assert!(m.contains("a.xacro:2") && m.contains("undefined property \"nope\""), "{m}");
+        assert!(
+            m.contains("a.xacro:2") && m.contains("undefined property \"nope\""),
+            "{m}"
+        );
 
         let no_macro = format!("{HEAD}\n\n<xacro:wheel side=\"l\"/></robot>");
         let m = message(expand(&[("a.xacro", &no_macro)], &[]));
-        assert!(m.contains("a.xacro:3") && m.contains("unknown macro \"xacro:wheel\""), "{m}");
+        assert!(
+            m.contains("a.xacro:3") && m.contains("unknown macro \"xacro:wheel\""),
+            "{m}"
+        );
 
         let no_arg = format!("{HEAD}\n<link name=\"$(arg robot)\"/></robot>");
         let m = message(expand(&[("a.xacro", &no_arg)], &[]));
-        assert!(m.contains("undefined arg \"robot\"") && m.contains("--xacro-arg"), "{m}");
+        assert!(
+            m.contains("undefined arg \"robot\"") && m.contains("--xacro-arg"),
+            "{m}"
+        );
 
         let cycle_a = format!("{HEAD}<xacro:include filename=\"b.xacro\"/></robot>");
         let cycle_b = format!("{HEAD}\n<xacro:include filename=\"a.xacro\"/></robot>");
         let m = message(expand(&[("a.xacro", &cycle_a), ("b.xacro", &cycle_b)], &[]));
-        assert!(m.contains("include cycle") && m.contains("b.xacro:2"), "{m}");
+        assert!(
+            m.contains("include cycle") && m.contains("b.xacro:2"),
+            "{m}"
+        );
 
         let recursive = format!(
             "{HEAD}<xacro:macro name=\"m\" params=\"\"><xacro:m/></xacro:macro><xacro:m/></robot>"
@@ -1266,11 +1328,13 @@ mod tests {
         let m = message(expand(&[("a.xacro", &selfref)], &[]));
         assert!(m.contains("in terms of itself"), "{m}");
 
-        let missing = format!(
-            "{HEAD}<xacro:macro name=\"m\" params=\"x\"/>\n<xacro:m y=\"1\"/></robot>"
-        );
+        let missing =
+            format!("{HEAD}<xacro:macro name=\"m\" params=\"x\"/>\n<xacro:m y=\"1\"/></robot>");
         let m = message(expand(&[("a.xacro", &missing)], &[]));
-        assert!(m.contains("unknown parameter \"y\"") && m.contains("a.xacro:2"), "{m}");
+        assert!(
+            m.contains("unknown parameter \"y\"") && m.contains("a.xacro:2"),
+            "{m}"
+        );
     }
 
     #[test]
@@ -1280,8 +1344,13 @@ mod tests {
             source,
         })?;
         let p = dir.path().join("m.xacro");
-        let text = format!("{HEAD}\n<xacro:macro name=\"l\" params=\"n\">\n<link name=\"${{n}}\"/>\n</xacro:macro>\n<xacro:l n=\"a\"/>\n</robot>");
-        std::fs::write(&p, text).map_err(|source| SimError::Io { path: p.clone(), source })?;
+        let text = format!(
+            "{HEAD}\n<xacro:macro name=\"l\" params=\"n\">\n<link name=\"${{n}}\"/>\n</xacro:macro>\n<xacro:l n=\"a\"/>\n</robot>"
+        );
+        std::fs::write(&p, text).map_err(|source| SimError::Io {
+            path: p.clone(),
+            source,
+        })?;
         let out = expand_file(&p, &BTreeMap::new(), &ResourcePaths::default())?;
         let line = out
             .text
