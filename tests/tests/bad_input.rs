@@ -232,3 +232,174 @@ fn the_bundled_worlds_load() -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+/// Writes `files` into a fresh folder and loads the first as a robot (xacro or URDF).
+fn load_robot_files(files: &[(&str, &str)]) -> anyhow::Result<(tempfile::TempDir, String)> {
+    let dir = tempfile::tempdir()?;
+    for (name, text) in files {
+        let p = dir.path().join(name);
+        if let Some(parent) = p.parent() {
+            std::fs::create_dir_all(parent)?;
+        }
+        std::fs::write(p, text)?;
+    }
+    let message = match RobotModel::load_with(
+        &dir.path().join(files[0].0),
+        &rover_sim::LoadOptions::default(),
+    ) {
+        Ok(_) => String::from("(loaded without error)"),
+        Err(e) => e.to_string(),
+    };
+    Ok((dir, message))
+}
+
+const XACRO_HEAD: &str = r#"<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">"#;
+
+#[test]
+fn xacro_errors_name_the_xacro_file_line_and_the_undefined_thing() -> anyhow::Result<()> {
+    let cases = [
+        (
+            format!("{XACRO_HEAD}\n<link name=\"${{wheel_radius * 2}}\"/>\n</robot>"),
+            "r.urdf.xacro:2: in \"${wheel_radius * 2}\": undefined property \"wheel_radius\"",
+        ),
+        (
+            format!("{XACRO_HEAD}\n<link name=\"a\"/>\n<xacro:wheel/>\n</robot>"),
+            "r.urdf.xacro:3: unknown macro \"xacro:wheel\"",
+        ),
+        (
+            format!("{XACRO_HEAD}\n<link name=\"$(arg prefix)base\"/>\n</robot>"),
+            "r.urdf.xacro:2: in \"$(arg prefix)base\": undefined arg \"prefix\"",
+        ),
+        (
+            format!(
+                "{XACRO_HEAD}\n<xacro:include filename=\"$(find no_such_pkg)/urdf/x.xacro\"/>\n</robot>"
+            ),
+            "$(find no_such_pkg): ROS package \"no_such_pkg\" not found; searched:",
+        ),
+    ];
+    for (text, expected) in cases {
+        let (_dir, message) = load_robot_files(&[("r.urdf.xacro", &text)])?;
+        assert!(
+            message.contains(expected),
+            "{message}\nexpected: {expected}"
+        );
+    }
+    let (_dir, message) = load_robot_files(&[
+        (
+            "r.urdf.xacro",
+            &format!("{XACRO_HEAD}\n<xacro:include filename=\"b.xacro\"/>\n</robot>"),
+        ),
+        (
+            "b.xacro",
+            &format!("{XACRO_HEAD}\n\n<xacro:include filename=\"r.urdf.xacro\"/>\n</robot>"),
+        ),
+    ])?;
+    assert!(
+        message.contains("b.xacro:3: include cycle:") && message.contains("r.urdf.xacro -> "),
+        "{message}"
+    );
+    // A URDF error found after expansion points at the xacro line the element came from.
+    let (_dir, message) = load_robot_files(&[(
+        "r.urdf.xacro",
+        &format!(
+            "{XACRO_HEAD}\n<xacro:macro name=\"j\" params=\"p\">\n<joint name=\"j\" type=\"fixed\"><parent link=\"${{p}}\"/><child link=\"a\"/></joint>\n</xacro:macro>\n<link name=\"a\"/>\n<xacro:j p=\"nowhere\"/>\n</robot>"
+        ),
+    )])?;
+    assert!(
+        message.contains("r.urdf.xacro:3:")
+            && message.contains("<parent link=\"nowhere\">: no such link"),
+        "{message}"
+    );
+    Ok(())
+}
+
+#[test]
+fn missing_mesh_names_the_uri_and_every_folder_searched() -> anyhow::Result<()> {
+    let urdf = r#"<robot name="r"><link name="a"><visual><geometry>
+<mesh filename="package://my_pkg/meshes/gone.stl"/></geometry></visual></link></robot>"#;
+    let (dir, message) = load_robot_files(&[
+        ("my_pkg/urdf/r.urdf", urdf),
+        (
+            "my_pkg/package.xml",
+            "<package><name>my_pkg</name></package>",
+        ),
+    ])?;
+    let searched = dir.path().join("my_pkg/meshes/gone.stl");
+    assert!(
+        message.contains("r.urdf:1: <link name=\"a\"> <mesh>: file package://my_pkg/meshes/gone.stl not found; searched:")
+            && message.contains(&searched.display().to_string()),
+        "{message}"
+    );
+    let (_dir, message) = load_robot_files(&[("r.urdf", &urdf.replace("my_pkg", "other_pkg"))])?;
+    assert!(
+        message.contains(
+            "package://other_pkg/meshes/gone.stl: ROS package \"other_pkg\" not found; searched:"
+        ),
+        "{message}"
+    );
+    Ok(())
+}
+
+#[test]
+fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let dae = dir.path().join("empty.dae");
+    std::fs::write(
+        &dae,
+        r##"<?xml version="1.0"?><COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1"><asset><unit meter="1"/><up_axis>Z_UP</up_axis></asset>
+<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa" count="6">0 0 0 1 0 0</float_array><technique_common><accessor source="#pa" count="2" stride="3"><param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<lines count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1</p></lines>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>"##,
+    )?;
+    let message = rover_sim::load_mesh(&dae, glam::Vec3::ONE)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("empty.dae") && message.contains("mesh has no triangles"),
+        "{message}"
+    );
+
+    let world = dir.path().join("bad.world");
+    std::fs::write(
+        &world,
+        "<sdf version='1.6'>\n<world name='w'>\n<model name='m'>\n</world></sdf>",
+    )?;
+    let message = World::load(&world)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(message.contains("bad.world:4: malformed XML"), "{message}");
+
+    std::fs::write(
+        &world,
+        "<sdf version='1.6'><world name='w'>\n<include><uri>model://no_such_model</uri></include></world></sdf>",
+    )?;
+    let message = World::load_with(
+        &world,
+        &rover_sim::ResourcePaths::default().with_model_path(dir.path()),
+    )
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(
+        message.contains("bad.world:2: <include><uri>model://no_such_model</uri>: Gazebo model \"no_such_model\" (model://no_such_model) not found; searched:"),
+        "{message}"
+    );
+    std::fs::write(
+        &world,
+        "<sdf version='1.6'><world name='w'><model name='m'><link name='l'>\n<visual name='v'><pose>0 0 one 0 0 0</pose><geometry><box><size>1 1 1</size></box></geometry></visual></link></model></world></sdf>",
+    )?;
+    let message = World::load(&world)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("bad.world:2: <pose>0 0 one 0 0 0</pose>: expected 6 finite numbers"),
+        "{message}"
+    );
+    Ok(())
+}
