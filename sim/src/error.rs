@@ -76,5 +76,24 @@ impl SimError {
     }
 }
 
+/// Parses XML (URDF, xacro, SDF; DTDs allowed), reporting malformed input with its line.
+pub(crate) fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Document<'a>> {
+    roxmltree::Document::parse_with_options(
+        text,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| {
+        let pos = e.pos();
+        SimError::invalid(
+            path,
+            Some(pos.row),
+            format!("malformed XML (column {}): {e}", pos.col),
+        )
+    })
+}
+
 /// Result alias for the simulation core.
 pub type Result<T, E = SimError> = std::result::Result<T, E>;

@@ -181,14 +181,7 @@ impl RobotModel {
     }
 
     fn parse(text: &str, path: &Path, resources: &ResourcePaths) -> Result<Self> {
-        let doc = roxmltree::Document::parse(text).map_err(|e| {
-            let pos = e.pos();
-            SimError::invalid(
-                path,
-                Some(pos.row),
-                format!("malformed XML (column {}): {e}", pos.col),
-            )
-        })?;
+        let doc = crate::error::parse_xml(text, path)?;
         let root = doc.root_element();
         if root.tag_name().name() != "robot" {
             return Err(SimError::invalid(

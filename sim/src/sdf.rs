@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use roxmltree::Node;
 
-use crate::error::{Result, SimError};
+use crate::error::{Result, SimError, parse_xml};
 use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy};
 use crate::resource::ResourcePaths;
 use crate::robot::{Collision, Visual};
@@ -183,24 +183,6 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     world.ground.size_m = [100.0, 100.0];
     world.models = models;
     Ok(world)
-}
-
-fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Document<'a>> {
-    roxmltree::Document::parse_with_options(
-        text,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| {
-        let pos = e.pos();
-        SimError::invalid(
-            path,
-            Some(pos.row),
-            format!("malformed XML (column {}): {e}", pos.col),
-        )
-    })
 }
 
 struct Ctx<'a, 'input> {

@@ -235,21 +235,7 @@ impl Expander<'_> {
         let text = std::fs::read_to_string(path).map_err(io)?;
         let file = self.files.len();
         self.files.push(path.to_path_buf());
-        let doc = roxmltree::Document::parse_with_options(
-            &text,
-            roxmltree::ParsingOptions {
-                allow_dtd: true,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| {
-            let pos = e.pos();
-            SimError::invalid(
-                path,
-                Some(pos.row),
-                format!("malformed XML (column {}): {e}", pos.col),
-            )
-        })?;
+        let doc = crate::error::parse_xml(&text, path)?;
         let root = convert(&doc, doc.root_element(), file, &mut self.namespaces);
         Ok(root)
     }
