@@ -56,6 +56,8 @@ pub struct Recorder {
     trail: Vec<[f32; 3]>,
     trail_logged_s: f64,
     paths: ScenePaths,
+    /// Reused buffer for SDF model link poses.
+    model_poses: Vec<Pose>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -90,6 +92,7 @@ impl Recorder {
             frame: 0,
             trail: Vec::with_capacity(4096),
             trail_logged_s: f64::NEG_INFINITY,
+            model_poses: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -173,6 +176,14 @@ impl Observer for Recorder {
         {
             if i != sim.robot().root {
                 self.log(path, &transform(base_from_world * sim.world_from_link(i)));
+            }
+        }
+        if !self.paths.moving_model_links.is_empty() {
+            sim.model_link_poses_into(&mut self.model_poses);
+            for (i, path) in &self.paths.moving_model_links {
+                if let Some(pose) = self.model_poses.get(*i) {
+                    self.log(path, &transform(*pose));
+                }
             }
         }
         for (i, path) in self.paths.people.iter().enumerate() {

@@ -16,6 +16,9 @@ pub(super) struct ScenePaths {
     pub links: Vec<String>,
     /// `world/people/<name>` per person.
     pub people: Vec<String>,
+    /// `world/models/<model>/<link>` of SDF model links that move, with their index among all
+    /// model links.
+    pub moving_model_links: Vec<(usize, String)>,
 }
 
 /// Logs the static scene and returns the paths per-tick logging uses.
@@ -52,6 +55,27 @@ pub(super) fn log_scene(
         log(&path, &mesh(&object_mesh(&object.shape), object.color));
     }
     let mut paths = ScenePaths::default();
+    let model_links = world
+        .models
+        .iter()
+        .flat_map(|m| m.links.iter().map(move |l| (m, l)));
+    for (i, (model, link)) in model_links.enumerate() {
+        let path = format!("world/models/{}/{}", model.name, link.name);
+        // Moving links get their transform per tick (static data would shadow it).
+        if !link.is_dynamic(model) {
+            log(&path, &transform(link.world_from_link));
+        }
+        for (v, visual) in link.visuals.iter().enumerate() {
+            let vpath = format!("{path}/visual_{v}");
+            if let Ok(m) = shape_mesh(&visual.shape) {
+                log(&vpath, &transform(visual.link_from_shape));
+                log(&vpath, &mesh(&m, visual.color));
+            }
+        }
+        if link.is_dynamic(model) {
+            paths.moving_model_links.push((i, path));
+        }
+    }
     for (i, person) in world.people.iter().enumerate() {
         let path = format!("world/people/{}", person.name);
         let mut positions = Vec::new();
