@@ -110,3 +110,59 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
         None
     }
 }
+
+/// A PyPI wheel unpacked into `~/.cache/rover/pypi/NAME-VERSION` (downloaded with pip the first
+/// time; nothing is committed). `None`, with the reason printed, when it cannot be had (offline,
+/// no pip), so tests can skip.
+pub fn pypi(name: &str, version: &str) -> Option<PathBuf> {
+    let cache = std::env::var_os("HOME")
+        .map(PathBuf::from)
+        .unwrap_or_else(std::env::temp_dir)
+        .join(".cache/rover");
+    let dir = cache.join("pypi").join(format!("{name}-{version}"));
+    if dir.join(".complete").is_file() {
+        return Some(dir);
+    }
+    let fetch = || -> anyhow::Result<()> {
+        let wheels = cache.join("wheels");
+        std::fs::create_dir_all(&wheels)?;
+        let status = std::process::Command::new("python3")
+            .args([
+                "-m",
+                "pip",
+                "download",
+                "--quiet",
+                "--no-deps",
+                "--only-binary=:all:",
+            ])
+            .arg(format!("{name}=={version}"))
+            .arg("-d")
+            .arg(&wheels)
+            .status()?;
+        anyhow::ensure!(status.success(), "pip download {name}=={version} failed");
+        let prefix = format!("{}-{version}-", name.replace('-', "_"));
+        let wheel = std::fs::read_dir(&wheels)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| {
+                p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".whl"))
+            })
+            .ok_or_else(|| anyhow::anyhow!("no {prefix}*.whl in {}", wheels.display()))?;
+        let status = std::process::Command::new("python3")
+            .args(["-m", "zipfile", "-e"])
+            .arg(&wheel)
+            .arg(&dir)
+            .status()?;
+        anyhow::ensure!(status.success(), "cannot unpack {}", wheel.display());
+        std::fs::write(dir.join(".complete"), "")?;
+        Ok(())
+    };
+    match fetch() {
+        Ok(()) => Some(dir),
+        Err(e) => {
+            eprintln!("SKIP: PyPI {name}=={version} unavailable: {e}");
+            None
+        }
+    }
+}
