@@ -26,6 +26,8 @@ pub struct RunConfig {
     pub robot_options: LoadOptions,
     /// Where the robot spawns: x m, y m, yaw deg (overrides the world's `[robot]`).
     pub spawn: Option<[f64; 3]>,
+    /// Wheels to drive (overrides the world's `[robot.drive]`).
+    pub drive: Option<rover_sim::DriveSpec>,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -118,7 +120,10 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
         .clone()
         .or_else(|| world.robot.urdf.clone())
         .unwrap_or_else(paths::default_robot);
-    let robot = RobotModel::load_with(&robot_path, &robot_load_options(config, &world))?;
+    let mut robot = RobotModel::load_with(&robot_path, &robot_load_options(config, &world))?;
+    if let Some(spec) = config.drive.as_ref().or(world.robot.drive.as_ref()) {
+        robot.set_drive(spec)?;
+    }
     Ok((world, robot))
 }
 

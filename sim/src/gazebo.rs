@@ -36,6 +36,12 @@ pub struct DiffDriveConfig {
     pub left_joint: String,
     /// `<rightJoint>` (default `right_joint`).
     pub right_joint: String,
+    /// More wheel joints driven like the left and right ones: a skid-steer robot's rear wheels
+    /// (`leftRearJoint`, `rightRearJoint`, with `leftFrontJoint`/`rightFrontJoint` as
+    /// `left_joint`/`right_joint`).
+    pub extra_left_joints: Vec<String>,
+    /// See [`Self::extra_left_joints`].
+    pub extra_right_joints: Vec<String>,
     /// `<wheelSeparation>` (m, default 0.34).
     pub wheel_separation_m: f64,
     /// `<wheelDiameter>` (m, default 0.15).
@@ -72,6 +78,8 @@ impl Default for DiffDriveConfig {
             robot_base_frame: "base_footprint".to_owned(),
             left_joint: "left_joint".to_owned(),
             right_joint: "right_joint".to_owned(),
+            extra_left_joints: Vec::new(),
+            extra_right_joints: Vec::new(),
             wheel_separation_m: 0.34,
             wheel_diameter_m: 0.15,
             wheel_torque_nm: 5.0,
@@ -192,7 +200,7 @@ impl<'a, 'input> Ctx<'a, 'input> {
     }
 
     fn number(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
-        let text = node.text().map(str::trim).unwrap_or("");
+        let text = text_of(node);
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
             _ => Err(self.err(
@@ -236,7 +244,7 @@ impl<'a, 'input> Ctx<'a, 'input> {
     }
 
     fn boolean(&self, node: Node<'_, '_>, what: &str) -> Result<bool> {
-        match node.text().map(str::trim).unwrap_or("") {
+        match text_of(node) {
             "true" | "1" => Ok(true),
             "false" | "0" => Ok(false),
             other => Err(self.err(
@@ -250,7 +258,7 @@ impl<'a, 'input> Ctx<'a, 'input> {
     }
 
     fn pixels(&self, node: Node<'_, '_>, what: &str) -> Result<u32> {
-        let text = node.text().map(str::trim).unwrap_or("");
+        let text = text_of(node);
         match text.parse::<u32>() {
             Ok(v) if (1..=16384).contains(&v) => Ok(v),
             _ => Err(self.err(
@@ -265,8 +273,13 @@ impl<'a, 'input> Ctx<'a, 'input> {
 }
 
 /// Trimmed text content of an element ("" when empty).
+/// Trimmed text of an element, or its `value` attribute (the older `<mu1 value="1.0"/>` form
+/// Gazebo's URDF reader accepts too).
 fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
-    node.text().map(str::trim).unwrap_or("")
+    match node.text().map(str::trim) {
+        Some(text) if !text.is_empty() => text,
+        _ => node.attribute("value").map_or("", str::trim),
+    }
 }
 
 fn elements<'a, 'input>(node: Node<'a, 'input>) -> impl Iterator<Item = Node<'a, 'input>> {
@@ -284,12 +297,14 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
             match child.tag_name().name() {
                 "plugin" => {
                     let file = child.attribute("filename").unwrap_or("");
-                    if file.contains("gazebo_ros_diff_drive") {
+                    if file.contains("gazebo_ros_diff_drive")
+                        || file.contains("gazebo_ros_skid_steer_drive")
+                    {
                         if let Some(first) = &ext.diff_drive {
                             return Err(ctx.err(
                                 child,
                                 format!(
-                                    "a second libgazebo_ros_diff_drive.so plugin (the first is at line {}); expected one",
+                                    "a second drive plugin (the first is at line {}); expected one diff drive or skid steer plugin",
                                     first.line.unwrap_or(0)
                                 ),
                             ));
@@ -345,8 +360,17 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
     Ok(ext)
 }
 
+/// gazebo_ros_diff_drive and gazebo_ros_skid_steer_drive (same wheel speed formula; the skid
+/// steer drives a front and a rear joint per side).
 fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDriveConfig> {
-    let what = "the libgazebo_ros_diff_drive.so plugin";
+    let skid = plugin
+        .attribute("filename")
+        .is_some_and(|f| f.contains("skid_steer_drive"));
+    let what = if skid {
+        "the libgazebo_ros_skid_steer_drive.so plugin"
+    } else {
+        "the libgazebo_ros_diff_drive.so plugin"
+    };
     let mut c = DiffDriveConfig {
         name: plugin
             .attribute("name")
@@ -362,8 +386,10 @@ fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDrive
             "odometryTopic" => c.odometry_topic = text(),
             "odometryFrame" => c.odometry_frame = text(),
             "robotBaseFrame" => c.robot_base_frame = text(),
-            "leftJoint" => c.left_joint = text(),
-            "rightJoint" => c.right_joint = text(),
+            "leftJoint" | "leftFrontJoint" => c.left_joint = text(),
+            "rightJoint" | "rightFrontJoint" => c.right_joint = text(),
+            "leftRearJoint" => c.extra_left_joints.push(text()),
+            "rightRearJoint" => c.extra_right_joints.push(text()),
             "wheelSeparation" => c.wheel_separation_m = ctx.positive(p, what, "metres")?,
             "wheelDiameter" => c.wheel_diameter_m = ctx.positive(p, what, "metres")?,
             "wheelTorque" | "torque" => c.wheel_torque_nm = ctx.positive(p, what, "N m")?,
@@ -392,7 +418,8 @@ fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDrive
                 c.cmd_timeout_s = (t > 0.0).then_some(t);
             }
             "alwaysOn" | "legacyMode" | "rosDebugLevel" | "robotNamespace" | "odometryRate"
-            | "publishOdom" => {}
+            | "publishOdom" | "broadcastTF" | "covariance_x" | "covariance_y"
+            | "covariance_yaw" => {}
             other => tracing::warn!(
                 "{}:{}: <{other}> in {what}: unknown parameter, ignored",
                 ctx.path.display(),

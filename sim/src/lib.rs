@@ -26,6 +26,7 @@ mod sdf;
 mod sensor;
 mod simulation;
 mod tomlfile;
+mod urdf;
 mod world;
 mod xacro;
 
@@ -51,7 +52,7 @@ pub use sensor::{CameraFrame, CameraSensor};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use tomlfile::{load_toml, parse_toml};
 pub use world::{
-    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Person, Physics, RobotSpawn, STEP_HZ_RANGE, Walk,
-    World, check_step_hz,
+    DEFAULT_STEP_HZ, DriveSpec, Ground, Object, ObjectShape, Person, Physics, RobotSpawn,
+    STEP_HZ_RANGE, Walk, World, check_step_hz,
 };
 pub use xacro::{Expanded, expand_file as expand_xacro, uses_xacro};

@@ -5,7 +5,9 @@
 //! A ROS package is a folder with a `package.xml`; its name is the `<name>` in that file, not the
 //! folder's name. Packages are looked up, in order: in the explicit `--package-path NAME=DIR`
 //! entries, upward from the file being loaded (each ancestor folder that is a package, and the
-//! packages beside it), and in the folders of `ROS_PACKAGE_PATH` (searched a few levels deep).
+//! packages beside it; then an ancestor folder called NAME holding a package.xml, as in a ROS 2
+//! install's `share/NAME`), and in the folders of `ROS_PACKAGE_PATH` (searched a few levels
+//! deep).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -103,6 +105,14 @@ impl ResourcePaths {
                     return Ok(found);
                 }
             }
+        }
+        // A ROS 2 install's share/NAME folder is found by its name even when its package.xml
+        // says otherwise (example-robot-data's says example_robot_descriptions).
+        if let Some(dir) = near
+            .ancestors()
+            .find(|d| d.file_name().is_some_and(|n| n == name) && d.join("package.xml").is_file())
+        {
+            return Ok(dir.to_path_buf());
         }
         for root in &self.package_search {
             searched.push(root.clone());

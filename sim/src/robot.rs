@@ -1,8 +1,8 @@
 //! Robot descriptions loaded from URDF, with the `<gazebo>` extensions rover honours.
 //!
-//! `urdf-rs` parses the standard URDF elements; rover reads the `<gazebo>` elements itself
-//! (urdf-rs drops them) and validates the file first with `roxmltree`, so that every error names
-//! the file, the line and the element.
+//! The standard URDF elements are read by `urdf.rs` with urdfdom's rules, the `<gazebo>`
+//! elements by `gazebo.rs`, both from one `roxmltree` document, so that every error names the
+//! file, the line and the element.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -154,8 +154,9 @@ impl RobotModel {
         Self::load_with(path, &LoadOptions::from_env())
     }
 
-    /// Loads and validates a URDF file, or expands a xacro file (a `.xacro` name, or a file
-    /// that declares the xacro namespace) and loads the result. Errors in an expanded file name
+    /// Loads and validates a URDF file, or expands a xacro file (a `.xacro` name, a file that
+    /// declares the xacro namespace, or one with `$(...)` substitution args) and loads the
+    /// result. Errors in an expanded file name
     /// the xacro file and line the element came from.
     pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
@@ -166,7 +167,10 @@ impl RobotModel {
             .file_name()
             .and_then(|n| n.to_str())
             .is_some_and(|n| n.ends_with(".xacro"))
-            || xacro::uses_xacro(&text);
+            || xacro::uses_xacro(&text)
+            // Substitution args left in a plain URDF (pybullet's husky: `$(optenv ...)`) are
+            // expanded as xacro would, rather than failing as numbers.
+            || text.contains("$(");
         if is_xacro {
             let expanded = xacro::expand_file(path, &options.xacro_args, &options.resources)?;
             return Self::parse(&expanded.text, path, &options.resources)
@@ -196,14 +200,13 @@ impl RobotModel {
         validate_numbers(&doc, path)?;
         let lines = ElementLines::collect(&doc);
 
-        let urdf = urdf_rs::read_from_string(text)
-            .map_err(|e| SimError::invalid(path, None, format!("not a valid URDF robot: {e}")))?;
+        let urdf = crate::urdf::read(&doc, path)?;
 
         let base_dir = path.parent().unwrap_or(Path::new("."));
         let materials: HashMap<&str, Rgba> = urdf
             .materials
             .iter()
-            .filter_map(|m| m.color.as_ref().map(|c| (m.name.as_str(), rgba(c.rgba.0))))
+            .filter_map(|m| m.color.map(|c| (m.name.as_str(), rgba(c))))
             .collect();
 
         let mut link_index: BTreeMap<String, usize> = BTreeMap::new();
@@ -257,15 +260,15 @@ impl RobotModel {
                     )
                 })
             };
-            let parent = find("parent", &joint.parent.link)?;
-            let child = find("child", &joint.child.link)?;
+            let parent = find("parent", &joint.parent)?;
+            let child = find("child", &joint.child)?;
             if let Some(previous) = parent_of[child] {
                 return Err(SimError::invalid(
                     path,
                     line,
                     format!(
                         "<joint name=\"{}\">: link \"{}\" already has a parent joint \"{}\"; a URDF must be a tree",
-                        joint.name, joint.child.link, urdf.joints[previous].name
+                        joint.name, joint.child, urdf.joints[previous].name
                     ),
                 ));
             }
@@ -353,6 +356,79 @@ impl RobotModel {
         Ok(model)
     }
 
+    /// Drives the robot's wheels `spec` names like gazebo_ros_diff_drive (replacing a drive
+    /// plugin from the URDF). Separation and diameter default to what the URDF says: the
+    /// distance between the two joints and the left wheel's collision cylinder or sphere.
+    pub fn set_drive(&mut self, spec: &crate::world::DriveSpec) -> Result<()> {
+        let setup =
+            |m: String| SimError::Setup(format!("[robot.drive] for \"{}\": {m}", self.name));
+        let joint = |name: &str| {
+            self.joint_index(name).ok_or_else(|| {
+                setup(format!(
+                    "no joint \"{name}\"; joints in this robot: {}",
+                    names(self.joints.iter().map(|j| &j.name))
+                ))
+            })
+        };
+        let (left, right) = (joint(&spec.left_joint)?, joint(&spec.right_joint)?);
+        let poses = self.root_from_links();
+        let separation = match spec.wheel_separation_m {
+            Some(s) => s,
+            None => f64::from(
+                poses[self.joints[left].child]
+                    .translation
+                    .distance(poses[self.joints[right].child].translation),
+            ),
+        };
+        let diameter = match spec.wheel_diameter_m {
+            Some(d) => d,
+            None => {
+                let wheel = &self.links[self.joints[left].child];
+                let radius = wheel.collisions.iter().find_map(|c| match c.shape {
+                    Shape::Cylinder { radius_m, .. } | Shape::Sphere { radius_m } => {
+                        Some(f64::from(radius_m))
+                    }
+                    _ => None,
+                });
+                2.0 * radius.ok_or_else(|| {
+                    setup(format!(
+                        "cannot tell the diameter of wheel link \"{}\" (no cylinder or sphere collision); give wheel_diameter_m",
+                        wheel.name
+                    ))
+                })?
+            }
+        };
+        for (what, v) in [
+            ("wheel_separation_m", separation),
+            ("wheel_diameter_m", diameter),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(setup(format!(
+                    "{what} is {v}; expected a positive number of metres"
+                )));
+            }
+        }
+        let mut config = DiffDriveConfig {
+            name: "rover_drive".to_owned(),
+            left_joint: spec.left_joint.clone(),
+            right_joint: spec.right_joint.clone(),
+            wheel_separation_m: separation,
+            wheel_diameter_m: diameter,
+            ..DiffDriveConfig::default()
+        };
+        if let Some(t) = spec.wheel_torque_nm {
+            config.wheel_torque_nm = t;
+        }
+        tracing::info!(
+            "{}: driving joints \"{}\" and \"{}\" (wheel separation {separation:.3} m, diameter {diameter:.3} m)",
+            self.name,
+            spec.left_joint,
+            spec.right_joint
+        );
+        self.diff_drive = Some(config);
+        self.validate_plugins(&self.source.clone())
+    }
+
     /// Index of the link called `name`.
     pub fn link_index(&self, name: &str) -> Option<usize> {
         self.links.iter().position(|l| l.name == name)
@@ -382,10 +458,18 @@ impl RobotModel {
 
     fn validate_plugins(&self, path: &Path) -> Result<()> {
         if let Some(dd) = &self.diff_drive {
+            let extras = dd
+                .extra_left_joints
+                .iter()
+                .map(|j| ("leftRearJoint", j))
+                .chain(dd.extra_right_joints.iter().map(|j| ("rightRearJoint", j)));
             for (role, name) in [
                 ("leftJoint", &dd.left_joint),
                 ("rightJoint", &dd.right_joint),
-            ] {
+            ]
+            .into_iter()
+            .chain(extras)
+            {
                 let Some(index) = self.joint_index(name) else {
                     return Err(SimError::invalid(
                         path,
@@ -504,7 +588,7 @@ impl ElementLines {
     }
 }
 
-/// Checks every numeric URDF attribute before urdf-rs sees it, so a typo is reported with its
+/// Checks every numeric URDF attribute before the elements are read, so a typo is reported with its
 /// line and element instead of a bare deserialisation message.
 fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
     for node in doc.descendants().filter(|n| n.is_element()) {
@@ -576,25 +660,24 @@ fn remap(e: SimError, expanded: &Expanded) -> SimError {
 }
 
 fn convert_link(
-    link: &urdf_rs::Link,
+    link: &crate::urdf::LinkEl,
     materials: &HashMap<&str, Rgba>,
     base_dir: (&Path, &ResourcePaths),
     path: &Path,
     lines: &ElementLines,
 ) -> Result<Link> {
     let line = lines.link(&link.name);
-    let geometry = |g: &urdf_rs::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
-    let inertial = (link.inertial.mass.value > 0.0).then(|| {
-        let i = &link.inertial.inertia;
-        Inertial {
-            mass_kg: link.inertial.mass.value as f32,
-            link_from_inertial: pose_from_xyz_rpy(
-                link.inertial.origin.xyz.0,
-                link.inertial.origin.rpy.0,
-            ),
-            inertia: [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz].map(|v| v as f32),
-        }
-    });
+    let geometry =
+        |g: &crate::urdf::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
+    let inertial = link
+        .inertial
+        .as_ref()
+        .filter(|i| i.mass > 0.0)
+        .map(|i| Inertial {
+            mass_kg: i.mass as f32,
+            link_from_inertial: pose_from_xyz_rpy(i.origin.xyz, i.origin.rpy),
+            inertia: i.inertia.map(|v| v as f32),
+        });
     let mut visuals = Vec::with_capacity(link.visual.len());
     for v in &link.visual {
         let color = v
@@ -602,13 +685,12 @@ fn convert_link(
             .as_ref()
             .and_then(|m| {
                 m.color
-                    .as_ref()
-                    .map(|c| rgba(c.rgba.0))
+                    .map(rgba)
                     .or_else(|| materials.get(m.name.as_str()).copied())
             })
             .unwrap_or(Rgba::rgb(0.7, 0.7, 0.7));
         visuals.push(Visual {
-            link_from_shape: pose_from_xyz_rpy(v.origin.xyz.0, v.origin.rpy.0),
+            link_from_shape: pose_from_xyz_rpy(v.origin.xyz, v.origin.rpy),
             shape: geometry(&v.geometry)?,
             color,
         });
@@ -616,7 +698,7 @@ fn convert_link(
     let mut collisions = Vec::with_capacity(link.collision.len());
     for c in &link.collision {
         collisions.push(Collision {
-            link_from_shape: pose_from_xyz_rpy(c.origin.xyz.0, c.origin.rpy.0),
+            link_from_shape: pose_from_xyz_rpy(c.origin.xyz, c.origin.rpy),
             shape: geometry(&c.geometry)?,
         });
     }
@@ -630,28 +712,28 @@ fn convert_link(
 }
 
 fn convert_geometry(
-    g: &urdf_rs::Geometry,
+    g: &crate::urdf::Geometry,
     (base_dir, resources): (&Path, &ResourcePaths),
     path: &Path,
     line: Option<u32>,
     link: &str,
 ) -> Result<Shape> {
     Ok(match g {
-        urdf_rs::Geometry::Box { size } => Shape::Box {
-            size_m: vec3(size.0),
+        crate::urdf::Geometry::Box { size } => Shape::Box {
+            size_m: vec3(*size),
         },
-        urdf_rs::Geometry::Cylinder { radius, length } => Shape::Cylinder {
+        crate::urdf::Geometry::Cylinder { radius, length } => Shape::Cylinder {
             radius_m: *radius as f32,
             length_m: *length as f32,
         },
-        urdf_rs::Geometry::Capsule { radius, length } => Shape::Capsule {
+        crate::urdf::Geometry::Capsule { radius, length } => Shape::Capsule {
             radius_m: *radius as f32,
             length_m: *length as f32,
         },
-        urdf_rs::Geometry::Sphere { radius } => Shape::Sphere {
+        crate::urdf::Geometry::Sphere { radius } => Shape::Sphere {
             radius_m: *radius as f32,
         },
-        urdf_rs::Geometry::Mesh { filename, scale } => {
+        crate::urdf::Geometry::Mesh { filename, scale } => {
             let resolved = resources.resolve(filename, base_dir).map_err(|e| {
                 SimError::invalid(path, line, format!("<link name=\"{link}\"> <mesh>: {e}"))
             })?;
@@ -670,28 +752,28 @@ fn convert_geometry(
             }
             Shape::Mesh {
                 path: resolved,
-                scale: scale.as_ref().map(|s| vec3(s.0)).unwrap_or(Vec3::ONE),
+                scale: scale.map(vec3).unwrap_or(Vec3::ONE),
             }
         }
     })
 }
 
 fn convert_joint(
-    joint: &urdf_rs::Joint,
+    joint: &crate::urdf::JointEl,
     parent: usize,
     child: usize,
     path: &Path,
     line: Option<u32>,
 ) -> Result<Joint> {
-    let limit = &joint.limit;
+    let (lower, upper) = joint.limit.unwrap_or((0.0, 0.0));
     let limits_ok = || {
-        if limit.lower > limit.upper {
+        if lower > upper {
             Err(SimError::invalid(
                 path,
                 line,
                 format!(
                     "<joint name=\"{}\"> <limit lower=\"{}\" upper=\"{}\">: expected lower <= upper",
-                    joint.name, limit.lower, limit.upper
+                    joint.name, lower, upper
                 ),
             ))
         } else {
@@ -699,24 +781,24 @@ fn convert_joint(
         }
     };
     let kind = match joint.joint_type {
-        urdf_rs::JointType::Fixed => JointKind::Fixed,
-        urdf_rs::JointType::Continuous => JointKind::Continuous,
-        urdf_rs::JointType::Revolute => {
+        crate::urdf::JointType::Fixed => JointKind::Fixed,
+        crate::urdf::JointType::Continuous => JointKind::Continuous,
+        crate::urdf::JointType::Revolute => {
             limits_ok()?;
             JointKind::Revolute {
-                lower_rad: limit.lower as f32,
-                upper_rad: limit.upper as f32,
+                lower_rad: lower as f32,
+                upper_rad: upper as f32,
             }
         }
-        urdf_rs::JointType::Prismatic => {
+        crate::urdf::JointType::Prismatic => {
             limits_ok()?;
             JointKind::Prismatic {
-                lower_m: limit.lower as f32,
-                upper_m: limit.upper as f32,
+                lower_m: lower as f32,
+                upper_m: upper as f32,
             }
         }
-        urdf_rs::JointType::Floating => JointKind::Floating,
-        urdf_rs::JointType::Planar | urdf_rs::JointType::Spherical => {
+        crate::urdf::JointType::Floating => JointKind::Floating,
+        crate::urdf::JointType::Planar | crate::urdf::JointType::Spherical => {
             return Err(SimError::invalid(
                 path,
                 line,
@@ -727,7 +809,7 @@ fn convert_joint(
             ));
         }
     };
-    let axis = vec3(joint.axis.xyz.0);
+    let axis = vec3(joint.axis);
     let needs_axis = !matches!(kind, JointKind::Fixed | JointKind::Floating);
     if needs_axis && axis.length() < 1e-6 {
         return Err(SimError::invalid(
@@ -744,8 +826,8 @@ fn convert_joint(
         kind,
         parent,
         child,
-        parent_from_child: pose_from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0),
+        parent_from_child: pose_from_xyz_rpy(joint.origin.xyz, joint.origin.rpy),
         axis: axis.normalize_or(Vec3::X),
-        damping: joint.dynamics.as_ref().map_or(0.0, |d| d.damping as f32),
+        damping: joint.damping.map_or(0.0, |d| d as f32),
     })
 }

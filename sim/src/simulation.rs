@@ -55,6 +55,8 @@ struct WheelJoint {
     child: RigidBodyHandle,
     /// Joint axis in the child body's frame.
     axis_child: Vec3,
+    /// [`LEFT`] or [`RIGHT`]: which commanded wheel speed drives it.
+    side: usize,
 }
 
 /// A running simulation.
@@ -65,7 +67,9 @@ pub struct Simulation {
     link_body: Vec<RigidBodyHandle>,
     body_from_link: Vec<Pose>,
     base: RigidBodyHandle,
-    wheels: [WheelJoint; 2],
+    /// Driven wheel joints: the left and right ones first (their speeds are the measured
+    /// wheel speeds), then a skid steer's rear wheels. Empty when the robot cannot be driven.
+    wheels: Vec<WheelJoint>,
     drive: DiffDriveController,
     encoder: EncoderOdometry,
     step_index: u64,
@@ -90,12 +94,15 @@ impl std::fmt::Debug for Simulation {
 impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
-        let mut drive_config = robot.diff_drive.clone().ok_or_else(|| {
-            SimError::Setup(format!(
-                "{}: the robot has no <gazebo><plugin filename=\"libgazebo_ros_diff_drive.so\">; rover needs it to drive the robot",
-                robot.source.display()
-            ))
-        })?;
+        let drivable = robot.diff_drive.is_some();
+        if !drivable {
+            tracing::warn!(
+                "{}: robot \"{}\" cannot be driven: it has no libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin and the world gives no [robot.drive]; it is simulated and shown, commands are ignored",
+                robot.source.display(),
+                robot.name
+            );
+        }
+        let mut drive_config = robot.diff_drive.clone().unwrap_or_default();
         if let Some(timeout) = options.cmd_timeout_s {
             if !(timeout.is_finite() && timeout >= 0.0) {
                 return Err(SimError::Setup(format!(
@@ -131,7 +138,7 @@ impl Simulation {
             physics.integration_parameters.num_solver_iterations = STIFF_SOLVER_ITERATIONS;
         }
 
-        let wheel = |name: &str| -> Result<WheelJoint> {
+        let wheel = |name: &str, side: usize| -> Result<WheelJoint> {
             let index = robot.joint_index(name).ok_or_else(|| {
                 SimError::Setup(format!(
                     "diff drive joint \"{name}\" missing from the robot"
@@ -147,12 +154,20 @@ impl Simulation {
                 parent: robot_bodies.link_body[joint.parent],
                 child: robot_bodies.link_body[joint.child],
                 axis_child: child_from_link.rotation * joint.axis,
+                side,
             })
         };
-        let wheels = [
-            wheel(&drive_config.left_joint)?,
-            wheel(&drive_config.right_joint)?,
-        ];
+        let mut wheels = Vec::new();
+        if drivable {
+            wheels.push(wheel(&drive_config.left_joint, LEFT)?);
+            wheels.push(wheel(&drive_config.right_joint, RIGHT)?);
+            for name in &drive_config.extra_left_joints {
+                wheels.push(wheel(name, LEFT)?);
+            }
+            for name in &drive_config.extra_right_joints {
+                wheels.push(wheel(name, RIGHT)?);
+            }
+        }
         for w in &wheels {
             if let Some(j) = physics.impulse_joints.get_mut(w.joint, true) {
                 j.data
@@ -202,7 +217,8 @@ impl Simulation {
         let now = self.sim_time_s();
         let sample = if self.drive.update(now) {
             let targets = self.drive.wheel_targets_radps();
-            for (wheel, target) in self.wheels.iter().zip(targets) {
+            for wheel in &self.wheels {
+                let target = targets[wheel.side];
                 if let Some(j) = self.physics.impulse_joints.get_mut(wheel.joint, true) {
                     j.data
                         .set_motor_velocity(JointAxis::AngX, target as f32, WHEEL_MOTOR_GAIN);
@@ -347,7 +363,8 @@ impl Simulation {
     /// its parent, about the joint axis.
     pub fn wheel_speeds_radps(&self) -> WheelSpeeds {
         let mut out = [0.0; 2];
-        for (slot, w) in [LEFT, RIGHT].into_iter().zip(&self.wheels) {
+        for w in self.wheels.iter().take(2) {
+            let slot = w.side;
             let (Some(parent), Some(child)) = (
                 self.physics.bodies.get(w.parent),
                 self.physics.bodies.get(w.child),

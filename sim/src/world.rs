@@ -45,6 +45,28 @@ pub struct RobotSpawn {
     pub yaw_rad: f64,
     /// `xacro_args`: `$(arg NAME)` values when the robot is a xacro file.
     pub xacro_args: std::collections::BTreeMap<String, String>,
+    /// `[robot.drive]`: how to drive a robot whose URDF names no drive plugin.
+    pub drive: Option<DriveSpec>,
+}
+
+/// Wheels to drive like gazebo_ros_diff_drive, for a robot whose URDF has no drive plugin
+/// (`[robot.drive]`, or `--drive LEFT,RIGHT`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSpec {
+    /// The left wheel's joint.
+    pub left_joint: String,
+    /// The right wheel's joint.
+    pub right_joint: String,
+    /// Distance between the wheels (m); default: between the two joints' origins.
+    #[serde(default)]
+    pub wheel_separation_m: Option<f64>,
+    /// Wheel diameter (m); default: from the left wheel's collision cylinder or sphere.
+    #[serde(default)]
+    pub wheel_diameter_m: Option<f64>,
+    /// Motor torque limit (N m); default gazebo_ros_diff_drive's 5.
+    #[serde(default)]
+    pub wheel_torque_nm: Option<f64>,
 }
 
 /// Physics settings (`[physics]`).
@@ -282,6 +304,8 @@ struct RawRobot {
     yaw_deg: f64,
     #[serde(default)]
     xacro_args: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    drive: Option<DriveSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -525,6 +549,7 @@ impl RawWorld {
             position_m: self.robot.position_m,
             yaw_rad: self.robot.yaw_deg.to_radians(),
             xacro_args: self.robot.xacro_args,
+            drive: self.robot.drive,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

@@ -140,3 +140,155 @@ fn turtlebot3_autorace_camera_has_gazebos_intrinsics() -> Result<()> {
     assert_eq!((info.width, info.height), (320, 240));
     Ok(())
 }
+
+/// pybullet's robots (PyPI `pybullet`, its `pybullet_data/`): files ROS's parser accepts load.
+#[test]
+fn pybullet_r2d2_husky_and_racecar_load_and_simulate() -> Result<()> {
+    let Some(wheel) = rover_tests::pypi("pybullet", "3.2.7") else {
+        return Ok(());
+    };
+    let data = wheel.join("pybullet_data");
+    // r2d2: no drive plugin; it loads, is simulated, and commands are ignored.
+    let r2d2 = RobotModel::load_with(&data.join("r2d2.urdf"), &LoadOptions::default())?;
+    assert!(r2d2.diff_drive.is_none());
+    let mut sim = flat_sim(r2d2)?;
+    drive(&mut sim, Twist::new(0.5, 0.0), 1.0)?;
+    let g = sim.ground_truth();
+    assert!(
+        g.x_m.hypot(g.y_m) < 0.1,
+        "an undrivable r2d2 moved to {g:?}"
+    );
+    // husky: `$(optenv HUSKY_IMU_XYZ 0.19 0 0.149)` in a plain .urdf is expanded like xacro
+    // would (the defaults, as the variables are unset here).
+    let husky = RobotModel::load_with(&data.join("husky/husky.urdf"), &LoadOptions::default())?;
+    let imu = husky
+        .joint_index("imu_joint")
+        .ok_or_else(|| anyhow::anyhow!("husky has no imu_joint"))?;
+    let t = husky.joints[imu].parent_from_child.translation;
+    assert!(
+        (t - glam::Vec3::new(0.19, 0.0, 0.149)).length() < 1e-6,
+        "imu at {t}"
+    );
+    assert!(!husky.description.contains("$("));
+    // racecar: <material> inside <geometry>, which urdfdom ignores.
+    let racecar =
+        RobotModel::load_with(&data.join("racecar/racecar.urdf"), &LoadOptions::default())?;
+    assert!(racecar.links.len() > 10, "{} links", racecar.links.len());
+    flat_sim(racecar)?;
+    Ok(())
+}
+
+/// PAL's TIAGo from PyPI `example-robot-data` (`package://example-robot-data/...`, STL and
+/// COLLADA meshes, 78 links) loads and drives with a `[robot.drive]` naming its wheel joints.
+#[test]
+fn tiago_loads_and_drives_with_robot_drive() -> Result<()> {
+    let Some(wheel) = rover_tests::pypi("example-robot-data", "6.0.0") else {
+        return Ok(());
+    };
+    let urdf = wheel
+        .join("cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago.urdf");
+    let robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+    assert_eq!(robot.links.len(), 78);
+    let meshes: Vec<&std::path::Path> = robot
+        .links
+        .iter()
+        .flat_map(|l| {
+            l.visuals
+                .iter()
+                .map(|v| &v.shape)
+                .chain(l.collisions.iter().map(|c| &c.shape))
+        })
+        .filter_map(|shape| match shape {
+            Shape::Mesh { path, .. } => Some(path.as_path()),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        meshes
+            .iter()
+            .any(|p| p.extension().is_some_and(|e| e == "dae"))
+    );
+    for path in &meshes {
+        load_mesh(path, glam::Vec3::ONE)?;
+    }
+
+    let tmp = tempfile::tempdir()?;
+    let world = tmp.path().join("world.toml");
+    std::fs::write(
+        &world,
+        "name = \"tiago\"\n[robot.drive]\nleft_joint = \"wheel_left_joint\"\nright_joint = \"wheel_right_joint\"\n",
+    )?;
+    let script = tmp.path().join("drive.toml");
+    std::fs::write(&script, "steps = [ { at = 0.5, cmd_vel = [0.3, 0.0] } ]\n")?;
+    let summary = rover_core::headless::run(&rover_core::RunConfig {
+        world: Some(world),
+        robot: Some(urdf),
+        script: Some(script),
+        duration_s: Some(4.0),
+        ..rover_core::RunConfig::default()
+    })?;
+    let g = summary
+        .last
+        .ok_or_else(|| anyhow::anyhow!("no control samples"))?
+        .ground_truth;
+    println!("tiago after 3.5 s at 0.3 m/s: {g:?}");
+    assert!(
+        g.x_m > 0.7,
+        "tiago reached x = {} m; expected about 1 m",
+        g.x_m
+    );
+    Ok(())
+}
+
+/// A four-wheeled robot with gazebo_ros_skid_steer_drive: all four wheels driven, it goes
+/// straight and turns in place.
+#[test]
+fn skid_steer_plugin_drives_four_wheels() -> Result<()> {
+    let wheel = |name: &str, x: f64, y: f64| {
+        format!(
+            r#"<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  <collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.1" length="0.05"/></geometry></collision></link>
+<joint name="{name}_joint" type="continuous"><parent link="base_link"/><child link="{name}"/><origin xyz="{x} {y} 0"/><axis xyz="0 1 0"/></joint>"#
+        )
+    };
+    let urdf = format!(
+        r#"<robot name="skid"><link name="base_link"><inertial><mass value="10"/><inertia ixx="0.2" ixy="0" ixz="0" iyy="0.3" iyz="0" izz="0.4"/></inertial>
+  <collision><origin xyz="0 0 0.1"/><geometry><box size="0.6 0.4 0.15"/></geometry></collision></link>
+{}{}{}{}
+<gazebo><plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so">
+  <leftFrontJoint>front_left_joint</leftFrontJoint><rightFrontJoint>front_right_joint</rightFrontJoint>
+  <leftRearJoint>rear_left_joint</leftRearJoint><rightRearJoint>rear_right_joint</rightRearJoint>
+  <wheelSeparation>0.5</wheelSeparation><wheelDiameter>0.2</wheelDiameter><torque>20</torque>
+</plugin></gazebo></robot>"#,
+        wheel("front_left", 0.2, 0.25),
+        wheel("front_right", 0.2, -0.25),
+        wheel("rear_left", -0.2, 0.25),
+        wheel("rear_right", -0.2, -0.25)
+    );
+    let robot = RobotModel::from_str(&urdf, std::path::Path::new("skid.urdf"))?;
+    let dd = robot
+        .diff_drive
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("skid steer plugin not read"))?;
+    assert_eq!(dd.extra_left_joints, ["rear_left_joint"]);
+    assert_eq!(dd.extra_right_joints, ["rear_right_joint"]);
+    let mut sim = flat_sim(robot.clone())?;
+    let samples = drive(&mut sim, Twist::new(0.5, 0.0), 2.0)?;
+    drive(&mut sim, Twist::ZERO, 1.0)?;
+    let g = sim.ground_truth();
+    assert!(
+        (g.x_m - 1.0).abs() < 0.1,
+        "0.5 m/s for 2 s reached x = {} m",
+        g.x_m
+    );
+    assert!(
+        samples
+            .iter()
+            .all(|s| s.wheel_targets_radps[0] <= 5.0 + 1e-9)
+    );
+    let mut sim = flat_sim(robot)?;
+    drive(&mut sim, Twist::new(0.0, 1.0), 1.0)?;
+    let yaw = sim.ground_truth().yaw_rad;
+    assert!(yaw > 0.3, "turning in place reached yaw {yaw} rad");
+    Ok(())
+}

@@ -84,6 +84,12 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "X,Y[,YAW_DEG]", value_parser = parse_spawn)]
     pub(crate) spawn: Option<[f64; 3]>,
 
+    /// Drive the wheel joints LEFT and RIGHT like gazebo_ros_diff_drive, for a robot whose URDF
+    /// names no drive plugin (separation and diameter from the URDF); overrides the world's
+    /// [robot.drive]
+    #[arg(long, value_name = "LEFT_JOINT,RIGHT_JOINT", value_parser = parse_drive)]
+    pub(crate) drive: Option<rover_sim::DriveSpec>,
+
     /// A folder of Gazebo models, for model://NAME in SDF worlds (repeatable; searched before
     /// GAZEBO_MODEL_PATH)
     #[arg(long = "model-path", value_name = "DIR")]
@@ -471,6 +477,20 @@ fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
     Ok((name.to_owned(), value.to_owned()))
 }
 
+/// `LEFT_JOINT,RIGHT_JOINT`.
+fn parse_drive(s: &str) -> Result<rover_sim::DriveSpec, String> {
+    match s.split(',').map(str::trim).collect::<Vec<_>>().as_slice() {
+        [left, right] if !left.is_empty() && !right.is_empty() => Ok(rover_sim::DriveSpec {
+            left_joint: (*left).to_owned(),
+            right_joint: (*right).to_owned(),
+            wheel_separation_m: None,
+            wheel_diameter_m: None,
+            wheel_torque_nm: None,
+        }),
+        _ => Err(format!("expected LEFT_JOINT,RIGHT_JOINT, found \"{s}\"")),
+    }
+}
+
 /// `X,Y` or `X,Y,YAW_DEG`.
 fn parse_spawn(s: &str) -> Result<[f64; 3], String> {
     let values: Vec<f64> = s
@@ -522,6 +542,7 @@ impl WorldArgs {
             robot: self.robot.clone(),
             robot_options: self.robot_options(),
             spawn: self.spawn,
+            drive: self.drive.clone(),
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,
