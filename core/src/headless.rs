@@ -28,6 +28,8 @@ pub struct RunConfig {
     pub spawn: Option<[f64; 3]>,
     /// Wheels to drive (overrides the world's `[robot.drive]`).
     pub drive: Option<rover_sim::DriveSpec>,
+    /// Which camera to render when the robot has several (default: the first in the file).
+    pub camera: Option<String>,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -123,6 +125,16 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
     let mut robot = RobotModel::load_with(&robot_path, &robot_load_options(config, &world))?;
     if let Some(spec) = config.drive.as_ref().or(world.robot.drive.as_ref()) {
         robot.set_drive(spec)?;
+    }
+    if let Some(name) = &config.camera {
+        robot.select_camera(name)?;
+    } else if robot.cameras.len() > 1 {
+        tracing::info!(
+            "{}: {} cameras; rendering \"{}\" (choose with --camera NAME)",
+            robot.name,
+            robot.cameras.len(),
+            robot.cameras[0].name
+        );
     }
     Ok((world, robot))
 }

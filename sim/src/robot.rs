@@ -429,6 +429,25 @@ impl RobotModel {
         self.validate_plugins(&self.source.clone())
     }
 
+    /// Makes the camera sensor called `name` (its `<sensor name>` or plugin `cameraName`) the
+    /// one rover renders (the first); the others stay listed after it.
+    pub fn select_camera(&mut self, name: &str) -> Result<()> {
+        let Some(i) = self
+            .cameras
+            .iter()
+            .position(|c| c.name == name || c.camera_name == name)
+        else {
+            return Err(SimError::Setup(format!(
+                "robot \"{}\" has no camera \"{name}\"; its cameras: {}",
+                self.name,
+                names(self.cameras.iter().map(|c| &c.name))
+            )));
+        };
+        let chosen = self.cameras.remove(i);
+        self.cameras.insert(0, chosen);
+        Ok(())
+    }
+
     /// Index of the link called `name`.
     pub fn link_index(&self, name: &str) -> Option<usize> {
         self.links.iter().position(|l| l.name == name)

@@ -138,6 +138,19 @@ fn turtlebot3_autorace_camera_has_gazebos_intrinsics() -> Result<()> {
     assert!((info.k[0] - f).abs() < 1e-9 && (info.k[4] - f).abs() < 1e-9);
     assert_eq!((info.k[2], info.k[5]), (160.5, 120.5));
     assert_eq!((info.width, info.height), (320, 240));
+
+    // --camera NAME picks by sensor name or cameraName; an unknown name lists the cameras.
+    let mut robot = robot.clone();
+    robot.select_camera("camera")?;
+    let err = robot
+        .select_camera("front")
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("no camera \"front\"; its cameras: \"Pi Camera\""),
+        "{err}"
+    );
     Ok(())
 }
 

@@ -90,6 +90,11 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "LEFT_JOINT,RIGHT_JOINT", value_parser = parse_drive)]
     pub(crate) drive: Option<rover_sim::DriveSpec>,
 
+    /// The camera to render when the robot has several: its <sensor name> or cameraName
+    /// [default: the first in the file]
+    #[arg(long, value_name = "NAME")]
+    pub(crate) camera: Option<String>,
+
     /// A folder of Gazebo models, for model://NAME in SDF worlds (repeatable; searched before
     /// GAZEBO_MODEL_PATH)
     #[arg(long = "model-path", value_name = "DIR")]
@@ -543,6 +548,7 @@ impl WorldArgs {
             robot_options: self.robot_options(),
             spawn: self.spawn,
             drive: self.drive.clone(),
+            camera: self.camera.clone(),
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,
