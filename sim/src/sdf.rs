@@ -13,10 +13,10 @@ use glam::Vec3;
 use roxmltree::Node;
 
 use crate::error::{Result, SimError, parse_xml};
-use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy};
+use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of};
 use crate::resource::ResourcePaths;
 use crate::robot::{Collision, Visual};
-use crate::world::{DEFAULT_STEP_HZ, STEP_HZ_RANGE, World};
+use crate::world::{DEFAULT_STEP_HZ, Person, STEP_HZ_RANGE, Walk, World};
 
 /// Deepest `<include>` nesting followed (models including models).
 const MAX_INCLUDE_DEPTH: usize = 16;
@@ -131,7 +131,23 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     for node in world_el.children().filter(Node::is_element) {
         match node.tag_name().name() {
             "model" => loader.model(&ctx, node, Pose::IDENTITY, None, &mut models, 0)?,
+            "include" if person_model(node).is_some() => {
+                let model = person_model(node).unwrap_or_default();
+                let name = child(node, "name")
+                    .and_then(|n| n.text())
+                    .map(|s| s.trim().to_owned())
+                    .unwrap_or_else(|| format!("{model}_{}", world.people.len()));
+                let pose = child(node, "pose").map(|p| ctx.pose(p)).transpose()?;
+                let pose = pose.unwrap_or(Pose::IDENTITY);
+                let t = pose.translation;
+                world.people.push(Person::standing(
+                    name,
+                    [f64::from(t.x), f64::from(t.y)],
+                    yaw_of(pose.rotation),
+                ));
+            }
             "include" => loader.include(&ctx, node, Pose::IDENTITY, &mut models, 0)?,
+            "actor" => world.people.push(actor(&ctx, node)?),
             "physics" | "gravity" | "state" => {}
             other => {
                 loader.skipped.insert(format!("<{other}>"));
@@ -545,6 +561,66 @@ impl Loader<'_> {
         };
         self.model(&inner, model, placed, Some(overrides), out, depth)
     }
+}
+
+/// `person_standing` or `person_walking` when an `<include>` brings in one of Gazebo's people
+/// (they become rover people: the figure the detector is tested on, not the mesh).
+fn person_model(include: Node<'_, '_>) -> Option<String> {
+    let uri = child(include, "uri")?.text()?.trim();
+    let name = uri.strip_prefix("model://")?.trim_end_matches('/');
+    matches!(name, "person_standing" | "person_walking").then(|| name.to_owned())
+}
+
+/// An `<actor>`: a rover person at the actor's pose, walking its `<script><trajectory>`
+/// waypoints (at the speed that covers them in the trajectory's time) when it has one.
+fn actor(ctx: &Ctx<'_, '_>, node: Node<'_, '_>) -> Result<Person> {
+    let name = node.attribute("name").unwrap_or("actor").to_owned();
+    let pose = ctx.local_pose(node)?;
+    let mut person = Person::standing(
+        name,
+        [f64::from(pose.translation.x), f64::from(pose.translation.y)],
+        yaw_of(pose.rotation),
+    );
+    let Some(trajectory) = child(node, "script").and_then(|s| child(s, "trajectory")) else {
+        return Ok(person);
+    };
+    let mut points: Vec<(f64, [f64; 2])> = Vec::new();
+    for w in trajectory.children().filter(|n| n.has_tag_name("waypoint")) {
+        let time = child(w, "time")
+            .ok_or_else(|| ctx.err(w, "<waypoint> needs a <time>"))
+            .and_then(|t| ctx.number(t))?;
+        let p = child(w, "pose")
+            .ok_or_else(|| ctx.err(w, "<waypoint> needs a <pose>"))
+            .and_then(|p| ctx.pose(p))?;
+        points.push((
+            time,
+            [f64::from(p.translation.x), f64::from(p.translation.y)],
+        ));
+    }
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return Ok(person);
+    };
+    let duration = last.0 - first.0;
+    let length: f64 = points
+        .windows(2)
+        .map(|w| (w[1].1[0] - w[0].1[0]).hypot(w[1].1[1] - w[0].1[1]))
+        .sum();
+    if duration <= 0.0 || length <= 1e-6 {
+        return Ok(person);
+    }
+    let speed = (length / duration).clamp(0.05, 3.0);
+    person.position_m = first.1;
+    let mut waypoints: Vec<[f64; 2]> = points[1..].iter().map(|p| p.1).collect();
+    // rover's walks close the loop themselves.
+    if waypoints.last() == Some(&first.1) {
+        waypoints.pop();
+    }
+    person.walk = (!waypoints.is_empty()).then_some(Walk {
+        waypoints_m: waypoints,
+        speed_mps: speed,
+    });
+    Ok(person)
 }
 
 /// The SDF file of a model folder: the newest `<sdf>` model.config names, else model.sdf.

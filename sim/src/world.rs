@@ -192,6 +192,22 @@ impl Object {
 }
 
 impl Person {
+    /// A 1.75 m person in rover's default clothes, standing at `position_m` facing
+    /// `heading_rad`.
+    pub fn standing(name: impl Into<String>, position_m: [f64; 2], heading_rad: f64) -> Self {
+        Self {
+            name: name.into(),
+            position_m,
+            heading_rad,
+            height_m: default_person_height(),
+            shirt_color: Rgba::rgb(0.75, 0.15, 0.12),
+            trousers_color: Rgba::rgb(0.15, 0.2, 0.35),
+            skin_color: Rgba::rgb(0.87, 0.67, 0.53),
+            hair_color: Rgba::rgb(0.2, 0.13, 0.08),
+            walk: None,
+        }
+    }
+
     /// The person's pose at sim time `t_s`: feet on the ground, x facing where they look.
     pub fn world_from_person(&self, t_s: f64) -> Pose {
         let (x, y, heading) = self.pose_at(t_s);

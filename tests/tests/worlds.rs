@@ -110,3 +110,99 @@ fn the_tutorial_car_drives_in_the_turtlebot_playground() -> Result<()> {
     );
     Ok(())
 }
+
+const PEOPLE_WORLD: &str = r#"<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="people">
+    <physics type="ode"><max_step_size>0.005</max_step_size></physics>
+    <include>
+      <uri>model://person_standing</uri>
+      <name>alice</name>
+      <pose>4 0 0 0 0 3.14159</pose>
+    </include>
+    <actor name="walker">
+      <pose>0 5 0 0 0 0</pose>
+      <script>
+        <loop>true</loop>
+        <trajectory id="0" type="walking">
+          <waypoint><time>0</time><pose>0 5 0 0 0 0</pose></waypoint>
+          <waypoint><time>5</time><pose>5 5 0 0 0 0</pose></waypoint>
+          <waypoint><time>10</time><pose>0 5 0 0 0 3.14</pose></waypoint>
+        </trajectory>
+      </script>
+    </actor>
+    <model name="crate">
+      <static>true</static>
+      <pose>2 3 0.3 0 0 0</pose>
+      <link name="link">
+        <visual name="v"><geometry><box><size>0.6 0.6 0.6</size></box></geometry>
+          <material><diffuse>0.6 0.3 0.1 1</diffuse></material></visual>
+        <collision name="c"><geometry><box><size>0.6 0.6 0.6</size></box></geometry></collision>
+      </link>
+    </model>
+  </world>
+</sdf>
+"#;
+
+#[test]
+fn gazebo_people_and_actors_become_rover_people() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("people.world");
+    std::fs::write(&path, PEOPLE_WORLD)?;
+    let world = World::load_with(&path, &ResourcePaths::default())?;
+    assert_eq!(world.physics.step_hz, 200.0);
+    assert_eq!(world.people.len(), 2);
+    let alice = &world.people[0];
+    assert_eq!(alice.name, "alice");
+    assert_eq!(alice.position_m, [4.0, 0.0]);
+    assert!((alice.heading_rad - 3.14159).abs() < 1e-5);
+    let walker = &world.people[1];
+    let walk = walker
+        .walk
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("the actor does not walk"))?;
+    assert_eq!(walker.position_m, [0.0, 5.0]);
+    assert_eq!(walk.waypoints_m, [[5.0, 5.0]]);
+    assert!(
+        (walk.speed_mps - 1.0).abs() < 1e-9,
+        "speed {}",
+        walk.speed_mps
+    );
+    let crate_color = world.models[0].links[0].visuals[0].color;
+    assert_eq!(crate_color, rover_sim::Rgba([0.6, 0.3, 0.1, 1.0]));
+    Ok(())
+}
+
+/// The follower end to end in a Gazebo world: real renderer, real detector in lockstep, the
+/// tutorial car following the person_standing 4 m ahead to its standoff.
+#[test]
+fn follows_a_gazebo_person_in_an_sdf_world() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("people.world");
+    std::fs::write(&path, PEOPLE_WORLD)?;
+    let script = dir.path().join("follow.toml");
+    std::fs::write(&script, "steps = [ { at = 0.5, toggle = \"follow\" } ]\n")?;
+    let trace = dir.path().join("trace.csv");
+    let config = rover_core::RunConfig {
+        world: Some(path),
+        script: Some(script),
+        duration_s: Some(20.0),
+        trace: Some(trace.clone()),
+        ..rover_core::RunConfig::default()
+    };
+    let standoff_m = config.follower.standoff_m;
+    rover_core::headless::run(&config)?;
+    let rows = rover_core::parse_trace(&std::fs::read_to_string(trace)?)?;
+    let last = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
+    let range = (4.0 - last.x_m).hypot(last.y_m);
+    println!(
+        "after 20 s: at ({:.2}, {:.2}), range {range:.2} m",
+        last.x_m, last.y_m
+    );
+    assert_eq!(last.mode, "follow");
+    assert!(
+        (range - standoff_m).abs() <= 0.3,
+        "range {range:.2} m; expected {standoff_m} m within 0.3"
+    );
+    Ok(())
+}
