@@ -305,3 +305,48 @@ fn skid_steer_plugin_drives_four_wheels() -> Result<()> {
     assert!(yaw > 0.3, "turning in place reached yaw {yaw} rad");
     Ok(())
 }
+
+/// Renders `robot` at rest, seen from a camera 1.2 m in front of it looking back (the tutorial
+/// car's 640x480 camera), and counts the pixels that differ from the same view without it.
+/// With `ROVER_SAVE_VIEWS=DIR` the image is also written there (how docs/ got its pictures).
+fn robot_in_view(robot: RobotModel, file: &str) -> Result<usize> {
+    let camera = rover_tests::my_robot()?.cameras[0].clone();
+    let world = rover_sim::World::flat()?;
+    let mut sim = flat_sim(robot.clone())?;
+    drive(&mut sim, Twist::ZERO, 0.5)?;
+    let mut poses = Vec::new();
+    sim.link_poses_into(&mut poses);
+    let view = rover_sim::pose_from_position_yaw([1.2, 0.3, 0.5], PI + 0.25)
+        * rover_sim::Pose::from_rotation(glam::Quat::from_rotation_y(0.3));
+    let mut renderer = rover_sim::CameraRenderer::new(&world, &robot, &camera, 0)?;
+    let with = renderer.render(&poses, view)?.to_vec();
+    let parked = vec![rover_sim::Pose::from_translation(glam::Vec3::NEG_Z * 100.0); poses.len()];
+    let without = renderer.render(&parked, view)?.to_vec();
+    if let Some(dir) = std::env::var_os("ROVER_SAVE_VIEWS") {
+        let img = image::RgbImage::from_raw(camera.width_px, camera.height_px, with.clone())
+            .ok_or_else(|| anyhow::anyhow!("bad image size"))?;
+        img.save(std::path::Path::new(&dir).join(file))?;
+    }
+    Ok(with
+        .chunks_exact(3)
+        .zip(without.chunks_exact(3))
+        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 30))
+        .count())
+}
+
+#[test]
+fn turtlebot3_and_tiago_render_with_their_meshes() -> Result<()> {
+    if let Some(robot) = turtlebot3("turtlebot3_burger.urdf.xacro")? {
+        let pixels = robot_in_view(robot, "turtlebot3-burger.png")?;
+        assert!(pixels > 2_000, "the burger covers only {pixels} px");
+    }
+    if let Some(wheel) = rover_tests::pypi("example-robot-data", "6.0.0") {
+        let urdf = wheel.join(
+            "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago.urdf",
+        );
+        let robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+        let pixels = robot_in_view(robot, "tiago.png")?;
+        assert!(pixels > 20_000, "TIAGo covers only {pixels} px");
+    }
+    Ok(())
+}
