@@ -54,6 +54,20 @@ pub struct Visual {
     pub shape: Shape,
     /// Colour from the URDF material (grey when none is given).
     pub color: Rgba,
+    /// Whether the description gave the colour; when not, a mesh file's own material colour
+    /// is shown (see [`Visual::display_color`]).
+    pub color_given: bool,
+}
+
+impl Visual {
+    /// The colour to draw `mesh` (this visual's triangles) in: the description's colour, else
+    /// the mesh file's material, else grey.
+    pub fn display_color(&self, mesh: &crate::render::meshes::MeshData) -> Rgba {
+        match (self.color_given, mesh.color) {
+            (false, Some(c)) => c,
+            _ => self.color,
+        }
+    }
 }
 
 /// A collision shape of a link.
@@ -699,19 +713,16 @@ fn convert_link(
         });
     let mut visuals = Vec::with_capacity(link.visual.len());
     for v in &link.visual {
-        let color = v
-            .material
-            .as_ref()
-            .and_then(|m| {
-                m.color
-                    .map(rgba)
-                    .or_else(|| materials.get(m.name.as_str()).copied())
-            })
-            .unwrap_or(Rgba::rgb(0.7, 0.7, 0.7));
+        let color = v.material.as_ref().and_then(|m| {
+            m.color
+                .map(rgba)
+                .or_else(|| materials.get(m.name.as_str()).copied())
+        });
         visuals.push(Visual {
             link_from_shape: pose_from_xyz_rpy(v.origin.xyz, v.origin.rpy),
             shape: geometry(&v.geometry)?,
-            color,
+            color: color.unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)),
+            color_given: color.is_some(),
         });
     }
     let mut collisions = Vec::with_capacity(link.collision.len());

@@ -381,10 +381,12 @@ impl Loader<'_> {
                     let Some(shape) = self.geometry(ctx, item, base)? else {
                         continue;
                     };
+                    let color = material_color(ctx, item)?;
                     link.visuals.push(Visual {
                         link_from_shape: ctx.local_pose(item)?,
                         shape,
-                        color: material_color(ctx, item)?,
+                        color: color.unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)),
+                        color_given: color.is_some(),
                     });
                 }
                 "collision" => {
@@ -657,10 +659,10 @@ fn model_file(dir: &Path) -> std::result::Result<PathBuf, String> {
 }
 
 /// A visual's colour: `<material><diffuse>` (else `<ambient>`), else a known Gazebo material
-/// script name, else grey.
-fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Rgba> {
+/// script name; `None` when the file says nothing rover can use.
+fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Option<Rgba>> {
     let Some(material) = child(visual, "material") else {
-        return Ok(Rgba::rgb(0.7, 0.7, 0.7));
+        return Ok(None);
     };
     for tag in ["diffuse", "ambient"] {
         if let Some(c) = child(material, tag) {
@@ -670,8 +672,8 @@ fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Rgba> {
                 .filter_map(|t| t.parse::<f32>().ok())
                 .collect();
             return match values.as_slice() {
-                [r, g, b] => Ok(Rgba::rgb(*r, *g, *b)),
-                [r, g, b, a] => Ok(Rgba([*r, *g, *b, *a].map(|v| v.clamp(0.0, 1.0)))),
+                [r, g, b] => Ok(Some(Rgba::rgb(*r, *g, *b))),
+                [r, g, b, a] => Ok(Some(Rgba([*r, *g, *b, *a].map(|v| v.clamp(0.0, 1.0))))),
                 _ => Err(ctx.err(
                     c,
                     format!("<{tag}>{}</{tag}>: expected 3 or 4 numbers", text.trim()),
@@ -684,7 +686,7 @@ fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Rgba> {
         .and_then(|n| n.text())
         .unwrap_or("")
         .trim();
-    Ok(gazebo_material(script).unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)))
+    Ok(gazebo_material(script))
 }
 
 /// Colours of the common `Gazebo/*` material scripts (gazebo.material).

@@ -78,6 +78,15 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
         (size.x - 4.06).abs() < 0.2 && (size.z - 1.14).abs() < 0.2,
         "barrier {size}"
     );
+    // The dumpster's COLLADA material colour is what it is drawn in (its <visual> names only a
+    // material script rover cannot read).
+    let dumpster_visual = &dumpster.visuals[0];
+    assert!(!dumpster_visual.color_given);
+    let m = rover_sim::shape_mesh(&dumpster_visual.shape)?;
+    let c = m
+        .color
+        .ok_or_else(|| anyhow::anyhow!("dumpster.dae gave no material colour"))?;
+    assert_eq!(dumpster_visual.display_color(&m), c);
     Ok(())
 }
 

@@ -69,7 +69,7 @@ pub(super) fn log_scene(
             let vpath = format!("{path}/visual_{v}");
             if let Ok(m) = shape_mesh(&visual.shape) {
                 log(&vpath, &transform(visual.link_from_shape));
-                log(&vpath, &mesh(&m, visual.color));
+                log(&vpath, &mesh(&m, visual.display_color(&m)));
             }
         }
         if link.is_dynamic(model) {
@@ -115,7 +115,7 @@ pub(super) fn log_scene(
             let vpath = format!("{path}/visual_{v}");
             if let Ok(m) = shape_mesh(&visual.shape) {
                 log(&vpath, &transform(visual.link_from_shape));
-                log(&vpath, &mesh(&m, visual.color));
+                log(&vpath, &mesh(&m, visual.display_color(&m)));
             }
         }
         paths.links.push(path);

@@ -25,6 +25,8 @@ pub struct MeshData {
     pub vertices: Vec<Vertex>,
     /// Triangle indices, counter-clockwise seen from outside.
     pub indices: Vec<u32>,
+    /// The colour a mesh file's material gives it, if any.
+    pub color: Option<Rgba>,
 }
 
 impl MeshData {
@@ -158,7 +160,10 @@ pub fn shape_mesh(shape: &Shape) -> Result<MeshData> {
         Shape::Capsule { radius_m, length_m } => capsule(*radius_m, *length_m),
         Shape::Mesh { path, scale } => {
             let tri = load_mesh(path, *scale)?;
-            let mut m = MeshData::default();
+            let mut m = MeshData {
+                color: tri.color,
+                ..MeshData::default()
+            };
             // Flat shading: one normal per face.
             for t in &tri.triangles {
                 let [a, b, c] =

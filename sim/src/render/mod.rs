@@ -356,7 +356,7 @@ impl CameraRenderer {
             for visual in &link.visuals {
                 let mesh = shape_mesh(&visual.shape)?;
                 let pose = link.world_from_link * visual.link_from_shape;
-                let index = add(&mesh, instance(pose, visual.color));
+                let index = add(&mesh, instance(pose, visual.display_color(&mesh)));
                 if link.is_dynamic(model) {
                     model_parts_at.push(Attached {
                         instance: index,
@@ -384,7 +384,10 @@ impl CameraRenderer {
         for (link_index, link) in robot.links.iter().enumerate() {
             for visual in &link.visuals {
                 let mesh = shape_mesh(&visual.shape)?;
-                let index = add(&mesh, instance(visual.link_from_shape, visual.color));
+                let index = add(
+                    &mesh,
+                    instance(visual.link_from_shape, visual.display_color(&mesh)),
+                );
                 attached.push(Attached {
                     instance: index,
                     link: link_index,
