@@ -467,6 +467,33 @@ mod tests {
     }
 
     #[test]
+    fn range_from_the_feet_honours_a_pitched_camera() {
+        // A TurtleBot3-like camera: 0.15 m up, looking 0.174 rad down. Feet at 2 m dip
+        // atan(0.15 / 2) below the horizon, so atan(0.15 / 2) - 0.174 below the optical axis.
+        let pitched = CameraGeometry {
+            height_m: 0.15,
+            pitch_down_rad: 0.174,
+            ..camera()
+        };
+        let f = Follower::new(FollowerConfig::default(), pitched);
+        for range in [1.5f64, 2.0, 3.0] {
+            let dip = (0.15 / range).atan() - 0.174;
+            let feet = pitched.cy + pitched.fy * dip.tan();
+            let clipped = BoundingBox {
+                class: "person".into(),
+                probability: 0.8,
+                xmin: 300,
+                ymin: 0,
+                xmax: 340,
+                ymax: feet.round() as i64,
+                id: 0,
+            };
+            let (r, _) = f.range_bearing(&clipped);
+            assert!((r - range).abs() < 0.1 * range, "{r} vs {range}");
+        }
+    }
+
+    #[test]
     fn approaches_a_centred_target_and_stops_at_the_standoff() {
         let mut f = Follower::new(FollowerConfig::default(), camera());
         let odom = Odometry::default();
