@@ -166,3 +166,13 @@ pub fn pypi(name: &str, version: &str) -> Option<PathBuf> {
         }
     }
 }
+
+/// Turns `sim`'s robot at 1 rad/s for pi seconds, lets it settle for 1 s, and returns how far
+/// (degrees) its heading ends from a half turn, with the ground truth at the end.
+pub fn half_turn_error_deg(sim: &mut Simulation) -> anyhow::Result<(f64, rover_sim::Odometry)> {
+    drive(sim, Twist::new(0.0, 1.0), std::f64::consts::PI)?;
+    drive(sim, Twist::ZERO, 1.0)?;
+    let g = sim.ground_truth();
+    let error = rover_sim::wrap_angle(g.yaw_rad - std::f64::consts::PI).abs();
+    Ok((error.to_degrees(), g))
+}

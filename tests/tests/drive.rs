@@ -1,9 +1,6 @@
 //! Physics and diff-drive behaviour of the tutorial car on real rapier physics.
 
-use std::f64::consts::PI;
-
 use anyhow::Result;
-use rover_sim::wrap_angle;
 use rover_sim::{SimOptions, Simulation, Twist, World};
 use rover_tests::{drive, flat_sim, my_robot, my_robot_with_plugin_param};
 
@@ -25,10 +22,7 @@ fn straight_line_half_a_metre_per_second_for_four_seconds() -> Result<()> {
 #[test]
 fn turn_in_place_half_a_turn() -> Result<()> {
     let mut sim = flat_sim(my_robot()?)?;
-    drive(&mut sim, Twist::new(0.0, 1.0), PI)?;
-    drive(&mut sim, Twist::ZERO, 1.0)?;
-    let g = sim.ground_truth();
-    let error_deg = wrap_angle(g.yaw_rad - PI).abs().to_degrees();
+    let (error_deg, g) = rover_tests::half_turn_error_deg(&mut sim)?;
     assert!(
         error_deg < 5.0,
         "yaw {} deg, expected 180 within 5",

@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use anyhow::Result;
-use rover_sim::{JointKind, LoadOptions, RobotModel, Shape, Twist, load_mesh, wrap_angle};
+use rover_sim::{JointKind, LoadOptions, RobotModel, Shape, Twist, load_mesh};
 use rover_tests::{drive, flat_sim, shared};
 
 fn turtlebot3(file: &str) -> Result<Option<RobotModel>> {
@@ -109,10 +109,7 @@ fn turtlebot3_burger_rests_drives_a_metre_and_turns_half_a_turn() -> Result<()> 
 
     let mut sim = flat_sim(robot)?;
     drive(&mut sim, Twist::ZERO, 0.5)?;
-    drive(&mut sim, Twist::new(0.0, 1.0), PI)?;
-    drive(&mut sim, Twist::ZERO, 1.0)?;
-    let g = sim.ground_truth();
-    let error_deg = wrap_angle(g.yaw_rad - PI).abs().to_degrees();
+    let (error_deg, g) = rover_tests::half_turn_error_deg(&mut sim)?;
     assert!(
         error_deg < 5.0,
         "1 rad/s for pi s turned to {} deg; expected 180 within 5",
