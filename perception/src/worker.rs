@@ -250,11 +250,16 @@ mod tests {
             err.contains("crashed") && err.contains("index out of bounds"),
             "{err}"
         );
-        // The thread has stopped: later calls say so instead of waiting forever.
+        // The thread stops: later calls say so instead of waiting forever. (`wait` returns
+        // once the thread has exited, whenever that is; `latest` may still see it exiting.)
         worker.submit(frame(3));
+        match worker.wait() {
+            Err(PerceptionError::WorkerGone(_)) => {}
+            other => panic!("expected WorkerGone, got {other:?}"),
+        }
         match worker.latest() {
             Some(Err(PerceptionError::WorkerGone(_))) => {}
-            other => panic!("expected WorkerGone, got {other:?}"),
+            other => panic!("expected WorkerGone once the thread is gone, got {other:?}"),
         }
         Ok(())
     }
