@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use rover_perception::DetectorConfig;
-use rover_sim::{ControlSample, LoadOptions, RobotModel, SimOptions, World};
+use rover_sim::{ControlSample, LoadOptions, ResourcePaths, RobotModel, SimOptions, World};
 
 use crate::error::{CoreError, Result};
 use crate::follower::FollowerConfig;
@@ -111,8 +111,7 @@ impl RunSummary {
 /// Loads the world and robot a [`RunConfig`] names.
 pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
     let world_path = config.world.clone().unwrap_or_else(paths::default_world);
-    let resources = robot_load_options(config, &World::flat()?).resources;
-    let mut world = World::load_with(&world_path, &resources)?;
+    let mut world = World::load_with(&world_path, &resource_paths(config))?;
     if let Some([x, y, yaw_deg]) = config.spawn {
         world.robot.position_m = [x, y];
         world.robot.yaw_rad = yaw_deg.to_radians();
@@ -139,32 +138,30 @@ pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
     Ok((world, robot))
 }
 
-/// How the robot is read: packages from `ROS_PACKAGE_PATH`, then the config's; xacro arguments
-/// from the world's `[robot]`, then the config's.
+/// Where packages and models are found: the config's folders first, then `ROS_PACKAGE_PATH`
+/// and `GAZEBO_MODEL_PATH`.
+pub fn resource_paths(config: &RunConfig) -> ResourcePaths {
+    let mine = &config.robot_options.resources;
+    let mut paths = ResourcePaths::from_env();
+    paths.packages.extend(mine.packages.clone());
+    paths
+        .package_search
+        .splice(0..0, mine.package_search.iter().cloned());
+    paths
+        .model_search
+        .splice(0..0, mine.model_search.iter().cloned());
+    paths
+}
+
+/// How the robot is read: [`resource_paths`], and xacro arguments from the world's `[robot]`,
+/// then the config's.
 pub fn robot_load_options(config: &RunConfig, world: &World) -> LoadOptions {
-    let mut options = LoadOptions::from_env();
-    options
-        .resources
-        .packages
-        .extend(config.robot_options.resources.packages.clone());
-    options.resources.package_search.splice(
-        0..0,
-        config
-            .robot_options
-            .resources
-            .package_search
-            .iter()
-            .cloned(),
-    );
-    options.resources.model_search.splice(
-        0..0,
-        config.robot_options.resources.model_search.iter().cloned(),
-    );
-    options.xacro_args = world.robot.xacro_args.clone();
-    options
-        .xacro_args
-        .extend(config.robot_options.xacro_args.clone());
-    options
+    let mut xacro_args = world.robot.xacro_args.clone();
+    xacro_args.extend(config.robot_options.xacro_args.clone());
+    LoadOptions {
+        xacro_args,
+        resources: resource_paths(config),
+    }
 }
 
 /// Loads the script a [`RunConfig`] names (an empty one without).

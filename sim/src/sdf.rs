@@ -131,22 +131,22 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     for node in world_el.children().filter(Node::is_element) {
         match node.tag_name().name() {
             "model" => loader.model(&ctx, node, Pose::IDENTITY, None, &mut models, 0)?,
-            "include" if person_model(node).is_some() => {
-                let model = person_model(node).unwrap_or_default();
-                let name = child(node, "name")
-                    .and_then(|n| n.text())
-                    .map(|s| s.trim().to_owned())
-                    .unwrap_or_else(|| format!("{model}_{}", world.people.len()));
-                let pose = child(node, "pose").map(|p| ctx.pose(p)).transpose()?;
-                let pose = pose.unwrap_or(Pose::IDENTITY);
-                let t = pose.translation;
-                world.people.push(Person::standing(
-                    name,
-                    [f64::from(t.x), f64::from(t.y)],
-                    yaw_of(pose.rotation),
-                ));
-            }
-            "include" => loader.include(&ctx, node, Pose::IDENTITY, &mut models, 0)?,
+            "include" => match person_model(node) {
+                Some(model) => {
+                    let name = child(node, "name")
+                        .and_then(|n| n.text())
+                        .map(|s| s.trim().to_owned())
+                        .unwrap_or_else(|| format!("{model}_{}", world.people.len()));
+                    let pose = ctx.local_pose(node)?;
+                    let t = pose.translation;
+                    world.people.push(Person::standing(
+                        name,
+                        [f64::from(t.x), f64::from(t.y)],
+                        yaw_of(pose.rotation),
+                    ));
+                }
+                None => loader.include(&ctx, node, Pose::IDENTITY, &mut models, 0)?,
+            },
             "actor" => world.people.push(actor(&ctx, node)?),
             "physics" | "gravity" | "state" => {}
             other => {
