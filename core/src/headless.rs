@@ -187,6 +187,20 @@ pub fn run_observed(
 ) -> Result<RunSummary> {
     let (world, robot) = load(config)?;
     let script = load_script(config)?;
+    run_loaded(config, world, robot, script, observer, observer_wants_camera)
+}
+
+/// [`run_observed`] with the world, robot and script already loaded (the config's paths for
+/// them are not read; its spawn, drive and camera choices are not applied): for tools that
+/// build them in memory, such as scenario files.
+pub fn run_loaded(
+    config: &RunConfig,
+    world: World,
+    robot: RobotModel,
+    script: Script,
+    observer: &mut dyn Observer,
+    observer_wants_camera: bool,
+) -> Result<RunSummary> {
     let duration_s = match config.duration_s {
         Some(d) if d.is_finite() && d >= 0.0 => d,
         Some(d) => {
@@ -194,7 +208,7 @@ pub fn run_observed(
                 "--duration must be a number of seconds >= 0, found {d}"
             )));
         }
-        None if config.script.is_some() => script.end_s() + 1.0,
+        None if config.script.is_some() || !script.steps.is_empty() => script.end_s() + 1.0,
         None => 10.0,
     };
     let detect_hz = config.detect_hz.unwrap_or(DEFAULT_DETECT_HZ);

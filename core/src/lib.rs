@@ -16,14 +16,16 @@ pub mod headless;
 mod observers;
 pub mod paths;
 mod pilot;
+pub mod scenario;
 pub mod script;
 mod session;
 pub mod teleop;
 pub mod trace;
 
 pub use error::{CoreError, Result};
-pub use follower::{CameraGeometry, FollowState, Follower, FollowerConfig};
+pub use follower::{CameraGeometry, FollowState, Follower, FollowerConfig, LaserMount};
 pub use headless::{DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary};
+pub use scenario::{Scenario, ScenarioResult};
 pub use observers::{Fanout, FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use pilot::{Mode, Pilot};
 pub use script::{Action, Script, ScriptPlayer, Step};

@@ -7,7 +7,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
 
 use crate::error::{CoreError, Result};
 use crate::session::{EventLevel, LoopStats, Observer};
@@ -62,6 +62,11 @@ impl Observer for Fanout<'_> {
             o.detections(boxes, labels);
         }
     }
+    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
+        for o in &mut self.observers {
+            o.laser_scan(scan, world_from_laser);
+        }
+    }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         for o in &mut self.observers {
             o.event(sim_time_s, level, text);
@@ -112,7 +117,7 @@ impl TraceObserver {
 impl Observer for TraceObserver {
     fn control(&mut self, _sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         if let Some(w) = self.writer.as_mut() {
-            match w.row(sample, stats.mode) {
+            match w.row(sample, stats.mode, stats.follow_state) {
                 Ok(()) => self.rows += 1,
                 Err(e) => {
                     self.writer = None;

@@ -13,11 +13,12 @@ use rover_perception::{
     PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraInfo, CameraSensor, ControlSample, Pose, RobotModel, SimOptions, Simulation, World,
+    CameraInfo, CameraSensor, ControlSample, LaserScan, LaserSensor, Pose, RobotModel, SimOptions,
+    Simulation, World, wrap_angle, yaw_of,
 };
 
 use crate::error::{CoreError, Result};
-use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig};
+use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig, LaserMount};
 use crate::pilot::{Mode, Pilot};
 use crate::script::Action;
 
@@ -90,6 +91,11 @@ pub struct LoopStats {
     pub detector_ok: bool,
     /// Whether the detector failed during the run (an error or a panic in it); it stays off.
     pub detector_failed: bool,
+    /// Whether the follower is steering around an obstacle (it has a laser and something is in
+    /// the way of its own command).
+    pub avoiding: bool,
+    /// Laser scans taken.
+    pub scans: u64,
 }
 
 /// Watches a session without influencing it (the Rerun recorder, the window).
@@ -103,6 +109,8 @@ pub trait Observer {
     fn camera_frame(&mut self, _frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {}
     /// Detections of an earlier camera image (see their `image_stamp`).
     fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
+    /// A laser scan, taken from `world_from_laser` (the sensor's frame) at `scan.stamp_s`.
+    fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -130,6 +138,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
         self.0.detections(boxes, labels);
         self.1.detections(boxes, labels);
+    }
+    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
+        self.0.laser_scan(scan, world_from_laser);
+        self.1.laser_scan(scan, world_from_laser);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -166,6 +178,7 @@ pub struct Session {
     sim: Simulation,
     camera: Option<CameraSensor>,
     camera_link: usize,
+    laser: Option<LaserSensor>,
     detection: Detection,
     labels: Vec<String>,
     pilot: Pilot,
@@ -226,6 +239,31 @@ impl Session {
             .and_then(|c| sim.robot().link_index(&c.link))
             .unwrap_or(0);
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
+        // The first laser, if any: always on (casting a scan is cheap), for the follower's
+        // obstacles and target and for observers.
+        let laser = match sim.robot().lasers.first() {
+            Some(config) => {
+                let sensor = LaserSensor::new(&sim, 0)?;
+                tracing::info!(
+                    "laser: {} rays, {:.1}-{:.1} m at {} Hz",
+                    config.samples,
+                    config.range_min_m,
+                    config.range_max_m,
+                    config.update_rate_hz
+                );
+                Some(sensor)
+            }
+            None => None,
+        };
+        let mut follower = Follower::new(options.follower.clone(), geometry);
+        if let Some(l) = &laser {
+            let base_from_laser = sim.world_from_base().inverse() * l.world_from_sensor(&sim);
+            follower = follower.with_laser(LaserMount {
+                x_m: f64::from(base_from_laser.translation.x),
+                y_m: f64::from(base_from_laser.translation.y),
+                yaw_rad: wrap_angle(yaw_of(base_from_laser.rotation)),
+            });
+        }
         let mut labels = Vec::new();
         let detection = match (options.detector, camera.is_some()) {
             (DetectorMode::Off, _) | (_, false) => Detection::Off,
@@ -264,10 +302,11 @@ impl Session {
         };
         observer.start(&sim, camera.as_ref().map(|c| c.info()), &labels);
         Ok(Self {
-            follower: Follower::new(options.follower.clone(), geometry),
+            follower,
             sim,
             camera,
             camera_link,
+            laser,
             detection,
             labels,
             pilot: Pilot::default(),
@@ -343,19 +382,58 @@ impl Session {
         self.stats.mode = after;
     }
 
-    /// Advances one physics step: camera (when due), detector, follower, physics. Returns the
-    /// control sample when the diff drive's control loop ran.
+    /// The laser scanner, when the robot has one.
+    pub fn laser(&self) -> Option<&LaserSensor> {
+        self.laser.as_ref()
+    }
+
+    /// Advances one physics step: camera and laser (when due), detector, follower, physics.
+    /// Returns the control sample when the diff drive's control loop ran.
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<Option<ControlSample>> {
         self.camera_and_detection(observer)?;
+        // The scan sees the world as it is now, before this step moves it.
+        let scanned = match self.laser.as_mut() {
+            Some(laser) => {
+                let world_from_laser = laser.world_from_sensor(&self.sim);
+                laser
+                    .scan_if_due(&self.sim)
+                    .is_some()
+                    .then_some(world_from_laser)
+            }
+            None => None,
+        };
         let sample = self.sim.step();
         if let Some(sample) = &sample {
+            // Every mode: detections are placed with the pose at their image's time.
+            self.follower
+                .record_pose(sample.sim_time_s, sample.odometry);
+        }
+        if let (Some(world_from_laser), Some(laser)) = (scanned, self.laser.as_ref()) {
+            self.stats.scans += 1;
+            self.follower.observe_scan(laser.last());
+            observer.laser_scan(laser.last(), world_from_laser);
+        }
+        if let Some(sample) = &sample {
             if self.pilot.mode() == Mode::Follow {
+                let before = self.follower.state();
                 let cmd = self.follower.command(
                     sample.sim_time_s,
                     sample.odometry,
                     self.stats.detector_ok,
                 );
+                let after = self.follower.state();
+                if after != before {
+                    emit(
+                        observer,
+                        sample.sim_time_s,
+                        EventLevel::Info,
+                        &format!("follower: {} -> {}", before.as_str(), after.as_str()),
+                    );
+                }
+                self.stats.avoiding = self.follower.avoidance().is_some_and(|a| a.steering);
                 self.sim.set_cmd_vel(cmd)?;
+            } else {
+                self.stats.avoiding = false;
             }
             self.stats.mode = self.pilot.mode();
             self.stats.follow_state = self.follower.state();

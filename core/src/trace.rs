@@ -4,10 +4,11 @@ use std::io::Write;
 
 use rover_sim::ControlSample;
 
+use crate::follower::FollowState;
 use crate::pilot::Mode;
 
 /// Column header of the trace CSV.
-pub const TRACE_HEADER: &str = "sim_time_s,x_m,y_m,yaw_rad,odom_x_m,odom_y_m,odom_yaw_rad,cmd_linear_mps,cmd_angular_radps,mode";
+pub const TRACE_HEADER: &str = "sim_time_s,x_m,y_m,yaw_rad,odom_x_m,odom_y_m,odom_yaw_rad,cmd_linear_mps,cmd_angular_radps,mode,follow_state";
 
 /// Writes trace rows with fixed formatting, so identical runs give identical bytes.
 #[derive(Debug)]
@@ -23,13 +24,14 @@ impl<W: Write> TraceWriter<W> {
         Ok(Self { out, rows: 0 })
     }
 
-    /// Appends one row.
-    pub fn row(&mut self, s: &ControlSample, mode: Mode) -> std::io::Result<()> {
+    /// Appends one row. `state` is what the follower is doing (in manual mode too: it keeps
+    /// watching).
+    pub fn row(&mut self, s: &ControlSample, mode: Mode, state: FollowState) -> std::io::Result<()> {
         let g = &s.ground_truth;
         let o = &s.odometry;
         writeln!(
             self.out,
-            "{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{}",
+            "{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{}",
             s.sim_time_s,
             g.x_m,
             g.y_m,
@@ -39,7 +41,8 @@ impl<W: Write> TraceWriter<W> {
             o.yaw_rad,
             s.cmd.linear_mps,
             s.cmd.angular_radps,
-            mode.as_str()
+            mode.as_str(),
+            state.as_str()
         )?;
         self.rows += 1;
         Ok(())
@@ -80,6 +83,8 @@ pub struct TraceRow {
     pub cmd_angular_radps: f64,
     /// `manual` or `follow`.
     pub mode: String,
+    /// The follower's state ([`FollowState::as_str`]).
+    pub follow_state: String,
 }
 
 /// A trace CSV that is not what [`TraceWriter`] writes.
@@ -105,10 +110,10 @@ pub fn parse_trace(text: &str) -> Result<Vec<TraceRow>, TraceParseError> {
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 10 {
+        if f.len() != 11 {
             return Err(TraceParseError {
                 line: n + 2,
-                message: format!("expected 10 fields, found {}", f.len()),
+                message: format!("expected 11 fields, found {}", f.len()),
             });
         }
         let num = |i: usize| -> Result<f64, TraceParseError> {
@@ -128,6 +133,7 @@ pub fn parse_trace(text: &str) -> Result<Vec<TraceRow>, TraceParseError> {
             cmd_linear_mps: num(7)?,
             cmd_angular_radps: num(8)?,
             mode: f[9].to_owned(),
+            follow_state: f[10].to_owned(),
         });
     }
     Ok(rows)

@@ -1,5 +1,6 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
-//! `<sensor>` blocks (with `libgazebo_ros_camera.so`), and per-link friction (`mu1`/`mu2`).
+//! `<sensor>` blocks (with `libgazebo_ros_camera.so`), 2D laser `<sensor type="ray">` blocks (with
+//! `libgazebo_ros_laser.so`), and per-link friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
@@ -8,6 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::error::{Result, SimError};
+use crate::geometry::{Pose, pose_from_xyz_rpy};
 use crate::robot::line_of;
 
 /// Where the diff drive takes its odometry from (`<odometrySource>`).
@@ -106,7 +108,8 @@ pub enum PixelFormat {
     Mono8,
 }
 
-/// Gaussian pixel noise (`<noise type="gaussian">`), on the 0..1 scale per channel.
+/// Gaussian noise (`<noise type="gaussian">`): on the 0..1 scale per channel for a camera, in
+/// metres for a laser's ranges.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GaussianNoise {
     /// Mean.
@@ -176,11 +179,60 @@ pub struct CameraConfig {
     pub line: Option<u32>,
 }
 
+/// A 2D laser scanner: `<sensor type="ray">` (or `gpu_ray`) with `libgazebo_ros_laser.so`'s
+/// parameters. One horizontal plane of rays, as Gazebo's ray sensor with one vertical sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaserConfig {
+    /// Sensor `name`.
+    pub name: String,
+    /// Link the sensor is attached to (`<gazebo reference>`).
+    pub link: String,
+    /// The sensor's `<pose>` in its link (x y z roll pitch yaw).
+    pub link_from_sensor: Pose,
+    /// `<update_rate>` (Hz, sim time).
+    pub update_rate_hz: f64,
+    /// `<scan><horizontal><samples>` times `<resolution>`: rays per scan.
+    pub samples: u32,
+    /// `<min_angle>` (rad, counter-clockwise from the sensor's x axis).
+    pub min_angle_rad: f64,
+    /// `<max_angle>` (rad).
+    pub max_angle_rad: f64,
+    /// `<range><min>` (m): closer returns read as -inf (REP-117).
+    pub range_min_m: f64,
+    /// `<range><max>` (m): no return within it reads as +inf (REP-117).
+    pub range_max_m: f64,
+    /// `<range><resolution>` (m): ranges are rounded to multiples of it.
+    pub range_resolution_m: f64,
+    /// Gaussian range noise (m), `<ray><noise>`.
+    pub noise: Option<GaussianNoise>,
+    /// The laser plugin's `<topicName>` (default `scan`).
+    pub topic: String,
+    /// The laser plugin's `<frameName>` (default: the link).
+    pub frame_name: String,
+    /// Line of the `<sensor>` element, for messages.
+    pub line: Option<u32>,
+}
+
+impl LaserConfig {
+    /// Angle between two rays (rad): Gazebo spreads the samples from min to max inclusive.
+    pub fn angle_increment_rad(&self) -> f64 {
+        if self.samples > 1 {
+            (self.max_angle_rad - self.min_angle_rad) / f64::from(self.samples - 1)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Rays per scan rover accepts (a 0.1 deg lidar has 3600; more is a typo, not a sensor).
+pub const MAX_LASER_SAMPLES: u32 = 100_000;
+
 /// Everything read from `<gazebo>` elements.
 #[derive(Debug, Default)]
 pub(crate) struct Extensions {
     pub diff_drive: Option<DiffDriveConfig>,
     pub cameras: Vec<CameraConfig>,
+    pub lasers: Vec<LaserConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
     /// Sensors and plugins rover does not simulate, for one summary line.
@@ -329,6 +381,15 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ));
                     };
                     ext.cameras.push(parse_camera(&ctx, child, link)?);
+                }
+                "sensor" if matches!(child.attribute("type"), Some("ray" | "gpu_ray")) => {
+                    let Some(link) = reference else {
+                        return Err(ctx.err(
+                            child,
+                            "<sensor type=\"ray\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
+                        ));
+                    };
+                    ext.lasers.push(parse_laser(&ctx, child, link)?);
                 }
                 "sensor" => ext.ignored.push(format!(
                     "sensor \"{}\" (type {})",
@@ -510,7 +571,7 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
                                 ));
                             }
                         }
-                        "noise" => c.noise = parse_noise(ctx, cam, what)?,
+                        "noise" => c.noise = parse_noise(ctx, cam, what, "0..1 intensity")?,
                         "distortion" => {
                             let mut d = Distortion::default();
                             for k in elements(cam) {
@@ -564,7 +625,145 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
     Ok(c)
 }
 
-fn parse_noise(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str) -> Result<Option<GaussianNoise>> {
+fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<LaserConfig> {
+    let name = sensor.attribute("name").unwrap_or("laser").to_owned();
+    let what = format!("<sensor name=\"{name}\">");
+    let what = what.as_str();
+    // Gazebo's defaults for a ray sensor.
+    let mut c = LaserConfig {
+        name,
+        link: link.to_owned(),
+        link_from_sensor: Pose::IDENTITY,
+        update_rate_hz: 10.0,
+        samples: 640,
+        min_angle_rad: 0.0,
+        max_angle_rad: 0.0,
+        range_min_m: 0.1,
+        range_max_m: 10.0,
+        range_resolution_m: 0.01,
+        noise: None,
+        topic: "scan".to_owned(),
+        frame_name: link.to_owned(),
+        line: Some(line_of(ctx.doc, sensor)),
+    };
+    let mut samples = 640u32;
+    let mut resolution = 1.0f64;
+    for s in elements(sensor) {
+        match s.tag_name().name() {
+            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "pose" => {
+                let text = text_of(s);
+                let v: Vec<f64> = text
+                    .split_whitespace()
+                    .map(str::parse::<f64>)
+                    .collect::<std::result::Result<_, _>>()
+                    .ok()
+                    .filter(|v: &Vec<f64>| v.len() == 6 && v.iter().all(|x| x.is_finite()))
+                    .ok_or_else(|| {
+                        ctx.err(
+                            s,
+                            format!("<pose> in {what}: expected six numbers 'x y z roll pitch yaw', found '{text}'"),
+                        )
+                    })?;
+                c.link_from_sensor = pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+            }
+            "ray" => {
+                for ray in elements(s) {
+                    match ray.tag_name().name() {
+                        "scan" => {
+                            for h in elements(ray).filter(|n| n.has_tag_name("horizontal")) {
+                                for p in elements(h) {
+                                    match p.tag_name().name() {
+                                        "samples" => {
+                                            let text = text_of(p);
+                                            samples = match text.parse::<u32>() {
+                                                Ok(n) if (1..=MAX_LASER_SAMPLES).contains(&n) => n,
+                                                _ => {
+                                                    return Err(ctx.err(
+                                                        p,
+                                                        format!("<samples> in {what}: expected a whole number of rays between 1 and {MAX_LASER_SAMPLES}, found '{text}'"),
+                                                    ));
+                                                }
+                                            }
+                                        }
+                                        "resolution" => {
+                                            resolution = ctx.positive(p, what, "rays per sample")?
+                                        }
+                                        "min_angle" => {
+                                            c.min_angle_rad = ctx.number(p, what, "radians")?
+                                        }
+                                        "max_angle" => {
+                                            c.max_angle_rad = ctx.number(p, what, "radians")?
+                                        }
+                                        _ => {}
+                                    }
+                                }
+                            }
+                        }
+                        "range" => {
+                            for r in elements(ray) {
+                                match r.tag_name().name() {
+                                    "min" => c.range_min_m = ctx.non_negative(r, what, "metres")?,
+                                    "max" => c.range_max_m = ctx.positive(r, what, "metres")?,
+                                    "resolution" => {
+                                        c.range_resolution_m = ctx.non_negative(r, what, "metres")?
+                                    }
+                                    _ => {}
+                                }
+                            }
+                            if c.range_min_m >= c.range_max_m {
+                                return Err(ctx.err(
+                                    ray,
+                                    format!(
+                                        "<range> in {what}: expected min < max, found min {} and max {}",
+                                        c.range_min_m, c.range_max_m
+                                    ),
+                                ));
+                            }
+                        }
+                        "noise" => c.noise = parse_noise(ctx, ray, what, "metres")?,
+                        _ => {}
+                    }
+                }
+            }
+            "plugin" => {
+                for p in elements(s) {
+                    match p.tag_name().name() {
+                        "topicName" => c.topic = text_of(p).to_owned(),
+                        "frameName" => c.frame_name = text_of(p).to_owned(),
+                        _ => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let rays = (f64::from(samples) * resolution).round();
+    if !(1.0..=f64::from(MAX_LASER_SAMPLES)).contains(&rays) {
+        return Err(ctx.err(
+            sensor,
+            format!("{what}: <samples> x <resolution> gives {rays} rays; expected 1 to {MAX_LASER_SAMPLES}"),
+        ));
+    }
+    c.samples = rays as u32;
+    if c.max_angle_rad < c.min_angle_rad {
+        return Err(ctx.err(
+            sensor,
+            format!(
+                "<horizontal> in {what}: expected min_angle <= max_angle, found {} and {}",
+                c.min_angle_rad, c.max_angle_rad
+            ),
+        ));
+    }
+    Ok(c)
+}
+
+fn parse_noise(
+    ctx: &Ctx<'_, '_>,
+    node: Node<'_, '_>,
+    what: &str,
+    unit: &str,
+) -> Result<Option<GaussianNoise>> {
     let mut kind = "gaussian".to_owned();
     let mut noise = GaussianNoise {
         mean: 0.0,
@@ -573,8 +772,8 @@ fn parse_noise(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str) -> Result<Opti
     for n in elements(node) {
         match n.tag_name().name() {
             "type" => kind = text_of(n).to_owned(),
-            "mean" => noise.mean = ctx.number(n, what, "0..1 intensity")?,
-            "stddev" => noise.stddev = ctx.non_negative(n, what, "0..1 intensity")?,
+            "mean" => noise.mean = ctx.number(n, what, unit)?,
+            "stddev" => noise.stddev = ctx.non_negative(n, what, unit)?,
             _ => {}
         }
     }

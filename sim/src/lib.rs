@@ -28,6 +28,8 @@ mod simulation;
 mod tomlfile;
 mod urdf;
 mod world;
+mod laser;
+mod noise;
 mod xacro;
 
 pub use camera::{CameraInfo, link_from_optical};
@@ -37,8 +39,12 @@ pub use diff_drive::{
 };
 pub use error::{Location, Result, SimError};
 pub use gazebo::{
-    CameraConfig, DiffDriveConfig, Distortion, GaussianNoise, OdometrySource, PixelFormat,
+    CameraConfig, DiffDriveConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
+    OdometrySource, PixelFormat,
 };
+pub use laser::{LaserScan, LaserSensor};
+/// nalgebra, the version rapier uses: for estimation and general matrices (one copy in the build).
+pub use rapier3d::na as nalgebra;
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use mesh::{TriMesh, load_mesh};
 pub use render::meshes::{
@@ -53,6 +59,6 @@ pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use tomlfile::{load_toml, parse_toml};
 pub use world::{
     DEFAULT_STEP_HZ, DriveSpec, Ground, Object, ObjectShape, Person, Physics, RobotSpawn,
-    STEP_HZ_RANGE, Walk, World, check_step_hz,
+    STEP_HZ_RANGE, Walk, World, WorldFile, check_step_hz,
 };
 pub use xacro::{Expanded, expand_file as expand_xacro, uses_xacro};

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use crate::error::{Result, SimError};
-use crate::gazebo::{self, CameraConfig, DiffDriveConfig};
+use crate::gazebo::{self, CameraConfig, DiffDriveConfig, LaserConfig};
 use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, vec3};
 use crate::resource::ResourcePaths;
 use crate::xacro::{self, Expanded};
@@ -155,6 +155,8 @@ pub struct RobotModel {
     pub diff_drive: Option<DiffDriveConfig>,
     /// Camera sensors (`<sensor type="camera">`).
     pub cameras: Vec<CameraConfig>,
+    /// 2D laser scanners (`<sensor type="ray">`).
+    pub lasers: Vec<LaserConfig>,
     /// Gazebo sensors and plugins in the file that rover does not simulate (IMU, GPS, ...).
     pub not_simulated: Vec<String>,
     /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
@@ -356,6 +358,7 @@ impl RobotModel {
             root,
             diff_drive: extensions.diff_drive,
             cameras: extensions.cameras,
+            lasers: extensions.lasers,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
         };
@@ -535,6 +538,19 @@ impl RobotModel {
                     format!(
                         "<plugin filename=\"libgazebo_ros_diff_drive.so\">: leftJoint and rightJoint are both \"{}\"; expected two different wheel joints",
                         dd.left_joint
+                    ),
+                ));
+            }
+        }
+        for laser in &self.lasers {
+            if self.link_index(&laser.link).is_none() {
+                return Err(SimError::invalid(
+                    path,
+                    laser.line,
+                    format!(
+                        "<gazebo reference=\"{}\"> <sensor type=\"ray\">: no such link; links in this robot: {}",
+                        laser.link,
+                        names(self.links.iter().map(|l| &l.name))
                     ),
                 ));
             }

@@ -621,6 +621,8 @@ fn actor(ctx: &Ctx<'_, '_>, node: Node<'_, '_>) -> Result<Person> {
     person.walk = (!waypoints.is_empty()).then_some(Walk {
         waypoints_m: waypoints,
         speed_mps: speed,
+        repeat: true,
+        start_after_s: 0.0,
     });
     Ok(person)
 }

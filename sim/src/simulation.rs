@@ -79,6 +79,8 @@ pub struct Simulation {
     people: Vec<RigidBodyHandle>,
     /// Bodies of the SDF models' links, in model then link order.
     model_links: Vec<RigidBodyHandle>,
+    /// The ground's body (not an obstacle for clearance figures).
+    ground: RigidBodyHandle,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -121,7 +123,7 @@ impl Simulation {
         physics.integration_parameters.dt = dt_s as f32;
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
 
-        let people = add_world(&mut physics, &world);
+        let (ground, people) = add_world(&mut physics, &world);
         let model_links = add_models(&mut physics, &world)?;
         let robot_bodies = add_robot(&mut physics, &world, &robot)?;
         let ratio = joint_mass_ratio(&robot, &robot_bodies);
@@ -199,6 +201,7 @@ impl Simulation {
             seed: options.seed,
             people,
             model_links,
+            ground,
             robot,
             world,
         })
@@ -254,6 +257,61 @@ impl Simulation {
             wheel_targets_radps: self.drive.wheel_targets_radps(),
             wheel_measured_radps: self.wheel_speeds_radps(),
         }
+    }
+
+    /// Distance (m) along a ray from `origin` in direction `dir` (unit, world frame) to the
+    /// first surface of the world (ground, objects, walls, models, people), not the robot
+    /// itself; `None` when nothing is hit within `max_m`.
+    pub fn cast_world_ray(&self, origin: Vec3, dir: Vec3, max_m: f32) -> Option<f32> {
+        let filter = QueryFilter::default().groups(InteractionGroups::new(
+            Group::ALL,
+            WORLD_GROUP,
+            InteractionTestMode::And,
+        ));
+        let ray = Ray::new(origin, dir);
+        self.physics
+            .cast_ray(&ray, max_m, true, filter)
+            .map(|(_, toi)| toi)
+    }
+
+    /// The smallest distance (m) between the robot's collision shapes and the world's
+    /// obstacles (objects, walls, SDF models; not the ground, not people), looking no further
+    /// than `within_m`: returns `within_m` when nothing is closer. 0 when touching.
+    pub fn obstacle_clearance_m(&self, within_m: f32) -> f32 {
+        let mut best = within_m;
+        let obstacles = QueryFilter::default().groups(InteractionGroups::new(
+            Group::ALL,
+            WORLD_GROUP,
+            InteractionTestMode::And,
+        ));
+        let query = self.physics.query_pipeline_with_filter(obstacles);
+        for (_, robot_collider) in self.physics.colliders.iter() {
+            let is_robot = robot_collider
+                .parent()
+                .is_some_and(|p| self.link_body.contains(&p));
+            if !is_robot {
+                continue;
+            }
+            let mut aabb = robot_collider.compute_aabb();
+            aabb.mins -= Vec3::splat(best);
+            aabb.maxs += Vec3::splat(best);
+            for (_, other) in query.intersect_aabb_conservative(aabb) {
+                let parent = other.parent();
+                if parent == Some(self.ground) || parent.is_some_and(|p| self.people.contains(&p))
+                {
+                    continue;
+                }
+                if let Ok(d) = rapier3d::parry::query::distance(
+                    robot_collider.position(),
+                    robot_collider.shape(),
+                    other.position(),
+                    other.shape(),
+                ) {
+                    best = best.min(d.distance.max(0.0));
+                }
+            }
+        }
+        best
     }
 
     /// Pose of person `index` (world order) now: feet on the ground, x facing where they look.
@@ -442,7 +500,7 @@ fn add_models(physics: &mut PhysicsWorld, world: &World) -> Result<Vec<RigidBody
     Ok(bodies)
 }
 
-fn add_world(physics: &mut PhysicsWorld, world: &World) -> Vec<RigidBodyHandle> {
+fn add_world(physics: &mut PhysicsWorld, world: &World) -> (RigidBodyHandle, Vec<RigidBodyHandle>) {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
     let [sx, sy] = world.ground.size_m;
@@ -498,7 +556,7 @@ fn add_world(physics: &mut PhysicsWorld, world: &World) -> Vec<RigidBodyHandle> 
         );
         people.push(body);
     }
-    people
+    (ground, people)
 }
 
 struct RobotBodies {

@@ -175,13 +175,18 @@ pub struct Person {
     pub walk: Option<Walk>,
 }
 
-/// A person's walk: a closed path at a constant speed.
+/// A person's walk: a path at a constant speed, closed and repeated (the default) or walked
+/// once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Walk {
     /// Waypoints after the start position (m, world frame).
     pub waypoints_m: Vec<[f64; 2]>,
     /// Walking speed (m/s).
     pub speed_mps: f64,
+    /// Back to the start and round again (true), or stop at the last waypoint (false).
+    pub repeat: bool,
+    /// Stand at the start this long before walking (s).
+    pub start_after_s: f64,
 }
 
 impl Object {
@@ -221,22 +226,37 @@ impl Person {
         let Some(walk) = &self.walk else {
             return (x0, y0, self.heading_rad);
         };
-        let corners: Vec<[f64; 2]> = std::iter::once(self.position_m)
-            .chain(walk.waypoints_m.iter().copied())
-            .collect();
+        let n = walk.waypoints_m.len() + 1;
+        let corner = |i: usize| {
+            if i % n == 0 {
+                self.position_m
+            } else {
+                walk.waypoints_m[i % n - 1]
+            }
+        };
+        // Legs: corner i to corner i + 1; a repeated walk closes the loop, a single one does not.
+        let legs = if walk.repeat { n } else { n - 1 };
         let leg = |i: usize| {
-            let a = corners[i];
-            let b = corners[(i + 1) % corners.len()];
+            let (a, b) = (corner(i), corner(i + 1));
             (a, b, (b[0] - a[0]).hypot(b[1] - a[1]))
         };
-        let length: f64 = (0..corners.len()).map(|i| leg(i).2).sum();
+        let length: f64 = (0..legs).map(|i| leg(i).2).sum();
         if length <= 1e-9 {
             return (x0, y0, self.heading_rad);
         }
-        let mut s = (walk.speed_mps * t_s.max(0.0)).rem_euclid(length);
-        for i in 0..corners.len() {
+        let walked = walk.speed_mps * (t_s - walk.start_after_s).max(0.0);
+        if t_s < walk.start_after_s {
+            let (a, b, _) = leg(0);
+            return (x0, y0, (b[1] - a[1]).atan2(b[0] - a[0]));
+        }
+        let mut s = if walk.repeat {
+            walked.rem_euclid(length)
+        } else {
+            walked.min(length)
+        };
+        for i in 0..legs {
             let (a, b, l) = leg(i);
-            if s <= l || i + 1 == corners.len() {
+            if s <= l || i + 1 == legs {
                 let f = if l > 0.0 { (s / l).min(1.0) } else { 0.0 };
                 let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
                 return (a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f, heading);
@@ -281,6 +301,25 @@ impl World {
     /// An empty flat world (ground only, every setting at its default), for tests and calibration.
     pub fn flat() -> Result<Self> {
         Self::from_str("name = \"flat\"\n", Path::new("<built-in flat world>"))
+    }
+}
+
+/// A TOML world as written, before validation: for files that embed a world (rover's scenario
+/// files hold one under `[world]`). Deserialise it with serde, then [`WorldFile::into_world`].
+#[derive(Debug)]
+pub struct WorldFile(RawWorld);
+
+impl<'de> Deserialize<'de> for WorldFile {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        RawWorld::deserialize(d).map(WorldFile)
+    }
+}
+
+impl WorldFile {
+    /// Validates it into a [`World`]; `path` is the file it came from (for messages and for
+    /// resolving the robot's URDF relative to it).
+    pub fn into_world(self, path: &Path) -> Result<World> {
+        self.0.into_world(path)
     }
 }
 
@@ -448,6 +487,14 @@ struct RawPerson {
     #[serde(default)]
     waypoints_m: Vec<[f64; 2]>,
     speed_mps: Option<f64>,
+    #[serde(default = "default_repeat")]
+    repeat: bool,
+    #[serde(default)]
+    start_after_s: f64,
+}
+
+fn default_repeat() -> bool {
+    true
 }
 
 fn default_person_height() -> f64 {
@@ -705,9 +752,17 @@ impl RawWorld {
                             format!("expected a walking speed in (0, 3] m/s, found {speed}"),
                         ));
                     }
+                    if !(p.start_after_s.is_finite() && p.start_after_s >= 0.0) {
+                        return Err(c.fail(
+                            &key("start_after_s"),
+                            format!("expected seconds >= 0, found {}", p.start_after_s),
+                        ));
+                    }
                     Some(Walk {
                         waypoints_m: p.waypoints_m,
                         speed_mps: speed,
+                        repeat: p.repeat,
+                        start_after_s: p.start_after_s,
                     })
                 }
             };

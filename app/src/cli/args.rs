@@ -280,8 +280,9 @@ pub(crate) struct FollowArgs {
     #[arg(long, default_value_t = 1.5, value_name = "M")]
     pub(crate) standoff: f64,
 
-    /// Follower: speed limit (m/s)
-    #[arg(long, default_value_t = 0.5, value_name = "MPS")]
+    /// Follower: speed limit (m/s; the follower's default, enough to keep up with a person
+    /// walking at 0.6 m/s)
+    #[arg(long, default_value_t = 0.8, value_name = "MPS")]
     pub(crate) follow_speed: f64,
 }
 
@@ -355,6 +356,25 @@ fn parse_size(text: &str) -> Result<(usize, usize), String> {
 }
 
 impl DetectorArgs {
+    /// The same options as command-line arguments (to hand them to a child process).
+    pub(crate) fn to_args(&self) -> Vec<std::ffi::OsString> {
+        let mut args: Vec<std::ffi::OsString> = Vec::new();
+        if let Some(m) = &self.model {
+            args.push("--model".into());
+            args.push(m.into());
+        }
+        if let Some(l) = &self.labels {
+            args.push("--labels".into());
+            args.push(l.into());
+        }
+        args.push(format!("--threshold={}", self.threshold).into());
+        args.push(format!("--nms={}", self.nms).into());
+        if let Some((w, h)) = self.input_size {
+            args.push(format!("--input-size={w}x{h}").into());
+        }
+        args
+    }
+
     pub(crate) fn config(&self) -> anyhow::Result<DetectorConfig> {
         anyhow::ensure!(
             (0.0..=1.0).contains(&self.threshold),
@@ -406,6 +426,16 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value_t = 60)]
         frames: usize,
     },
+    /// Laser: ms per scan (ray casts against the physics scene) and the follower's command cost
+    /// with a scan's obstacles
+    Laser {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Scans to time (after one warm-up)
+        #[arg(long, default_value_t = 200)]
+        scans: usize,
+    },
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]
@@ -419,6 +449,62 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value_t = 15)]
         runs: usize,
     },
+}
+
+/// `rover eval`'s options.
+#[derive(Debug, Args)]
+pub(crate) struct EvalArgs {
+    /// Scenario files, or folders of them (their *.toml in name order) [default: scenarios/]
+    #[arg(value_name = "PATH")]
+    pub(crate) paths: Vec<PathBuf>,
+
+    /// Scenarios run at once, each in its own process [default: the number of CPU cores]
+    #[arg(long, short = 'j', value_name = "N")]
+    pub(crate) jobs: Option<usize>,
+
+    /// Folder for eval.json and eval.csv (and per-scenario .rrd/.csv files)
+    #[arg(long, default_value = "eval-out", value_name = "DIR")]
+    pub(crate) out: PathBuf,
+
+    /// Also record every scenario to OUT/NAME.rrd, for inspection in Rerun
+    #[arg(long)]
+    pub(crate) rrd: bool,
+
+    /// Also write every scenario's trace to OUT/NAME.csv
+    #[arg(long)]
+    pub(crate) traces: bool,
+
+    /// Run only shard I of N: the scenarios (in name order) whose index modulo N is I; the
+    /// results go to OUT/eval-shard-I-of-N.json for `--merge` (see docs/FOLLOWER.md)
+    #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+    pub(crate) shard: Option<(usize, usize)>,
+
+    /// Merge shards' result files into OUT/eval.json and eval.csv instead of running anything
+    #[arg(long, value_name = "JSON", num_args = 1.., conflicts_with_all = ["jobs", "rrd", "shard", "paths"])]
+    pub(crate) merge: Vec<PathBuf>,
+
+    /// Run only scenarios with this tag (repeatable), e.g. --tag fast
+    #[arg(long, value_name = "TAG")]
+    pub(crate) tag: Vec<String>,
+
+    #[command(flatten)]
+    pub(crate) detector: DetectorArgs,
+
+    /// Internal: run the one scenario given in this process and write its result to this file
+    #[arg(long, hide = true, value_name = "RESULT.json")]
+    pub(crate) worker: Option<PathBuf>,
+}
+
+fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let parsed = text
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse::<usize>().ok()?, n.trim().parse::<usize>().ok()?)));
+    match parsed {
+        Some((i, n)) if n > 0 && i < n => Ok((i, n)),
+        _ => Err(format!(
+            "expected I/N with 0 <= I < N (shard I of N, counted from 0), found '{text}'"
+        )),
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -445,6 +531,15 @@ pub(crate) enum Command {
         #[arg(long, value_name = "PATH")]
         out: Option<PathBuf>,
     },
+
+    /// Run follower scenarios (world + robot + success criteria) headless in parallel and judge
+    /// them
+    ///
+    /// Each scenario file (scenarios/*.toml; format in docs/FOLLOWER.md) runs deterministically
+    /// in its own process, --jobs at a time. Prints a table, writes OUT/eval.json and
+    /// OUT/eval.csv, and exits 1 when a scenario fails. --shard and --merge split a suite over
+    /// machines.
+    Eval(EvalArgs),
 
     /// Benchmarks: physics-only real-time factor (default), or `bench detect`
     Bench {

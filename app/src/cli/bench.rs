@@ -203,6 +203,122 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
     })
 }
 
+/// Laser benchmark figures.
+#[derive(Debug, Clone)]
+pub struct LaserBench {
+    /// Rays per scan.
+    pub rays: u32,
+    /// Scans per sim second.
+    pub rate_hz: f64,
+    /// Median wall time of one scan (ms).
+    pub median_ms: f64,
+    /// Fastest scan (ms).
+    pub best_ms: f64,
+    /// Median wall time of one follower command with the scan's obstacles (us).
+    pub follower_us: f64,
+    /// Median wall time of the avoidance's full window search over the scan's returns, with
+    /// the way ahead blocked (the worst case, us).
+    pub window_search_us: f64,
+}
+
+/// Laser: time per scan (ray casts against the physics scene) and the follower's command with
+/// that scan's obstacles, in the configured world with its robot (default: the playground and
+/// the tutorial car with its laser).
+pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
+    let (world, robot) = headless::load(config)?;
+    anyhow::ensure!(
+        !robot.lasers.is_empty(),
+        "{}: the robot has no <sensor type=\"ray\">; try --robot assets/robots/my_robot_laser.urdf.xacro",
+        robot.source.display()
+    );
+    let mut sim = Simulation::new(world, robot, &config.options)?;
+    let mut sensor = rover_sim::LaserSensor::new(&sim, 0)?;
+    let mount = {
+        let base_from_laser = sim.world_from_base().inverse() * sensor.world_from_sensor(&sim);
+        rover_core::LaserMount {
+            x_m: f64::from(base_from_laser.translation.x),
+            y_m: f64::from(base_from_laser.translation.y),
+            yaw_rad: rover_sim::wrap_angle(rover_sim::yaw_of(base_from_laser.rotation)),
+        }
+    };
+    let geometry = rover_core::CameraGeometry {
+        fx: 381.0,
+        fy: 381.0,
+        cx: 320.5,
+        cy: 240.5,
+        height_px: 480.0,
+        height_m: 0.18,
+        forward_m: 0.15,
+        pitch_down_rad: 0.0,
+    };
+    let mut follower =
+        rover_core::Follower::new(rover_core::FollowerConfig::default(), geometry).with_laser(mount);
+    sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
+    sensor.scan_now(&sim);
+    let mut times = Vec::with_capacity(scans);
+    let mut follower_times = Vec::with_capacity(scans);
+    let mut window_times = Vec::with_capacity(scans);
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let avoid = rover_core::follower::AvoidConfig::default();
+    for _ in 0..scans.max(1) {
+        for _ in 0..5 {
+            if let Some(sample) = sim.step() {
+                follower.record_pose(sample.sim_time_s, sample.odometry);
+            }
+        }
+        let start = Instant::now();
+        let scan = sensor.scan_now(&sim);
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        points.clear();
+        points.extend(
+            scan.points()
+                .map(|[x, y]| [f64::from(x) + mount.x_m, f64::from(y) + mount.y_m]),
+        );
+        points.push([0.5, 0.0]);
+        follower.observe_scan(scan);
+        let start = Instant::now();
+        let _ = follower.command(sim.sim_time_s(), sim.odometry(), true);
+        follower_times.push(start.elapsed().as_secs_f64() * 1e6);
+        let start = Instant::now();
+        let out = rover_core::follower::avoid::choose(
+            Twist::new(0.8, 0.0),
+            [4.0, 0.0],
+            &points,
+            0.8,
+            1.2,
+            &avoid,
+        );
+        window_times.push(start.elapsed().as_secs_f64() * 1e6);
+        std::hint::black_box(out);
+    }
+    let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok(LaserBench {
+        rays: sensor.config().samples,
+        rate_hz: sensor.config().update_rate_hz,
+        median_ms: median(&mut times),
+        best_ms,
+        follower_us: median(&mut follower_times),
+        window_search_us: median(&mut window_times),
+    })
+}
+
+pub(crate) fn bench_laser(world: WorldArgs, scans: usize) -> Result<()> {
+    let config = world.run_config(None);
+    let b = laser(&config, scans)?;
+    println!(
+        "laser benchmark: {} rays at {} Hz, {scans} scans: median {:.3} ms, best {:.3} ms per scan ({:.2}% of a core at {} Hz); follower command {:.1} us; avoidance window search (worst case, every return) {:.0} us",
+        b.rays,
+        b.rate_hz,
+        b.median_ms,
+        b.best_ms,
+        b.median_ms * b.rate_hz / 10.0,
+        b.rate_hz,
+        b.follower_us,
+        b.window_search_us
+    );
+    Ok(())
+}
+
 /// Recording overhead: the same headless run (camera and lockstep detector on) without and
 /// with `--record`.
 #[derive(Debug, Clone)]

@@ -5,6 +5,7 @@
 mod args;
 pub mod bench;
 pub mod detect;
+pub mod eval;
 mod run;
 
 use std::process::ExitCode;
@@ -45,6 +46,10 @@ pub fn main() -> ExitCode {
             ..
         }) => bench::bench_camera(world, frames),
         Some(Command::Bench {
+            kind: Some(BenchKind::Laser { world, scans }),
+            ..
+        }) => bench::bench_laser(world, scans),
+        Some(Command::Bench {
             kind:
                 Some(BenchKind::Record {
                     world,
@@ -74,6 +79,7 @@ pub fn main() -> ExitCode {
                 out,
             })
         }),
+        Some(Command::Eval(args)) => eval::run(args),
         None => run::run(cli.run),
     };
     match result {

@@ -64,7 +64,11 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
     let (mode_text, mode_color) = match stats.mode {
         Mode::Manual => ("MANUAL".to_owned(), [120, 220, 120]),
         Mode::Follow => (
-            format!("FOLLOW ({})", stats.follow_state.as_str()),
+            format!(
+                "FOLLOW ({}{})",
+                stats.follow_state.as_str().to_uppercase(),
+                if stats.avoiding { ", avoiding" } else { "" }
+            ),
             [255, 170, 60],
         ),
     };

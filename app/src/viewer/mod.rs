@@ -35,7 +35,7 @@ use anyhow::{Context, Result};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 use rover_core::{EventLevel, LoopStats, Mode, Observer};
 use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
 
 pub use blueprint::blueprint;
 pub use images::ImageOptions;
@@ -58,6 +58,10 @@ pub struct Recorder {
     paths: ScenePaths,
     /// Reused buffer for SDF model link poses.
     model_poses: Vec<Pose>,
+    /// Entity path of the laser's scan and the sensor's pose in its link.
+    laser: Option<(String, Pose)>,
+    /// Scan points in the link frame (reused).
+    scan_points: Vec<[f32; 3]>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -93,6 +97,8 @@ impl Recorder {
             trail: Vec::with_capacity(4096),
             trail_logged_s: f64::NEG_INFINITY,
             model_poses: Vec::new(),
+            laser: None,
+            scan_points: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -160,6 +166,11 @@ impl Recorder {
 impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
         self.paths = scene::log_scene(&self.rec, sim, camera, labels, self.images.options());
+        self.laser = sim.robot().lasers.first().and_then(|l| {
+            let link = sim.robot().link_index(&l.link)?;
+            let path = self.paths.links.get(link)?;
+            Some((format!("{path}/scan"), l.link_from_sensor))
+        });
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
@@ -224,6 +235,12 @@ impl Observer for Recorder {
             "plots/mode",
             &rerun::Scalars::single(if stats.mode == Mode::Follow { 1.0 } else { 0.0 }),
         );
+        if stats.mode == Mode::Follow {
+            self.log(
+                "plots/follower/state",
+                &rerun::Scalars::single(stats.follow_state.index() as f64),
+            );
+        }
         if stats.detector_ok {
             self.log(
                 "plots/detector/latency_ms",
@@ -273,6 +290,24 @@ impl Observer for Recorder {
         .with_class_ids(b.iter().map(|b| u16::try_from(b.id).unwrap_or(u16::MAX)));
         self.log("world/robot/camera/image/detections", &data);
         self.set_time(stamp.sim_time_s);
+    }
+
+    fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
+        let Some(link_from_sensor) = self.laser.as_ref().map(|l| l.1) else {
+            return;
+        };
+        self.scan_points.clear();
+        for [x, y] in scan.points() {
+            let p = link_from_sensor.transform_point(glam::Vec3::new(x, y, 0.0));
+            self.scan_points.push([p.x, p.y, p.z]);
+        }
+        self.rec.set_duration_secs("sim_time", scan.stamp_s);
+        let points = rerun::Points3D::new(self.scan_points.iter().copied())
+            .with_radii([0.015f32])
+            .with_colors([rerun::Color::from_rgb(230, 40, 40)]);
+        if let Some((path, _)) = &self.laser {
+            self.log(path, &points);
+        }
     }
 
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

@@ -1,0 +1,428 @@
+//! `rover eval`: runs scenario files (world + robot + success criteria, see
+//! docs/FOLLOWER.md) headless, several at once, and judges the follower.
+//!
+//! Each scenario runs in a child process of this binary (`--worker`): deterministic (lockstep
+//! detection on sim time), single-threaded rendering (`LP_NUM_THREADS=1`) so that `--jobs N`
+//! scales with cores, and isolated (a crash fails one scenario, not the suite). The parent shows
+//! progress, prints a table and writes `eval.json` and `eval.csv`; `--shard I/N` runs a slice
+//! of the suite on one machine and `--merge` puts the slices' JSON back together.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use rover_core::scenario::{self, RunOptions, Scenario, ScenarioResult};
+use serde::{Deserialize, Serialize};
+
+use super::args::EvalArgs;
+use crate::viewer::{Recorder, RecorderOptions};
+
+/// What `eval.json` holds.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EvalReport {
+    /// Scenarios run.
+    pub scenarios: usize,
+    /// Scenarios whose criteria all held.
+    pub passed: usize,
+    /// passed / scenarios.
+    pub pass_rate: f64,
+    /// One result per scenario, in name order.
+    pub results: Vec<ScenarioResult>,
+    /// Wall-clock figures (the only part that differs between identical evaluations).
+    pub timing: Timing,
+}
+
+/// Wall-clock figures of an evaluation.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Timing {
+    /// Scenarios run at once.
+    pub jobs: usize,
+    /// Wall seconds for the whole evaluation.
+    pub wall_s: f64,
+    /// Sum of the scenarios' sim seconds divided by `wall_s`.
+    pub sim_per_wall: f64,
+}
+
+pub(crate) fn run(args: EvalArgs) -> Result<()> {
+    if let Some(out) = &args.worker {
+        return worker(&args, out);
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create the output folder {}", args.out.display()))?;
+    if !args.merge.is_empty() {
+        let report = merge(&args.merge)?;
+        return finish(&args, report, "eval.json");
+    }
+    let paths = if args.paths.is_empty() {
+        vec![rover_core::paths::bundled("scenarios")]
+    } else {
+        args.paths.clone()
+    };
+    let files = scenario::collect_files(&paths)?;
+    if files.is_empty() {
+        bail!(
+            "no scenario files (*.toml) in {}",
+            paths
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    // Load them all first: a bad file is reported before anything runs.
+    let mut scenarios = Vec::with_capacity(files.len());
+    for f in &files {
+        let s = Scenario::load(f).with_context(|| format!("scenario {}", f.display()))?;
+        if args.tag.is_empty() || args.tag.iter().any(|t| s.tags.contains(t)) {
+            scenarios.push((f.clone(), s.name.clone(), s.duration_s));
+        }
+    }
+    let mut names: Vec<&str> = scenarios.iter().map(|s| s.1.as_str()).collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        bail!("two scenarios are named \"{}\"; names must be unique", w[0]);
+    }
+    if let Some((index, count)) = args.shard {
+        scenarios = scenarios
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| i % count == index)
+            .map(|(_, s)| s)
+            .collect();
+    }
+    if scenarios.is_empty() {
+        bail!("no scenarios to run (check --tag and --shard)");
+    }
+    if args.detector.model.is_none() {
+        // Fetch the default model once, before the workers race for it.
+        rover_perception::fetch::ensure_default_model()?;
+    }
+    let jobs = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, scenarios.len());
+    let report = run_all(&args, &scenarios, jobs)?;
+    let name = match args.shard {
+        Some((i, n)) => format!("eval-shard-{i}-of-{n}.json"),
+        None => "eval.json".to_owned(),
+    };
+    finish(&args, report, &name)
+}
+
+/// Runs the scenarios in child processes, `jobs` at a time, longest first.
+fn run_all(args: &EvalArgs, scenarios: &[(PathBuf, String, f64)], jobs: usize) -> Result<EvalReport> {
+    let exe = std::env::current_exe().context("cannot find rover's own executable")?;
+    let total_sim_s: f64 = scenarios.iter().map(|s| s.2).sum();
+    let bar = ProgressBar::new(scenarios.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} scenarios  {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    // Longest first: the last job to finish is a short one.
+    let mut order: Vec<usize> = (0..scenarios.len()).collect();
+    order.sort_by(|&a, &b| scenarios[b].2.total_cmp(&scenarios[a].2).then(a.cmp(&b)));
+    let queue = Mutex::new(order.into_iter());
+    let results: Mutex<Vec<Option<ScenarioResult>>> = Mutex::new(vec![None; scenarios.len()]);
+    let running: Mutex<Vec<String>> = Mutex::new(Vec::new());
+    let scratch = tempfile::tempdir().context("cannot create a temporary folder")?;
+    let started = Instant::now();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| {
+                loop {
+                    let next = queue.lock().ok().and_then(|mut q| q.next());
+                    let Some(i) = next else { break };
+                    let (file, name, _) = &scenarios[i];
+                    if let Ok(mut r) = running.lock() {
+                        r.push(name.clone());
+                        bar.set_message(r.join(", "));
+                    }
+                    let json = scratch.path().join(format!("{i}.json"));
+                    let result = run_child(&exe, args, file, name, &json);
+                    let line = format!(
+                        "{} {:<28} {:>6.1} s",
+                        if result.passed { "pass" } else { "FAIL" },
+                        result.name,
+                        result.wall_s
+                    );
+                    bar.println(line);
+                    bar.inc(1);
+                    if let Ok(mut r) = running.lock() {
+                        r.retain(|n| n != name);
+                        bar.set_message(r.join(", "));
+                    }
+                    if let Ok(mut all) = results.lock() {
+                        all[i] = Some(result);
+                    }
+                }
+            });
+        }
+    });
+    bar.finish_and_clear();
+    let wall_s = started.elapsed().as_secs_f64();
+    let results: Vec<ScenarioResult> = results
+        .into_inner()
+        .map_err(|_| anyhow::anyhow!("a worker thread panicked"))?
+        .into_iter()
+        .flatten()
+        .collect();
+    Ok(report_of(
+        results,
+        Timing {
+            jobs,
+            wall_s,
+            sim_per_wall: total_sim_s / wall_s.max(1e-9),
+        },
+    ))
+}
+
+fn report_of(mut results: Vec<ScenarioResult>, timing: Timing) -> EvalReport {
+    results.sort_by(|a, b| a.name.cmp(&b.name));
+    let passed = results.iter().filter(|r| r.passed).count();
+    EvalReport {
+        scenarios: results.len(),
+        passed,
+        pass_rate: if results.is_empty() {
+            0.0
+        } else {
+            passed as f64 / results.len() as f64
+        },
+        results,
+        timing,
+    }
+}
+
+/// One scenario in a child process; a child that fails to start, crashes or writes no result
+/// becomes a failed result carrying its last words.
+fn run_child(exe: &Path, args: &EvalArgs, file: &Path, name: &str, json: &Path) -> ScenarioResult {
+    let mut cmd = Command::new(exe);
+    cmd.arg("eval")
+        .arg("--worker")
+        .arg(json)
+        .arg("--out")
+        .arg(&args.out)
+        .args(args.detector.to_args())
+        .arg(file)
+        .env("LP_NUM_THREADS", "1")
+        .env(
+            "RUST_LOG",
+            std::env::var("ROVER_EVAL_LOG").unwrap_or_else(|_| "warn".into()),
+        )
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    if args.rrd {
+        cmd.arg("--rrd");
+    }
+    if args.traces {
+        cmd.arg("--traces");
+    }
+    let file_text = file.display().to_string();
+    let output = match cmd.output() {
+        Ok(o) => o,
+        Err(e) => return ScenarioResult::failed(name, &file_text, format!("cannot start: {e}")),
+    };
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    match std::fs::read_to_string(json)
+        .ok()
+        .and_then(|t| serde_json::from_str::<ScenarioResult>(&t).ok())
+    {
+        Some(r) => r,
+        None => {
+            let tail: Vec<&str> = stderr.lines().rev().take(5).collect();
+            let tail: Vec<&str> = tail.into_iter().rev().collect();
+            ScenarioResult::failed(
+                name,
+                &file_text,
+                format!(
+                    "the run ended without a result ({}): {}",
+                    output.status,
+                    tail.join(" | ")
+                ),
+            )
+        }
+    }
+}
+
+/// `--worker RESULT.json FILE`: runs one scenario in this process and writes its result.
+fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
+    let [file] = args.paths.as_slice() else {
+        bail!("--worker runs exactly one scenario file");
+    };
+    let result = match Scenario::load(file) {
+        Err(e) => ScenarioResult::failed("?", &file.display().to_string(), e.to_string()),
+        Ok(s) => {
+            let options = RunOptions {
+                detector: args.detector.config()?,
+                trace: args
+                    .traces
+                    .then(|| args.out.join(format!("{}.csv", s.name))),
+            };
+            let outcome = if args.rrd {
+                let rrd = args.out.join(format!("{}.rrd", s.name));
+                let rec_options = RecorderOptions {
+                    record: Some(rrd),
+                    ..RecorderOptions::default()
+                };
+                match Recorder::start(&rec_options)? {
+                    Some(mut rec) => {
+                        let r = scenario::run(&s, &options, &mut rec);
+                        rec.finish();
+                        r
+                    }
+                    None => scenario::run(&s, &options, &mut rover_core::NoObserver),
+                }
+            } else {
+                scenario::run(&s, &options, &mut rover_core::NoObserver)
+            };
+            outcome.unwrap_or_else(|e| {
+                ScenarioResult::failed(&s.name, &file.display().to_string(), e.to_string())
+            })
+        }
+    };
+    let text = serde_json::to_string_pretty(&result)?;
+    std::fs::write(out, text).with_context(|| format!("cannot write {}", out.display()))?;
+    Ok(())
+}
+
+/// Reads shards' reports and puts them together (each scenario once).
+fn merge(files: &[PathBuf]) -> Result<EvalReport> {
+    let mut results: Vec<ScenarioResult> = Vec::new();
+    let mut timing = Timing::default();
+    for f in files {
+        let text =
+            std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
+        let report: EvalReport = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a rover eval report", f.display()))?;
+        for r in report.results {
+            if results.iter().any(|o| o.name == r.name) {
+                bail!(
+                    "{}: scenario \"{}\" is in more than one shard",
+                    f.display(),
+                    r.name
+                );
+            }
+            results.push(r);
+        }
+        timing.jobs += report.timing.jobs;
+        timing.wall_s = timing.wall_s.max(report.timing.wall_s);
+    }
+    let sim: f64 = results.iter().map(|r| r.metrics.sim_s).sum();
+    timing.sim_per_wall = sim / timing.wall_s.max(1e-9);
+    Ok(report_of(results, timing))
+}
+
+/// Prints the table, writes JSON and CSV; fails (exit 1) when a scenario failed.
+fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    write_table(&mut stdout, &report)?;
+    let json_path = args.out.join(json_name);
+    std::fs::write(&json_path, serde_json::to_string_pretty(&report)?)
+        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    let csv_path = json_path.with_extension("csv");
+    let mut csv = Vec::new();
+    write_csv(&mut csv, &report)?;
+    std::fs::write(&csv_path, csv).with_context(|| format!("cannot write {}", csv_path.display()))?;
+    writeln!(
+        stdout,
+        "\n{}/{} scenarios passed ({:.0}%); {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",
+        report.passed,
+        report.scenarios,
+        100.0 * report.pass_rate,
+        report.timing.jobs,
+        report.timing.wall_s,
+        report.timing.sim_per_wall,
+        json_path.display(),
+        csv_path.display()
+    )?;
+    if report.passed < report.scenarios {
+        bail!(
+            "{} of {} scenarios failed",
+            report.scenarios - report.passed,
+            report.scenarios
+        );
+    }
+    Ok(())
+}
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".to_owned(), |v| format!("{v:.digits$}"))
+}
+
+/// The human table: one row per scenario, the measured figures and what failed.
+pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{:<26} {:<6} {:>8} {:>8} {:>8} {:>9} {:>7} {:>6}  failed",
+        "scenario", "result", "acq s", "final m", "max m", "clear m", "avoid s", "wall s"
+    )?;
+    for r in &report.results {
+        let m = &r.metrics;
+        let failed: Vec<String> = r
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| format!("{} ({}; want {})", c.name, c.value, c.limit))
+            .chain(r.error.iter().cloned())
+            .collect();
+        writeln!(
+            out,
+            "{:<26} {:<6} {:>8} {:>8} {:>8} {:>9.3} {:>7.1} {:>6.1}  {}",
+            r.name,
+            if r.passed { "pass" } else { "FAIL" },
+            opt(m.acquired_at_s, 1),
+            opt(m.final_range_m, 2),
+            opt(m.max_range_after_acquire_m, 2),
+            m.min_clearance_m,
+            m.avoiding_s,
+            r.wall_s,
+            failed.join("; ")
+        )?;
+    }
+    Ok(())
+}
+
+/// One CSV row per scenario.
+fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "scenario,passed,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,wall_s,failed"
+    )?;
+    for r in &report.results {
+        let m = &r.metrics;
+        let failed: Vec<&str> = r
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.name.as_str())
+            .chain(r.error.as_deref().map(|_| "error"))
+            .collect();
+        writeln!(
+            out,
+            "{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{}",
+            r.name,
+            r.passed,
+            opt(m.acquired_at_s, 3),
+            opt(m.final_range_m, 4),
+            opt(m.max_range_after_acquire_m, 4),
+            m.min_clearance_m,
+            opt(m.min_person_range_m, 4),
+            m.drove_while_searching_s,
+            m.travel_m,
+            opt(m.final_facing_deg, 2),
+            m.transitions,
+            m.final_state,
+            m.avoiding_s,
+            r.wall_s,
+            failed.join(" ")
+        )?;
+    }
+    Ok(())
+}

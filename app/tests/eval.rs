@@ -1,0 +1,197 @@
+//! `rover eval` as users run it: real binary, real renderer and detector in worker processes.
+//! Parallel runs give the same results as serial ones (byte-identical JSON apart from timings);
+//! shards merge back into the whole; bad scenario files are refused with file, line and key.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use anyhow::Result;
+
+fn repo(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative)
+}
+
+fn rover(args: &[&str], cwd: &Path) -> Result<Output> {
+    Ok(Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(args)
+        .current_dir(cwd)
+        .env("RUST_LOG", "warn")
+        .output()?)
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Two short scenarios: nobody in the room (search, never drive) and a person ahead.
+fn write_scenarios(dir: &Path) -> Result<Vec<PathBuf>> {
+    let robot = repo("assets/robots/my_robot_laser.urdf.xacro");
+    let world = |person: &str| {
+        format!(
+            "[world]\nname = \"w\"\n[world.robot]\nurdf = \"{}\"\n{person}",
+            robot.display()
+        )
+    };
+    let a = dir.join("a_nobody.toml");
+    std::fs::write(
+        &a,
+        format!(
+            "[scenario]\nduration_s = 3.0\n[criteria]\nmax_travel_m = 0.05\n{}",
+            world("")
+        ),
+    )?;
+    let b = dir.join("b_person.toml");
+    std::fs::write(
+        &b,
+        format!(
+            "[scenario]\nduration_s = 4.0\ntarget = \"alice\"\n[criteria]\nacquire_within_s = 2.0\nmax_range_after_acquire_m = 4.5\n{}",
+            world("[[world.person]]\nname = \"alice\"\nposition_m = [4.0, 0.0]\nheading_deg = 180.0\n")
+        ),
+    )?;
+    Ok(vec![a, b])
+}
+
+/// The report without its wall-clock fields.
+fn without_timings(json: &str) -> Result<serde_json::Value> {
+    let mut v: serde_json::Value = serde_json::from_str(json)?;
+    if let Some(o) = v.as_object_mut() {
+        o.remove("timing");
+    }
+    if let Some(results) = v.get_mut("results").and_then(|r| r.as_array_mut()) {
+        for r in results {
+            if let Some(o) = r.as_object_mut() {
+                o.remove("wall_s");
+            }
+        }
+    }
+    Ok(v)
+}
+
+#[test]
+fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let files = write_scenarios(dir.path())?;
+    let folder = dir.path().display().to_string();
+    let run = |jobs: &str, out: &str, extra: &[&str]| -> Result<(Output, String)> {
+        let mut args = vec!["eval", folder.as_str(), "--jobs", jobs, "--out", out];
+        args.extend_from_slice(extra);
+        let o = rover(&args, dir.path())?;
+        let name = if extra.is_empty() {
+            "eval.json".to_owned()
+        } else {
+            format!("eval-shard-{}-of-2.json", &extra[1][..1])
+        };
+        let json = std::fs::read_to_string(dir.path().join(out).join(name)).unwrap_or_default();
+        Ok((o, json))
+    };
+    let (serial, serial_json) = run("1", "serial", &[])?;
+    assert!(
+        serial.status.success(),
+        "{}{}",
+        text(&serial.stdout),
+        text(&serial.stderr)
+    );
+    let table = text(&serial.stdout);
+    assert!(table.contains("a_nobody") && table.contains("b_person"), "{table}");
+    assert!(table.contains("2/2 scenarios passed"), "{table}");
+    let (parallel, parallel_json) = run("2", "parallel", &[])?;
+    assert!(parallel.status.success(), "{}", text(&parallel.stderr));
+    assert_eq!(without_timings(&serial_json)?, without_timings(&parallel_json)?);
+    // Byte for byte too, once the timing lines are dropped.
+    let strip = |s: &str| -> String {
+        s.lines()
+            .filter(|l| !l.contains("wall_s") && !l.contains("\"jobs\"") && !l.contains("sim_per_wall"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(strip(&serial_json), strip(&parallel_json));
+    let csv = std::fs::read_to_string(dir.path().join("serial/eval.csv"))?;
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(csv.starts_with("scenario,passed,"), "{csv}");
+
+    // Shards: 0/2 and 1/2 each run one scenario; merged they are the whole.
+    let (s0, j0) = run("1", "shards", &["--shard", "0/2"])?;
+    assert!(s0.status.success(), "{}", text(&s0.stderr));
+    let (s1, j1) = run("1", "shards", &["--shard", "1/2"])?;
+    assert!(s1.status.success(), "{}", text(&s1.stderr));
+    assert!(j0.contains("a_nobody") && !j0.contains("b_person"), "{j0}");
+    assert!(j1.contains("b_person"), "{j1}");
+    let merged = rover(
+        &[
+            "eval",
+            "--merge",
+            "shards/eval-shard-0-of-2.json",
+            "shards/eval-shard-1-of-2.json",
+            "--out",
+            "merged",
+        ],
+        dir.path(),
+    )?;
+    assert!(merged.status.success(), "{}", text(&merged.stderr));
+    let merged_json = std::fs::read_to_string(dir.path().join("merged/eval.json"))?;
+    assert_eq!(without_timings(&serial_json)?, without_timings(&merged_json)?);
+    drop(files);
+    Ok(())
+}
+
+#[test]
+fn a_failing_scenario_fails_the_evaluation_and_says_why() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let robot = repo("assets/robots/my_robot_laser.urdf.xacro");
+    std::fs::write(
+        dir.path().join("too_strict.toml"),
+        format!(
+            "[scenario]\nduration_s = 2.0\ntarget = \"alice\"\n[criteria]\nfinal_range_m = [0.0, 0.5]\n[world]\n[world.robot]\nurdf = \"{}\"\n[[world.person]]\nname = \"alice\"\nposition_m = [4.0, 0.0]\n",
+            robot.display()
+        ),
+    )?;
+    let out = rover(&["eval", ".", "--out", "out"], dir.path())?;
+    assert!(!out.status.success());
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("FAIL"), "{stdout}");
+    assert!(stdout.contains("final_range_m"), "{stdout}");
+    assert!(text(&out.stderr).contains("1 of 1 scenarios failed"), "{}", text(&out.stderr));
+    Ok(())
+}
+
+#[test]
+fn bad_scenario_files_are_refused_with_file_line_and_key() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let cases = [
+        (
+            "typo.toml",
+            "[scenario]\nduration_s = 5.0\n[criteria]\nfinal_rnage_m = [1.0, 2.0]\n[world]\n",
+            "unknown field `final_rnage_m`",
+        ),
+        (
+            "target.toml",
+            "[scenario]\nduration_s = 5.0\ntarget = \"zoe\"\n[world]\n[[world.person]]\nname = \"alice\"\nposition_m = [1.0, 0.0]\n",
+            "\"zoe\" is not a person in the world; its people: alice",
+        ),
+        (
+            "noworld.toml",
+            "[scenario]\nduration_s = 5.0\n",
+            "expected either a [world] table or world_file",
+        ),
+        (
+            "range.toml",
+            "[scenario]\nduration_s = 5.0\n[criteria]\nfinal_range_m = [2.0, 1.0]\n[world]\n",
+            "criteria.final_range_m",
+        ),
+    ];
+    for (name, body, expected) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, body)?;
+        let out = rover(&["eval", name, "--out", "out"], dir.path())?;
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{name}: {stderr}");
+        assert!(stderr.contains(name), "{name}: {stderr}");
+        assert!(stderr.contains(expected), "{name}: {stderr}");
+    }
+    // The typo's line is named.
+    let out = rover(&["eval", "typo.toml", "--out", "out"], dir.path())?;
+    assert!(text(&out.stderr).contains("line 4"), "{}", text(&out.stderr));
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! Obstacle avoidance for the follower: a dynamic-window search over (linear, angular) commands,
+//! each rolled out as a constant-velocity arc and checked against the newest laser returns.
+//!
+//! The follower's own command (steer to the target, keep the standoff) is kept whenever its arc
+//! stays well clear of every return. Otherwise the arcs of a window of commands are scored by
+//! how they head toward the target, how much nearer they bring the robot, how much room they
+//! leave and how fast they go; arcs that come closer than the hard margin are never taken.
+//! Obstacles are points in the robot's base frame (x forward, y left), the robot a circle.
+
+use rover_sim::{Twist, wrap_angle};
+
+/// Avoidance settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AvoidConfig {
+    /// Radius of a circle around the base origin that holds the robot's footprint (m).
+    pub robot_radius_m: f64,
+    /// Arcs passing closer than this to a return (beyond the robot's radius) are never taken (m).
+    pub hard_margin_m: f64,
+    /// The follower's own command is kept when its arc stays this clear (m).
+    pub free_margin_m: f64,
+    /// How far ahead arcs are rolled out (s)...
+    pub horizon_s: f64,
+    /// ... and at least this far along the arc (m): a slow arc is not safe just because it
+    /// is short.
+    pub lookahead_m: f64,
+}
+
+impl Default for AvoidConfig {
+    fn default() -> Self {
+        Self {
+            robot_radius_m: 0.25,
+            hard_margin_m: 0.17,
+            free_margin_m: 0.3,
+            horizon_s: 2.0,
+            lookahead_m: 1.5,
+        }
+    }
+}
+
+/// Rollout step (s).
+const STEP_S: f64 = 0.1;
+/// Longest rollout (s).
+const MAX_ROLLOUT_S: f64 = 6.0;
+
+/// How long an arc at `linear_mps` is rolled out (s).
+fn rollout_s(linear_mps: f64, config: &AvoidConfig) -> f64 {
+    let v = linear_mps.abs();
+    if v < 1e-6 {
+        0.0
+    } else {
+        (config.lookahead_m / v).clamp(config.horizon_s, MAX_ROLLOUT_S)
+    }
+}
+/// Linear speeds tried, as fractions of the allowed maximum.
+const SPEED_FRACTIONS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
+/// Angular speeds tried across [-max, max].
+const TURN_SAMPLES: usize = 17;
+
+/// What the avoidance decided.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Avoided {
+    /// The command to send.
+    pub cmd: Twist,
+    /// Whether it differs from the follower's own command (an obstacle was in the way).
+    pub steering: bool,
+    /// Smallest gap (m) between the robot's circle and a return along the chosen arc.
+    pub clearance_m: f64,
+}
+
+/// Smallest gap (m) between the robot circle and any obstacle along the arc of `cmd`.
+pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
+    let steps = (rollout_s(cmd.linear_mps, config) / STEP_S).ceil() as usize;
+    let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
+    let mut nearest = f64::INFINITY;
+    for step in 0..=steps {
+        if step > 0 {
+            // Exact integration of a constant (v, w) over one step.
+            let w = cmd.angular_radps;
+            let v = cmd.linear_mps;
+            if w.abs() < 1e-6 {
+                x += v * STEP_S * yaw.cos();
+                y += v * STEP_S * yaw.sin();
+            } else {
+                let next = yaw + w * STEP_S;
+                x += v / w * (next.sin() - yaw.sin());
+                y -= v / w * (next.cos() - yaw.cos());
+                yaw = next;
+            }
+        }
+        for o in obstacles {
+            let d2 = (o[0] - x).powi(2) + (o[1] - y).powi(2);
+            if d2 < nearest {
+                nearest = d2;
+            }
+        }
+        if cmd.linear_mps == 0.0 {
+            break;
+        }
+    }
+    nearest.sqrt() - config.robot_radius_m
+}
+
+/// Picks the command: `preferred` when its arc is free, else the best admissible arc toward
+/// `goal_m` (base frame) with forward speed at most `max_linear_mps` and turn rate within
+/// `max_turn_radps`. With no admissible arc the robot stops.
+pub fn choose(
+    preferred: Twist,
+    goal_m: [f64; 2],
+    obstacles: &[[f64; 2]],
+    max_linear_mps: f64,
+    max_turn_radps: f64,
+    config: &AvoidConfig,
+) -> Avoided {
+    let own = arc_clearance_m(preferred, obstacles, config);
+    if own >= config.free_margin_m || (preferred.linear_mps == 0.0 && own >= 0.02) {
+        return Avoided {
+            cmd: preferred,
+            steering: false,
+            clearance_m: own,
+        };
+    }
+    let goal_distance = goal_m[0].hypot(goal_m[1]);
+    let reach = config.lookahead_m.max(1e-3);
+    let mut best: Option<(f64, Twist, f64)> = None;
+    for fraction in SPEED_FRACTIONS {
+        let v = fraction * max_linear_mps.max(0.0);
+        for k in 0..TURN_SAMPLES {
+            let w = max_turn_radps * (2.0 * k as f64 / (TURN_SAMPLES - 1) as f64 - 1.0);
+            let cmd = Twist::new(v, w);
+            let clearance = arc_clearance_m(cmd, obstacles, config);
+            if v <= 0.0 || clearance < config.hard_margin_m {
+                continue;
+            }
+            // Where the arc ends (constant v, w over the rollout).
+            let t = rollout_s(v, config).max(config.horizon_s);
+            let (ex, ey, eyaw) = if w.abs() < 1e-6 {
+                (v * t, 0.0, 0.0)
+            } else {
+                let yaw = w * t;
+                (v / w * yaw.sin(), v / w * (1.0 - yaw.cos()), yaw)
+            };
+            let to_goal = wrap_angle((goal_m[1] - ey).atan2(goal_m[0] - ex) - eyaw);
+            let heading = 1.0 - to_goal.abs() / std::f64::consts::PI;
+            let progress = (goal_distance - (goal_m[0] - ex).hypot(goal_m[1] - ey)) / reach;
+            let room = clearance.min(1.0);
+            let score = heading + progress + 0.4 * room + 0.5 * fraction
+                - 0.1 * (w - preferred.angular_radps).abs() / max_turn_radps.max(1e-3);
+            if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
+                best = Some((score, cmd, clearance));
+            }
+        }
+    }
+    if let Some((_, cmd, clearance_m)) = best {
+        return Avoided {
+            cmd,
+            steering: true,
+            clearance_m,
+        };
+    }
+    // No arc that moves is free: turn in place toward the target while nothing touches (the
+    // next scans may show a way out), else stop.
+    let turn = Twist::new(
+        0.0,
+        0.5 * max_turn_radps * goal_m[1].atan2(goal_m[0]).signum(),
+    );
+    let room = arc_clearance_m(turn, obstacles, config);
+    Avoided {
+        cmd: if room >= 0.02 { turn } else { Twist::ZERO },
+        steering: true,
+        clearance_m: room,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Returns from the face of a 0.6 m box whose near side is `ahead_m` in front.
+    fn crate_ahead(ahead_m: f64) -> Vec<[f64; 2]> {
+        let mut points = Vec::new();
+        for i in 0..=12 {
+            let y = -0.3 + 0.05 * f64::from(i);
+            points.push([ahead_m, y]);
+        }
+        points
+    }
+
+    #[test]
+    fn a_free_path_keeps_the_followers_command() {
+        let cmd = Twist::new(0.5, 0.1);
+        let out = choose(cmd, [4.0, 0.0], &[[0.0, 3.0]], 0.8, 1.0, &AvoidConfig::default());
+        assert_eq!(out.cmd, cmd);
+        assert!(!out.steering);
+    }
+
+    #[test]
+    fn an_obstacle_in_the_way_is_passed_with_room_to_spare() {
+        let config = AvoidConfig::default();
+        let obstacles = crate_ahead(1.2);
+        let straight = Twist::new(0.8, 0.0);
+        assert!(arc_clearance_m(straight, &obstacles, &config) < 0.0);
+        let out = choose(straight, [4.0, 0.0], &obstacles, 0.8, 1.0, &config);
+        assert!(out.steering);
+        assert!(out.cmd.angular_radps.abs() > 0.1, "{out:?}");
+        assert!(out.clearance_m >= config.hard_margin_m, "{out:?}");
+        assert!(out.cmd.linear_mps > 0.0, "{out:?}");
+    }
+
+    #[test]
+    fn boxed_in_it_stops_rather_than_touches() {
+        let config = AvoidConfig::default();
+        let mut ring = Vec::new();
+        for i in 0..72 {
+            let a = f64::from(i) * 5f64.to_radians();
+            ring.push([0.26 * a.cos(), 0.26 * a.sin()]);
+        }
+        let out = choose(Twist::new(0.5, 0.0), [4.0, 0.0], &ring, 0.8, 1.0, &config);
+        assert_eq!(out.cmd.linear_mps, 0.0);
+        assert_eq!(out.cmd.angular_radps, 0.0, "touching: not even a turn");
+        // With room to turn but none to drive: turn toward the target.
+        let mut wide = Vec::new();
+        for i in 0..72 {
+            let a = f64::from(i) * 5f64.to_radians();
+            wide.push([0.5 * a.cos(), 0.5 * a.sin()]);
+        }
+        let out = choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, &config);
+        assert_eq!(out.cmd.linear_mps, 0.0);
+        assert!(out.cmd.angular_radps > 0.0, "{out:?}");
+    }
+}

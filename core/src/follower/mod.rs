@@ -1,0 +1,1049 @@
+//! The person follower: turns darknet_ros-style detections (and, when the robot has one, 2D laser
+//! scans) into cmd_vel. docs/FOLLOWER.md describes it for users.
+//!
+//! - **Target**: a person of the configured class, picked as the nearest and then kept: each
+//!   detection is placed in the odometry frame (range from the box height, or from where the feet
+//!   meet the ground when the box is cut off at the top; the robot's pose at the image's time) and
+//!   associated with the target when it falls inside a gate around the target's prediction.
+//! - **Estimator**: a constant-velocity Kalman filter ([`TargetFilter`]) on the target's position
+//!   and velocity, fed by the camera and by laser returns around the prediction (the laser keeps
+//!   a close target whose head the low camera cannot see). Its prediction leads moving targets,
+//!   centres the gate and aims the search.
+//! - **States** ([`FollowState`]): TRACKING (seen lately: steer to centre it, regulate the range
+//!   to the standoff, calm inside a deadband), HOLDING (lost briefly: stay, face the prediction;
+//!   longer for a close, centred target that only flickers), SEARCHING (turn toward the
+//!   prediction, then sweep; never drives), STALE (detector messages stopped: stop), NO DETECTOR,
+//!   WAITING (nothing heard yet).
+//! - **Obstacles**: with a laser, commands whose arcs come near a return are replaced by the best
+//!   free arc toward the target ([`avoid`]). Without a laser the follower cannot see obstacles.
+//!
+//! Pure library code on sim time: no threads, no clocks, no UI, no allocation per update once
+//! the buffers have grown.
+
+pub mod avoid;
+pub mod filter;
+
+use std::collections::VecDeque;
+
+use rover_perception::{BoundingBox, BoundingBoxes};
+use rover_sim::nalgebra::Matrix2;
+use rover_sim::{CameraInfo, LaserScan, Odometry, Twist, wrap_angle};
+
+pub use avoid::{AvoidConfig, Avoided};
+pub use filter::TargetFilter;
+use filter::polar_covariance;
+
+/// Follower settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FollowerConfig {
+    /// Class to follow (darknet_ros `Class`).
+    pub target_class: String,
+    /// Minimum detection probability for a target.
+    pub min_probability: f64,
+    /// Distance to keep from the target (m).
+    pub standoff_m: f64,
+    /// Assumed real height of the target (m), for range from box height.
+    pub target_height_m: f64,
+    /// Forward speed limit (m/s); reversing is limited to a third of it.
+    pub max_speed_mps: f64,
+    /// Turn rate limit (rad/s).
+    pub max_turn_radps: f64,
+    /// Linear acceleration limit (m/s^2).
+    pub max_accel_mps2: f64,
+    /// Angular acceleration limit (rad/s^2).
+    pub max_turn_accel_radps2: f64,
+    /// Turn rate while searching for a lost target (rad/s).
+    pub search_turn_radps: f64,
+    /// Stop when the newest detector message is older than this (s of sim time).
+    pub stale_after_s: f64,
+    /// TRACKING becomes HOLDING when the target has not been seen for this long (s).
+    pub lost_after_s: f64,
+    /// HOLDING becomes SEARCHING after this long without the target (s).
+    pub hold_s: f64,
+    /// ... or after this long when the target was last seen close and centred (s): at the
+    /// standoff a low camera sees only legs and detections flicker; that is no reason to search.
+    pub close_hold_s: f64,
+    /// A target not seen by the camera for this long is forgotten: the next person of the class
+    /// becomes a new target wherever it is (s).
+    pub forget_after_s: f64,
+    /// Laser returns keep a target only while the camera confirmed it within this long (s).
+    pub laser_confirm_s: f64,
+    /// Proportional gain from bearing error (rad) to turn rate (rad/s).
+    pub turn_gain: f64,
+    /// Proportional gain from range error (m) to speed (m/s).
+    pub speed_gain: f64,
+    /// Lead moving targets by this long (s): aim where the target will be.
+    pub lead_s: f64,
+    /// At the standoff: range errors within this band (m) and bearings within
+    /// [`FollowerConfig::bearing_deadband_rad`] are left alone once settled (hysteresis: calm).
+    pub standoff_band_m: f64,
+    /// Bearing deadband at rest (rad).
+    pub bearing_deadband_rad: f64,
+    /// Obstacle avoidance (used when the robot has a laser).
+    pub avoid: AvoidConfig,
+}
+
+impl Default for FollowerConfig {
+    fn default() -> Self {
+        Self {
+            target_class: "person".into(),
+            min_probability: 0.4,
+            standoff_m: 1.5,
+            target_height_m: 1.75,
+            max_speed_mps: 0.8,
+            max_turn_radps: 1.2,
+            max_accel_mps2: 0.8,
+            max_turn_accel_radps2: 3.0,
+            search_turn_radps: 0.6,
+            stale_after_s: 1.0,
+            lost_after_s: 0.6,
+            hold_s: 2.0,
+            close_hold_s: 12.0,
+            forget_after_s: 8.0,
+            laser_confirm_s: 10.0,
+            turn_gain: 1.8,
+            speed_gain: 0.8,
+            lead_s: 0.5,
+            standoff_band_m: 0.25,
+            bearing_deadband_rad: 0.1,
+            avoid: AvoidConfig::default(),
+        }
+    }
+}
+/// Where the camera is and how it projects, as the follower needs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraGeometry {
+    /// Focal length (px).
+    pub fx: f64,
+    /// Focal length (px).
+    pub fy: f64,
+    /// Principal point (px).
+    pub cx: f64,
+    /// Principal point (px).
+    pub cy: f64,
+    /// Image height (px).
+    pub height_px: f64,
+    /// Camera height above the ground (m).
+    pub height_m: f64,
+    /// Camera position ahead of the base origin (m).
+    pub forward_m: f64,
+    /// How far the optical axis looks below the horizon (rad; a TurtleBot3's camera: 0.174).
+    pub pitch_down_rad: f64,
+}
+
+impl CameraGeometry {
+    /// From a CameraInfo and the camera's mounting (height above ground, offset ahead of base).
+    pub fn new(info: &CameraInfo, height_m: f64, forward_m: f64) -> Self {
+        Self {
+            fx: info.k[0],
+            fy: info.k[4],
+            cx: info.k[2],
+            cy: info.k[5],
+            height_px: f64::from(info.height),
+            height_m,
+            forward_m,
+            pitch_down_rad: 0.0,
+        }
+    }
+}
+
+/// What the follower is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FollowState {
+    /// No detector message yet: holding still.
+    #[default]
+    Waiting,
+    /// No detector (missing model, failure): holding still.
+    NoDetector,
+    /// Following a target seen lately.
+    Tracking,
+    /// Target lost briefly: staying, facing where it is expected.
+    Holding,
+    /// Target lost: turning toward where it is expected, then sweeping on the spot.
+    Searching,
+    /// Detections are stale: stopped.
+    Stale,
+}
+
+impl FollowState {
+    /// Lower-case name for logs, traces and the HUD.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FollowState::Waiting => "waiting",
+            FollowState::NoDetector => "no_detector",
+            FollowState::Tracking => "tracking",
+            FollowState::Holding => "holding",
+            FollowState::Searching => "searching",
+            FollowState::Stale => "stale",
+        }
+    }
+
+    /// Every state, in a stable order (for plots: the index is the state's number).
+    pub const ALL: [FollowState; 6] = [
+        FollowState::Waiting,
+        FollowState::NoDetector,
+        FollowState::Tracking,
+        FollowState::Holding,
+        FollowState::Searching,
+        FollowState::Stale,
+    ];
+
+    /// The state's number in [`FollowState::ALL`].
+    pub fn index(self) -> usize {
+        FollowState::ALL.iter().position(|s| *s == self).unwrap_or(0)
+    }
+}
+
+/// The followed target, in the odometry frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Target {
+    /// Track id (increments each time a new target is picked).
+    pub id: u32,
+    /// Position/velocity estimate.
+    pub filter: TargetFilter,
+    /// Sim time of the image it was last detected in (s).
+    pub camera_s: f64,
+    /// Sim time it was last seen by the camera or the laser (s).
+    pub seen_s: f64,
+    /// Range from the camera at the last detection (m).
+    pub range_m: f64,
+    /// Bearing at the last detection (rad, positive left).
+    pub bearing_rad: f64,
+    /// Detection probability.
+    pub probability: f64,
+    /// Whether it was close and centred when last seen (a flickering target at the standoff).
+    pub close_and_centred: bool,
+}
+
+impl Target {
+    /// Estimated position now-ish (m, odometry frame): the filter's prediction at `time_s`.
+    pub fn position_at(&self, time_s: f64) -> [f64; 2] {
+        self.filter.predicted_position_m(time_s, PREDICTION_HORIZON_S)
+    }
+}
+
+/// How far ahead a lost target's motion is extrapolated (s).
+const PREDICTION_HORIZON_S: f64 = 2.0;
+/// Pose history length: enough for a few seconds of control updates at 100 Hz.
+const HISTORY: usize = 512;
+/// Laser returns within this distance of the target's prediction are taken to be the target
+/// (m), and returns this close to it are not obstacles.
+const LASER_GATE_M: f64 = 0.4;
+/// The target's returns are its near surface: the centre is about this much further (m).
+const BODY_DEPTH_M: f64 = 0.1;
+/// Returns further than this from the target's prediction are obstacles (m).
+const TARGET_EXCLUSION_M: f64 = 0.6;
+/// Obstacles are only considered within this distance of the robot (m).
+const OBSTACLE_REACH_M: f64 = 3.0;
+/// A scan older than this (s) is too old to steer by.
+const SCAN_FRESH_S: f64 = 0.5;
+
+/// Where a laser scanner sits on the robot, in the base frame (planar).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LaserMount {
+    /// Ahead of the base origin (m).
+    pub x_m: f64,
+    /// Left of the base origin (m).
+    pub y_m: f64,
+    /// Yaw of the scan frame relative to the base (rad).
+    pub yaw_rad: f64,
+}
+
+/// The follower. Feed it the robot's odometry every control update ([`Follower::record_pose`]),
+/// every detector message ([`Follower::observe`]) and laser scan ([`Follower::observe_scan`]),
+/// and ask for a command every control update in follow mode ([`Follower::command`]).
+#[derive(Debug, Clone)]
+pub struct Follower {
+    config: FollowerConfig,
+    camera: CameraGeometry,
+    laser: Option<LaserMount>,
+    target: Option<Target>,
+    next_id: u32,
+    last_message_s: Option<f64>,
+    last_cmd: Twist,
+    last_cmd_s: Option<f64>,
+    state: FollowState,
+    /// (sim time, odometry) of recent control updates, oldest first.
+    poses: VecDeque<(f64, Odometry)>,
+    /// Which way to sweep when searching (+1 left, -1 right).
+    search_sign: f64,
+    /// The newest scan's returns in the odometry frame, and its time.
+    returns_odom: Vec<[f64; 2]>,
+    scan_s: Option<f64>,
+    /// Obstacles in the base frame for this update (scratch, reused).
+    obstacles_base: Vec<[f64; 2]>,
+    /// Hysteresis at the standoff.
+    range_settled: bool,
+    heading_settled: bool,
+    /// What the avoidance did at the last update.
+    avoided: Option<Avoided>,
+}
+
+impl Follower {
+    /// A follower for a camera with this geometry (no laser).
+    pub fn new(config: FollowerConfig, camera: CameraGeometry) -> Self {
+        Self {
+            config,
+            camera,
+            laser: None,
+            target: None,
+            next_id: 0,
+            last_message_s: None,
+            last_cmd: Twist::ZERO,
+            last_cmd_s: None,
+            state: FollowState::Waiting,
+            poses: VecDeque::with_capacity(HISTORY),
+            search_sign: 1.0,
+            returns_odom: Vec::new(),
+            scan_s: None,
+            obstacles_base: Vec::new(),
+            range_settled: false,
+            heading_settled: false,
+            avoided: None,
+        }
+    }
+
+    /// Uses a laser mounted here: its scans keep the target and steer around obstacles.
+    pub fn with_laser(mut self, mount: LaserMount) -> Self {
+        self.laser = Some(mount);
+        self
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &FollowerConfig {
+        &self.config
+    }
+
+    /// What the follower is doing.
+    pub fn state(&self) -> FollowState {
+        self.state
+    }
+
+    /// The current target, if any.
+    pub fn target(&self) -> Option<&Target> {
+        self.target.as_ref()
+    }
+
+    /// Whether the follower has a laser to see obstacles with.
+    pub fn has_laser(&self) -> bool {
+        self.laser.is_some()
+    }
+
+    /// What the obstacle avoidance did at the last command (None without a fresh scan).
+    pub fn avoidance(&self) -> Option<Avoided> {
+        self.avoided
+    }
+
+    /// Forgets the target and the command history (call when follow mode is entered). The pose
+    /// history stays: it is recorded in every mode.
+    pub fn reset(&mut self) {
+        self.target = None;
+        self.last_cmd = Twist::ZERO;
+        self.last_cmd_s = None;
+        self.state = FollowState::Waiting;
+        self.range_settled = false;
+        self.heading_settled = false;
+        self.avoided = None;
+    }
+
+    /// Records the robot's odometry at a control update. Call it at every control update in
+    /// every mode: detections are placed with the pose at their image's time.
+    pub fn record_pose(&mut self, now_s: f64, odom: Odometry) {
+        if self.poses.back().is_some_and(|(t, _)| *t >= now_s) {
+            return;
+        }
+        if self.poses.len() == HISTORY {
+            self.poses.pop_front();
+        }
+        self.poses.push_back((now_s, odom));
+    }
+
+    /// Range (m) and bearing (rad, positive left) of a box, seen from the camera.
+    pub fn range_bearing(&self, b: &BoundingBox) -> (f64, f64) {
+        let c = &self.camera;
+        let u = (b.xmin + b.xmax) as f64 / 2.0;
+        let bearing = ((c.cx - u) / c.fx).atan();
+        let height_px = (b.ymax - b.ymin).max(1) as f64;
+        let from_height = c.fy * self.config.target_height_m / height_px;
+        // A box cut off at the top underestimates the height (overestimates the range): use
+        // where the feet meet the ground instead, when they are below the horizon.
+        let clipped_top = b.ymin <= 2;
+        // The feet's ray dips below the horizon by the camera's pitch plus its angle below the
+        // optical axis.
+        let feet_dip_rad = ((b.ymax as f64 - c.cy) / c.fy).atan() + c.pitch_down_rad;
+        let from_feet = (feet_dip_rad > (1.0 / c.fy).atan() && (b.ymax as f64) < c.height_px - 2.0)
+            .then(|| c.height_m / feet_dip_rad.tan());
+        let along_axis = match (clipped_top, from_feet) {
+            (true, Some(d)) => d,
+            (true, None) => from_height.min(self.config.standoff_m),
+            (false, _) => from_height,
+        };
+        (along_axis / bearing.cos(), bearing)
+    }
+
+    /// Takes one detector message (possibly with no boxes: darknet_ros' ObjectCount = 0).
+    pub fn observe(&mut self, message: &BoundingBoxes) {
+        let t_image = message.image_stamp.sim_time_s;
+        self.last_message_s = Some(self.last_message_s.map_or(t_image, |t| t.max(t_image)));
+        let Some(pose) = self.pose_at(t_image) else {
+            return;
+        };
+        let (sin, cos) = pose.yaw_rad.sin_cos();
+        let camera_x = pose.x_m + cos * self.camera.forward_m;
+        let camera_y = pose.y_m + sin * self.camera.forward_m;
+        let keep = self
+            .target
+            .as_ref()
+            .filter(|t| t_image - t.camera_s < self.config.forget_after_s);
+        // Best candidate: inside the gate around the target's prediction (nearest to it), or,
+        // with no target to keep, the nearest person.
+        let mut best: Option<(f64, [f64; 2], f64, f64, f64)> = None;
+        for b in &message.bounding_boxes {
+            if b.class != self.config.target_class || b.probability < self.config.min_probability {
+                continue;
+            }
+            let (range_m, bearing_rad) = self.range_bearing(b);
+            let heading = pose.yaw_rad + bearing_rad;
+            let position = [
+                camera_x + range_m * heading.cos(),
+                camera_y + range_m * heading.sin(),
+            ];
+            let score = match keep {
+                Some(t) => {
+                    let expected = t.position_at(t_image);
+                    let gap = (position[0] - expected[0]).hypot(position[1] - expected[1]);
+                    let unseen_s = (t_image - t.seen_s).max(0.0);
+                    // Range from a box is good to ~15%: the gate scales with range too.
+                    let gate = (0.7 + 0.15 * range_m + 0.8 * unseen_s).min(2.5);
+                    if gap > gate {
+                        continue;
+                    }
+                    gap
+                }
+                None => range_m,
+            };
+            if best.as_ref().is_none_or(|(s, ..)| score < *s) {
+                best = Some((score, position, range_m, bearing_rad, b.probability));
+            }
+        }
+        let keeping = keep.is_some();
+        let Some((_, position, range_m, bearing_rad, probability)) = best else {
+            return;
+        };
+        let heading = pose.yaw_rad + bearing_rad;
+        let cov = polar_covariance(heading, 0.05 + 0.1 * range_m, 0.05 + 0.02 * range_m);
+        let close_and_centred = range_m < self.config.standoff_m + 0.8 && bearing_rad.abs() < 0.3;
+        match (keeping, self.target.as_mut()) {
+            (true, Some(t)) => {
+                t.filter.update(t_image, position, &cov);
+                if (bearing_rad - t.bearing_rad).abs() > 1e-3 {
+                    self.search_sign = (bearing_rad - t.bearing_rad).signum();
+                }
+                t.camera_s = t.camera_s.max(t_image);
+                t.seen_s = t.seen_s.max(t_image);
+                t.range_m = range_m;
+                t.bearing_rad = bearing_rad;
+                t.probability = probability;
+                t.close_and_centred = close_and_centred;
+            }
+            _ => {
+                self.next_id += 1;
+                self.target = Some(Target {
+                    id: self.next_id,
+                    filter: TargetFilter::new(t_image, position, cov),
+                    camera_s: t_image,
+                    seen_s: t_image,
+                    range_m,
+                    bearing_rad,
+                    probability,
+                    close_and_centred,
+                });
+            }
+        }
+        if bearing_rad.abs() > 0.2 {
+            self.search_sign = bearing_rad.signum();
+        }
+    }
+
+    /// Takes one laser scan: its returns become the obstacles the next commands avoid, and the
+    /// returns around the target's prediction (while the camera confirmed it lately) update the
+    /// target. Ignored when the follower has no laser mount.
+    pub fn observe_scan(&mut self, scan: &LaserScan) {
+        let Some(mount) = self.laser else {
+            return;
+        };
+        let Some(pose) = self.pose_at(scan.stamp_s) else {
+            return;
+        };
+        let (sin, cos) = pose.yaw_rad.sin_cos();
+        let laser_x = pose.x_m + cos * mount.x_m - sin * mount.y_m;
+        let laser_y = pose.y_m + sin * mount.x_m + cos * mount.y_m;
+        let laser_yaw = pose.yaw_rad + mount.yaw_rad;
+        self.returns_odom.clear();
+        for (i, &r) in scan.ranges_m.iter().enumerate() {
+            if !r.is_finite() {
+                continue;
+            }
+            let a = laser_yaw + f64::from(scan.angle_rad(i));
+            let r = f64::from(r);
+            self.returns_odom
+                .push([laser_x + r * a.cos(), laser_y + r * a.sin()]);
+        }
+        self.scan_s = Some(scan.stamp_s);
+        let Some(t) = self.target.as_mut() else {
+            return;
+        };
+        if scan.stamp_s - t.camera_s > self.config.laser_confirm_s {
+            return;
+        }
+        let expected = t.position_at(scan.stamp_s);
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0usize);
+        for p in &self.returns_odom {
+            if (p[0] - expected[0]).hypot(p[1] - expected[1]) <= LASER_GATE_M {
+                sx += p[0];
+                sy += p[1];
+                n += 1;
+            }
+        }
+        if n < 2 {
+            return;
+        }
+        let (cx, cy) = (sx / n as f64, sy / n as f64);
+        let away = (cy - laser_y).atan2(cx - laser_x);
+        let centre = [cx + BODY_DEPTH_M * away.cos(), cy + BODY_DEPTH_M * away.sin()];
+        let cov = Matrix2::identity() * 0.08f64.powi(2);
+        t.filter.update(scan.stamp_s, centre, &cov);
+        t.seen_s = t.seen_s.max(scan.stamp_s);
+    }
+
+    /// The command for this control update at sim time `now_s`, given the robot's odometry
+    /// now. `detector_ok` is false when there is no detector (missing model, failure): the
+    /// follower then stops.
+    pub fn command(&mut self, now_s: f64, odom: Odometry, detector_ok: bool) -> Twist {
+        self.record_pose(now_s, odom);
+        let dt = self.last_cmd_s.map_or(0.0, |t| (now_s - t).clamp(0.0, 0.1));
+        let fresh = self
+            .last_message_s
+            .is_some_and(|t| now_s - t <= self.config.stale_after_s);
+        self.avoided = None;
+        let state = if !detector_ok {
+            FollowState::NoDetector
+        } else if self.last_message_s.is_none() {
+            FollowState::Waiting
+        } else if !fresh {
+            FollowState::Stale
+        } else {
+            match &self.target {
+                Some(t) => {
+                    let unseen_s = now_s - t.seen_s;
+                    let hold_s = if t.close_and_centred {
+                        self.config.close_hold_s
+                    } else {
+                        self.config.hold_s
+                    };
+                    if unseen_s <= self.config.lost_after_s {
+                        FollowState::Tracking
+                    } else if unseen_s <= hold_s {
+                        FollowState::Holding
+                    } else {
+                        FollowState::Searching
+                    }
+                }
+                None => FollowState::Searching,
+            }
+        };
+        if state == FollowState::Searching && self.state != FollowState::Searching {
+            self.aim_search(now_s, odom);
+        }
+        self.state = state;
+        let wanted = match state {
+            FollowState::Tracking | FollowState::Holding => self.pursue(now_s, odom, state),
+            FollowState::Searching => self.search(now_s, odom),
+            _ => Twist::ZERO,
+        };
+        let cmd = if matches!(
+            state,
+            FollowState::Tracking | FollowState::Holding | FollowState::Searching
+        ) {
+            self.limit(wanted, dt)
+        } else {
+            // Stale or no detector: stop now, no ramp (the wheels' own ramp still applies).
+            Twist::ZERO
+        };
+        self.last_cmd = cmd;
+        self.last_cmd_s = Some(now_s);
+        cmd
+    }
+
+    /// Range (m) and bearing (rad) of a point in the odometry frame from the robot's base now.
+    fn relative(point: [f64; 2], odom: Odometry) -> (f64, f64) {
+        let (dx, dy) = (point[0] - odom.x_m, point[1] - odom.y_m);
+        (dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad))
+    }
+
+    /// TRACKING and HOLDING: face the target (leading it when it moves) and, when tracking,
+    /// regulate the range to the standoff; calm inside the deadbands; around obstacles.
+    fn pursue(&mut self, now_s: f64, odom: Odometry, state: FollowState) -> Twist {
+        let Some(t) = &self.target else {
+            return Twist::ZERO;
+        };
+        let c = &self.config;
+        let here = t.position_at(now_s);
+        let [vx, vy] = t.filter.velocity_mps();
+        let moving = vx.hypot(vy) > 0.25;
+        let lead = if state == FollowState::Tracking && moving {
+            c.lead_s
+        } else {
+            0.0
+        };
+        let aim = [here[0] + vx * lead, here[1] + vy * lead];
+        let (range, _) = Self::relative(here, odom);
+        let (_, bearing) = Self::relative(aim, odom);
+        // Hysteresis: once centred and at the standoff, stay still until the error is clear.
+        if bearing.abs() < 0.03 {
+            self.heading_settled = true;
+        } else if bearing.abs() > c.bearing_deadband_rad || moving {
+            self.heading_settled = false;
+        }
+        let range_error = range - c.standoff_m;
+        if range_error.abs() < 0.05 {
+            self.range_settled = true;
+        } else if range_error.abs() > c.standoff_band_m || moving {
+            self.range_settled = false;
+        }
+        let angular = if self.heading_settled {
+            0.0
+        } else {
+            (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps)
+        };
+        let mut speed_cap = 0.0;
+        let linear = if state == FollowState::Tracking && !self.range_settled {
+            // The target's speed along the line of sight, fed forward: keep up with people
+            // walking away, give way to people walking closer.
+            let (dx, dy) = (here[0] - odom.x_m, here[1] - odom.y_m);
+            let radial = if moving && range > 1e-6 {
+                (vx * dx + vy * dy) / range
+            } else {
+                0.0
+            };
+            let law = (c.speed_gain * range_error + radial)
+                .clamp(-c.max_speed_mps / 3.0, c.max_speed_mps);
+            speed_cap = law.max(0.0);
+            // Drive only while the target is roughly ahead; full speed when centred.
+            let alignment = (1.0 - bearing.abs() / 0.8).clamp(0.0, 1.0);
+            law * alignment
+        } else {
+            0.0
+        };
+        let preferred = Twist::new(linear, angular);
+        self.avoid(preferred, here, speed_cap, now_s, odom)
+    }
+
+    /// Replaces `preferred` by a free arc when the laser shows an obstacle in its way.
+    fn avoid(
+        &mut self,
+        preferred: Twist,
+        target: [f64; 2],
+        speed_cap_mps: f64,
+        now_s: f64,
+        odom: Odometry,
+    ) -> Twist {
+        let Some(scan_s) = self.scan_s else {
+            return preferred;
+        };
+        if self.laser.is_none() || now_s - scan_s > SCAN_FRESH_S {
+            return preferred;
+        }
+        let (sin, cos) = odom.yaw_rad.sin_cos();
+        self.obstacles_base.clear();
+        for p in &self.returns_odom {
+            if (p[0] - target[0]).hypot(p[1] - target[1]) < TARGET_EXCLUSION_M {
+                continue;
+            }
+            let (dx, dy) = (p[0] - odom.x_m, p[1] - odom.y_m);
+            if dx.hypot(dy) > OBSTACLE_REACH_M {
+                continue;
+            }
+            self.obstacles_base
+                .push([cos * dx + sin * dy, -sin * dx + cos * dy]);
+        }
+        let (dx, dy) = (target[0] - odom.x_m, target[1] - odom.y_m);
+        let goal = [cos * dx + sin * dy, -sin * dx + cos * dy];
+        let out = avoid::choose(
+            preferred,
+            goal,
+            &self.obstacles_base,
+            speed_cap_mps.min(self.config.max_speed_mps),
+            self.config.max_turn_radps,
+            &self.config.avoid,
+        );
+        self.avoided = Some(out);
+        out.cmd
+    }
+
+    /// Sets the sweep direction when a search starts: the way the target was moving around
+    /// the robot, else the side it was last seen on.
+    fn aim_search(&mut self, now_s: f64, odom: Odometry) {
+        if let Some(t) = &self.target {
+            let here = t.position_at(now_s);
+            let [vx, vy] = t.filter.velocity_mps();
+            let (dx, dy) = (here[0] - odom.x_m, here[1] - odom.y_m);
+            let around = dx * vy - dy * vx;
+            if vx.hypot(vy) > 0.2 && around.abs() > 1e-6 {
+                self.search_sign = around.signum();
+            }
+        }
+    }
+
+    /// SEARCHING: first face where the target is expected; once facing it (and still nothing),
+    /// sweep the way it was going. Never drives.
+    fn search(&mut self, now_s: f64, odom: Odometry) -> Twist {
+        let c = &self.config;
+        if let Some(t) = &self.target {
+            let (_, bearing) = Self::relative(t.position_at(now_s), odom);
+            if bearing.abs() > 0.15 && now_s - t.seen_s < c.forget_after_s {
+                let angular = (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps);
+                return Twist::new(0.0, angular);
+            }
+        }
+        Twist::new(0.0, self.search_sign * c.search_turn_radps)
+    }
+
+    fn limit(&self, wanted: Twist, dt: f64) -> Twist {
+        let c = &self.config;
+        // Slowing down (toward zero) may be twice as quick as speeding up: braking for an
+        // obstacle must not wait for the ramp.
+        let step = |from: f64, to: f64, rate: f64| {
+            let slowing = to.abs() < from.abs() && to * from >= 0.0;
+            let rate = if slowing { 2.0 * rate } else { rate };
+            from + (to - from).clamp(-rate * dt, rate * dt)
+        };
+        Twist::new(
+            step(
+                self.last_cmd.linear_mps,
+                wanted.linear_mps,
+                c.max_accel_mps2,
+            ),
+            step(
+                self.last_cmd.angular_radps,
+                wanted.angular_radps,
+                c.max_turn_accel_radps2,
+            ),
+        )
+    }
+
+    /// Odometry at sim time `t` (nearest recorded control update at or before it).
+    fn pose_at(&self, t: f64) -> Option<Odometry> {
+        let mut found = self.poses.front().map(|(_, o)| *o);
+        for (time, odom) in self.poses.iter().rev() {
+            if *time <= t + 1e-9 {
+                found = Some(*odom);
+                break;
+            }
+        }
+        found
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::expect_used)]
+mod tests {
+    use super::*;
+    use rover_perception::FrameStamp;
+
+    fn camera() -> CameraGeometry {
+        CameraGeometry {
+            fx: 381.36,
+            fy: 381.36,
+            cx: 320.5,
+            cy: 240.5,
+            height_px: 480.0,
+            height_m: 0.18,
+            forward_m: 0.15,
+            pitch_down_rad: 0.0,
+        }
+    }
+
+    fn person_box(range_m: f64, bearing_rad: f64) -> BoundingBox {
+        let c = camera();
+        let along = range_m * bearing_rad.cos();
+        let u = c.cx - c.fx * bearing_rad.tan();
+        let h = c.fy * 1.75 / along;
+        let feet = c.cy + c.fy * 0.18 / along;
+        BoundingBox {
+            class: "person".into(),
+            probability: 0.8,
+            xmin: (u - h * 0.15) as i64,
+            ymin: (feet - h) as i64,
+            xmax: (u + h * 0.15) as i64,
+            ymax: feet as i64,
+            id: 0,
+        }
+    }
+
+    fn message(t: f64, boxes: Vec<BoundingBox>) -> BoundingBoxes {
+        BoundingBoxes {
+            image_stamp: FrameStamp {
+                sim_time_s: t,
+                frame: (t * 30.0) as u64,
+            },
+            frame_id: "camera_link_optical".into(),
+            bounding_boxes: boxes,
+            latency_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn range_and_bearing_come_back_from_a_projected_box() {
+        let f = Follower::new(FollowerConfig::default(), camera());
+        for (range, bearing) in [(3.0, 0.0), (5.0, 0.3), (2.0, -0.4)] {
+            let (r, b) = f.range_bearing(&person_box(range, bearing));
+            assert!((r - range).abs() < 0.05 * range, "{r} vs {range}");
+            assert!((b - bearing).abs() < 0.01, "{b} vs {bearing}");
+        }
+        // Cut off at the top: the feet give the range.
+        let mut clipped = person_box(1.5, 0.0);
+        clipped.ymin = 0;
+        let (r, _) = f.range_bearing(&clipped);
+        assert!((r - 1.5).abs() < 0.1, "{r}");
+    }
+
+    #[test]
+    fn range_from_the_feet_honours_a_pitched_camera() {
+        // A TurtleBot3-like camera: 0.15 m up, looking 0.174 rad down. Feet at 2 m dip
+        // atan(0.15 / 2) below the horizon, so atan(0.15 / 2) - 0.174 below the optical axis.
+        let pitched = CameraGeometry {
+            height_m: 0.15,
+            pitch_down_rad: 0.174,
+            ..camera()
+        };
+        let f = Follower::new(FollowerConfig::default(), pitched);
+        for range in [1.5f64, 2.0, 3.0] {
+            let dip = (0.15 / range).atan() - 0.174;
+            let feet = pitched.cy + pitched.fy * dip.tan();
+            let clipped = BoundingBox {
+                class: "person".into(),
+                probability: 0.8,
+                xmin: 300,
+                ymin: 0,
+                xmax: 340,
+                ymax: feet.round() as i64,
+                id: 0,
+            };
+            let (r, _) = f.range_bearing(&clipped);
+            assert!((r - range).abs() < 0.1 * range, "{r} vs {range}");
+        }
+    }
+
+    #[test]
+    fn approaches_a_centred_target_and_stops_at_the_standoff() {
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        f.observe(&message(0.0, vec![person_box(4.0, 0.0)]));
+        let mut cmd = Twist::ZERO;
+        for i in 1..200 {
+            cmd = f.command(i as f64 * 0.01, odom, true);
+            f.observe(&message(i as f64 * 0.01, vec![person_box(4.0, 0.0)]));
+        }
+        assert_eq!(f.state(), FollowState::Tracking);
+        assert!(
+            (cmd.linear_mps - FollowerConfig::default().max_speed_mps).abs() < 0.01,
+            "{cmd:?}"
+        );
+        assert!(cmd.angular_radps.abs() < 0.01, "{cmd:?}");
+        // At the standoff it holds still.
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        f.command(0.0, odom, true);
+        f.observe(&message(0.0, vec![person_box(1.5 - 0.15, 0.0)]));
+        let cmd = f.command(0.01, odom, true);
+        assert!(cmd.linear_mps.abs() < 0.01, "{cmd:?}");
+    }
+
+    #[test]
+    fn acceleration_is_limited() {
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        f.observe(&message(0.0, vec![person_box(6.0, 0.5)]));
+        let cmd = f.command(0.01, odom, true);
+        assert!(cmd.linear_mps <= FollowerConfig::default().max_accel_mps2 * 0.01 + 1e-9);
+        assert!(cmd.angular_radps <= 3.0 * 0.01 + 1e-9 && cmd.angular_radps > 0.0);
+    }
+
+    #[test]
+    fn keeps_the_same_target_among_several_people() {
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        // The nearer one is picked first...
+        f.observe(&message(
+            0.0,
+            vec![person_box(5.0, 0.3), person_box(3.0, -0.3)],
+        ));
+        let first = f.target().expect("target").clone();
+        assert!(first.bearing_rad < 0.0);
+        // ...and kept when the other comes a little nearer.
+        f.command(0.1, odom, true);
+        f.observe(&message(
+            0.1,
+            vec![person_box(2.9, 0.3), person_box(3.05, -0.3)],
+        ));
+        let t = f.target().expect("target");
+        assert_eq!(t.id, first.id);
+        assert!(t.bearing_rad < 0.0);
+    }
+
+    #[test]
+    fn searches_toward_where_the_target_went_and_stops_when_stale() {
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        f.observe(&message(0.0, vec![person_box(3.0, -0.5)]));
+        // Lost: empty messages keep coming (past the hold).
+        let mut cmd = Twist::ZERO;
+        for i in 1..=250 {
+            let t = i as f64 * 0.01;
+            f.observe(&message(t, vec![]));
+            cmd = f.command(t, odom, true);
+        }
+        assert_eq!(f.state(), FollowState::Searching);
+        assert!(cmd.angular_radps < 0.0, "turns right toward it: {cmd:?}");
+        assert!(cmd.linear_mps.abs() < 1e-9, "never drives while searching");
+        // No messages for more than a second: stop.
+        let cmd = f.command(2.5 + 1.01, odom, true);
+        assert_eq!(f.state(), FollowState::Stale);
+        assert_eq!(cmd, Twist::ZERO);
+        // No detector: stop.
+        let cmd = f.command(3.6, odom, false);
+        assert_eq!(cmd, Twist::ZERO);
+        assert_eq!(f.state(), FollowState::NoDetector);
+    }
+
+    #[test]
+    fn uses_the_pose_at_image_time() {
+        // The robot turned 0.3 rad left after the image was taken: the target, dead ahead in
+        // the image, is now 0.3 rad to the right.
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        f.command(0.0, Odometry::default(), true);
+        let turned = Odometry {
+            yaw_rad: 0.3,
+            ..Odometry::default()
+        };
+        f.command(0.2, turned, true);
+        f.observe(&message(0.0, vec![person_box(4.0, 0.0)]));
+        let here = f.target().expect("target").position_at(0.2);
+        let (_, bearing) = Follower::relative(here, turned);
+        assert!((bearing + 0.3).abs() < 0.05, "{bearing}");
+    }
+
+    #[test]
+    fn a_detection_after_follow_off_drive_on_is_placed_with_the_current_pose() {
+        // Review fix: poses are recorded in every mode. Follow on, off, drive 2 m forward by
+        // hand (the session records poses but asks for no command), on again: a person seen
+        // 3 m ahead is 5 m from the start, not 3 m (a phantom at the old pose).
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        f.command(0.0, Odometry::default(), true);
+        f.reset();
+        for i in 1..=200 {
+            let t = f64::from(i) * 0.01;
+            let odom = Odometry {
+                x_m: t,
+                ..Odometry::default()
+            };
+            f.record_pose(t, odom);
+        }
+        f.reset();
+        let now = Odometry {
+            x_m: 2.0,
+            ..Odometry::default()
+        };
+        f.observe(&message(2.0, vec![person_box(3.0, 0.0)]));
+        let here = f.target().expect("target").position_at(2.0);
+        let expected_x = 2.0 + camera().forward_m + 3.0;
+        assert!((here[0] - expected_x).abs() < 0.2, "{here:?}");
+        f.command(2.01, now, true);
+        let cmd = f.command(2.02, now, true);
+        assert_eq!(f.state(), FollowState::Tracking);
+        assert!(cmd.linear_mps > 0.0, "{cmd:?}");
+    }
+
+    #[test]
+    fn a_close_centred_target_that_flickers_is_held_not_searched_for() {
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        // At the standoff (1.5 m from the base: the camera is 0.15 m ahead of it), dead ahead,
+        // seen once, then only empty messages for 5 s.
+        f.observe(&message(0.0, vec![person_box(1.5 - 0.15, 0.0)]));
+        for i in 1..=500 {
+            let t = f64::from(i) * 0.01;
+            f.observe(&message(t, vec![]));
+            let cmd = f.command(t, odom, true);
+            if t > 0.7 {
+                assert_eq!(f.state(), FollowState::Holding, "at {t}");
+            }
+            assert!(cmd.angular_radps.abs() < 0.05, "{cmd:?} at {t}");
+            assert!(cmd.linear_mps.abs() < 1e-9, "{cmd:?} at {t}");
+        }
+        // A far target lost for longer than hold_s is searched for.
+        let mut g = Follower::new(FollowerConfig::default(), camera());
+        g.command(0.0, odom, true);
+        g.observe(&message(0.0, vec![person_box(5.0, 0.3)]));
+        for i in 1..=300 {
+            let t = f64::from(i) * 0.01;
+            g.observe(&message(t, vec![]));
+            g.command(t, odom, true);
+        }
+        assert_eq!(g.state(), FollowState::Searching);
+    }
+
+    fn scan_with_person_at(range_m: f32, bearing_rad: f32, t: f64) -> LaserScan {
+        // 360 rays; the person's 0.13 m body hides a few of them.
+        let mut ranges = vec![f32::INFINITY; 360];
+        for (i, r) in ranges.iter_mut().enumerate() {
+            let a = (i as f32).to_radians();
+            let off = rover_sim::wrap_angle(f64::from(a - bearing_rad)) as f32;
+            if (off * range_m).abs() < 0.13 {
+                *r = range_m - 0.1;
+            }
+        }
+        LaserScan {
+            stamp_s: t,
+            seq: 0,
+            frame_id: "base_scan".into(),
+            angle_min_rad: 0.0,
+            angle_max_rad: 359f32.to_radians(),
+            angle_increment_rad: 1f32.to_radians(),
+            time_increment_s: 0.0,
+            scan_time_s: 0.1,
+            range_min_m: 0.12,
+            range_max_m: 3.5,
+            ranges_m: ranges,
+        }
+    }
+
+    #[test]
+    fn laser_returns_keep_a_target_the_camera_no_longer_sees() {
+        let mut f =
+            Follower::new(FollowerConfig::default(), camera()).with_laser(LaserMount::default());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        f.observe(&message(0.0, vec![person_box(2.0, 0.0)]));
+        // The person steps 0.5 m to the left over 2 s; only the laser sees it.
+        for i in 1..=200 {
+            let t = f64::from(i) * 0.01;
+            f.observe(&message(t, vec![]));
+            if i % 10 == 0 {
+                let y = 0.5 * (t / 2.0);
+                let range = (2.15f64.powi(2) + y * y).sqrt() as f32;
+                let bearing = (y / 2.15).atan() as f32;
+                f.observe_scan(&scan_with_person_at(range, bearing, t));
+            }
+            f.command(t, odom, true);
+        }
+        assert_eq!(f.state(), FollowState::Tracking);
+        let here = f.target().expect("target").position_at(2.0);
+        assert!((here[1] - 0.5).abs() < 0.15, "{here:?}");
+    }
+}
