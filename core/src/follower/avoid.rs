@@ -67,12 +67,25 @@ pub struct Avoided {
     pub clearance_m: f64,
 }
 
-/// Smallest gap (m) between the robot circle and any obstacle along the arc of `cmd`.
+/// Smallest gap (m) between the robot circle and any obstacle where it is now.
+pub fn clearance_here_m(obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
+    let nearest = obstacles
+        .iter()
+        .map(|o| o[0] * o[0] + o[1] * o[1])
+        .fold(f64::INFINITY, f64::min);
+    nearest.sqrt() - config.robot_radius_m
+}
+
+/// Smallest gap (m) between the robot circle and any obstacle along the arc of `cmd`, from its
+/// first step on (where the robot is now is [`clearance_here_m`]; a turn in place stays there).
 pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
+    if cmd.linear_mps == 0.0 {
+        return clearance_here_m(obstacles, config);
+    }
     let steps = (rollout_s(cmd.linear_mps, config) / STEP_S).ceil() as usize;
     let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
     let mut nearest = f64::INFINITY;
-    for step in 0..=steps {
+    for step in 1..=steps {
         if step > 0 {
             // Exact integration of a constant (v, w) over one step.
             let w = cmd.angular_radps;
@@ -92,9 +105,6 @@ pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig)
             if d2 < nearest {
                 nearest = d2;
             }
-        }
-        if cmd.linear_mps == 0.0 {
-            break;
         }
     }
     nearest.sqrt() - config.robot_radius_m
@@ -120,6 +130,10 @@ pub fn choose(
         };
     }
     let goal_distance = goal_m[0].hypot(goal_m[1]);
+    // Already inside the margin (pushed there, or the obstacle came closer): arcs that do not
+    // come closer still than now are the way out.
+    let here = clearance_here_m(obstacles, config);
+    let floor = config.hard_margin_m.min(here - 0.01);
     let reach = config.lookahead_m.max(1e-3);
     let mut best: Option<(f64, Twist, f64)> = None;
     for fraction in SPEED_FRACTIONS {
@@ -128,7 +142,7 @@ pub fn choose(
             let w = max_turn_radps * (2.0 * k as f64 / (TURN_SAMPLES - 1) as f64 - 1.0);
             let cmd = Twist::new(v, w);
             let clearance = arc_clearance_m(cmd, obstacles, config);
-            if v <= 0.0 || clearance < config.hard_margin_m {
+            if v <= 0.0 || clearance < floor {
                 continue;
             }
             // Where the arc ends (constant v, w over the rollout).
@@ -157,11 +171,13 @@ pub fn choose(
             clearance_m,
         };
     }
-    // No arc that moves is free: turn in place toward the target while nothing touches (the
-    // next scans may show a way out), else stop.
+    // No arc that moves is free from here: turn in place toward the free direction that leads
+    // most toward the target (a wall ahead: face along it, to its end), while nothing touches.
+    let heading = free_heading_rad(goal_m, obstacles, floor, config)
+        .unwrap_or_else(|| goal_m[1].atan2(goal_m[0]));
     let turn = Twist::new(
         0.0,
-        0.5 * max_turn_radps * goal_m[1].atan2(goal_m[0]).signum(),
+        (2.0 * heading).clamp(-max_turn_radps, max_turn_radps),
     );
     let room = arc_clearance_m(turn, obstacles, config);
     Avoided {
@@ -169,6 +185,42 @@ pub fn choose(
         steering: true,
         clearance_m: room,
     }
+}
+
+/// Headings tried by [`free_heading_rad`] (every 5 deg).
+const HEADINGS: usize = 72;
+
+/// The heading (rad, base frame) of a straight path that stays `floor` clear for the lookahead
+/// distance and points most toward `goal_m`; None when every direction is blocked.
+pub fn free_heading_rad(
+    goal_m: [f64; 2],
+    obstacles: &[[f64; 2]],
+    floor: f64,
+    config: &AvoidConfig,
+) -> Option<f64> {
+    let goal_bearing = goal_m[1].atan2(goal_m[0]);
+    let steps = (config.lookahead_m / 0.1).ceil() as usize;
+    let mut best: Option<(f64, f64)> = None;
+    for k in 0..HEADINGS {
+        let heading = wrap_angle(k as f64 * std::f64::consts::TAU / HEADINGS as f64);
+        let (s, c) = heading.sin_cos();
+        let mut nearest = f64::INFINITY;
+        for step in 1..=steps {
+            let d = step as f64 * 0.1;
+            let (x, y) = (d * c, d * s);
+            for o in obstacles {
+                nearest = nearest.min((o[0] - x).powi(2) + (o[1] - y).powi(2));
+            }
+        }
+        if nearest.sqrt() - config.robot_radius_m < floor {
+            continue;
+        }
+        let score = wrap_angle(heading - goal_bearing).cos();
+        if best.is_none_or(|(b, _)| score > b) {
+            best = Some((score, heading));
+        }
+    }
+    best.map(|(_, h)| h)
 }
 
 #[cfg(test)]
@@ -226,5 +278,14 @@ mod tests {
         let out = choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, &config);
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert!(out.cmd.angular_radps > 0.0, "{out:?}");
+    }
+
+    #[test]
+    fn facing_a_wall_it_turns_toward_the_walls_open_end() {
+        // A wall 0.45 m ahead from y = -1.2 to y = 0.5; the target beyond it, dead ahead.
+        let config = AvoidConfig::default();
+        let wall: Vec<[f64; 2]> = (0..=34).map(|i| [0.45, -1.2 + 0.05 * f64::from(i)]).collect();
+        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, &config);
+        assert!(out.cmd.angular_radps > 0.1, "turns left, to the open end: {out:?}");
     }
 }

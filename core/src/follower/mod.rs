@@ -231,10 +231,14 @@ const HISTORY: usize = 512;
 const LASER_GATE_M: f64 = 0.4;
 /// The target's returns are its near surface: the centre is about this much further (m).
 const BODY_DEPTH_M: f64 = 0.1;
+/// Laser returns keep following a target seen this recently (s): a few scans.
+const LASER_CONTINUITY_S: f64 = 0.35;
 /// Returns further than this from the target's prediction are obstacles (m).
 const TARGET_EXCLUSION_M: f64 = 0.6;
 /// Obstacles are only considered within this distance of the robot (m).
 const OBSTACLE_REACH_M: f64 = 3.0;
+/// Half-width of the line of sight an obstacle must block to hide the target (m).
+const OCCLUSION_WIDTH_M: f64 = 0.3;
 /// A scan older than this (s) is too old to steer by.
 const SCAN_FRESH_S: f64 = 0.5;
 
@@ -426,7 +430,30 @@ impl Follower {
                 best = Some((score, position, range_m, bearing_rad, b.probability));
             }
         }
-        let keeping = keep.is_some();
+        let mut keeping = keep.is_some();
+        if best.is_none()
+            && keep.is_some_and(|t| t_image - t.camera_s > self.config.laser_confirm_s)
+        {
+            // The camera has not confirmed the target for long (the laser alone kept it) and
+            // now sees people elsewhere: trust the camera, take the nearest as a new target.
+            keeping = false;
+            for b in &message.bounding_boxes {
+                if b.class != self.config.target_class
+                    || b.probability < self.config.min_probability
+                {
+                    continue;
+                }
+                let (range_m, bearing_rad) = self.range_bearing(b);
+                let heading = pose.yaw_rad + bearing_rad;
+                let position = [
+                    camera_x + range_m * heading.cos(),
+                    camera_y + range_m * heading.sin(),
+                ];
+                if best.as_ref().is_none_or(|(s, ..)| range_m < *s) {
+                    best = Some((range_m, position, range_m, bearing_rad, b.probability));
+                }
+            }
+        }
         let Some((_, position, range_m, bearing_rad, probability)) = best else {
             return;
         };
@@ -493,7 +520,10 @@ impl Follower {
         let Some(t) = self.target.as_mut() else {
             return;
         };
-        if scan.stamp_s - t.camera_s > self.config.laser_confirm_s {
+        // The laser keeps a target the camera confirmed lately, or one it has been following
+        // scan after scan (a person at the standoff, whose head the camera cannot see).
+        let continuous = scan.stamp_s - t.seen_s <= LASER_CONTINUITY_S;
+        if scan.stamp_s - t.camera_s > self.config.laser_confirm_s && !continuous {
             return;
         }
         let expected = t.position_at(scan.stamp_s);
@@ -536,7 +566,11 @@ impl Follower {
             match &self.target {
                 Some(t) => {
                     let unseen_s = now_s - t.seen_s;
-                    let hold_s = if t.close_and_centred {
+                    let hold_s = if self.occluded(t.position_at(now_s), now_s, odom) {
+                        // Behind an obstacle: searching on the spot cannot help; keep going
+                        // toward where it is expected until it is forgotten.
+                        self.config.forget_after_s
+                    } else if t.close_and_centred {
                         self.config.close_hold_s
                     } else {
                         self.config.hold_s
@@ -561,11 +595,11 @@ impl Follower {
             FollowState::Searching => self.search(now_s, odom),
             _ => Twist::ZERO,
         };
-        let cmd = if matches!(
-            state,
-            FollowState::Tracking | FollowState::Holding | FollowState::Searching
-        ) {
+        let cmd = if matches!(state, FollowState::Tracking | FollowState::Holding) {
             self.limit(wanted, dt)
+        } else if state == FollowState::Searching {
+            // Searching never drives: the forward command drops to zero at once.
+            Twist::new(0.0, self.limit(wanted, dt).angular_radps)
         } else {
             // Stale or no detector: stop now, no ramp (the wheels' own ramp still applies).
             Twist::ZERO
@@ -573,6 +607,26 @@ impl Follower {
         self.last_cmd = cmd;
         self.last_cmd_s = Some(now_s);
         cmd
+    }
+
+    /// Whether the laser shows an obstacle on the line of sight from the robot to `target`
+    /// (odometry frame): the camera cannot see the target, and the robot should go around.
+    fn occluded(&self, target: [f64; 2], now_s: f64, odom: Odometry) -> bool {
+        if self.laser.is_none() || self.scan_s.is_none_or(|t| now_s - t > SCAN_FRESH_S) {
+            return false;
+        }
+        let (dx, dy) = (target[0] - odom.x_m, target[1] - odom.y_m);
+        let range = dx.hypot(dy);
+        if range < 1e-6 {
+            return false;
+        }
+        let (ux, uy) = (dx / range, dy / range);
+        self.returns_odom.iter().any(|p| {
+            let (px, py) = (p[0] - odom.x_m, p[1] - odom.y_m);
+            let along = px * ux + py * uy;
+            let across = (py * ux - px * uy).abs();
+            along > 0.2 && along < range - TARGET_EXCLUSION_M && across < OCCLUSION_WIDTH_M
+        })
     }
 
     /// Range (m) and bearing (rad) of a point in the odometry frame from the robot's base now.
@@ -617,7 +671,11 @@ impl Follower {
             (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps)
         };
         let mut speed_cap = 0.0;
-        let linear = if state == FollowState::Tracking && !self.range_settled {
+        // Holding a target hidden behind an obstacle: go on toward where it is expected (around
+        // the obstacle), to see it again.
+        let approach = state == FollowState::Tracking
+            || (state == FollowState::Holding && self.occluded(here, now_s, odom));
+        let linear = if approach && !self.range_settled {
             // The target's speed along the line of sight, fed forward: keep up with people
             // walking away, give way to people walking closer.
             let (dx, dy) = (here[0] - odom.x_m, here[1] - odom.y_m);
@@ -713,9 +771,11 @@ impl Follower {
         let c = &self.config;
         // Slowing down (toward zero) may be twice as quick as speeding up: braking for an
         // obstacle must not wait for the ramp.
+        // Steering around an obstacle needs the arc it chose, not a slow blend toward it.
+        let steering = self.avoided.is_some_and(|a| a.steering);
         let step = |from: f64, to: f64, rate: f64| {
             let slowing = to.abs() < from.abs() && to * from >= 0.0;
-            let rate = if slowing { 2.0 * rate } else { rate };
+            let rate = if slowing || steering { 2.0 * rate } else { rate };
             from + (to - from).clamp(-rate * dt, rate * dt)
         };
         Twist::new(
