@@ -286,6 +286,7 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
             &points,
             0.8,
             1.2,
+            0.0,
             &avoid,
         );
         window_times.push(start.elapsed().as_secs_f64() * 1e6);

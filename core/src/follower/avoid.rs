@@ -112,17 +112,27 @@ pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig)
 
 /// Picks the command: `preferred` when its arc is free, else the best admissible arc toward
 /// `goal_m` (base frame) with forward speed at most `max_linear_mps` and turn rate within
-/// `max_turn_radps`. With no admissible arc the robot stops.
+/// `max_turn_radps`. `side` (+1 left, -1 right, 0 none) is the way around the obstacle chosen
+/// before: keeping to it stops the robot from dithering between two equally good ways. With no
+/// admissible arc the robot turns in place toward a free direction, or stops.
 pub fn choose(
     preferred: Twist,
     goal_m: [f64; 2],
     obstacles: &[[f64; 2]],
     max_linear_mps: f64,
     max_turn_radps: f64,
+    side: f64,
     config: &AvoidConfig,
 ) -> Avoided {
     let own = arc_clearance_m(preferred, obstacles, config);
-    if own >= config.free_margin_m || (preferred.linear_mps == 0.0 && own >= 0.02) {
+    // While going around something (a side chosen), the follower's own command must be clearly
+    // free to take over again: no flipping between it and the detour.
+    let free = if side == 0.0 {
+        config.free_margin_m
+    } else {
+        config.free_margin_m + 0.3
+    };
+    if own >= free || (preferred.linear_mps == 0.0 && own >= 0.02 && side == 0.0) {
         return Avoided {
             cmd: preferred,
             steering: false,
@@ -157,7 +167,12 @@ pub fn choose(
             let heading = 1.0 - to_goal.abs() / std::f64::consts::PI;
             let progress = (goal_distance - (goal_m[0] - ex).hypot(goal_m[1] - ey)) / reach;
             let room = clearance.min(1.0);
-            let score = heading + progress + 0.4 * room + 0.5 * fraction
+            let keep_side = if side != 0.0 && w.abs() > 1e-6 && w.signum() == side {
+                0.3
+            } else {
+                0.0
+            };
+            let score = heading + progress + 0.4 * room + 0.5 * fraction + keep_side
                 - 0.1 * (w - preferred.angular_radps).abs() / max_turn_radps.max(1e-3);
             if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
                 best = Some((score, cmd, clearance));
@@ -173,7 +188,7 @@ pub fn choose(
     }
     // No arc that moves is free from here: turn in place toward the free direction that leads
     // most toward the target (a wall ahead: face along it, to its end), while nothing touches.
-    let heading = free_heading_rad(goal_m, obstacles, floor, config)
+    let heading = free_heading_rad(goal_m, obstacles, floor, side, config)
         .unwrap_or_else(|| goal_m[1].atan2(goal_m[0]));
     let turn = Twist::new(
         0.0,
@@ -191,11 +206,13 @@ pub fn choose(
 const HEADINGS: usize = 72;
 
 /// The heading (rad, base frame) of a straight path that stays `floor` clear for the lookahead
-/// distance and points most toward `goal_m`; None when every direction is blocked.
+/// distance and points most toward `goal_m` (on `side` when one was chosen: +1 left, -1 right);
+/// None when every direction is blocked.
 pub fn free_heading_rad(
     goal_m: [f64; 2],
     obstacles: &[[f64; 2]],
     floor: f64,
+    side: f64,
     config: &AvoidConfig,
 ) -> Option<f64> {
     let goal_bearing = goal_m[1].atan2(goal_m[0]);
@@ -215,7 +232,9 @@ pub fn free_heading_rad(
         if nearest.sqrt() - config.robot_radius_m < floor {
             continue;
         }
-        let score = wrap_angle(heading - goal_bearing).cos();
+        let off = wrap_angle(heading - goal_bearing);
+        let on_side = side != 0.0 && off.abs() > 1e-6 && off.signum() == side;
+        let score = off.cos() + if on_side { 0.5 } else { 0.0 };
         if best.is_none_or(|(b, _)| score > b) {
             best = Some((score, heading));
         }
@@ -240,7 +259,7 @@ mod tests {
     #[test]
     fn a_free_path_keeps_the_followers_command() {
         let cmd = Twist::new(0.5, 0.1);
-        let out = choose(cmd, [4.0, 0.0], &[[0.0, 3.0]], 0.8, 1.0, &AvoidConfig::default());
+        let out = choose(cmd, [4.0, 0.0], &[[0.0, 3.0]], 0.8, 1.0, 0.0, &AvoidConfig::default());
         assert_eq!(out.cmd, cmd);
         assert!(!out.steering);
     }
@@ -251,7 +270,7 @@ mod tests {
         let obstacles = crate_ahead(1.2);
         let straight = Twist::new(0.8, 0.0);
         assert!(arc_clearance_m(straight, &obstacles, &config) < 0.0);
-        let out = choose(straight, [4.0, 0.0], &obstacles, 0.8, 1.0, &config);
+        let out = choose(straight, [4.0, 0.0], &obstacles, 0.8, 1.0, 0.0, &config);
         assert!(out.steering);
         assert!(out.cmd.angular_radps.abs() > 0.1, "{out:?}");
         assert!(out.clearance_m >= config.hard_margin_m, "{out:?}");
@@ -266,7 +285,7 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             ring.push([0.26 * a.cos(), 0.26 * a.sin()]);
         }
-        let out = choose(Twist::new(0.5, 0.0), [4.0, 0.0], &ring, 0.8, 1.0, &config);
+        let out = choose(Twist::new(0.5, 0.0), [4.0, 0.0], &ring, 0.8, 1.0, 0.0, &config);
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert_eq!(out.cmd.angular_radps, 0.0, "touching: not even a turn");
         // With room to turn but none to drive: turn toward the target.
@@ -275,7 +294,7 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             wide.push([0.5 * a.cos(), 0.5 * a.sin()]);
         }
-        let out = choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, &config);
+        let out = choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, 0.0, &config);
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert!(out.cmd.angular_radps > 0.0, "{out:?}");
     }
@@ -285,7 +304,10 @@ mod tests {
         // A wall 0.45 m ahead from y = -1.2 to y = 0.5; the target beyond it, dead ahead.
         let config = AvoidConfig::default();
         let wall: Vec<[f64; 2]> = (0..=34).map(|i| [0.45, -1.2 + 0.05 * f64::from(i)]).collect();
-        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, &config);
+        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, 0.0, &config);
         assert!(out.cmd.angular_radps > 0.1, "turns left, to the open end: {out:?}");
+        // Having chosen to go right, it keeps to the right.
+        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, -1.0, &config);
+        assert!(out.cmd.angular_radps < -0.1, "keeps its side: {out:?}");
     }
 }

@@ -237,6 +237,8 @@ const LASER_CONTINUITY_S: f64 = 0.35;
 const TARGET_EXCLUSION_M: f64 = 0.6;
 /// Obstacles are only considered within this distance of the robot (m).
 const OBSTACLE_REACH_M: f64 = 3.0;
+/// The way chosen around an obstacle is kept until the avoidance has not steered for this long (s).
+const DETOUR_MEMORY_S: f64 = 3.0;
 /// Half-width of the line of sight an obstacle must block to hide the target (m).
 const OCCLUSION_WIDTH_M: f64 = 0.3;
 /// A scan older than this (s) is too old to steer by.
@@ -281,6 +283,10 @@ pub struct Follower {
     heading_settled: bool,
     /// What the avoidance did at the last update.
     avoided: Option<Avoided>,
+    /// The way around the current obstacle (+1 left, -1 right, 0 none) and when the avoidance
+    /// last steered (s).
+    detour_side: f64,
+    detour_s: f64,
 }
 
 impl Follower {
@@ -304,6 +310,8 @@ impl Follower {
             range_settled: false,
             heading_settled: false,
             avoided: None,
+            detour_side: 0.0,
+            detour_s: f64::NEG_INFINITY,
         }
     }
 
@@ -348,6 +356,7 @@ impl Follower {
         self.range_settled = false;
         self.heading_settled = false;
         self.avoided = None;
+        self.detour_side = 0.0;
     }
 
     /// Records the robot's odometry at a control update. Call it at every control update in
@@ -727,14 +736,24 @@ impl Follower {
         }
         let (dx, dy) = (target[0] - odom.x_m, target[1] - odom.y_m);
         let goal = [cos * dx + sin * dy, -sin * dx + cos * dy];
+        if now_s - self.detour_s > DETOUR_MEMORY_S {
+            self.detour_side = 0.0;
+        }
         let out = avoid::choose(
             preferred,
             goal,
             &self.obstacles_base,
             speed_cap_mps.min(self.config.max_speed_mps),
             self.config.max_turn_radps,
+            self.detour_side,
             &self.config.avoid,
         );
+        if out.steering {
+            self.detour_s = now_s;
+            if self.detour_side == 0.0 && out.cmd.angular_radps.abs() > 0.05 {
+                self.detour_side = out.cmd.angular_radps.signum();
+            }
+        }
         self.avoided = Some(out);
         out.cmd
     }
