@@ -152,7 +152,12 @@ fn run_all(args: &EvalArgs, scenarios: &[(PathBuf, String, f64)], jobs: usize) -
                         result.name,
                         result.wall_s
                     );
-                    bar.println(line);
+                    if bar.is_hidden() {
+                        // Not a terminal (CI, a pipe): plain lines instead of the bar.
+                        eprintln!("{line}");
+                    } else {
+                        bar.println(line);
+                    }
                     bar.inc(1);
                     if let Ok(mut r) = running.lock() {
                         r.retain(|n| n != name);

@@ -139,6 +139,17 @@ pub fn choose(
             clearance_m: own,
         };
     }
+    if preferred.linear_mps < 0.0 {
+        // Backing away (from a person who comes too close) is only ever the follower's own
+        // straight-ish command: blocked behind, it stands (turning if that is free).
+        let turn = Twist::new(0.0, preferred.angular_radps);
+        let room = arc_clearance_m(turn, obstacles, config);
+        return Avoided {
+            cmd: if room >= 0.02 { turn } else { Twist::ZERO },
+            steering: true,
+            clearance_m: room,
+        };
+    }
     let goal_distance = goal_m[0].hypot(goal_m[1]);
     // Already inside the margin (pushed there, or the obstacle came closer): arcs that do not
     // come closer still than now are the way out.

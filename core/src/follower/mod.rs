@@ -44,7 +44,8 @@ pub struct FollowerConfig {
     pub standoff_m: f64,
     /// Assumed real height of the target (m), for range from box height.
     pub target_height_m: f64,
-    /// Forward speed limit (m/s); reversing is limited to a third of it.
+    /// Forward speed limit (m/s); backing away from a target that comes too close is limited to
+    /// [`REVERSE_FRACTION`] of it.
     pub max_speed_mps: f64,
     /// Turn rate limit (rad/s).
     pub max_turn_radps: f64,
@@ -222,6 +223,8 @@ impl Target {
     }
 }
 
+/// Backing away is limited to this fraction of the forward speed limit.
+pub const REVERSE_FRACTION: f64 = 0.6;
 /// How far ahead a lost target's motion is extrapolated (s).
 const PREDICTION_HORIZON_S: f64 = 2.0;
 /// Pose history length: enough for a few seconds of control updates at 100 Hz.
@@ -694,11 +697,15 @@ impl Follower {
                 0.0
             };
             let law = (c.speed_gain * range_error + radial)
-                .clamp(-c.max_speed_mps / 3.0, c.max_speed_mps);
+                .clamp(-c.max_speed_mps * REVERSE_FRACTION, c.max_speed_mps);
             speed_cap = law.max(0.0);
-            // Drive only while the target is roughly ahead; full speed when centred.
-            let alignment = (1.0 - bearing.abs() / 0.8).clamp(0.0, 1.0);
-            law * alignment
+            if law >= 0.0 {
+                // Drive only while the target is roughly ahead; full speed when centred.
+                law * (1.0 - bearing.abs() / 0.8).clamp(0.0, 1.0)
+            } else {
+                // Back away from a target that comes too close, as far as backing up helps.
+                law * bearing.cos().max(0.0)
+            }
         } else {
             0.0
         };
