@@ -192,6 +192,6 @@ fn bad_scenario_files_are_refused_with_file_line_and_key() -> Result<()> {
     }
     // The typo's line is named.
     let out = rover(&["eval", "typo.toml", "--out", "out"], dir.path())?;
-    assert!(text(&out.stderr).contains("line 4"), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("typo.toml:4:"), "{}", text(&out.stderr));
     Ok(())
 }

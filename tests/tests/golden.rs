@@ -1,6 +1,7 @@
-//! Golden traces: scripted headless runs whose traces were recorded before the loop moved into
-//! rover-core (app/src, commit bc11d80). The refactor and anything after it must reproduce them
-//! byte for byte: same physics, same script timing, same detector schedule, same follower.
+//! Golden traces: scripted headless runs whose traces must be reproduced byte for byte: same
+//! physics, same script timing, same detector schedule, same follower. The manual-driving trace
+//! was recorded before the loop moved into rover-core (app/src, commit bc11d80); the follow trace
+//! when the follower gained its states, estimator and laser.
 //!
 //! Regenerate (only when a change is meant to alter behaviour, and say so in the commit):
 //! `ROVER_BLESS=1 cargo test -p rover-tests --test golden`.
@@ -12,12 +13,20 @@ use rover_core::{RunConfig, headless};
 use rover_sim::{CameraSensor, SimOptions, Simulation};
 use rover_tests::repo;
 
-/// Runs `world` with `script` for `duration_s` and compares the trace with `golden`.
-fn check(world: &str, script: &str, duration_s: f64, golden: &str) -> Result<()> {
+/// Runs `world` (with `robot`, or the world's own) with `script` for `duration_s` and compares
+/// the trace with `golden`.
+fn check(
+    world: &str,
+    robot: Option<&str>,
+    script: &str,
+    duration_s: f64,
+    golden: &str,
+) -> Result<()> {
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
     headless::run(&RunConfig {
         world: Some(repo(world)),
+        robot: robot.map(repo),
         script: Some(repo(script)),
         duration_s: Some(duration_s),
         trace: Some(trace.clone()),
@@ -51,8 +60,11 @@ fn check(world: &str, script: &str, duration_s: f64, golden: &str) -> Result<()>
 
 #[test]
 fn manual_driving_reproduces_the_golden_trace() -> Result<()> {
+    // The tutorial car as recorded at bc11d80 (the default world now carries the laser car):
+    // columns 1-10 are those of the original recording; `follow_state` was added after.
     check(
         "worlds/playground.toml",
+        Some("assets/robots/my_robot.urdf"),
         "tests/golden/drive.toml",
         9.0,
         "tests/golden/drive.csv",
@@ -104,8 +116,11 @@ fn following_a_walking_person_reproduces_the_golden_trace() -> Result<()> {
             return Ok(());
         }
     }
+    // Re-recorded when the follower gained its states, estimator and laser (the walking world
+    // now carries the laser car).
     check(
         "worlds/walking.toml",
+        None,
         "tests/golden/follow.toml",
         12.0,
         "tests/golden/follow.csv",

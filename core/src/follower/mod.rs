@@ -683,10 +683,13 @@ impl Follower {
             (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps)
         };
         let mut speed_cap = 0.0;
-        // Holding a target hidden behind an obstacle: go on toward where it is expected (around
-        // the obstacle), to see it again.
+        // HOLDING still approaches the estimate (1) of a standing target last seen close and
+        // centred (the low camera loses the head near the standoff: finish the approach), and
+        // (2) of a target hidden behind an obstacle the laser sees (go around it to see again).
+        let close_and_still = t.close_and_centred && !moving;
         let approach = state == FollowState::Tracking
-            || (state == FollowState::Holding && self.occluded(here, now_s, odom));
+            || (state == FollowState::Holding
+                && (close_and_still || self.occluded(here, now_s, odom)));
         let linear = if approach && !self.range_settled {
             // The target's speed along the line of sight, fed forward: keep up with people
             // walking away, give way to people walking closer.
