@@ -47,7 +47,9 @@ fn write_scenarios(dir: &Path) -> Result<Vec<PathBuf>> {
         &b,
         format!(
             "[scenario]\nduration_s = 4.0\ntarget = \"alice\"\n[criteria]\nacquire_within_s = 2.0\nmax_range_after_acquire_m = 4.5\n{}",
-            world("[[world.person]]\nname = \"alice\"\nposition_m = [4.0, 0.0]\nheading_deg = 180.0\n")
+            world(
+                "[[world.person]]\nname = \"alice\"\nposition_m = [4.0, 0.0]\nheading_deg = 180.0\n"
+            )
         ),
     )?;
     Ok(vec![a, b])
@@ -94,15 +96,23 @@ fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
         text(&serial.stderr)
     );
     let table = text(&serial.stdout);
-    assert!(table.contains("a_nobody") && table.contains("b_person"), "{table}");
+    assert!(
+        table.contains("a_nobody") && table.contains("b_person"),
+        "{table}"
+    );
     assert!(table.contains("2/2 scenarios passed"), "{table}");
     let (parallel, parallel_json) = run("2", "parallel", &[])?;
     assert!(parallel.status.success(), "{}", text(&parallel.stderr));
-    assert_eq!(without_timings(&serial_json)?, without_timings(&parallel_json)?);
+    assert_eq!(
+        without_timings(&serial_json)?,
+        without_timings(&parallel_json)?
+    );
     // Byte for byte too, once the timing lines are dropped.
     let strip = |s: &str| -> String {
         s.lines()
-            .filter(|l| !l.contains("wall_s") && !l.contains("\"jobs\"") && !l.contains("sim_per_wall"))
+            .filter(|l| {
+                !l.contains("wall_s") && !l.contains("\"jobs\"") && !l.contains("sim_per_wall")
+            })
             .collect::<Vec<_>>()
             .join("\n")
     };
@@ -131,7 +141,10 @@ fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
     )?;
     assert!(merged.status.success(), "{}", text(&merged.stderr));
     let merged_json = std::fs::read_to_string(dir.path().join("merged/eval.json"))?;
-    assert_eq!(without_timings(&serial_json)?, without_timings(&merged_json)?);
+    assert_eq!(
+        without_timings(&serial_json)?,
+        without_timings(&merged_json)?
+    );
     drop(files);
     Ok(())
 }
@@ -152,7 +165,11 @@ fn a_failing_scenario_fails_the_evaluation_and_says_why() -> Result<()> {
     let stdout = text(&out.stdout);
     assert!(stdout.contains("FAIL"), "{stdout}");
     assert!(stdout.contains("final_range_m"), "{stdout}");
-    assert!(text(&out.stderr).contains("1 of 1 scenarios failed"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("1 of 1 scenarios failed"),
+        "{}",
+        text(&out.stderr)
+    );
     Ok(())
 }
 
@@ -192,6 +209,10 @@ fn bad_scenario_files_are_refused_with_file_line_and_key() -> Result<()> {
     }
     // The typo's line is named.
     let out = rover(&["eval", "typo.toml", "--out", "out"], dir.path())?;
-    assert!(text(&out.stderr).contains("typo.toml:4:"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("typo.toml:4:"),
+        "{}",
+        text(&out.stderr)
+    );
     Ok(())
 }

@@ -187,7 +187,14 @@ pub fn run_observed(
 ) -> Result<RunSummary> {
     let (world, robot) = load(config)?;
     let script = load_script(config)?;
-    run_loaded(config, world, robot, script, observer, observer_wants_camera)
+    run_loaded(
+        config,
+        world,
+        robot,
+        script,
+        observer,
+        observer_wants_camera,
+    )
 }
 
 /// [`run_observed`] with the world, robot and script already loaded (the config's paths for

@@ -25,9 +25,9 @@ pub mod trace;
 pub use error::{CoreError, Result};
 pub use follower::{CameraGeometry, FollowState, Follower, FollowerConfig, LaserMount};
 pub use headless::{DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary};
-pub use scenario::{Scenario, ScenarioResult};
 pub use observers::{Fanout, FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use pilot::{Mode, Pilot};
+pub use scenario::{Scenario, ScenarioResult};
 pub use script::{Action, Script, ScriptPlayer, Step};
 pub use session::{
     DetectorMode, EventLevel, LoopStats, NoObserver, Observer, Session, SessionOptions,

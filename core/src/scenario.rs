@@ -444,7 +444,8 @@ pub fn judge(criteria: &Criteria, m: &Metrics, follow_at_s: f64) -> Vec<Check> {
             passed,
         });
     };
-    let show = |v: Option<f64>, unit: &str| v.map_or("none".to_owned(), |v| format!("{v:.2} {unit}"));
+    let show =
+        |v: Option<f64>, unit: &str| v.map_or("none".to_owned(), |v| format!("{v:.2} {unit}"));
     if let Some([lo, hi]) = criteria.final_range_m {
         let ok = m.final_range_m.is_some_and(|r| (lo..=hi).contains(&r));
         check(
@@ -512,7 +513,8 @@ pub fn judge(criteria: &Criteria, m: &Metrics, follow_at_s: f64) -> Vec<Check> {
             format!(
                 "max |w| {}, searched {}",
                 show(m.calm_max_turn_radps, "rad/s"),
-                m.calm_searched.map_or("?", |s| if s { "yes" } else { "no" })
+                m.calm_searched
+                    .map_or("?", |s| if s { "yes" } else { "no" })
             ),
             ok,
         );

@@ -391,7 +391,14 @@ impl Session {
     /// Returns the control sample when the diff drive's control loop ran.
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<Option<ControlSample>> {
         self.camera_and_detection(observer)?;
-        // The scan sees the world as it is now, before this step moves it.
+        let sample = self.sim.step();
+        if let Some(sample) = &sample {
+            // Every mode: detections are placed with the pose at their image's time.
+            self.follower
+                .record_pose(sample.sim_time_s, sample.odometry);
+        }
+        // The scan sees the world as this step left it (rapier's scene index is current only
+        // after a step).
         let scanned = match self.laser.as_mut() {
             Some(laser) => {
                 let world_from_laser = laser.world_from_sensor(&self.sim);
@@ -402,12 +409,6 @@ impl Session {
             }
             None => None,
         };
-        let sample = self.sim.step();
-        if let Some(sample) = &sample {
-            // Every mode: detections are placed with the pose at their image's time.
-            self.follower
-                .record_pose(sample.sim_time_s, sample.odometry);
-        }
         if let (Some(world_from_laser), Some(laser)) = (scanned, self.laser.as_ref()) {
             self.stats.scans += 1;
             self.follower.observe_scan(laser.last());

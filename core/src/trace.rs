@@ -26,7 +26,12 @@ impl<W: Write> TraceWriter<W> {
 
     /// Appends one row. `state` is what the follower is doing (in manual mode too: it keeps
     /// watching).
-    pub fn row(&mut self, s: &ControlSample, mode: Mode, state: FollowState) -> std::io::Result<()> {
+    pub fn row(
+        &mut self,
+        s: &ControlSample,
+        mode: Mode,
+        state: FollowState,
+    ) -> std::io::Result<()> {
         let g = &s.ground_truth;
         let o = &s.odometry;
         writeln!(

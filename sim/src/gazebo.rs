@@ -706,7 +706,8 @@ fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<La
                                     "min" => c.range_min_m = ctx.non_negative(r, what, "metres")?,
                                     "max" => c.range_max_m = ctx.positive(r, what, "metres")?,
                                     "resolution" => {
-                                        c.range_resolution_m = ctx.non_negative(r, what, "metres")?
+                                        c.range_resolution_m =
+                                            ctx.non_negative(r, what, "metres")?
                                     }
                                     _ => {}
                                 }

@@ -51,12 +51,14 @@ impl LaserScan {
 
     /// The valid returns as points in the sensor's frame (x, y in metres).
     pub fn points(&self) -> impl Iterator<Item = [f32; 2]> + '_ {
-        self.ranges_m.iter().enumerate().filter_map(|(i, &r)| {
-            r.is_finite().then(|| {
+        self.ranges_m
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.is_finite())
+            .map(|(i, &r)| {
                 let a = self.angle_rad(i);
                 [r * a.cos(), r * a.sin()]
             })
-        })
     }
 }
 
@@ -85,9 +87,9 @@ impl LaserSensor {
                 robot.lasers.len()
             ))
         })?;
-        let link = robot.link_index(&config.link).ok_or_else(|| {
-            SimError::Setup(format!("laser link \"{}\" missing", config.link))
-        })?;
+        let link = robot
+            .link_index(&config.link)
+            .ok_or_else(|| SimError::Setup(format!("laser link \"{}\" missing", config.link)))?;
         let increment = config.angle_increment_rad();
         let directions = (0..config.samples)
             .map(|i| {

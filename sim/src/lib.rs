@@ -18,7 +18,9 @@ mod diff_drive;
 mod error;
 mod gazebo;
 mod geometry;
+mod laser;
 mod mesh;
+mod noise;
 mod render;
 mod resource;
 mod robot;
@@ -28,8 +30,6 @@ mod simulation;
 mod tomlfile;
 mod urdf;
 mod world;
-mod laser;
-mod noise;
 mod xacro;
 
 pub use camera::{CameraInfo, link_from_optical};
@@ -42,11 +42,11 @@ pub use gazebo::{
     CameraConfig, DiffDriveConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
     OdometrySource, PixelFormat,
 };
+pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use laser::{LaserScan, LaserSensor};
+pub use mesh::{TriMesh, load_mesh};
 /// nalgebra, the version rapier uses: for estimation and general matrices (one copy in the build).
 pub use rapier3d::na as nalgebra;
-pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
-pub use mesh::{TriMesh, load_mesh};
 pub use render::meshes::{
     MeshData, Part as PersonPart, Vertex as MeshVertex, object_mesh, person_parts, shape_mesh,
 };

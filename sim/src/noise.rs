@@ -25,4 +25,3 @@ impl Rng {
         (r * t.cos(), r * t.sin())
     }
 }
-

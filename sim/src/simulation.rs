@@ -297,8 +297,7 @@ impl Simulation {
             aabb.maxs += Vec3::splat(best);
             for (_, other) in query.intersect_aabb_conservative(aabb) {
                 let parent = other.parent();
-                if parent == Some(self.ground) || parent.is_some_and(|p| self.people.contains(&p))
-                {
+                if parent == Some(self.ground) || parent.is_some_and(|p| self.people.contains(&p)) {
                     continue;
                 }
                 if let Ok(d) = rapier3d::parry::query::distance(

@@ -228,7 +228,7 @@ impl Person {
         };
         let n = walk.waypoints_m.len() + 1;
         let corner = |i: usize| {
-            if i % n == 0 {
+            if i.is_multiple_of(n) {
                 self.position_m
             } else {
                 walk.waypoints_m[i % n - 1]

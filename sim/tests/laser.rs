@@ -76,7 +76,9 @@ fn walls_read_back_within_the_range_resolution_and_noise() -> Result<()> {
     assert_eq!(config.samples, 360);
     assert!((config.range_max_m - 3.5).abs() < 1e-9);
     assert!((config.range_resolution_m - 0.015).abs() < 1e-9);
-    let noise = config.noise.ok_or("the laser car's scanner has gaussian noise")?;
+    let noise = config
+        .noise
+        .ok_or("the laser car's scanner has gaussian noise")?;
     let tolerance = config.range_resolution_m / 2.0 + 4.5 * noise.stddev;
     let pose = laser.world_from_sensor(&sim);
     let scan = laser.scan_now(&sim).clone();
@@ -87,25 +89,25 @@ fn walls_read_back_within_the_range_resolution_and_noise() -> Result<()> {
         let dir = pose.rotation * Vec3::new(a.cos(), a.sin(), 0.0);
         let expected = |margin: f32| {
             [
-            // Turned by 90 deg, the box's local y faces are its x faces in the world.
-            hit_box_face(
-                pose.translation,
-                dir,
-                Vec3::new(2.1, 0.0, 0.5),
-                90f32.to_radians(),
-                [3.0, 0.1],
-                margin,
-            )
-            .map(|t| (t, "ahead")),
-            hit_box_face(
-                pose.translation,
-                dir,
-                Vec3::new(-0.5, 2.5, 0.5),
-                30f32.to_radians(),
-                [2.0, 0.1],
-                margin,
-            )
-            .map(|t| (t, "slanted")),
+                // Turned by 90 deg, the box's local y faces are its x faces in the world.
+                hit_box_face(
+                    pose.translation,
+                    dir,
+                    Vec3::new(2.1, 0.0, 0.5),
+                    90f32.to_radians(),
+                    [3.0, 0.1],
+                    margin,
+                )
+                .map(|t| (t, "ahead")),
+                hit_box_face(
+                    pose.translation,
+                    dir,
+                    Vec3::new(-0.5, 2.5, 0.5),
+                    30f32.to_radians(),
+                    [2.0, 0.1],
+                    margin,
+                )
+                .map(|t| (t, "slanted")),
             ]
             .into_iter()
             .flatten()
@@ -123,7 +125,10 @@ fn walls_read_back_within_the_range_resolution_and_noise() -> Result<()> {
                 );
                 // Ranges come in steps of the resolution.
                 let steps = f64::from(r) / config.range_resolution_m;
-                assert!((steps - steps.round()).abs() < 1e-3, "{r} is not a multiple");
+                assert!(
+                    (steps - steps.round()).abs() < 1e-3,
+                    "{r} is not a multiple"
+                );
                 if which == "ahead" {
                     ahead += 1;
                 } else {

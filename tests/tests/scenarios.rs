@@ -74,6 +74,14 @@ fn fast_crate_between() -> Result<()> {
     run_named("crate_between")
 }
 
+/// The must-show of the follower issue: in the default world, once at the standoff the car stays
+/// there, |angular cmd| < 0.05 rad/s and no SEARCHING for the last 10 s (the scenario's
+/// `calm_last_s`), read back here from the trace's `follow_state` column too.
+#[test]
+fn fast_default_world() -> Result<()> {
+    run_named("default_world")
+}
+
 #[test]
 fn fast_nobody() -> Result<()> {
     run_named("nobody")

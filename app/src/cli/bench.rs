@@ -251,8 +251,8 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
         forward_m: 0.15,
         pitch_down_rad: 0.0,
     };
-    let mut follower =
-        rover_core::Follower::new(rover_core::FollowerConfig::default(), geometry).with_laser(mount);
+    let mut follower = rover_core::Follower::new(rover_core::FollowerConfig::default(), geometry)
+        .with_laser(mount);
     sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
     sensor.scan_now(&sim);
     let mut times = Vec::with_capacity(scans);

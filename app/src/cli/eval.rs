@@ -114,7 +114,11 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
 }
 
 /// Runs the scenarios in child processes, `jobs` at a time, longest first.
-fn run_all(args: &EvalArgs, scenarios: &[(PathBuf, String, f64)], jobs: usize) -> Result<EvalReport> {
+fn run_all(
+    args: &EvalArgs,
+    scenarios: &[(PathBuf, String, f64)],
+    jobs: usize,
+) -> Result<EvalReport> {
     let exe = std::env::current_exe().context("cannot find rover's own executable")?;
     let total_sim_s: f64 = scenarios.iter().map(|s| s.2).sum();
     let bar = ProgressBar::new(scenarios.len() as u64);
@@ -334,7 +338,8 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
     let csv_path = json_path.with_extension("csv");
     let mut csv = Vec::new();
     write_csv(&mut csv, &report)?;
-    std::fs::write(&csv_path, csv).with_context(|| format!("cannot write {}", csv_path.display()))?;
+    std::fs::write(&csv_path, csv)
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
     writeln!(
         stdout,
         "\n{}/{} scenarios passed ({:.0}%); {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",

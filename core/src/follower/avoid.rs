@@ -201,10 +201,7 @@ pub fn choose(
     // most toward the target (a wall ahead: face along it, to its end), while nothing touches.
     let heading = free_heading_rad(goal_m, obstacles, floor, side, config)
         .unwrap_or_else(|| goal_m[1].atan2(goal_m[0]));
-    let turn = Twist::new(
-        0.0,
-        (2.0 * heading).clamp(-max_turn_radps, max_turn_radps),
-    );
+    let turn = Twist::new(0.0, (2.0 * heading).clamp(-max_turn_radps, max_turn_radps));
     let room = arc_clearance_m(turn, obstacles, config);
     Avoided {
         cmd: if room >= 0.02 { turn } else { Twist::ZERO },
@@ -270,7 +267,15 @@ mod tests {
     #[test]
     fn a_free_path_keeps_the_followers_command() {
         let cmd = Twist::new(0.5, 0.1);
-        let out = choose(cmd, [4.0, 0.0], &[[0.0, 3.0]], 0.8, 1.0, 0.0, &AvoidConfig::default());
+        let out = choose(
+            cmd,
+            [4.0, 0.0],
+            &[[0.0, 3.0]],
+            0.8,
+            1.0,
+            0.0,
+            &AvoidConfig::default(),
+        );
         assert_eq!(out.cmd, cmd);
         assert!(!out.steering);
     }
@@ -296,7 +301,15 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             ring.push([0.26 * a.cos(), 0.26 * a.sin()]);
         }
-        let out = choose(Twist::new(0.5, 0.0), [4.0, 0.0], &ring, 0.8, 1.0, 0.0, &config);
+        let out = choose(
+            Twist::new(0.5, 0.0),
+            [4.0, 0.0],
+            &ring,
+            0.8,
+            1.0,
+            0.0,
+            &config,
+        );
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert_eq!(out.cmd.angular_radps, 0.0, "touching: not even a turn");
         // With room to turn but none to drive: turn toward the target.
@@ -305,7 +318,15 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             wide.push([0.5 * a.cos(), 0.5 * a.sin()]);
         }
-        let out = choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, 0.0, &config);
+        let out = choose(
+            Twist::new(0.5, 0.0),
+            [1.0, 4.0],
+            &wide,
+            0.8,
+            1.0,
+            0.0,
+            &config,
+        );
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert!(out.cmd.angular_radps > 0.0, "{out:?}");
     }
@@ -314,11 +335,32 @@ mod tests {
     fn facing_a_wall_it_turns_toward_the_walls_open_end() {
         // A wall 0.45 m ahead from y = -1.2 to y = 0.5; the target beyond it, dead ahead.
         let config = AvoidConfig::default();
-        let wall: Vec<[f64; 2]> = (0..=34).map(|i| [0.45, -1.2 + 0.05 * f64::from(i)]).collect();
-        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, 0.0, &config);
-        assert!(out.cmd.angular_radps > 0.1, "turns left, to the open end: {out:?}");
+        let wall: Vec<[f64; 2]> = (0..=34)
+            .map(|i| [0.45, -1.2 + 0.05 * f64::from(i)])
+            .collect();
+        let out = choose(
+            Twist::new(0.5, 0.0),
+            [3.0, 0.0],
+            &wall,
+            0.8,
+            1.2,
+            0.0,
+            &config,
+        );
+        assert!(
+            out.cmd.angular_radps > 0.1,
+            "turns left, to the open end: {out:?}"
+        );
         // Having chosen to go right, it keeps to the right.
-        let out = choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, -1.0, &config);
+        let out = choose(
+            Twist::new(0.5, 0.0),
+            [3.0, 0.0],
+            &wall,
+            0.8,
+            1.2,
+            -1.0,
+            &config,
+        );
         assert!(out.cmd.angular_radps < -0.1, "keeps its side: {out:?}");
     }
 }

@@ -114,10 +114,7 @@ impl TargetFilter {
     /// Squared Mahalanobis distance of a position measurement from the estimate at the filter's
     /// time (call [`TargetFilter::predict`] first).
     pub fn mahalanobis2(&self, position_m: [f64; 2], cov: &Matrix2<f64>) -> f64 {
-        let innovation = Vector2::new(
-            position_m[0] - self.state[0],
-            position_m[1] - self.state[1],
-        );
+        let innovation = Vector2::new(position_m[0] - self.state[0], position_m[1] - self.state[1]);
         let s = self.covariance.fixed_view::<2, 2>(0, 0) + cov;
         match s.try_inverse() {
             Some(inv) => (innovation.transpose() * inv * innovation)[(0, 0)],
@@ -134,10 +131,7 @@ impl TargetFilter {
             1.0, 0.0, 0.0, 0.0, //
             0.0, 1.0, 0.0, 0.0,
         );
-        let innovation = Vector2::new(
-            position_m[0] - self.state[0],
-            position_m[1] - self.state[1],
-        );
+        let innovation = Vector2::new(position_m[0] - self.state[0], position_m[1] - self.state[1]);
         let s = h * self.covariance * h.transpose() + cov;
         let Some(s_inv) = s.try_inverse() else {
             return;
@@ -166,7 +160,10 @@ mod tests {
         assert!(vx.abs() < 0.05, "{vx}");
         assert!((vy - 0.6).abs() < 0.05, "{vy}");
         let [x, y] = f.predicted_position_m(8.0 + 0.5, 1.0);
-        assert!((x - 3.0).abs() < 0.05 && (y - (-2.0 + 0.6 * 8.5)).abs() < 0.08, "{x} {y}");
+        assert!(
+            (x - 3.0).abs() < 0.05 && (y - (-2.0 + 0.6 * 8.5)).abs() < 0.08,
+            "{x} {y}"
+        );
         // The prediction stops at the horizon.
         let far = f.predicted_position_m(100.0, 1.0);
         let near = f.predicted_position_m(9.0, 1.0);

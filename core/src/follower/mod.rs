@@ -191,7 +191,10 @@ impl FollowState {
 
     /// The state's number in [`FollowState::ALL`].
     pub fn index(self) -> usize {
-        FollowState::ALL.iter().position(|s| *s == self).unwrap_or(0)
+        FollowState::ALL
+            .iter()
+            .position(|s| *s == self)
+            .unwrap_or(0)
     }
 }
 
@@ -219,7 +222,8 @@ pub struct Target {
 impl Target {
     /// Estimated position now-ish (m, odometry frame): the filter's prediction at `time_s`.
     pub fn position_at(&self, time_s: f64) -> [f64; 2] {
-        self.filter.predicted_position_m(time_s, PREDICTION_HORIZON_S)
+        self.filter
+            .predicted_position_m(time_s, PREDICTION_HORIZON_S)
     }
 }
 
@@ -552,7 +556,10 @@ impl Follower {
         }
         let (cx, cy) = (sx / n as f64, sy / n as f64);
         let away = (cy - laser_y).atan2(cx - laser_x);
-        let centre = [cx + BODY_DEPTH_M * away.cos(), cy + BODY_DEPTH_M * away.sin()];
+        let centre = [
+            cx + BODY_DEPTH_M * away.cos(),
+            cy + BODY_DEPTH_M * away.sin(),
+        ];
         let cov = Matrix2::identity() * 0.08f64.powi(2);
         t.filter.update(scan.stamp_s, centre, &cov);
         t.seen_s = t.seen_s.max(scan.stamp_s);
@@ -804,7 +811,11 @@ impl Follower {
         let steering = self.avoided.is_some_and(|a| a.steering);
         let step = |from: f64, to: f64, rate: f64| {
             let slowing = to.abs() < from.abs() && to * from >= 0.0;
-            let rate = if slowing || steering { 2.0 * rate } else { rate };
+            let rate = if slowing || steering {
+                2.0 * rate
+            } else {
+                rate
+            };
             from + (to - from).clamp(-rate * dt, rate * dt)
         };
         Twist::new(
