@@ -117,10 +117,11 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
     let boxes = get("/world/robot/camera/image/detections")?;
     assert_eq!(boxes.timed_rows, 10);
     assert!(boxes.components.iter().any(|c| c.starts_with("Boxes2D:")));
-    // The laser car's scans at 10 Hz (2 s: 20, the first at t = 0), as points in the laser's
-    // frame; the follower's state for the second in follow mode.
+    // The laser car's scans at 10 Hz after each physics step: at 0.005 s, then 0.1, 0.2, ...,
+    // 2.0 s (21), as points in the laser's frame; the follower's state for the second in
+    // follow mode.
     let scan = get("/world/robot/base_scan/scan")?;
-    assert_eq!(scan.timed_rows, 20, "{:?}", scan.components);
+    assert_eq!(scan.timed_rows, 21, "{:?}", scan.components);
     assert!(scan.components.iter().any(|c| c.starts_with("Points3D:")));
     assert_eq!(get("/plots/follower/state")?.timed_rows, 100);
     // The mode toggle is in the log.
