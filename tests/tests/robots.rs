@@ -67,6 +67,20 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
         (0.10..0.20).contains(&size.x) && (0.10..0.20).contains(&size.y),
         "burger base is {size:?} m; expected ~0.14 m across"
     );
+    // Its LDS-01 laser, as the xacro describes it (Gazebo's ray sensor).
+    let lds = robot
+        .lasers
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("the LDS laser was not read"))?;
+    assert_eq!(lds.name, "lds_lfcd_sensor");
+    assert_eq!(lds.link, "base_scan");
+    assert_eq!(lds.samples, 360);
+    assert_eq!(lds.update_rate_hz, 5.0);
+    assert_eq!((lds.range_min_m, lds.range_max_m), (0.12, 3.5));
+    assert_eq!(lds.range_resolution_m, 0.015);
+    assert_eq!(lds.noise.map(|n| n.stddev), Some(0.01));
+    assert_eq!(lds.topic, "scan");
+    assert!(!robot.not_simulated.iter().any(|s| s.contains("lds")));
     // The expanded URDF is kept for ROS's /robot_description.
     assert!(
         robot
