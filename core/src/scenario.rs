@@ -330,7 +330,6 @@ impl ScenarioResult {
 #[derive(Debug)]
 pub struct Probe {
     target: Option<usize>,
-    dt_guess_s: f64,
     last_t: Option<f64>,
     last_xy: Option<[f64; 2]>,
     last_state: FollowState,
@@ -348,7 +347,6 @@ impl Probe {
     pub fn new(target: Option<usize>, calm_from_s: Option<f64>) -> Self {
         Self {
             target,
-            dt_guess_s: 0.01,
             last_t: None,
             last_xy: None,
             last_state: FollowState::Waiting,
@@ -370,7 +368,8 @@ impl Probe {
 impl Observer for Probe {
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         let t = sample.sim_time_s;
-        let dt = self.last_t.map_or(self.dt_guess_s, |l| (t - l).max(0.0));
+        // The first update counts for one control period of the tutorial car (100 Hz).
+        let dt = self.last_t.map_or(0.01, |l| (t - l).max(0.0));
         self.last_t = Some(t);
         let m = &mut self.metrics;
         m.sim_s = t;

@@ -14,7 +14,7 @@ use rover_perception::{
 };
 use rover_sim::{
     CameraInfo, CameraSensor, ControlSample, LaserScan, LaserSensor, Pose, RobotModel, SimOptions,
-    Simulation, World, wrap_angle, yaw_of,
+    Simulation, World,
 };
 
 use crate::error::{CoreError, Result};
@@ -94,8 +94,6 @@ pub struct LoopStats {
     /// Whether the follower is steering around an obstacle (it has a laser and something is in
     /// the way of its own command).
     pub avoiding: bool,
-    /// Laser scans taken.
-    pub scans: u64,
 }
 
 /// Watches a session without influencing it (the Rerun recorder, the window).
@@ -258,11 +256,7 @@ impl Session {
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
             let base_from_laser = sim.world_from_base().inverse() * l.world_from_sensor(&sim);
-            follower = follower.with_laser(LaserMount {
-                x_m: f64::from(base_from_laser.translation.x),
-                y_m: f64::from(base_from_laser.translation.y),
-                yaw_rad: wrap_angle(yaw_of(base_from_laser.rotation)),
-            });
+            follower = follower.with_laser(LaserMount::from_base_from_laser(base_from_laser));
         }
         let mut labels = Vec::new();
         let detection = match (options.detector, camera.is_some()) {
@@ -399,20 +393,11 @@ impl Session {
         }
         // The scan sees the world as this step left it (rapier's scene index is current only
         // after a step).
-        let scanned = match self.laser.as_mut() {
-            Some(laser) => {
-                let world_from_laser = laser.world_from_sensor(&self.sim);
-                laser
-                    .scan_if_due(&self.sim)
-                    .is_some()
-                    .then_some(world_from_laser)
-            }
-            None => None,
-        };
-        if let (Some(world_from_laser), Some(laser)) = (scanned, self.laser.as_ref()) {
-            self.stats.scans += 1;
+        if let Some(laser) = self.laser.as_mut()
+            && laser.scan_if_due(&self.sim).is_some()
+        {
             self.follower.observe_scan(laser.last());
-            observer.laser_scan(laser.last(), world_from_laser);
+            observer.laser_scan(laser.last(), laser.world_from_sensor(&self.sim));
         }
         if let Some(sample) = &sample {
             if self.pilot.mode() == Mode::Follow {

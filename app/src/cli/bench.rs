@@ -233,14 +233,10 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
     );
     let mut sim = Simulation::new(world, robot, &config.options)?;
     let mut sensor = rover_sim::LaserSensor::new(&sim, 0)?;
-    let mount = {
-        let base_from_laser = sim.world_from_base().inverse() * sensor.world_from_sensor(&sim);
-        rover_core::LaserMount {
-            x_m: f64::from(base_from_laser.translation.x),
-            y_m: f64::from(base_from_laser.translation.y),
-            yaw_rad: rover_sim::wrap_angle(rover_sim::yaw_of(base_from_laser.rotation)),
-        }
-    };
+    let mount = rover_core::LaserMount::from_base_from_laser(
+        sim.world_from_base().inverse() * sensor.world_from_sensor(&sim),
+    );
+    // The camera's geometry does not matter here: no detections are fed.
     let geometry = rover_core::CameraGeometry {
         fx: 381.0,
         fy: 381.0,

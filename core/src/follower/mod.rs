@@ -262,6 +262,17 @@ pub struct LaserMount {
     pub yaw_rad: f64,
 }
 
+impl LaserMount {
+    /// The planar part of the sensor's pose in the base frame.
+    pub fn from_base_from_laser(base_from_laser: rover_sim::Pose) -> Self {
+        Self {
+            x_m: f64::from(base_from_laser.translation.x),
+            y_m: f64::from(base_from_laser.translation.y),
+            yaw_rad: wrap_angle(rover_sim::yaw_of(base_from_laser.rotation)),
+        }
+    }
+}
+
 /// The follower. Feed it the robot's odometry every control update ([`Follower::record_pose`]),
 /// every detector message ([`Follower::observe`]) and laser scan ([`Follower::observe_scan`]),
 /// and ask for a command every control update in follow mode ([`Follower::command`]).
@@ -415,19 +426,31 @@ impl Follower {
             .target
             .as_ref()
             .filter(|t| t_image - t.camera_s < self.config.forget_after_s);
+        // People of the target class in this message: (position in the odom frame, range,
+        // bearing, probability).
+        let this: &Self = self;
+        let candidates = || {
+            message
+                .bounding_boxes
+                .iter()
+                .filter(move |b| {
+                    b.class == this.config.target_class
+                        && b.probability >= this.config.min_probability
+                })
+                .map(move |b| {
+                    let (range_m, bearing_rad) = this.range_bearing(b);
+                    let heading = pose.yaw_rad + bearing_rad;
+                    let position = [
+                        camera_x + range_m * heading.cos(),
+                        camera_y + range_m * heading.sin(),
+                    ];
+                    (position, range_m, bearing_rad, b.probability)
+                })
+        };
         // Best candidate: inside the gate around the target's prediction (nearest to it), or,
         // with no target to keep, the nearest person.
         let mut best: Option<(f64, [f64; 2], f64, f64, f64)> = None;
-        for b in &message.bounding_boxes {
-            if b.class != self.config.target_class || b.probability < self.config.min_probability {
-                continue;
-            }
-            let (range_m, bearing_rad) = self.range_bearing(b);
-            let heading = pose.yaw_rad + bearing_rad;
-            let position = [
-                camera_x + range_m * heading.cos(),
-                camera_y + range_m * heading.sin(),
-            ];
+        for (position, range_m, bearing_rad, probability) in candidates() {
             let score = match keep {
                 Some(t) => {
                     let expected = t.position_at(t_image);
@@ -443,7 +466,7 @@ impl Follower {
                 None => range_m,
             };
             if best.as_ref().is_none_or(|(s, ..)| score < *s) {
-                best = Some((score, position, range_m, bearing_rad, b.probability));
+                best = Some((score, position, range_m, bearing_rad, probability));
             }
         }
         let mut keeping = keep.is_some();
@@ -453,22 +476,11 @@ impl Follower {
             // The camera has not confirmed the target for long (the laser alone kept it) and
             // now sees people elsewhere: trust the camera, take the nearest as a new target.
             keeping = false;
-            for b in &message.bounding_boxes {
-                if b.class != self.config.target_class
-                    || b.probability < self.config.min_probability
-                {
-                    continue;
-                }
-                let (range_m, bearing_rad) = self.range_bearing(b);
-                let heading = pose.yaw_rad + bearing_rad;
-                let position = [
-                    camera_x + range_m * heading.cos(),
-                    camera_y + range_m * heading.sin(),
-                ];
-                if best.as_ref().is_none_or(|(s, ..)| range_m < *s) {
-                    best = Some((range_m, position, range_m, bearing_rad, b.probability));
-                }
-            }
+            best = candidates().min_by(|a, b| a.1.total_cmp(&b.1)).map(
+                |(position, range_m, bearing_rad, probability)| {
+                    (range_m, position, range_m, bearing_rad, probability)
+                },
+            );
         }
         let Some((_, position, range_m, bearing_rad, probability)) = best else {
             return;
