@@ -1,0 +1,323 @@
+//! Message definitions, their MD5 sums (genmsg's rules) and the ROS 1 wire format.
+//!
+//! Definitions are written here as field lists, so nothing from a ROS install is needed at
+//! build time. The MD5 sum of a type is computed from them the way genmsg does (constants,
+//! then fields; a field of message type contributes that type's MD5 instead of its name), and
+//! the full text sent as `message_definition` (which rosbag stores) is the type's fields
+//! followed by each dependency's, as gendeps writes it.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::sync::OnceLock;
+
+use md5::{Digest, Md5};
+
+use crate::error::{Error, Result};
+
+/// The definitions this client knows: full type name and its fields, one per line.
+const DEFINITIONS: &[(&str, &str)] = &[
+    ("std_msgs/Header", "uint32 seq\ntime stamp\nstring frame_id"),
+    ("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z"),
+    ("geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z"),
+    (
+        "geometry_msgs/Quaternion",
+        "float64 x\nfloat64 y\nfloat64 z\nfloat64 w",
+    ),
+    (
+        "geometry_msgs/Twist",
+        "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular",
+    ),
+    (
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation",
+    ),
+    (
+        "geometry_msgs/PoseWithCovariance",
+        "geometry_msgs/Pose pose\nfloat64[36] covariance",
+    ),
+    (
+        "geometry_msgs/TwistWithCovariance",
+        "geometry_msgs/Twist twist\nfloat64[36] covariance",
+    ),
+    (
+        "geometry_msgs/Transform",
+        "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation",
+    ),
+    (
+        "geometry_msgs/TransformStamped",
+        "Header header\nstring child_frame_id\ngeometry_msgs/Transform transform",
+    ),
+    (
+        "nav_msgs/Odometry",
+        "Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist",
+    ),
+    (
+        "tf2_msgs/TFMessage",
+        "geometry_msgs/TransformStamped[] transforms",
+    ),
+    (
+        "sensor_msgs/Image",
+        "Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data",
+    ),
+    (
+        "sensor_msgs/RegionOfInterest",
+        "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify",
+    ),
+    (
+        "sensor_msgs/CameraInfo",
+        "Header header\nuint32 height\nuint32 width\nstring distortion_model\nfloat64[] D\nfloat64[9] K\nfloat64[9] R\nfloat64[12] P\nuint32 binning_x\nuint32 binning_y\nsensor_msgs/RegionOfInterest roi",
+    ),
+    (
+        "sensor_msgs/JointState",
+        "Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort",
+    ),
+    (
+        "sensor_msgs/LaserScan",
+        "Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities",
+    ),
+    ("rosgraph_msgs/Clock", "time clock"),
+    (
+        "darknet_ros_msgs/BoundingBox",
+        "float64 probability\nint64 xmin\nint64 ymin\nint64 xmax\nint64 ymax\nint16 id\nstring Class",
+    ),
+    (
+        "darknet_ros_msgs/BoundingBoxes",
+        "Header header\nHeader image_header\ndarknet_ros_msgs/BoundingBox[] bounding_boxes",
+    ),
+    ("darknet_ros_msgs/ObjectCount", "Header header\nint8 count"),
+];
+
+const BUILTIN: &[&str] = &[
+    "bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "float32",
+    "float64", "string", "time", "duration", "byte", "char",
+];
+
+fn definition(type_name: &str) -> Result<&'static str> {
+    DEFINITIONS
+        .iter()
+        .find(|(name, _)| *name == type_name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| Error::UnknownType(type_name.to_owned()))
+}
+
+/// The full name a field's type refers to (`Header` is `std_msgs/Header`), without array
+/// brackets; `None` for built-in types.
+fn message_type_of(field_type: &str) -> Option<&str> {
+    let base = field_type.split('[').next().unwrap_or(field_type);
+    if BUILTIN.contains(&base) {
+        None
+    } else if base == "Header" {
+        Some("std_msgs/Header")
+    } else {
+        Some(base)
+    }
+}
+
+fn fields(text: &str) -> impl Iterator<Item = (&str, &str)> {
+    text.lines()
+        .filter_map(|line| line.trim().split_once(' '))
+        .map(|(t, n)| (t.trim(), n.trim()))
+}
+
+fn compute_md5(type_name: &str, memo: &mut BTreeMap<String, String>) -> Result<String> {
+    if let Some(sum) = memo.get(type_name) {
+        return Ok(sum.clone());
+    }
+    let mut text = String::new();
+    for (field_type, name) in fields(definition(type_name)?) {
+        if !text.is_empty() {
+            text.push('\n');
+        }
+        match message_type_of(field_type) {
+            None => {
+                let _ = write!(text, "{field_type} {name}");
+            }
+            Some(sub) => {
+                let sum = compute_md5(sub, memo)?;
+                let _ = write!(text, "{sum} {name}");
+            }
+        }
+    }
+    let digest = Md5::digest(text.as_bytes());
+    let mut hex = String::with_capacity(32);
+    for b in digest {
+        let _ = write!(hex, "{b:02x}");
+    }
+    memo.insert(type_name.to_owned(), hex.clone());
+    Ok(hex)
+}
+
+/// The MD5 sum of a message type, as genmsg computes it.
+pub fn md5sum(type_name: &str) -> Result<String> {
+    static MEMO: OnceLock<std::sync::Mutex<BTreeMap<String, String>>> = OnceLock::new();
+    let memo = MEMO.get_or_init(Default::default);
+    let mut memo = memo
+        .lock()
+        .map_err(|_| Error::protocol("message MD5 table poisoned"))?;
+    compute_md5(type_name, &mut memo)
+}
+
+fn collect_dependencies(type_name: &str, out: &mut Vec<&'static str>) -> Result<()> {
+    for (field_type, _) in fields(definition(type_name)?) {
+        if let Some(sub) = message_type_of(field_type) {
+            let (name, _) = DEFINITIONS
+                .iter()
+                .find(|(n, _)| *n == sub)
+                .ok_or_else(|| Error::UnknownType(sub.to_owned()))?;
+            if !out.contains(name) {
+                out.push(name);
+                collect_dependencies(name, out)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The `message_definition` of a type: its fields, then each message type it uses.
+pub fn full_definition(type_name: &str) -> Result<String> {
+    let mut text = String::from(definition(type_name)?);
+    text.push('\n');
+    let mut deps = Vec::new();
+    collect_dependencies(type_name, &mut deps)?;
+    for dep in deps {
+        text.push_str(&"=".repeat(80));
+        text.push_str("\nMSG: ");
+        text.push_str(dep);
+        text.push('\n');
+        text.push_str(definition(dep)?);
+        text.push('\n');
+    }
+    Ok(text)
+}
+
+/// Every type this client can publish or subscribe.
+pub fn known_types() -> impl Iterator<Item = &'static str> {
+    DEFINITIONS.iter().map(|(name, _)| *name)
+}
+
+/// A message that can be written in the ROS 1 wire format (little-endian; strings and
+/// variable-length arrays prefixed with a u32 length; fixed arrays without).
+pub trait Message {
+    /// Full type name, `pkg/Type`.
+    const TYPE: &'static str;
+    /// Appends the serialized message to `out`.
+    fn encode(&self, out: &mut Vec<u8>);
+}
+
+/// A message that can be read from the wire.
+pub trait Decode: Message + Sized {
+    /// Reads a message; an error on short or malformed input.
+    fn decode(bytes: &[u8]) -> Result<Self>;
+}
+
+/// Wire-format writers.
+pub mod wire {
+    /// A u8.
+    pub fn u8(out: &mut Vec<u8>, v: u8) {
+        out.push(v);
+    }
+    /// An i8.
+    pub fn i8(out: &mut Vec<u8>, v: i8) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// An i16.
+    pub fn i16(out: &mut Vec<u8>, v: i16) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// A u32.
+    pub fn u32(out: &mut Vec<u8>, v: u32) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// An i64.
+    pub fn i64(out: &mut Vec<u8>, v: i64) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// An f32.
+    pub fn f32(out: &mut Vec<u8>, v: f32) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// An f64.
+    pub fn f64(out: &mut Vec<u8>, v: f64) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// A length prefix (saturating at u32::MAX, which no real message reaches).
+    pub fn len(out: &mut Vec<u8>, n: usize) {
+        u32(out, u32::try_from(n).unwrap_or(u32::MAX));
+    }
+    /// A string.
+    pub fn string(out: &mut Vec<u8>, s: &str) {
+        len(out, s.len());
+        out.extend_from_slice(s.as_bytes());
+    }
+    /// A `time` from seconds (u32 s + u32 ns; negative times clamp to 0).
+    pub fn time(out: &mut Vec<u8>, t_s: f64) {
+        let (s, ns) = super::secs_nsecs(t_s);
+        u32(out, s);
+        u32(out, ns);
+    }
+    /// A fixed array of f64 (no length prefix).
+    pub fn f64_fixed(out: &mut Vec<u8>, v: &[f64]) {
+        for x in v {
+            f64(out, *x);
+        }
+    }
+    /// A variable-length array of f64.
+    pub fn f64_array(out: &mut Vec<u8>, v: &[f64]) {
+        len(out, v.len());
+        f64_fixed(out, v);
+    }
+    /// A variable-length array of f32.
+    pub fn f32_array(out: &mut Vec<u8>, v: &[f32]) {
+        len(out, v.len());
+        for x in v {
+            f32(out, *x);
+        }
+    }
+    /// A variable-length byte array.
+    pub fn bytes(out: &mut Vec<u8>, v: &[u8]) {
+        len(out, v.len());
+        out.extend_from_slice(v);
+    }
+}
+
+/// Seconds as ROS `time` (secs, nsecs); negative clamps to zero.
+pub fn secs_nsecs(t_s: f64) -> (u32, u32) {
+    if !(t_s.is_finite() && t_s > 0.0) {
+        return (0, 0);
+    }
+    let total_ns = (t_s * 1e9).round() as u64;
+    (
+        u32::try_from(total_ns / 1_000_000_000).unwrap_or(u32::MAX),
+        (total_ns % 1_000_000_000) as u32,
+    )
+}
+
+/// A little-endian reader over a message's bytes.
+#[derive(Debug)]
+pub struct Reader<'a> {
+    bytes: &'a [u8],
+}
+
+impl<'a> Reader<'a> {
+    /// Reads from the start of `bytes`.
+    pub fn new(bytes: &'a [u8]) -> Self {
+        Self { bytes }
+    }
+
+    fn take(&mut self, n: usize) -> Result<&'a [u8]> {
+        if self.bytes.len() < n {
+            return Err(Error::protocol("message shorter than its type"));
+        }
+        let (head, rest) = self.bytes.split_at(n);
+        self.bytes = rest;
+        Ok(head)
+    }
+
+    /// An f64.
+    pub fn f64(&mut self) -> Result<f64> {
+        let b = self.take(8)?;
+        let mut a = [0u8; 8];
+        a.copy_from_slice(b);
+        Ok(f64::from_le_bytes(a))
+    }
+}

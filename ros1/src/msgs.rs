@@ -1,0 +1,504 @@
+//! The messages rover publishes and subscribes. Big payloads (images, scans) borrow their data
+//! so that publishing copies it once, into the wire buffer.
+
+use crate::error::Result;
+use crate::msg::{Decode, Message, Reader, wire};
+
+/// `std_msgs/Header`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Header {
+    /// Sequence number.
+    pub seq: u32,
+    /// Stamp (s).
+    pub stamp_s: f64,
+    /// Frame id.
+    pub frame_id: String,
+}
+
+impl Header {
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::u32(out, self.seq);
+        wire::time(out, self.stamp_s);
+        wire::string(out, &self.frame_id);
+    }
+}
+
+/// `geometry_msgs/Vector3` and `Point`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+impl Vector3 {
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::f64_fixed(out, &[self.x, self.y, self.z]);
+    }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            x: r.f64()?,
+            y: r.f64()?,
+            z: r.f64()?,
+        })
+    }
+}
+
+/// `geometry_msgs/Quaternion`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w.
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    fn default() -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }
+    }
+}
+
+impl Quaternion {
+    /// A rotation about z by `yaw_rad`.
+    pub fn from_yaw(yaw_rad: f64) -> Self {
+        let (s, c) = (yaw_rad / 2.0).sin_cos();
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: s,
+            w: c,
+        }
+    }
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::f64_fixed(out, &[self.x, self.y, self.z, self.w]);
+    }
+}
+
+/// `geometry_msgs/Twist`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Twist {
+    /// Linear velocity (m/s).
+    pub linear: Vector3,
+    /// Angular velocity (rad/s).
+    pub angular: Vector3,
+}
+
+impl Message for Twist {
+    const TYPE: &'static str = "geometry_msgs/Twist";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.linear.encode(out);
+        self.angular.encode(out);
+    }
+}
+
+impl Decode for Twist {
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes);
+        Ok(Self {
+            linear: Vector3::decode(&mut r)?,
+            angular: Vector3::decode(&mut r)?,
+        })
+    }
+}
+
+/// `geometry_msgs/Transform` (with its parent and child frames: `TransformStamped`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TransformStamped {
+    /// Parent frame and stamp.
+    pub header: Header,
+    /// Child frame.
+    pub child_frame_id: String,
+    /// Translation (m).
+    pub translation: Vector3,
+    /// Rotation.
+    pub rotation: Quaternion,
+}
+
+impl TransformStamped {
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::string(out, &self.child_frame_id);
+        self.translation.encode(out);
+        self.rotation.encode(out);
+    }
+}
+
+/// `tf2_msgs/TFMessage`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TfMessage {
+    /// The transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
+impl Message for TfMessage {
+    const TYPE: &'static str = "tf2_msgs/TFMessage";
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::len(out, self.transforms.len());
+        for t in &self.transforms {
+            t.encode(out);
+        }
+    }
+}
+
+/// `nav_msgs/Odometry`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Odometry {
+    /// Odometry frame and stamp.
+    pub header: Header,
+    /// The base frame.
+    pub child_frame_id: String,
+    /// Position (m).
+    pub position: Vector3,
+    /// Orientation.
+    pub orientation: Quaternion,
+    /// Pose covariance, row-major 6x6 (x, y, z, roll, pitch, yaw).
+    pub pose_covariance: [f64; 36],
+    /// Linear velocity in the base frame (m/s).
+    pub linear: Vector3,
+    /// Angular velocity (rad/s).
+    pub angular: Vector3,
+    /// Twist covariance, row-major 6x6.
+    pub twist_covariance: [f64; 36],
+}
+
+impl Message for Odometry {
+    const TYPE: &'static str = "nav_msgs/Odometry";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::string(out, &self.child_frame_id);
+        self.position.encode(out);
+        self.orientation.encode(out);
+        wire::f64_fixed(out, &self.pose_covariance);
+        self.linear.encode(out);
+        self.angular.encode(out);
+        wire::f64_fixed(out, &self.twist_covariance);
+    }
+}
+
+/// `sensor_msgs/Image`, borrowing its pixels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image<'a> {
+    /// Camera optical frame and stamp.
+    pub header: Header,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `rgb8`, `bgr8`, `mono8`.
+    pub encoding: &'a str,
+    /// Bytes per row.
+    pub step: u32,
+    /// Pixels, rows top to bottom.
+    pub data: &'a [u8],
+}
+
+impl Message for Image<'_> {
+    const TYPE: &'static str = "sensor_msgs/Image";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::u32(out, self.height);
+        wire::u32(out, self.width);
+        wire::string(out, self.encoding);
+        wire::u8(out, 0);
+        wire::u32(out, self.step);
+        wire::bytes(out, self.data);
+    }
+}
+
+/// `sensor_msgs/CameraInfo` (no binning, full-frame ROI).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CameraInfo {
+    /// Camera optical frame and stamp.
+    pub header: Header,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `plumb_bob`.
+    pub distortion_model: String,
+    /// Distortion coefficients.
+    pub d: Vec<f64>,
+    /// Intrinsics, row-major 3x3.
+    pub k: [f64; 9],
+    /// Rectification, row-major 3x3.
+    pub r: [f64; 9],
+    /// Projection, row-major 3x4.
+    pub p: [f64; 12],
+}
+
+impl Message for CameraInfo {
+    const TYPE: &'static str = "sensor_msgs/CameraInfo";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::u32(out, self.height);
+        wire::u32(out, self.width);
+        wire::string(out, &self.distortion_model);
+        wire::f64_array(out, &self.d);
+        wire::f64_fixed(out, &self.k);
+        wire::f64_fixed(out, &self.r);
+        wire::f64_fixed(out, &self.p);
+        wire::u32(out, 0);
+        wire::u32(out, 0);
+        // roi: x_offset, y_offset, height, width, do_rectify (all zero = full image)
+        for _ in 0..4 {
+            wire::u32(out, 0);
+        }
+        wire::u8(out, 0);
+    }
+}
+
+/// `rosgraph_msgs/Clock`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Clock {
+    /// Sim time (s).
+    pub clock_s: f64,
+}
+
+impl Message for Clock {
+    const TYPE: &'static str = "rosgraph_msgs/Clock";
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::time(out, self.clock_s);
+    }
+}
+
+/// `sensor_msgs/JointState`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointState {
+    /// Stamp (frame empty).
+    pub header: Header,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Positions (rad).
+    pub position: Vec<f64>,
+    /// Velocities (rad/s).
+    pub velocity: Vec<f64>,
+    /// Efforts (N m); may be empty.
+    pub effort: Vec<f64>,
+}
+
+impl Message for JointState {
+    const TYPE: &'static str = "sensor_msgs/JointState";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::len(out, self.name.len());
+        for n in &self.name {
+            wire::string(out, n);
+        }
+        wire::f64_array(out, &self.position);
+        wire::f64_array(out, &self.velocity);
+        wire::f64_array(out, &self.effort);
+    }
+}
+
+/// `sensor_msgs/LaserScan`, borrowing its ranges.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaserScan<'a> {
+    /// Laser frame and stamp.
+    pub header: Header,
+    /// First ray's angle (rad).
+    pub angle_min: f32,
+    /// Last ray's angle (rad).
+    pub angle_max: f32,
+    /// Between rays (rad).
+    pub angle_increment: f32,
+    /// Between measurements (s).
+    pub time_increment: f32,
+    /// Between scans (s).
+    pub scan_time: f32,
+    /// Minimum range (m).
+    pub range_min: f32,
+    /// Maximum range (m).
+    pub range_max: f32,
+    /// Ranges (m; +-inf out of range, REP-117).
+    pub ranges: &'a [f32],
+}
+
+impl Message for LaserScan<'_> {
+    const TYPE: &'static str = "sensor_msgs/LaserScan";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        for v in [
+            self.angle_min,
+            self.angle_max,
+            self.angle_increment,
+            self.time_increment,
+            self.scan_time,
+            self.range_min,
+            self.range_max,
+        ] {
+            wire::f32(out, v);
+        }
+        wire::f32_array(out, self.ranges);
+        wire::f32_array(out, &[]);
+    }
+}
+
+/// `darknet_ros_msgs/BoundingBox`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BoundingBox {
+    /// Confidence, 0..1.
+    pub probability: f64,
+    /// Left (px).
+    pub xmin: i64,
+    /// Top (px).
+    pub ymin: i64,
+    /// Right (px).
+    pub xmax: i64,
+    /// Bottom (px).
+    pub ymax: i64,
+    /// Class index.
+    pub id: i16,
+    /// Class name.
+    pub class: String,
+}
+
+/// `darknet_ros_msgs/BoundingBoxes`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BoundingBoxes {
+    /// When the boxes were published.
+    pub header: Header,
+    /// The image they came from.
+    pub image_header: Header,
+    /// The boxes.
+    pub bounding_boxes: Vec<BoundingBox>,
+}
+
+impl Message for BoundingBoxes {
+    const TYPE: &'static str = "darknet_ros_msgs/BoundingBoxes";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        self.image_header.encode(out);
+        wire::len(out, self.bounding_boxes.len());
+        for b in &self.bounding_boxes {
+            wire::f64(out, b.probability);
+            wire::i64(out, b.xmin);
+            wire::i64(out, b.ymin);
+            wire::i64(out, b.xmax);
+            wire::i64(out, b.ymax);
+            wire::i16(out, b.id);
+            wire::string(out, &b.class);
+        }
+    }
+}
+
+/// `darknet_ros_msgs/ObjectCount`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjectCount {
+    /// Stamp.
+    pub header: Header,
+    /// Objects found.
+    pub count: i8,
+}
+
+impl Message for ObjectCount {
+    const TYPE: &'static str = "darknet_ros_msgs/ObjectCount";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::i8(out, self.count);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::msg::{full_definition, md5sum};
+
+    /// The sums ROS tools check (genmsg's, listed in ../shared/ros/README.md), plus JointState
+    /// and LaserScan.
+    #[test]
+    fn md5_sums_match_genmsg() -> Result<()> {
+        for (t, sum) in [
+            ("geometry_msgs/Twist", "9f195f881246fdfa2798d1d3eebca84a"),
+            ("nav_msgs/Odometry", "cd5e73d190d741a2f92e81eda573aca7"),
+            ("tf2_msgs/TFMessage", "94810edda583a504dfda3829e70d7eec"),
+            ("sensor_msgs/Image", "060021388200f6f0f447d0fcd9c64743"),
+            ("sensor_msgs/CameraInfo", "c9a58c1b0b154e0e6da7578cb991d214"),
+            ("rosgraph_msgs/Clock", "a9c97c1d230cfc112e270351a944ee47"),
+            (
+                "darknet_ros_msgs/BoundingBox",
+                "6b8f03f076d75c692c40b501a56253e0",
+            ),
+            (
+                "darknet_ros_msgs/BoundingBoxes",
+                "004f6f4f48a741582d10735997905846",
+            ),
+            (
+                "darknet_ros_msgs/ObjectCount",
+                "123675bf4420958597b5a78cb3800a1f",
+            ),
+            ("sensor_msgs/JointState", "3066dcd76a6cfaef579bd0f34173e9fd"),
+            ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
+            ("std_msgs/Header", "2176decaecbce78abc3b96ef049fabed"),
+        ] {
+            assert_eq!(md5sum(t)?, sum, "{t}");
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn full_definitions_list_each_dependency_once() -> Result<()> {
+        let text = full_definition("nav_msgs/Odometry")?;
+        assert!(text.starts_with("Header header\n"));
+        for dep in [
+            "MSG: std_msgs/Header\n",
+            "MSG: geometry_msgs/PoseWithCovariance\n",
+            "MSG: geometry_msgs/Point\n",
+            "MSG: geometry_msgs/Vector3\n",
+        ] {
+            assert_eq!(text.matches(dep).count(), 1, "{dep} in\n{text}");
+        }
+        assert!(md5sum("nope/Nothing").is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn twist_round_trips_and_short_input_is_an_error() -> Result<()> {
+        let t = Twist {
+            linear: Vector3 {
+                x: 0.1,
+                y: 0.0,
+                z: -2.0,
+            },
+            angular: Vector3 {
+                x: 0.0,
+                y: 0.5,
+                z: 1.5,
+            },
+        };
+        let mut bytes = Vec::new();
+        t.encode(&mut bytes);
+        assert_eq!(bytes.len(), 48);
+        assert_eq!(Twist::decode(&bytes)?, t);
+        assert!(Twist::decode(&bytes[..47]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn headers_encode_stamps_as_secs_and_nsecs() {
+        let mut out = Vec::new();
+        Header {
+            seq: 7,
+            stamp_s: 12.25,
+            frame_id: "odom".into(),
+        }
+        .encode(&mut out);
+        assert_eq!(&out[0..4], &7u32.to_le_bytes());
+        assert_eq!(&out[4..8], &12u32.to_le_bytes());
+        assert_eq!(&out[8..12], &250_000_000u32.to_le_bytes());
+        assert_eq!(&out[12..16], &4u32.to_le_bytes());
+        assert_eq!(&out[16..], b"odom");
+    }
+}
