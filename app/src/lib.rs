@@ -4,11 +4,14 @@
 //! * [`viewer`] — the Rerun recorder: viewer modes, the static scene, per-tick logging, images,
 //!   the blueprint.
 //! * [`station`] — the driver's station: the window, its HUD, keyboard and gamepad teleop.
+//! * [`ros`] — the ROS 1 bridge (`--ros`): `/cmd_vel` in; odometry, TF, camera and darknet_ros
+//!   topics out, on [`rover_ros1`].
 //!
 //! The binary `rover` is a thin `main` over [`cli::main`], so tests drive exactly what users
 //! run.
 
 pub mod cli;
 pub mod palette;
+pub mod ros;
 pub mod station;
 pub mod viewer;

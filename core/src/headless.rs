@@ -12,7 +12,9 @@ use crate::observers::{Fanout, RunFiles};
 use crate::paths;
 use crate::pilot::Mode;
 use crate::script::{Script, ScriptPlayer};
-use crate::session::{DetectorMode, NoObserver, Observer, Session, SessionOptions};
+use crate::session::{
+    DetectorMode, InputSource, NoInput, NoObserver, Observer, Session, SessionOptions,
+};
 
 /// Everything a headless run needs.
 #[derive(Debug, Clone, Default)]
@@ -51,6 +53,11 @@ pub struct RunConfig {
     pub detect_hz: Option<f64>,
     /// Detector settings.
     pub detector: DetectorConfig,
+    /// Run the detector on its own thread on the newest frame, as the window does, instead of
+    /// in lockstep on sim time: for real-time runs with outside peers (`--ros`), where the loop
+    /// must keep pace with the wall clock. Detections then depend on the machine's speed, so
+    /// such runs are not deterministic.
+    pub detector_thread: bool,
     /// Follower settings.
     pub follower: FollowerConfig,
     /// Pace the run to this many sim seconds per wall second (None = as fast as the CPU
@@ -197,6 +204,29 @@ pub fn run_observed(
     )
 }
 
+/// [`run_loaded`] with input from outside (the ROS bridge's `/cmd_vel`), polled before every
+/// physics step after the script's due steps. Such runs are only as deterministic as their
+/// input's timing.
+pub fn run_driven(
+    config: &RunConfig,
+    world: World,
+    robot: RobotModel,
+    observer: &mut dyn Observer,
+    observer_wants_camera: bool,
+    inputs: &mut dyn InputSource,
+) -> Result<RunSummary> {
+    let script = load_script(config)?;
+    run_inner(
+        config,
+        world,
+        robot,
+        script,
+        observer,
+        observer_wants_camera,
+        inputs,
+    )
+}
+
 /// [`run_observed`] with the world, robot and script already loaded (the config's paths for
 /// them are not read; its spawn, drive and camera choices are not applied): for tools that
 /// build them in memory, such as scenario files.
@@ -207,6 +237,26 @@ pub fn run_loaded(
     script: Script,
     observer: &mut dyn Observer,
     observer_wants_camera: bool,
+) -> Result<RunSummary> {
+    run_inner(
+        config,
+        world,
+        robot,
+        script,
+        observer,
+        observer_wants_camera,
+        &mut NoInput,
+    )
+}
+
+fn run_inner(
+    config: &RunConfig,
+    world: World,
+    robot: RobotModel,
+    script: Script,
+    observer: &mut dyn Observer,
+    observer_wants_camera: bool,
+    inputs: &mut dyn InputSource,
 ) -> Result<RunSummary> {
     let duration_s = match config.duration_s {
         Some(d) if d.is_finite() && d >= 0.0 => d,
@@ -248,7 +298,9 @@ pub fn run_loaded(
     let options = SessionOptions {
         sim: config.options.clone(),
         camera: perceive || files.frames.is_some(),
-        detector: if perceive {
+        detector: if perceive && config.detector_thread {
+            DetectorMode::Worker
+        } else if perceive {
             DetectorMode::Lockstep { rate_hz: detect_hz }
         } else {
             DetectorMode::Off
@@ -266,7 +318,11 @@ pub fn run_loaded(
     let mut last_report = started;
 
     while session.sim().step_index() < total_steps {
-        if let Some(sample) = player.step(&mut session, &mut fan)? {
+        player.play(&mut session, &mut fan);
+        while let Some(action) = inputs.poll() {
+            session.input(action, &mut fan);
+        }
+        if let Some(sample) = session.step(&mut fan)? {
             last = Some(sample);
         }
         if let Some(failure) = fan.failure() {

@@ -30,7 +30,8 @@ pub use pilot::{Mode, Pilot};
 pub use scenario::{Scenario, ScenarioResult};
 pub use script::{Action, Script, ScriptPlayer, Step};
 pub use session::{
-    DetectorMode, EventLevel, LoopStats, NoObserver, Observer, Session, SessionOptions,
+    DetectorMode, EventLevel, InputSource, LoopStats, NoInput, NoObserver, Observer, Session,
+    SessionOptions,
 };
 pub use teleop::{KeyAction, Teleop, key_action};
 pub use trace::{TRACE_HEADER, TraceRow, TraceWriter, parse_trace};

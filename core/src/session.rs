@@ -159,6 +159,23 @@ fn emit(observer: &mut dyn Observer, sim_time_s: f64, level: EventLevel, text: &
     observer.event(sim_time_s, level, text);
 }
 
+/// Input from outside the loop that drives it like manual input: the ROS bridge's `/cmd_vel`.
+/// Polled before every physics step; it must not block.
+pub trait InputSource {
+    /// The next input waiting, if any.
+    fn poll(&mut self) -> Option<Action>;
+}
+
+/// No outside input.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoInput;
+
+impl InputSource for NoInput {
+    fn poll(&mut self) -> Option<Action> {
+        None
+    }
+}
+
 /// An observer that ignores everything.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct NoObserver;

@@ -1,5 +1,5 @@
-//! The messages rover publishes and subscribes. Big payloads (images, scans) borrow their data
-//! so that publishing copies it once, into the wire buffer.
+//! The messages rover publishes and subscribes. Big payloads (images, scans) are plain `Vec`s
+//! the caller can move in and take back, so steady publishing reuses them.
 
 use crate::error::Result;
 use crate::msg::{Decode, Message, Reader, wire};
@@ -188,9 +188,9 @@ impl Message for Odometry {
     }
 }
 
-/// `sensor_msgs/Image`, borrowing its pixels.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Image<'a> {
+/// `sensor_msgs/Image`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Image {
     /// Camera optical frame and stamp.
     pub header: Header,
     /// Rows.
@@ -198,23 +198,23 @@ pub struct Image<'a> {
     /// Columns.
     pub width: u32,
     /// `rgb8`, `bgr8`, `mono8`.
-    pub encoding: &'a str,
+    pub encoding: String,
     /// Bytes per row.
     pub step: u32,
     /// Pixels, rows top to bottom.
-    pub data: &'a [u8],
+    pub data: Vec<u8>,
 }
 
-impl Message for Image<'_> {
+impl Message for Image {
     const TYPE: &'static str = "sensor_msgs/Image";
     fn encode(&self, out: &mut Vec<u8>) {
         self.header.encode(out);
         wire::u32(out, self.height);
         wire::u32(out, self.width);
-        wire::string(out, self.encoding);
+        wire::string(out, &self.encoding);
         wire::u8(out, 0);
         wire::u32(out, self.step);
-        wire::bytes(out, self.data);
+        wire::bytes(out, &self.data);
     }
 }
 
@@ -303,9 +303,9 @@ impl Message for JointState {
     }
 }
 
-/// `sensor_msgs/LaserScan`, borrowing its ranges.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LaserScan<'a> {
+/// `sensor_msgs/LaserScan` (no intensities).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LaserScan {
     /// Laser frame and stamp.
     pub header: Header,
     /// First ray's angle (rad).
@@ -323,10 +323,10 @@ pub struct LaserScan<'a> {
     /// Maximum range (m).
     pub range_max: f32,
     /// Ranges (m; +-inf out of range, REP-117).
-    pub ranges: &'a [f32],
+    pub ranges: Vec<f32>,
 }
 
-impl Message for LaserScan<'_> {
+impl Message for LaserScan {
     const TYPE: &'static str = "sensor_msgs/LaserScan";
     fn encode(&self, out: &mut Vec<u8>) {
         self.header.encode(out);
@@ -341,7 +341,7 @@ impl Message for LaserScan<'_> {
         ] {
             wire::f32(out, v);
         }
-        wire::f32_array(out, self.ranges);
+        wire::f32_array(out, &self.ranges);
         wire::f32_array(out, &[]);
     }
 }

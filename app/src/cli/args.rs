@@ -38,6 +38,7 @@ Examples:
   rover --headless --record run.rrd                 the same, recorded for `rerun run.rrd`
   rover --headless --script drive.toml --trace out.csv
   rover --headless --world worlds/playground.toml --robot assets/robots/my_robot.urdf --duration 30 --seed 7
+  roscore & rover --ros --headless                  join a ROS 1 graph: /cmd_vel in; /odom, /tf, camera, darknet_ros boxes out
   rover bench                                       physics-only real-time factor
   rover detect photo.jpg --out boxes.png            YOLO boxes on an image (the model's quick check)
 
@@ -155,6 +156,39 @@ pub(crate) struct RunArgs {
 
     #[command(flatten)]
     pub(crate) window: WindowArgs,
+
+    #[command(flatten)]
+    pub(crate) ros: RosArgs,
+}
+
+/// ROS 1 bridge options.
+#[derive(Debug, Args)]
+pub(crate) struct RosArgs {
+    /// Join a ROS 1 graph (start `roscore` first; ROS_MASTER_URI, ROS_IP, ROS_HOSTNAME are
+    /// honoured): /cmd_vel drives the car, and rover publishes what Gazebo and darknet_ros would
+    /// (/odom, /tf, /tf_static, /joint_states, /clock, the camera's image and camera_info,
+    /// /darknet_ros/bounding_boxes, found_object, detection_image, the laser's scan) and sets
+    /// /robot_description. Headless runs then default to --rtf 1. See docs/ROS.md
+    #[arg(long)]
+    pub(crate) ros: bool,
+
+    /// With --ros: the node name
+    #[arg(long, value_name = "NAME", default_value = "rover", requires = "ros")]
+    pub(crate) ros_name: String,
+
+    /// With --ros: also set /use_sim_time so ROS nodes follow rover's /clock
+    #[arg(long, requires = "ros")]
+    pub(crate) ros_sim_time: bool,
+}
+
+impl RosArgs {
+    /// The bridge's settings, when --ros is on.
+    pub(crate) fn options(&self) -> Option<crate::ros::RosOptions> {
+        self.ros.then(|| crate::ros::RosOptions {
+            name: self.ros_name.clone(),
+            sim_time: self.ros_sim_time,
+        })
+    }
 }
 
 /// Window options.

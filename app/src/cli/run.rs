@@ -4,9 +4,12 @@ use std::time::Duration;
 
 use anyhow::Result;
 use rover_core::headless;
-use rover_core::{DetectorMode, Fanout, RunConfig, RunFiles, Session, SessionOptions};
+use rover_core::{
+    DetectorMode, Fanout, InputSource, NoInput, RunConfig, RunFiles, Session, SessionOptions,
+};
 
 use super::args::RunArgs;
+use crate::ros::RosBridge;
 use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
@@ -25,32 +28,56 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         detect_hz: Some(args.follow.detect_hz),
         detector: args.detector.config()?,
         follower: args.follow.follower()?,
-        real_time_factor: args.window.rtf,
+        // ROS peers expect real time: --ros paces headless runs unless --rtf says otherwise.
+        real_time_factor: args.window.rtf.or(args.ros.ros.then_some(1.0)),
+        // ... and the detector keeps up on its own thread (newest frame), as in the window.
+        detector_thread: args.ros.ros,
         ..args.world.run_config(args.cmd_timeout)
     };
     let recorder_options = args.viewer.options(false)?;
-    let summary = match Recorder::start(&recorder_options)? {
-        Some(mut rec) => {
-            if let Some(url) = &rec.web_url {
-                println!("Rerun web viewer: {url}");
+    let mut recorder = Recorder::start(&recorder_options)?;
+    if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
+        println!("Rerun web viewer: {url}");
+    }
+    let summary = match args.ros.options() {
+        Some(ros) => {
+            let (world, robot) = headless::load(&config)?;
+            let (mut bridge, mut cmd_vel) = RosBridge::start(&ros, &robot)?;
+            let result = {
+                let mut fan = Fanout::default();
+                fan.push(&mut bridge);
+                fan.push_some(recorder.as_mut());
+                headless::run_driven(&config, world, robot, &mut fan, true, &mut cmd_vel)
+            };
+            bridge.finish();
+            if bridge.dropped() > 0 {
+                tracing::info!(
+                    "ROS bridge: {} events dropped while it was behind",
+                    bridge.dropped()
+                );
             }
-            let summary = headless::run_observed(&config, &mut rec, true);
-            rec.finish();
-            if let Some(path) = &recorder_options.record {
-                println!("recording: {}", viewer::describe_file(path));
-            }
-            if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
-                println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
-                loop {
-                    std::thread::sleep(Duration::from_secs(3600));
-                }
-            }
-            summary?
+            result
         }
-        None => headless::run(&config)?,
+        None => match recorder.as_mut() {
+            Some(rec) => headless::run_observed(&config, rec, true),
+            None => headless::run(&config),
+        },
     };
+    if let Some(rec) = recorder.as_mut() {
+        rec.finish();
+        if let Some(path) = &recorder_options.record {
+            println!("recording: {}", viewer::describe_file(path));
+        }
+        if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
+            println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
+            loop {
+                std::thread::sleep(Duration::from_secs(3600));
+            }
+        }
+    }
+    let summary = summary?;
     println!(
-        "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.0}x real time)",
+        "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.2}x real time)",
         summary.world,
         summary.robot,
         summary.sim_time_s,
@@ -118,14 +145,28 @@ fn run_window(args: RunArgs) -> Result<()> {
         detector_config: args.detector.config()?,
         follower: args.follow.follower()?,
     };
+    let mut ros = args
+        .ros
+        .options()
+        .map(|o| RosBridge::start(&o, &robot))
+        .transpose()?;
     let summary = {
         let mut fan = Fanout::default();
         fan.push(&mut files);
         fan.push_some(recorder.as_mut());
+        let mut no_input = NoInput;
+        let inputs: &mut dyn InputSource = match ros.as_mut() {
+            Some((bridge, cmd_vel)) => {
+                fan.push(bridge);
+                cmd_vel
+            }
+            None => &mut no_input,
+        };
         let session = Session::new(world, robot, &options, &mut fan)?;
         station::run(
             session,
             &mut fan,
+            inputs,
             WindowOptions {
                 real_time_factor: rtf,
                 latched: args.window.latched,
@@ -139,6 +180,9 @@ fn run_window(args: RunArgs) -> Result<()> {
     };
     if let Some(r) = recorder.as_mut() {
         r.finish();
+    }
+    if let Some((bridge, _)) = ros.as_mut() {
+        bridge.finish();
     }
     println!(
         "rover: {:.1} s sim time in {:.1} s wall; mode {}",

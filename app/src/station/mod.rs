@@ -18,7 +18,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use rover_core::{
-    Action, CoreError, EventLevel, Fanout, LoopStats, Mode, Observer, Script, ScriptPlayer, Session,
+    Action, CoreError, EventLevel, Fanout, InputSource, LoopStats, Mode, Observer, Script,
+    ScriptPlayer, Session,
 };
 use rover_sim::{CameraFrame, ControlSample, Pose, Simulation, Twist};
 use winit::application::ApplicationHandler;
@@ -107,6 +108,8 @@ struct App<'a, 'o> {
     session: Session,
     feed: Feed,
     observers: &'a mut Fanout<'o>,
+    /// Input from outside (the ROS bridge's /cmd_vel), polled like the gamepad.
+    external: &'a mut dyn InputSource,
     player: ScriptPlayer,
     keys: KeyTeleop,
     options: WindowOptions,
@@ -173,6 +176,9 @@ impl App<'_, '_> {
                 }
                 Some(PadCommand::Stop) | None => {}
             }
+        }
+        while let Some(action) = self.external.poll() {
+            self.input(action);
         }
         let target = if self.paused {
             if std::mem::take(&mut self.step_once) {
@@ -374,6 +380,7 @@ impl ApplicationHandler for App<'_, '_> {
 pub fn run(
     session: Session,
     observers: &mut Fanout<'_>,
+    external: &mut dyn InputSource,
     options: WindowOptions,
 ) -> Result<WindowSummary> {
     check_display()?;
@@ -400,6 +407,7 @@ pub fn run(
             ..Feed::default()
         },
         observers,
+        external,
         player: ScriptPlayer::new(options.script.clone()),
         keys: KeyTeleop::new(KeyOptions {
             latched: options.latched,

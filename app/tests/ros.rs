@@ -1,0 +1,621 @@
+//! The ROS 1 bridge against real ROS: Debian's rosmaster, rospy nodes nobody on the project
+//! wrote (the tutorial's listener_yolo.py, teleop_twist_keyboard.py from ../shared/ros),
+//! rostopic, and rosbag's C++ recorder. Each test starts its own master on a free port. They
+//! run one at a time (each runs rover in real time with its camera and detector, and the rate
+//! checks need the CPU), and skip with the reason when ROS or ../shared is missing
+//! (`./test` installs the ROS packages).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail, ensure};
+use rover_core::{TraceRow, parse_trace};
+use rover_ros1::Value;
+use rover_ros1::xmlrpc::ros_call;
+
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+const PYTHON: &str = "/usr/bin/python3";
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn shared_ros() -> PathBuf {
+    repo().join("../shared/ros")
+}
+
+/// Why these tests cannot run here, if they cannot.
+fn missing_ros() -> Option<String> {
+    for tool in ["/usr/bin/rosmaster", "/usr/bin/rostopic", "/usr/bin/rosbag"] {
+        if !Path::new(tool).exists() {
+            return Some(format!(
+                "{tool} not found (apt-get install python3-rosmaster python3-rostopic python3-rosbag ros-core; ./test does)"
+            ));
+        }
+    }
+    let ok = Command::new(PYTHON)
+        .args(["-c", "import rospy, geometry_msgs.msg, nav_msgs.msg"])
+        .status()
+        .is_ok_and(|s| s.success());
+    (!ok).then(|| format!("{PYTHON} cannot import rospy/geometry_msgs/nav_msgs"))
+}
+
+fn skip(reason: &str) -> Result<()> {
+    eprintln!("SKIPPED: {reason}");
+    Ok(())
+}
+
+/// A master on a free port, its environment, and the processes started against it (killed
+/// when dropped).
+struct RosGraph {
+    dir: tempfile::TempDir,
+    master_uri: String,
+    port: u16,
+    master: Option<Child>,
+    children: Vec<Child>,
+    /// Index of rover in `children`.
+    rover: Option<usize>,
+}
+
+impl RosGraph {
+    fn start() -> Result<Self> {
+        let dir = tempfile::tempdir()?;
+        let port = std::net::TcpListener::bind("127.0.0.1:0")?
+            .local_addr()?
+            .port();
+        let mut graph = Self {
+            master_uri: format!("http://127.0.0.1:{port}/"),
+            port,
+            dir,
+            master: None,
+            children: Vec::new(),
+            rover: None,
+        };
+        graph.start_master()?;
+        Ok(graph)
+    }
+
+    fn start_master(&mut self) -> Result<()> {
+        let log = std::fs::File::create(self.dir.path().join("master.log"))?;
+        let child = self
+            .command("/usr/bin/rosmaster")
+            .args(["--core", "-p", &self.port.to_string()])
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .context("starting rosmaster")?;
+        self.master = Some(child);
+        self.wait_for(Duration::from_secs(30), "the master to answer", |g| {
+            ros_call(
+                &g.master_uri,
+                "getPid",
+                &[Value::from("/test")],
+                Duration::from_secs(1),
+            )
+            .is_ok()
+        })
+    }
+
+    fn kill_master(&mut self) {
+        if let Some(mut m) = self.master.take() {
+            let _ = m.kill();
+            let _ = m.wait();
+        }
+    }
+
+    /// A command with this graph's ROS environment.
+    fn command(&self, program: impl AsRef<std::ffi::OsStr>) -> Command {
+        let mut c = Command::new(program);
+        c.env("ROS_MASTER_URI", &self.master_uri)
+            .env("ROS_IP", "127.0.0.1")
+            .env("ROS_HOME", self.dir.path())
+            .env("ROS_LOG_DIR", self.dir.path().join("log"))
+            .env("PYTHONUNBUFFERED", "1")
+            .stdin(Stdio::null());
+        c
+    }
+
+    /// Starts a process whose output goes to `<dir>/<name>.log`.
+    fn spawn(&mut self, name: &str, mut command: Command) -> Result<()> {
+        let log = std::fs::File::create(self.log_path(name))?;
+        let child = command
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .with_context(|| format!("starting {name}"))?;
+        self.children.push(child);
+        Ok(())
+    }
+
+    fn log_path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(format!("{name}.log"))
+    }
+
+    fn log(&self, name: &str) -> String {
+        std::fs::read_to_string(self.log_path(name)).unwrap_or_default()
+    }
+
+    /// `rover --headless --ros` for `duration_s` of sim time, tracing to `<dir>/trace.csv`.
+    fn spawn_rover(&mut self, duration_s: f64, extra: &[&str]) -> Result<()> {
+        let mut c = self.command(env!("CARGO_BIN_EXE_rover"));
+        c.args(["--headless", "--ros", "--rtf", "1", "--duration"])
+            .arg(duration_s.to_string())
+            .arg("--trace")
+            .arg(self.trace_path())
+            .args(extra)
+            .env("RUST_LOG", "info");
+        self.rover = Some(self.children.len());
+        self.spawn("rover", c)?;
+        self.wait_for(Duration::from_secs(120), "rover to register", |g| {
+            ros_call(
+                &g.master_uri,
+                "lookupNode",
+                &[Value::from("/test"), Value::from("/rover")],
+                Duration::from_secs(1),
+            )
+            .is_ok()
+        })
+    }
+
+    fn trace_path(&self) -> PathBuf {
+        self.dir.path().join("trace.csv")
+    }
+
+    /// Waits for rover (the first child named rover) to exit; returns its trace.
+    fn wait_rover(&mut self, timeout: Duration) -> Result<Vec<TraceRow>> {
+        let start = Instant::now();
+        let rover = self
+            .rover
+            .and_then(|i| self.children.get_mut(i))
+            .context("no rover process")?;
+        loop {
+            if let Some(status) = rover.try_wait()? {
+                ensure!(status.success(), "rover failed: {}", self.log("rover"));
+                break;
+            }
+            if start.elapsed() > timeout {
+                bail!("rover did not finish in {timeout:?}: {}", self.log("rover"));
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        Ok(parse_trace(&std::fs::read_to_string(self.trace_path())?)?)
+    }
+
+    fn wait_for(
+        &self,
+        timeout: Duration,
+        what: &str,
+        mut ready: impl FnMut(&Self) -> bool,
+    ) -> Result<()> {
+        let start = Instant::now();
+        while !ready(self) {
+            if start.elapsed() > timeout {
+                bail!(
+                    "timed out waiting for {what}; rover log:\n{}",
+                    self.log("rover")
+                );
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        Ok(())
+    }
+
+    /// Runs a ROS tool to completion (killed after `timeout`); returns its stdout + stderr.
+    fn run(&self, mut command: Command, timeout: Duration) -> Result<String> {
+        let mut child = command
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()?;
+        let start = Instant::now();
+        while child.try_wait()?.is_none() {
+            if start.elapsed() > timeout {
+                let _ = child.kill();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = child.wait();
+        let mut out = String::new();
+        if let Some(mut o) = child.stdout.take() {
+            o.read_to_string(&mut out)?;
+        }
+        if let Some(mut e) = child.stderr.take() {
+            e.read_to_string(&mut out)?;
+        }
+        Ok(out)
+    }
+
+    /// rospy can import darknet_ros_msgs: generated from ../shared/ros with genpy, as the README
+    /// there says.
+    fn darknet_msgs(&self) -> Result<PathBuf> {
+        let out = self.dir.path().join("py");
+        let msgs = shared_ros().join("darknet_ros_msgs/msg");
+        let pkg = out.join("darknet_ros_msgs");
+        let gen_args = |c: &mut Command| {
+            c.args(["/usr/lib/genpy/genmsg_py.py", "-p", "darknet_ros_msgs"])
+                .arg(format!("-Idarknet_ros_msgs:{}", msgs.display()))
+                .arg("-Istd_msgs:/usr/share/std_msgs/msg")
+                .arg("-o")
+                .arg(pkg.join("msg"));
+        };
+        let mut files = Command::new(PYTHON);
+        gen_args(&mut files);
+        for entry in std::fs::read_dir(&msgs)? {
+            files.arg(entry?.path());
+        }
+        ensure!(files.status()?.success(), "genmsg_py failed");
+        let mut init = Command::new(PYTHON);
+        gen_args(&mut init);
+        init.arg("--initpy");
+        ensure!(init.status()?.success(), "genmsg_py --initpy failed");
+        std::fs::write(pkg.join("__init__.py"), "")?;
+        Ok(out)
+    }
+}
+
+impl Drop for RosGraph {
+    fn drop(&mut self) {
+        for c in &mut self.children {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+        self.kill_master();
+    }
+}
+
+fn lock() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+fn row_at(rows: &[TraceRow], t_s: f64) -> Result<&TraceRow> {
+    rows.iter()
+        .find(|r| r.sim_time_s >= t_s - 1e-6)
+        .with_context(|| format!("no trace row at {t_s} s"))
+}
+
+#[test]
+fn the_tutorials_listener_yolo_drives_the_car_toward_the_person() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let listener = shared_ros().join("seed_nodes/listener_yolo.py");
+    if !listener.exists() {
+        return skip(&format!("{} not found", listener.display()));
+    }
+    let mut graph = RosGraph::start()?;
+    let py = graph.darknet_msgs()?;
+    // The tutorial's node first (it waits for boxes), then rover in the default world.
+    let mut node = graph.command(PYTHON);
+    node.arg(&listener).env("PYTHONPATH", &py);
+    graph.spawn("listener", node)?;
+    graph.spawn_rover(12.0, &[])?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let said = graph.log("listener");
+    assert!(
+        said.lines().any(|l| l.trim() == "person"),
+        "listener_yolo.py printed no `person`:\n{said}\nrover:\n{}",
+        graph.log("rover")
+    );
+    assert!(said.contains("go on"), "listener never published:\n{said}");
+    // Its 0.1 m/s reached the car (the trace's cmd column) and moved it.
+    assert!(
+        rows.iter()
+            .any(|r| (r.cmd_linear_mps - 0.1).abs() < 1e-9 && r.cmd_angular_radps == 0.0),
+        "no 0.1 m/s command in the trace; rover:\n{}",
+        graph.log("rover")
+    );
+    let (start, end) = (row_at(&rows, 0.0)?, row_at(&rows, 10.0)?);
+    let moved_m = end.x_m - start.x_m;
+    assert!(
+        moved_m >= 0.3,
+        "the car moved {moved_m:.3} m forward in 10 s of sim time (want >= 0.3 m)"
+    );
+    Ok(())
+}
+
+#[test]
+fn teleop_twist_keyboard_in_tmux_drives_and_stops_the_car() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let teleop_dir = shared_ros().join("teleop_twist_keyboard");
+    if !teleop_dir.join("teleop_twist_keyboard.py").exists() {
+        return skip(&format!("{} not found", teleop_dir.display()));
+    }
+    if Command::new("tmux").arg("-V").output().is_err() {
+        return skip("tmux not found (apt-get install tmux)");
+    }
+    let mut graph = RosGraph::start()?;
+    graph.spawn_rover(14.0, &["--no-detector"])?;
+    let session = format!("rover-teleop-{}", std::process::id());
+    let tmux_conf = graph.dir.path().join("tmux.conf");
+    std::fs::write(&tmux_conf, "")?;
+    let socket = graph.dir.path().join("tmux.sock");
+    let tmux = |args: &[&str]| -> Result<()> {
+        let status = Command::new("tmux")
+            .arg("-S")
+            .arg(&socket)
+            .arg("-f")
+            .arg(&tmux_conf)
+            .args(args)
+            .status()?;
+        ensure!(status.success(), "tmux {args:?} failed");
+        Ok(())
+    };
+    let script = teleop_dir.join("teleop_twist_keyboard.py");
+    let shell = format!(
+        "PYTHONUNBUFFERED=1 ROS_MASTER_URI={} ROS_IP=127.0.0.1 ROS_HOME={} ROS_PACKAGE_PATH={} {PYTHON} {} > {} 2>&1",
+        graph.master_uri,
+        graph.dir.path().display(),
+        teleop_dir.display(),
+        script.display(),
+        graph.log_path("teleop").display()
+    );
+    tmux(&[
+        "new-session",
+        "-d",
+        "-s",
+        &session,
+        "-x",
+        "120",
+        "-y",
+        "40",
+        &shell,
+    ])?;
+    let result = (|| -> Result<Vec<TraceRow>> {
+        // teleop waits for rover's /cmd_vel subscription, then reads keys.
+        graph.wait_for(Duration::from_secs(30), "teleop's key help", |g| {
+            g.log("teleop").contains("CTRL-C to quit")
+        })?;
+        // A held key repeats (teleop stops after its 0.5 s key_timeout without one).
+        for _ in 0..15 {
+            tmux(&["send-keys", "-t", &session, "i"])?;
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        tmux(&["send-keys", "-t", &session, "k"])?;
+        graph.wait_rover(Duration::from_secs(120))
+    })();
+    let _ = tmux(&["kill-server"]);
+    let rows = result?;
+    let driving: Vec<&TraceRow> = rows.iter().filter(|r| r.cmd_linear_mps == 0.5).collect();
+    let (Some(first), Some(last)) = (driving.first(), driving.last()) else {
+        bail!(
+            "`i` never drove the car; teleop:\n{}\nrover:\n{}",
+            graph.log("teleop"),
+            graph.log("rover")
+        );
+    };
+    assert!(
+        last.x_m - first.x_m > 0.3,
+        "drove {:.3} m while `i` was held",
+        last.x_m - first.x_m
+    );
+    let end = rows.last().context("empty trace")?;
+    assert_eq!(end.cmd_linear_mps, 0.0, "`k` stopped the command");
+    let settled: Vec<&TraceRow> = rows
+        .iter()
+        .filter(|r| r.sim_time_s > last.sim_time_s + 1.0)
+        .collect();
+    ensure!(!settled.is_empty(), "the run ended right after `k`");
+    let spread = settled
+        .iter()
+        .map(|r| r.x_m)
+        .fold(f64::NEG_INFINITY, f64::max)
+        - settled.iter().map(|r| r.x_m).fold(f64::INFINITY, f64::min);
+    assert!(
+        spread < 0.01,
+        "the car kept moving after `k` ({spread:.3} m)"
+    );
+    Ok(())
+}
+
+/// `rostopic hz` prints `average rate: X`; the last one.
+fn average_rate(text: &str) -> Option<f64> {
+    text.lines()
+        .filter_map(|l| l.trim().strip_prefix("average rate:"))
+        .filter_map(|v| v.trim().parse().ok())
+        .next_back()
+}
+
+#[test]
+fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    if !shared_ros().join("darknet_ros_msgs/msg").exists() {
+        return skip("../shared/ros/darknet_ros_msgs not found");
+    }
+    let mut graph = RosGraph::start()?;
+    let py = graph.darknet_msgs()?;
+    graph.spawn_rover(45.0, &[])?;
+
+    // /odom as a rospy node sees it, for comparison with the trace.
+    let recorder = graph.dir.path().join("odom.py");
+    std::fs::write(
+        &recorder,
+        "import math, threading, rospy\nfrom nav_msgs.msg import Odometry\nrospy.init_node('odom_check')\ngot = []\ndone = threading.Event()\ndef keep(m):\n    if len(got) < 200:\n        got.append(m)\n    else:\n        done.set()\nrospy.Subscriber('/odom', Odometry, keep, queue_size=500)\ndone.wait(60)\nfor m in got[:200]:\n    q = m.pose.pose.orientation\n    print('%d.%09d %.12f %.12f %.12f %s %s' % (m.header.stamp.secs, m.header.stamp.nsecs, m.pose.pose.position.x, m.pose.pose.position.y, 2 * math.atan2(q.z, q.w), m.header.frame_id, m.child_frame_id))\n",
+    )?;
+    let mut c = graph.command(PYTHON);
+    c.arg(&recorder);
+    let odom = graph.run(c, Duration::from_secs(60))?;
+
+    let mut c = graph.command("/usr/bin/rostopic");
+    c.args(["echo", "-n", "1", "/darknet_ros/bounding_boxes"])
+        .env("PYTHONPATH", &py);
+    let boxes = graph.run(c, Duration::from_secs(30))?;
+
+    let mut c = graph.command("/usr/bin/rostopic");
+    c.args(["hz", "/camera/image_raw"]);
+    let image_hz = graph.run(c, Duration::from_secs(8))?;
+    let mut c = graph.command("/usr/bin/rostopic");
+    c.args(["hz", "/odom"]);
+    let odom_hz = graph.run(c, Duration::from_secs(8))?;
+
+    let bag = graph.dir.path().join("run.bag");
+    let mut c = graph.command("/usr/bin/rosbag");
+    c.args(["record", "--duration=5", "-O"]).arg(&bag).args([
+        "/odom",
+        "/tf",
+        "/tf_static",
+        "/clock",
+        "/joint_states",
+        "/camera/image_raw",
+        "/camera/camera_info",
+        "/darknet_ros/bounding_boxes",
+        "/darknet_ros/found_object",
+    ]);
+    let record = graph.run(c, Duration::from_secs(30))?;
+    let mut c = graph.command("/usr/bin/rosbag");
+    c.arg("info").arg(&bag);
+    let info = graph.run(c, Duration::from_secs(30))?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let rover_log = graph.log("rover");
+
+    // rostopic echo: darknet_ros's message, a person with pixel bounds inside the image.
+    assert!(
+        boxes.contains("Class: \"person\""),
+        "no person in\n{boxes}\nrover:\n{rover_log}"
+    );
+    let field = |name: &str| -> Result<i64> {
+        boxes
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(&format!("{name}: ")))
+            .with_context(|| format!("no {name} in\n{boxes}"))?
+            .trim()
+            .parse()
+            .with_context(|| format!("{name} is not an integer"))
+    };
+    let (xmin, ymin, xmax, ymax) = (
+        field("xmin")?,
+        field("ymin")?,
+        field("xmax")?,
+        field("ymax")?,
+    );
+    assert!(
+        0 <= xmin && xmin < xmax && xmax <= 640 && 0 <= ymin && ymin < ymax && ymax <= 480,
+        "box ({xmin}, {ymin})-({xmax}, {ymax}) in a 640x480 image"
+    );
+    assert!(xmax - xmin >= 10 && ymax - ymin >= 30, "a person-sized box");
+
+    // rostopic hz: the camera's 30 Hz within 20%, the plugin's 100 Hz within 10%.
+    let image_rate =
+        average_rate(&image_hz).with_context(|| format!("rostopic hz said\n{image_hz}"))?;
+    assert!(
+        (24.0..=36.0).contains(&image_rate),
+        "image at {image_rate:.1} Hz, camera rate 30 Hz"
+    );
+    let odom_rate =
+        average_rate(&odom_hz).with_context(|| format!("rostopic hz said\n{odom_hz}"))?;
+    assert!(
+        (90.0..=110.0).contains(&odom_rate),
+        "/odom at {odom_rate:.1} Hz, updateRate 100 Hz"
+    );
+
+    // rosbag record + info: every topic, with counts.
+    for topic in [
+        "/odom",
+        "/tf ",
+        "/clock",
+        "/camera/image_raw",
+        "/darknet_ros/found_object",
+    ] {
+        let line = info.lines().find(|l| l.contains(topic)).with_context(|| {
+            format!("{topic} missing in rosbag info:\n{info}\nrecord said:\n{record}")
+        })?;
+        assert!(line.contains(" msgs"), "no count for {topic}: {line}");
+    }
+    assert!(info.contains("nav_msgs/Odometry"), "{info}");
+    assert!(info.contains("darknet_ros_msgs/ObjectCount"), "{info}");
+
+    // /odom equals the trace's odometry columns at matching stamps.
+    let mut compared = 0;
+    for line in odom.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        let [t, x, y, yaw, frame, child] = f[..] else {
+            bail!("odom recorder said: {line}\n{odom}");
+        };
+        assert_eq!((frame, child), ("odom", "base_link"));
+        let (t, x, y, yaw): (f64, f64, f64, f64) =
+            (t.parse()?, x.parse()?, y.parse()?, yaw.parse()?);
+        let row = rows
+            .iter()
+            .find(|r| (r.sim_time_s - t).abs() < 5e-5)
+            .with_context(|| format!("no trace row at {t} s"))?;
+        let dyaw = (row.odom_yaw_rad - yaw + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        assert!(
+            (row.odom_x_m - x).abs() <= 1e-6
+                && (row.odom_y_m - y).abs() <= 1e-6
+                && dyaw.abs() <= 1e-6,
+            "at {t} s /odom ({x}, {y}, {yaw}) vs trace ({}, {}, {})",
+            row.odom_x_m,
+            row.odom_y_m,
+            row.odom_yaw_rad
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 200, "odom recorder said\n{odom}");
+    Ok(())
+}
+
+#[test]
+fn rover_survives_a_roscore_restart_and_publishes_again() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let mut graph = RosGraph::start()?;
+    graph.spawn_rover(30.0, &["--no-detector"])?;
+    let echo_odom = |g: &RosGraph| -> Result<String> {
+        let mut c = g.command("/usr/bin/rostopic");
+        c.args(["echo", "-n", "1", "/odom/header/stamp"]);
+        g.run(c, Duration::from_secs(20))
+    };
+    let before = echo_odom(&graph)?;
+    assert!(
+        before.contains("secs:"),
+        "no /odom before the restart: {before}"
+    );
+    graph.kill_master();
+    std::thread::sleep(Duration::from_secs(2));
+    graph.start_master()?;
+    // rover notices (it watches the master) and registers again.
+    graph.wait_for(Duration::from_secs(20), "rover to register again", |g| {
+        ros_call(
+            &g.master_uri,
+            "lookupNode",
+            &[Value::from("/test"), Value::from("/rover")],
+            Duration::from_secs(1),
+        )
+        .is_ok()
+    })?;
+    let after = echo_odom(&graph)?;
+    assert!(
+        after.contains("secs:"),
+        "no /odom after the restart: {after}"
+    );
+    // The parameter a restarted master lost is set again.
+    let description = ros_call(
+        &graph.master_uri,
+        "getParam",
+        &[Value::from("/test"), Value::from("/robot_description")],
+        Duration::from_secs(2),
+    )?;
+    assert!(
+        description.as_str().is_some_and(|d| d.contains("<robot")),
+        "/robot_description after the restart: {description:?}"
+    );
+    graph.wait_rover(Duration::from_secs(120))?;
+    let log = graph.log("rover");
+    assert_eq!(log.matches("went away").count(), 1, "one warning:\n{log}");
+    assert!(log.contains("registered again"), "{log}");
+    Ok(())
+}
