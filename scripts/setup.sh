@@ -21,10 +21,16 @@ fi
 #   run:   mesa-vulkan-drivers (software Vulkan: the camera renders without a GPU), the X11
 #          keyboard/cursor libraries winit loads for the window
 #   test:  darknet (its sample photos), xvfb/xauth/xdotool (the window test), chromium (the web
-#          viewer test), python3 with venv and pip (onnxruntime and scikit-image references)
+#          viewer test), python3 with venv and pip (onnxruntime and scikit-image references),
+#          Debian's ROS 1 packages and tmux (the ROS bridge tests; rover itself needs no ROS)
 packages=(gcc libc6-dev pkg-config libudev-dev mesa-vulkan-drivers libxkbcommon-x11-0 libxcursor1 libxi6)
 if [ "$purpose" = test ]; then
   packages+=(darknet xvfb xauth xdotool chromium python3 python3-venv python3-pip npm)
+  # The ROS bridge's peers: a real ROS 1 master, rospy and its messages, rostopic, rosbag (its C++
+  # recorder), and tmux for teleop_twist_keyboard's terminal.
+  packages+=(python3-rosmaster python3-rospy python3-rostopic python3-rosbag ros-std-msgs
+    python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
+    python3-rosgraph-msgs python3-roslib python3-genpy tmux)
 fi
 missing=()
 if command -v dpkg-query >/dev/null 2>&1; then

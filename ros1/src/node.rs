@@ -244,19 +244,43 @@ impl Node {
         topic: &str,
         queue: usize,
     ) -> Result<Subscriber<T>> {
+        self.subscribe_with(topic, T::TYPE, queue, T::decode)
+    }
+
+    /// Subscribes to a topic of a known type without decoding it: each message arrives as its
+    /// serialized bytes (rospy's `AnyMsg`, for tools and benchmarks).
+    pub fn subscribe_raw(
+        &self,
+        topic: &str,
+        type_name: &str,
+        queue: usize,
+    ) -> Result<Subscriber<Vec<u8>>> {
+        let type_name = crate::msg::known_types()
+            .find(|t| *t == type_name)
+            .ok_or_else(|| Error::UnknownType(type_name.to_owned()))?;
+        self.subscribe_with(topic, type_name, queue, |b| Ok(b.to_vec()))
+    }
+
+    fn subscribe_with<T: Send + 'static>(
+        &self,
+        topic: &str,
+        type_name: &'static str,
+        queue: usize,
+        decode: fn(&[u8]) -> Result<T>,
+    ) -> Result<Subscriber<T>> {
         let topic = global_name(topic)?;
         let (tx, rx) = sync_channel::<T>(queue.max(1));
         let dropped = Arc::new(AtomicU64::new(0));
         let counter = dropped.clone();
         let subscription = Arc::new(Subscription {
-            md5: md5sum(T::TYPE)?,
-            definition: full_definition(T::TYPE)?,
-            type_name: T::TYPE,
+            md5: md5sum(type_name)?,
+            definition: full_definition(type_name)?,
+            type_name,
             topic: topic.clone(),
             connected: Mutex::default(),
             streams: Mutex::default(),
             deliver: Box::new(move |bytes| {
-                let msg = T::decode(bytes)?;
+                let msg = decode(bytes)?;
                 if let Err(TrySendError::Full(_)) = tx.try_send(msg) {
                     counter.fetch_add(1, Ordering::Relaxed);
                 }
@@ -898,6 +922,80 @@ mod tests {
         };
         publisher.publish(&msg);
         assert_eq!(subscriber.recv_timeout(Duration::from_secs(10)), Some(msg));
+        Ok(())
+    }
+
+    /// A subscriber that connects and then never reads must not slow the publisher: its queue
+    /// fills and further messages are dropped for it.
+    #[test]
+    fn a_subscriber_that_never_reads_loses_messages_and_blocks_nothing() -> Result<()> {
+        use crate::msgs::Image;
+        let node = Node::start(NodeOptions {
+            name: "/pub".into(),
+            master_uri: "http://127.0.0.1:9/".into(),
+            host: "127.0.0.1".into(),
+        })?;
+        let mut publisher = node.advertise::<Image>("/camera/image_raw", 2, false)?;
+        // The slave API tells where to connect, as it tells rospy.
+        let reply = xmlrpc::ros_call(
+            node.uri(),
+            "requestTopic",
+            &[
+                Value::from("/slow"),
+                Value::from("/camera/image_raw"),
+                Value::Array(vec![Value::Array(vec![Value::from("TCPROS")])]),
+            ],
+            Duration::from_secs(10),
+        )?;
+        let port = reply
+            .as_array()
+            .and_then(|a| a.get(2))
+            .and_then(Value::as_int)
+            .ok_or_else(|| Error::protocol(format!("requestTopic: {reply:?}")))?;
+        let mut stream = TcpStream::connect(("127.0.0.1", u16::try_from(port).unwrap_or(0)))?;
+        write_header(
+            &mut stream,
+            &[
+                ("callerid", "/slow"),
+                ("topic", "/camera/image_raw"),
+                ("md5sum", "*"),
+                ("type", "sensor_msgs/Image"),
+            ],
+        )?;
+        let header = read_header(&mut stream)?;
+        assert_eq!(
+            header.get("md5sum").map(String::as_str),
+            Some("060021388200f6f0f447d0fcd9c64743")
+        );
+        assert!(header.contains_key("message_definition"));
+        let start = Instant::now();
+        while publisher.subscribers() == 0 && start.elapsed() < Duration::from_secs(10) {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert_eq!(publisher.subscribers(), 1);
+        let (done_tx, done_rx) = std::sync::mpsc::channel();
+        let worker = std::thread::spawn(move || {
+            let image = Image {
+                width: 640,
+                height: 480,
+                step: 1920,
+                encoding: "rgb8".into(),
+                data: vec![7; 640 * 480 * 3],
+                ..Image::default()
+            };
+            for _ in 0..100 {
+                publisher.publish(&image);
+            }
+            let _ = done_tx.send(publisher.dropped());
+        });
+        // 100 images are 92 MB: far more than the socket buffers and the queue of 2 hold.
+        let dropped = done_rx.recv_timeout(Duration::from_secs(120));
+        assert!(
+            matches!(dropped, Ok(d) if d > 50),
+            "publishing to a stuck subscriber: {dropped:?} dropped"
+        );
+        let _ = worker.join();
+        drop(stream);
         Ok(())
     }
 }

@@ -451,6 +451,21 @@ pub(crate) enum BenchKind {
         #[arg(long, value_name = "Q")]
         image_jpeg: Option<u8>,
     },
+    /// ROS bridge cost: the same headless run (camera + lockstep detector) without and with
+    /// --ros and in-process subscribers to the image, /odom and /tf. Needs a master
+    /// (`roscore`; ROS_MASTER_URI)
+    Ros {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per run
+        #[arg(long, default_value_t = 10.0, value_name = "SECS")]
+        duration: f64,
+
+        /// Repeats (the fastest of each counts)
+        #[arg(long, default_value_t = 2)]
+        repeats: u32,
+    },
     /// Camera: ms per image (render + readback) on this machine's GPU or software Vulkan
     Camera {
         #[command(flatten)]

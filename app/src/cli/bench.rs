@@ -443,6 +443,146 @@ pub(crate) fn bench_record(
     Ok(())
 }
 
+/// What the ROS bridge costs the loop.
+#[derive(Debug, Clone, Copy)]
+pub struct RosBench {
+    /// Wall seconds without the bridge (best of the repeats).
+    pub plain_s: f64,
+    /// Wall seconds with the bridge and its subscribers (best of the repeats).
+    pub bridged_s: f64,
+    /// Messages the subscribers received in the fastest bridged run, per topic (image, /odom,
+    /// /tf).
+    pub received: [u64; 3],
+}
+
+/// The same headless run (camera + lockstep detector, unpaced) without and with the ROS
+/// bridge, while an in-process node subscribes to the camera image, /odom and /tf (raw bytes,
+/// like `rostopic hz`).
+pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
+    use rover_ros1::{Node, NodeOptions};
+    let master = NodeOptions::from_env("rover_bench")?;
+    rover_ros1::xmlrpc::ros_call(
+        &master.master_uri,
+        "getPid",
+        &[rover_ros1::Value::from("/rover_bench")],
+        std::time::Duration::from_secs(2),
+    )
+    .map_err(|e| {
+        anyhow::anyhow!(
+            "no ROS master at {} ({e}): start roscore (or `rosmaster --core`) first",
+            master.master_uri
+        )
+    })?;
+    let config = RunConfig {
+        perception: Perception::On,
+        real_time_factor: None,
+        ..config.clone()
+    };
+    let (world, robot) = headless::load(&config)?;
+    let plan = crate::ros::RosPlan::for_robot(&robot);
+    let image_topic = plan
+        .image_topic
+        .clone()
+        .ok_or_else(|| anyhow::anyhow!("the robot has no camera"))?;
+    let listener = Node::start(master)?;
+    let mut subs = vec![
+        listener.subscribe_raw(&image_topic, "sensor_msgs/Image", 4)?,
+        listener.subscribe_raw(&plan.odom_topic, "nav_msgs/Odometry", 1000)?,
+        listener.subscribe_raw("/tf", "tf2_msgs/TFMessage", 1000)?,
+    ];
+    let options = crate::ros::RosOptions {
+        name: "rover".into(),
+        sim_time: false,
+    };
+    let mut plain = f64::INFINITY;
+    let mut bridged = f64::INFINITY;
+    let mut received = [0; 3];
+    for _ in 0..repeats.max(1) {
+        let started = Instant::now();
+        headless::run(&config)?;
+        plain = plain.min(started.elapsed().as_secs_f64());
+
+        let (mut bridge, mut cmd_vel) = crate::ros::RosBridge::start(&options, &robot)?;
+        // The subscribers connect before the clock starts.
+        let wait = Instant::now();
+        while !listener.is_registered() && wait.elapsed().as_secs_f64() < 10.0 {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        std::thread::sleep(std::time::Duration::from_secs(2));
+        for s in &subs {
+            while s.try_recv().is_some() {}
+        }
+        let counting = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+        let flag = counting.clone();
+        let owned = std::mem::take(&mut subs);
+        let counter = std::thread::spawn(move || {
+            let mut n = [0u64; 3];
+            while flag.load(std::sync::atomic::Ordering::Relaxed) {
+                let mut any = false;
+                for (i, s) in owned.iter().enumerate() {
+                    while s.try_recv().is_some() {
+                        n[i] += 1;
+                        any = true;
+                    }
+                }
+                if !any {
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                }
+            }
+            (n, owned)
+        });
+        let started = Instant::now();
+        let run = headless::run_driven(
+            &config,
+            world.clone(),
+            robot.clone(),
+            &mut bridge,
+            true,
+            &mut cmd_vel,
+        );
+        let wall = started.elapsed().as_secs_f64();
+        bridge.finish();
+        std::thread::sleep(std::time::Duration::from_millis(500));
+        counting.store(false, std::sync::atomic::Ordering::Relaxed);
+        let (n, owned) = counter
+            .join()
+            .map_err(|_| anyhow::anyhow!("the counting thread panicked"))?;
+        subs = owned;
+        run?;
+        if wall < bridged {
+            bridged = wall;
+            received = n;
+        }
+    }
+    Ok(RosBench {
+        plain_s: plain,
+        bridged_s: bridged,
+        received,
+    })
+}
+
+pub(crate) fn bench_ros(world: WorldArgs, duration: f64, repeats: u32) -> Result<()> {
+    let config = RunConfig {
+        duration_s: Some(duration),
+        ..world.run_config(None)
+    };
+    println!(
+        "ROS bridge cost: {duration} sim s headless, camera + lockstep detector on, unpaced, best of {repeats}"
+    );
+    let b = ros(&config, repeats)?;
+    println!("without --ros: {:.2} s wall", b.plain_s);
+    println!(
+        "with --ros and 3 subscribers: {:.2} s wall (received {} images, {} odom, {} tf)",
+        b.bridged_s, b.received[0], b.received[1], b.received[2]
+    );
+    println!(
+        "ratio: {:.3}x; {:.2} ms more per sim second",
+        b.bridged_s / b.plain_s,
+        (b.bridged_s - b.plain_s) * 1e3 / duration
+    );
+    Ok(())
+}
+
 pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
     let config = world.run_config(None);
     let b = camera(&config, frames)?;

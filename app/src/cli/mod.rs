@@ -51,6 +51,15 @@ pub fn main() -> ExitCode {
         }) => bench::bench_laser(world, scans),
         Some(Command::Bench {
             kind:
+                Some(BenchKind::Ros {
+                    world,
+                    duration,
+                    repeats,
+                }),
+            ..
+        }) => bench::bench_ros(world, duration, repeats),
+        Some(Command::Bench {
+            kind:
                 Some(BenchKind::Record {
                     world,
                     duration,
