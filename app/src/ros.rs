@@ -206,6 +206,8 @@ pub struct RosBridge {
     now_s: f64,
     dropped: u64,
     warned: bool,
+    /// Time spent in this observer's callbacks on the loop thread.
+    busy: std::time::Duration,
 }
 
 impl std::fmt::Debug for RosBridge {
@@ -310,6 +312,7 @@ impl RosBridge {
                 now_s: 0.0,
                 dropped: 0,
                 warned: false,
+                busy: std::time::Duration::ZERO,
             },
             cmd,
         ))
@@ -318,6 +321,11 @@ impl RosBridge {
     /// Events the publishing thread could not take (it was behind).
     pub fn dropped(&self) -> u64 {
         self.dropped
+    }
+
+    /// Time the bridge took on the loop thread so far (copies and hand-offs).
+    pub fn loop_time(&self) -> std::time::Duration {
+        self.busy
     }
 
     fn send(&mut self, event: Event) {
@@ -426,6 +434,7 @@ impl Observer for RosBridge {
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
+        let started = std::time::Instant::now();
         self.now_s = sample.sim_time_s;
         let mut wheels = [WheelSample {
             parent_from_child: Pose::IDENTITY,
@@ -440,9 +449,11 @@ impl Observer for RosBridge {
             sample: *sample,
             wheels,
         });
+        self.busy += started.elapsed();
     }
 
     fn camera_frame(&mut self, frame: &CameraFrame<'_>, _world_from_camera: Pose) {
+        let started = std::time::Instant::now();
         let mut pixels = self.recycled_pixels.try_recv().unwrap_or_default();
         pixels.clear();
         pixels.extend_from_slice(frame.rgb);
@@ -453,9 +464,11 @@ impl Observer for RosBridge {
             height: frame.height,
             pixels,
         });
+        self.busy += started.elapsed();
     }
 
     fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
+        let started = std::time::Instant::now();
         let out = boxes
             .bounding_boxes
             .iter()
@@ -476,9 +489,11 @@ impl Observer for RosBridge {
             image_seq: boxes.image_stamp.frame,
             boxes: out,
         });
+        self.busy += started.elapsed();
     }
 
     fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
+        let started = std::time::Instant::now();
         let mut ranges = self.recycled_ranges.try_recv().unwrap_or_default();
         ranges.clear();
         ranges.extend_from_slice(&scan.ranges_m);
@@ -497,6 +512,7 @@ impl Observer for RosBridge {
             }),
             ranges,
         });
+        self.busy += started.elapsed();
     }
 }
 

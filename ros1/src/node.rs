@@ -10,7 +10,7 @@ use std::io::{BufReader, Write};
 use std::marker::PhantomData;
 use std::net::{TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, TrySendError, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -97,6 +97,9 @@ struct Publication {
     dropped: AtomicU64,
 }
 
+/// Decodes a message's bytes and queues it for the subscriber.
+type Deliver = Box<dyn Fn(&[u8]) -> Result<()> + Send + Sync>;
+
 struct Subscription {
     topic: String,
     type_name: &'static str,
@@ -106,7 +109,7 @@ struct Subscription {
     connected: Mutex<BTreeSet<String>>,
     /// Sockets to those publishers (to shut them down with the node).
     streams: Mutex<Vec<TcpStream>>,
-    deliver: Box<dyn Fn(&[u8]) -> Result<()> + Send + Sync>,
+    deliver: Deliver,
 }
 
 #[derive(Default)]
@@ -457,10 +460,7 @@ pub struct Subscriber<T> {
 impl<T> Subscriber<T> {
     /// The next waiting message, if any.
     pub fn try_recv(&self) -> Option<T> {
-        match self.rx.try_recv() {
-            Ok(m) => Some(m),
-            Err(TryRecvError::Empty | TryRecvError::Disconnected) => None,
-        }
+        self.rx.try_recv().ok()
     }
 
     /// The newest waiting message, discarding older ones.
