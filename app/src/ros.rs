@@ -49,6 +49,7 @@ enum Event {
     Start {
         static_tf: Vec<TransformStamped>,
         camera: Option<CameraInfo>,
+        labels: Vec<String>,
     },
     Control {
         sample: ControlSample,
@@ -65,12 +66,23 @@ enum Event {
         stamp_s: f64,
         image_stamp_s: f64,
         image_seq: u64,
-        boxes: Vec<msgs::BoundingBox>,
+        boxes: Vec<BoxSample>,
     },
     Scan {
         scan: Box<LaserScanMeta>,
         ranges: Vec<f32>,
     },
+}
+
+/// A detection, without its class name (the publishing thread has the labels).
+#[derive(Debug, Clone, Copy)]
+struct BoxSample {
+    probability: f64,
+    xmin: i64,
+    ymin: i64,
+    xmax: i64,
+    ymax: i64,
+    id: i16,
 }
 
 struct LaserScanMeta {
@@ -200,6 +212,7 @@ pub struct RosBridge {
     tx: Option<SyncSender<Event>>,
     recycled_pixels: Receiver<Vec<u8>>,
     recycled_ranges: Receiver<Vec<f32>>,
+    recycled_boxes: Receiver<Vec<BoxSample>>,
     thread: Option<JoinHandle<()>>,
     wheels: Vec<Wheel>,
     camera_link: Option<String>,
@@ -287,16 +300,15 @@ impl RosBridge {
         let (tx, rx) = sync_channel::<Event>(64);
         let (pixels_back, recycled_pixels) = sync_channel::<Vec<u8>>(IMAGE_RING + 4);
         let (ranges_back, recycled_ranges) = sync_channel::<Vec<f32>>(4);
-        let worker = Worker {
+        let (boxes_back, recycled_boxes) = sync_channel::<Vec<BoxSample>>(4);
+        let worker = Worker::new(
             node,
-            plan: plan.clone(),
+            plan.clone(),
             publishers,
             pixels_back,
             ranges_back,
-            camera: None,
-            images: Vec::with_capacity(IMAGE_RING),
-            seq: 0,
-        };
+            boxes_back,
+        );
         let thread = std::thread::Builder::new()
             .name("ros-bridge".into())
             .spawn(move || worker.run(rx))
@@ -306,6 +318,7 @@ impl RosBridge {
                 tx: Some(tx),
                 recycled_pixels,
                 recycled_ranges,
+                recycled_boxes,
                 thread: Some(thread),
                 wheels: plan.wheels,
                 camera_link: robot.cameras.first().map(|c| c.link.clone()),
@@ -396,7 +409,7 @@ fn transform(parent: &str, child: &str, stamp_s: f64, pose: Pose) -> TransformSt
 }
 
 impl Observer for RosBridge {
-    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, _labels: &[String]) {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
         let robot = sim.robot();
         let mut static_tf: Vec<TransformStamped> = robot
             .joints
@@ -430,6 +443,7 @@ impl Observer for RosBridge {
         self.send(Event::Start {
             static_tf,
             camera: camera.cloned(),
+            labels: labels.to_vec(),
         });
     }
 
@@ -469,19 +483,16 @@ impl Observer for RosBridge {
 
     fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
         let started = std::time::Instant::now();
-        let out = boxes
-            .bounding_boxes
-            .iter()
-            .map(|b| msgs::BoundingBox {
-                probability: b.probability,
-                xmin: b.xmin,
-                ymin: b.ymin,
-                xmax: b.xmax,
-                ymax: b.ymax,
-                id: b.id,
-                class: b.class.clone(),
-            })
-            .collect();
+        let mut out = self.recycled_boxes.try_recv().unwrap_or_default();
+        out.clear();
+        out.extend(boxes.bounding_boxes.iter().map(|b| BoxSample {
+            probability: b.probability,
+            xmin: b.xmin,
+            ymin: b.ymin,
+            xmax: b.xmax,
+            ymax: b.ymax,
+            id: b.id,
+        }));
         // Published now, which is never before the image was taken.
         self.send(Event::Boxes {
             stamp_s: self.now_s.max(boxes.image_stamp.sim_time_s),
@@ -522,10 +533,23 @@ struct Worker {
     publishers: Publishers,
     pixels_back: SyncSender<Vec<u8>>,
     ranges_back: SyncSender<Vec<f32>>,
+    boxes_back: SyncSender<Vec<BoxSample>>,
     camera: Option<CameraInfo>,
+    labels: Vec<String>,
     /// The newest images (seq, stamp, width, height, pixels), for the detection image.
     images: Vec<(u64, f64, u32, u32, Vec<u8>)>,
-    seq: u32,
+    // Messages kept from one update to the next: only their numbers change, so steady
+    // publishing allocates nothing.
+    clock: msgs::Clock,
+    odom: msgs::Odometry,
+    tf: msgs::TfMessage,
+    joints: msgs::JointState,
+    info: msgs::CameraInfo,
+    image: msgs::Image,
+    detection: msgs::Image,
+    found: msgs::ObjectCount,
+    boxes: msgs::BoundingBoxes,
+    scan: msgs::LaserScan,
 }
 
 fn covariance(diagonal: [f64; 6]) -> [f64; 36] {
@@ -536,18 +560,101 @@ fn covariance(diagonal: [f64; 6]) -> [f64; 36] {
     c
 }
 
+fn header(frame_id: &str) -> Header {
+    Header {
+        seq: 0,
+        stamp_s: 0.0,
+        frame_id: frame_id.to_owned(),
+    }
+}
+
+/// A per-topic sequence number, as roscpp and rospy set `header.seq`: messages published so far.
+fn seq_of<T: rover_ros1::Message>(p: &Publisher<T>) -> u32 {
+    p.published() as u32
+}
+
 impl Worker {
+    fn new(
+        node: Node,
+        plan: RosPlan,
+        publishers: Publishers,
+        pixels_back: SyncSender<Vec<u8>>,
+        ranges_back: SyncSender<Vec<f32>>,
+        boxes_back: SyncSender<Vec<BoxSample>>,
+    ) -> Self {
+        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
+        let odom = msgs::Odometry {
+            header: header(&plan.odom_frame),
+            child_frame_id: plan.base_frame.clone(),
+            position: Vector3::default(),
+            orientation: Quaternion::default(),
+            pose_covariance: cov,
+            linear: Vector3::default(),
+            angular: Vector3::default(),
+            twist_covariance: cov,
+        };
+        let mut transforms = Vec::new();
+        if plan.odom_tf {
+            transforms.push(transform(
+                &plan.odom_frame,
+                &plan.base_frame,
+                0.0,
+                Pose::IDENTITY,
+            ));
+        }
+        if plan.wheel_tf {
+            for w in &plan.wheels {
+                transforms.push(transform(&w.parent_link, &w.child_link, 0.0, w.origin));
+            }
+        }
+        let joints = msgs::JointState {
+            header: header(""),
+            name: plan.wheels.iter().map(|w| w.joint.clone()).collect(),
+            ..msgs::JointState::default()
+        };
+        Self {
+            node,
+            plan,
+            publishers,
+            pixels_back,
+            ranges_back,
+            boxes_back,
+            camera: None,
+            labels: Vec::new(),
+            images: Vec::with_capacity(IMAGE_RING),
+            clock: msgs::Clock::default(),
+            odom,
+            tf: msgs::TfMessage { transforms },
+            joints,
+            info: msgs::CameraInfo::default(),
+            image: msgs::Image {
+                encoding: "rgb8".into(),
+                ..msgs::Image::default()
+            },
+            detection: msgs::Image {
+                encoding: "rgb8".into(),
+                ..msgs::Image::default()
+            },
+            found: msgs::ObjectCount {
+                header: header("detection"),
+                count: 0,
+            },
+            boxes: msgs::BoundingBoxes {
+                header: header("detection"),
+                ..msgs::BoundingBoxes::default()
+            },
+            scan: msgs::LaserScan::default(),
+        }
+    }
+
     fn run(mut self, rx: Receiver<Event>) {
-        let mut detection = msgs::Image::default();
         for event in rx {
-            self.seq = self.seq.wrapping_add(1);
             match event {
-                Event::Start { static_tf, camera } => {
-                    self.camera = camera;
-                    self.publishers.tf_static.publish(&msgs::TfMessage {
-                        transforms: static_tf,
-                    });
-                }
+                Event::Start {
+                    static_tf,
+                    camera,
+                    labels,
+                } => self.start(static_tf, camera, labels),
                 Event::Control { sample, wheels } => self.control(&sample, &wheels),
                 Event::Image {
                     stamp_s,
@@ -561,200 +668,195 @@ impl Worker {
                     image_stamp_s,
                     image_seq,
                     boxes,
-                } => self.boxes(stamp_s, image_stamp_s, image_seq, boxes, &mut detection),
+                } => self.boxes(stamp_s, image_stamp_s, image_seq, boxes),
                 Event::Scan { scan, ranges } => self.scan(&scan, ranges),
             }
         }
         drop(self.node);
     }
 
-    fn header(&self, stamp_s: f64, frame_id: &str) -> Header {
-        Header {
-            seq: self.seq,
-            stamp_s,
-            frame_id: frame_id.to_owned(),
+    fn start(
+        &mut self,
+        static_tf: Vec<TransformStamped>,
+        camera: Option<CameraInfo>,
+        labels: Vec<String>,
+    ) {
+        self.publishers.tf_static.publish(&msgs::TfMessage {
+            transforms: static_tf,
+        });
+        if let Some(c) = &camera {
+            self.info = msgs::CameraInfo {
+                header: header(&c.frame_id),
+                height: c.height,
+                width: c.width,
+                distortion_model: c.distortion_model.to_owned(),
+                d: c.d.to_vec(),
+                k: c.k,
+                r: c.r,
+                p: c.p,
+            };
+            self.image.header.frame_id = c.frame_id.clone();
+            self.boxes.image_header.frame_id = c.frame_id.clone();
         }
+        self.camera = camera;
+        self.labels = labels;
     }
 
     fn control(&mut self, sample: &ControlSample, wheels: &[WheelSample; 2]) {
         let t = sample.sim_time_s;
         let o = sample.odometry;
         let p = &mut self.publishers;
-        p.clock.publish(&msgs::Clock { clock_s: t });
-        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
+        self.clock.clock_s = t;
+        p.clock.publish(&self.clock);
         let orientation = Quaternion::from_yaw(o.yaw_rad);
         let position = Vector3 {
             x: o.x_m,
             y: o.y_m,
             z: 0.0,
         };
-        let header = Header {
-            seq: self.seq,
-            stamp_s: t,
-            frame_id: self.plan.odom_frame.clone(),
-        };
-        p.odom.publish(&msgs::Odometry {
-            header: header.clone(),
-            child_frame_id: self.plan.base_frame.clone(),
-            position,
-            orientation,
-            pose_covariance: cov,
-            linear: Vector3 {
-                x: o.linear_mps,
-                ..Vector3::default()
-            },
-            angular: Vector3 {
-                z: o.angular_radps,
-                ..Vector3::default()
-            },
-            twist_covariance: cov,
-        });
-        let mut transforms = Vec::with_capacity(3);
-        if self.plan.odom_tf {
-            transforms.push(TransformStamped {
-                header,
-                child_frame_id: self.plan.base_frame.clone(),
-                translation: position,
-                rotation: orientation,
-            });
+        let odom = &mut self.odom;
+        odom.header.seq = seq_of(&p.odom);
+        odom.header.stamp_s = t;
+        odom.position = position;
+        odom.orientation = orientation;
+        odom.linear.x = o.linear_mps;
+        odom.angular.z = o.angular_radps;
+        p.odom.publish(odom);
+
+        let mut next = self.tf.transforms.iter_mut();
+        if self.plan.odom_tf
+            && let Some(tr) = next.next()
+        {
+            tr.header.stamp_s = t;
+            tr.translation = position;
+            tr.rotation = orientation;
         }
-        let mut joints = msgs::JointState {
-            header: Header {
-                seq: self.seq,
-                stamp_s: t,
-                frame_id: String::new(),
-            },
-            ..msgs::JointState::default()
-        };
+        self.joints.position.clear();
+        self.joints.velocity.clear();
         for (w, s) in self.plan.wheels.iter().zip(wheels) {
-            if self.plan.wheel_tf {
-                transforms.push(transform(
-                    &w.parent_link,
-                    &w.child_link,
-                    t,
-                    s.parent_from_child,
-                ));
+            if self.plan.wheel_tf
+                && let Some(tr) = next.next()
+            {
+                tr.header.stamp_s = t;
+                tr.translation = vec3(s.parent_from_child.translation);
+                tr.rotation = quat(s.parent_from_child.rotation);
             }
             // The joint angle: the rotation since the joint's rest pose, about its axis.
             let rel = w.origin.rotation.inverse() * s.parent_from_child.rotation;
             let along = glam::Vec3::new(rel.x, rel.y, rel.z).dot(w.axis);
-            joints.name.push(w.joint.clone());
-            joints
+            self.joints
                 .position
                 .push(2.0 * f64::from(along).atan2(f64::from(rel.w)));
-            joints.velocity.push(s.velocity_radps);
+            self.joints.velocity.push(s.velocity_radps);
         }
-        if !transforms.is_empty() {
-            p.tf.publish(&msgs::TfMessage { transforms });
+        if !self.tf.transforms.is_empty() {
+            p.tf.publish(&self.tf);
         }
-        if !joints.name.is_empty() {
-            p.joints.publish(&joints);
+        if !self.joints.name.is_empty() {
+            self.joints.header.seq = seq_of(&p.joints);
+            self.joints.header.stamp_s = t;
+            p.joints.publish(&self.joints);
         }
     }
 
     fn image(&mut self, stamp_s: f64, seq: u64, width: u32, height: u32, pixels: Vec<u8>) {
-        let frame_id = self
-            .camera
-            .as_ref()
-            .map_or_else(String::new, |c| c.frame_id.clone());
-        let header = self.header(stamp_s, &frame_id);
-        if let (Some(info), Some(p)) = (&self.camera, self.publishers.info.as_mut()) {
-            p.publish(&msgs::CameraInfo {
-                header: header.clone(),
-                height: info.height,
-                width: info.width,
-                distortion_model: info.distortion_model.to_owned(),
-                d: info.d.to_vec(),
-                k: info.k,
-                r: info.r,
-                p: info.p,
-            });
+        // The camera's frame number, which the boxes' image_header names too.
+        let seq = seq as u32;
+        if self.camera.is_some()
+            && let Some(p) = self.publishers.info.as_mut()
+        {
+            self.info.header.seq = seq;
+            self.info.header.stamp_s = stamp_s;
+            p.publish(&self.info);
         }
-        let mut msg = msgs::Image {
-            header,
-            height,
-            width,
-            encoding: "rgb8".into(),
-            step: width * 3,
-            data: pixels,
-        };
+        let msg = &mut self.image;
+        msg.header.seq = seq;
+        msg.header.stamp_s = stamp_s;
+        msg.width = width;
+        msg.height = height;
+        msg.step = width * 3;
+        msg.data = pixels;
         if let Some(p) = self.publishers.image.as_mut() {
-            p.publish(&msg);
+            p.publish(msg);
         }
         let pixels = std::mem::take(&mut msg.data);
         if self.images.len() >= IMAGE_RING {
             let (_, _, _, _, old) = self.images.remove(0);
             let _ = self.pixels_back.try_send(old);
         }
-        self.images.push((seq, stamp_s, width, height, pixels));
+        self.images
+            .push((seq.into(), stamp_s, width, height, pixels));
     }
 
-    fn boxes(
-        &mut self,
-        stamp_s: f64,
-        image_stamp_s: f64,
-        image_seq: u64,
-        boxes: Vec<msgs::BoundingBox>,
-        detection: &mut msgs::Image,
-    ) {
-        let frame_id = self
-            .camera
-            .as_ref()
-            .map_or_else(String::new, |c| c.frame_id.clone());
-        let image_header = Header {
-            seq: u32::try_from(image_seq).unwrap_or(u32::MAX),
-            stamp_s: image_stamp_s,
-            frame_id,
-        };
-        let header = self.header(stamp_s, "detection");
-        self.publishers.found.publish(&msgs::ObjectCount {
-            header: header.clone(),
-            count: i8::try_from(boxes.len()).unwrap_or(i8::MAX),
-        });
+    fn boxes(&mut self, stamp_s: f64, image_stamp_s: f64, image_seq: u64, boxes: Vec<BoxSample>) {
+        let p = &mut self.publishers;
+        self.found.header.seq = seq_of(&p.found);
+        self.found.header.stamp_s = stamp_s;
+        self.found.count = i8::try_from(boxes.len()).unwrap_or(i8::MAX);
+        p.found.publish(&self.found);
+
+        let out = &mut self.boxes;
+        out.header.seq = seq_of(&p.boxes);
+        out.header.stamp_s = stamp_s;
+        out.image_header.seq = image_seq as u32;
+        out.image_header.stamp_s = image_stamp_s;
+        out.bounding_boxes
+            .resize_with(boxes.len(), msgs::BoundingBox::default);
+        for (m, b) in out.bounding_boxes.iter_mut().zip(&boxes) {
+            m.probability = b.probability;
+            m.xmin = b.xmin;
+            m.ymin = b.ymin;
+            m.xmax = b.xmax;
+            m.ymax = b.ymax;
+            m.id = b.id;
+            m.class.clear();
+            m.class.push_str(
+                usize::try_from(b.id)
+                    .ok()
+                    .and_then(|i| self.labels.get(i))
+                    .map_or("unknown", String::as_str),
+            );
+        }
+        if !boxes.is_empty() {
+            p.boxes.publish(out);
+        }
         if let Some((_, _, width, height, pixels)) =
             self.images.iter().find(|(seq, ..)| *seq == image_seq)
         {
-            detection.header = image_header.clone();
-            detection.width = *width;
-            detection.height = *height;
-            detection.encoding = "rgb8".into();
-            detection.step = width * 3;
-            detection.data.clear();
-            detection.data.extend_from_slice(pixels);
-            for b in &boxes {
-                draw_box(&mut detection.data, *width, *height, b);
+            let d = &mut self.detection;
+            d.header = out.image_header.clone();
+            d.width = *width;
+            d.height = *height;
+            d.step = width * 3;
+            d.data.clear();
+            d.data.extend_from_slice(pixels);
+            for b in &out.bounding_boxes {
+                draw_box(&mut d.data, *width, *height, b);
             }
-            self.publishers.detection_image.publish(detection);
+            p.detection_image.publish(d);
         }
-        if !boxes.is_empty() {
-            self.publishers.boxes.publish(&msgs::BoundingBoxes {
-                header,
-                image_header,
-                bounding_boxes: boxes,
-            });
-        }
+        let _ = self.boxes_back.try_send(boxes);
     }
 
     fn scan(&mut self, meta: &LaserScanMeta, ranges: Vec<f32>) {
         let Some(p) = self.publishers.scan.as_mut() else {
             return;
         };
-        let mut msg = msgs::LaserScan {
-            header: Header {
-                seq: u32::try_from(meta.seq).unwrap_or(u32::MAX),
-                stamp_s: meta.stamp_s,
-                frame_id: meta.frame_id.clone(),
-            },
-            angle_min: meta.angle_min,
-            angle_max: meta.angle_max,
-            angle_increment: meta.angle_increment,
-            time_increment: meta.time_increment,
-            scan_time: meta.scan_time,
-            range_min: meta.range_min,
-            range_max: meta.range_max,
-            ranges,
-        };
-        p.publish(&msg);
+        let msg = &mut self.scan;
+        msg.header.seq = meta.seq as u32;
+        msg.header.stamp_s = meta.stamp_s;
+        if msg.header.frame_id != meta.frame_id {
+            msg.header.frame_id = meta.frame_id.clone();
+        }
+        msg.angle_min = meta.angle_min;
+        msg.angle_max = meta.angle_max;
+        msg.angle_increment = meta.angle_increment;
+        msg.time_increment = meta.time_increment;
+        msg.scan_time = meta.scan_time;
+        msg.range_min = meta.range_min;
+        msg.range_max = meta.range_max;
+        msg.ranges = ranges;
+        p.publish(msg);
         let _ = self.ranges_back.try_send(std::mem::take(&mut msg.ranges));
     }
 }

@@ -518,6 +518,7 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
         "/odom at {odom_rate:.1} Hz, updateRate 100 Hz"
     );
 
+    eprintln!("rostopic hz: image {image_rate:.2} Hz, /odom {odom_rate:.2} Hz");
     // rosbag record + info: every topic, with counts.
     for topic in [
         "/odom",
