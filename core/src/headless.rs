@@ -58,6 +58,10 @@ pub struct RunConfig {
     /// must keep pace with the wall clock. Detections then depend on the machine's speed, so
     /// such runs are not deterministic.
     pub detector_thread: bool,
+    /// Detect on the loop's own thread, results at once (one core), instead of the default
+    /// pipelined detection ([`DetectorMode::Pipelined`]: a second thread, results one
+    /// detection period later). Both are deterministic.
+    pub serial_detection: bool,
     /// Follower settings.
     pub follower: FollowerConfig,
     /// Pace the run to this many sim seconds per wall second (None = as fast as the CPU
@@ -300,8 +304,10 @@ fn run_inner(
         camera: perceive || files.frames.is_some(),
         detector: if perceive && config.detector_thread {
             DetectorMode::Worker
-        } else if perceive {
+        } else if perceive && config.serial_detection {
             DetectorMode::Lockstep { rate_hz: detect_hz }
+        } else if perceive {
+            DetectorMode::Pipelined { rate_hz: detect_hz }
         } else {
             DetectorMode::Off
         },

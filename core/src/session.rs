@@ -32,6 +32,15 @@ pub enum DetectorMode {
         /// Detections per sim second.
         rate_hz: f64,
     },
+    /// At this rate on sim time, on a second thread while the simulation and camera go on;
+    /// each result is handed to the follower one detection period (sim time) after its image
+    /// was taken, waiting for the thread if it is not done. Deterministic like `Lockstep`
+    /// (the same images, the same delivery times whatever the wall clock does), using two
+    /// cores.
+    Pipelined {
+        /// Detections per sim second.
+        rate_hz: f64,
+    },
     /// On its own thread, always on the newest frame (interactive, real time).
     Worker,
 }
@@ -185,7 +194,19 @@ impl Observer for NoObserver {}
 enum Detection {
     Off,
     Lockstep(Box<LockstepDetector>),
+    Pipelined(Box<Pipelined>),
     Worker(DetectorWorker),
+}
+
+/// [`DetectorMode::Pipelined`]: a worker thread fed on a sim-time schedule, its results taken
+/// at a fixed sim-time delay. At most one image is in flight.
+struct Pipelined {
+    worker: DetectorWorker,
+    period_s: f64,
+    /// Sim time from which the next image is detected.
+    next_s: f64,
+    /// When the image in flight is due back (its stamp + one period).
+    deliver_at_s: Option<f64>,
 }
 
 /// A running session.
@@ -290,6 +311,19 @@ impl Session {
                     match mode {
                         DetectorMode::Lockstep { rate_hz } => {
                             Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
+                        }
+                        DetectorMode::Pipelined { rate_hz } => {
+                            if !(rate_hz.is_finite() && rate_hz > 0.0) {
+                                return Err(CoreError::Option(format!(
+                                    "the detection rate must be a positive number of Hz, found {rate_hz}"
+                                )));
+                            }
+                            Detection::Pipelined(Box::new(Pipelined {
+                                worker: DetectorWorker::spawn(detector)?,
+                                period_s: 1.0 / rate_hz,
+                                next_s: 0.0,
+                                deliver_at_s: None,
+                            }))
                         }
                         _ => Detection::Worker(DetectorWorker::spawn(detector)?),
                     }
@@ -458,6 +492,20 @@ impl Session {
                 Err(e) => self.detector_failed(&e, observer),
             }
         }
+        // A pipelined result is taken when its sim time comes, waiting for it if need be.
+        let now_s = self.sim.sim_time_s();
+        let delivered = match &mut self.detection {
+            Detection::Pipelined(p) if p.deliver_at_s.is_some_and(|t| now_s + 1e-9 >= t) => {
+                p.deliver_at_s = None;
+                Some(p.worker.wait())
+            }
+            _ => None,
+        };
+        match delivered {
+            Some(Ok(boxes)) => self.accept(boxes, None, observer),
+            Some(Err(e)) => self.detector_failed(&e, observer),
+            None => {}
+        }
         let Some(camera) = self.camera.as_mut() else {
             return Ok(());
         };
@@ -477,15 +525,31 @@ impl Session {
         let (w, h) = (frame.width as usize, frame.height as usize);
         let detected = match &mut self.detection {
             Detection::Off => None,
-            Detection::Lockstep(detector) => {
-                match RgbView::new(w, h, frame.rgb)
-                    .and_then(|view| detector.detect_if_due(view, stamp))
-                {
-                    Ok(boxes) => boxes,
-                    Err(e) => {
-                        self.detector_failed(&e, observer);
-                        None
+            Detection::Lockstep(detector) => RgbView::new(w, h, frame.rgb)
+                .and_then(|view| detector.detect_if_due(view, stamp))
+                .transpose(),
+            Detection::Pipelined(p) => {
+                if frame.sim_time_s + 1e-9 >= p.next_s {
+                    p.next_s += p.period_s;
+                    if p.next_s + 1e-9 < frame.sim_time_s {
+                        p.next_s = frame.sim_time_s + p.period_s;
                     }
+                    // Never two in flight: one still out is taken now (a camera slower than
+                    // the detection rate), on sim time like everything else.
+                    let earlier = p.deliver_at_s.take().map(|_| p.worker.wait());
+                    let mut pixels = p.worker.buffer();
+                    pixels.clear();
+                    pixels.extend_from_slice(frame.rgb);
+                    p.worker.submit(Frame {
+                        pixels,
+                        width: w,
+                        height: h,
+                        stamp,
+                    });
+                    p.deliver_at_s = Some(frame.sim_time_s + p.period_s);
+                    earlier
+                } else {
+                    None
                 }
             }
             Detection::Worker(worker) => {
@@ -502,8 +566,10 @@ impl Session {
                 None
             }
         };
-        if let Some(boxes) = detected {
-            self.accept(boxes, None, observer);
+        match detected {
+            Some(Ok(boxes)) => self.accept(boxes, None, observer),
+            Some(Err(e)) => self.detector_failed(&e, observer),
+            None => {}
         }
         Ok(())
     }

@@ -93,3 +93,76 @@ fn script_keys_and_toggle_drive_the_robot() -> Result<()> {
     );
     Ok(())
 }
+
+/// Records when each detection reached the session (the last control update's sim time) and
+/// which image it came from.
+#[derive(Default)]
+struct Deliveries {
+    now_s: f64,
+    seen: Vec<(f64, f64)>,
+}
+
+impl rover_core::Observer for Deliveries {
+    fn control(
+        &mut self,
+        _sim: &rover_sim::Simulation,
+        sample: &rover_sim::ControlSample,
+        _stats: &rover_core::LoopStats,
+    ) {
+        self.now_s = sample.sim_time_s;
+    }
+    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
+        self.seen.push((self.now_s, boxes.image_stamp.sim_time_s));
+    }
+}
+
+fn deliveries(serial_detection: bool) -> Result<Vec<(f64, f64)>> {
+    let mut seen = Deliveries::default();
+    headless::run_observed(
+        &RunConfig {
+            world: Some(repo("worlds/playground.toml")),
+            duration_s: Some(3.0),
+            perception: rover_core::Perception::On,
+            serial_detection,
+            ..RunConfig::default()
+        },
+        &mut seen,
+        true,
+    )?;
+    Ok(seen.seen)
+}
+
+#[test]
+fn pipelined_detections_arrive_one_period_after_their_image_and_serial_ones_at_once() -> Result<()>
+{
+    let period_s = 1.0 / rover_core::DEFAULT_DETECT_HZ;
+    // Control updates come every 10 ms: a delivery is seen within one of them.
+    let control_s = 0.0101;
+    let pipelined = deliveries(false)?;
+    let serial = deliveries(true)?;
+    assert_eq!(
+        pipelined.len(),
+        14,
+        "images at 0.0..2.6 s delivered by 3 s: {pipelined:?}"
+    );
+    assert_eq!(serial.len(), 15, "images at 0.0..2.8 s: {serial:?}");
+    for (i, (at, image)) in pipelined.iter().enumerate() {
+        assert!(
+            (image - i as f64 * period_s).abs() < 1e-6,
+            "image {i} at {image} s"
+        );
+        let delay = at - image;
+        assert!(
+            delay > period_s - control_s && delay <= period_s + 1e-9,
+            "pipelined image of {image} s delivered at {at} s"
+        );
+    }
+    for (at, image) in &serial {
+        assert!(
+            at - image > -control_s && at - image <= 1e-9,
+            "serial image of {image} s delivered at {at} s"
+        );
+    }
+    // Nothing moves here (manual mode, no command): the same images give the same boxes.
+    Ok(())
+}

@@ -306,6 +306,12 @@ pub(crate) struct FollowArgs {
     #[arg(long, value_name = "HZ", default_value_t = rover_core::DEFAULT_DETECT_HZ)]
     pub(crate) detect_hz: f64,
 
+    /// Headless: detect on the loop's own thread with results at once, instead of pipelined on
+    /// a second thread with results one detection period (1 / --detect-hz) after their image.
+    /// Both are deterministic; pipelined uses two cores
+    #[arg(long)]
+    pub(crate) serial_detect: bool,
+
     /// Follower: class to follow (a darknet_ros `Class`, e.g. person, dog)
     #[arg(long, default_value = "person", value_name = "CLASS")]
     pub(crate) target_class: String,

@@ -26,6 +26,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         frame_every: args.frame_every,
         perception: args.follow.perception(),
         detect_hz: Some(args.follow.detect_hz),
+        serial_detection: args.follow.serial_detect,
         detector: args.detector.config()?,
         follower: args.follow.follower()?,
         // ROS peers expect real time: --ros paces headless runs unless --rtf says otherwise.
