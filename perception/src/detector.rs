@@ -12,7 +12,7 @@ use crate::graph;
 use crate::head::{self, Candidate, Head};
 use crate::labels::{COCO80, read_labels_file};
 use crate::messages::{BoundingBox, BoundingBoxes, FrameStamp};
-use crate::preprocess::{RgbView, letterbox_into};
+use crate::preprocess::{LetterboxPlan, RgbView};
 
 /// Input size the default model runs at: the camera's 4:3 aspect, so camera frames need no
 /// letterbox padding, at 0.8x scale: about half the work of the native 640x640 (measured on
@@ -84,6 +84,7 @@ pub struct Detector {
     input_w: usize,
     input_h: usize,
     input: Arc<Tensor>,
+    letterbox: LetterboxPlan,
     candidates: Vec<Candidate>,
     kept: Vec<Candidate>,
     config: DetectorConfig,
@@ -195,6 +196,7 @@ impl Detector {
             input: Arc::new(Tensor::zero::<f32>(&[1, 3, input_h, input_w]).map_err(|e| {
                 PerceptionError::Inference(format!("allocating the input tensor: {e}"))
             })?),
+            letterbox: LetterboxPlan::default(),
             candidates: Vec::with_capacity(1024),
             kept: Vec::with_capacity(128),
             config,
@@ -262,7 +264,7 @@ impl Detector {
         let slice = plain
             .as_slice_mut::<f32>()
             .map_err(|e| PerceptionError::Inference(e.to_string()))?;
-        let lb = letterbox_into(image, slice, w, h)?;
+        let lb = self.letterbox.letterbox_into(image, slice, w, h)?;
         Ok((f32_slice(&self.input)?, lb))
     }
 

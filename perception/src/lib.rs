@@ -28,5 +28,5 @@ pub use detector::{
 pub use error::{PerceptionError, Result};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
-pub use preprocess::{Letterbox, RgbView};
+pub use preprocess::{Letterbox, LetterboxPlan, RgbView};
 pub use worker::{DetectorWorker, Frame, WorkerStats};
