@@ -75,6 +75,19 @@ pub struct StageTimes {
     pub decode_ms: f64,
 }
 
+/// Where tract spends its time, for one ONNX op type ([`Detector::profile_ops`]).
+#[derive(Debug, Clone, Default)]
+pub struct OpProfile {
+    /// The ONNX op type (`Conv`, `MatMul`, ...).
+    pub onnx_op: String,
+    /// Milliseconds per run in tract's nodes that came from it.
+    pub ms: f64,
+    /// How many tract nodes.
+    pub nodes: usize,
+    /// tract's own ops among them and their milliseconds, slowest first.
+    pub tract_ops: Vec<(String, f64)>,
+}
+
 /// A loaded YOLO model.
 pub struct Detector {
     plan: Arc<TypedRunnableModel>,
@@ -274,6 +287,71 @@ impl Detector {
         let out = &outputs[0];
         let data = f32_slice(out)?.to_vec();
         Ok((data, out.shape().to_vec()))
+    }
+
+    /// Times every node of tract's plan over `runs` runs of the current input tensor, grouped
+    /// by the ONNX op type each node came from (tract's node names keep the ONNX node's name as
+    /// a prefix; its own ops are listed beside). Milliseconds per run, slowest first.
+    pub fn profile_ops(&mut self, runs: usize) -> Result<Vec<OpProfile>> {
+        let onnx_ops: Vec<(&str, &str)> = self
+            .proto
+            .graph
+            .as_ref()
+            .map(|g| {
+                g.node
+                    .iter()
+                    .map(|n| (n.name.as_str(), n.op_type.as_str()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let plan = self.plan.clone();
+        let model = plan.model();
+        let mut per_node = vec![std::time::Duration::ZERO; model.nodes().len()];
+        let mut state = tract_onnx::tract_core::plan::SimpleState::new(&plan)
+            .map_err(|e| PerceptionError::Inference(format!("{e:#}")))?;
+        let runs = runs.max(1);
+        for _ in 0..runs {
+            state
+                .run_plan_with_eval(
+                    tvec!(TValue::from_const(self.input.clone())),
+                    |ctx, op_state, node, inputs| {
+                        let start = Instant::now();
+                        let out = tract_onnx::tract_core::plan::eval(ctx, op_state, node, inputs);
+                        if let Some(t) = per_node.get_mut(node.id) {
+                            *t += start.elapsed();
+                        }
+                        out
+                    },
+                )
+                .map_err(|e| PerceptionError::Inference(format!("{e:#}")))?;
+        }
+        let mut groups: std::collections::BTreeMap<String, OpProfile> = Default::default();
+        for node in model.nodes() {
+            let ms = per_node[node.id].as_secs_f64() * 1e3 / runs as f64;
+            // The longest ONNX node name that prefixes this node's name.
+            let onnx = onnx_ops
+                .iter()
+                .filter(|(name, _)| !name.is_empty() && node.name.starts_with(name))
+                .max_by_key(|(name, _)| name.len())
+                .map_or("(no ONNX node)", |(_, op)| op);
+            let g = groups.entry(onnx.to_owned()).or_insert_with(|| OpProfile {
+                onnx_op: onnx.to_owned(),
+                ..OpProfile::default()
+            });
+            g.ms += ms;
+            g.nodes += 1;
+            let tract_op = node.op().name().to_string();
+            match g.tract_ops.iter_mut().find(|(n, _)| *n == tract_op) {
+                Some((_, t)) => *t += ms,
+                None => g.tract_ops.push((tract_op, ms)),
+            }
+        }
+        let mut out: Vec<OpProfile> = groups.into_values().collect();
+        for g in &mut out {
+            g.tract_ops.sort_by(|a, b| b.1.total_cmp(&a.1));
+        }
+        out.sort_by(|a, b| b.ms.total_cmp(&a.ms));
+        Ok(out)
     }
 
     fn run_network(&mut self) -> Result<TVec<TValue>> {

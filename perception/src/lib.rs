@@ -23,7 +23,8 @@ pub mod reference;
 pub mod worker;
 
 pub use detector::{
-    DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, StageTimes,
+    DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, OpProfile,
+    StageTimes,
 };
 pub use error::{PerceptionError, Result};
 pub use lockstep::LockstepDetector;

@@ -23,6 +23,8 @@ pub struct OrtRun {
     pub median_ms: f64,
     /// onnxruntime's version.
     pub version: String,
+    /// Milliseconds per run by ONNX op type, from onnxruntime's profiler (empty unless asked).
+    pub ops: Vec<(String, f64)>,
 }
 
 /// Runs `model` on `input` (`shape`, f32) with onnxruntime, `threads` intra-op threads,
@@ -41,7 +43,21 @@ pub fn onnxruntime(
         CALLS.fetch_add(1, Ordering::Relaxed)
     ));
     std::fs::create_dir_all(&dir).map_err(|e| PerceptionError::io(&dir, e))?;
-    let result = run_in(&dir, model, input, shape, threads, runs);
+    let result = run_in(&dir, model, input, shape, threads, runs, false);
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
+/// [`onnxruntime`] on one thread with its profiler on: [`OrtRun::ops`] says where the time goes.
+pub fn onnxruntime_profiled(
+    model: &Path,
+    input: &[f32],
+    shape: &[usize],
+    runs: usize,
+) -> Result<OrtRun> {
+    let dir = std::env::temp_dir().join(format!("rover-ort-profile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| PerceptionError::io(&dir, e))?;
+    let result = run_in(&dir, model, input, shape, 1, runs, true);
     let _ = std::fs::remove_dir_all(&dir);
     result
 }
@@ -53,6 +69,7 @@ fn run_in(
     shape: &[usize],
     threads: usize,
     runs: usize,
+    profile: bool,
 ) -> Result<OrtRun> {
     let input_path = dir.join("input.f32");
     let output_path = dir.join("output.f32");
@@ -76,6 +93,8 @@ fn run_in(
             &threads.to_string(),
             "--runs",
             &runs.max(1).to_string(),
+            "--profile",
+            if profile { "1" } else { "0" },
         ])
         .output()
         .map_err(|e| PerceptionError::Reference(format!("cannot run python3: {e}")))?;
@@ -107,5 +126,13 @@ fn run_in(
         shape,
         median_ms: report["median_ms"].as_f64().unwrap_or(f64::NAN),
         version: report["onnxruntime"].as_str().unwrap_or("?").to_owned(),
+        ops: report["ops"]
+            .as_object()
+            .map(|ops| {
+                ops.iter()
+                    .filter_map(|(k, v)| v.as_f64().map(|ms| (k.clone(), ms)))
+                    .collect()
+            })
+            .unwrap_or_default(),
     })
 }

@@ -503,6 +503,10 @@ pub(crate) enum BenchKind {
         /// Timed runs (after one warm-up)
         #[arg(long, default_value_t = 15)]
         runs: usize,
+
+        /// Also time every node: tract's plan beside onnxruntime's profiler, by ONNX op type
+        #[arg(long)]
+        profile: bool,
     },
 }
 

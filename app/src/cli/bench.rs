@@ -138,6 +138,88 @@ pub fn detector(
     })
 }
 
+/// Per-op profile: tract's plan node by node beside onnxruntime's profiler, grouped by the
+/// ONNX op type, on the same graph and input tensor (one thread each).
+fn profile_detector(
+    config: rover_perception::DetectorConfig,
+    image: &std::path::Path,
+    runs: usize,
+) -> Result<()> {
+    use rover_perception::preprocess::load_rgb;
+    use rover_perception::{Detector, FrameStamp, RgbView};
+    let mut detector = Detector::load(config)?;
+    let (w, h, pixels) = load_rgb(image)?;
+    let view = RgbView::new(w, h, &pixels)?;
+    detector.detect(view, FrameStamp::default())?;
+    detector.preprocess(view)?;
+    let tract = detector.profile_ops(runs)?;
+    let model = std::env::temp_dir().join(format!("rover-profile-{}.onnx", std::process::id()));
+    let (iw, ih) = detector.input_size();
+    let ort = detector
+        .export_onnx(&model)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| {
+            let (input, _) = detector.preprocess(view)?;
+            Ok(rover_perception::reference::onnxruntime_profiled(
+                &model,
+                input,
+                &[1, 3, ih, iw],
+                runs.max(1),
+            )?)
+        });
+    let _ = std::fs::remove_file(&model);
+    let ort_ops = match ort {
+        Ok(run) => run.ops,
+        Err(e) => {
+            println!("onnxruntime: not profiled ({e:#})");
+            Vec::new()
+        }
+    };
+    let tract_total: f64 = tract.iter().map(|g| g.ms).sum();
+    let ort_total: f64 = ort_ops.iter().map(|(_, ms)| ms).sum();
+    println!("per-op profile, ms per run (sum of node times), one thread, {runs} runs:");
+    println!(
+        "{:<20} {:>6} {:>9} {:>9} {:>7}   tract's ops (ms)",
+        "ONNX op", "nodes", "tract", "ort", "ratio"
+    );
+    for g in &tract {
+        let ort_ms = ort_ops
+            .iter()
+            .find(|(op, _)| *op == g.onnx_op)
+            .map(|(_, ms)| *ms);
+        let top: Vec<String> = g
+            .tract_ops
+            .iter()
+            .take(3)
+            .map(|(op, ms)| format!("{op} {ms:.1}"))
+            .collect();
+        println!(
+            "{:<20} {:>6} {:>9.2} {:>9} {:>7}   {}",
+            g.onnx_op,
+            g.nodes,
+            g.ms,
+            ort_ms.map_or_else(|| "-".to_owned(), |m| format!("{m:.2}")),
+            ort_ms.map_or_else(|| "-".to_owned(), |m| format!("{:.2}x", g.ms / m)),
+            top.join(", ")
+        );
+    }
+    for (op, ms) in &ort_ops {
+        if !tract.iter().any(|g| g.onnx_op == *op) {
+            println!("{op:<20} {:>6} {:>9} {ms:>9.2}", "-", "-");
+        }
+    }
+    println!(
+        "{:<20} {:>6} {:>9.2} {:>9.2} {:>7.2}x",
+        "total",
+        "",
+        tract_total,
+        ort_total,
+        tract_total / ort_total
+    );
+    println!();
+    Ok(())
+}
+
 fn onnxruntime_median(
     detector: &mut rover_perception::Detector,
     view: rover_perception::RgbView<'_>,
@@ -607,6 +689,7 @@ pub(crate) fn bench_detect(
     config: DetectorConfig,
     image: Option<PathBuf>,
     runs: usize,
+    profile: bool,
 ) -> Result<()> {
     let image = match image {
         Some(path) => path,
@@ -628,6 +711,9 @@ pub(crate) fn bench_detect(
         "detector benchmark on {}: {runs} runs after a warm-up, one thread",
         image.display()
     );
+    if profile {
+        profile_detector(config.clone(), &image, runs)?;
+    }
     let b = detector(config, &image, runs)?;
     println!("input {}x{}", b.input_size.0, b.input_size.1);
     println!("{:<28} {:>10}", "stage (median)", "ms");

@@ -36,11 +36,12 @@ pub fn main() -> ExitCode {
                     detector,
                     image,
                     runs,
+                    profile,
                 }),
             ..
         }) => detector
             .config()
-            .and_then(|config| bench::bench_detect(config, image, runs)),
+            .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
             ..
