@@ -198,3 +198,54 @@ fn lockstep_detection_runs_at_its_sim_rate_and_repeats_exactly() -> Result<()> {
     assert!(LockstepDetector::new(Detector::load(DetectorConfig::default())?, 0.0).is_err());
     Ok(())
 }
+
+/// `rover bench detect --profile`'s two halves on the real model: every tract node is timed and
+/// attributed to an ONNX op type (convolutions dominate, as they do in onnxruntime's own
+/// profile), and onnxruntime's profiler reports the same graph's op types.
+#[test]
+fn the_per_op_profile_attributes_tract_and_onnxruntime_time_to_onnx_ops() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let mut detector = Detector::load(DetectorConfig::default())?;
+    let path = photo("person", dir.path())?;
+    let (width, height, pixels) = load_rgb(&path)?;
+    let view = RgbView::new(width, height, &pixels)?;
+    detector.preprocess(view)?;
+    let tract = detector.profile_ops(1)?;
+    let total: f64 = tract.iter().map(|g| g.ms).sum();
+    assert!(total > 0.0);
+    let conv = tract
+        .iter()
+        .find(|g| g.onnx_op == "Conv")
+        .ok_or_else(|| anyhow::anyhow!("no Conv group in {tract:?}"))?;
+    assert_eq!(tract[0].onnx_op, "Conv", "slowest first: {tract:?}");
+    assert!(
+        conv.nodes > 100 && conv.ms > 0.5 * total,
+        "{conv:?} of {total} ms"
+    );
+    // Nearly everything comes from an ONNX node (the graph's input is the exception).
+    let unmatched = tract
+        .iter()
+        .filter(|g| g.onnx_op == "(no ONNX node)")
+        .map(|g| g.ms)
+        .sum::<f64>();
+    assert!(
+        unmatched < 0.05 * total,
+        "{unmatched} of {total} ms unattributed"
+    );
+
+    let model = dir.path().join("model.onnx");
+    detector.export_onnx(&model)?;
+    let (w, h) = detector.input_size();
+    let (input, _) = detector.preprocess(view)?;
+    let input = input.to_vec();
+    let run = rover_perception::reference::onnxruntime_profiled(&model, &input, &[1, 3, h, w], 1)?;
+    let ort_conv = run
+        .ops
+        .iter()
+        .find(|(op, _)| op == "Conv")
+        .map(|(_, ms)| *ms)
+        .ok_or_else(|| anyhow::anyhow!("onnxruntime's profile has no Conv: {:?}", run.ops))?;
+    let ort_total: f64 = run.ops.iter().map(|(_, ms)| ms).sum();
+    assert!(ort_conv > 0.5 * ort_total, "{:?}", run.ops);
+    Ok(())
+}
