@@ -302,6 +302,7 @@ fn run_inner(
     let options = SessionOptions {
         sim: config.options.clone(),
         camera: perceive || files.frames.is_some(),
+        every_frame: observer_wants_camera || files.frames.is_some(),
         detector: if perceive && config.detector_thread {
             DetectorMode::Worker
         } else if perceive && config.serial_detection {

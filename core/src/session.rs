@@ -52,6 +52,10 @@ pub struct SessionOptions {
     pub sim: SimOptions,
     /// Whether to render the camera at all.
     pub camera: bool,
+    /// Whether every camera image is rendered and shown to the observers (a viewer, a recorder,
+    /// saved frames, ROS). When false, only the images the detector takes are rendered; the
+    /// others are skipped with the same schedule and frame numbers, so results are the same.
+    pub every_frame: bool,
     /// How detection runs (needs the camera).
     pub detector: DetectorMode,
     /// Detector settings (model, input size, thresholds).
@@ -65,6 +69,7 @@ impl Default for SessionOptions {
         Self {
             sim: SimOptions::default(),
             camera: false,
+            every_frame: true,
             detector: DetectorMode::Off,
             detector_config: DetectorConfig::default(),
             follower: FollowerConfig::default(),
@@ -217,6 +222,7 @@ pub struct Session {
     laser: Option<LaserSensor>,
     detection: Detection,
     labels: Vec<String>,
+    every_frame: bool,
     pilot: Pilot,
     follower: Follower,
     stats: LoopStats,
@@ -354,6 +360,7 @@ impl Session {
             laser,
             detection,
             labels,
+            every_frame: options.every_frame,
             pilot: Pilot::default(),
             stats,
             last_boxes: None,
@@ -509,6 +516,20 @@ impl Session {
         let Some(camera) = self.camera.as_mut() else {
             return Ok(());
         };
+        if !self.every_frame && camera.due(&self.sim) {
+            // Nobody looks at this image unless the detector takes it.
+            let t = self.sim.sim_time_s() + 1e-9;
+            let wanted = match &self.detection {
+                Detection::Off => false,
+                Detection::Lockstep(d) => d.due(self.sim.sim_time_s()),
+                Detection::Pipelined(p) => t >= p.next_s,
+                Detection::Worker(_) => true,
+            };
+            if !wanted {
+                camera.skip_if_due(&self.sim);
+                return Ok(());
+            }
+        }
         let world_from_camera = self.sim.world_from_link(self.camera_link);
         let Some(frame) = camera
             .capture_if_due(&self.sim)

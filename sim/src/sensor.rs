@@ -95,12 +95,29 @@ impl CameraSensor {
         self.capture(sim).map(Some)
     }
 
+    /// Takes the image due now, if one is, without rendering it (nobody would look at it):
+    /// the schedule and frame numbers advance exactly as [`Self::capture_if_due`] would.
+    /// Returns the skipped frame's number.
+    pub fn skip_if_due(&mut self, sim: &Simulation) -> Option<u64> {
+        if !self.due(sim) {
+            return None;
+        }
+        self.next_s += self.period_s;
+        if self.next_s + 1e-9 < sim.sim_time_s() {
+            self.next_s = sim.sim_time_s() + self.period_s;
+        }
+        let seq = self.seq;
+        self.seq += 1;
+        Some(seq)
+    }
+
     /// Renders an image now.
     pub fn capture(&mut self, sim: &Simulation) -> Result<CameraFrame<'_>, RenderError> {
         sim.link_poses_into(&mut self.link_poses);
         let camera = self.link_poses[self.link];
         let seq = self.seq;
         self.seq += 1;
+        self.renderer.seed_frame(seq);
         let (width, height) = (self.renderer.info().width, self.renderer.info().height);
         for (index, person) in sim.world().people.iter().enumerate() {
             if person.walk.is_some() {

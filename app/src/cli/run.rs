@@ -138,6 +138,8 @@ fn run_window(args: RunArgs) -> Result<()> {
     let options = SessionOptions {
         sim: config.options.clone(),
         camera: true,
+        // The window shows every image.
+        every_frame: true,
         detector: if args.follow.no_detector {
             DetectorMode::Off
         } else {

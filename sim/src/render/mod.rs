@@ -108,6 +108,8 @@ pub struct CameraRenderer {
     ideal: Vec<u8>,
     rgb: Vec<u8>,
     noise: Option<(GaussianNoise, Rng)>,
+    /// The noise seed; each frame's noise comes from it and the frame number.
+    noise_seed: u64,
     distortion_map: Option<Vec<[f32; 2]>>,
     adapter: String,
     mapped: Arc<AtomicU8>,
@@ -401,6 +403,7 @@ impl CameraRenderer {
             ideal: vec![0; pixels * 3],
             rgb: vec![0; pixels * 3],
             noise: camera.noise.map(|n| (n, Rng(seed ^ 0x5EED_CA3E_5EED_CA3E))),
+            noise_seed: seed ^ 0x5EED_CA3E_5EED_CA3E,
             distortion_map: None,
             adapter: adapter_name,
             mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
@@ -467,6 +470,15 @@ impl CameraRenderer {
             let pose = world_from_person * a.link_from_shape;
             self.instances[a.instance].model =
                 Mat4::from_rotation_translation(pose.rotation, pose.translation).to_cols_array_2d();
+        }
+    }
+
+    /// Seeds the next image's noise from the frame number, so that an image's noise does not
+    /// depend on which earlier frames were rendered (headless runs skip the ones nobody uses).
+    pub fn seed_frame(&mut self, frame: u64) {
+        if let Some((_, rng)) = &mut self.noise {
+            let mut mix = Rng(self.noise_seed ^ frame.wrapping_mul(0xA076_1D64_78BD_642F));
+            *rng = Rng(mix.next_u64());
         }
     }
 
