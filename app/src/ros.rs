@@ -49,7 +49,6 @@ enum Event {
     Start {
         static_tf: Vec<TransformStamped>,
         camera: Option<CameraInfo>,
-        labels: Vec<String>,
     },
     Control {
         sample: ControlSample,
@@ -66,23 +65,12 @@ enum Event {
         stamp_s: f64,
         image_stamp_s: f64,
         image_seq: u64,
-        boxes: Vec<BoxSample>,
+        boxes: Vec<msgs::BoundingBox>,
     },
     Scan {
         scan: Box<LaserScanMeta>,
         ranges: Vec<f32>,
     },
-}
-
-/// A detection, without its class name (the publishing thread has the labels).
-#[derive(Debug, Clone, Copy)]
-struct BoxSample {
-    probability: f64,
-    xmin: i64,
-    ymin: i64,
-    xmax: i64,
-    ymax: i64,
-    id: i16,
 }
 
 struct LaserScanMeta {
@@ -212,7 +200,7 @@ pub struct RosBridge {
     tx: Option<SyncSender<Event>>,
     recycled_pixels: Receiver<Vec<u8>>,
     recycled_ranges: Receiver<Vec<f32>>,
-    recycled_boxes: Receiver<Vec<BoxSample>>,
+    recycled_boxes: Receiver<Vec<msgs::BoundingBox>>,
     thread: Option<JoinHandle<()>>,
     wheels: Vec<Wheel>,
     camera_link: Option<String>,
@@ -300,7 +288,7 @@ impl RosBridge {
         let (tx, rx) = sync_channel::<Event>(64);
         let (pixels_back, recycled_pixels) = sync_channel::<Vec<u8>>(IMAGE_RING + 4);
         let (ranges_back, recycled_ranges) = sync_channel::<Vec<f32>>(4);
-        let (boxes_back, recycled_boxes) = sync_channel::<Vec<BoxSample>>(4);
+        let (boxes_back, recycled_boxes) = sync_channel::<Vec<msgs::BoundingBox>>(4);
         let worker = Worker::new(
             node,
             plan.clone(),
@@ -409,7 +397,7 @@ fn transform(parent: &str, child: &str, stamp_s: f64, pose: Pose) -> TransformSt
 }
 
 impl Observer for RosBridge {
-    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, _labels: &[String]) {
         let robot = sim.robot();
         let mut static_tf: Vec<TransformStamped> = robot
             .joints
@@ -443,7 +431,6 @@ impl Observer for RosBridge {
         self.send(Event::Start {
             static_tf,
             camera: camera.cloned(),
-            labels: labels.to_vec(),
         });
     }
 
@@ -483,16 +470,18 @@ impl Observer for RosBridge {
 
     fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
         let started = std::time::Instant::now();
+        // Recycled boxes keep their class strings' capacity: no allocation once warm.
         let mut out = self.recycled_boxes.try_recv().unwrap_or_default();
-        out.clear();
-        out.extend(boxes.bounding_boxes.iter().map(|b| BoxSample {
-            probability: b.probability,
-            xmin: b.xmin,
-            ymin: b.ymin,
-            xmax: b.xmax,
-            ymax: b.ymax,
-            id: b.id,
-        }));
+        out.resize_with(boxes.bounding_boxes.len(), msgs::BoundingBox::default);
+        for (m, b) in out.iter_mut().zip(&boxes.bounding_boxes) {
+            m.probability = b.probability;
+            m.xmin = b.xmin;
+            m.ymin = b.ymin;
+            m.xmax = b.xmax;
+            m.ymax = b.ymax;
+            m.id = b.id;
+            m.class.clone_from(&b.class);
+        }
         // Published now, which is never before the image was taken.
         self.send(Event::Boxes {
             stamp_s: self.now_s.max(boxes.image_stamp.sim_time_s),
@@ -533,9 +522,8 @@ struct Worker {
     publishers: Publishers,
     pixels_back: SyncSender<Vec<u8>>,
     ranges_back: SyncSender<Vec<f32>>,
-    boxes_back: SyncSender<Vec<BoxSample>>,
+    boxes_back: SyncSender<Vec<msgs::BoundingBox>>,
     camera: Option<CameraInfo>,
-    labels: Vec<String>,
     /// The newest images (seq, stamp, width, height, pixels), for the detection image.
     images: Vec<(u64, f64, u32, u32, Vec<u8>)>,
     // Messages kept from one update to the next: only their numbers change, so steady
@@ -580,7 +568,7 @@ impl Worker {
         publishers: Publishers,
         pixels_back: SyncSender<Vec<u8>>,
         ranges_back: SyncSender<Vec<f32>>,
-        boxes_back: SyncSender<Vec<BoxSample>>,
+        boxes_back: SyncSender<Vec<msgs::BoundingBox>>,
     ) -> Self {
         let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
         let odom = msgs::Odometry {
@@ -620,7 +608,6 @@ impl Worker {
             ranges_back,
             boxes_back,
             camera: None,
-            labels: Vec::new(),
             images: Vec::with_capacity(IMAGE_RING),
             clock: msgs::Clock::default(),
             odom,
@@ -650,11 +637,7 @@ impl Worker {
     fn run(mut self, rx: Receiver<Event>) {
         for event in rx {
             match event {
-                Event::Start {
-                    static_tf,
-                    camera,
-                    labels,
-                } => self.start(static_tf, camera, labels),
+                Event::Start { static_tf, camera } => self.start(static_tf, camera),
                 Event::Control { sample, wheels } => self.control(&sample, &wheels),
                 Event::Image {
                     stamp_s,
@@ -675,12 +658,7 @@ impl Worker {
         drop(self.node);
     }
 
-    fn start(
-        &mut self,
-        static_tf: Vec<TransformStamped>,
-        camera: Option<CameraInfo>,
-        labels: Vec<String>,
-    ) {
+    fn start(&mut self, static_tf: Vec<TransformStamped>, camera: Option<CameraInfo>) {
         self.publishers.tf_static.publish(&msgs::TfMessage {
             transforms: static_tf,
         });
@@ -699,7 +677,6 @@ impl Worker {
             self.boxes.image_header.frame_id = c.frame_id.clone();
         }
         self.camera = camera;
-        self.labels = labels;
     }
 
     fn control(&mut self, sample: &ControlSample, wheels: &[WheelSample; 2]) {
@@ -788,7 +765,13 @@ impl Worker {
             .push((seq.into(), stamp_s, width, height, pixels));
     }
 
-    fn boxes(&mut self, stamp_s: f64, image_stamp_s: f64, image_seq: u64, boxes: Vec<BoxSample>) {
+    fn boxes(
+        &mut self,
+        stamp_s: f64,
+        image_stamp_s: f64,
+        image_seq: u64,
+        mut boxes: Vec<msgs::BoundingBox>,
+    ) {
         let p = &mut self.publishers;
         self.found.header.seq = seq_of(&p.found);
         self.found.header.stamp_s = stamp_s;
@@ -800,31 +783,16 @@ impl Worker {
         out.header.stamp_s = stamp_s;
         out.image_header.seq = image_seq as u32;
         out.image_header.stamp_s = image_stamp_s;
-        out.bounding_boxes
-            .resize_with(boxes.len(), msgs::BoundingBox::default);
-        for (m, b) in out.bounding_boxes.iter_mut().zip(&boxes) {
-            m.probability = b.probability;
-            m.xmin = b.xmin;
-            m.ymin = b.ymin;
-            m.xmax = b.xmax;
-            m.ymax = b.ymax;
-            m.id = b.id;
-            m.class.clear();
-            m.class.push_str(
-                usize::try_from(b.id)
-                    .ok()
-                    .and_then(|i| self.labels.get(i))
-                    .map_or("unknown", String::as_str),
-            );
-        }
-        if !boxes.is_empty() {
+        // The new boxes go in; the previous ones go back to the loop thread for reuse.
+        std::mem::swap(&mut out.bounding_boxes, &mut boxes);
+        if !out.bounding_boxes.is_empty() {
             p.boxes.publish(out);
         }
         if let Some((_, _, width, height, pixels)) =
             self.images.iter().find(|(seq, ..)| *seq == image_seq)
         {
             let d = &mut self.detection;
-            d.header = out.image_header.clone();
+            d.header.clone_from(&out.image_header);
             d.width = *width;
             d.height = *height;
             d.step = width * 3;

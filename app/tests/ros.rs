@@ -150,15 +150,22 @@ impl RosGraph {
             .env("RUST_LOG", "info");
         self.rover = Some(self.children.len());
         self.spawn("rover", c)?;
-        self.wait_for(Duration::from_secs(120), "rover to register", |g| {
-            ros_call(
-                &g.master_uri,
-                "lookupNode",
-                &[Value::from("/test"), Value::from("/rover")],
-                Duration::from_secs(1),
-            )
-            .is_ok()
-        })
+        self.wait_for(
+            Duration::from_secs(120),
+            "rover to register",
+            Self::rover_registered,
+        )
+    }
+
+    /// Whether the master knows the node /rover.
+    fn rover_registered(&self) -> bool {
+        ros_call(
+            &self.master_uri,
+            "lookupNode",
+            &[Value::from("/test"), Value::from("/rover")],
+            Duration::from_secs(1),
+        )
+        .is_ok()
     }
 
     fn trace_path(&self) -> PathBuf {
@@ -589,15 +596,11 @@ fn rover_survives_a_roscore_restart_and_publishes_again() -> Result<()> {
     std::thread::sleep(Duration::from_secs(2));
     graph.start_master()?;
     // rover notices (it watches the master) and registers again.
-    graph.wait_for(Duration::from_secs(20), "rover to register again", |g| {
-        ros_call(
-            &g.master_uri,
-            "lookupNode",
-            &[Value::from("/test"), Value::from("/rover")],
-            Duration::from_secs(1),
-        )
-        .is_ok()
-    })?;
+    graph.wait_for(
+        Duration::from_secs(20),
+        "rover to register again",
+        RosGraph::rover_registered,
+    )?;
     let after = echo_odom(&graph)?;
     assert!(
         after.contains("secs:"),

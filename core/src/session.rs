@@ -508,10 +508,8 @@ impl Session {
             }
             _ => None,
         };
-        match delivered {
-            Some(Ok(boxes)) => self.accept(boxes, None, observer),
-            Some(Err(e)) => self.detector_failed(&e, observer),
-            None => {}
+        if let Some(result) = delivered {
+            self.take(result, observer);
         }
         let Some(camera) = self.camera.as_mut() else {
             return Ok(());
@@ -587,12 +585,22 @@ impl Session {
                 None
             }
         };
-        match detected {
-            Some(Ok(boxes)) => self.accept(boxes, None, observer),
-            Some(Err(e)) => self.detector_failed(&e, observer),
-            None => {}
+        if let Some(result) = detected {
+            self.take(result, observer);
         }
         Ok(())
+    }
+
+    /// A lockstep or pipelined result: its boxes, or the detector's failure.
+    fn take(
+        &mut self,
+        result: std::result::Result<BoundingBoxes, PerceptionError>,
+        observer: &mut dyn Observer,
+    ) {
+        match result {
+            Ok(boxes) => self.accept(boxes, None, observer),
+            Err(e) => self.detector_failed(&e, observer),
+        }
     }
 
     /// One policy for a detector that fails mid-run, headless or in the window: say so (log,

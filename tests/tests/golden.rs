@@ -99,60 +99,47 @@ fn machine() -> Result<String> {
     Ok(format!("{} [{features}] {adapter}", std::env::consts::ARCH))
 }
 
+// Re-recorded when the follower gained its states, estimator and laser (the walking world now
+// carries the laser car).
 #[test]
 fn following_a_walking_person_reproduces_the_golden_trace() -> Result<()> {
-    let Some(()) = same_machine()? else {
-        return Ok(());
-    };
-    // Re-recorded when the follower gained its states, estimator and laser (the walking world
-    // now carries the laser car). Detection on the loop's thread (--serial-detect): unchanged
-    // by pipelined detection.
-    check(
-        "worlds/walking.toml",
-        None,
-        "tests/golden/follow.toml",
-        12.0,
-        "tests/golden/follow.csv",
-        true,
-    )
+    // Detection on the loop's thread (--serial-detect): unchanged by pipelined detection.
+    follow_golden("tests/golden/follow.csv", true)
 }
 
 #[test]
 fn following_with_pipelined_detection_reproduces_its_golden_trace() -> Result<()> {
-    let Some(()) = same_machine()? else {
-        return Ok(());
-    };
     // The default: detection on a second thread, results one period (0.2 s) after their image.
+    follow_golden("tests/golden/follow_pipelined.csv", false)
+}
+
+/// The walking-person follow run against `golden`, on the machine the follow goldens were
+/// recorded on (detector and renderer floating point differ across CPUs); elsewhere a note.
+fn follow_golden(golden: &str, serial_detection: bool) -> Result<()> {
+    let here = machine()?;
+    let machine_file = repo("tests/golden/follow.machine");
+    if std::env::var_os("ROVER_BLESS").is_some() {
+        std::fs::write(&machine_file, format!("{here}\n"))?;
+    } else {
+        let recorded = std::fs::read_to_string(&machine_file).map_err(|e| {
+            anyhow::anyhow!("{}: {e}; this machine is `{here}`", machine_file.display())
+        })?;
+        if recorded.trim() != here {
+            eprintln!(
+                "skipped: the golden follow traces were recorded on `{}`, this machine is \
+                 `{here}` (detector and renderer floating point differ across CPUs); the manual \
+                 golden trace and the determinism tests still run",
+                recorded.trim()
+            );
+            return Ok(());
+        }
+    }
     check(
         "worlds/walking.toml",
         None,
         "tests/golden/follow.toml",
         12.0,
-        "tests/golden/follow_pipelined.csv",
-        false,
+        golden,
+        serial_detection,
     )
-}
-
-/// `Some` when this machine is the one the follow goldens were recorded on (or when
-/// re-recording them); `None` (and a note) when not.
-fn same_machine() -> Result<Option<()>> {
-    let here = machine()?;
-    let machine_file = repo("tests/golden/follow.machine");
-    if std::env::var_os("ROVER_BLESS").is_some() {
-        std::fs::write(&machine_file, format!("{here}\n"))?;
-        return Ok(Some(()));
-    }
-    let recorded = std::fs::read_to_string(&machine_file).map_err(|e| {
-        anyhow::anyhow!("{}: {e}; this machine is `{here}`", machine_file.display())
-    })?;
-    if recorded.trim() != here {
-        eprintln!(
-            "skipped: the golden follow traces were recorded on `{}`, this machine is `{here}` \
-             (detector and renderer floating point differ across CPUs); the manual golden \
-             trace and the determinism tests still run",
-            recorded.trim()
-        );
-        return Ok(None);
-    }
-    Ok(Some(()))
 }
