@@ -111,8 +111,18 @@ pub fn parse_metadata_names(text: &str) -> Option<Vec<String>> {
     (!names.is_empty()).then_some(names)
 }
 
+/// Largest labels file read (darknet's 9k.names is 100 kB).
+const MAX_LABELS_BYTES: u64 = 16 << 20;
+
 /// Reads a labels file: one class name per line (darknet's coco.names format).
 pub fn read_labels_file(path: &Path) -> Result<Vec<String>> {
+    let meta = std::fs::metadata(path).map_err(|e| PerceptionError::io(path, e))?;
+    if !meta.is_file() || meta.len() > MAX_LABELS_BYTES {
+        return Err(PerceptionError::Labels(format!(
+            "{}: expected a regular file of at most {MAX_LABELS_BYTES} bytes",
+            path.display()
+        )));
+    }
     let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
     let names: Vec<String> = text
         .lines()

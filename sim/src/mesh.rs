@@ -28,37 +28,42 @@ pub struct TriMesh {
 
 /// Loads an STL, OBJ or COLLADA file and applies a per-axis scale.
 pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
-    let io = |source| SimError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let size = std::fs::metadata(path).map_err(io)?.len();
-    if size > MAX_MESH_BYTES {
-        return Err(SimError::invalid(
-            path,
-            None,
-            format!("mesh file is {size} bytes; expected at most {MAX_MESH_BYTES}"),
-        ));
-    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let loader = mesh_loader::Loader::default();
-    let bytes = std::fs::read(path).map_err(io)?;
-    let scene = match ext.as_deref() {
-        Some("stl") => loader.load_stl_from_slice(&bytes, path),
-        Some("obj") => loader.load_obj_from_slice(&bytes, path),
-        Some("dae") => loader.load_collada_from_slice(&bytes, path),
-        _ => {
-            return Err(SimError::invalid(
-                path,
-                None,
-                "unsupported mesh format: expected .stl, .obj or .dae (COLLADA)",
-            ));
-        }
-    }
-    .map_err(|e| SimError::invalid(path, None, format!("cannot read mesh: {e}")))?;
+    let bytes = crate::error::read_bounded(path, MAX_MESH_BYTES)?;
+    let load: fn(&mesh_loader::Loader, &[u8], &Path) -> std::io::Result<mesh_loader::Scene> =
+        match ext.as_deref() {
+            Some("stl") => |l, b, p| l.load_stl_from_slice(b, p),
+            Some("obj") => |l, b, p| l.load_obj_from_slice(b, p),
+            Some("dae") => |l, b, p| l.load_collada_from_slice(b, p),
+            _ => {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    "unsupported mesh format: expected .stl, .obj or .dae (COLLADA)",
+                ));
+            }
+        };
+    // mesh-loader 0.1.13 indexes some malformed COLLADA files out of bounds (found by
+    // tests/tests/fuzz.rs); its panic becomes this file's error instead of taking rover down.
+    let scene =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load(&loader, &bytes, path)))
+            .map_err(|payload| {
+                let why = payload
+                    .downcast_ref::<String>()
+                    .map(String::as_str)
+                    .or_else(|| payload.downcast_ref::<&str>().copied())
+                    .unwrap_or("unknown");
+                SimError::invalid(
+                    path,
+                    None,
+                    format!("cannot read mesh: the mesh parser failed ({why})"),
+                )
+            })?
+            .map_err(|e| SimError::invalid(path, None, format!("cannot read mesh: {e}")))?;
 
     let mut mesh = TriMesh {
         color: scene

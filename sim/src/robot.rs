@@ -175,10 +175,7 @@ impl RobotModel {
     /// result. Errors in an expanded file name
     /// the xacro file and line the element came from.
     pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::error::read_text(path)?;
         let is_xacro = path
             .file_name()
             .and_then(|n| n.to_str())

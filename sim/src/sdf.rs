@@ -58,10 +58,7 @@ impl ModelLink {
 
 /// Loads an SDF world file; `resources` finds `model://` models and meshes.
 pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
-    let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::error::read_text(path)?;
     let doc = parse_xml(&text, path)?;
     let root = doc.root_element();
     let ctx = Ctx { path, doc: &doc };
@@ -537,10 +534,7 @@ impl Loader<'_> {
         };
         let file = model_file(&dir)
             .map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
-        let text = std::fs::read_to_string(&file).map_err(|source| SimError::Io {
-            path: file.clone(),
-            source,
-        })?;
+        let text = crate::error::read_text(&file)?;
         let doc = parse_xml(&text, &file)?;
         let inner = Ctx {
             path: &file,

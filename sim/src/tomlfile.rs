@@ -9,10 +9,7 @@ use crate::error::{Result, SimError};
 
 /// Reads and deserialises a TOML file into `T`.
 pub fn load_toml<T: DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| SimError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::error::read_text(path)?;
     parse_toml(&text, path)
 }
 

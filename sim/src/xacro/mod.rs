@@ -220,19 +220,16 @@ impl Expander<'_> {
 
     /// Reads and converts one file; returns its root element.
     fn read(&mut self, path: &Path) -> Result<Rc<XElem>> {
-        let io = |source| SimError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let size = std::fs::metadata(path).map_err(io)?.len();
-        if size > MAX_FILE_BYTES {
-            return Err(SimError::invalid(
-                path,
-                None,
-                format!("file is {size} bytes; expected at most {MAX_FILE_BYTES}"),
-            ));
-        }
-        let text = std::fs::read_to_string(path).map_err(io)?;
+        let text =
+            String::from_utf8(crate::error::read_bounded(path, MAX_FILE_BYTES)?).map_err(|e| {
+                SimError::Io {
+                    path: path.to_path_buf(),
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::InvalidData,
+                        format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+                    ),
+                }
+            })?;
         let file = self.files.len();
         self.files.push(path.to_path_buf());
         let doc = crate::error::parse_xml(&text, path)?;
