@@ -18,13 +18,12 @@ pub enum CoreError {
     #[error("camera: {0}")]
     Camera(#[source] RenderError),
     /// A file the run writes (trace, frames) could not be created or written.
-    #[error("cannot write {}: {source}", path.display())]
+    #[error("cannot write {}: {cause}", path.display())]
     Write {
         /// The file or folder.
         path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
+        /// The underlying error (in the message, so not repeated as a source).
+        cause: std::io::Error,
     },
     /// An option is out of range (what was found and what is expected).
     #[error("{0}")]
@@ -36,7 +35,7 @@ impl CoreError {
     pub fn write(path: &Path, source: std::io::Error) -> Self {
         Self::Write {
             path: path.to_path_buf(),
-            source,
+            cause: source,
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Headless runs: a world, a robot and an input script, stepped as fast as the CPU allows.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use rover_perception::DetectorConfig;
@@ -67,6 +69,10 @@ pub struct RunConfig {
     /// Pace the run to this many sim seconds per wall second (None = as fast as the CPU
     /// allows). Pacing never changes the trace: it only waits.
     pub real_time_factor: Option<f64>,
+    /// Set from outside (the CLI's SIGINT/SIGTERM handler) to end the run after the current
+    /// step; the trace and frames are finished as at a normal end, and
+    /// [`RunSummary::interrupted`] says so.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// Whether a headless run renders the camera and runs the detector.
@@ -106,6 +112,8 @@ pub struct RunSummary {
     pub last: Option<ControlSample>,
     /// Mode at the end.
     pub mode: Mode,
+    /// The run was ended early through [`RunConfig::stop`].
+    pub interrupted: bool,
 }
 
 impl RunSummary {
@@ -324,7 +332,16 @@ fn run_inner(
     let started = Instant::now();
     let mut last_report = started;
 
+    let mut interrupted = false;
     while session.sim().step_index() < total_steps {
+        if config
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+        {
+            interrupted = true;
+            break;
+        }
         player.play(&mut session, &mut fan);
         while let Some(action) = inputs.poll() {
             session.input(action, &mut fan);
@@ -367,5 +384,6 @@ fn run_inner(
         frames_written: written.frames,
         last,
         mode: session.pilot().mode(),
+        interrupted,
     })
 }

@@ -3,7 +3,7 @@
 //! same ones; they differ only in pacing and detector mode.
 
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 use rover_perception::BoundingBoxes;
@@ -77,11 +77,75 @@ impl Observer for Fanout<'_> {
     }
 }
 
+/// A buffered file that only ever holds whole lines: it writes its buffer up to the last
+/// newline, and when a write fails (disk full) it cuts the file back to the end of the last
+/// line written in full, so a trace stays readable up to its last complete row.
+#[derive(Debug)]
+pub struct RowFile {
+    file: File,
+    buffer: Vec<u8>,
+    /// Bytes of whole lines in the file.
+    durable: u64,
+    /// Whole lines in the file.
+    lines: u64,
+}
+
+impl RowFile {
+    const CHUNK: usize = 64 << 10;
+
+    /// Wraps a file opened for writing (at its start).
+    pub fn new(file: File) -> Self {
+        Self {
+            file,
+            buffer: Vec::with_capacity(Self::CHUNK * 2),
+            durable: 0,
+            lines: 0,
+        }
+    }
+
+    /// Lines written to the file in full so far.
+    pub fn lines_in_file(&self) -> u64 {
+        self.lines
+    }
+
+    /// Writes the buffer's whole lines; on failure cuts the file back to `durable`.
+    fn write_lines(&mut self) -> std::io::Result<()> {
+        let Some(last_newline) = self.buffer.iter().rposition(|&b| b == b'\n') else {
+            return Ok(());
+        };
+        let end = last_newline + 1;
+        if let Err(e) = self.file.write_all(&self.buffer[..end]) {
+            let _ = self.file.set_len(self.durable);
+            let _ = self.file.seek(std::io::SeekFrom::Start(self.durable));
+            self.buffer.clear();
+            return Err(e);
+        }
+        self.durable += end as u64;
+        self.lines += self.buffer[..end].iter().filter(|&&b| b == b'\n').count() as u64;
+        self.buffer.drain(..end);
+        Ok(())
+    }
+}
+
+impl Write for RowFile {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.buffer.extend_from_slice(bytes);
+        if self.buffer.len() >= Self::CHUNK {
+            self.write_lines()?;
+        }
+        Ok(bytes.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.write_lines()?;
+        self.file.flush()
+    }
+}
+
 /// Writes the trace CSV: one row per control update ([`crate::trace::TRACE_HEADER`]).
 #[derive(Debug)]
 pub struct TraceObserver {
     path: PathBuf,
-    writer: Option<TraceWriter<BufWriter<File>>>,
+    writer: Option<TraceWriter<RowFile>>,
     failed: Option<std::io::Error>,
     rows: u64,
 }
@@ -90,8 +154,7 @@ impl TraceObserver {
     /// Creates (truncates) the trace file and writes its header.
     pub fn create(path: &Path) -> Result<Self> {
         let file = File::create(path).map_err(|e| CoreError::write(path, e))?;
-        let writer =
-            TraceWriter::new(BufWriter::new(file)).map_err(|e| CoreError::write(path, e))?;
+        let writer = TraceWriter::new(RowFile::new(file)).map_err(|e| CoreError::write(path, e))?;
         Ok(Self {
             path: path.to_path_buf(),
             writer: Some(writer),
@@ -120,8 +183,14 @@ impl Observer for TraceObserver {
             match w.row(sample, stats.mode, stats.follow_state) {
                 Ok(()) => self.rows += 1,
                 Err(e) => {
-                    self.writer = None;
-                    self.failed = Some(e);
+                    let kept = self
+                        .writer
+                        .take()
+                        .map_or(0, |w| w.into_inner().lines_in_file().saturating_sub(1));
+                    self.failed = Some(std::io::Error::new(
+                        e.kind(),
+                        format!("{e}; the file keeps its first {kept} rows, each complete"),
+                    ));
                 }
             }
         }

@@ -58,6 +58,11 @@ impl<W: Write> TraceWriter<W> {
         self.rows
     }
 
+    /// The writer, without flushing it.
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+
     /// Flushes and returns the writer.
     pub fn finish(mut self) -> std::io::Result<W> {
         self.out.flush()?;

@@ -42,6 +42,28 @@ pub struct DetectorConfig {
     pub max_boxes: usize,
     /// `frame_id` stamped on results.
     pub frame_id: String,
+    /// A fault to inject, for tests of what a failing detector does to a run
+    /// (`--inject-fault`); `None` in normal use.
+    pub fault: Option<InjectedFault>,
+}
+
+/// A detector fault injected on purpose: after `after_detections` good detections, every
+/// further call panics or returns an error, as a bug in tract or a model it cannot run would.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InjectedFault {
+    /// Good detections before the fault.
+    pub after_detections: u64,
+    /// What happens then.
+    pub kind: FaultKind,
+}
+
+/// How an [`InjectedFault`] fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FaultKind {
+    /// The detection panics.
+    Panic,
+    /// The detection returns an error.
+    Error,
 }
 
 impl Default for DetectorConfig {
@@ -54,6 +76,7 @@ impl Default for DetectorConfig {
             nms_iou: DEFAULT_NMS_IOU,
             max_boxes: 100,
             frame_id: "camera_link_optical".to_owned(),
+            fault: None,
         }
     }
 }
@@ -104,6 +127,8 @@ pub struct Detector {
     model_path: PathBuf,
     proto: tract_onnx::pb::ModelProto,
     last_times: StageTimes,
+    /// Detections run (for [`DetectorConfig::fault`]).
+    detections: u64,
 }
 
 impl std::fmt::Debug for Detector {
@@ -216,6 +241,7 @@ impl Detector {
             model_path,
             proto: prepared.proto,
             last_times: StageTimes::default(),
+            detections: 0,
         })
     }
 
@@ -421,6 +447,19 @@ impl Detector {
     /// Detects objects in an RGB8 image. Boxes are in the image's pixels; the result carries
     /// `stamp` (the frame it came from).
     pub fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes> {
+        if let Some(fault) = self.config.fault
+            && self.detections >= fault.after_detections
+        {
+            let what = format!(
+                "injected fault after {} detections (--inject-fault)",
+                fault.after_detections
+            );
+            match fault.kind {
+                FaultKind::Panic => panic!("{what}"),
+                FaultKind::Error => return Err(PerceptionError::model(&self.model_path, what)),
+            }
+        }
+        self.detections += 1;
         let start = Instant::now();
         let (_, lb) = self.preprocess(image)?;
         let preprocessed = Instant::now();

@@ -23,8 +23,8 @@ pub mod reference;
 pub mod worker;
 
 pub use detector::{
-    DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, OpProfile,
-    StageTimes,
+    DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, FaultKind,
+    InjectedFault, OpProfile, StageTimes,
 };
 pub use error::{PerceptionError, Result};
 pub use lockstep::LockstepDetector;

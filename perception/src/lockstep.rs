@@ -49,7 +49,15 @@ impl LockstepDetector {
         if self.next_s + 1e-9 < stamp.sim_time_s {
             self.next_s = stamp.sim_time_s + self.period_s;
         }
-        self.detector.detect(image, stamp).map(Some)
+        // A panic in the detector (rover, tract or the model) becomes an error, as on the
+        // worker thread: the run goes on without detections instead of ending.
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            self.detector.detect(image, stamp)
+        }))
+        .map_err(|payload| {
+            crate::PerceptionError::Panicked(crate::worker::panic_text(payload.as_ref()))
+        })?
+        .map(Some)
     }
 
     /// The wrapped detector.

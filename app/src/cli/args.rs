@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use rover_core::{FollowerConfig, Perception, RunConfig};
-use rover_perception::{DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig};
+use rover_perception::{
+    DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, DetectorConfig, FaultKind, InjectedFault,
+};
 use rover_sim::SimOptions;
 
 use crate::viewer::{ImageOptions, RecorderOptions, Viewer};
@@ -381,6 +383,29 @@ pub(crate) struct DetectorArgs {
     /// (the camera's 4:3 aspect), the model's own size otherwise]
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub(crate) input_size: Option<(usize, usize)>,
+
+    /// Make the detector fail on purpose after N detections, to see (or test) how a run
+    /// copes: KIND@N with KIND `panic` or `error`, e.g. `panic@10`
+    #[arg(long, value_name = "KIND@N", value_parser = parse_fault)]
+    pub(crate) inject_fault: Option<InjectedFault>,
+}
+
+fn parse_fault(text: &str) -> Result<InjectedFault, String> {
+    let (kind, n) = text
+        .split_once('@')
+        .ok_or_else(|| format!("expected KIND@N like panic@10, found '{text}'"))?;
+    let kind = match kind {
+        "panic" => FaultKind::Panic,
+        "error" => FaultKind::Error,
+        other => return Err(format!("'{other}' is not a fault: expected panic or error")),
+    };
+    let after_detections = n
+        .parse()
+        .map_err(|_| format!("'{n}' is not a whole number of detections"))?;
+    Ok(InjectedFault {
+        after_detections,
+        kind,
+    })
 }
 
 fn parse_size(text: &str) -> Result<(usize, usize), String> {
@@ -412,6 +437,13 @@ impl DetectorArgs {
         if let Some((w, h)) = self.input_size {
             args.push(format!("--input-size={w}x{h}").into());
         }
+        if let Some(f) = self.inject_fault {
+            let kind = match f.kind {
+                FaultKind::Panic => "panic",
+                FaultKind::Error => "error",
+            };
+            args.push(format!("--inject-fault={kind}@{}", f.after_detections).into());
+        }
         args
     }
 
@@ -432,6 +464,7 @@ impl DetectorArgs {
             input_size: self.input_size,
             threshold: self.threshold,
             nms_iou: self.nms,
+            fault: self.inject_fault,
             ..DetectorConfig::default()
         })
     }

@@ -445,7 +445,9 @@ pub fn record(
         let mut rec = Recorder::start(&options)?
             .ok_or_else(|| anyhow::anyhow!("the recorder did not start"))?;
         headless::run_observed(&config, &mut rec, true)?;
-        rec.finish();
+        if let Err(e) = rec.finish() {
+            tracing::warn!("the recording was not written in full: {e}");
+        }
         drop(rec);
         recorded = recorded.min(started.elapsed().as_secs_f64());
         rrd_bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);

@@ -283,7 +283,9 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
                 match Recorder::start(&rec_options)? {
                     Some(mut rec) => {
                         let r = scenario::run(&s, &options, &mut rec);
-                        rec.finish();
+                        if let Err(e) = rec.finish() {
+                            tracing::warn!("the recording was not written in full: {e}");
+                        }
                         r
                     }
                     None => scenario::run(&s, &options, &mut rover_core::NoObserver),

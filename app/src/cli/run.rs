@@ -1,5 +1,7 @@
 //! `rover` and `rover --headless`: a run in the window (the driver's station) or headless.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::Result;
@@ -14,10 +16,12 @@ use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
 pub(crate) fn run(args: RunArgs) -> Result<()> {
+    let stop = super::stop_on_signals()?;
     if !args.headless {
-        return run_window(args);
+        return run_window(args, stop);
     }
     let config = RunConfig {
+        stop: Some(Arc::clone(&stop)),
         script: args.script,
         duration_s: args.duration,
         trace: args.trace.clone(),
@@ -64,15 +68,16 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
             None => headless::run(&config),
         },
     };
+    let mut record_failed = None;
     if let Some(rec) = recorder.as_mut() {
-        rec.finish();
+        record_failed = rec.finish().err();
         if let Some(path) = &recorder_options.record {
             println!("recording: {}", viewer::describe_file(path));
         }
         if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
             println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
-            loop {
-                std::thread::sleep(Duration::from_secs(3600));
+            while !stop.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(100));
             }
         }
     }
@@ -103,10 +108,36 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(path) = &args.trace {
         println!("trace: {} ({} rows)", path.display(), summary.rows);
     }
+    recording_failed(record_failed, recorder_options.record.as_deref())?;
+    if summary.interrupted {
+        println!(
+            "interrupted by a signal at {:.2} s sim time: the trace and recording end there, complete",
+            summary.sim_time_s
+        );
+        return Err(super::Interrupted.into());
+    }
     Ok(())
 }
 
-fn run_window(args: RunArgs) -> Result<()> {
+/// A recording that could not be written in full (the file sink stopped: disk full, file
+/// removed) is an error at the end of the run, after everything else was written.
+fn recording_failed(failure: Option<String>, record: Option<&std::path::Path>) -> Result<()> {
+    match (failure, record) {
+        (Some(e), Some(path)) => anyhow::bail!(
+            "the recording {} was not written in full ({e}; rerun's warning above says why, \
+             e.g. no space left on device): it holds the run up to that point without the \
+             .rrd footer — the viewer opens it, `rerun rrd verify --check-footers false` checks it",
+            path.display()
+        ),
+        (Some(e), None) => {
+            tracing::warn!("rerun: could not flush everything: {e}");
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     station::check_display()?;
     let rtf = args.window.rtf.unwrap_or(1.0);
     anyhow::ensure!(
@@ -178,12 +209,11 @@ fn run_window(args: RunArgs) -> Result<()> {
                 paused: args.window.paused,
                 script,
                 screenshot: args.window.screenshot.clone(),
+                stop: Some(stop),
             },
         )?
     };
-    if let Some(r) = recorder.as_mut() {
-        r.finish();
-    }
+    let record_failed = recorder.as_mut().and_then(|r| r.finish().err());
     if let Some((bridge, _)) = ros.as_mut() {
         bridge.finish();
     }
@@ -199,6 +229,14 @@ fn run_window(args: RunArgs) -> Result<()> {
     }
     if let Some(path) = &recorder_options.record {
         println!("recording: {}", viewer::describe_file(path));
+    }
+    recording_failed(record_failed, recorder_options.record.as_deref())?;
+    if summary.interrupted {
+        println!(
+            "interrupted by a signal at {:.2} s sim time: the trace and recording end there, complete",
+            summary.sim_time_s
+        );
+        return Err(super::Interrupted.into());
     }
     Ok(())
 }

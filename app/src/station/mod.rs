@@ -14,6 +14,7 @@ pub mod keys;
 
 use std::num::NonZeroU32;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -49,6 +50,9 @@ pub struct WindowOptions {
     pub script: Script,
     /// Write the window's image (camera, boxes, HUD) as PNG here when quitting.
     pub screenshot: Option<std::path::PathBuf>,
+    /// Set from outside (SIGINT/SIGTERM) to close the window as if its close button was
+    /// pressed: the caller then finishes the trace and recording.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// What a window run did.
@@ -60,6 +64,8 @@ pub struct WindowSummary {
     pub wall_s: f64,
     /// Mode at the end.
     pub mode: Mode,
+    /// Closed by [`WindowOptions::stop`] (a signal) rather than by the user or a duration.
+    pub interrupted: bool,
 }
 
 /// Says plainly when there is no display to open a window on.
@@ -127,6 +133,8 @@ struct App<'a, 'o> {
     started: Instant,
     rtf_window: (Instant, f64),
     rtf: f64,
+    /// Closed by a signal.
+    interrupted: bool,
 }
 
 impl App<'_, '_> {
@@ -352,6 +360,16 @@ impl ApplicationHandler for App<'_, '_> {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self
+            .options
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+        {
+            self.interrupted = true;
+            event_loop.exit();
+            return;
+        }
         match self.advance() {
             Ok(true) => {
                 event_loop.exit();
@@ -427,6 +445,7 @@ pub fn run(
         started: Instant::now(),
         rtf_window: (Instant::now(), 0.0),
         rtf: 0.0,
+        interrupted: false,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.error {
@@ -449,6 +468,7 @@ pub fn run(
         sim_time_s: app.session.sim().sim_time_s(),
         wall_s: app.started.elapsed().as_secs_f64(),
         mode: app.feed.mode,
+        interrupted: app.interrupted,
     })
 }
 

@@ -131,15 +131,16 @@ impl Recorder {
     }
 
     /// Flushes the recording and closes its files (writes the .rrd footer); a web viewer
-    /// server keeps serving until the recorder is dropped.
-    pub fn finish(&mut self) {
-        if let Err(e) = self.rec.flush_with_timeout(Duration::from_secs(5))
-            && !self.viewer_gone
-        {
-            tracing::warn!("rerun: could not flush everything: {e}");
-        }
+    /// server keeps serving until the recorder is dropped. `Err` says why not everything was
+    /// written (a full disk, a viewer that stopped reading).
+    pub fn finish(&mut self) -> std::result::Result<(), String> {
+        let flushed = self.rec.flush_with_timeout(Duration::from_secs(5));
         self.rec.finalize_deferred_sinks();
         tracing::debug!("recorder ran {:.1} s", self.started.elapsed().as_secs_f64());
+        match flushed {
+            Err(e) if !self.viewer_gone => Err(e.to_string()),
+            _ => Ok(()),
+        }
     }
 
     /// Appends the odometry position to the trail, keeping it bounded.
