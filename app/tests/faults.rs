@@ -431,7 +431,13 @@ fn a_failing_detector_shows_on_the_window_hud() -> Result<()> {
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x800x24"])
         .arg(env!("CARGO_BIN_EXE_rover"))
-        .args(["--viewer", "none", "--duration", "6", "--inject-fault=panic@2"])
+        .args([
+            "--viewer",
+            "none",
+            "--duration",
+            "6",
+            "--inject-fault=panic@2",
+        ])
         .arg("--screenshot")
         .arg(&shot)
         .stderr(std::fs::File::create(&log)?)
@@ -439,7 +445,10 @@ fn a_failing_detector_shows_on_the_window_hud() -> Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot run xvfb-run ({e}): apt-get install xvfb xauth"))?;
     let log = std::fs::read_to_string(&log)?;
     assert!(out.status.success(), "{}\n{log}", text(&out.stdout));
-    assert!(log.contains("detector failed: the detector crashed"), "{log}");
+    assert!(
+        log.contains("detector failed: the detector crashed"),
+        "{log}"
+    );
     // The HUD's warning colour (255, 120, 90) is only used for a failure or a warning.
     let img = image::open(&shot)?.into_rgb8();
     let warm = img.pixels().filter(|p| p.0 == [255, 120, 90]).count();

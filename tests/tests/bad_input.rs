@@ -403,3 +403,101 @@ fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Res
     );
     Ok(())
 }
+
+/// NaN and infinities anywhere a number goes (robot, world TOML, SDF world, script, scenario)
+/// are refused at load, naming the file and the element or key path, before any physics runs.
+#[test]
+fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()> {
+    let robot = robot_text();
+    for (from, to, expect) in [
+        (
+            "<origin xyz=\"-0.045 0 0\"",
+            "<origin xyz=\"nan 0 0\"",
+            "<origin xyz=\"nan 0 0\">: expected 3 numbers; 'nan' is not a finite number",
+        ),
+        (
+            "<mass value=\"",
+            "<mass value=\"inf",
+            "is not a finite number",
+        ),
+        (
+            "<wheelSeparation>",
+            "<wheelSeparation>-inf",
+            "<wheelSeparation> in the libgazebo_ros_diff_drive.so plugin: expected a number",
+        ),
+    ] {
+        anyhow::ensure!(robot.contains(from), "my_robot.urdf has no {from}");
+        let text = robot.replacen(from, to, 1);
+        let message = urdf_error(&text);
+        let line = line_of(&text, to);
+        assert!(
+            message.contains(&format!("bad.urdf:{line}:")) && message.contains(expect),
+            "{message}"
+        );
+    }
+
+    let dir = tempfile::tempdir()?;
+    let world_text = std::fs::read_to_string(repo("worlds/playground.toml"))?;
+    for (value, shown) in [("nan", "NaN"), ("inf", "inf"), ("-inf", "-inf")] {
+        let path = dir.path().join("w.toml");
+        std::fs::write(
+            &path,
+            world_text.replacen(
+                "position_m = [4.0, 0.0]",
+                &format!("position_m = [4.0, {value}]"),
+                1,
+            ),
+        )?;
+        let message = World::load(&path)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            message.contains("w.toml: at `person[0].position_m`: expected finite numbers")
+                && message.contains(shown),
+            "{message}"
+        );
+    }
+
+    let sdf = dir.path().join("nan.world");
+    std::fs::write(
+        &sdf,
+        "<sdf version='1.6'><world name='w'>\n<model name='m'><pose>1 nan 0 0 0 0</pose><link name='l'/></model></world></sdf>",
+    )?;
+    let message = World::load(&sdf)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("nan.world:2:") && message.contains("expected 6 finite numbers"),
+        "{message}"
+    );
+
+    let script = Script::from_str("steps = [ { at = inf, key = \"k\" } ]", Path::new("s.toml"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        script.contains("s.toml: at `steps[0]`: `at` must be"),
+        "{script}"
+    );
+
+    let scenario = dir.path().join("scenarios/nan.toml");
+    std::fs::create_dir_all(scenario.parent().unwrap_or(dir.path()))?;
+    let text = std::fs::read_to_string(repo("scenarios/default_world.toml"))?
+        .replace(
+            "../worlds/playground.toml",
+            &repo("worlds/playground.toml").display().to_string(),
+        )
+        .replacen("duration_s = 35.0", "duration_s = nan", 1);
+    std::fs::write(&scenario, text)?;
+    let message = rover_core::Scenario::load(&scenario)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("nan.toml") && message.contains("scenario.duration_s"),
+        "{message}"
+    );
+    Ok(())
+}
