@@ -399,6 +399,11 @@ impl Session {
         self.last_boxes.as_ref()
     }
 
+    /// Detection results taken so far.
+    pub fn detections(&self) -> u64 {
+        self.detections_done
+    }
+
     /// Loop figures.
     pub fn stats(&self) -> LoopStats {
         self.stats

@@ -1,7 +1,7 @@
 #!/usr/bin/env node
 // Headless-Chromium smoke test for the Rerun web viewer.
 //
-// Usage: node screenshot.mjs URL OUT.png [--wait-s N] [--min-colour-frac F] [--renderer webgl|webgpu] [--verbose]
+// Usage: node screenshot.mjs URL OUT.png [--wait-s N] [--hold-s N] [--min-colour-frac F] [--renderer webgl|webgpu] [--verbose]
 //
 // Opens URL in headless Chromium (via playwright-core, /usr/bin/chromium by default,
 // override with $CHROMIUM), waits until the viewer has started and its rendering has
@@ -15,6 +15,8 @@
 // images); the welcome screen shown when the page has no ?url= data source has ~0.005.
 // --min-colour-frac F (default 0.01; 0 = off) requires at least that fraction, and the
 // wait goes on until it is reached and two consecutive screenshots 2 s apart are identical.
+// --hold-s N keeps the page open (the viewer connected and drawing) until N seconds after the
+// start, then takes the screenshot: for soak runs (scripts/soak.sh).
 
 import { chromium } from 'playwright-core';
 import { writeFileSync } from 'node:fs';
@@ -22,17 +24,18 @@ import { inflateSync } from 'node:zlib';
 
 function usage(msg) {
   if (msg) console.error(`error: ${msg}`);
-  console.error('usage: node screenshot.mjs URL OUT.png [--wait-s N] [--min-colour-frac F] [--renderer webgl|webgpu] [--verbose]');
+  console.error('usage: node screenshot.mjs URL OUT.png [--wait-s N] [--hold-s N] [--min-colour-frac F] [--renderer webgl|webgpu] [--verbose]');
   process.exit(2);
 }
 
 const argv = process.argv.slice(2);
 const positional = [];
-const opts = { waitS: 90, minColourFrac: 0.01, renderer: null, verbose: false };
+const opts = { waitS: 90, holdS: 0, minColourFrac: 0.01, renderer: null, verbose: false };
 for (let i = 0; i < argv.length; i++) {
   const a = argv[i];
   const next = () => (i + 1 < argv.length ? argv[++i] : usage(`${a} needs a value`));
   if (a === '--wait-s') opts.waitS = Number(next());
+  else if (a === '--hold-s') opts.holdS = Number(next());
   else if (a === '--min-colour-frac') opts.minColourFrac = Number(next());
   else if (a === '--renderer') opts.renderer = next();
   else if (a === '--verbose' || a === '-v') opts.verbose = true;
@@ -209,6 +212,12 @@ try {
     if (!state.started || isBlank(stats) || stats.colourFrac < opts.minColourFrac) { stable = 0; continue; }
     stable = stats.changedFrac != null && stats.changedFrac < 0.002 ? stable + 1 : 0;
     if (stable >= 2) { settledS = elapsed(); break; }
+  }
+  const holdUntil = t0 + opts.holdS * 1000;
+  if (Date.now() < holdUntil) {
+    await page.waitForTimeout(holdUntil - Date.now());
+    shot = await page.screenshot({ type: 'png' });
+    stats = analyse(shot, null);
   }
   if (!shot) shot = await page.screenshot({ type: 'png' });
   writeFileSync(outPath, shot);

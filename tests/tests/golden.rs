@@ -113,6 +113,32 @@ fn following_with_pipelined_detection_reproduces_its_golden_trace() -> Result<()
     follow_golden("tests/golden/follow_pipelined.csv", false)
 }
 
+/// Determinism under load: the pipelined run (detector on its own thread, results at a fixed
+/// sim-time delay) gives the same bytes while two busy threads load both cores, so the
+/// detector thread is late on the wall clock and the loop has to wait for it.
+#[test]
+fn the_pipelined_golden_trace_holds_while_both_cores_are_busy() -> Result<()> {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let load: Vec<_> = (0..2)
+        .map(|_| {
+            let stop = std::sync::Arc::clone(&stop);
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+                }
+                x
+            })
+        })
+        .collect();
+    let result = follow_golden("tests/golden/follow_pipelined.csv", false);
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    for t in load {
+        let _ = t.join();
+    }
+    result
+}
+
 /// The walking-person follow run against `golden`, on the machine the follow goldens were
 /// recorded on (detector and renderer floating point differ across CPUs); elsewhere a note.
 fn follow_golden(golden: &str, serial_detection: bool) -> Result<()> {

@@ -108,6 +108,9 @@ impl Observer for Feed {
     }
 }
 
+/// Seconds between the window's status lines in the log.
+const STATUS_EVERY_S: f64 = 10.0;
+
 type Surface = softbuffer::Surface<Arc<Window>, Arc<Window>>;
 
 struct App<'a, 'o> {
@@ -135,6 +138,8 @@ struct App<'a, 'o> {
     rtf: f64,
     /// Closed by a signal.
     interrupted: bool,
+    /// Start of the status log's window: wall time, sim time, detections.
+    status_window: (Instant, f64, u64),
 }
 
 impl App<'_, '_> {
@@ -213,6 +218,22 @@ impl App<'_, '_> {
         if dt >= 1.0 {
             self.rtf = (self.session.sim().sim_time_s() - s0) / dt;
             self.rtf_window = (now, self.session.sim().sim_time_s());
+        }
+        // A status line in the log every 10 s (what the HUD shows, for logs and soak runs).
+        let (w0, s0, d0) = self.status_window;
+        let dt = now.duration_since(w0).as_secs_f64();
+        if dt >= STATUS_EVERY_S {
+            let sim_s = self.session.sim().sim_time_s();
+            let detections = self.session.detections();
+            let stats = self.session.stats();
+            tracing::info!(
+                "status: sim {sim_s:.1} s, {:.2}x real time, detector {:.1} Hz, latency {:.0} ms, frames dropped {}",
+                (sim_s - s0) / dt,
+                (detections - d0) as f64 / dt,
+                stats.detector_latency_ms,
+                stats.frames_dropped
+            );
+            self.status_window = (now, sim_s, detections);
         }
         Ok(self
             .options
@@ -445,6 +466,7 @@ pub fn run(
         started: Instant::now(),
         rtf_window: (Instant::now(), 0.0),
         rtf: 0.0,
+        status_window: (Instant::now(), 0.0, 0),
         interrupted: false,
     };
     event_loop.run_app(&mut app)?;

@@ -185,7 +185,7 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
                 info.port
             );
             let url = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
-            sinks.push(Box::new(GrpcSink::new(proxy_uri(&url)?)));
+            sinks.push(Box::new(NonBlocking::new(GrpcSink::new(proxy_uri(&url)?))));
             watch = resolve("127.0.0.1", info.port).map(ViewerWatch::start);
         }
         Viewer::Connect(url) => {
@@ -200,7 +200,7 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
                     pip_command()
                 );
             };
-            sinks.push(Box::new(GrpcSink::new(uri)));
+            sinks.push(Box::new(NonBlocking::new(GrpcSink::new(uri))));
             watch = Some(ViewerWatch::start(addr));
         }
         Viewer::Web => {
@@ -208,12 +208,16 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
                 "127.0.0.1",
                 options.grpc_port,
                 rerun::ServerOptions {
-                    memory_limit: rerun::MemoryLimit::from_fraction_of_total(0.25),
+                    // The history kept for browsers that connect late. A fixed bound (not a
+                    // share of RAM) keeps a long window session's memory flat: the window's
+                    // stream (~3 MB/s) fills it in under a minute, after which the oldest data
+                    // goes; a connected browser keeps its own copy.
+                    memory_limit: rerun::MemoryLimit::from_bytes(WEB_HISTORY_BYTES),
                     ..rerun::ServerOptions::default()
                 },
             )
             .context("cannot start the Rerun data server for the web viewer")?;
-            sinks.push(Box::new(grpc));
+            sinks.push(Box::new(NonBlocking::new(grpc)));
             let connect = format!("rerun+http://127.0.0.1:{}/proxy", options.grpc_port);
             let server = rerun::serve_web_viewer(rerun::web_viewer::WebViewerConfig {
                 bind_ip: "127.0.0.1".into(),
@@ -247,6 +251,111 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
         web_server,
     }))
 }
+
+/// A viewer sink that never blocks the recording stream, and so never the loop: rerun applies
+/// back-pressure from a slow viewer (a browser on a busy CPU) all the way back to the logging
+/// call, which stalled the window's simulation for seconds in soak runs. Messages go through a
+/// bounded queue to a thread that feeds the real sink (which may block there); when the queue
+/// is full the new message is dropped for that viewer and counted, with one warning. `.rrd`
+/// files are not wrapped: a recording stays complete.
+pub struct NonBlocking {
+    tx: std::sync::Mutex<Option<mpsc::SyncSender<SinkCommand>>>,
+    dropped: Arc<std::sync::atomic::AtomicU64>,
+    thread: std::sync::Mutex<Option<JoinHandle<()>>>,
+}
+
+enum SinkCommand {
+    Msg(Box<rerun::log::LogMsg>),
+    Flush(
+        Duration,
+        mpsc::SyncSender<std::result::Result<(), rerun::sink::SinkFlushError>>,
+    ),
+}
+
+impl NonBlocking {
+    /// Messages (chunks, ~1 MB at most for a raw camera image) waiting for a slow viewer.
+    const QUEUE: usize = 64;
+
+    /// Feeds `inner` from its own thread.
+    pub fn new(inner: impl LogSink + 'static) -> Self {
+        let (tx, rx) = mpsc::sync_channel::<SinkCommand>(Self::QUEUE);
+        let thread = std::thread::Builder::new()
+            .name("rerun-viewer-feed".into())
+            .spawn(move || {
+                for command in rx {
+                    match command {
+                        SinkCommand::Msg(msg) => inner.send(*msg),
+                        SinkCommand::Flush(timeout, reply) => {
+                            let _ = reply.send(inner.flush_blocking(timeout));
+                        }
+                    }
+                }
+                // The inner sink (and a web viewer's data server) lives until the recording
+                // stream is dropped.
+            })
+            .ok();
+        Self {
+            tx: std::sync::Mutex::new(Some(tx)),
+            dropped: Arc::default(),
+            thread: std::sync::Mutex::new(thread),
+        }
+    }
+
+    fn sender(&self) -> Option<mpsc::SyncSender<SinkCommand>> {
+        self.tx.lock().ok().and_then(|tx| tx.clone())
+    }
+}
+
+impl LogSink for NonBlocking {
+    fn send(&self, msg: rerun::log::LogMsg) {
+        let Some(tx) = self.sender() else {
+            return;
+        };
+        if let Err(mpsc::TrySendError::Full(_)) = tx.try_send(SinkCommand::Msg(Box::new(msg))) {
+            let before = self.dropped.fetch_add(1, Ordering::Relaxed);
+            if before == 0 {
+                tracing::warn!(
+                    "the Rerun viewer is not keeping up: dropping data for it rather than slowing the run (a --record file still gets everything)"
+                );
+            }
+        }
+    }
+
+    fn flush_blocking(
+        &self,
+        timeout: Duration,
+    ) -> std::result::Result<(), rerun::sink::SinkFlushError> {
+        let Some(tx) = self.sender() else {
+            return Ok(());
+        };
+        let (reply_tx, reply_rx) = mpsc::sync_channel(1);
+        // Waiting here is fine: flushes happen at the end of a run, not in the loop.
+        if tx.send(SinkCommand::Flush(timeout, reply_tx)).is_err() {
+            return Ok(());
+        }
+        reply_rx
+            .recv_timeout(timeout + Duration::from_secs(1))
+            .unwrap_or(Err(rerun::sink::SinkFlushError::Timeout))
+    }
+}
+
+impl Drop for NonBlocking {
+    fn drop(&mut self) {
+        if let Ok(mut tx) = self.tx.lock() {
+            tx.take();
+        }
+        if let Some(thread) = self.thread.lock().ok().and_then(|mut t| t.take()) {
+            let _ = thread.join();
+        }
+        let dropped = self.dropped.load(Ordering::Relaxed);
+        if dropped > 0 {
+            tracing::info!("Rerun viewer: {dropped} messages dropped while it was behind");
+        }
+    }
+}
+
+/// History the web viewer's data server keeps (see above).
+const WEB_HISTORY_BYTES: u64 = 64 << 20;
 
 fn proxy_uri(url: &str) -> Result<ProxyUri> {
     url.parse::<ProxyUri>().map_err(|e| {
