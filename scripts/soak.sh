@@ -75,6 +75,7 @@ if [ "$mode" = window ]; then
     python3 scripts/soak_plot.py "$out/rss.csv" "$out/rss.png" "rover window soak: RSS, $minutes min"
     echo "status lines: $(wc -l < "$out/status.txt") (every 10 s); after the first minute:"
     tail -n +7 "$out/status.txt" | awk -F'[ ,]+' '
+      BEGIN { n = 0 }
       { for (i = 1; i <= NF; i++) { if ($(i+1) == "real") rtf[n] = $i; if ($i == "detector") hz[n] = $(i+1) } n++ }
       END { if (n == 0) exit; minr = maxr = rtf[0]; minh = maxh = hz[0]
             for (i = 0; i < n; i++) { sr += rtf[i]; sh += hz[i]

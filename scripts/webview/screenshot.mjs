@@ -216,7 +216,8 @@ try {
   const holdUntil = t0 + opts.holdS * 1000;
   if (Date.now() < holdUntil) {
     await page.waitForTimeout(holdUntil - Date.now());
-    shot = await page.screenshot({ type: 'png' });
+    // A page on a CPU the soak keeps busy can take long to paint.
+    shot = await page.screenshot({ type: 'png', timeout: 120000 });
     stats = analyse(shot, null);
   }
   if (!shot) shot = await page.screenshot({ type: 'png' });
