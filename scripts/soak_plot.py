@@ -46,7 +46,7 @@ def main():
     )
 
     w, h = 900, 420
-    left, right, top, bottom = 80, 20, 50, 50
+    left, right, top, bottom = 80, 40, 50, 50
     img = Image.new("RGB", (w, h), "white")
     d = ImageDraw.Draw(img)
     f, small = font(16), font(12)

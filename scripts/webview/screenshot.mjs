@@ -202,7 +202,7 @@ try {
     }
     if (state.started && startedS == null) startedS = elapsed();
     result.canvas = state.canvas;
-    shot = await page.screenshot({ type: 'png' });
+    shot = await page.screenshot({ type: 'png', timeout: 120000 });
     stats = analyse(shot, prev);
     prev = stats;
     if (opts.verbose) {

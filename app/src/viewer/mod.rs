@@ -84,8 +84,15 @@ impl Recorder {
         let Some(sinks) = sinks::open(options)? else {
             return Ok(None);
         };
+        // A live viewer wants data at once; a file alone is better served by rerun's default
+        // batching (fewer, larger chunks: less per-chunk bookkeeping over an hour's recording).
+        let live = sinks.watch.is_some() || sinks.web_url.is_some();
         let rec = RecordingStreamBuilder::new("rover")
-            .batcher_config(rerun::log::ChunkBatcherConfig::LOW_LATENCY)
+            .batcher_config(if live {
+                rerun::log::ChunkBatcherConfig::LOW_LATENCY
+            } else {
+                rerun::log::ChunkBatcherConfig::DEFAULT
+            })
             .with_blueprint(blueprint())
             .set_sinks(sinks.sinks)
             .context("cannot start the Rerun recording")?;
