@@ -156,13 +156,13 @@ pub enum Mutation {
 fn mutation() -> impl Strategy<Value = Mutation> {
     let at = any::<usize>();
     prop_oneof![
-        1 => (at.clone(), 0u8..8).prop_map(|(at, bit)| Mutation::Flip { at, bit }),
-        1 => (at.clone(), any::<u8>()).prop_map(|(at, byte)| Mutation::Set { at, byte }),
-        1 => (at.clone(), 1usize..64).prop_map(|(at, len)| Mutation::Delete { at, len }),
-        1 => (at.clone(), 1usize..256, any::<usize>())
+        1 => (at, 0u8..8).prop_map(|(at, bit)| Mutation::Flip { at, bit }),
+        1 => (at, any::<u8>()).prop_map(|(at, byte)| Mutation::Set { at, byte }),
+        1 => (at, 1usize..64).prop_map(|(at, len)| Mutation::Delete { at, len }),
+        1 => (at, 1usize..256, any::<usize>())
             .prop_map(|(from, len, to)| Mutation::Duplicate { from, len, to }),
-        3 => (at.clone(), any::<usize>()).prop_map(|(at, token)| Mutation::Token { at, token }),
-        1 => (at.clone(), any::<usize>(), any::<usize>(), 1usize..512).prop_map(
+        3 => (at, any::<usize>()).prop_map(|(at, token)| Mutation::Token { at, token }),
+        1 => (at, any::<usize>(), any::<usize>(), 1usize..512).prop_map(
             |(at, seed, from, len)| Mutation::Splice {
                 at,
                 seed,
