@@ -292,17 +292,45 @@ fn a_model_file_corrupted_mid_run_does_not_touch_the_run() -> Result<()> {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()?;
-    // Wait for the run to be under way (the trace file exists once the session has started).
-    wait_for(
-        &mut child,
-        "the run to start",
-        Duration::from_secs(300),
-        || trace.exists(),
-    )?;
+    // Wait until the detector has loaded: the follower's first state change is logged after
+    // the session (and its detector) started.
+    let stderr_pipe = child
+        .stderr
+        .take()
+        .ok_or_else(|| anyhow::anyhow!("no stderr"))?;
+    let (line_tx, line_rx) = std::sync::mpsc::channel::<String>();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stderr_pipe)
+            .lines()
+            .map_while(|l| l.ok())
+        {
+            let _ = line_tx.send(line);
+        }
+    });
+    let mut stderr = String::new();
+    let t0 = Instant::now();
+    loop {
+        let line = line_rx.recv_timeout(Duration::from_secs(300))?;
+        stderr.push_str(&line);
+        stderr.push('\n');
+        if line.contains("follower: ") {
+            break;
+        }
+        anyhow::ensure!(
+            t0.elapsed() < Duration::from_secs(300),
+            "no follower state: {stderr}"
+        );
+    }
     std::fs::write(&copy, b"this is no longer an ONNX model")?;
-    let out = child.wait_with_output()?;
-    let stderr = text(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let status = child.wait()?;
+    let _ = reader.join();
+    stderr.extend(line_rx.try_iter().map(|l| l + "\n"));
+    assert!(status.success(), "{stderr}");
+    assert!(
+        stderr.contains("follower: waiting -> searching"),
+        "{stderr}"
+    );
     assert!(!stderr.contains("detector failed"), "{stderr}");
     let rows = rows_of(&trace)?;
     let tracking = rows

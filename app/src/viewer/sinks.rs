@@ -334,7 +334,8 @@ impl LogSink for NonBlocking {
             return Ok(());
         }
         reply_rx
-            .recv_timeout(timeout + Duration::from_secs(1))
+            // rerun flushes with `Duration::MAX` when finalizing: saturate, never overflow.
+            .recv_timeout(timeout.saturating_add(Duration::from_secs(1)))
             .unwrap_or(Err(rerun::sink::SinkFlushError::Timeout))
     }
 }
