@@ -7,8 +7,10 @@
 #                                       web viewer served and kept open in headless Chromium
 #                                       for the whole run; default 10 minutes
 #   scripts/soak.sh headless [MINUTES]  headless follow run in worlds/walking.toml with
-#                                       --record (images at 1/4 size, 5 per sim second) and
-#                                       --trace, unpaced; default 60 sim minutes
+#                                       --record (images at 1/4 size, 5 per sim second,
+#                                       --record-no-footer: see docs/RELIABILITY.md) and
+#                                       --trace, unpaced; default 60 sim minutes;
+#                                       SOAK_FOOTER=1 keeps the footer
 #
 # Output in $SOAK_OUT (default target/soak/MODE/): rss.csv (wall_s, rss_mib), rover.log (the
 # window's status lines / headless progress), rss.png, summary.txt. Needs what ./test installs
@@ -19,7 +21,7 @@ mode="${1:-}"
 case "$mode" in
   window) minutes="${2:-10}" ;;
   headless) minutes="${2:-60}" ;;
-  *) sed -n '2,17p' "$0"; exit 2 ;;
+  *) sed -n '2,19p' "$0"; exit 2 ;;
 esac
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rover/target}"
 venv="$HOME/.cache/rover/venv"
@@ -86,14 +88,14 @@ if [ "$mode" = window ]; then
   } | tee "$out/summary.txt"
 else
   "$rover" --headless --world worlds/walking.toml --script "$script" --duration "$seconds" \
-    --record "$out/soak.rrd" --image-downscale 4 --image-hz 5 --trace "$out/trace.csv" \
+    --record "$out/soak.rrd" $([ -n "${SOAK_FOOTER:-}" ] || echo --record-no-footer) --image-downscale 4 --image-hz 5 --trace "$out/trace.csv" \
     > "$out/rover.out" 2> "$out/rover.log" &
   pid=$!
   echo "soak: headless pid $pid, $minutes sim minutes"
   sample "$pid"
   wait "$pid"
   {
-    echo "headless soak, $minutes sim min, worlds/walking.toml, follow mode, --record (1/4 size, 5 Hz images) + --trace"
+    echo "headless soak, $minutes sim min, worlds/walking.toml, follow mode, --record (1/4 size, 5 Hz images${SOAK_FOOTER:+, with footer}${SOAK_FOOTER:-, --record-no-footer}) + --trace"
     python3 scripts/soak_plot.py "$out/rss.csv" "$out/rss.png" "rover headless soak: RSS, $minutes sim min with --record"
     grep -E '^rover:|^recording:|^trace:' "$out/rover.out"
   } | tee "$out/summary.txt"

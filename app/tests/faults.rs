@@ -483,3 +483,29 @@ fn a_failing_detector_shows_on_the_window_hud() -> Result<()> {
     assert!(warm > 200, "{warm} pixels in the HUD's warning colour");
     Ok(())
 }
+
+/// `--record-no-footer` (long recordings with flat memory): the file reads back without the
+/// footer; with it (the default) the footer is there.
+#[test]
+fn a_recording_without_its_footer_is_still_valid() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    for footer in [false, true] {
+        let rrd = dir.path().join(format!("footer-{footer}.rrd"));
+        let mut c = rover();
+        c.args(["--headless", "--duration", "1", "--record"])
+            .arg(&rrd);
+        if !footer {
+            c.arg("--record-no-footer");
+        }
+        let out = c.output()?;
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_verified(&rrd, footer)?;
+        if !footer && let Some(out) = rrd_verify(&rrd, true)? {
+            assert!(
+                !out.status.success(),
+                "a footer check passed on a file without one"
+            );
+        }
+    }
+    Ok(())
+}

@@ -233,6 +233,12 @@ pub(crate) struct ViewerArgs {
     #[arg(long, value_name = "FILE.rrd")]
     pub(crate) record: Option<PathBuf>,
 
+    /// Write the .rrd without its footer (the chunk index rerun keeps in memory until the end,
+    /// ~MB per hour of recording): memory stays flat on runs of many hours. The file is still
+    /// valid; `rerun rrd optimize` adds the index later
+    #[arg(long, requires = "record")]
+    pub(crate) record_no_footer: bool,
+
     /// Camera images sent to Rerun per sim second [default: every camera frame]
     #[arg(long, value_name = "HZ")]
     pub(crate) image_hz: Option<f64>,
@@ -281,6 +287,7 @@ impl ViewerArgs {
         Ok(RecorderOptions {
             viewer,
             record: self.record.clone(),
+            footer: !self.record_no_footer,
             images: ImageOptions {
                 rate_hz: self.image_hz,
                 downscale: self.image_downscale,

@@ -40,6 +40,14 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         ..args.world.run_config(args.cmd_timeout)
     };
     let recorder_options = args.viewer.options(false)?;
+    if recorder_options.record.is_some()
+        && recorder_options.footer
+        && config.duration_s.is_some_and(|d| d > LONG_RECORDING_S)
+    {
+        tracing::info!(
+            "a long recording: rerun keeps an index entry per chunk in memory until it writes the .rrd footer (~150 MB per sim hour of the walking world); --record-no-footer keeps memory flat"
+        );
+    }
     let mut recorder = Recorder::start(&recorder_options)?;
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
         println!("Rerun web viewer: {url}");
@@ -118,6 +126,9 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     }
     Ok(())
 }
+
+/// Sim seconds from which a recording with a footer gets the memory hint.
+const LONG_RECORDING_S: f64 = 1800.0;
 
 /// A recording that could not be written in full (the file sink stopped: disk full, file
 /// removed) is an error at the end of the run, after everything else was written.

@@ -78,20 +78,28 @@ impl std::fmt::Debug for Recorder {
     }
 }
 
+/// Batching for recordings no live viewer watches (see [`Recorder::start`]).
+const FILE_BATCHING: rerun::log::ChunkBatcherConfig = rerun::log::ChunkBatcherConfig {
+    flush_tick: Duration::from_secs(2),
+    flush_num_bytes: 16 << 20,
+    ..rerun::log::ChunkBatcherConfig::DEFAULT
+};
+
 impl Recorder {
     /// Opens the viewer/file sinks. Returns `Ok(None)` when there is nothing to record to.
     pub fn start(options: &RecorderOptions) -> Result<Option<Self>> {
         let Some(sinks) = sinks::open(options)? else {
             return Ok(None);
         };
-        // A live viewer wants data at once; a file alone is better served by rerun's default
-        // batching (fewer, larger chunks: less per-chunk bookkeeping over an hour's recording).
+        // A live viewer wants data at once; a file alone gets larger, fewer chunks: rerun
+        // keeps an index entry per chunk in memory until it writes the .rrd footer, so chunk
+        // count is what a long recording's memory grows with.
         let live = sinks.watch.is_some() || sinks.web_url.is_some();
         let rec = RecordingStreamBuilder::new("rover")
             .batcher_config(if live {
                 rerun::log::ChunkBatcherConfig::LOW_LATENCY
             } else {
-                rerun::log::ChunkBatcherConfig::DEFAULT
+                FILE_BATCHING
             })
             .with_blueprint(blueprint())
             .set_sinks(sinks.sinks)

@@ -64,6 +64,8 @@ pub struct RecorderOptions {
     pub viewer: Viewer,
     /// Also record to this .rrd file.
     pub record: Option<PathBuf>,
+    /// Write the .rrd footer (rerun keeps a per-chunk index in memory until the end for it).
+    pub footer: bool,
     /// Image logging.
     pub images: ImageOptions,
     /// Web viewer (HTTP) port.
@@ -77,6 +79,7 @@ impl Default for RecorderOptions {
         Self {
             viewer: Viewer::None,
             record: None,
+            footer: true,
             images: ImageOptions::default(),
             web_port: 9090,
             grpc_port: 9876,
@@ -241,7 +244,13 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
                 .with_context(|| format!("cannot create {}", dir.display()))?;
         }
         sinks.push(Box::new(
-            FileSink::new(path).with_context(|| format!("cannot write {}", path.display()))?,
+            FileSink::with_options(
+                path,
+                rerun::sink::FileSinkOptions {
+                    write_footer: options.footer,
+                },
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?,
         ));
     }
     Ok(Some(Sinks {
