@@ -146,7 +146,7 @@ impl Write for RowFile {
 pub struct TraceObserver {
     path: PathBuf,
     writer: Option<TraceWriter<RowFile>>,
-    failed: Option<std::io::Error>,
+    failed: Option<CoreError>,
     rows: u64,
 }
 
@@ -171,9 +171,22 @@ impl TraceObserver {
     /// Flushes the file; returns the number of rows.
     pub fn finish(mut self) -> Result<u64> {
         if let Some(w) = self.writer.take() {
-            w.finish().map_err(|e| CoreError::write(&self.path, e))?;
+            let mut file = w.into_inner();
+            file.flush().map_err(|e| self.write_failed(e, &file))?;
         }
         Ok(self.rows)
+    }
+
+    /// A failed write, saying how many whole rows the file keeps ([`RowFile`] cut it back).
+    fn write_failed(&self, e: std::io::Error, file: &RowFile) -> CoreError {
+        let kept = file.lines_in_file().saturating_sub(1);
+        CoreError::write(
+            &self.path,
+            std::io::Error::new(
+                e.kind(),
+                format!("{e}; the file keeps its first {kept} rows, each complete"),
+            ),
+        )
     }
 }
 
@@ -183,20 +196,15 @@ impl Observer for TraceObserver {
             match w.row(sample, stats.mode, stats.follow_state) {
                 Ok(()) => self.rows += 1,
                 Err(e) => {
-                    let kept = self
-                        .writer
-                        .take()
-                        .map_or(0, |w| w.into_inner().lines_in_file().saturating_sub(1));
-                    self.failed = Some(std::io::Error::new(
-                        e.kind(),
-                        format!("{e}; the file keeps its first {kept} rows, each complete"),
-                    ));
+                    if let Some(w) = self.writer.take() {
+                        self.failed = Some(self.write_failed(e, &w.into_inner()));
+                    }
                 }
             }
         }
     }
     fn failure(&mut self) -> Option<CoreError> {
-        self.failed.take().map(|e| CoreError::write(&self.path, e))
+        self.failed.take()
     }
 }
 

@@ -149,3 +149,12 @@ pub fn read_text(path: &Path) -> Result<String> {
         ),
     })
 }
+
+/// The message of a caught panic (`catch_unwind`'s payload), for errors that report it.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> &str {
+    payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied())
+        .unwrap_or("a panic without a message")
+}

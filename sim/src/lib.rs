@@ -37,7 +37,7 @@ pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
     WheelSpeeds, wrap_angle,
 };
-pub use error::{Location, Result, SimError};
+pub use error::{Location, Result, SimError, panic_message};
 pub use gazebo::{
     CameraConfig, DiffDriveConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
     OdometrySource, PixelFormat,

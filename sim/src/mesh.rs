@@ -52,15 +52,13 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
     let scene =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load(&loader, &bytes, path)))
             .map_err(|payload| {
-                let why = payload
-                    .downcast_ref::<String>()
-                    .map(String::as_str)
-                    .or_else(|| payload.downcast_ref::<&str>().copied())
-                    .unwrap_or("unknown");
                 SimError::invalid(
                     path,
                     None,
-                    format!("cannot read mesh: the mesh parser failed ({why})"),
+                    format!(
+                        "cannot read mesh: the mesh parser failed ({})",
+                        crate::error::panic_message(payload.as_ref())
+                    ),
                 )
             })?
             .map_err(|e| SimError::invalid(path, None, format!("cannot read mesh: {e}")))?;

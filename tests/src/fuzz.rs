@@ -456,16 +456,17 @@ pub fn check_one(target: &Target, bytes: &[u8]) -> Result<Option<String>, String
     match outcome {
         Err(payload) => Err(format!(
             "panicked: {}",
-            payload
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| payload.downcast_ref::<&str>().map(|s| (*s).to_owned()))
-                .unwrap_or_default()
+            rover_sim::panic_message(payload.as_ref())
         )),
         Ok(Ok(())) => Ok(None),
         Ok(Err(text)) if text.trim().is_empty() => Err("an empty error message".into()),
         Ok(Err(text)) => Ok(Some(text)),
     }
+}
+
+/// A loader's result as the harness sees it: `Ok`, or the error's text.
+fn outcome<T, E: std::fmt::Display>(result: Result<T, E>) -> Result<(), String> {
+    result.map(drop).map_err(|e| e.to_string())
 }
 
 fn read_all(paths: &[PathBuf]) -> anyhow::Result<Vec<Vec<u8>>> {
@@ -578,11 +579,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         name: "world_toml",
         seeds: read_all(&files_with(&crate::repo("worlds"), "toml"))?,
         input_path: dir.join("world.toml"),
-        load: Box::new(|p| {
-            rover_sim::World::load(p)
-                .map(drop)
-                .map_err(|e| e.to_string())
-        }),
+        load: Box::new(|p| outcome(rover_sim::World::load(p))),
         hang_limit: text_limit,
     });
 
@@ -595,11 +592,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             name: "sdf",
             seeds: read_all(&[c.join("turtlebot_gazebo/worlds/playground.world")])?,
             input_path: dir.join("input.world"),
-            load: Box::new(move |p| {
-                rover_sim::World::load_with(p, &resources)
-                    .map(drop)
-                    .map_err(|e| e.to_string())
-            }),
+            load: Box::new(move |p| outcome(rover_sim::World::load_with(p, &resources))),
             hang_limit: text_limit,
         });
     }
@@ -613,11 +606,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         name: "scenario",
         seeds: read_all(&files_with(&crate::repo("scenarios"), "toml"))?,
         input_path: dir.join("scenario.toml"),
-        load: Box::new(|p| {
-            rover_core::Scenario::load(p)
-                .map(drop)
-                .map_err(|e| e.to_string())
-        }),
+        load: Box::new(|p| outcome(rover_core::Scenario::load(p))),
         hang_limit: text_limit,
     });
 
@@ -628,11 +617,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         name: "script",
         seeds: read_all(&files_with(&crate::repo("examples/scripts"), "toml"))?,
         input_path: dir.join("script.toml"),
-        load: Box::new(|p| {
-            rover_core::Script::load(p)
-                .map(drop)
-                .map_err(|e| e.to_string())
-        }),
+        load: Box::new(|p| outcome(rover_core::Script::load(p))),
         hang_limit: text_limit,
     });
 
@@ -665,11 +650,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
                 },
                 seeds: read_all(&seeds)?,
                 input_path: dir.join(format!("mesh.{ext}")),
-                load: Box::new(|p| {
-                    rover_sim::load_mesh(p, glam::Vec3::ONE)
-                        .map(drop)
-                        .map_err(|e| e.to_string())
-                }),
+                load: Box::new(|p| outcome(rover_sim::load_mesh(p, glam::Vec3::ONE))),
                 hang_limit: text_limit,
             });
         }
@@ -688,9 +669,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
                 if let Ok(text) = std::fs::read_to_string(p) {
                     let _ = rover_perception::labels::parse_metadata_names(&text);
                 }
-                rover_perception::labels::read_labels_file(p)
-                    .map(drop)
-                    .map_err(|e| e.to_string())
+                outcome(rover_perception::labels::read_labels_file(p))
             }),
             hang_limit: text_limit,
         });
@@ -711,11 +690,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             name: "image_jpeg",
             seeds: read_all(&photos)?,
             input_path: dir.join("photo.jpg"),
-            load: Box::new(|p| {
-                rover_perception::preprocess::load_rgb(p)
-                    .map(drop)
-                    .map_err(|e| e.to_string())
-            }),
+            load: Box::new(|p| outcome(rover_perception::preprocess::load_rgb(p))),
             hang_limit: text_limit,
         });
     }
@@ -723,11 +698,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         name: "image_png",
         seeds: read_all(&[crate::repo("docs/turtlebot3-burger.png")])?,
         input_path: dir.join("photo.png"),
-        load: Box::new(|p| {
-            rover_perception::preprocess::load_rgb(p)
-                .map(drop)
-                .map_err(|e| e.to_string())
-        }),
+        load: Box::new(|p| outcome(rover_perception::preprocess::load_rgb(p))),
         hang_limit: text_limit,
     });
 
@@ -741,12 +712,12 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             seeds: read_all(&[model])?,
             input_path: dir.join("model.onnx"),
             load: Box::new(|p| {
-                rover_perception::Detector::load(rover_perception::DetectorConfig {
-                    model: Some(p.to_path_buf()),
-                    ..Default::default()
-                })
-                .map(drop)
-                .map_err(|e| e.to_string())
+                outcome(rover_perception::Detector::load(
+                    rover_perception::DetectorConfig {
+                        model: Some(p.to_path_buf()),
+                        ..Default::default()
+                    },
+                ))
             }),
             hang_limit: Duration::from_secs(30),
         });

@@ -116,36 +116,43 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(path) = &args.trace {
         println!("trace: {} ({} rows)", path.display(), summary.rows);
     }
-    recording_failed(record_failed, recorder_options.record.as_deref())?;
-    if summary.interrupted {
-        println!(
-            "interrupted by a signal at {:.2} s sim time: the trace and recording end there, complete",
-            summary.sim_time_s
-        );
-        return Err(super::Interrupted.into());
-    }
-    Ok(())
+    end_of_run(
+        record_failed,
+        recorder_options.record.as_deref(),
+        summary.interrupted,
+        summary.sim_time_s,
+    )
 }
 
 /// Sim seconds from which a recording with a footer gets the memory hint.
 const LONG_RECORDING_S: f64 = 1800.0;
 
-/// A recording that could not be written in full (the file sink stopped: disk full, file
-/// removed) is an error at the end of the run, after everything else was written.
-fn recording_failed(failure: Option<String>, record: Option<&std::path::Path>) -> Result<()> {
-    match (failure, record) {
+/// How a run ends once its files are written: a recording that could not be written in full
+/// (the file sink stopped: disk full, file removed) is an error; a run ended by a signal says
+/// so and exits with 130 ([`super::Interrupted`]).
+fn end_of_run(
+    record_failed: Option<String>,
+    record: Option<&std::path::Path>,
+    interrupted: bool,
+    sim_time_s: f64,
+) -> Result<()> {
+    match (record_failed, record) {
         (Some(e), Some(path)) => anyhow::bail!(
             "the recording {} was not written in full ({e}; rerun's warning above says why, \
              e.g. no space left on device): it holds the run up to that point without the \
              .rrd footer — the viewer opens it, `rerun rrd verify --check-footers false` checks it",
             path.display()
         ),
-        (Some(e), None) => {
-            tracing::warn!("rerun: could not flush everything: {e}");
-            Ok(())
-        }
-        _ => Ok(()),
+        (Some(e), None) => tracing::warn!("rerun: could not flush everything: {e}"),
+        _ => {}
     }
+    if interrupted {
+        println!(
+            "interrupted by a signal at {sim_time_s:.2} s sim time: the trace and recording end there, complete"
+        );
+        return Err(super::Interrupted.into());
+    }
+    Ok(())
 }
 
 fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
@@ -241,13 +248,10 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     if let Some(path) = &recorder_options.record {
         println!("recording: {}", viewer::describe_file(path));
     }
-    recording_failed(record_failed, recorder_options.record.as_deref())?;
-    if summary.interrupted {
-        println!(
-            "interrupted by a signal at {:.2} s sim time: the trace and recording end there, complete",
-            summary.sim_time_s
-        );
-        return Err(super::Interrupted.into());
-    }
-    Ok(())
+    end_of_run(
+        record_failed,
+        recorder_options.record.as_deref(),
+        summary.interrupted,
+        summary.sim_time_s,
+    )
 }

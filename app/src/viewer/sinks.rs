@@ -268,9 +268,10 @@ pub(super) fn open(options: &RecorderOptions) -> Result<Option<Sinks>> {
 /// is full the new message is dropped for that viewer and counted, with one warning. `.rrd`
 /// files are not wrapped: a recording stays complete.
 pub struct NonBlocking {
-    tx: std::sync::Mutex<Option<mpsc::SyncSender<SinkCommand>>>,
-    dropped: Arc<std::sync::atomic::AtomicU64>,
-    thread: std::sync::Mutex<Option<JoinHandle<()>>>,
+    /// `None` only while dropping (to end the feeder thread before joining it).
+    tx: Option<mpsc::SyncSender<SinkCommand>>,
+    dropped: std::sync::atomic::AtomicU64,
+    thread: Option<JoinHandle<()>>,
 }
 
 enum SinkCommand {
@@ -304,20 +305,16 @@ impl NonBlocking {
             })
             .ok();
         Self {
-            tx: std::sync::Mutex::new(Some(tx)),
-            dropped: Arc::default(),
-            thread: std::sync::Mutex::new(thread),
+            tx: Some(tx),
+            dropped: Default::default(),
+            thread,
         }
-    }
-
-    fn sender(&self) -> Option<mpsc::SyncSender<SinkCommand>> {
-        self.tx.lock().ok().and_then(|tx| tx.clone())
     }
 }
 
 impl LogSink for NonBlocking {
     fn send(&self, msg: rerun::log::LogMsg) {
-        let Some(tx) = self.sender() else {
+        let Some(tx) = &self.tx else {
             return;
         };
         if let Err(mpsc::TrySendError::Full(_)) = tx.try_send(SinkCommand::Msg(Box::new(msg))) {
@@ -334,7 +331,7 @@ impl LogSink for NonBlocking {
         &self,
         timeout: Duration,
     ) -> std::result::Result<(), rerun::sink::SinkFlushError> {
-        let Some(tx) = self.sender() else {
+        let Some(tx) = &self.tx else {
             return Ok(());
         };
         let (reply_tx, reply_rx) = mpsc::sync_channel(1);
@@ -351,10 +348,8 @@ impl LogSink for NonBlocking {
 
 impl Drop for NonBlocking {
     fn drop(&mut self) {
-        if let Ok(mut tx) = self.tx.lock() {
-            tx.take();
-        }
-        if let Some(thread) = self.thread.lock().ok().and_then(|mut t| t.take()) {
+        self.tx = None;
+        if let Some(thread) = self.thread.take() {
             let _ = thread.join();
         }
         let dropped = self.dropped.load(Ordering::Relaxed);

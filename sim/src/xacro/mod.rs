@@ -32,8 +32,6 @@ const XACRO_NAMESPACES: [&str; 2] = ["http://ros.org/wiki/xacro", "http://www.ro
 const MAX_MACRO_DEPTH: usize = 100;
 /// Most output elements accepted, so that runaway expansion fails instead of eating memory.
 const MAX_OUTPUT_ELEMENTS: usize = 2_000_000;
-/// Largest file accepted.
-const MAX_FILE_BYTES: u64 = 64 << 20;
 
 /// A URDF produced by expanding a xacro file.
 #[derive(Debug, Clone)]
@@ -220,16 +218,7 @@ impl Expander<'_> {
 
     /// Reads and converts one file; returns its root element.
     fn read(&mut self, path: &Path) -> Result<Rc<XElem>> {
-        let text =
-            String::from_utf8(crate::error::read_bounded(path, MAX_FILE_BYTES)?).map_err(|e| {
-                SimError::Io {
-                    path: path.to_path_buf(),
-                    source: std::io::Error::new(
-                        std::io::ErrorKind::InvalidData,
-                        format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-                    ),
-                }
-            })?;
+        let text = crate::error::read_text(path)?;
         let file = self.files.len();
         self.files.push(path.to_path_buf());
         let doc = crate::error::parse_xml(&text, path)?;
