@@ -504,20 +504,40 @@ impl Session {
                 Err(e) => self.detector_failed(&e, observer),
             }
         }
-        // A pipelined result is taken when its sim time comes, waiting for it if need be.
+        // A pipelined result is taken when its sim time comes, waiting for it if need be; but
+        // first this step's image, when one is due, goes to the detector's queue, so the thread
+        // starts on it the moment the owed result is done (nothing in the image depends on that
+        // result: the follower acts on it at the next control update, as before).
         let now_s = self.sim.sim_time_s();
-        let delivered = match &mut self.detection {
+        let mut owed = match &mut self.detection {
             Detection::Pipelined(p) if p.deliver_at_s.is_some_and(|t| now_s + 1e-9 >= t) => {
                 p.deliver_at_s = None;
-                Some(p.worker.wait())
+                true
             }
-            _ => None,
+            _ => false,
         };
-        if let Some(result) = delivered {
+        let detected = self.camera_step(observer, &mut owed)?;
+        if let Some(result) = detected {
             self.take(result, observer);
         }
+        if owed && let Detection::Pipelined(p) = &self.detection {
+            let result = p.worker.wait();
+            self.take(result, observer);
+        }
+        Ok(())
+    }
+
+    /// Renders the camera image when due (or skips it when nobody would look at it), shows it to
+    /// the observers and hands it to the detector. `owed`: a pipelined result is due this step;
+    /// when an image is submitted here, that result is waited for right after (and `owed`
+    /// cleared) and returned.
+    fn camera_step(
+        &mut self,
+        observer: &mut dyn Observer,
+        owed: &mut bool,
+    ) -> Result<Option<std::result::Result<BoundingBoxes, PerceptionError>>> {
         let Some(camera) = self.camera.as_mut() else {
-            return Ok(());
+            return Ok(None);
         };
         if !self.every_frame && camera.due(&self.sim) {
             // Nobody looks at this image unless the detector takes it.
@@ -530,7 +550,7 @@ impl Session {
             };
             if !wanted {
                 camera.skip_if_due(&self.sim);
-                return Ok(());
+                return Ok(None);
             }
         }
         let world_from_camera = self.sim.world_from_link(self.camera_link);
@@ -538,7 +558,7 @@ impl Session {
             .capture_if_due(&self.sim)
             .map_err(CoreError::Camera)?
         else {
-            return Ok(());
+            return Ok(None);
         };
         self.stats.frames += 1;
         observer.camera_frame(&frame, world_from_camera);
@@ -558,20 +578,21 @@ impl Session {
                     if p.next_s + 1e-9 < frame.sim_time_s {
                         p.next_s = frame.sim_time_s + p.period_s;
                     }
-                    // Never two in flight: one still out is taken now (a camera slower than
-                    // the detection rate), on sim time like everything else.
-                    let earlier = p.deliver_at_s.take().map(|_| p.worker.wait());
+                    // Queued behind the one in flight; that one (due now, or still out when
+                    // the camera is slower than the detection rate) is taken right after, on
+                    // sim time like everything else: never two results outstanding.
+                    let earlier = p.deliver_at_s.take().is_some() || std::mem::take(owed);
                     let mut pixels = p.worker.buffer();
                     pixels.clear();
                     pixels.extend_from_slice(frame.rgb);
-                    p.worker.submit(Frame {
+                    p.worker.submit_queued(Frame {
                         pixels,
                         width: w,
                         height: h,
                         stamp,
                     });
                     p.deliver_at_s = Some(frame.sim_time_s + p.period_s);
-                    earlier
+                    earlier.then(|| p.worker.wait())
                 } else {
                     None
                 }
@@ -590,10 +611,7 @@ impl Session {
                 None
             }
         };
-        if let Some(result) = detected {
-            self.take(result, observer);
-        }
-        Ok(())
+        Ok(detected)
     }
 
     /// A lockstep or pipelined result: its boxes, or the detector's failure.

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+use rayon::ThreadPoolBuilder;
+use tract_linalg::multithread::{Executor, multithread_tract_scope};
 use tract_onnx::prelude::*;
 
 use crate::error::{PerceptionError, Result};
@@ -45,6 +47,10 @@ pub struct DetectorConfig {
     /// A fault to inject, for tests of what a failing detector does to a run
     /// (`--inject-fault`); `None` in normal use.
     pub fault: Option<InjectedFault>,
+    /// Threads for one detection: tract splits its matrix products across a pool of this many
+    /// (1 = on the calling thread only). The results are bit-identical whatever the count: each
+    /// output tile is computed whole by one thread, in the same order.
+    pub threads: usize,
 }
 
 /// A detector fault injected on purpose: after `after_detections` good detections, every
@@ -77,6 +83,7 @@ impl Default for DetectorConfig {
             max_boxes: 100,
             frame_id: "camera_link_optical".to_owned(),
             fault: None,
+            threads: 1,
         }
     }
 }
@@ -129,6 +136,8 @@ pub struct Detector {
     last_times: StageTimes,
     /// Detections run (for [`DetectorConfig::fault`]).
     detections: u64,
+    /// tract's thread pool when [`DetectorConfig::threads`] > 1.
+    executor: Option<Executor>,
 }
 
 impl std::fmt::Debug for Detector {
@@ -219,6 +228,25 @@ impl Detector {
                 }
             )));
         }
+        let executor = match config.threads {
+            0 => {
+                return Err(PerceptionError::model(
+                    &model_path,
+                    "the detector needs at least one thread",
+                ));
+            }
+            1 => None,
+            n => Some(
+                ThreadPoolBuilder::new()
+                    .thread_name(|i| format!("rover-detect-{i}"))
+                    .num_threads(n)
+                    .build()
+                    .map(|pool| Executor::MultiThread(Arc::new(pool)))
+                    .map_err(|e| {
+                        PerceptionError::Inference(format!("starting {n} detector threads: {e}"))
+                    })?,
+            ),
+        };
         tracing::debug!(
             "detector: {} at {input_w}x{input_h}, head {}, {num_classes} classes",
             model_path.display(),
@@ -242,6 +270,7 @@ impl Detector {
             proto: prepared.proto,
             last_times: StageTimes::default(),
             detections: 0,
+            executor,
         })
     }
 
@@ -381,9 +410,12 @@ impl Detector {
     }
 
     fn run_network(&mut self) -> Result<TVec<TValue>> {
-        self.plan
-            .run(tvec!(TValue::from_const(self.input.clone())))
-            .map_err(|e| PerceptionError::Inference(format!("{e:#}")))
+        let run = || self.plan.run(tvec!(TValue::from_const(self.input.clone())));
+        match &self.executor {
+            Some(pool) => multithread_tract_scope(pool.clone(), run),
+            None => run(),
+        }
+        .map_err(|e| PerceptionError::Inference(format!("{e:#}")))
     }
 
     /// Decodes a raw output (as from [`Detector::infer_raw`], or another runtime given the same

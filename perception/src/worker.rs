@@ -2,6 +2,7 @@
 //! another waits replaces it (the stale one is dropped and counted), so detections never lag
 //! behind a queue.
 
+use std::collections::VecDeque;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::thread::JoinHandle;
@@ -37,7 +38,9 @@ pub struct WorkerStats {
 
 #[derive(Default)]
 struct Slot {
-    pending: Option<Frame>,
+    /// Frames waiting, oldest first: at most one after [`DetectorWorker::submit`], as many as
+    /// queued with [`DetectorWorker::submit_queued`].
+    pending: VecDeque<Frame>,
     shutdown: bool,
     stats: WorkerStats,
 }
@@ -91,7 +94,7 @@ impl DetectorWorker {
                             if slot.shutdown {
                                 return;
                             }
-                            if let Some(frame) = slot.pending.take() {
+                            if let Some(frame) = slot.pending.pop_front() {
                                 break frame;
                             }
                             slot = thread_shared
@@ -136,21 +139,30 @@ impl DetectorWorker {
         self.recycled.try_recv().unwrap_or_default()
     }
 
-    /// Hands a frame to the detector, replacing (dropping) one still waiting.
+    /// Hands a frame to the detector, replacing (dropping) any still waiting.
     pub fn submit(&self, frame: Frame) {
-        let stale = {
+        {
             let mut slot = lock(&self.shared);
             slot.stats.submitted += 1;
-            let stale = slot.pending.replace(frame);
-            if stale.is_some() {
+            while let Some(stale) = slot.pending.pop_front() {
                 slot.stats.dropped += 1;
+                let _ = self.recycle.send(stale.pixels);
             }
-            stale
-        };
-        self.shared.1.notify_one();
-        if let Some(stale) = stale {
-            let _ = self.recycle.send(stale.pixels);
+            slot.pending.push_back(frame);
         }
+        self.shared.1.notify_one();
+    }
+
+    /// Queues a frame behind any still waiting, dropping none: every queued frame gets its
+    /// result, in order (for a caller that takes each result, like pipelined detection, and so
+    /// bounds the queue).
+    pub fn submit_queued(&self, frame: Frame) {
+        {
+            let mut slot = lock(&self.shared);
+            slot.stats.submitted += 1;
+            slot.pending.push_back(frame);
+        }
+        self.shared.1.notify_one();
     }
 
     /// The newest result since the last call, if any (older boxes are skipped; an error is

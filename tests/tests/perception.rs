@@ -69,6 +69,53 @@ fn default_model_finds_the_expected_objects_like_onnxruntime() -> Result<()> {
     Ok(())
 }
 
+/// Determinism does not depend on `--detect-threads`: tract's matrix products split over a pool
+/// give the very same numbers as on one thread (each output tile is computed whole by one
+/// thread), so traces and goldens hold for any thread count.
+#[test]
+fn several_detector_threads_give_bit_identical_outputs() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let mut one = Detector::load(DetectorConfig::default())?;
+    let mut three = Detector::load(DetectorConfig {
+        threads: 3,
+        ..DetectorConfig::default()
+    })?;
+    for name in ["person", "dog"] {
+        let (width, height, pixels) = load_rgb(&photo(name, dir.path())?)?;
+        let view = RgbView::new(width, height, &pixels)?;
+        one.preprocess(view)?;
+        three.preprocess(view)?;
+        let (a, shape_a) = one.infer_raw()?;
+        let (b, shape_b) = three.infer_raw()?;
+        assert_eq!(shape_a, shape_b);
+        let differing = a
+            .iter()
+            .zip(&b)
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count();
+        assert_eq!(
+            differing,
+            0,
+            "{name}: {differing} of {} outputs differ",
+            a.len()
+        );
+        let stamp = FrameStamp::default();
+        assert_eq!(
+            one.detect(view, stamp)?.bounding_boxes,
+            three.detect(view, stamp)?.bounding_boxes
+        );
+    }
+    let err = Detector::load(DetectorConfig {
+        threads: 0,
+        ..DetectorConfig::default()
+    })
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(err.contains("at least one thread"), "{err}");
+    Ok(())
+}
+
 #[test]
 fn the_worker_always_finishes_on_the_newest_frame() -> Result<()> {
     let dir = tempfile::tempdir()?;

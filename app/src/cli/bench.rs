@@ -97,8 +97,9 @@ fn median(values: &mut [f64]) -> f64 {
     values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-/// Times the detector (single thread, `runs` frames after one warm-up) on `image`, then
-/// onnxruntime (Python, scripts/ort_reference.py) on exactly the same graph and input tensor.
+/// Times the detector (`config.threads` threads, `runs` frames after one warm-up) on `image`,
+/// then onnxruntime (Python, scripts/ort_reference.py) on exactly the same graph and input
+/// tensor with as many intra-op threads.
 pub fn detector(
     config: rover_perception::DetectorConfig,
     image: &std::path::Path,
@@ -227,6 +228,7 @@ fn onnxruntime_median(
 ) -> Result<f64, String> {
     let model = std::env::temp_dir().join(format!("rover-bench-{}.onnx", std::process::id()));
     let (w, h) = detector.input_size();
+    let threads = detector.config().threads;
     let result = detector
         .export_onnx(&model)
         .map_err(|e| e.to_string())
@@ -236,7 +238,7 @@ fn onnxruntime_median(
                 &model,
                 input,
                 &[1, 3, h, w],
-                1,
+                threads,
                 runs.max(1) + 1,
             )
             .map(|r| r.median_ms)
@@ -710,11 +712,20 @@ pub(crate) fn bench_detect(
         }
     };
     println!(
-        "detector benchmark on {}: {runs} runs after a warm-up, one thread",
-        image.display()
+        "detector benchmark on {}: {runs} runs after a warm-up, {} thread(s) for both runtimes (--detect-threads)",
+        image.display(),
+        config.threads
     );
     if profile {
-        profile_detector(config.clone(), &image, runs)?;
+        // Node by node, one thread: the times add up to the run.
+        profile_detector(
+            DetectorConfig {
+                threads: 1,
+                ..config.clone()
+            },
+            &image,
+            runs,
+        )?;
     }
     let b = detector(config, &image, runs)?;
     println!("input {}x{}", b.input_size.0, b.input_size.1);

@@ -269,7 +269,8 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
         Err(e) => ScenarioResult::failed("?", &file.display().to_string(), e.to_string()),
         Ok(s) => {
             let options = RunOptions {
-                detector: args.detector.config()?,
+                // `--jobs` workers already fill the cores.
+                detector: args.detector.config(1)?,
                 trace: args
                     .traces
                     .then(|| args.out.join(format!("{}.csv", s.name))),

@@ -42,7 +42,7 @@ pub fn main() -> ExitCode {
                 }),
             ..
         }) => detector
-            .config()
+            .config(1)
             .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
@@ -83,14 +83,16 @@ pub fn main() -> ExitCode {
             detector,
             json,
             out,
-        }) => detector.config().and_then(|config| {
-            detect::run(&DetectOptions {
-                images,
-                detector: config,
-                json,
-                out,
-            })
-        }),
+        }) => detector
+            .config(args::spare_detect_threads())
+            .and_then(|config| {
+                detect::run(&DetectOptions {
+                    images,
+                    detector: config,
+                    json,
+                    out,
+                })
+            }),
         Some(Command::Eval(args)) => eval::run(args),
         None => run::run(cli.run),
     };
