@@ -220,6 +220,34 @@ fn detect_prints_boxes_json_and_draws_them() -> Result<()> {
     Ok(())
 }
 
+/// `--runtime onnxruntime` where its library is not where ORT_DYLIB_PATH says: one clear error
+/// naming the variable and the file, nothing loaded.
+#[test]
+fn a_missing_onnxruntime_library_is_a_clear_error() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let missing = dir.path().join("libonnxruntime.so.1.99.0");
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args([
+            "detect",
+            "/usr/share/darknet/data/person.jpg",
+            "--runtime",
+            "onnxruntime",
+        ])
+        .env("ORT_DYLIB_PATH", &missing)
+        .env("RUST_LOG", "warn")
+        .current_dir(dir.path())
+        .output()?;
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("ORT_DYLIB_PATH")
+            && stderr.contains("libonnxruntime.so.1.99.0")
+            && stderr.contains("not a file"),
+        "{stderr}"
+    );
+    Ok(())
+}
+
 #[test]
 fn save_frames_writes_the_camera_images() -> Result<()> {
     let dir = tempfile::tempdir()?;

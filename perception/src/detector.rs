@@ -14,6 +14,7 @@ use crate::graph;
 use crate::head::{self, Candidate, Head};
 use crate::labels::{COCO80, read_labels_file};
 use crate::messages::{BoundingBox, BoundingBoxes, FrameStamp};
+use crate::onnxruntime::{OrtSession, Runtime};
 use crate::preprocess::{LetterboxPlan, RgbView};
 
 /// Input size the default model runs at: the camera's 4:3 aspect, so camera frames need no
@@ -51,6 +52,8 @@ pub struct DetectorConfig {
     /// (1 = on the calling thread only). The results are bit-identical whatever the count: each
     /// output tile is computed whole by one thread, in the same order.
     pub threads: usize,
+    /// The runtime: tract (default) or onnxruntime's shared library (`--runtime onnxruntime`).
+    pub runtime: Runtime,
 }
 
 /// A detector fault injected on purpose: after `after_detections` good detections, every
@@ -84,6 +87,7 @@ impl Default for DetectorConfig {
             frame_id: "camera_link_optical".to_owned(),
             fault: None,
             threads: 1,
+            runtime: Runtime::Tract,
         }
     }
 }
@@ -138,6 +142,11 @@ pub struct Detector {
     detections: u64,
     /// tract's thread pool when [`DetectorConfig::threads`] > 1.
     executor: Option<Executor>,
+    /// The onnxruntime session when [`DetectorConfig::runtime`] asks for it (tract's plan is
+    /// still built: it gives the output shape and the per-op profile).
+    ort: Option<OrtSession>,
+    /// onnxruntime's output, copied into a reused buffer, and its shape.
+    ort_output: (Vec<f32>, Vec<usize>),
 }
 
 impl std::fmt::Debug for Detector {
@@ -228,15 +237,15 @@ impl Detector {
                 }
             )));
         }
-        let executor = match config.threads {
-            0 => {
+        let executor = match (config.threads, config.runtime) {
+            (0, _) => {
                 return Err(PerceptionError::model(
                     &model_path,
                     "the detector needs at least one thread",
                 ));
             }
-            1 => None,
-            n => Some(
+            (1, _) | (_, Runtime::OnnxRuntime) => None,
+            (n, Runtime::Tract) => Some(
                 ThreadPoolBuilder::new()
                     .thread_name(|i| format!("rover-detect-{i}"))
                     .num_threads(n)
@@ -246,6 +255,18 @@ impl Detector {
                         PerceptionError::Inference(format!("starting {n} detector threads: {e}"))
                     })?,
             ),
+        };
+        let ort = match config.runtime {
+            Runtime::Tract => None,
+            Runtime::OnnxRuntime => {
+                use prost::Message as _;
+                Some(OrtSession::new(
+                    &prepared.proto.encode_to_vec(),
+                    [1, 3, input_h, input_w],
+                    config.threads,
+                    &model_path,
+                )?)
+            }
         };
         tracing::debug!(
             "detector: {} at {input_w}x{input_h}, head {}, {num_classes} classes",
@@ -271,6 +292,8 @@ impl Detector {
             last_times: StageTimes::default(),
             detections: 0,
             executor,
+            ort,
+            ort_output: (Vec::new(), Vec::new()),
         })
     }
 
@@ -495,18 +518,28 @@ impl Detector {
         let start = Instant::now();
         let (_, lb) = self.preprocess(image)?;
         let preprocessed = Instant::now();
-        let outputs = self.run_network()?;
-        let inferred = Instant::now();
-        let out = &outputs[0];
-        let data = f32_slice(out)?;
         let mut result = BoundingBoxes {
             image_stamp: stamp,
             frame_id: self.config.frame_id.clone(),
             ..BoundingBoxes::default()
         };
-        let shape: TVec<usize> = out.shape().into();
-        self.decode_into(data, &shape, lb, &mut result)?;
-        drop(outputs);
+        let inferred;
+        if let Some(ort) = self.ort.as_mut() {
+            let (mut output, mut shape) = std::mem::take(&mut self.ort_output);
+            let input = f32_slice(&self.input)?;
+            let ran = ort.run(input, &mut output, &mut shape);
+            inferred = Instant::now();
+            let decoded = ran.and_then(|()| self.decode_into(&output, &shape, lb, &mut result));
+            self.ort_output = (output, shape);
+            decoded?;
+        } else {
+            let outputs = self.run_network()?;
+            inferred = Instant::now();
+            let out = &outputs[0];
+            let data = f32_slice(out)?;
+            let shape: TVec<usize> = out.shape().into();
+            self.decode_into(data, &shape, lb, &mut result)?;
+        }
         let done = Instant::now();
         self.last_times = StageTimes {
             preprocess_ms: (preprocessed - start).as_secs_f64() * 1e3,

@@ -48,6 +48,9 @@ pub enum PerceptionError {
     /// The detector panicked (a bug in rover or tract, or a model it cannot run).
     #[error("the detector crashed: {0}")]
     Panicked(String),
+    /// The optional onnxruntime runtime (`--runtime onnxruntime`) is not available.
+    #[error("{0}")]
+    Runtime(String),
     /// The onnxruntime reference (tests and benchmarks) could not run.
     #[error("{0}")]
     Reference(String),

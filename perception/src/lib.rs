@@ -18,6 +18,7 @@ pub mod head;
 pub mod labels;
 pub mod lockstep;
 pub mod messages;
+pub mod onnxruntime;
 pub mod preprocess;
 pub mod reference;
 pub mod worker;
@@ -29,5 +30,6 @@ pub use detector::{
 pub use error::{PerceptionError, Result};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
+pub use onnxruntime::Runtime;
 pub use preprocess::{Letterbox, LetterboxPlan, RgbView};
 pub use worker::{DetectorWorker, Frame, WorkerStats};

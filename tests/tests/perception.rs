@@ -4,7 +4,9 @@
 use anyhow::Result;
 use rover_perception::preprocess::load_rgb;
 use rover_perception::reference::onnxruntime;
-use rover_perception::{Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView};
+use rover_perception::{
+    Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView, Runtime,
+};
 use rover_tests::photo;
 
 const CASES: [(&str, &[&str]); 3] = [
@@ -113,6 +115,54 @@ fn several_detector_threads_give_bit_identical_outputs() -> Result<()> {
     .map(|e| e.to_string())
     .unwrap_or_default();
     assert!(err.contains("at least one thread"), "{err}");
+    Ok(())
+}
+
+/// `--runtime onnxruntime`: the same graph run by the libonnxruntime.so of a pip install finds
+/// the same objects as tract (every tract box matched by an onnxruntime box of its class with
+/// IoU >= 0.9, and the other way round). Skips where no onnxruntime library is installed.
+#[test]
+fn the_onnxruntime_runtime_gives_the_same_boxes_as_tract() -> Result<()> {
+    if let Err(e) = rover_perception::onnxruntime::find_library() {
+        eprintln!("skipped: {e}");
+        return Ok(());
+    }
+    let dir = tempfile::tempdir()?;
+    let mut tract = Detector::load(DetectorConfig::default())?;
+    let mut ort = Detector::load(DetectorConfig {
+        runtime: Runtime::OnnxRuntime,
+        threads: 2,
+        ..DetectorConfig::default()
+    })?;
+    for (name, expected) in CASES {
+        let (width, height, pixels) = load_rgb(&photo(name, dir.path())?)?;
+        let view = RgbView::new(width, height, &pixels)?;
+        let stamp = FrameStamp::default();
+        let a = tract.detect(view, stamp)?.bounding_boxes;
+        let b = ort.detect(view, stamp)?.bounding_boxes;
+        for class in expected {
+            assert!(
+                b.iter().any(|x| x.class == *class),
+                "{name}: onnxruntime found no {class}: {b:?}"
+            );
+        }
+        for (from, to, what) in [
+            (&a, &b, "tract -> onnxruntime"),
+            (&b, &a, "onnxruntime -> tract"),
+        ] {
+            for x in from {
+                let best = to
+                    .iter()
+                    .filter(|y| y.class == x.class)
+                    .map(|y| y.iou(x))
+                    .fold(0.0, f64::max);
+                assert!(
+                    best >= 0.9,
+                    "{name} ({what}): {x:?} unmatched (best IoU {best})"
+                );
+            }
+        }
+    }
     Ok(())
 }
 

@@ -82,13 +82,16 @@ pub struct DetectorBench {
     pub input_size: (usize, usize),
     /// Median letterbox + normalisation (ms).
     pub preprocess_ms: f64,
-    /// Median tract inference (ms).
+    /// The runtime measured (`tract` or `onnxruntime`).
+    pub runtime: &'static str,
+    /// Median inference (ms).
     pub inference_ms: f64,
     /// Median decode + NMS (ms).
     pub decode_ms: f64,
     /// Median end to end (ms).
     pub total_ms: f64,
-    /// onnxruntime's median on the same graph and input, one thread, when it could run.
+    /// onnxruntime's median (Python, as many threads) on the same graph and input, when it
+    /// could run.
     pub onnxruntime_ms: Result<f64, String>,
 }
 
@@ -130,6 +133,7 @@ pub fn detector(
     let input_size = detector.input_size();
     let onnxruntime_ms = onnxruntime_median(&mut detector, view, runs);
     Ok(DetectorBench {
+        runtime: detector.config().runtime.name(),
         input_size,
         preprocess_ms: median(&mut pre),
         inference_ms: median(&mut inf),
@@ -721,6 +725,7 @@ pub(crate) fn bench_detect(
         profile_detector(
             DetectorConfig {
                 threads: 1,
+                runtime: rover_perception::Runtime::Tract,
                 ..config.clone()
             },
             &image,
@@ -731,7 +736,11 @@ pub(crate) fn bench_detect(
     println!("input {}x{}", b.input_size.0, b.input_size.1);
     println!("{:<28} {:>10}", "stage (median)", "ms");
     println!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
-    println!("{:<28} {:>10.1}", "tract inference", b.inference_ms);
+    println!(
+        "{:<28} {:>10.1}",
+        format!("{} inference", b.runtime),
+        b.inference_ms
+    );
     println!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
     println!(
         "{:<28} {:>10.1}   ({:.1} Hz)",
@@ -744,7 +753,7 @@ pub(crate) fn bench_detect(
             println!("{:<28} {:>10.1}", "onnxruntime inference", ort);
             println!(
                 "{:<28} {:>10.2}x",
-                "tract / onnxruntime",
+                format!("{} / onnxruntime (Python)", b.runtime),
                 b.inference_ms / ort
             );
         }
