@@ -398,7 +398,7 @@ pub(crate) struct DetectorArgs {
 
     /// Threads for one detection: tract splits the network's matrix products across them, and
     /// the boxes are bit-identical whatever the count [default: 2 (1 on a one-core machine);
-    /// 1 in `rover eval`'s workers, which already fill the cores, and in `rover bench detect`]
+    /// 1 in `rover eval`'s workers, which already fill the cores]
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=64))]
     pub(crate) detect_threads: Option<u16>,
 

@@ -42,7 +42,7 @@ pub fn main() -> ExitCode {
                 }),
             ..
         }) => detector
-            .config(1)
+            .config(args::spare_detect_threads())
             .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
