@@ -309,10 +309,12 @@ impl Session {
                 Ok(detector) => {
                     labels = detector.labels().to_vec();
                     tracing::info!(
-                        "detector: {} at {}x{}",
+                        "detector: {} at {}x{} on {}, {} thread(s)",
                         detector.model_path().display(),
                         detector.input_size().0,
-                        detector.input_size().1
+                        detector.input_size().1,
+                        detector.config().runtime.name(),
+                        detector.config().threads
                     );
                     match mode {
                         DetectorMode::Lockstep { rate_hz } => {
@@ -581,7 +583,8 @@ impl Session {
                     // Queued behind the one in flight; that one (due now, or still out when
                     // the camera is slower than the detection rate) is taken right after, on
                     // sim time like everything else: never two results outstanding.
-                    let earlier = p.deliver_at_s.take().is_some() || std::mem::take(owed);
+                    let still_out = p.deliver_at_s.take().is_some();
+                    let earlier = std::mem::take(owed) || still_out;
                     let mut pixels = p.worker.buffer();
                     pixels.clear();
                     pixels.extend_from_slice(frame.rgb);

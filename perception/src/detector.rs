@@ -361,6 +361,11 @@ impl Detector {
 
     /// Runs the network on the current input tensor; returns the raw output and its shape.
     pub fn infer_raw(&mut self) -> Result<(Vec<f32>, Vec<usize>)> {
+        if let Some(ort) = self.ort.as_mut() {
+            let (mut output, mut shape) = (Vec::new(), Vec::new());
+            ort.run(f32_slice(&self.input)?, &mut output, &mut shape)?;
+            return Ok((output, shape));
+        }
         let outputs = self.run_network()?;
         let out = &outputs[0];
         let data = f32_slice(out)?.to_vec();

@@ -37,14 +37,16 @@ pub fn run(options: &DetectOptions) -> Result<()> {
     let (w, h) = detector.input_size();
     if !options.json {
         println!(
-            "model {} ({}x{}, {}, {} classes), threshold {}, NMS IoU {}",
+            "model {} ({}x{}, {}, {} classes), threshold {}, NMS IoU {}, {} on {} thread(s)",
             detector.model_path().display(),
             w,
             h,
             detector.head().name(),
             detector.labels().len(),
             options.detector.threshold,
-            options.detector.nms_iou
+            options.detector.nms_iou,
+            options.detector.runtime.name(),
+            options.detector.threads
         );
     }
     if let Some(out) = &options.out
