@@ -245,6 +245,36 @@ fn a_missing_onnxruntime_library_is_a_clear_error() -> Result<()> {
             && stderr.contains("not a file"),
         "{stderr}"
     );
+
+    // Nowhere to be found: the error says what to install and lists the folders searched.
+    let model = rover_perception::fetch::ensure_default_model()?;
+    let home = dir.path().join("home");
+    std::fs::create_dir_all(home.join(".local/lib/python3.11/site-packages"))?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .arg("detect")
+        .arg("/usr/share/darknet/data/person.jpg")
+        .arg("--model")
+        .arg(&model)
+        .args(["--runtime", "onnxruntime"])
+        .env_remove("ORT_DYLIB_PATH")
+        .env_remove("VIRTUAL_ENV")
+        .env_remove("ROVER_CACHE_DIR")
+        .env("HOME", &home)
+        .env("XDG_CACHE_HOME", home.join(".cache"))
+        .env("RUST_LOG", "warn")
+        .current_dir(dir.path())
+        .output()?;
+    let stderr = text(&out.stderr);
+    if out.status.success() {
+        eprintln!("skipped the not-found case: this machine's system Python has onnxruntime");
+        return Ok(());
+    }
+    assert!(
+        stderr.contains("pip install onnxruntime")
+            && stderr.contains("Searched:")
+            && stderr.contains(".local/lib/python3.11/site-packages/onnxruntime/capi"),
+        "{stderr}"
+    );
     Ok(())
 }
 

@@ -173,6 +173,10 @@ impl Detector {
         if !model_path.is_file() {
             return Err(PerceptionError::model(&model_path, "no such model file"));
         }
+        if config.runtime == Runtime::OnnxRuntime {
+            // Before tract's plan is built (seconds): a missing library is said at once.
+            crate::onnxruntime::find_library()?;
+        }
         let prepared = graph::prepare(&model_path, requested)?;
         let (input_w, input_h) = prepared.input_size;
         let fail = |stage: &str, e: TractError| {

@@ -114,7 +114,8 @@ fn environment(library: &Path) -> std::result::Result<ort::environment::Environm
 
 /// Where onnxruntime's library is: `ORT_DYLIB_PATH` (ort's variable) when set, else the
 /// `onnxruntime/capi/libonnxruntime.so*` of a pip install in `$VIRTUAL_ENV`, rover's cache venv
-/// (`~/.cache/rover/venv`), `~/.local` or the system's Python. The error lists every place
+/// (`$ROVER_CACHE_DIR/venv`, `$XDG_CACHE_HOME/rover/venv`, `~/.cache/rover/venv`: where
+/// `scripts/setup.sh` puts it), `~/.local` or the system's Python. The error lists every place
 /// searched.
 pub fn find_library() -> Result<PathBuf> {
     if let Some(path) = std::env::var_os("ORT_DYLIB_PATH") {
@@ -135,6 +136,9 @@ pub fn find_library() -> Result<PathBuf> {
     }
     if let Some(cache) = std::env::var_os("ROVER_CACHE_DIR") {
         prefixes.push(PathBuf::from(cache).join("venv/lib"));
+    }
+    if let Some(cache) = std::env::var_os("XDG_CACHE_HOME") {
+        prefixes.push(PathBuf::from(cache).join("rover/venv/lib"));
     }
     if let Some(home) = &home {
         prefixes.push(home.join(".cache/rover/venv/lib"));
