@@ -20,7 +20,10 @@ fn main() -> TractResult<()> {
                 .ok()
                 .and_then(|s| s.parse().ok())
                 .unwrap_or(640),
-            640,
+            std::env::var("W")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(640),
         ),
         0.5,
     )

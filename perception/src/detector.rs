@@ -182,11 +182,26 @@ impl Detector {
         let fail = |stage: &str, e: TractError| {
             PerceptionError::model(&model_path, format!("{stage}: {e:#}"))
         };
-        let plan = tract_onnx::onnx()
+        let mut model = tract_onnx::onnx()
             .model_for_proto_model(&prepared.proto)
             .map_err(|e| fail("tract cannot load it", e))?
             .with_input_fact(0, f32::fact([1, 3, input_h, input_w]).into())
-            .map_err(|e| fail("setting the input shape", e))?
+            .map_err(|e| fail("setting the input shape", e))?;
+        // Concatenations before 1x1 convolutions stay whole (see graph.rs): tract leaves them
+        // alone when they are outputs. Output 0 stays the head; the extra ones are ignored.
+        let mut outlets = model
+            .output_outlets()
+            .map_err(|e| fail("its outputs", e))?
+            .to_vec();
+        for name in &prepared.whole_concats {
+            if let Some(node) = model.nodes().iter().find(|n| &n.name == name) {
+                outlets.push(OutletId::new(node.id, 0));
+            }
+        }
+        model
+            .select_output_outlets(&outlets)
+            .map_err(|e| fail("setting its outputs", e))?;
+        let plan = model
             .into_optimized()
             .map_err(|e| fail("tract cannot optimise it", e))?
             .into_runnable()
