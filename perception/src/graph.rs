@@ -6,6 +6,9 @@
 //! * the input size can then change (e.g. 640x480 to match the camera instead of letterboxing
 //!   into 640x640): Reshape shapes that bake the feature-map grids (YOLOv12's area attention)
 //!   are rewritten for the new grids.
+//! * softmax spelled out as five ops (YOLOv12's attention) becomes one `Softmax`;
+//! * `Concat` nodes that feed only 1x1 convolutions are listed, so the detector keeps them whole
+//!   in tract's plan (tract would split each such convolution into small products).
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;

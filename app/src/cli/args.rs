@@ -405,7 +405,7 @@ pub(crate) struct DetectorArgs {
     /// The network's runtime: `tract` (pure Rust, built in) or `onnxruntime`, the
     /// libonnxruntime.so of a `pip install onnxruntime` (found in $VIRTUAL_ENV, rover's
     /// ~/.cache/rover/venv, ~/.local or the system's Python; or set ORT_DYLIB_PATH), loaded at
-    /// run time. Same graph, same boxes within float rounding; onnxruntime is ~1.7x faster here
+    /// run time. Same graph, same boxes within float rounding; onnxruntime is ~1.6x faster here
     #[arg(long, value_enum, default_value_t = RuntimeArg::Tract, value_name = "RUNTIME")]
     pub(crate) runtime: RuntimeArg,
 }
@@ -459,7 +459,7 @@ impl From<RuntimeArg> for Runtime {
 }
 
 /// Detector threads where the loop leaves a core free for them: 2, or 1 on a one-core machine.
-/// Two measured here (2 vCPU, 512x384): one detection 80 -> 56 ms, the same boxes.
+/// Two measured here (2 vCPU, 512x384): one detection 76 -> 49 ms, the same boxes.
 pub(crate) fn spare_detect_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get().min(2))
 }
