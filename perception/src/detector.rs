@@ -173,10 +173,17 @@ impl Detector {
         if !model_path.is_file() {
             return Err(PerceptionError::model(&model_path, "no such model file"));
         }
-        if config.runtime == Runtime::OnnxRuntime {
-            // Before tract's plan is built (seconds): a missing library is said at once.
-            crate::onnxruntime::find_library()?;
+        if config.threads == 0 {
+            return Err(PerceptionError::model(
+                &model_path,
+                "the detector needs at least one thread",
+            ));
         }
+        // Before tract's plan is built (seconds): a missing library is said at once.
+        let ort_library = match config.runtime {
+            Runtime::Tract => None,
+            Runtime::OnnxRuntime => Some(crate::onnxruntime::find_library()?),
+        };
         let prepared = graph::prepare(&model_path, requested)?;
         let (input_w, input_h) = prepared.input_size;
         let fail = |stage: &str, e: TractError| {
@@ -257,13 +264,7 @@ impl Detector {
             )));
         }
         let executor = match (config.threads, config.runtime) {
-            (0, _) => {
-                return Err(PerceptionError::model(
-                    &model_path,
-                    "the detector needs at least one thread",
-                ));
-            }
-            (1, _) | (_, Runtime::OnnxRuntime) => None,
+            (0 | 1, _) | (_, Runtime::OnnxRuntime) => None,
             (n, Runtime::Tract) => Some(
                 ThreadPoolBuilder::new()
                     .thread_name(|i| format!("rover-detect-{i}"))
@@ -275,11 +276,12 @@ impl Detector {
                     })?,
             ),
         };
-        let ort = match config.runtime {
-            Runtime::Tract => None,
-            Runtime::OnnxRuntime => {
+        let ort = match &ort_library {
+            None => None,
+            Some(library) => {
                 use prost::Message as _;
                 Some(OrtSession::new(
+                    library,
                     &prepared.proto.encode_to_vec(),
                     [1, 3, input_h, input_w],
                     config.threads,

@@ -196,7 +196,7 @@ fn fuse_manual_softmax(graph: &mut tract_onnx::pb::GraphProto) -> usize {
             && n.attribute.iter().all(|a| a.name != "keepdims" || a.i == 1)
             && n.attribute.iter().all(|a| a.name != "noop_with_empty_axes")
     };
-    let used_once = |name: &str, times: usize| uses.get(name).copied() == Some(times);
+    let used = |name: &str, times: usize| uses.get(name).copied() == Some(times);
     let mut fused = Vec::new();
     for (i, div) in graph.node.iter().enumerate() {
         let [exp_out, sum_out] = div.input.as_slice() else {
@@ -224,11 +224,11 @@ fn fuse_manual_softmax(graph: &mut tract_onnx::pb::GraphProto) -> usize {
             && max.input.first() == Some(x)
             && reduces_last(sum)
             && reduces_last(max)
-            && used_once(exp_out, 2)
-            && used_once(sum_out, 1)
-            && used_once(max_out, 1)
+            && used(exp_out, 2)
+            && used(sum_out, 1)
+            && used(max_out, 1)
             && exp.output.first().is_some_and(|o| o == exp_out)
-            && sub.output.first().is_some_and(|o| used_once(o, 1));
+            && sub.output.first().is_some_and(|o| used(o, 1));
         if pattern {
             fused.push((i, x.clone()));
         }
@@ -513,6 +513,67 @@ mod tests {
                 .collect(),
             ..Default::default()
         }
+    }
+
+    fn softmax_graph(extra_exp_use: bool) -> tract_onnx::pb::GraphProto {
+        let mut axes = TensorProto {
+            name: "axes".into(),
+            data_type: 7,
+            dims: vec![1],
+            ..Default::default()
+        };
+        set_tensor_i64(&mut axes, &[-1]);
+        let mut nodes = vec![
+            node("max", "ReduceMax", &["x", "axes"], "m", None),
+            node("sub", "Sub", &["x", "m"], "d", None),
+            node("exp", "Exp", &["d"], "e", None),
+            node("sum", "ReduceSum", &["e", "axes"], "s", None),
+            node("div", "Div", &["e", "s"], "y", None),
+        ];
+        let mut output = vec![ValueInfoProto {
+            name: "y".into(),
+            ..Default::default()
+        }];
+        if extra_exp_use {
+            nodes.push(node("other", "Relu", &["e"], "z", None));
+            output.push(ValueInfoProto {
+                name: "z".into(),
+                ..Default::default()
+            });
+        }
+        tract_onnx::pb::GraphProto {
+            node: nodes,
+            output,
+            initializer: vec![axes],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn spelled_out_softmax_becomes_one_softmax_unless_its_parts_are_used_elsewhere() {
+        let mut graph = softmax_graph(false);
+        assert_eq!(fuse_manual_softmax(&mut graph), 1);
+        prune(&mut graph);
+        let ops: Vec<(&str, &[String])> = graph
+            .node
+            .iter()
+            .map(|n| (n.op_type.as_str(), n.input.as_slice()))
+            .collect();
+        assert_eq!(ops, vec![("Softmax", &["x".to_owned()][..])]);
+        assert_eq!(graph.node[0].output, vec!["y".to_owned()]);
+        assert!(
+            graph.node[0]
+                .attribute
+                .iter()
+                .any(|a| a.name == "axis" && a.i == -1)
+        );
+
+        let mut graph = softmax_graph(true);
+        assert_eq!(
+            fuse_manual_softmax(&mut graph),
+            0,
+            "Exp's output is used elsewhere"
+        );
     }
 
     #[test]

@@ -39,19 +39,19 @@ pub(crate) struct OrtSession {
 }
 
 impl OrtSession {
-    /// Loads the library (once per process) and builds a session on `model_bytes` with
-    /// `threads` intra-op threads.
+    /// Loads `library` (once per process; see [`find_library`]) and builds a session on
+    /// `model_bytes` with `threads` intra-op threads.
     pub(crate) fn new(
+        library: &Path,
         model_bytes: &[u8],
         input_shape: [usize; 4],
         threads: usize,
         model_path: &Path,
     ) -> Result<Self> {
-        let library = find_library()?;
         let fail = |stage: &str, e: &dyn std::fmt::Display| {
             PerceptionError::model(model_path, format!("onnxruntime: {stage}: {e}"))
         };
-        let environment = environment(&library).map_err(|e| fail("loading the library", &e))?;
+        let environment = environment(library).map_err(|e| fail("loading the library", &e))?;
         let session = Session::builder(&environment)
             .map_err(|e| fail("creating a session", &e))?
             .with_optimization_level(GraphOptimizationLevel::Level3)
@@ -113,9 +113,9 @@ fn environment(library: &Path) -> std::result::Result<ort::environment::Environm
 }
 
 /// Where onnxruntime's library is: `ORT_DYLIB_PATH` (ort's variable) when set, else the
-/// `onnxruntime/capi/libonnxruntime.so*` of a pip install in `$VIRTUAL_ENV`, rover's cache venv
-/// (`$ROVER_CACHE_DIR/venv`, `$XDG_CACHE_HOME/rover/venv`, `~/.cache/rover/venv`: where
-/// `scripts/setup.sh` puts it), `~/.local` or the system's Python. The error lists every place
+/// `onnxruntime/capi/libonnxruntime.so*` of a pip install in `$VIRTUAL_ENV`, the venv in rover's
+/// cache ([`crate::fetch::cache_dir`], where `scripts/setup.sh` puts it), `~/.local` or the
+/// system's Python. The error lists every place
 /// searched.
 pub fn find_library() -> Result<PathBuf> {
     if let Some(path) = std::env::var_os("ORT_DYLIB_PATH") {
@@ -129,20 +129,14 @@ pub fn find_library() -> Result<PathBuf> {
             )))
         };
     }
-    let home = std::env::var_os("HOME").map(PathBuf::from);
     let mut prefixes: Vec<PathBuf> = Vec::new();
     if let Some(venv) = std::env::var_os("VIRTUAL_ENV") {
         prefixes.push(PathBuf::from(venv).join("lib"));
     }
-    if let Some(cache) = std::env::var_os("ROVER_CACHE_DIR") {
-        prefixes.push(PathBuf::from(cache).join("venv/lib"));
-    }
-    if let Some(cache) = std::env::var_os("XDG_CACHE_HOME") {
-        prefixes.push(PathBuf::from(cache).join("rover/venv/lib"));
-    }
-    if let Some(home) = &home {
-        prefixes.push(home.join(".cache/rover/venv/lib"));
-        prefixes.push(home.join(".local/lib"));
+    // The venv scripts/setup.sh makes, in the cache the default model also lives in.
+    prefixes.push(crate::fetch::cache_dir().join("venv/lib"));
+    if let Some(home) = std::env::var_os("HOME") {
+        prefixes.push(PathBuf::from(home).join(".local/lib"));
     }
     prefixes.push(PathBuf::from("/usr/local/lib"));
     prefixes.push(PathBuf::from("/usr/lib"));

@@ -107,14 +107,6 @@ fn several_detector_threads_give_bit_identical_outputs() -> Result<()> {
             three.detect(view, stamp)?.bounding_boxes
         );
     }
-    let err = Detector::load(DetectorConfig {
-        threads: 0,
-        ..DetectorConfig::default()
-    })
-    .err()
-    .map(|e| e.to_string())
-    .unwrap_or_default();
-    assert!(err.contains("at least one thread"), "{err}");
     Ok(())
 }
 
@@ -220,51 +212,53 @@ fn bad_models_and_labels_are_clear_errors() -> Result<()> {
     let dir = tempfile::tempdir()?;
     let junk = dir.path().join("junk.onnx");
     std::fs::write(&junk, b"definitely not protobuf")?;
-    let err = Detector::load(DetectorConfig {
+    let err = load_error(DetectorConfig {
         model: Some(junk.clone()),
         ..DetectorConfig::default()
-    })
-    .err()
-    .map(|e| e.to_string())
-    .unwrap_or_default();
+    });
     assert!(
         err.starts_with(&format!("{}: not a readable ONNX model", junk.display())),
         "{err}"
     );
 
     let missing = dir.path().join("missing.onnx");
-    let err = Detector::load(DetectorConfig {
+    let err = load_error(DetectorConfig {
         model: Some(missing),
         ..DetectorConfig::default()
-    })
-    .err()
-    .map(|e| e.to_string())
-    .unwrap_or_default();
+    });
     assert!(err.contains("no such model file"), "{err}");
 
     let labels = dir.path().join("three.names");
     std::fs::write(&labels, "cat\ndog\nbird\n")?;
-    let err = Detector::load(DetectorConfig {
+    let err = load_error(DetectorConfig {
         labels: Some(labels),
         ..DetectorConfig::default()
-    })
-    .err()
-    .map(|e| e.to_string())
-    .unwrap_or_default();
+    });
     assert!(
         err.contains("the model predicts 80 classes but 3 class names were found"),
         "{err}"
     );
 
-    let err = Detector::load(DetectorConfig {
+    let err = load_error(DetectorConfig {
         input_size: Some((600, 480)),
         ..DetectorConfig::default()
-    })
-    .err()
-    .map(|e| e.to_string())
-    .unwrap_or_default();
+    });
     assert!(err.contains("multiples of 32"), "{err}");
+
+    let err = load_error(DetectorConfig {
+        threads: 0,
+        ..DetectorConfig::default()
+    });
+    assert!(err.contains("at least one thread"), "{err}");
     Ok(())
+}
+
+/// The error text of a detector that must not load.
+fn load_error(config: DetectorConfig) -> String {
+    Detector::load(config)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default()
 }
 
 #[test]
