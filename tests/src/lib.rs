@@ -1,5 +1,6 @@
 //! Helpers for rover's end-to-end tests (the tests themselves are in `tests/`).
 
+pub mod architecture;
 pub mod fuzz;
 pub mod sweep;
 

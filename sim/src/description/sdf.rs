@@ -12,53 +12,20 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use roxmltree::Node;
 
-use crate::error::{Result, SimError, parse_xml};
+use crate::description::xml::{child, children, line_of, parse_xml};
+use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of};
-use crate::resource::ResourcePaths;
-use crate::robot::{Collision, Visual};
-use crate::world::{DEFAULT_STEP_HZ, Person, STEP_HZ_RANGE, Walk, World};
+use crate::description::resource::ResourcePaths;
+use crate::model::person::{Person, Walk};
+use crate::model::robot::{Collision, Visual};
+use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
 
 /// Deepest `<include>` nesting followed (models including models).
 const MAX_INCLUDE_DEPTH: usize = 16;
 
-/// A model of an SDF world: rigid links with their shapes.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Model {
-    /// Model name (`<model name>` or the `<include><name>`).
-    pub name: String,
-    /// `<static>`: fixed in the world whatever its links' masses.
-    pub is_static: bool,
-    /// Where the model's frame is (world frame).
-    pub world_from_model: Pose,
-    /// Links, each a rigid body.
-    pub links: Vec<ModelLink>,
-}
-
-/// One link of a [`Model`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct ModelLink {
-    /// Link name.
-    pub name: String,
-    /// Where the link starts (world frame).
-    pub world_from_link: Pose,
-    /// `<inertial><mass>` (kg); `None` when the link gives none.
-    pub mass_kg: Option<f64>,
-    /// Visual shapes in the link frame.
-    pub visuals: Vec<Visual>,
-    /// Collision shapes in the link frame.
-    pub collisions: Vec<Collision>,
-}
-
-impl ModelLink {
-    /// Whether physics moves this link (its model is not static and it has a mass).
-    pub fn is_dynamic(&self, model: &Model) -> bool {
-        !model.is_static && self.mass_kg.is_some_and(|m| m > 0.0)
-    }
-}
-
 /// Loads an SDF world file; `resources` finds `model://` models and meshes.
 pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::io::read_text(path)?;
     let doc = parse_xml(&text, path)?;
     let root = doc.root_element();
     let ctx = Ctx { path, doc: &doc };
@@ -207,7 +174,7 @@ impl Ctx<'_, '_> {
     fn err(&self, node: Node<'_, '_>, message: impl Into<String>) -> SimError {
         SimError::invalid(
             self.path,
-            Some(self.doc.text_pos_at(node.range().start).row),
+            Some(line_of(self.doc, node)),
             message,
         )
     }
@@ -261,17 +228,6 @@ impl Ctx<'_, '_> {
     fn flag(&self, node: Node<'_, '_>) -> bool {
         matches!(node.text().map(str::trim), Some("1" | "true"))
     }
-}
-
-fn child<'a, 'input>(node: Node<'a, 'input>, name: &str) -> Option<Node<'a, 'input>> {
-    node.children().find(|n| n.has_tag_name(name))
-}
-
-fn children<'a, 'input>(
-    node: Node<'a, 'input>,
-    name: &'static str,
-) -> impl Iterator<Item = Node<'a, 'input>> {
-    node.children().filter(move |n| n.has_tag_name(name))
 }
 
 struct Loader<'r> {
@@ -534,7 +490,7 @@ impl Loader<'_> {
         };
         let file = model_file(&dir)
             .map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
-        let text = crate::error::read_text(&file)?;
+        let text = crate::io::read_text(&file)?;
         let doc = parse_xml(&text, &file)?;
         let inner = Ctx {
             path: &file,

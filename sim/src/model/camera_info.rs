@@ -4,7 +4,7 @@
 
 use glam::{Mat3, Quat};
 
-use crate::gazebo::{CameraConfig, Distortion};
+use crate::model::sensors::{CameraConfig, Distortion};
 
 /// Like sensor_msgs/CameraInfo.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,7 +87,7 @@ pub(crate) mod tests {
             horizontal_fov_rad: 1.3962634,
             width_px: 640,
             height_px: 480,
-            format: crate::gazebo::PixelFormat::Rgb8,
+            format: crate::model::sensors::PixelFormat::Rgb8,
             clip_near_m: 0.02,
             clip_far_m: 300.0,
             noise: None,

@@ -11,10 +11,10 @@
 use glam::Vec3;
 
 use crate::error::{Result, SimError};
-use crate::gazebo::LaserConfig;
+use crate::model::sensors::LaserConfig;
 use crate::geometry::Pose;
 use crate::noise::Rng;
-use crate::simulation::Simulation;
+use crate::physics::simulation::Simulation;
 
 /// One scan, shaped like `sensor_msgs/LaserScan` (f32 fields as in the message).
 #[derive(Debug, Clone, PartialEq)]

@@ -3,63 +3,15 @@
 
 use glam::{Quat, Vec3};
 
+use crate::description::mesh_file::load_mesh;
 use crate::error::Result;
 use crate::geometry::{Pose, Rgba, Shape};
-use crate::mesh::load_mesh;
-use crate::world::Person;
-
-/// One vertex: position and normal.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Vertex {
-    /// Position (m).
-    pub position: [f32; 3],
-    /// Unit normal.
-    pub normal: [f32; 3],
-}
-
-/// An indexed triangle mesh.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct MeshData {
-    /// Vertices.
-    pub vertices: Vec<Vertex>,
-    /// Triangle indices, counter-clockwise seen from outside.
-    pub indices: Vec<u32>,
-    /// The colour a mesh file's material gives it, if any.
-    pub color: Option<Rgba>,
-}
-
-impl MeshData {
-    fn push(&mut self, position: Vec3, normal: Vec3) -> u32 {
-        self.vertices.push(Vertex {
-            position: position.to_array(),
-            normal: normal.normalize_or_zero().to_array(),
-        });
-        (self.vertices.len() - 1) as u32
-    }
-
-    fn quad(&mut self, corners: [Vec3; 4], normal: Vec3) {
-        let base = corners.map(|c| self.push(c, normal));
-        self.indices
-            .extend_from_slice(&[base[0], base[1], base[2], base[0], base[2], base[3]]);
-    }
-
-    /// Appends `other` transformed by `pose`.
-    pub fn append(&mut self, other: &MeshData, pose: Pose) {
-        let offset = self.vertices.len() as u32;
-        for v in &other.vertices {
-            self.vertices.push(Vertex {
-                position: (pose * Vec3::from_array(v.position)).to_array(),
-                normal: (pose.rotation * Vec3::from_array(v.normal)).to_array(),
-            });
-        }
-        self.indices
-            .extend(other.indices.iter().map(|i| i + offset));
-    }
-}
+use crate::model::mesh::MeshData;
+use crate::model::person::Person;
+use crate::model::world::ObjectShape;
 
 /// A box with full side lengths, centred.
-pub fn cuboid(size: Vec3) -> MeshData {
+pub(crate) fn cuboid(size: Vec3) -> MeshData {
     let h = size / 2.0;
     let mut m = MeshData::default();
     let faces = [
@@ -79,7 +31,7 @@ pub fn cuboid(size: Vec3) -> MeshData {
 }
 
 /// A cylinder along z, centred.
-pub fn cylinder(radius: f32, length: f32, segments: u32) -> MeshData {
+pub(crate) fn cylinder(radius: f32, length: f32, segments: u32) -> MeshData {
     let mut m = MeshData::default();
     let hz = length / 2.0;
     let ring = |i: u32| {
@@ -117,7 +69,7 @@ pub fn cylinder(radius: f32, length: f32, segments: u32) -> MeshData {
 }
 
 /// A UV sphere, centred, stretched by `scale` per axis (an ellipsoid when not uniform).
-pub fn ellipsoid(radius: f32, scale: Vec3, rings: u32, segments: u32) -> MeshData {
+pub(crate) fn ellipsoid(radius: f32, scale: Vec3, rings: u32, segments: u32) -> MeshData {
     let mut m = MeshData::default();
     for r in 0..=rings {
         let phi = r as f32 / rings as f32 * std::f32::consts::PI;
@@ -138,12 +90,12 @@ pub fn ellipsoid(radius: f32, scale: Vec3, rings: u32, segments: u32) -> MeshDat
 }
 
 /// A sphere, centred.
-pub fn sphere(radius: f32) -> MeshData {
+pub(crate) fn sphere(radius: f32) -> MeshData {
     ellipsoid(radius, Vec3::ONE, 12, 20)
 }
 
 /// A capsule along z: cylinder part `length`, caps of `radius`.
-pub fn capsule(radius: f32, length: f32) -> MeshData {
+pub(crate) fn capsule(radius: f32, length: f32) -> MeshData {
     let mut m = cylinder(radius, length, 20);
     let cap = sphere(radius);
     m.append(&cap, Pose::from_translation(Vec3::Z * length / 2.0));
@@ -180,8 +132,7 @@ pub fn shape_mesh(shape: &Shape) -> Result<MeshData> {
 }
 
 /// The mesh of a world object (box, cylinder, sphere), centred on its position.
-pub fn object_mesh(shape: &crate::world::ObjectShape) -> MeshData {
-    use crate::world::ObjectShape;
+pub fn object_mesh(shape: &ObjectShape) -> MeshData {
     match *shape {
         ObjectShape::Box { size_m } => cuboid(Vec3::new(
             size_m[0] as f32,
@@ -197,7 +148,7 @@ pub fn object_mesh(shape: &crate::world::ObjectShape) -> MeshData {
 
 /// A coloured part of a figure, in the figure's frame.
 #[derive(Debug, Clone)]
-pub struct Part {
+pub struct PersonPart {
     /// The mesh, in the part's frame.
     pub mesh: MeshData,
     /// Where the part sits in the figure's frame.
@@ -209,7 +160,7 @@ pub struct Part {
 /// One cross-section of a [`loft`]: at height `z`, a rounded rectangle with half sizes
 /// `half_x` (front-back) and `half_y` (side to side), centred at (`x`, `y`).
 #[derive(Debug, Clone, Copy)]
-pub struct Section {
+pub(crate) struct Section {
     /// Height (m).
     pub z: f32,
     /// Centre, front-back (m).
@@ -243,7 +194,7 @@ impl Section {
 /// A smooth closed body through `sections` (bottom to top): each section is a superellipse
 /// with exponent `squareness` (2 = ellipse, larger = boxier); the ends are capped. Normals are
 /// averaged over the faces around each vertex, so the surface shades smoothly.
-pub fn loft(sections: &[Section], squareness: f32, segments: u32) -> MeshData {
+pub(crate) fn loft(sections: &[Section], squareness: f32, segments: u32) -> MeshData {
     let mut m = MeshData::default();
     if sections.len() < 2 {
         return m;
@@ -330,11 +281,34 @@ fn limb(from: Vec3, to: Vec3, r_from: f32, r_to: f32) -> (MeshData, Pose) {
 
 /// A standing person in its own frame: feet on z = 0, facing +x, proportioned to `height_m`
 /// (a head about 1/7.5 of the height, shoulders about a quarter of it wide).
-pub fn person_parts(person: &Person) -> Vec<Part> {
-    let s = (person.height_m / 1.75) as f32;
-    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * s;
-    let at = |x: f32, y: f32, z: f32| Pose::from_translation(v(x, y, z));
-    let scaled = |sections: &[Section]| -> Vec<Section> {
+pub fn person_parts(person: &Person) -> Vec<PersonPart> {
+    let mut f = Figure {
+        s: (person.height_m / 1.75) as f32,
+        parts: Vec::new(),
+    };
+    limbs(&mut f, person);
+    trunk(&mut f, person);
+    face(&mut f, person);
+    f.parts
+}
+
+/// A figure being built: its scale against a 1.75 m person, and its parts so far.
+struct Figure {
+    s: f32,
+    parts: Vec<PersonPart>,
+}
+
+impl Figure {
+    fn v(&self, x: f32, y: f32, z: f32) -> Vec3 {
+        Vec3::new(x, y, z) * self.s
+    }
+
+    fn at(&self, x: f32, y: f32, z: f32) -> Pose {
+        Pose::from_translation(self.v(x, y, z))
+    }
+
+    fn scaled(&self, sections: &[Section]) -> Vec<Section> {
+        let s = self.s;
         sections
             .iter()
             .map(|c| Section {
@@ -345,19 +319,25 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
                 half_y: c.half_y * s,
             })
             .collect()
-    };
+    }
+
+    fn add(&mut self, mesh: MeshData, pose: Pose, color: Rgba) {
+        self.parts.push(PersonPart { mesh, pose, color });
+    }
+}
+
+/// Shoes, legs and arms.
+fn limbs(f: &mut Figure, person: &Person) {
     let shoe = Rgba::rgb(0.1, 0.08, 0.07);
-    let mut parts = Vec::new();
-    let mut add = |mesh: MeshData, pose: Pose, color: Rgba| parts.push(Part { mesh, pose, color });
     for side in [-1.0f32, 1.0] {
         let y = 0.09 * side;
-        add(
-            ellipsoid(0.1 * s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
-            at(0.035, y, 0.045),
+        f.add(
+            ellipsoid(0.1 * f.s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
+            f.at(0.035, y, 0.045),
             shoe,
         );
         // Leg: ankle, calf, knee, thigh, hip.
-        let leg = scaled(&[
+        let leg = f.scaled(&[
             Section::new(0.06, 0.045, 0.042).at(0.0, y),
             Section::new(0.2, 0.05, 0.045).at(0.0, y),
             Section::new(0.36, 0.06, 0.055).at(0.0, y),
@@ -366,34 +346,38 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
             Section::new(0.86, 0.08, 0.08).at(0.0, y * 0.9),
             Section::new(0.9, 0.07, 0.07).at(0.0, y * 0.85),
         ]);
-        add(loft(&leg, 2.0, 16), Pose::IDENTITY, person.trousers_color);
+        f.add(loft(&leg, 2.0, 16), Pose::IDENTITY, person.trousers_color);
         // Arm: shoulder, elbow, wrist hanging just off the body.
-        let shoulder = v(0.0, 0.185 * side, 1.42);
-        let elbow = v(-0.03, 0.225 * side, 1.14);
-        let wrist = v(0.07, 0.24 * side, 0.9);
-        let (mesh, pose) = limb(shoulder, elbow, 0.052 * s, 0.042 * s);
-        add(mesh, pose, person.shirt_color);
-        let (mesh, pose) = limb(elbow, wrist, 0.036 * s, 0.027 * s);
-        add(mesh, pose, person.skin_color);
-        add(
-            ellipsoid(0.045 * s, Vec3::new(0.65, 0.5, 1.3), 8, 12),
-            Pose::from_parts(v(0.09, 0.243 * side, 0.84), Quat::from_rotation_y(-0.35)),
+        let shoulder = f.v(0.0, 0.185 * side, 1.42);
+        let elbow = f.v(-0.03, 0.225 * side, 1.14);
+        let wrist = f.v(0.07, 0.24 * side, 0.9);
+        let (mesh, pose) = limb(shoulder, elbow, 0.052 * f.s, 0.042 * f.s);
+        f.add(mesh, pose, person.shirt_color);
+        let (mesh, pose) = limb(elbow, wrist, 0.036 * f.s, 0.027 * f.s);
+        f.add(mesh, pose, person.skin_color);
+        f.add(
+            ellipsoid(0.045 * f.s, Vec3::new(0.65, 0.5, 1.3), 8, 12),
+            Pose::from_parts(f.v(0.09, 0.243 * side, 0.84), Quat::from_rotation_y(-0.35)),
             person.skin_color,
         );
     }
+}
+
+/// Pelvis, torso and neck.
+fn trunk(f: &mut Figure, person: &Person) {
     // Pelvis in trousers, torso in the shirt: shoulders broad, waist narrower.
-    let pelvis = scaled(&[
+    let pelvis = f.scaled(&[
         Section::new(0.8, 0.06, 0.1),
         Section::new(0.86, 0.1, 0.165),
         Section::new(0.95, 0.11, 0.175),
         Section::new(1.03, 0.105, 0.165),
     ]);
-    add(
+    f.add(
         loft(&pelvis, 2.6, 24),
         Pose::IDENTITY,
         person.trousers_color,
     );
-    let torso = scaled(&[
+    let torso = f.scaled(&[
         Section::new(0.98, 0.1, 0.16),
         Section::new(1.1, 0.1, 0.155),
         Section::new(1.22, 0.11, 0.165),
@@ -402,60 +386,63 @@ pub fn person_parts(person: &Person) -> Vec<Part> {
         Section::new(1.46, 0.07, 0.14),
         Section::new(1.48, 0.04, 0.06),
     ]);
-    add(loft(&torso, 2.6, 24), Pose::IDENTITY, person.shirt_color);
-    let neck = scaled(&[
+    f.add(loft(&torso, 2.6, 24), Pose::IDENTITY, person.shirt_color);
+    let neck = f.scaled(&[
         Section::new(1.42, 0.048, 0.048),
         Section::new(1.58, 0.045, 0.045),
     ]);
-    add(loft(&neck, 2.0, 12), at(-0.01, 0.0, 0.0), person.skin_color);
+    f.add(loft(&neck, 2.0, 12), f.at(-0.01, 0.0, 0.0), person.skin_color);
+}
+
+/// Eyes, brows, ears, mouth, nose, head and hair.
+fn face(f: &mut Figure, person: &Person) {
     // Eyes, brows and mouth on the face (the face's front is at x ~ 0.1).
     let dark = Rgba::rgb(0.08, 0.06, 0.05);
     for side in [-1.0f32, 1.0] {
-        add(
-            ellipsoid(0.012 * s, Vec3::new(0.6, 1.2, 0.8), 6, 8),
-            at(0.093, 0.032 * side, 1.655),
+        f.add(
+            ellipsoid(0.012 * f.s, Vec3::new(0.6, 1.2, 0.8), 6, 8),
+            f.at(0.093, 0.032 * side, 1.655),
             dark,
         );
-        add(
-            ellipsoid(0.016 * s, Vec3::new(0.4, 1.6, 0.35), 6, 8),
-            at(0.092, 0.034 * side, 1.682),
+        f.add(
+            ellipsoid(0.016 * f.s, Vec3::new(0.4, 1.6, 0.35), 6, 8),
+            f.at(0.092, 0.034 * side, 1.682),
             person.hair_color,
         );
         // Ears.
-        add(
-            ellipsoid(0.03 * s, Vec3::new(0.6, 0.35, 1.0), 6, 8),
-            at(0.0, 0.08 * side, 1.64),
+        f.add(
+            ellipsoid(0.03 * f.s, Vec3::new(0.6, 0.35, 1.0), 6, 8),
+            f.at(0.0, 0.08 * side, 1.64),
             person.skin_color,
         );
     }
-    add(
-        ellipsoid(0.018 * s, Vec3::new(0.4, 1.5, 0.35), 6, 8),
-        at(0.09, 0.0, 1.585),
+    f.add(
+        ellipsoid(0.018 * f.s, Vec3::new(0.4, 1.5, 0.35), 6, 8),
+        f.at(0.09, 0.0, 1.585),
         Rgba::rgb(0.55, 0.25, 0.22),
     );
     // Nose.
-    add(
-        ellipsoid(0.016 * s, Vec3::new(0.9, 0.8, 1.3), 6, 8),
-        at(0.1, 0.0, 1.625),
+    f.add(
+        ellipsoid(0.016 * f.s, Vec3::new(0.9, 0.8, 1.3), 6, 8),
+        f.at(0.1, 0.0, 1.625),
         person.skin_color,
     );
     // Head: the face in skin, hair over the top and back.
-    add(
-        ellipsoid(0.1 * s, Vec3::new(0.95, 0.8, 1.15), 12, 18),
-        at(0.005, 0.0, 1.635),
+    f.add(
+        ellipsoid(0.1 * f.s, Vec3::new(0.95, 0.8, 1.15), 12, 18),
+        f.at(0.005, 0.0, 1.635),
         person.skin_color,
     );
-    add(
-        ellipsoid(0.104 * s, Vec3::new(0.98, 0.86, 0.7), 10, 16),
-        at(-0.006, 0.0, 1.7),
+    f.add(
+        ellipsoid(0.104 * f.s, Vec3::new(0.98, 0.86, 0.7), 10, 16),
+        f.at(-0.006, 0.0, 1.7),
         person.hair_color,
     );
-    add(
-        ellipsoid(0.09 * s, Vec3::new(0.7, 0.88, 1.0), 8, 12),
-        at(-0.045, 0.0, 1.62),
+    f.add(
+        ellipsoid(0.09 * f.s, Vec3::new(0.7, 0.88, 1.0), 8, 12),
+        f.at(-0.045, 0.0, 1.62),
         person.hair_color,
     );
-    parts
 }
 
 #[cfg(test)]

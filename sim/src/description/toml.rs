@@ -9,7 +9,7 @@ use crate::error::{Result, SimError};
 
 /// Reads and deserialises a TOML file into `T`.
 pub fn load_toml<T: DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::io::read_text(path)?;
     parse_toml(&text, path)
 }
 

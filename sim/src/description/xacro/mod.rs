@@ -23,7 +23,7 @@ use std::rc::Rc;
 use expr::{ExprError, Names, Value};
 
 use crate::error::{Location, Result, SimError};
-use crate::resource::ResourcePaths;
+use crate::description::resource::ResourcePaths;
 
 /// The xacro namespace URIs in use (the wiki moved from ros.org to www.ros.org).
 const XACRO_NAMESPACES: [&str; 2] = ["http://ros.org/wiki/xacro", "http://www.ros.org/wiki/xacro"];
@@ -218,10 +218,10 @@ impl Expander<'_> {
 
     /// Reads and converts one file; returns its root element.
     fn read(&mut self, path: &Path) -> Result<Rc<XElem>> {
-        let text = crate::error::read_text(path)?;
+        let text = crate::io::read_text(path)?;
         let file = self.files.len();
         self.files.push(path.to_path_buf());
-        let doc = crate::error::parse_xml(&text, path)?;
+        let doc = crate::description::xml::parse_xml(&text, path)?;
         let root = convert(&doc, doc.root_element(), file, &mut self.namespaces);
         Ok(root)
     }

@@ -33,7 +33,7 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let loader = mesh_loader::Loader::default();
-    let bytes = crate::error::read_bounded(path, MAX_MESH_BYTES)?;
+    let bytes = crate::io::read_bounded(path, MAX_MESH_BYTES)?;
     let load: fn(&mesh_loader::Loader, &[u8], &Path) -> std::io::Result<mesh_loader::Scene> =
         match ext.as_deref() {
             Some("stl") => |l, b, p| l.load_stl_from_slice(b, p),

@@ -1,7 +1,7 @@
 //! The differential-drive controller, with gazebo_ros_diff_drive's semantics, and odometry.
 
 use crate::error::{Result, SimError};
-use crate::gazebo::DiffDriveConfig;
+use crate::model::drive::DiffDriveConfig;
 
 /// A velocity command, the part of `geometry_msgs/Twist` a diff drive uses.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

@@ -10,7 +10,7 @@ use std::path::Path;
 use roxmltree::Node;
 
 use crate::error::{Result, SimError};
-use crate::robot::line_of;
+use crate::description::xml::{child, line_of};
 
 /// `<origin xyz rpy>` (zeros when absent).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -111,10 +111,6 @@ pub(crate) struct RobotEl {
 struct Reader<'a, 'input> {
     doc: &'a roxmltree::Document<'input>,
     path: &'a Path,
-}
-
-fn child<'a, 'input>(node: Node<'a, 'input>, name: &str) -> Option<Node<'a, 'input>> {
-    node.children().find(|n| n.has_tag_name(name))
 }
 
 impl Reader<'_, '_> {

@@ -1,0 +1,564 @@
+//! Robot descriptions from URDF (or xacro, expanded first), with the `<gazebo>` extensions
+//! rover honours.
+//!
+//! The standard URDF elements are read by `urdf.rs` with urdfdom's rules, the `<gazebo>`
+//! elements by `gazebo.rs`, both from one `roxmltree` document, so that every error names the
+//! file, the line and the element.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::description::gazebo;
+use crate::description::resource::ResourcePaths;
+use crate::description::urdf;
+use crate::description::xacro::{self, Expanded};
+use crate::description::xml::{line_of, parse_xml};
+use crate::error::{Result, SimError, quoted_list as names};
+use crate::geometry::{Rgba, Shape, pose_from_xyz_rpy, vec3};
+use crate::model::robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
+
+/// How to read a robot description: xacro arguments and where ROS packages are.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LoadOptions {
+    /// `name:=value` arguments for `$(arg name)` in xacro files.
+    pub xacro_args: BTreeMap<String, String>,
+    /// Where `package://` and `$(find)` look.
+    pub resources: ResourcePaths,
+}
+
+impl LoadOptions {
+    /// No xacro arguments; packages from `ROS_PACKAGE_PATH`.
+    pub fn from_env() -> Self {
+        Self {
+            xacro_args: BTreeMap::new(),
+            resources: ResourcePaths::from_env(),
+        }
+    }
+}
+
+impl RobotModel {
+    /// Loads and validates a URDF or xacro file, with packages from `ROS_PACKAGE_PATH`.
+    pub fn load(path: &Path) -> Result<Self> {
+        Self::load_with(path, &LoadOptions::from_env())
+    }
+
+    /// Loads and validates a URDF file, or expands a xacro file (a `.xacro` name, a file that
+    /// declares the xacro namespace, or one with `$(...)` substitution args) and loads the
+    /// result. Errors in an expanded file name
+    /// the xacro file and line the element came from.
+    pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Self> {
+        let text = crate::io::read_text(path)?;
+        let is_xacro = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.ends_with(".xacro"))
+            || xacro::uses_xacro(&text)
+            // Substitution args left in a plain URDF (pybullet's husky: `$(optenv ...)`) are
+            // expanded as xacro would, rather than failing as numbers.
+            || text.contains("$(");
+        if is_xacro {
+            let expanded = xacro::expand_file(path, &options.xacro_args, &options.resources)?;
+            return Self::parse(&expanded.text, path, &options.resources)
+                .map_err(|e| remap(e, &expanded));
+        }
+        Self::parse(&text, path, &options.resources)
+    }
+
+    /// Parses URDF text; `path` is used for messages and to resolve relative mesh files.
+    pub fn from_str(text: &str, path: &Path) -> Result<Self> {
+        Self::parse(text, path, &ResourcePaths::from_env())
+    }
+
+    fn parse(text: &str, path: &Path, resources: &ResourcePaths) -> Result<Self> {
+        let doc = parse_xml(text, path)?;
+        let root = doc.root_element();
+        if root.tag_name().name() != "robot" {
+            return Err(SimError::invalid(
+                path,
+                Some(line_of(&doc, root)),
+                format!(
+                    "expected a <robot> root element, found <{}>",
+                    root.tag_name().name()
+                ),
+            ));
+        }
+        validate_numbers(&doc, path)?;
+        let lines = ElementLines::collect(&doc);
+
+        let urdf = urdf::read(&doc, path)?;
+
+        let base_dir = path.parent().unwrap_or(Path::new("."));
+        let materials: HashMap<&str, Rgba> = urdf
+            .materials
+            .iter()
+            .filter_map(|m| m.color.map(|c| (m.name.as_str(), rgba(c))))
+            .collect();
+
+        let (mut links, link_index) =
+            read_links(&urdf.links, &materials, (base_dir, resources), path, &lines, || {
+                Some(line_of(&doc, root))
+            })?;
+        let joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
+        let root = find_root(&links, &joints, path, &lines)?;
+
+        let extensions = gazebo::parse(&doc, path)?;
+        for (reference, friction) in &extensions.friction {
+            match link_index.get(reference) {
+                Some(&i) => links[i].friction = Some(*friction),
+                None => tracing::warn!(
+                    "{}: <gazebo reference=\"{reference}\">: no link of that name; ignored",
+                    path.display()
+                ),
+            }
+        }
+
+        let model = Self {
+            name: urdf.name.clone(),
+            source: path.to_path_buf(),
+            links,
+            joints,
+            root,
+            diff_drive: extensions.diff_drive,
+            cameras: extensions.cameras,
+            lasers: extensions.lasers,
+            description: text.to_owned(),
+            not_simulated: extensions.ignored,
+        };
+        if !model.not_simulated.is_empty() {
+            tracing::info!(
+                "{}: not simulated (rover has no model for them): {}",
+                path.display(),
+                model.not_simulated.join(", ")
+            );
+        }
+        model.validate_plugins(path)?;
+        Ok(model)
+    }
+
+}
+
+/// Converts the links (file order) and indexes them by name; duplicate names and a robot
+/// without links are errors.
+fn read_links(
+    urdf_links: &[urdf::LinkEl],
+    materials: &HashMap<&str, Rgba>,
+    base_dir: (&Path, &ResourcePaths),
+    path: &Path,
+    lines: &ElementLines,
+    robot_line: impl Fn() -> Option<u32>,
+) -> Result<(Vec<Link>, BTreeMap<String, usize>)> {
+    let mut link_index: BTreeMap<String, usize> = BTreeMap::new();
+    let mut links = Vec::with_capacity(urdf_links.len());
+    for link in urdf_links {
+        if link_index.insert(link.name.clone(), links.len()).is_some() {
+            return Err(SimError::invalid(
+                path,
+                lines.link(&link.name),
+                format!("<link name=\"{}\"> is defined twice", link.name),
+            ));
+        }
+        links.push(convert_link(
+            link,
+            materials,
+            base_dir,
+            path,
+            lines,
+        )?);
+    }
+    if links.is_empty() {
+        return Err(SimError::invalid(
+            path,
+            robot_line(),
+            "<robot> has no <link>: expected at least one",
+        ));
+    }
+
+    Ok((links, link_index))
+}
+
+/// Converts the joints (file order), checking their links exist and form a tree.
+fn read_joints(
+    urdf_joints: &[urdf::JointEl],
+    link_index: &BTreeMap<String, usize>,
+    link_count: usize,
+    path: &Path,
+    lines: &ElementLines,
+) -> Result<Vec<Joint>> {
+    let mut joints = Vec::with_capacity(urdf_joints.len());
+    let mut parent_of: Vec<Option<usize>> = vec![None; link_count];
+    let mut joint_names = BTreeMap::new();
+    for joint in urdf_joints {
+        let line = lines.joint(&joint.name);
+        if joint_names.insert(joint.name.clone(), ()).is_some() {
+            return Err(SimError::invalid(
+                path,
+                line,
+                format!("<joint name=\"{}\"> is defined twice", joint.name),
+            ));
+        }
+        let find = |role: &str, name: &str| {
+            link_index.get(name).copied().ok_or_else(|| {
+                SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "<joint name=\"{}\"> <{role} link=\"{name}\">: no such link; links in this robot: {}",
+                        joint.name,
+                        names(link_index.keys())
+                    ),
+                )
+            })
+        };
+        let parent = find("parent", &joint.parent)?;
+        let child = find("child", &joint.child)?;
+        if let Some(previous) = parent_of[child] {
+            return Err(SimError::invalid(
+                path,
+                line,
+                format!(
+                    "<joint name=\"{}\">: link \"{}\" already has a parent joint \"{}\"; a URDF must be a tree",
+                    joint.name, joint.child, urdf_joints[previous].name
+                ),
+            ));
+        }
+        parent_of[child] = Some(joints.len());
+        joints.push(convert_joint(joint, parent, child, path, line)?);
+    }
+
+    Ok(joints)
+}
+
+/// The one link that is no joint's child; every link must be reachable from it.
+fn find_root(links: &[Link], joints: &[Joint], path: &Path, lines: &ElementLines) -> Result<usize> {
+    let roots: Vec<usize> = (0..links.len())
+        .filter(|&i| parent_of[i].is_none())
+        .collect();
+    let root = match roots.as_slice() {
+        [single] => *single,
+        [] => {
+            return Err(SimError::invalid(
+                path,
+                None,
+                "every link is some joint's child (a cycle): expected exactly one root link",
+            ));
+        }
+        many => {
+            return Err(SimError::invalid(
+                path,
+                None,
+                format!(
+                    "the links {} are not connected by joints: expected exactly one root link",
+                    names(many.iter().map(|&i| &links[i].name))
+                ),
+            ));
+        }
+    };
+    // A cycle that does not touch the root leaves some link unreachable from it.
+    let mut reachable = vec![false; links.len()];
+    reachable[root] = true;
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for j in joints {
+            if reachable[j.parent] && !reachable[j.child] {
+                reachable[j.child] = true;
+                changed = true;
+            }
+        }
+    }
+    if let Some(lost) = (0..links.len()).find(|&i| !reachable[i]) {
+        return Err(SimError::invalid(
+            path,
+            lines.link(&links[lost].name),
+            format!(
+                "link \"{}\" is part of a joint cycle: a URDF must be a tree",
+                links[lost].name
+            ),
+        ));
+    }
+
+    Ok(root)
+}
+
+fn rgba(c: [f64; 4]) -> Rgba {
+    Rgba(c.map(|v| v.clamp(0.0, 1.0) as f32))
+}
+
+/// Lines of `<link>` and `<joint>` elements by name, for messages about them.
+struct ElementLines {
+    links: HashMap<String, u32>,
+    joints: HashMap<String, u32>,
+}
+
+impl ElementLines {
+    fn collect(doc: &roxmltree::Document<'_>) -> Self {
+        let mut links = HashMap::new();
+        let mut joints = HashMap::new();
+        for node in doc.root_element().children().filter(|n| n.is_element()) {
+            let Some(name) = node.attribute("name") else {
+                continue;
+            };
+            match node.tag_name().name() {
+                "link" => {
+                    links.entry(name.to_owned()).or_insert(line_of(doc, node));
+                }
+                "joint" => {
+                    joints.entry(name.to_owned()).or_insert(line_of(doc, node));
+                }
+                _ => {}
+            }
+        }
+        Self { links, joints }
+    }
+
+    fn link(&self, name: &str) -> Option<u32> {
+        self.links.get(name).copied()
+    }
+
+    fn joint(&self, name: &str) -> Option<u32> {
+        self.joints.get(name).copied()
+    }
+}
+
+/// Checks every numeric URDF attribute before the elements are read, so a typo is reported with its
+/// line and element instead of a bare deserialisation message.
+fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
+    for node in doc.descendants().filter(|n| n.is_element()) {
+        let element = node.tag_name().name();
+        for attr in node.attributes() {
+            let expected = match (element, attr.name()) {
+                (_, "xyz" | "rpy") | ("box", "size") | ("mesh", "scale") => 3,
+                ("color", "rgba") => 4,
+                ("mass", "value")
+                | ("cylinder" | "sphere" | "capsule", "radius")
+                | ("cylinder" | "capsule", "length")
+                | ("inertia", "ixx" | "ixy" | "ixz" | "iyy" | "iyz" | "izz")
+                | ("limit", "lower" | "upper" | "effort" | "velocity")
+                | ("dynamics", "damping" | "friction") => 1,
+                _ => continue,
+            };
+            let tokens: Vec<&str> = attr.value().split_whitespace().collect();
+            let bad = tokens
+                .iter()
+                .find(|t| t.parse::<f64>().map(|v| !v.is_finite()).unwrap_or(true));
+            let unit = if expected == 1 { "number" } else { "numbers" };
+            if tokens.len() != expected || bad.is_some() {
+                let found = match bad {
+                    Some(token) => format!("'{token}' is not a finite number"),
+                    None => format!("found {} value(s)", tokens.len()),
+                };
+                return Err(SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!(
+                        "<{element} {}=\"{}\">: expected {expected} {unit}; {found}",
+                        attr.name(),
+                        attr.value()
+                    ),
+                ));
+            }
+            if matches!(attr.name(), "radius" | "length" | "value" | "size")
+                && let Some(neg) = tokens
+                    .iter()
+                    .find(|t| t.parse::<f64>().is_ok_and(|v| v < 0.0))
+            {
+                return Err(SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!(
+                        "<{element} {}=\"{}\">: expected non-negative values, found {neg}",
+                        attr.name(),
+                        attr.value()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Points an error in expanded text back at the xacro file and line it came from.
+fn remap(e: SimError, expanded: &Expanded) -> SimError {
+    match e {
+        SimError::Invalid { location, message } => {
+            let location = location
+                .line
+                .and_then(|line| expanded.source_of(line))
+                .unwrap_or(location);
+            SimError::Invalid { location, message }
+        }
+        other => other,
+    }
+}
+
+fn convert_link(
+    link: &urdf::LinkEl,
+    materials: &HashMap<&str, Rgba>,
+    base_dir: (&Path, &ResourcePaths),
+    path: &Path,
+    lines: &ElementLines,
+) -> Result<Link> {
+    let line = lines.link(&link.name);
+    let geometry =
+        |g: &urdf::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
+    let inertial = link
+        .inertial
+        .as_ref()
+        .filter(|i| i.mass > 0.0)
+        .map(|i| Inertial {
+            mass_kg: i.mass as f32,
+            link_from_inertial: pose_from_xyz_rpy(i.origin.xyz, i.origin.rpy),
+            inertia: i.inertia.map(|v| v as f32),
+        });
+    let mut visuals = Vec::with_capacity(link.visual.len());
+    for v in &link.visual {
+        let color = v.material.as_ref().and_then(|m| {
+            m.color
+                .map(rgba)
+                .or_else(|| materials.get(m.name.as_str()).copied())
+        });
+        visuals.push(Visual {
+            link_from_shape: pose_from_xyz_rpy(v.origin.xyz, v.origin.rpy),
+            shape: geometry(&v.geometry)?,
+            color: color.unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)),
+            color_given: color.is_some(),
+        });
+    }
+    let mut collisions = Vec::with_capacity(link.collision.len());
+    for c in &link.collision {
+        collisions.push(Collision {
+            link_from_shape: pose_from_xyz_rpy(c.origin.xyz, c.origin.rpy),
+            shape: geometry(&c.geometry)?,
+        });
+    }
+    Ok(Link {
+        name: link.name.clone(),
+        inertial,
+        visuals,
+        collisions,
+        friction: None,
+    })
+}
+
+fn convert_geometry(
+    g: &urdf::Geometry,
+    (base_dir, resources): (&Path, &ResourcePaths),
+    path: &Path,
+    line: Option<u32>,
+    link: &str,
+) -> Result<Shape> {
+    Ok(match g {
+        urdf::Geometry::Box { size } => Shape::Box {
+            size_m: vec3(*size),
+        },
+        urdf::Geometry::Cylinder { radius, length } => Shape::Cylinder {
+            radius_m: *radius as f32,
+            length_m: *length as f32,
+        },
+        urdf::Geometry::Capsule { radius, length } => Shape::Capsule {
+            radius_m: *radius as f32,
+            length_m: *length as f32,
+        },
+        urdf::Geometry::Sphere { radius } => Shape::Sphere {
+            radius_m: *radius as f32,
+        },
+        urdf::Geometry::Mesh { filename, scale } => {
+            let resolved = resources.resolve(filename, base_dir).map_err(|e| {
+                SimError::invalid(path, line, format!("<link name=\"{link}\"> <mesh>: {e}"))
+            })?;
+            let ext = resolved
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            if !matches!(ext.as_deref(), Some("stl" | "obj" | "dae")) {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "<link name=\"{link}\"> <mesh filename=\"{filename}\">: unsupported mesh format; expected .stl, .obj or .dae (COLLADA)"
+                    ),
+                ));
+            }
+            Shape::Mesh {
+                path: resolved,
+                scale: scale.map(vec3).unwrap_or(Vec3::ONE),
+            }
+        }
+    })
+}
+
+fn convert_joint(
+    joint: &urdf::JointEl,
+    parent: usize,
+    child: usize,
+    path: &Path,
+    line: Option<u32>,
+) -> Result<Joint> {
+    let (lower, upper) = joint.limit.unwrap_or((0.0, 0.0));
+    let limits_ok = || {
+        if lower > upper {
+            Err(SimError::invalid(
+                path,
+                line,
+                format!(
+                    "<joint name=\"{}\"> <limit lower=\"{}\" upper=\"{}\">: expected lower <= upper",
+                    joint.name, lower, upper
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    let kind = match joint.joint_type {
+        urdf::JointType::Fixed => JointKind::Fixed,
+        urdf::JointType::Continuous => JointKind::Continuous,
+        urdf::JointType::Revolute => {
+            limits_ok()?;
+            JointKind::Revolute {
+                lower_rad: lower as f32,
+                upper_rad: upper as f32,
+            }
+        }
+        urdf::JointType::Prismatic => {
+            limits_ok()?;
+            JointKind::Prismatic {
+                lower_m: lower as f32,
+                upper_m: upper as f32,
+            }
+        }
+        urdf::JointType::Floating => JointKind::Floating,
+        urdf::JointType::Planar | urdf::JointType::Spherical => {
+            return Err(SimError::invalid(
+                path,
+                line,
+                format!(
+                    "<joint name=\"{}\" type=\"{:?}\">: unsupported joint type; expected fixed, continuous, revolute, prismatic or floating",
+                    joint.name, joint.joint_type
+                ),
+            ));
+        }
+    };
+    let axis = vec3(joint.axis);
+    let needs_axis = !matches!(kind, JointKind::Fixed | JointKind::Floating);
+    if needs_axis && axis.length() < 1e-6 {
+        return Err(SimError::invalid(
+            path,
+            line,
+            format!(
+                "<joint name=\"{}\"> <axis xyz=\"0 0 0\">: expected a non-zero axis",
+                joint.name
+            ),
+        ));
+    }
+    Ok(Joint {
+        name: joint.name.clone(),
+        kind,
+        parent,
+        child,
+        parent_from_child: pose_from_xyz_rpy(joint.origin.xyz, joint.origin.rpy),
+        axis: axis.normalize_or(Vec3::X),
+        damping: joint.damping.map_or(0.0, |d| d as f32),
+    })
+}

@@ -1,0 +1,661 @@
+//! World files: a small, strict TOML format (documented in docs/WORLDS.md), and the one entry
+//! that loads any world file (TOML, or Gazebo SDF through `sdf.rs`).
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::description::resource::ResourcePaths;
+use crate::description::{sdf, toml as tomlfile};
+use crate::error::{Result, SimError};
+use crate::geometry::Rgba;
+use crate::model::drive::DriveSpec;
+use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
+use crate::model::world::{
+    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Physics, RobotSpawn, STEP_HZ_RANGE, World,
+    check_step_hz,
+};
+
+impl World {
+    /// Loads a world file: TOML, or a Gazebo SDF world (`.world`, `.sdf`) with `model://`
+    /// models found through `GAZEBO_MODEL_PATH`.
+    pub fn load(path: &Path) -> Result<Self> {
+        Self::load_with(path, &ResourcePaths::from_env())
+    }
+
+    /// Loads a world file; `resources` finds an SDF world's `model://` models and meshes.
+    pub fn load_with(path: &Path, resources: &ResourcePaths) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if matches!(ext.as_deref(), Some("world" | "sdf")) {
+            return sdf::load_world(path, resources);
+        }
+        let raw: RawWorld = tomlfile::load_toml(path)?;
+        raw.into_world(path)
+    }
+
+    /// Parses world TOML text; `path` is used in messages and to resolve the robot's URDF.
+    pub fn from_str(text: &str, path: &Path) -> Result<Self> {
+        let raw: RawWorld = tomlfile::parse_toml(text, path)?;
+        raw.into_world(path)
+    }
+
+    /// An empty flat world (ground only, every setting at its default), for tests and calibration.
+    pub fn flat() -> Result<Self> {
+        Self::from_str("name = \"flat\"\n", Path::new("<built-in flat world>"))
+    }
+}
+
+/// A TOML world as written, before validation: for files that embed a world (rover's scenario
+/// files hold one under `[world]`). Deserialise it with serde, then [`WorldFile::into_world`].
+#[derive(Debug)]
+pub struct WorldFile(RawWorld);
+
+impl<'de> Deserialize<'de> for WorldFile {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        RawWorld::deserialize(d).map(WorldFile)
+    }
+}
+
+impl WorldFile {
+    /// Validates it into a [`World`]; `path` is the file it came from (for messages and for
+    /// resolving the robot's URDF relative to it).
+    pub fn into_world(self, path: &Path) -> Result<World> {
+        self.0.into_world(path)
+    }
+}
+
+// ---- Raw (file) representation -------------------------------------------------------------
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWorld {
+    name: Option<String>,
+    #[serde(default)]
+    description: String,
+    #[serde(default)]
+    robot: RawRobot,
+    #[serde(default)]
+    physics: RawPhysics,
+    #[serde(default)]
+    ground: RawGround,
+    #[serde(default, rename = "box")]
+    boxes: Vec<RawBox>,
+    #[serde(default, rename = "cylinder")]
+    cylinders: Vec<RawCylinder>,
+    #[serde(default, rename = "sphere")]
+    spheres: Vec<RawSphere>,
+    #[serde(default, rename = "wall")]
+    walls: Vec<RawWall>,
+    #[serde(default, rename = "person")]
+    people: Vec<RawPerson>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRobot {
+    urdf: Option<PathBuf>,
+    #[serde(default)]
+    position_m: [f64; 2],
+    #[serde(default)]
+    yaw_deg: f64,
+    #[serde(default)]
+    xacro_args: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    drive: Option<DriveSpec>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RawPhysics {
+    step_hz: f64,
+    gravity_mps2: [f64; 3],
+    solver_iterations: usize,
+}
+
+impl Default for RawPhysics {
+    fn default() -> Self {
+        Self {
+            step_hz: DEFAULT_STEP_HZ,
+            gravity_mps2: [0.0, 0.0, -9.81],
+            solver_iterations: 4,
+        }
+    }
+}
+
+impl From<RawPhysics> for Physics {
+    fn from(p: RawPhysics) -> Self {
+        Self {
+            step_hz: p.step_hz,
+            gravity_mps2: p.gravity_mps2,
+            solver_iterations: p.solver_iterations,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RawGround {
+    size_m: [f64; 2],
+    friction: f64,
+    color: String,
+    checker_color: String,
+    checker_size_m: f64,
+}
+
+impl Default for RawGround {
+    fn default() -> Self {
+        Self {
+            size_m: [60.0, 60.0],
+            friction: 1.0,
+            color: "#7d8a6a".to_owned(),
+            checker_color: "#6f7c5d".to_owned(),
+            checker_size_m: 1.0,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBox {
+    name: Option<String>,
+    size_m: [f64; 3],
+    position_m: Vec<f64>,
+    #[serde(default)]
+    yaw_deg: f64,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCylinder {
+    name: Option<String>,
+    radius_m: f64,
+    length_m: f64,
+    position_m: Vec<f64>,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSphere {
+    name: Option<String>,
+    radius_m: f64,
+    position_m: Vec<f64>,
+    color: Option<String>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWall {
+    name: Option<String>,
+    from_m: [f64; 2],
+    to_m: [f64; 2],
+    #[serde(default = "default_wall_height")]
+    height_m: f64,
+    #[serde(default = "default_wall_thickness")]
+    thickness_m: f64,
+    color: Option<String>,
+    friction: Option<f64>,
+}
+
+fn default_wall_height() -> f64 {
+    1.0
+}
+
+fn default_wall_thickness() -> f64 {
+    0.1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPerson {
+    name: Option<String>,
+    position_m: [f64; 2],
+    #[serde(default)]
+    heading_deg: f64,
+    #[serde(default = "default_person_height")]
+    height_m: f64,
+    shirt_color: Option<String>,
+    trousers_color: Option<String>,
+    skin_color: Option<String>,
+    hair_color: Option<String>,
+    #[serde(default)]
+    waypoints_m: Vec<[f64; 2]>,
+    speed_mps: Option<f64>,
+    #[serde(default = "default_repeat")]
+    repeat: bool,
+    #[serde(default)]
+    start_after_s: f64,
+}
+
+fn default_repeat() -> bool {
+    true
+}
+
+fn default_person_height() -> f64 {
+    DEFAULT_PERSON_HEIGHT_M
+}
+
+
+/// Collects validation problems as `key: message` pairs.
+struct Checker<'a> {
+    path: &'a Path,
+}
+
+impl Checker<'_> {
+    fn fail(&self, key: &str, message: impl std::fmt::Display) -> SimError {
+        SimError::invalid(self.path, None, format!("at `{key}`: {message}"))
+    }
+
+    fn finite(&self, key: &str, values: &[f64]) -> Result<()> {
+        if values.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.fail(key, format!("expected finite numbers, found {values:?}")))
+        }
+    }
+
+    fn positive(&self, key: &str, values: &[f64], unit: &str) -> Result<()> {
+        self.finite(key, values)?;
+        if values.iter().all(|v| *v > 0.0) {
+            Ok(())
+        } else {
+            Err(self.fail(
+                key,
+                format!("expected positive numbers ({unit}), found {values:?}"),
+            ))
+        }
+    }
+
+    fn color(&self, key: &str, text: Option<&str>, default: Rgba) -> Result<Rgba> {
+        match text {
+            None => Ok(default),
+            Some(t) => Rgba::from_hex(t).ok_or_else(|| {
+                self.fail(
+                    key,
+                    format!(
+                        "expected a colour like \"#a0522d\" (#rrggbb or #rrggbbaa), found \"{t}\""
+                    ),
+                )
+            }),
+        }
+    }
+
+    fn friction(&self, key: &str, value: Option<f64>) -> Result<f32> {
+        let f = value.unwrap_or(0.8);
+        if f.is_finite() && f >= 0.0 {
+            Ok(f as f32)
+        } else {
+            Err(self.fail(
+                key,
+                format!("expected a friction coefficient >= 0, found {f}"),
+            ))
+        }
+    }
+
+    fn mass(&self, key: &str, value: Option<f64>) -> Result<Option<f64>> {
+        match value {
+            Some(m) if !(m.is_finite() && m > 0.0) => Err(self.fail(
+                key,
+                format!("expected a positive mass in kg (omit it for a static object), found {m}"),
+            )),
+            other => Ok(other),
+        }
+    }
+
+    /// `[x, y]` (resting on the ground, z = `half_height`) or `[x, y, z]`.
+    fn position(&self, key: &str, values: &[f64], half_height: f64) -> Result<[f64; 3]> {
+        self.finite(key, values)?;
+        match *values {
+            [x, y] => Ok([x, y, half_height]),
+            [x, y, z] => Ok([x, y, z]),
+            _ => Err(self.fail(
+                key,
+                format!(
+                    "expected [x, y] (resting on the ground) or [x, y, z] in metres, found {} values",
+                    values.len()
+                ),
+            )),
+        }
+    }
+}
+
+impl RawGround {
+    fn into_ground(self, path: &Path) -> Result<Ground> {
+        let c = Checker { path };
+        c.positive("ground.size_m", &self.size_m, "m")?;
+        c.positive("ground.checker_size_m", &[self.checker_size_m], "m")?;
+        let color = c.color("ground.color", Some(&self.color), Rgba::rgb(0.5, 0.5, 0.5))?;
+        Ok(Ground {
+            size_m: self.size_m,
+            friction: c.friction("ground.friction", Some(self.friction))?,
+            color,
+            checker_color: c.color("ground.checker_color", Some(&self.checker_color), color)?,
+            checker_size_m: self.checker_size_m,
+        })
+    }
+}
+
+impl RawWorld {
+    /// Boxes, cylinders, spheres, then walls, each checked in file order.
+    fn objects(&mut self, c: &Checker<'_>) -> Result<Vec<Object>> {
+        let mut objects = Vec::new();
+        for (i, b) in std::mem::take(&mut self.boxes).into_iter().enumerate() {
+            objects.push(b.into_object(i, c)?);
+        }
+        for (i, cy) in std::mem::take(&mut self.cylinders).into_iter().enumerate() {
+            objects.push(cy.into_object(i, c)?);
+        }
+        for (i, s) in std::mem::take(&mut self.spheres).into_iter().enumerate() {
+            objects.push(s.into_object(i, c)?);
+        }
+        for (i, w) in std::mem::take(&mut self.walls).into_iter().enumerate() {
+            objects.push(w.into_object(i, c)?);
+        }
+        Ok(objects)
+    }
+
+    fn into_world(mut self, path: &Path) -> Result<World> {
+        let c = Checker { path };
+        let base_dir = path.parent().unwrap_or(Path::new("."));
+
+        let raw_robot = std::mem::take(&mut self.robot);
+        c.finite("robot.position_m", &raw_robot.position_m)?;
+        c.finite("robot.yaw_deg", &[raw_robot.yaw_deg])?;
+        let robot = RobotSpawn {
+            urdf: raw_robot.urdf.map(|u| base_dir.join(u)),
+            position_m: raw_robot.position_m,
+            yaw_rad: raw_robot.yaw_deg.to_radians(),
+            xacro_args: raw_robot.xacro_args,
+            drive: raw_robot.drive,
+        };
+
+        c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;
+        if let Err(message) = check_step_hz(self.physics.step_hz) {
+            return Err(c.fail("physics.step_hz", message));
+        }
+        c.finite("physics.gravity_mps2", &self.physics.gravity_mps2)?;
+        if !(1..=100).contains(&self.physics.solver_iterations) {
+            return Err(c.fail(
+                "physics.solver_iterations",
+                format!("expected 1..=100, found {}", self.physics.solver_iterations),
+            ));
+        }
+
+        let ground = std::mem::take(&mut self.ground).into_ground(path)?;
+
+        let objects = self.objects(&c)?;
+
+        let people = self
+            .people
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| p.into_person(i, &c))
+            .collect::<Result<Vec<_>>>()?;
+
+        let mut seen = std::collections::BTreeSet::new();
+        for name in objects
+            .iter()
+            .map(|o| &o.name)
+            .chain(people.iter().map(|p| &p.name))
+        {
+            if !seen.insert(name.clone()) {
+                return Err(SimError::invalid(
+                    path,
+                    None,
+                    format!("two entries are named \"{name}\": names must be unique"),
+                ));
+            }
+        }
+
+        Ok(World {
+            name: self.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "world".to_owned())
+            }),
+            source: path.to_path_buf(),
+            description: self.description,
+            robot,
+            physics: self.physics.into(),
+            ground,
+            objects,
+            people,
+            models: Vec::new(),
+        })
+    }
+}
+
+impl RawBox {
+    fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
+        let b = self;
+        let key = |field: &str| format!("box[{i}].{field}");
+        c.positive(&key("size_m"), &b.size_m, "m")?;
+        c.finite(&key("yaw_deg"), &[b.yaw_deg])?;
+        Ok(Object {
+            name: b.name.unwrap_or_else(|| format!("box_{i}")),
+            position_m: c.position(&key("position_m"), &b.position_m, b.size_m[2] / 2.0)?,
+            shape: ObjectShape::Box { size_m: b.size_m },
+            yaw_rad: b.yaw_deg.to_radians(),
+            color: c.color(
+                &key("color"),
+                b.color.as_deref(),
+                Rgba::rgb(0.63, 0.42, 0.25),
+            )?,
+            mass_kg: c.mass(&key("mass_kg"), b.mass_kg)?,
+            friction: c.friction(&key("friction"), b.friction)?,
+        })
+    }
+}
+
+impl RawCylinder {
+    fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
+        let cy = self;
+        let key = |field: &str| format!("cylinder[{i}].{field}");
+        c.positive(&key("radius_m"), &[cy.radius_m], "m")?;
+        c.positive(&key("length_m"), &[cy.length_m], "m")?;
+        Ok(Object {
+            name: cy.name.unwrap_or_else(|| format!("cylinder_{i}")),
+            position_m: c.position(&key("position_m"), &cy.position_m, cy.length_m / 2.0)?,
+            shape: ObjectShape::Cylinder {
+                radius_m: cy.radius_m,
+                length_m: cy.length_m,
+            },
+            yaw_rad: 0.0,
+            color: c.color(
+                &key("color"),
+                cy.color.as_deref(),
+                Rgba::rgb(0.8, 0.45, 0.1),
+            )?,
+            mass_kg: c.mass(&key("mass_kg"), cy.mass_kg)?,
+            friction: c.friction(&key("friction"), cy.friction)?,
+        })
+    }
+}
+
+impl RawSphere {
+    fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
+        let s = self;
+        let key = |field: &str| format!("sphere[{i}].{field}");
+        c.positive(&key("radius_m"), &[s.radius_m], "m")?;
+        Ok(Object {
+            name: s.name.unwrap_or_else(|| format!("sphere_{i}")),
+            position_m: c.position(&key("position_m"), &s.position_m, s.radius_m)?,
+            shape: ObjectShape::Sphere {
+                radius_m: s.radius_m,
+            },
+            yaw_rad: 0.0,
+            color: c.color(&key("color"), s.color.as_deref(), Rgba::rgb(0.85, 0.2, 0.2))?,
+            mass_kg: c.mass(&key("mass_kg"), s.mass_kg)?,
+            friction: c.friction(&key("friction"), s.friction)?,
+        })
+    }
+}
+
+impl RawWall {
+    fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
+        let w = self;
+        let key = |field: &str| format!("wall[{i}].{field}");
+        c.finite(&key("from_m"), &w.from_m)?;
+        c.finite(&key("to_m"), &w.to_m)?;
+        c.positive(&key("height_m"), &[w.height_m], "m")?;
+        c.positive(&key("thickness_m"), &[w.thickness_m], "m")?;
+        let (dx, dy) = (w.to_m[0] - w.from_m[0], w.to_m[1] - w.from_m[1]);
+        let length = dx.hypot(dy);
+        if length < 1e-3 {
+            return Err(c.fail(
+                &key("to_m"),
+                "expected a wall end point different from from_m",
+            ));
+        }
+        Ok(Object {
+            name: w.name.unwrap_or_else(|| format!("wall_{i}")),
+            shape: ObjectShape::Box {
+                size_m: [length, w.thickness_m, w.height_m],
+            },
+            position_m: [
+                (w.from_m[0] + w.to_m[0]) / 2.0,
+                (w.from_m[1] + w.to_m[1]) / 2.0,
+                w.height_m / 2.0,
+            ],
+            yaw_rad: dy.atan2(dx),
+            color: c.color(
+                &key("color"),
+                w.color.as_deref(),
+                Rgba::rgb(0.85, 0.83, 0.78),
+            )?,
+            mass_kg: None,
+            friction: c.friction(&key("friction"), w.friction)?,
+        })
+    }
+}
+
+impl RawPerson {
+    fn into_person(self, i: usize, c: &Checker<'_>) -> Result<Person> {
+        let p = self;
+        let key = |field: &str| format!("person[{i}].{field}");
+        c.finite(&key("position_m"), &p.position_m)?;
+        c.finite(&key("heading_deg"), &[p.heading_deg])?;
+        if !(p.height_m.is_finite() && (0.5..=2.5).contains(&p.height_m)) {
+            return Err(c.fail(
+                &key("height_m"),
+                format!(
+                    "expected a height between 0.5 and 2.5 m, found {}",
+                    p.height_m
+                ),
+            ));
+        }
+        for (j, w) in p.waypoints_m.iter().enumerate() {
+            c.finite(&format!("person[{i}].waypoints_m[{j}]"), w)?;
+        }
+        let walk = match (p.waypoints_m.is_empty(), p.speed_mps) {
+            (true, None) => None,
+            (true, Some(_)) => {
+                return Err(c.fail(
+                    &key("speed_mps"),
+                    "a walking speed needs `waypoints_m = [[x, y], ...]` to walk through",
+                ));
+            }
+            (false, speed) => {
+                let speed = speed.unwrap_or(0.8);
+                if !(speed.is_finite() && speed > 0.0 && speed <= 3.0) {
+                    return Err(c.fail(
+                        &key("speed_mps"),
+                        format!("expected a walking speed in (0, 3] m/s, found {speed}"),
+                    ));
+                }
+                if !(p.start_after_s.is_finite() && p.start_after_s >= 0.0) {
+                    return Err(c.fail(
+                        &key("start_after_s"),
+                        format!("expected seconds >= 0, found {}", p.start_after_s),
+                    ));
+                }
+                Some(Walk {
+                    waypoints_m: p.waypoints_m,
+                    speed_mps: speed,
+                    repeat: p.repeat,
+                    start_after_s: p.start_after_s,
+                })
+            }
+        };
+        Ok(Person {
+            name: p.name.unwrap_or_else(|| format!("person_{i}")),
+            walk,
+            position_m: p.position_m,
+            heading_rad: p.heading_deg.to_radians(),
+            height_m: p.height_m,
+            shirt_color: c.color(
+                &key("shirt_color"),
+                p.shirt_color.as_deref(),
+                Rgba::rgb(0.75, 0.15, 0.12),
+            )?,
+            trousers_color: c.color(
+                &key("trousers_color"),
+                p.trousers_color.as_deref(),
+                Rgba::rgb(0.15, 0.2, 0.35),
+            )?,
+            skin_color: c.color(
+                &key("skin_color"),
+                p.skin_color.as_deref(),
+                Rgba::rgb(0.87, 0.67, 0.53),
+            )?,
+            hair_color: c.color(
+                &key("hair_color"),
+                p.hair_color.as_deref(),
+                Rgba::rgb(0.2, 0.13, 0.08),
+            )?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn world(person: &str) -> Result<World> {
+        World::from_str(
+            &format!("name = \"t\"\n[[person]]\n{person}\n"),
+            Path::new("t.toml"),
+        )
+    }
+
+    #[test]
+    fn a_walking_person_follows_the_closed_path_facing_ahead() -> Result<()> {
+        let w = world(
+            "position_m = [0.0, 0.0]\nwaypoints_m = [[2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]\nspeed_mps = 0.5",
+        )?;
+        let p = &w.people[0];
+        let close = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+            (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9
+        };
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        assert!(close(p.pose_at(0.0), (0.0, 0.0, 0.0)));
+        assert!(close(p.pose_at(2.0), (1.0, 0.0, 0.0)));
+        assert!(close(p.pose_at(6.0), (2.0, 1.0, half_pi)));
+        // Last leg back to the start, then around again (16 s per lap).
+        assert!(close(p.pose_at(14.0), (0.0, 1.0, -half_pi)));
+        assert!(close(p.pose_at(18.0), (1.0, 0.0, 0.0)));
+        Ok(())
+    }
+
+    #[test]
+    fn a_speed_without_waypoints_or_a_bad_speed_is_an_error() {
+        let e = world("position_m = [0.0, 0.0]\nspeed_mps = 0.5").err();
+        assert!(
+            e.is_some_and(|e| e.to_string().contains("waypoints_m")),
+            "speed without a path"
+        );
+        let e =
+            world("position_m = [0.0, 0.0]\nwaypoints_m = [[1.0, 0.0]]\nspeed_mps = -1.0").err();
+        assert!(e.is_some_and(|e| e.to_string().contains("person[0].speed_mps")));
+    }
+}

@@ -1,0 +1,24 @@
+//! Plain data: robots, worlds, people, drives, sensors and meshes as rover simulates them.
+//! Imports only `geometry` and `error`; `description` fills it from files, `physics`, `render`
+//! and `sensors` run it.
+
+pub(crate) mod camera_info;
+pub(crate) mod drive;
+pub(crate) mod mesh;
+pub(crate) mod person;
+pub(crate) mod robot;
+pub(crate) mod sensors;
+pub(crate) mod world;
+
+pub use camera_info::{CameraInfo, link_from_optical};
+pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
+pub use mesh::{MeshData, MeshVertex};
+pub use person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
+pub use robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
+pub use sensors::{
+    CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
+};
+pub use world::{
+    DEFAULT_STEP_HZ, Ground, Model, ModelLink, Object, ObjectShape, Physics, RobotSpawn,
+    STEP_HZ_RANGE, World, check_step_hz,
+};

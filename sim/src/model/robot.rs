@@ -1,0 +1,352 @@
+//! A robot: links, joints, the drive and sensors it carries. Plain data; loaded by
+//! `description` (URDF, xacro, the `<gazebo>` extensions), simulated by `physics`.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::error::{Result, SimError, quoted_list as names};
+use crate::geometry::{Pose, Rgba, Shape};
+use crate::model::drive::{DiffDriveConfig, DriveSpec};
+use crate::model::mesh::MeshData;
+use crate::model::sensors::{CameraConfig, LaserConfig};
+
+/// Mass properties of a link, from its `<inertial>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inertial {
+    /// Mass (kg).
+    pub mass_kg: f32,
+    /// Pose of the centre of mass and inertia frame in the link frame.
+    pub link_from_inertial: Pose,
+    /// Inertia tensor about the centre of mass, in the inertial frame: ixx, ixy, ixz, iyy, iyz, izz (kg m^2).
+    pub inertia: [f32; 6],
+}
+
+/// Something drawn for a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Visual {
+    /// Pose of the shape in the link frame.
+    pub link_from_shape: Pose,
+    /// The shape.
+    pub shape: Shape,
+    /// Colour from the URDF material (grey when none is given).
+    pub color: Rgba,
+    /// Whether the description gave the colour; when not, a mesh file's own material colour
+    /// is shown (see [`Visual::display_color`]).
+    pub color_given: bool,
+}
+
+impl Visual {
+    /// The colour to draw `mesh` (this visual's triangles) in: the description's colour, else
+    /// the mesh file's material, else grey.
+    pub fn display_color(&self, mesh: &MeshData) -> Rgba {
+        match (self.color_given, mesh.color) {
+            (false, Some(c)) => c,
+            _ => self.color,
+        }
+    }
+}
+
+/// A collision shape of a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collision {
+    /// Pose of the shape in the link frame.
+    pub link_from_shape: Pose,
+    /// The shape.
+    pub shape: Shape,
+}
+
+/// A URDF link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    /// Link name.
+    pub name: String,
+    /// Mass properties; `None` when the URDF gives no `<inertial>`.
+    pub inertial: Option<Inertial>,
+    /// Visual shapes.
+    pub visuals: Vec<Visual>,
+    /// Collision shapes.
+    pub collisions: Vec<Collision>,
+    /// Friction coefficient from `<gazebo reference="link"><mu1>`/`<mu2>` (the smaller one).
+    pub friction: Option<f32>,
+}
+
+/// Kind of a URDF joint that rover simulates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JointKind {
+    /// Rigidly welded.
+    Fixed,
+    /// Rotation about the axis without limits.
+    Continuous,
+    /// Rotation about the axis between limits (rad).
+    Revolute {
+        /// Lower limit (rad).
+        lower_rad: f32,
+        /// Upper limit (rad).
+        upper_rad: f32,
+    },
+    /// Translation along the axis between limits (m).
+    Prismatic {
+        /// Lower limit (m).
+        lower_m: f32,
+        /// Upper limit (m).
+        upper_m: f32,
+    },
+    /// No constraint: the child moves freely.
+    Floating,
+}
+
+/// A URDF joint, with links referred to by index into [`RobotModel::links`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Joint name.
+    pub name: String,
+    /// Kind and limits.
+    pub kind: JointKind,
+    /// Parent link index.
+    pub parent: usize,
+    /// Child link index.
+    pub child: usize,
+    /// Joint origin: the child link frame expressed in the parent link frame at zero position.
+    pub parent_from_child: Pose,
+    /// Unit axis in the joint (= child link) frame.
+    pub axis: Vec3,
+    /// Viscous damping from `<dynamics damping>` (N m s/rad).
+    pub damping: f32,
+}
+
+/// A robot loaded from URDF.
+#[derive(Debug, Clone)]
+pub struct RobotModel {
+    /// `<robot name>`.
+    pub name: String,
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Links in file order.
+    pub links: Vec<Link>,
+    /// Joints in file order.
+    pub joints: Vec<Joint>,
+    /// Index of the root link (the one that is no joint's child).
+    pub root: usize,
+    /// The `libgazebo_ros_diff_drive.so` plugin, if present.
+    pub diff_drive: Option<DiffDriveConfig>,
+    /// Camera sensors (`<sensor type="camera">`).
+    pub cameras: Vec<CameraConfig>,
+    /// 2D laser scanners (`<sensor type="ray">`).
+    pub lasers: Vec<LaserConfig>,
+    /// Gazebo sensors and plugins in the file that rover does not simulate (IMU, GPS, ...).
+    pub not_simulated: Vec<String>,
+    /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
+    /// `/robot_description`.
+    pub description: String,
+}
+
+impl RobotModel {
+    /// Drives the robot's wheels `spec` names like gazebo_ros_diff_drive (replacing a drive
+    /// plugin from the URDF). Separation and diameter default to what the URDF says: the
+    /// distance between the two joints and the left wheel's collision cylinder or sphere.
+    pub fn set_drive(&mut self, spec: &DriveSpec) -> Result<()> {
+        let setup =
+            |m: String| SimError::Setup(format!("[robot.drive] for \"{}\": {m}", self.name));
+        let joint = |name: &str| {
+            self.joint_index(name).ok_or_else(|| {
+                setup(format!(
+                    "no joint \"{name}\"; joints in this robot: {}",
+                    names(self.joints.iter().map(|j| &j.name))
+                ))
+            })
+        };
+        let (left, right) = (joint(&spec.left_joint)?, joint(&spec.right_joint)?);
+        let poses = self.root_from_links();
+        let separation = match spec.wheel_separation_m {
+            Some(s) => s,
+            None => f64::from(
+                poses[self.joints[left].child]
+                    .translation
+                    .distance(poses[self.joints[right].child].translation),
+            ),
+        };
+        let diameter = match spec.wheel_diameter_m {
+            Some(d) => d,
+            None => {
+                let wheel = &self.links[self.joints[left].child];
+                let radius = wheel.collisions.iter().find_map(|c| match c.shape {
+                    Shape::Cylinder { radius_m, .. } | Shape::Sphere { radius_m } => {
+                        Some(f64::from(radius_m))
+                    }
+                    _ => None,
+                });
+                2.0 * radius.ok_or_else(|| {
+                    setup(format!(
+                        "cannot tell the diameter of wheel link \"{}\" (no cylinder or sphere collision); give wheel_diameter_m",
+                        wheel.name
+                    ))
+                })?
+            }
+        };
+        for (what, v) in [
+            ("wheel_separation_m", separation),
+            ("wheel_diameter_m", diameter),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(setup(format!(
+                    "{what} is {v}; expected a positive number of metres"
+                )));
+            }
+        }
+        let mut config = DiffDriveConfig {
+            name: "rover_drive".to_owned(),
+            left_joint: spec.left_joint.clone(),
+            right_joint: spec.right_joint.clone(),
+            wheel_separation_m: separation,
+            wheel_diameter_m: diameter,
+            ..DiffDriveConfig::default()
+        };
+        if let Some(t) = spec.wheel_torque_nm {
+            config.wheel_torque_nm = t;
+        }
+        tracing::info!(
+            "{}: driving joints \"{}\" and \"{}\" (wheel separation {separation:.3} m, diameter {diameter:.3} m)",
+            self.name,
+            spec.left_joint,
+            spec.right_joint
+        );
+        self.diff_drive = Some(config);
+        self.validate_plugins(&self.source.clone())
+    }
+
+    /// Makes the camera sensor called `name` (its `<sensor name>` or plugin `cameraName`) the
+    /// one rover renders (the first); the others stay listed after it.
+    pub fn select_camera(&mut self, name: &str) -> Result<()> {
+        let Some(i) = self
+            .cameras
+            .iter()
+            .position(|c| c.name == name || c.camera_name == name)
+        else {
+            return Err(SimError::Setup(format!(
+                "robot \"{}\" has no camera \"{name}\"; its cameras: {}",
+                self.name,
+                names(self.cameras.iter().map(|c| &c.name))
+            )));
+        };
+        let chosen = self.cameras.remove(i);
+        self.cameras.insert(0, chosen);
+        Ok(())
+    }
+
+    /// Index of the link called `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.name == name)
+    }
+
+    /// Index of the joint called `name`.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// Pose of every link in the root link's frame with all joints at zero.
+    pub fn root_from_links(&self) -> Vec<Pose> {
+        let mut poses = vec![None; self.links.len()];
+        poses[self.root] = Some(Pose::IDENTITY);
+        let mut pending = true;
+        while pending {
+            pending = false;
+            for j in &self.joints {
+                if let (Some(parent), None) = (poses[j.parent], poses[j.child]) {
+                    poses[j.child] = Some(parent * j.parent_from_child);
+                    pending = true;
+                }
+            }
+        }
+        poses.into_iter().map(|p| p.unwrap_or_default()).collect()
+    }
+
+    pub(crate) fn validate_plugins(&self, path: &Path) -> Result<()> {
+        if let Some(dd) = &self.diff_drive {
+            let extras = dd
+                .extra_left_joints
+                .iter()
+                .map(|j| ("leftRearJoint", j))
+                .chain(dd.extra_right_joints.iter().map(|j| ("rightRearJoint", j)));
+            for (role, name) in [
+                ("leftJoint", &dd.left_joint),
+                ("rightJoint", &dd.right_joint),
+            ]
+            .into_iter()
+            .chain(extras)
+            {
+                let Some(index) = self.joint_index(name) else {
+                    return Err(SimError::invalid(
+                        path,
+                        dd.line,
+                        format!(
+                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: no such joint; joints in this robot: {}",
+                            names(self.joints.iter().map(|j| &j.name))
+                        ),
+                    ));
+                };
+                let joint = &self.joints[index];
+                if !matches!(
+                    joint.kind,
+                    JointKind::Continuous | JointKind::Revolute { .. }
+                ) {
+                    return Err(SimError::invalid(
+                        path,
+                        dd.line,
+                        format!(
+                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: the joint is {}, expected a continuous or revolute wheel joint",
+                            kind_name(&joint.kind)
+                        ),
+                    ));
+                }
+            }
+            if dd.left_joint == dd.right_joint {
+                return Err(SimError::invalid(
+                    path,
+                    dd.line,
+                    format!(
+                        "<plugin filename=\"libgazebo_ros_diff_drive.so\">: leftJoint and rightJoint are both \"{}\"; expected two different wheel joints",
+                        dd.left_joint
+                    ),
+                ));
+            }
+        }
+        for laser in &self.lasers {
+            if self.link_index(&laser.link).is_none() {
+                return Err(SimError::invalid(
+                    path,
+                    laser.line,
+                    format!(
+                        "<gazebo reference=\"{}\"> <sensor type=\"ray\">: no such link; links in this robot: {}",
+                        laser.link,
+                        names(self.links.iter().map(|l| &l.name))
+                    ),
+                ));
+            }
+        }
+        for camera in &self.cameras {
+            if self.link_index(&camera.link).is_none() {
+                return Err(SimError::invalid(
+                    path,
+                    camera.line,
+                    format!(
+                        "<gazebo reference=\"{}\"> <sensor type=\"camera\">: no such link; links in this robot: {}",
+                        camera.link,
+                        names(self.links.iter().map(|l| &l.name))
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn kind_name(kind: &JointKind) -> &'static str {
+    match kind {
+        JointKind::Fixed => "fixed",
+        JointKind::Continuous => "continuous",
+        JointKind::Revolute { .. } => "revolute",
+        JointKind::Prismatic { .. } => "prismatic",
+        JointKind::Floating => "floating",
+    }
+}

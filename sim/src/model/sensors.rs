@@ -1,0 +1,133 @@
+//! Sensors a robot carries, as its `<gazebo>` `<sensor>` blocks and their plugins describe them.
+
+use crate::geometry::Pose;
+
+/// Pixel format of a camera image (`<image><format>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelFormat {
+    /// `R8G8B8` (ROS encoding `rgb8`).
+    Rgb8,
+    /// `B8G8R8` (ROS encoding `bgr8`).
+    Bgr8,
+    /// `L8` (ROS encoding `mono8`).
+    Mono8,
+}
+
+/// Gaussian noise (`<noise type="gaussian">`): on the 0..1 scale per channel for a camera, in
+/// metres for a laser's ranges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GaussianNoise {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub stddev: f64,
+}
+
+/// Brown-Conrady lens distortion (`<distortion>` or the camera plugin's `distortionK1`...).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Distortion {
+    /// Radial k1.
+    pub k1: f64,
+    /// Radial k2.
+    pub k2: f64,
+    /// Radial k3.
+    pub k3: f64,
+    /// Tangential p1 (Gazebo's t1).
+    pub p1: f64,
+    /// Tangential p2 (Gazebo's t2).
+    pub p2: f64,
+}
+
+impl Distortion {
+    /// True when every coefficient is zero.
+    pub fn is_zero(&self) -> bool {
+        [self.k1, self.k2, self.k3, self.p1, self.p2]
+            .iter()
+            .all(|c| *c == 0.0)
+    }
+}
+
+/// A `<sensor type="camera">` attached to a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraConfig {
+    /// Sensor `name`.
+    pub name: String,
+    /// Link the sensor is attached to (`<gazebo reference>`).
+    pub link: String,
+    /// `<update_rate>` (Hz, sim time).
+    pub update_rate_hz: f64,
+    /// `<horizontal_fov>` (rad).
+    pub horizontal_fov_rad: f64,
+    /// `<image><width>` (px).
+    pub width_px: u32,
+    /// `<image><height>` (px).
+    pub height_px: u32,
+    /// `<image><format>`.
+    pub format: PixelFormat,
+    /// `<clip><near>` (m).
+    pub clip_near_m: f64,
+    /// `<clip><far>` (m).
+    pub clip_far_m: f64,
+    /// Optional gaussian noise.
+    pub noise: Option<GaussianNoise>,
+    /// Lens distortion (zero when absent).
+    pub distortion: Distortion,
+    /// The camera plugin's `<cameraName>` (default: the sensor name).
+    pub camera_name: String,
+    /// The camera plugin's `<frameName>` (default: the link).
+    pub frame_name: String,
+    /// The camera plugin's `<imageTopicName>` (default `image_raw`).
+    pub image_topic: String,
+    /// The camera plugin's `<cameraInfoTopicName>` (default `camera_info`).
+    pub info_topic: String,
+    /// Line of the `<sensor>` element, for messages.
+    pub line: Option<u32>,
+}
+
+/// A 2D laser scanner: `<sensor type="ray">` (or `gpu_ray`) with `libgazebo_ros_laser.so`'s
+/// parameters. One horizontal plane of rays, as Gazebo's ray sensor with one vertical sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaserConfig {
+    /// Sensor `name`.
+    pub name: String,
+    /// Link the sensor is attached to (`<gazebo reference>`).
+    pub link: String,
+    /// The sensor's `<pose>` in its link (x y z roll pitch yaw).
+    pub link_from_sensor: Pose,
+    /// `<update_rate>` (Hz, sim time).
+    pub update_rate_hz: f64,
+    /// `<scan><horizontal><samples>` times `<resolution>`: rays per scan.
+    pub samples: u32,
+    /// `<min_angle>` (rad, counter-clockwise from the sensor's x axis).
+    pub min_angle_rad: f64,
+    /// `<max_angle>` (rad).
+    pub max_angle_rad: f64,
+    /// `<range><min>` (m): closer returns read as -inf (REP-117).
+    pub range_min_m: f64,
+    /// `<range><max>` (m): no return within it reads as +inf (REP-117).
+    pub range_max_m: f64,
+    /// `<range><resolution>` (m): ranges are rounded to multiples of it.
+    pub range_resolution_m: f64,
+    /// Gaussian range noise (m), `<ray><noise>`.
+    pub noise: Option<GaussianNoise>,
+    /// The laser plugin's `<topicName>` (default `scan`).
+    pub topic: String,
+    /// The laser plugin's `<frameName>` (default: the link).
+    pub frame_name: String,
+    /// Line of the `<sensor>` element, for messages.
+    pub line: Option<u32>,
+}
+
+impl LaserConfig {
+    /// Angle between two rays (rad): Gazebo spreads the samples from min to max inclusive.
+    pub fn angle_increment_rad(&self) -> f64 {
+        if self.samples > 1 {
+            (self.max_angle_rad - self.min_angle_rad) / f64::from(self.samples - 1)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Rays per scan rover accepts (a 0.1 deg lidar has 3600; more is a typo, not a sensor).
+pub const MAX_LASER_SAMPLES: u32 = 100_000;

@@ -1,0 +1,174 @@
+//! A world: the ground, objects, people, Gazebo models, physics settings and where the robot
+//! spawns. Plain data; read from TOML or SDF by `description`.
+
+use std::path::PathBuf;
+
+use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
+use crate::model::drive::DriveSpec;
+use crate::model::person::Person;
+use crate::model::robot::{Collision, Visual};
+
+/// Default physics step rate (Hz); see docs/WORLDS.md for why.
+pub const DEFAULT_STEP_HZ: f64 = 200.0;
+
+/// A loaded and validated world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct World {
+    /// World name (defaults to the file stem).
+    pub name: String,
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Free-text description.
+    pub description: String,
+    /// Where and which robot to spawn.
+    pub robot: RobotSpawn,
+    /// Physics settings.
+    pub physics: Physics,
+    /// The ground plane.
+    pub ground: Ground,
+    /// Boxes, cylinders, spheres and walls.
+    pub objects: Vec<Object>,
+    /// People standing in the world.
+    pub people: Vec<Person>,
+    /// Models of a Gazebo SDF world (empty for TOML worlds).
+    pub models: Vec<Model>,
+}
+
+/// Robot spawn settings (`[robot]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotSpawn {
+    /// URDF file, resolved against the world file's folder; `None` = the app's default robot.
+    pub urdf: Option<PathBuf>,
+    /// Spawn position on the ground (x, y in m).
+    pub position_m: [f64; 2],
+    /// Spawn heading (rad, counter-clockwise from +x).
+    pub yaw_rad: f64,
+    /// `xacro_args`: `$(arg NAME)` values when the robot is a xacro file.
+    pub xacro_args: std::collections::BTreeMap<String, String>,
+    /// `[robot.drive]`: how to drive a robot whose URDF names no drive plugin.
+    pub drive: Option<DriveSpec>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Physics {
+    /// Fixed step rate (Hz).
+    pub step_hz: f64,
+    /// Gravity (m/s^2, world frame).
+    pub gravity_mps2: [f64; 3],
+    /// Solver iterations per step.
+    pub solver_iterations: usize,
+}
+
+/// The ground (`[ground]`): a flat square centred on the origin, top at z = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ground {
+    /// Side lengths along x and y (m).
+    pub size_m: [f64; 2],
+    /// Friction coefficient.
+    pub friction: f32,
+    /// Main colour.
+    pub color: Rgba,
+    /// Second colour of the checker texture.
+    pub checker_color: Rgba,
+    /// Checker square size (m).
+    pub checker_size_m: f64,
+}
+
+/// Shape of a world object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ObjectShape {
+    /// Box with full side lengths (m).
+    Box {
+        /// Side lengths along the object's x, y, z (m).
+        size_m: [f64; 3],
+    },
+    /// Upright cylinder.
+    Cylinder {
+        /// Radius (m).
+        radius_m: f64,
+        /// Height (m).
+        length_m: f64,
+    },
+    /// Sphere.
+    Sphere {
+        /// Radius (m).
+        radius_m: f64,
+    },
+}
+
+/// A static or dynamic object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    /// Name (unique within the world).
+    pub name: String,
+    /// Shape.
+    pub shape: ObjectShape,
+    /// Centre position (m, world frame).
+    pub position_m: [f64; 3],
+    /// Heading about +z (rad).
+    pub yaw_rad: f64,
+    /// Colour.
+    pub color: Rgba,
+    /// Mass (kg); `None` for a static object.
+    pub mass_kg: Option<f64>,
+    /// Friction coefficient.
+    pub friction: f32,
+}
+
+/// Physics step rates rover accepts (Hz), from world files and `--physics-hz` alike.
+pub const STEP_HZ_RANGE: std::ops::RangeInclusive<f64> = 50.0..=10_000.0;
+
+/// Checks a physics step rate against [`STEP_HZ_RANGE`]; the error says what was expected.
+pub fn check_step_hz(step_hz: f64) -> std::result::Result<(), String> {
+    if step_hz.is_finite() && STEP_HZ_RANGE.contains(&step_hz) {
+        Ok(())
+    } else {
+        Err(format!(
+            "expected a physics step rate of {}..={} Hz (default {DEFAULT_STEP_HZ}), found {step_hz}",
+            STEP_HZ_RANGE.start(),
+            STEP_HZ_RANGE.end()
+        ))
+    }
+}
+
+impl Object {
+    /// Where the object's centre is, turned by its yaw.
+    pub fn world_from_object(&self) -> Pose {
+        pose_from_position_yaw(self.position_m, self.yaw_rad)
+    }
+}
+
+/// A model of an SDF world: rigid links with their shapes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Model name (`<model name>` or the `<include><name>`).
+    pub name: String,
+    /// `<static>`: fixed in the world whatever its links' masses.
+    pub is_static: bool,
+    /// Where the model's frame is (world frame).
+    pub world_from_model: Pose,
+    /// Links, each a rigid body.
+    pub links: Vec<ModelLink>,
+}
+
+/// One link of a [`Model`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelLink {
+    /// Link name.
+    pub name: String,
+    /// Where the link starts (world frame).
+    pub world_from_link: Pose,
+    /// `<inertial><mass>` (kg); `None` when the link gives none.
+    pub mass_kg: Option<f64>,
+    /// Visual shapes in the link frame.
+    pub visuals: Vec<Visual>,
+    /// Collision shapes in the link frame.
+    pub collisions: Vec<Collision>,
+}
+
+impl ModelLink {
+    /// Whether physics moves this link (its model is not static and it has a mass).
+    pub fn is_dynamic(&self, model: &Model) -> bool {
+        !model.is_static && self.mass_kg.is_some_and(|m| m > 0.0)
+    }
+}

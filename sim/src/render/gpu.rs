@@ -1,0 +1,177 @@
+//! The GPU context the renderer's passes share: adapter and device (a GPU, or Mesa's software
+//! Vulkan where there is none; no window, no surface) and the read back of a rendered texture
+//! into reused CPU memory.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
+use crate::error::SimError;
+
+/// Why the camera cannot render.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No GPU and no software renderer.
+    #[error(
+        "no graphics adapter found ({0}); without a GPU rover renders with Mesa's software Vulkan: install it (Debian/Ubuntu: sudo apt-get install mesa-vulkan-drivers)"
+    )]
+    NoAdapter(String),
+    /// The adapter refused a device.
+    #[error("the graphics adapter {adapter} refused a device: {message}")]
+    Device {
+        /// Adapter name.
+        adapter: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// A mesh file or the scene could not be loaded.
+    #[error(transparent)]
+    Scene(#[from] SimError),
+    /// Reading the image back failed.
+    #[error("reading the camera image back failed: {0}")]
+    Readback(String),
+}
+
+/// A device and its queue, with the adapter's name for messages.
+pub(crate) struct Gpu {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    pub(crate) adapter: String,
+}
+
+impl Gpu {
+    /// Native APIs first (Vulkan covers Mesa's software lavapipe); OpenGL only as a fallback,
+    /// because probing EGL without a display prints errors.
+    pub(crate) fn new() -> Result<Self, RenderError> {
+        let request = |backends: wgpu::Backends| {
+            let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+                backends,
+                ..wgpu::InstanceDescriptor::new_without_display_handle()
+            });
+            pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                ..Default::default()
+            }))
+        };
+        let adapter =
+            request(wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12)
+                .or_else(|_| request(wgpu::Backends::GL))
+                .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        let adapter_name = adapter.get_info().name;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("rover camera"),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device {
+            adapter: adapter_name.clone(),
+            message: e.to_string(),
+        })?;
+        Ok(Self {
+            device,
+            queue,
+            adapter: adapter_name,
+        })
+    }
+}
+
+const MAP_PENDING: u8 = 0;
+const MAP_OK: u8 = 1;
+const MAP_FAILED: u8 = 2;
+
+/// A mappable buffer a texture of 4-byte texels is copied into, allocated once.
+pub(crate) struct Readback {
+    buffer: wgpu::Buffer,
+    padded_row: u32,
+    width: u32,
+    height: u32,
+    /// One flag for the renderer's life (no channel per frame): the map callback has run once
+    /// the blocking poll returns.
+    mapped: Arc<AtomicU8>,
+}
+
+impl Readback {
+    /// A buffer for `width` x `height` texels of 4 bytes.
+    pub(crate) fn new(device: &wgpu::Device, label: &str, width: u32, height: u32) -> Self {
+        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: u64::from(padded_row) * u64::from(height),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            buffer,
+            padded_row,
+            width,
+            height,
+            mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
+        }
+    }
+
+    /// Records the copy of `texture` (same size) into the buffer.
+    pub(crate) fn copy_from(&self, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// Waits for the submitted copy and hands each row's `width * 4` bytes, top to bottom, to
+    /// `row`.
+    pub(crate) fn read_rows(
+        &self,
+        device: &wgpu::Device,
+        mut row: impl FnMut(usize, &[u8]),
+    ) -> Result<(), RenderError> {
+        let slice = self.buffer.slice(..);
+        self.mapped.store(MAP_PENDING, Ordering::Release);
+        let mapped = Arc::clone(&self.mapped);
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            mapped.store(
+                if r.is_ok() { MAP_OK } else { MAP_FAILED },
+                Ordering::Release,
+            );
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        match self.mapped.load(Ordering::Acquire) {
+            MAP_OK => {}
+            MAP_FAILED => {
+                return Err(RenderError::Readback(
+                    "the readback buffer could not be mapped".into(),
+                ));
+            }
+            _ => {
+                return Err(RenderError::Readback(
+                    "the GPU finished without mapping the readback buffer".into(),
+                ));
+            }
+        }
+        {
+            let data = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Readback(e.to_string()))?;
+            let w = self.width as usize;
+            for y in 0..self.height as usize {
+                row(y, &data[y * self.padded_row as usize..][..w * 4]);
+            }
+        }
+        self.buffer.unmap();
+        Ok(())
+    }
+}

@@ -1,0 +1,245 @@
+//! The colour pass: the scene shaded by a sun and an ambient term, the ground checkered, the
+//! sky as clear colour, into an RGBA8 target the size of the image (with its depth buffer).
+
+use glam::{Mat4, Vec3};
+
+use crate::geometry::{Pose, Rgba};
+use crate::model::mesh::MeshVertex;
+use crate::render::scene::{Instance, Scene};
+
+const SKY: [f32; 3] = [0.62, 0.75, 0.9];
+const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Globals {
+    view_proj: [[f32; 4]; 4],
+    camera_pos: [f32; 4],
+    sun: [f32; 4],
+    ambient: [f32; 4],
+    checker: [f32; 4],
+    sky: [f32; 4],
+}
+
+/// What the colour pass needs from the frame besides the scene.
+pub(crate) struct View {
+    /// Projection from the optical frame to clip space.
+    pub(crate) projection: Mat4,
+    /// The camera's optical frame.
+    pub(crate) world_from_optical: Pose,
+}
+
+/// The pipeline, its uniforms and its targets, created once.
+pub(crate) struct ColourPass {
+    pipeline: wgpu::RenderPipeline,
+    globals: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    /// The rendered image (RGBA8), copied out by the renderer's readback.
+    pub(crate) target: wgpu::Texture,
+    target_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    checker: Rgba,
+    checker_size_m: f32,
+}
+
+impl ColourPass {
+    /// Builds the pipeline and `width` x `height` targets; `checker` and `checker_size_m` are
+    /// the ground's second colour and square size.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        checker: Rgba,
+        checker_size_m: f32,
+    ) -> Self {
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("globals layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("globals"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            }],
+        });
+        let pipeline = pipeline(device, &layout);
+        let target = texture(device, "camera color", width, height, COLOR_FORMAT, true);
+        let depth = texture(device, "camera depth", width, height, DEPTH_FORMAT, false);
+        Self {
+            pipeline,
+            globals,
+            bind_group,
+            target_view: target.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            target,
+            checker,
+            checker_size_m,
+        }
+    }
+
+    /// Uploads this frame's uniforms and records the pass.
+    pub(crate) fn encode(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &Scene,
+        view: &View,
+    ) {
+        let world_from_optical = view.world_from_optical;
+        let view_matrix = Mat4::from_rotation_translation(
+            world_from_optical.rotation,
+            world_from_optical.translation,
+        )
+        .inverse();
+        // Late-morning sun from behind-left of a car facing +x.
+        let sun = Vec3::new(0.45, -0.35, -0.82).normalize();
+        let globals = Globals {
+            view_proj: (view.projection * view_matrix).to_cols_array_2d(),
+            camera_pos: world_from_optical.translation.extend(1.0).to_array(),
+            sun: sun.extend(0.75).to_array(),
+            ambient: [0.45, 0.47, 0.5, self.checker_size_m],
+            checker: self.checker.0,
+            sky: [SKY[0], SKY[1], SKY[2], 80.0],
+        };
+        queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("camera"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.target_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: f64::from(SKY[0]),
+                        g: f64::from(SKY[1]),
+                        b: f64::from(SKY[2]),
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_vertex_buffer(1, scene.instance_buffer.slice(..));
+        for (i, mesh) in scene.meshes.iter().enumerate() {
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.count, 0, i as u32..i as u32 + 1);
+        }
+    }
+}
+
+fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::RenderPipeline {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("camera shader"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("colour.wgsl").into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("camera pipeline layout"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let vertex_layout = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<MeshVertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+    };
+    let instance_layout = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Instance>() as u64,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &wgpu::vertex_attr_array![2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4],
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("camera pipeline"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout), Some(instance_layout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            // Meshes wind counter-clockwise seen from outside. Culling back faces also hides
+            // the inside of the camera's own link visual, which the camera sits in (as in
+            // Gazebo).
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: Some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &shader,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(COLOR_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A 2D render target; `readable` ones can be copied out.
+fn texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+    readable: bool,
+) -> wgpu::Texture {
+    let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if readable {
+        usage |= wgpu::TextureUsages::COPY_SRC;
+    }
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}

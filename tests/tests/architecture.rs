@@ -1,0 +1,106 @@
+//! The workspace's shape, checked on its own sources: no import circle between the files of
+//! any crate, sim/src's top level small, no long functions outside tests. What the rules are
+//! and why: docs/ARCHITECTURE.md.
+
+use rover_tests::architecture::CrateSources;
+use rover_tests::repo;
+
+/// Crates whose files must not import each other in a circle.
+const CRATES: [&str; 6] = ["sim", "perception", "core", "ros1", "app", "tests"];
+
+/// Longest function allowed outside tests (lines from `fn` to its closing brace).
+const MAX_FUNCTION_LINES: usize = 120;
+
+fn sources(krate: &str) -> anyhow::Result<CrateSources> {
+    Ok(CrateSources::read(&repo(&format!("{krate}/src")))?)
+}
+
+#[test]
+fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
+    let mut circles = Vec::new();
+    for krate in CRATES {
+        let sources = sources(krate)?;
+        assert!(
+            sources.files.len() > 1,
+            "{krate}: expected several source files, found {}",
+            sources.files.len()
+        );
+        if let Some(cycle) = sources.find_cycle() {
+            let files: Vec<String> = cycle.iter().map(|p| p.display().to_string()).collect();
+            circles.push(format!("{krate}/src: {}", files.join(" -> ")));
+        }
+    }
+    assert!(circles.is_empty(), "import circles:\n{}", circles.join("\n"));
+    Ok(())
+}
+
+#[test]
+fn the_circle_check_finds_a_known_circle_and_follows_reexports() -> anyhow::Result<()> {
+    // A crate where a.rs uses b's item through the root's re-export, and b.rs uses a: a circle
+    // only visible once the re-export is followed.
+    let dir = tempfile::tempdir()?;
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("b"))?;
+    std::fs::write(
+        src.join("lib.rs"),
+        "mod a;\nmod b;\npub use b::inner::Thing;\npub use a::Other;\n",
+    )?;
+    std::fs::write(src.join("a.rs"), "use crate::Thing;\npub struct Other(Thing);\n")?;
+    std::fs::write(src.join("b/mod.rs"), "pub(crate) mod inner;\n")?;
+    std::fs::write(
+        src.join("b/inner.rs"),
+        "pub struct Thing;\nfn f() -> Option<crate::a::Other> { None }\n// crate::c::Ignored\n",
+    )?;
+    let sources = CrateSources::read(&src)?;
+    let cycle = sources.find_cycle();
+    let names: Vec<String> = cycle
+        .iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    assert!(
+        names.contains(&"a.rs".to_owned()) && names.contains(&"b/inner.rs".to_owned()),
+        "expected a.rs <-> b/inner.rs, found {names:?}"
+    );
+    // Without the back edge there is none.
+    std::fs::write(src.join("b/inner.rs"), "pub struct Thing;\n")?;
+    assert_eq!(CrateSources::read(&src)?.find_cycle(), None);
+    Ok(())
+}
+
+#[test]
+fn sim_src_top_level_has_at_most_ten_entries() -> anyhow::Result<()> {
+    let mut entries: Vec<String> = std::fs::read_dir(repo("sim/src"))?
+        .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect::<Result<_, _>>()?;
+    entries.sort();
+    assert!(
+        entries.len() <= 10,
+        "sim/src has {} entries (expected at most 10: a folder per layer): {entries:?}",
+        entries.len()
+    );
+    Ok(())
+}
+
+#[test]
+fn no_function_outside_tests_is_longer_than_the_limit() -> anyhow::Result<()> {
+    let mut long = Vec::new();
+    // The tests crate is test code itself.
+    for krate in CRATES.iter().filter(|k| **k != "tests") {
+        for f in sources(krate)?.long_functions(MAX_FUNCTION_LINES) {
+            long.push(format!(
+                "{krate}/src/{}:{} fn {} is {} lines",
+                f.file.display(),
+                f.line,
+                f.name,
+                f.lines
+            ));
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "functions over {MAX_FUNCTION_LINES} lines (split them):\n{}",
+        long.join("\n")
+    );
+    Ok(())
+}
