@@ -56,4 +56,3 @@ pub fn read_text(path: &Path) -> Result<String> {
         ),
     })
 }
-

@@ -43,7 +43,7 @@ pub use physics::{
     ControlSample, DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry,
     SimOptions, Simulation, Twist, WheelSpeeds, wrap_angle,
 };
-pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
-pub use sensors::{CameraFrame, CameraSensor, LaserScan, LaserSensor};
 /// nalgebra, the version rapier uses: for estimation and general matrices (one copy in the build).
 pub use rapier3d::na as nalgebra;
+pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
+pub use sensors::{CameraFrame, CameraSensor, LaserScan, LaserSensor};

@@ -309,7 +309,10 @@ pub fn blank_literals(text: &str) -> String {
     while i < b.len() {
         let ident_before = i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_');
         if b[i..].starts_with(b"//") {
-            let end = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |p| i + p);
+            let end = b[i..]
+                .iter()
+                .position(|&c| c == b'\n')
+                .map_or(b.len(), |p| i + p);
             blank(&mut out, i, end);
             i = end;
         } else if b[i..].starts_with(b"/*") {
@@ -345,7 +348,10 @@ pub fn blank_literals(text: &str) -> String {
         } else if b[i] == b'\'' {
             // A char literal ('a', '\n', '\u{..}') or a lifetime ('a).
             let end = if b.get(i + 1) == Some(&b'\\') {
-                b[i + 2..].iter().position(|&c| c == b'\'').map(|p| i + 2 + p + 1)
+                b[i + 2..]
+                    .iter()
+                    .position(|&c| c == b'\'')
+                    .map(|p| i + 2 + p + 1)
             } else {
                 let ch_len = text[i + 1..].chars().next().map_or(1, char::len_utf8);
                 (b.get(i + 1 + ch_len) == Some(&b'\'')).then_some(i + 2 + ch_len)
@@ -398,7 +404,13 @@ fn without_test_items(code: &str) -> String {
             .iter()
             .position(|&c| c == b'{' || c == b';')
             .map(|q| at + q)
-            .and_then(|q| if b[q] == b'{' { matching_brace(b, q) } else { Some(q) })
+            .and_then(|q| {
+                if b[q] == b'{' {
+                    matching_brace(b, q)
+                } else {
+                    Some(q)
+                }
+            })
             .unwrap_or(b.len() - 1);
         for c in &mut out[at..=item_end] {
             if *c != b'\n' {
@@ -467,7 +479,10 @@ fn use_trees(code: &str) -> Vec<(bool, String)> {
             let tail = &before[before.len().saturating_sub(16)..];
             tail.trim_end().ends_with("pub") || tail.contains("pub(")
         };
-        out.push((is_pub, code[at + 3..end].split_whitespace().collect::<String>()));
+        out.push((
+            is_pub,
+            code[at + 3..end].split_whitespace().collect::<String>(),
+        ));
         i = end + 1;
     }
     out
@@ -551,7 +566,10 @@ fn inline_paths(code: &str) -> Vec<Vec<String>> {
             let mut j = i;
             while code[j..].starts_with("::") {
                 j += 2;
-                let seg: String = code[j..].chars().take_while(|c| is_ident(*c as u8)).collect();
+                let seg: String = code[j..]
+                    .chars()
+                    .take_while(|c| is_ident(*c as u8))
+                    .collect();
                 if seg.is_empty() {
                     break;
                 }
@@ -570,7 +588,8 @@ mod tests {
 
     #[test]
     fn literals_and_comments_are_blanked_and_lifetimes_kept() {
-        let code = blank_literals("fn f<'a>(x: &'a str) { let c = '}'; \"use crate::x;\" } // crate::y");
+        let code =
+            blank_literals("fn f<'a>(x: &'a str) { let c = '}'; \"use crate::x;\" } // crate::y");
         assert!(code.contains("'a"), "{code}");
         assert!(!code.contains("crate::"), "{code}");
         assert!(!code.contains("'}'"), "{code}");
@@ -580,7 +599,10 @@ mod tests {
     fn use_trees_expand_to_paths() {
         let paths = expand_tree("crate::{a::{B,c::D},e as F,g::*}");
         let flat: Vec<String> = paths.iter().map(|(p, _)| p.join("::")).collect();
-        assert_eq!(flat, ["crate::a::B", "crate::a::c::D", "crate::e", "crate::g"]);
+        assert_eq!(
+            flat,
+            ["crate::a::B", "crate::a::c::D", "crate::e", "crate::g"]
+        );
         assert_eq!(paths[2].1.as_deref(), Some("F"));
     }
 }

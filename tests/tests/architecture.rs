@@ -30,7 +30,11 @@ fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
             circles.push(format!("{krate}/src: {}", files.join(" -> ")));
         }
     }
-    assert!(circles.is_empty(), "import circles:\n{}", circles.join("\n"));
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
     Ok(())
 }
 
@@ -45,7 +49,10 @@ fn the_circle_check_finds_a_known_circle_and_follows_reexports() -> anyhow::Resu
         src.join("lib.rs"),
         "mod a;\nmod b;\npub use b::inner::Thing;\npub use a::Other;\n",
     )?;
-    std::fs::write(src.join("a.rs"), "use crate::Thing;\npub struct Other(Thing);\n")?;
+    std::fs::write(
+        src.join("a.rs"),
+        "use crate::Thing;\npub struct Other(Thing);\n",
+    )?;
     std::fs::write(src.join("b/mod.rs"), "pub(crate) mod inner;\n")?;
     std::fs::write(
         src.join("b/inner.rs"),

@@ -8,9 +8,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use crate::description::xml::{elements, line_of};
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, pose_from_xyz_rpy};
-use crate::description::xml::{elements, line_of};
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,

@@ -96,10 +96,14 @@ impl RobotModel {
             .filter_map(|m| m.color.map(|c| (m.name.as_str(), rgba(c))))
             .collect();
 
-        let (mut links, link_index) =
-            read_links(&urdf.links, &materials, (base_dir, resources), path, &lines, || {
-                Some(line_of(&doc, root))
-            })?;
+        let (mut links, link_index) = read_links(
+            &urdf.links,
+            &materials,
+            (base_dir, resources),
+            path,
+            &lines,
+            || Some(line_of(&doc, root)),
+        )?;
         let joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
@@ -136,7 +140,6 @@ impl RobotModel {
         model.validate_plugins(path)?;
         Ok(model)
     }
-
 }
 
 /// Converts the links (file order) and indexes them by name; duplicate names and a robot
@@ -159,13 +162,7 @@ fn read_links(
                 format!("<link name=\"{}\"> is defined twice", link.name),
             ));
         }
-        links.push(convert_link(
-            link,
-            materials,
-            base_dir,
-            path,
-            lines,
-        )?);
+        links.push(convert_link(link, materials, base_dir, path, lines)?);
     }
     if links.is_empty() {
         return Err(SimError::invalid(
@@ -233,7 +230,7 @@ fn read_joints(
 /// The one link that is no joint's child; every link must be reachable from it.
 fn find_root(links: &[Link], joints: &[Joint], path: &Path, lines: &ElementLines) -> Result<usize> {
     let roots: Vec<usize> = (0..links.len())
-        .filter(|&i| parent_of[i].is_none())
+        .filter(|&i| !joints.iter().any(|j| j.child == i))
         .collect();
     let root = match roots.as_slice() {
         [single] => *single,
@@ -401,8 +398,7 @@ fn convert_link(
     lines: &ElementLines,
 ) -> Result<Link> {
     let line = lines.link(&link.name);
-    let geometry =
-        |g: &urdf::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
+    let geometry = |g: &urdf::Geometry| convert_geometry(g, base_dir, path, line, &link.name);
     let inertial = link
         .inertial
         .as_ref()

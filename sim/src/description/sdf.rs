@@ -12,10 +12,10 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use roxmltree::Node;
 
+use crate::description::resource::ResourcePaths;
 use crate::description::xml::{child, children, line_of, parse_xml};
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of};
-use crate::description::resource::ResourcePaths;
 use crate::model::person::{Person, Walk};
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
@@ -172,11 +172,7 @@ struct Ctx<'a, 'input> {
 
 impl Ctx<'_, '_> {
     fn err(&self, node: Node<'_, '_>, message: impl Into<String>) -> SimError {
-        SimError::invalid(
-            self.path,
-            Some(line_of(self.doc, node)),
-            message,
-        )
+        SimError::invalid(self.path, Some(line_of(self.doc, node)), message)
     }
 
     fn number(&self, node: Node<'_, '_>) -> Result<f64> {

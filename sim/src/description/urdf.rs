@@ -9,8 +9,8 @@ use std::path::Path;
 
 use roxmltree::Node;
 
-use crate::error::{Result, SimError};
 use crate::description::xml::{child, line_of};
+use crate::error::{Result, SimError};
 
 /// `<origin xyz rpy>` (zeros when absent).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

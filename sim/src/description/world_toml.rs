@@ -12,8 +12,7 @@ use crate::geometry::Rgba;
 use crate::model::drive::DriveSpec;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Physics, RobotSpawn, STEP_HZ_RANGE, World,
-    check_step_hz,
+    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Physics, RobotSpawn, World, check_step_hz,
 };
 
 impl World {
@@ -244,7 +243,6 @@ fn default_repeat() -> bool {
 fn default_person_height() -> f64 {
     DEFAULT_PERSON_HEIGHT_M
 }
-
 
 /// Collects validation problems as `key: message` pairs.
 struct Checker<'a> {

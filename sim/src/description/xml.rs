@@ -26,7 +26,6 @@ pub(crate) fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Doc
     })
 }
 
-
 /// 1-based line of an element.
 pub(crate) fn line_of(doc: &roxmltree::Document<'_>, node: Node<'_, '_>) -> u32 {
     doc.text_pos_at(node.range().start).row
@@ -46,6 +45,8 @@ pub(crate) fn children<'a, 'input>(
 }
 
 /// Every child element.
-pub(crate) fn elements<'a, 'input>(node: Node<'a, 'input>) -> impl Iterator<Item = Node<'a, 'input>> {
+pub(crate) fn elements<'a, 'input>(
+    node: Node<'a, 'input>,
+) -> impl Iterator<Item = Node<'a, 'input>> {
     node.children().filter(|n| n.is_element())
 }

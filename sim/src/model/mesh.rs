@@ -54,4 +54,3 @@ impl MeshData {
             .extend(other.indices.iter().map(|i| i + offset));
     }
 }
-

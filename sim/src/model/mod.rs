@@ -13,7 +13,7 @@ pub(crate) mod world;
 pub use camera_info::{CameraInfo, link_from_optical};
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
 pub use mesh::{MeshData, MeshVertex};
-pub use person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
+pub use person::{Person, Walk};
 pub use robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
 pub use sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,

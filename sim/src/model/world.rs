@@ -49,6 +49,7 @@ pub struct RobotSpawn {
     pub drive: Option<DriveSpec>,
 }
 
+/// Physics settings (`[physics]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Physics {
     /// Fixed step rate (Hz).

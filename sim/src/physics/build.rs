@@ -30,7 +30,10 @@ pub(crate) fn person_body_pose(person: &Person, t_s: f64) -> Pose {
 
 /// Adds the ground, objects, walls and people; returns the people's bodies.
 /// Adds the SDF models' links, one rigid body each; returns the bodies in model/link order.
-pub(crate) fn add_models(physics: &mut PhysicsWorld, world: &World) -> Result<Vec<RigidBodyHandle>> {
+pub(crate) fn add_models(
+    physics: &mut PhysicsWorld,
+    world: &World,
+) -> Result<Vec<RigidBodyHandle>> {
     let mut bodies = Vec::new();
     for model in &world.models {
         for link in &model.links {
@@ -68,7 +71,10 @@ pub(crate) fn add_models(physics: &mut PhysicsWorld, world: &World) -> Result<Ve
     Ok(bodies)
 }
 
-pub(crate) fn add_world(physics: &mut PhysicsWorld, world: &World) -> (RigidBodyHandle, Vec<RigidBodyHandle>) {
+pub(crate) fn add_world(
+    physics: &mut PhysicsWorld,
+    world: &World,
+) -> (RigidBodyHandle, Vec<RigidBodyHandle>) {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
     let [sx, sy] = world.ground.size_m;
@@ -205,13 +211,10 @@ pub(crate) fn add_robot(
         ],
         spawn.yaw_rad,
     );
-    let (link_body, link_mass_kg) = add_link_bodies(
-        physics,
-        robot,
-        &body_root,
-        &body_from_link,
-        |root| world_from_root * root_from_links[root],
-    );
+    let (link_body, link_mass_kg) =
+        add_link_bodies(physics, robot, &body_root, &body_from_link, |root| {
+            world_from_root * root_from_links[root]
+        });
     let robot_groups = InteractionGroups::new(ROBOT_GROUP, !ROBOT_GROUP, InteractionTestMode::And);
     for (i, shape, link_from_shape) in shapes {
         physics.insert_collider(

@@ -391,7 +391,11 @@ fn trunk(f: &mut Figure, person: &Person) {
         Section::new(1.42, 0.048, 0.048),
         Section::new(1.58, 0.045, 0.045),
     ]);
-    f.add(loft(&neck, 2.0, 12), f.at(-0.01, 0.0, 0.0), person.skin_color);
+    f.add(
+        loft(&neck, 2.0, 12),
+        f.at(-0.01, 0.0, 0.0),
+        person.skin_color,
+    );
 }
 
 /// Eyes, brows, ears, mouth, nose, head and hair.

@@ -9,8 +9,8 @@ use crate::geometry::{Pose, Rgba};
 use crate::model::mesh::MeshData;
 use crate::model::robot::RobotModel;
 use crate::model::world::World;
-use crate::render::mesh::{cuboid, object_mesh, person_parts, shape_mesh};
 use crate::render::gpu::RenderError;
+use crate::render::mesh::{cuboid, object_mesh, person_parts, shape_mesh};
 
 /// Per-instance vertex data: the model matrix and the colour (alpha < 0 marks the checkered
 /// ground).

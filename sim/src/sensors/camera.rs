@@ -1,11 +1,11 @@
 //! The camera as a sensor: renders the robot's camera at its `update_rate` on sim time.
 
-use crate::model::camera_info::CameraInfo;
 use crate::error::SimError;
 use crate::geometry::Pose;
+use crate::model::camera_info::CameraInfo;
+use crate::physics::simulation::Simulation;
 use crate::render::gpu::RenderError;
 use crate::render::renderer::CameraRenderer;
-use crate::physics::simulation::Simulation;
 
 /// One camera image.
 #[derive(Debug, Clone, Copy)]

@@ -11,8 +11,8 @@
 use glam::Vec3;
 
 use crate::error::{Result, SimError};
-use crate::model::sensors::LaserConfig;
 use crate::geometry::Pose;
+use crate::model::sensors::LaserConfig;
 use crate::noise::Rng;
 use crate::physics::simulation::Simulation;
 

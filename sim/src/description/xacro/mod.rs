@@ -22,8 +22,8 @@ use std::rc::Rc;
 
 use expr::{ExprError, Names, Value};
 
-use crate::error::{Location, Result, SimError};
 use crate::description::resource::ResourcePaths;
+use crate::error::{Location, Result, SimError};
 
 /// The xacro namespace URIs in use (the wiki moved from ros.org to www.ros.org).
 const XACRO_NAMESPACES: [&str; 2] = ["http://ros.org/wiki/xacro", "http://www.ros.org/wiki/xacro"];

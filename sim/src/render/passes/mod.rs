@@ -3,5 +3,3 @@
 //! one line where the renderer records its passes.
 
 pub(crate) mod colour;
-
-
