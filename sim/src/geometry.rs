@@ -2,6 +2,20 @@
 
 use glam::{EulerRot, Quat, Vec3};
 
+/// Largest position coordinate rover accepts from a file (m): 100 km from the origin. Physics
+/// runs in f32; beyond this, millimetre contacts are lost to rounding and parry's contact code
+/// can fail on absurd values, so such a file is refused with its location instead.
+pub(crate) const MAX_COORDINATE_M: f64 = 1.0e5;
+/// Largest size (box side, radius, length, ground side) rover accepts from a file (m).
+pub(crate) const MAX_SIZE_M: f64 = 1.0e5;
+/// Largest mass rover accepts from a file (kg): a loaded freight wagon is ~1e5 kg.
+pub(crate) const MAX_MASS_KG: f64 = 1.0e6;
+/// Largest moment of inertia component rover accepts from a file (kg m^2).
+pub(crate) const MAX_INERTIA_KGM2: f64 = 1.0e6;
+/// Largest magnitude of any other number rover reads from a file (gravity, friction, mesh
+/// scale, ...).
+pub(crate) const MAX_MAGNITUDE: f64 = 1.0e6;
+
 /// A rigid transform (rotation then translation), f32 like the physics engine.
 ///
 /// Named by convention `a_from_b`: it maps coordinates in frame `b` into frame `a`.

@@ -93,6 +93,20 @@ const TOKENS: &[&str] = &[
     "step_hz = 0",
     "[[people]]",
     "[[objects]]",
+    // Finite but absurd magnitudes (sizes, positions, masses far outside physical sense), which
+    // reached rapier/parry before the accepted ranges.
+    "1e30",
+    "-1e30",
+    "3.4e38",
+    "1e-30",
+    "<box size=\"1e30 1 1\"/>",
+    "<origin xyz=\"1e30 0 0\"/>",
+    "<mass value=\"1e30\"/>",
+    "<pose>1e30 0 0 0 0 0</pose>",
+    "<size>1e30 1e30 1e30</size>",
+    "size_m = [1e30, 1.0, 1.0]",
+    "position_m = [1e30, 0.0]",
+    "mass_kg = 1e30",
 ];
 
 /// One edit of an input's bytes. Positions are taken modulo the input's length.

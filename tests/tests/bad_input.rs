@@ -501,3 +501,98 @@ fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()
     );
     Ok(())
 }
+
+/// Finite but absurd magnitudes (a 1e30 m box, a robot 1e30 m from the origin, a 1e30 kg
+/// mass) are refused at load with the file and the element or key path, before they reach
+/// rapier and parry (whose contact code can fail on them). The accepted ranges: positions
+/// within 1e5 m of the origin, sizes up to 1e5 m, masses up to 1e6 kg (docs/WORLDS.md).
+#[test]
+fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<()> {
+    let robot = robot_text();
+    for (from, to, expect) in [
+        (
+            "<origin xyz=\"-0.045 0 0\"",
+            "<origin xyz=\"1e30 0 0\"",
+            "1e30 is out of range: expected positions (m) up to 1e5",
+        ),
+        (
+            "<mass value=\"",
+            "<mass value=\"1e30",
+            "is out of range: expected a mass (kg) up to 1e6",
+        ),
+    ] {
+        anyhow::ensure!(robot.contains(from), "my_robot.urdf has no {from}");
+        let text = robot.replacen(from, to, 1);
+        let message = urdf_error(&text);
+        let line = line_of(&text, to);
+        assert!(
+            message.contains(&format!("bad.urdf:{line}:")) && message.contains(expect),
+            "{message}"
+        );
+    }
+    let message = urdf_error(&robot.replacen(
+        "<box size=\"0.3 0.2 0.1\"/>",
+        "<box size=\"3e30 0.2 0.1\"/>",
+        1,
+    ));
+    assert!(
+        message.contains("3e30 is out of range: expected sizes (m) up to 1e5"),
+        "{message}"
+    );
+
+    let dir = tempfile::tempdir()?;
+    let world_text = std::fs::read_to_string(repo("worlds/playground.toml"))?;
+    for (from, to, expect) in [
+        (
+            "position_m = [4.0, 0.0]",
+            "position_m = [1e30, 0.0]",
+            "at `person[0].position_m`: 1000000000000000000000000000000 m is out of range: expected positions within 1e5 m of the origin",
+        ),
+        (
+            "[[box]]\n",
+            "[[box]]\nmass_kg = 1e30\n",
+            "kg is out of range: expected a mass up to 1e6 kg",
+        ),
+    ] {
+        anyhow::ensure!(world_text.contains(from), "playground.toml has no {from:?}");
+        let path = dir.path().join("w.toml");
+        std::fs::write(&path, world_text.replacen(from, to, 1))?;
+        let message = World::load(&path)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            message.contains("w.toml: at `") && message.contains(expect),
+            "{message}"
+        );
+    }
+    let path = dir.path().join("big.toml");
+    std::fs::write(
+        &path,
+        "[[box]]\nsize_m = [1e30, 1.0, 1.0]\nposition_m = [0.0, 0.0]\n",
+    )?;
+    let message = World::load(&path)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("at `box[0].size_m`") && message.contains("expected sizes up to 1e5 m"),
+        "{message}"
+    );
+
+    let sdf = dir.path().join("far.world");
+    std::fs::write(
+        &sdf,
+        "<sdf version='1.6'><world name='w'>\n<model name='m'><pose>1e30 0 0 0 0 0</pose><link name='l'/></model></world></sdf>",
+    )?;
+    let message = World::load(&sdf)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        message.contains("far.world:2:")
+            && message.contains("expected 6 finite numbers of magnitude up to 1e5"),
+        "{message}"
+    );
+    Ok(())
+}

@@ -16,7 +16,10 @@ use crate::description::urdf;
 use crate::description::xacro::{self, Expanded};
 use crate::description::xml::{line_of, parse_xml};
 use crate::error::{Result, SimError, quoted_list as names};
-use crate::geometry::{Rgba, Shape, pose_from_xyz_rpy, vec3};
+use crate::geometry::{
+    MAX_COORDINATE_M, MAX_INERTIA_KGM2, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape,
+    pose_from_xyz_rpy, vec3,
+};
 use crate::model::robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
 
 /// How to read a robot description: xacro arguments and where ROS packages are.
@@ -356,6 +359,21 @@ fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
                     ),
                 ));
             }
+            if let Some((limit, what)) = magnitude_limit(element, attr.name())
+                && let Some(big) = tokens
+                    .iter()
+                    .find(|t| t.parse::<f64>().is_ok_and(|v| v.abs() > limit))
+            {
+                return Err(SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!(
+                        "<{element} {}=\"{}\">: {big} is out of range: expected {what} up to {limit:e}",
+                        attr.name(),
+                        attr.value()
+                    ),
+                ));
+            }
             if matches!(attr.name(), "radius" | "length" | "value" | "size")
                 && let Some(neg) = tokens
                     .iter()
@@ -374,6 +392,20 @@ fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The accepted magnitude of a numeric URDF attribute, where rover bounds it: positions,
+/// sizes, masses and inertias far outside physical sense would reach the physics engine (f32)
+/// and parry's contact code, which can fail on them.
+fn magnitude_limit(element: &str, attribute: &str) -> Option<(f64, &'static str)> {
+    match (element, attribute) {
+        (_, "xyz") => Some((MAX_COORDINATE_M, "positions (m)")),
+        ("box", "size") | (_, "radius" | "length") => Some((MAX_SIZE_M, "sizes (m)")),
+        ("mass", "value") => Some((MAX_MASS_KG, "a mass (kg)")),
+        ("inertia", _) => Some((MAX_INERTIA_KGM2, "inertia components (kg m^2)")),
+        ("mesh", "scale") => Some((MAX_MAGNITUDE, "scale factors")),
+        _ => None,
+    }
 }
 
 /// Points an error in expanded text back at the xacro file and line it came from.

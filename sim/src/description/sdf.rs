@@ -20,6 +20,11 @@ use crate::model::person::{Person, Walk};
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
 
+/// Largest magnitude of a number rover reads from an SDF world (poses, sizes, masses, gravity,
+/// step size): positions, sizes and masses far outside physical sense reach the physics engine
+/// otherwise, and parry's contact code can fail on them.
+const MAX_SDF_NUMBER: f64 = crate::geometry::MAX_COORDINATE_M;
+
 /// Deepest `<include>` nesting followed (models including models).
 const MAX_INCLUDE_DEPTH: usize = 16;
 
@@ -179,12 +184,12 @@ impl Ctx<'_, '_> {
         let text = node.text().unwrap_or("").trim();
         text.parse::<f64>()
             .ok()
-            .filter(|v| v.is_finite())
+            .filter(|v| v.is_finite() && v.abs() <= MAX_SDF_NUMBER)
             .ok_or_else(|| {
                 self.err(
                     node,
                     format!(
-                        "<{}>{text}</{}>: expected a finite number",
+                        "<{}>{text}</{}>: expected a finite number of magnitude up to {MAX_SDF_NUMBER:e}",
                         node.tag_name().name(),
                         node.tag_name().name()
                     ),
@@ -196,14 +201,18 @@ impl Ctx<'_, '_> {
         let text = node.text().unwrap_or("");
         let values: Vec<f64> = text
             .split_whitespace()
-            .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .map(|t| {
+                t.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && v.abs() <= MAX_SDF_NUMBER)
+            })
             .collect::<Option<Vec<_>>>()
             .unwrap_or_default();
         values.try_into().map_err(|_| {
             self.err(
                 node,
                 format!(
-                    "<{}>{}</{}>: expected {N} finite numbers",
+                    "<{}>{}</{}>: expected {N} finite numbers of magnitude up to {MAX_SDF_NUMBER:e}",
                     node.tag_name().name(),
                     text.trim(),
                     node.tag_name().name()

@@ -8,7 +8,7 @@ use serde::Deserialize;
 use crate::description::resource::ResourcePaths;
 use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
-use crate::geometry::Rgba;
+use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba};
 use crate::model::drive::DriveSpec;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
@@ -255,22 +255,46 @@ impl Checker<'_> {
     }
 
     fn finite(&self, key: &str, values: &[f64]) -> Result<()> {
-        if values.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err(self.fail(key, format!("expected finite numbers, found {values:?}")))
+        if !values.iter().all(|v| v.is_finite()) {
+            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
+        }
+        if let Some(v) = values.iter().find(|v| v.abs() > MAX_MAGNITUDE) {
+            return Err(self.fail(
+                key,
+                format!("{v} is out of range: expected a magnitude up to {MAX_MAGNITUDE:e}"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Finite coordinates within [`MAX_COORDINATE_M`] of the origin.
+    fn coordinates(&self, key: &str, values: &[f64]) -> Result<()> {
+        self.finite(key, values)?;
+        match values.iter().find(|v| v.abs() > MAX_COORDINATE_M) {
+            Some(v) => Err(self.fail(
+                key,
+                format!(
+                    "{v} m is out of range: expected positions within {MAX_COORDINATE_M:e} m of the origin"
+                ),
+            )),
+            None => Ok(()),
         }
     }
 
     fn positive(&self, key: &str, values: &[f64], unit: &str) -> Result<()> {
         self.finite(key, values)?;
-        if values.iter().all(|v| *v > 0.0) {
-            Ok(())
-        } else {
-            Err(self.fail(
+        if !values.iter().all(|v| *v > 0.0) {
+            return Err(self.fail(
                 key,
                 format!("expected positive numbers ({unit}), found {values:?}"),
-            ))
+            ));
+        }
+        match values.iter().find(|v| unit == "m" && **v > MAX_SIZE_M) {
+            Some(v) => Err(self.fail(
+                key,
+                format!("{v} m is out of range: expected sizes up to {MAX_SIZE_M:e} m"),
+            )),
+            None => Ok(()),
         }
     }
 
@@ -290,7 +314,7 @@ impl Checker<'_> {
 
     fn friction(&self, key: &str, value: Option<f64>) -> Result<f32> {
         let f = value.unwrap_or(0.8);
-        if f.is_finite() && f >= 0.0 {
+        if f.is_finite() && f >= 0.0 && f <= MAX_MAGNITUDE {
             Ok(f as f32)
         } else {
             Err(self.fail(
@@ -306,13 +330,17 @@ impl Checker<'_> {
                 key,
                 format!("expected a positive mass in kg (omit it for a static object), found {m}"),
             )),
+            Some(m) if m > MAX_MASS_KG => Err(self.fail(
+                key,
+                format!("{m} kg is out of range: expected a mass up to {MAX_MASS_KG:e} kg"),
+            )),
             other => Ok(other),
         }
     }
 
     /// `[x, y]` (resting on the ground, z = `half_height`) or `[x, y, z]`.
     fn position(&self, key: &str, values: &[f64], half_height: f64) -> Result<[f64; 3]> {
-        self.finite(key, values)?;
+        self.coordinates(key, values)?;
         match *values {
             [x, y] => Ok([x, y, half_height]),
             [x, y, z] => Ok([x, y, z]),
@@ -367,7 +395,7 @@ impl RawWorld {
         let base_dir = path.parent().unwrap_or(Path::new("."));
 
         let raw_robot = std::mem::take(&mut self.robot);
-        c.finite("robot.position_m", &raw_robot.position_m)?;
+        c.coordinates("robot.position_m", &raw_robot.position_m)?;
         c.finite("robot.yaw_deg", &[raw_robot.yaw_deg])?;
         let robot = RobotSpawn {
             urdf: raw_robot.urdf.map(|u| base_dir.join(u)),
@@ -503,8 +531,8 @@ impl RawWall {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
         let w = self;
         let key = |field: &str| format!("wall[{i}].{field}");
-        c.finite(&key("from_m"), &w.from_m)?;
-        c.finite(&key("to_m"), &w.to_m)?;
+        c.coordinates(&key("from_m"), &w.from_m)?;
+        c.coordinates(&key("to_m"), &w.to_m)?;
         c.positive(&key("height_m"), &[w.height_m], "m")?;
         c.positive(&key("thickness_m"), &[w.thickness_m], "m")?;
         let (dx, dy) = (w.to_m[0] - w.from_m[0], w.to_m[1] - w.from_m[1]);
@@ -541,7 +569,7 @@ impl RawPerson {
     fn into_person(self, i: usize, c: &Checker<'_>) -> Result<Person> {
         let p = self;
         let key = |field: &str| format!("person[{i}].{field}");
-        c.finite(&key("position_m"), &p.position_m)?;
+        c.coordinates(&key("position_m"), &p.position_m)?;
         c.finite(&key("heading_deg"), &[p.heading_deg])?;
         if !(p.height_m.is_finite() && (0.5..=2.5).contains(&p.height_m)) {
             return Err(c.fail(
@@ -553,7 +581,7 @@ impl RawPerson {
             ));
         }
         for (j, w) in p.waypoints_m.iter().enumerate() {
-            c.finite(&format!("person[{i}].waypoints_m[{j}]"), w)?;
+            c.coordinates(&format!("person[{i}].waypoints_m[{j}]"), w)?;
         }
         let walk = match (p.waypoints_m.is_empty(), p.speed_mps) {
             (true, None) => None,
