@@ -276,6 +276,8 @@ fn parse_diff_drive(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<DiffDrive
     Ok(c)
 }
 
+/// A camera `<sensor>` on `link`: the SDF `<camera>` element and the gazebo_ros_camera plugin's
+/// parameters, Gazebo's defaults where both are silent.
 fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<CameraConfig> {
     let name = sensor.attribute("name").unwrap_or("camera").to_owned();
     let what = format!("<sensor name=\"{name}\">");
@@ -303,106 +305,8 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
     for s in elements(sensor) {
         match s.tag_name().name() {
             "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
-            "camera" => {
-                for cam in elements(s) {
-                    match cam.tag_name().name() {
-                        "horizontal_fov" => {
-                            let fov = ctx.positive(cam, what, "radians")?;
-                            if fov >= std::f64::consts::PI {
-                                return Err(ctx.err(
-                                    cam,
-                                    format!("<horizontal_fov> in {what}: expected less than pi radians for a pinhole camera, found {fov}"),
-                                ));
-                            }
-                            c.horizontal_fov_rad = fov;
-                        }
-                        "image" => {
-                            for img in elements(cam) {
-                                match img.tag_name().name() {
-                                    "width" => c.width_px = ctx.pixels(img, what)?,
-                                    "height" => c.height_px = ctx.pixels(img, what)?,
-                                    "format" => {
-                                        c.format = match text_of(img) {
-                                            "R8G8B8" | "RGB_INT8" => PixelFormat::Rgb8,
-                                            "B8G8R8" | "BGR_INT8" => PixelFormat::Bgr8,
-                                            "L8" | "L_INT8" => PixelFormat::Mono8,
-                                            other => {
-                                                return Err(ctx.err(
-                                                    img,
-                                                    format!("<format> in {what}: expected R8G8B8, B8G8R8 or L8, found '{other}'"),
-                                                ));
-                                            }
-                                        }
-                                    }
-                                    _ => {}
-                                }
-                            }
-                        }
-                        "clip" => {
-                            for clip in elements(cam) {
-                                match clip.tag_name().name() {
-                                    "near" => c.clip_near_m = ctx.positive(clip, what, "metres")?,
-                                    "far" => c.clip_far_m = ctx.positive(clip, what, "metres")?,
-                                    _ => {}
-                                }
-                            }
-                            if c.clip_near_m >= c.clip_far_m {
-                                return Err(ctx.err(
-                                    cam,
-                                    format!(
-                                        "<clip> in {what}: expected near < far, found near {} and far {}",
-                                        c.clip_near_m, c.clip_far_m
-                                    ),
-                                ));
-                            }
-                        }
-                        "noise" => c.noise = parse_noise(ctx, cam, what, "0..1 intensity")?,
-                        "distortion" => {
-                            let mut d = Distortion::default();
-                            for k in elements(cam) {
-                                let slot = match k.tag_name().name() {
-                                    "k1" => &mut d.k1,
-                                    "k2" => &mut d.k2,
-                                    "k3" => &mut d.k3,
-                                    "p1" => &mut d.p1,
-                                    "p2" => &mut d.p2,
-                                    _ => continue,
-                                };
-                                *slot = ctx.number(k, what, "coefficient")?;
-                            }
-                            sdf_distortion = Some(d);
-                        }
-                        _ => {}
-                    }
-                }
-            }
-            "plugin" => {
-                for p in elements(s) {
-                    let text = || text_of(p).to_owned();
-                    match p.tag_name().name() {
-                        "cameraName" => c.camera_name = text(),
-                        "frameName" => c.frame_name = text(),
-                        "imageTopicName" => c.image_topic = text(),
-                        "cameraInfoTopicName" => c.info_topic = text(),
-                        "distortionK1" => {
-                            plugin_distortion.k1 = ctx.number(p, what, "coefficient")?
-                        }
-                        "distortionK2" => {
-                            plugin_distortion.k2 = ctx.number(p, what, "coefficient")?
-                        }
-                        "distortionK3" => {
-                            plugin_distortion.k3 = ctx.number(p, what, "coefficient")?
-                        }
-                        "distortionT1" => {
-                            plugin_distortion.p1 = ctx.number(p, what, "coefficient")?
-                        }
-                        "distortionT2" => {
-                            plugin_distortion.p2 = ctx.number(p, what, "coefficient")?
-                        }
-                        _ => {}
-                    }
-                }
-            }
+            "camera" => read_camera_element(ctx, s, what, &mut c, &mut sdf_distortion)?,
+            "plugin" => read_camera_plugin(ctx, s, what, &mut c, &mut plugin_distortion)?,
             _ => {}
         }
     }
@@ -410,6 +314,146 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
     Ok(c)
 }
 
+/// Reads the SDF `<camera>` element of camera sensor `what` into `c`; its `<distortion>`, when
+/// present, goes to `sdf_distortion` (it wins over the plugin's).
+fn read_camera_element(
+    ctx: &Ctx<'_, '_>,
+    camera: Node<'_, '_>,
+    what: &str,
+    c: &mut CameraConfig,
+    sdf_distortion: &mut Option<Distortion>,
+) -> Result<()> {
+    for cam in elements(camera) {
+        match cam.tag_name().name() {
+            "horizontal_fov" => {
+                let fov = ctx.positive(cam, what, "radians")?;
+                if fov >= std::f64::consts::PI {
+                    return Err(ctx.err(
+                        cam,
+                        format!("<horizontal_fov> in {what}: expected less than pi radians for a pinhole camera, found {fov}"),
+                    ));
+                }
+                c.horizontal_fov_rad = fov;
+            }
+            "image" => read_camera_image(ctx, cam, what, c)?,
+            "clip" => read_camera_clip(ctx, cam, what, c)?,
+            "noise" => c.noise = parse_noise(ctx, cam, what, "0..1 intensity")?,
+            "distortion" => {
+                let mut d = Distortion::default();
+                for k in elements(cam) {
+                    let slot = match k.tag_name().name() {
+                        "k1" => &mut d.k1,
+                        "k2" => &mut d.k2,
+                        "k3" => &mut d.k3,
+                        "p1" => &mut d.p1,
+                        "p2" => &mut d.p2,
+                        _ => continue,
+                    };
+                    *slot = ctx.number(k, what, "coefficient")?;
+                }
+                *sdf_distortion = Some(d);
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Reads `<camera><image>` (width, height, pixel format) of camera sensor `what` into `c`.
+fn read_camera_image(
+    ctx: &Ctx<'_, '_>,
+    image: Node<'_, '_>,
+    what: &str,
+    c: &mut CameraConfig,
+) -> Result<()> {
+    for img in elements(image) {
+        match img.tag_name().name() {
+            "width" => c.width_px = ctx.pixels(img, what)?,
+            "height" => c.height_px = ctx.pixels(img, what)?,
+            "format" => {
+                c.format = match text_of(img) {
+                    "R8G8B8" | "RGB_INT8" => PixelFormat::Rgb8,
+                    "B8G8R8" | "BGR_INT8" => PixelFormat::Bgr8,
+                    "L8" | "L_INT8" => PixelFormat::Mono8,
+                    other => {
+                        return Err(ctx.err(
+                            img,
+                            format!(
+                                "<format> in {what}: expected R8G8B8, B8G8R8 or L8, found '{other}'"
+                            ),
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Reads `<camera><clip>` (near and far planes) of camera sensor `what` into `c`, which must
+/// then have near < far.
+fn read_camera_clip(
+    ctx: &Ctx<'_, '_>,
+    clip_element: Node<'_, '_>,
+    what: &str,
+    c: &mut CameraConfig,
+) -> Result<()> {
+    for clip in elements(clip_element) {
+        match clip.tag_name().name() {
+            "near" => c.clip_near_m = ctx.positive(clip, what, "metres")?,
+            "far" => c.clip_far_m = ctx.positive(clip, what, "metres")?,
+            _ => {}
+        }
+    }
+    if c.clip_near_m >= c.clip_far_m {
+        return Err(ctx.err(
+            clip_element,
+            format!(
+                "<clip> in {what}: expected near < far, found near {} and far {}",
+                c.clip_near_m, c.clip_far_m
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads the gazebo_ros_camera `<plugin>` parameters of camera sensor `what` into `c`; its
+/// distortion coefficients go to `plugin_distortion`.
+fn read_camera_plugin(
+    ctx: &Ctx<'_, '_>,
+    plugin: Node<'_, '_>,
+    what: &str,
+    c: &mut CameraConfig,
+    plugin_distortion: &mut Distortion,
+) -> Result<()> {
+    for p in elements(plugin) {
+        let text = || text_of(p).to_owned();
+        match p.tag_name().name() {
+            "cameraName" => c.camera_name = text(),
+            "frameName" => c.frame_name = text(),
+            "imageTopicName" => c.image_topic = text(),
+            "cameraInfoTopicName" => c.info_topic = text(),
+            "distortionK1" => plugin_distortion.k1 = ctx.number(p, what, "coefficient")?,
+            "distortionK2" => plugin_distortion.k2 = ctx.number(p, what, "coefficient")?,
+            "distortionK3" => plugin_distortion.k3 = ctx.number(p, what, "coefficient")?,
+            "distortionT1" => plugin_distortion.p1 = ctx.number(p, what, "coefficient")?,
+            "distortionT2" => plugin_distortion.p2 = ctx.number(p, what, "coefficient")?,
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// A laser's horizontal `<scan>` as written: `<samples>` and `<resolution>` (rays per sample),
+/// Gazebo's defaults until read.
+struct HorizontalScan {
+    samples: u32,
+    resolution: f64,
+}
+
+/// A 2D laser `<sensor type="ray">` on `link`: the SDF `<ray>` element and the
+/// gazebo_ros_laser plugin's parameters, Gazebo's defaults where both are silent.
 fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<LaserConfig> {
     let name = sensor.attribute("name").unwrap_or("laser").to_owned();
     let what = format!("<sensor name=\"{name}\">");
@@ -431,87 +475,15 @@ fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<La
         frame_name: link.to_owned(),
         line: Some(line_of(ctx.doc, sensor)),
     };
-    let mut samples = 640u32;
-    let mut resolution = 1.0f64;
+    let mut scan = HorizontalScan {
+        samples: 640,
+        resolution: 1.0,
+    };
     for s in elements(sensor) {
         match s.tag_name().name() {
             "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
-            "pose" => {
-                let text = text_of(s);
-                let v: Vec<f64> = text
-                    .split_whitespace()
-                    .map(str::parse::<f64>)
-                    .collect::<std::result::Result<_, _>>()
-                    .ok()
-                    .filter(|v: &Vec<f64>| v.len() == 6 && v.iter().all(|x| x.is_finite()))
-                    .ok_or_else(|| {
-                        ctx.err(
-                            s,
-                            format!("<pose> in {what}: expected six numbers 'x y z roll pitch yaw', found '{text}'"),
-                        )
-                    })?;
-                c.link_from_sensor = pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
-            }
-            "ray" => {
-                for ray in elements(s) {
-                    match ray.tag_name().name() {
-                        "scan" => {
-                            for h in elements(ray).filter(|n| n.has_tag_name("horizontal")) {
-                                for p in elements(h) {
-                                    match p.tag_name().name() {
-                                        "samples" => {
-                                            let text = text_of(p);
-                                            samples = match text.parse::<u32>() {
-                                                Ok(n) if (1..=MAX_LASER_SAMPLES).contains(&n) => n,
-                                                _ => {
-                                                    return Err(ctx.err(
-                                                        p,
-                                                        format!("<samples> in {what}: expected a whole number of rays between 1 and {MAX_LASER_SAMPLES}, found '{text}'"),
-                                                    ));
-                                                }
-                                            }
-                                        }
-                                        "resolution" => {
-                                            resolution = ctx.positive(p, what, "rays per sample")?
-                                        }
-                                        "min_angle" => {
-                                            c.min_angle_rad = ctx.number(p, what, "radians")?
-                                        }
-                                        "max_angle" => {
-                                            c.max_angle_rad = ctx.number(p, what, "radians")?
-                                        }
-                                        _ => {}
-                                    }
-                                }
-                            }
-                        }
-                        "range" => {
-                            for r in elements(ray) {
-                                match r.tag_name().name() {
-                                    "min" => c.range_min_m = ctx.non_negative(r, what, "metres")?,
-                                    "max" => c.range_max_m = ctx.positive(r, what, "metres")?,
-                                    "resolution" => {
-                                        c.range_resolution_m =
-                                            ctx.non_negative(r, what, "metres")?
-                                    }
-                                    _ => {}
-                                }
-                            }
-                            if c.range_min_m >= c.range_max_m {
-                                return Err(ctx.err(
-                                    ray,
-                                    format!(
-                                        "<range> in {what}: expected min < max, found min {} and max {}",
-                                        c.range_min_m, c.range_max_m
-                                    ),
-                                ));
-                            }
-                        }
-                        "noise" => c.noise = parse_noise(ctx, ray, what, "metres")?,
-                        _ => {}
-                    }
-                }
-            }
+            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
+            "ray" => read_ray_element(ctx, s, what, &mut c, &mut scan)?,
             "plugin" => {
                 for p in elements(s) {
                     match p.tag_name().name() {
@@ -524,7 +496,7 @@ fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<La
             _ => {}
         }
     }
-    let rays = (f64::from(samples) * resolution).round();
+    let rays = (f64::from(scan.samples) * scan.resolution).round();
     if !(1.0..=f64::from(MAX_LASER_SAMPLES)).contains(&rays) {
         return Err(ctx.err(
             sensor,
@@ -542,6 +514,102 @@ fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<La
         ));
     }
     Ok(c)
+}
+
+/// A sensor's `<pose>`: six numbers `x y z roll pitch yaw`, the sensor in its link's frame.
+fn read_sensor_pose(ctx: &Ctx<'_, '_>, pose: Node<'_, '_>, what: &str) -> Result<Pose> {
+    let text = text_of(pose);
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .map(str::parse::<f64>)
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f64>| v.len() == 6 && v.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| {
+            ctx.err(
+                pose,
+                format!(
+                    "<pose> in {what}: expected six numbers 'x y z roll pitch yaw', found '{text}'"
+                ),
+            )
+        })?;
+    Ok(pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]))
+}
+
+/// Reads the SDF `<ray>` element of laser sensor `what`: its horizontal scan into `scan` and
+/// `c`'s angles, its `<range>` and `<noise>` into `c`.
+fn read_ray_element(
+    ctx: &Ctx<'_, '_>,
+    ray_element: Node<'_, '_>,
+    what: &str,
+    c: &mut LaserConfig,
+    scan: &mut HorizontalScan,
+) -> Result<()> {
+    for ray in elements(ray_element) {
+        match ray.tag_name().name() {
+            "scan" => {
+                for h in elements(ray).filter(|n| n.has_tag_name("horizontal")) {
+                    read_horizontal_scan(ctx, h, what, c, scan)?;
+                }
+            }
+            "range" => {
+                for r in elements(ray) {
+                    match r.tag_name().name() {
+                        "min" => c.range_min_m = ctx.non_negative(r, what, "metres")?,
+                        "max" => c.range_max_m = ctx.positive(r, what, "metres")?,
+                        "resolution" => {
+                            c.range_resolution_m = ctx.non_negative(r, what, "metres")?
+                        }
+                        _ => {}
+                    }
+                }
+                if c.range_min_m >= c.range_max_m {
+                    return Err(ctx.err(
+                        ray,
+                        format!(
+                            "<range> in {what}: expected min < max, found min {} and max {}",
+                            c.range_min_m, c.range_max_m
+                        ),
+                    ));
+                }
+            }
+            "noise" => c.noise = parse_noise(ctx, ray, what, "metres")?,
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Reads one `<ray><scan><horizontal>` of laser sensor `what`: samples and resolution into
+/// `scan`, the angle limits into `c`.
+fn read_horizontal_scan(
+    ctx: &Ctx<'_, '_>,
+    horizontal: Node<'_, '_>,
+    what: &str,
+    c: &mut LaserConfig,
+    scan: &mut HorizontalScan,
+) -> Result<()> {
+    for p in elements(horizontal) {
+        match p.tag_name().name() {
+            "samples" => {
+                let text = text_of(p);
+                scan.samples = match text.parse::<u32>() {
+                    Ok(n) if (1..=MAX_LASER_SAMPLES).contains(&n) => n,
+                    _ => {
+                        return Err(ctx.err(
+                            p,
+                            format!("<samples> in {what}: expected a whole number of rays between 1 and {MAX_LASER_SAMPLES}, found '{text}'"),
+                        ));
+                    }
+                }
+            }
+            "resolution" => scan.resolution = ctx.positive(p, what, "rays per sample")?,
+            "min_angle" => c.min_angle_rad = ctx.number(p, what, "radians")?,
+            "max_angle" => c.max_angle_rad = ctx.number(p, what, "radians")?,
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn parse_noise(

@@ -51,6 +51,36 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     };
 
     let mut world = World::flat()?;
+    read_physics(&ctx, world_el, &mut world)?;
+    let state_models = state_poses(&ctx, world_el)?;
+    let mut models = Vec::new();
+    read_world_entities(&ctx, world_el, &mut loader, &mut world, &mut models)?;
+    apply_state_poses(path, &mut models, &state_models)?;
+    if !loader.skipped.is_empty() {
+        tracing::info!(
+            "{}: not simulated (rover has no model for them): {}",
+            path.display(),
+            loader
+                .skipped
+                .iter()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    world.name = world_el.attribute("name").unwrap_or("default").to_owned();
+    world.source = path.to_path_buf();
+    world.description = format!("Gazebo SDF world {}", path.display());
+    // Gazebo's ground_plane is 100 m x 100 m.
+    world.ground.size_m = [100.0, 100.0];
+    world.models = models;
+    Ok(world)
+}
+
+/// Reads the world-level settings of `<world>` into `world`: the physics step
+/// (`<physics><max_step_size>`, outside rover's range a warning and the default) and gravity
+/// (`<physics><gravity>`, overridden by `<world><gravity>`).
+fn read_physics(ctx: &Ctx<'_, '_>, world_el: Node<'_, '_>, world: &mut World) -> Result<()> {
     let physics = &mut world.physics;
     if let Some(p) = child(world_el, "physics") {
         if let Some(step) = child(p, "max_step_size") {
@@ -61,7 +91,7 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
             } else {
                 tracing::warn!(
                     "{}: <max_step_size>{dt}</max_step_size> is outside rover's {}..={} Hz; using {DEFAULT_STEP_HZ} Hz",
-                    path.display(),
+                    ctx.path.display(),
                     STEP_HZ_RANGE.start(),
                     STEP_HZ_RANGE.end()
                 );
@@ -75,10 +105,16 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
     if let Some(g) = child(world_el, "gravity") {
         physics.gravity_mps2 = ctx.numbers::<3>(g)?;
     }
+    Ok(())
+}
 
-    // <state> poses override the models' own (Gazebo saves the world's last state there).
-    let mut state_models: BTreeMap<String, (Option<Pose>, BTreeMap<String, Pose>)> =
-        BTreeMap::new();
+/// The `<state>` poses of a world, by model name: the model's pose (world frame) when given,
+/// and its links' poses (world frame) by link name.
+type StatePoses = BTreeMap<String, (Option<Pose>, BTreeMap<String, Pose>)>;
+
+/// Reads the `<state>` elements of `<world>` (Gazebo saves the world's last state there).
+fn state_poses(ctx: &Ctx<'_, '_>, world_el: Node<'_, '_>) -> Result<StatePoses> {
+    let mut state_models = StatePoses::new();
     for state in children(world_el, "state") {
         for m in children(state, "model") {
             let name = m.attribute("name").unwrap_or_default().to_owned();
@@ -95,36 +131,65 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
             state_models.insert(name, (pose, links));
         }
     }
+    Ok(state_models)
+}
 
-    let mut models = Vec::new();
+/// Reads what `<world>` holds besides its settings, in order: models (`<model>`, `<include>`)
+/// into `models`, people (`<include>` of a person model, `<actor>`) into `world`; anything else
+/// is noted in `loader.skipped`.
+fn read_world_entities(
+    ctx: &Ctx<'_, '_>,
+    world_el: Node<'_, '_>,
+    loader: &mut Loader<'_>,
+    world: &mut World,
+    models: &mut Vec<Model>,
+) -> Result<()> {
     for node in world_el.children().filter(Node::is_element) {
         match node.tag_name().name() {
-            "model" => loader.model(&ctx, node, Pose::IDENTITY, None, &mut models, 0)?,
+            "model" => loader.model(ctx, node, Pose::IDENTITY, None, models, 0)?,
             "include" => match person_model(node) {
                 Some(model) => {
-                    let name = child(node, "name")
-                        .and_then(|n| n.text())
-                        .map(|s| s.trim().to_owned())
-                        .unwrap_or_else(|| format!("{model}_{}", world.people.len()));
-                    let pose = ctx.local_pose(node)?;
-                    let t = pose.translation;
-                    world.people.push(Person::standing(
-                        name,
-                        [f64::from(t.x), f64::from(t.y)],
-                        yaw_of(pose.rotation),
-                    ));
+                    let person = included_person(ctx, node, &model, world.people.len())?;
+                    world.people.push(person);
                 }
-                None => loader.include(&ctx, node, Pose::IDENTITY, &mut models, 0)?,
+                None => loader.include(ctx, node, Pose::IDENTITY, models, 0)?,
             },
-            "actor" => world.people.push(actor(&ctx, node)?),
+            "actor" => world.people.push(actor(ctx, node)?),
             "physics" | "gravity" | "state" => {}
             other => {
                 loader.skipped.insert(format!("<{other}>"));
             }
         }
     }
+    Ok(())
+}
+
+/// A person standing where `<include>` of the person model `model` puts it, named by the
+/// include's `<name>` or else `model_index` (`index`: how many people came before).
+fn included_person(
+    ctx: &Ctx<'_, '_>,
+    include: Node<'_, '_>,
+    model: &str,
+    index: usize,
+) -> Result<Person> {
+    let name = child(include, "name")
+        .and_then(|n| n.text())
+        .map(|s| s.trim().to_owned())
+        .unwrap_or_else(|| format!("{model}_{index}"));
+    let pose = ctx.local_pose(include)?;
+    let t = pose.translation;
+    Ok(Person::standing(
+        name,
+        [f64::from(t.x), f64::from(t.y)],
+        yaw_of(pose.rotation),
+    ))
+}
+
+/// Checks that model names are unique and moves the models named in `<state>` to their state
+/// poses: the model's frame, and each link to its state pose or else along with its model.
+fn apply_state_poses(path: &Path, models: &mut [Model], state_models: &StatePoses) -> Result<()> {
     let mut names = BTreeSet::new();
-    for model in &mut models {
+    for model in models {
         if !names.insert(model.name.clone()) {
             return Err(SimError::invalid(
                 path,
@@ -149,25 +214,7 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
             }
         }
     }
-    if !loader.skipped.is_empty() {
-        tracing::info!(
-            "{}: not simulated (rover has no model for them): {}",
-            path.display(),
-            loader
-                .skipped
-                .iter()
-                .cloned()
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    world.name = world_el.attribute("name").unwrap_or("default").to_owned();
-    world.source = path.to_path_buf();
-    world.description = format!("Gazebo SDF world {}", path.display());
-    // Gazebo's ground_plane is 100 m x 100 m.
-    world.ground.size_m = [100.0, 100.0];
-    world.models = models;
-    Ok(world)
+    Ok(())
 }
 
 struct Ctx<'a, 'input> {

@@ -689,40 +689,41 @@ fn eval(e: &Expr, names: &mut dyn Names) -> R<Value> {
                 .map(|i| eval(i, names))
                 .collect::<R<Vec<_>>>()?,
         )),
-        Expr::Index(target, index) => {
-            let target = eval(target, names)?;
-            let index = eval(index, names)?;
-            let Some(i) = index.int() else {
-                return err(format!(
-                    "indices must be integers, not {}",
-                    index.type_name()
-                ));
-            };
-            let pick = |len: usize| -> R<usize> {
-                let len = len as i64;
-                let j = if i < 0 { i + len } else { i };
-                if (0..len).contains(&j) {
-                    Ok(j as usize)
-                } else {
-                    err(format!("index {i} out of range"))
-                }
-            };
-            match target {
-                Value::List(items) => Ok(items[pick(items.len())?].clone()),
-                Value::Str(s) => {
-                    let chars: Vec<char> = s.chars().collect();
-                    Ok(Value::Str(chars[pick(chars.len())?].to_string()))
-                }
-                other => err(format!(
-                    "'{}' object is not subscriptable",
-                    other.type_name()
-                )),
-            }
-        }
+        Expr::Index(target, index) => subscript(eval(target, names)?, &eval(index, names)?),
         Expr::Call(name, args) => {
             let values = args.iter().map(|a| eval(a, names)).collect::<R<Vec<_>>>()?;
             call(name, values, names)
         }
+    }
+}
+
+/// `target[index]` on a list or a string, negative indices counting from the end.
+fn subscript(target: Value, index: &Value) -> R<Value> {
+    let Some(i) = index.int() else {
+        return err(format!(
+            "indices must be integers, not {}",
+            index.type_name()
+        ));
+    };
+    let pick = |len: usize| -> R<usize> {
+        let len = len as i64;
+        let j = if i < 0 { i + len } else { i };
+        if (0..len).contains(&j) {
+            Ok(j as usize)
+        } else {
+            err(format!("index {i} out of range"))
+        }
+    };
+    match target {
+        Value::List(items) => Ok(items[pick(items.len())?].clone()),
+        Value::Str(s) => {
+            let chars: Vec<char> = s.chars().collect();
+            Ok(Value::Str(chars[pick(chars.len())?].to_string()))
+        }
+        other => err(format!(
+            "'{}' object is not subscriptable",
+            other.type_name()
+        )),
     }
 }
 
@@ -836,210 +837,234 @@ fn values_equal(a: &Value, b: &Value) -> bool {
     }
 }
 
+/// One call of a builtin function: the name as written (`math.sqrt`, for messages) and the
+/// evaluated arguments, with the argument checks the builtins share.
+struct Builtin<'a> {
+    name: &'a str,
+    args: Vec<Value>,
+}
+
+impl Builtin<'_> {
+    /// Argument `i` (from 0) as a number.
+    fn num(&self, i: usize) -> R<f64> {
+        self.args.get(i).and_then(Value::number).ok_or_else(|| {
+            ExprError::Other(format!(
+                "{}() expects a number as argument {}",
+                self.name,
+                i + 1
+            ))
+        })
+    }
+
+    /// Fails unless exactly `n` arguments were given.
+    fn arity(&self, n: usize) -> R<()> {
+        if self.args.len() == n {
+            Ok(())
+        } else {
+            err(format!(
+                "{}() takes {n} argument(s), {} given",
+                self.name,
+                self.args.len()
+            ))
+        }
+    }
+
+    /// A float function of one number.
+    fn float1(&self, f: fn(f64) -> f64) -> R<Value> {
+        self.arity(1)?;
+        Ok(Value::Float(f(self.num(0)?)))
+    }
+
+    /// `x`, or Python's math domain error when `ok` is false.
+    fn domain(&self, x: f64, ok: bool) -> R<Value> {
+        if ok {
+            Ok(Value::Float(x))
+        } else {
+            err(format!("{}(): math domain error", self.name))
+        }
+    }
+}
+
+/// Calls the builtin `name` (`math.` and `xacro.` prefixes allowed) on `args`.
 fn call(name: &str, args: Vec<Value>, names: &mut dyn Names) -> R<Value> {
     let bare = name
         .strip_prefix("math.")
         .or_else(|| name.strip_prefix("xacro."))
         .unwrap_or(name);
-    let num = |i: usize| -> R<f64> {
-        args.get(i).and_then(Value::number).ok_or_else(|| {
-            ExprError::Other(format!("{name}() expects a number as argument {}", i + 1))
-        })
-    };
-    let arity = |n: usize| -> R<()> {
-        if args.len() == n {
-            Ok(())
-        } else {
-            err(format!(
-                "{name}() takes {n} argument(s), {} given",
-                args.len()
-            ))
+    let builtin = Builtin { name, args };
+    float_function(bare, &builtin)
+        .or_else(|| integer_function(bare, &builtin))
+        .or_else(|| conversion_function(bare, &builtin, names))
+        .unwrap_or_else(|| Err(ExprError::Undefined(format!("{name}()"))))
+}
+
+/// The float functions of Python's `math` module (trigonometry, logarithms, powers), or `None`
+/// when `bare` is none of them.
+fn float_function(bare: &str, b: &Builtin<'_>) -> Option<R<Value>> {
+    Some(match bare {
+        "sin" => b.float1(f64::sin),
+        "cos" => b.float1(f64::cos),
+        "tan" => b.float1(f64::tan),
+        "asin" => b.arity(1).and_then(|()| {
+            let x = b.num(0)?;
+            b.domain(x.asin(), (-1.0..=1.0).contains(&x))
+        }),
+        "acos" => b.arity(1).and_then(|()| {
+            let x = b.num(0)?;
+            b.domain(x.acos(), (-1.0..=1.0).contains(&x))
+        }),
+        "atan" => b.float1(f64::atan),
+        "exp" => b.float1(f64::exp),
+        "fabs" => b.float1(f64::abs),
+        "radians" => b.float1(f64::to_radians),
+        "degrees" => b.float1(f64::to_degrees),
+        "sqrt" => b.arity(1).and_then(|()| {
+            let x = b.num(0)?;
+            b.domain(x.sqrt(), x >= 0.0)
+        }),
+        "log10" => b.arity(1).and_then(|()| {
+            let x = b.num(0)?;
+            b.domain(x.log10(), x > 0.0)
+        }),
+        "log" => log(b),
+        "atan2" => b
+            .arity(2)
+            .and_then(|()| Ok(Value::Float(b.num(0)?.atan2(b.num(1)?)))),
+        "hypot" => b
+            .arity(2)
+            .and_then(|()| Ok(Value::Float(b.num(0)?.hypot(b.num(1)?)))),
+        "pow" => b
+            .arity(2)
+            .and_then(|()| Ok(Value::Float(b.num(0)?.powf(b.num(1)?)))),
+        "fmod" => b.arity(2).and_then(|()| {
+            let y = b.num(1)?;
+            b.domain(b.num(0)? % y, y != 0.0)
+        }),
+        "copysign" => b
+            .arity(2)
+            .and_then(|()| Ok(Value::Float(b.num(0)?.copysign(b.num(1)?)))),
+        _ => return None,
+    })
+}
+
+/// `log(x)` or `log(x, base)`.
+fn log(b: &Builtin<'_>) -> R<Value> {
+    let x = b.num(0)?;
+    match b.args.len() {
+        1 => b.domain(x.ln(), x > 0.0),
+        2 => {
+            let base = b.num(1)?;
+            b.domain(x.ln() / base.ln(), x > 0.0 && base > 0.0 && base != 1.0)
         }
-    };
-    let float1 = |f: fn(f64) -> f64| -> R<Value> {
-        arity(1)?;
-        Ok(Value::Float(f(num(0)?)))
-    };
-    let domain = |x: f64, ok: bool| -> R<Value> {
-        if ok {
-            Ok(Value::Float(x))
-        } else {
-            err(format!("{name}(): math domain error"))
-        }
-    };
-    match bare {
-        "sin" => float1(f64::sin),
-        "cos" => float1(f64::cos),
-        "tan" => float1(f64::tan),
-        "asin" => {
-            arity(1)?;
-            let x = num(0)?;
-            domain(x.asin(), (-1.0..=1.0).contains(&x))
-        }
-        "acos" => {
-            arity(1)?;
-            let x = num(0)?;
-            domain(x.acos(), (-1.0..=1.0).contains(&x))
-        }
-        "atan" => float1(f64::atan),
-        "exp" => float1(f64::exp),
-        "fabs" => float1(f64::abs),
-        "radians" => float1(f64::to_radians),
-        "degrees" => float1(f64::to_degrees),
-        "sqrt" => {
-            arity(1)?;
-            let x = num(0)?;
-            domain(x.sqrt(), x >= 0.0)
-        }
-        "log10" => {
-            arity(1)?;
-            let x = num(0)?;
-            domain(x.log10(), x > 0.0)
-        }
-        "log" => {
-            let x = num(0)?;
-            match args.len() {
-                1 => domain(x.ln(), x > 0.0),
-                2 => {
-                    let base = num(1)?;
-                    domain(x.ln() / base.ln(), x > 0.0 && base > 0.0 && base != 1.0)
-                }
-                n => err(format!("log() takes 1 or 2 arguments, {n} given")),
-            }
-        }
-        "atan2" => {
-            arity(2)?;
-            Ok(Value::Float(num(0)?.atan2(num(1)?)))
-        }
-        "hypot" => {
-            arity(2)?;
-            Ok(Value::Float(num(0)?.hypot(num(1)?)))
-        }
-        "pow" => {
-            arity(2)?;
-            Ok(Value::Float(num(0)?.powf(num(1)?)))
-        }
-        "fmod" => {
-            arity(2)?;
-            let y = num(1)?;
-            domain(num(0)? % y, y != 0.0)
-        }
-        "copysign" => {
-            arity(2)?;
-            Ok(Value::Float(num(0)?.copysign(num(1)?)))
-        }
-        "floor" | "ceil" | "trunc" => {
-            arity(1)?;
-            let x = num(0)?;
+        n => err(format!("log() takes 1 or 2 arguments, {n} given")),
+    }
+}
+
+/// Rounding, `abs`, `min` and `max`, or `None` when `bare` is none of them.
+fn integer_function(bare: &str, b: &Builtin<'_>) -> Option<R<Value>> {
+    Some(match bare {
+        "floor" | "ceil" | "trunc" => b.arity(1).and_then(|()| {
+            let x = b.num(0)?;
             let y = match bare {
                 "floor" => x.floor(),
                 "ceil" => x.ceil(),
                 _ => x.trunc(),
             };
-            to_int(y, name)
+            to_int(y, b.name)
+        }),
+        "abs" => b.arity(1).and_then(|()| match &b.args[0] {
+            Value::Int(i) => Ok(Value::Int(i.saturating_abs())),
+            other => Ok(Value::Float(
+                other
+                    .number()
+                    .ok_or_else(|| ExprError::Other("abs() expects a number".into()))?
+                    .abs(),
+            )),
+        }),
+        "round" => round(b),
+        "min" | "max" => extreme(bare == "min", b),
+        _ => return None,
+    })
+}
+
+/// `round(x)` (to an int, halves to even) or `round(x, digits)` (to a float).
+fn round(b: &Builtin<'_>) -> R<Value> {
+    let x = b.num(0)?;
+    match b.args.len() {
+        1 => to_int(round_half_even(x), b.name),
+        2 => {
+            let digits = b.args[1]
+                .int()
+                .ok_or_else(|| ExprError::Other("round() digits must be an int".into()))?
+                .clamp(-300, 300) as i32;
+            let scale = 10f64.powi(digits);
+            Ok(Value::Float(round_half_even(x * scale) / scale))
         }
-        "abs" => {
-            arity(1)?;
-            match &args[0] {
-                Value::Int(i) => Ok(Value::Int(i.saturating_abs())),
-                other => Ok(Value::Float(
-                    other
-                        .number()
-                        .ok_or_else(|| ExprError::Other("abs() expects a number".into()))?
-                        .abs(),
-                )),
-            }
-        }
-        "round" => {
-            let x = num(0)?;
-            match args.len() {
-                1 => to_int(round_half_even(x), name),
-                2 => {
-                    let digits = args[1]
-                        .int()
-                        .ok_or_else(|| ExprError::Other("round() digits must be an int".into()))?
-                        .clamp(-300, 300) as i32;
-                    let scale = 10f64.powi(digits);
-                    Ok(Value::Float(round_half_even(x * scale) / scale))
-                }
-                n => err(format!("round() takes 1 or 2 arguments, {n} given")),
-            }
-        }
-        "min" | "max" => {
-            let items = match args.as_slice() {
-                [Value::List(items)] => items.clone(),
-                _ => args.clone(),
-            };
-            let mut best: Option<Value> = None;
-            for item in items {
-                best = Some(match best {
-                    None => item,
-                    Some(current) => {
-                        let better = if bare == "min" {
-                            compare("<", &item, &current)?
-                        } else {
-                            compare(">", &item, &current)?
-                        };
-                        if better { item } else { current }
-                    }
-                });
-            }
-            best.ok_or_else(|| ExprError::Other(format!("{name}() of an empty sequence")))
-        }
-        "int" => {
-            arity(1)?;
-            match &args[0] {
-                Value::Str(s) => parse_python_int(s.trim())
-                    .map(Value::Int)
-                    .ok_or_else(|| ExprError::Other(format!("int(): invalid literal '{s}'"))),
-                other => to_int(
-                    other
-                        .number()
-                        .ok_or_else(|| ExprError::Other("int() expects a number".into()))?
-                        .trunc(),
-                    name,
-                ),
-            }
-        }
-        "float" => {
-            arity(1)?;
-            match &args[0] {
-                Value::Str(s) => parse_python_float(s.trim())
-                    .map(Value::Float)
-                    .ok_or_else(|| ExprError::Other(format!("float(): invalid literal '{s}'"))),
-                other => Ok(Value::Float(other.number().ok_or_else(|| {
-                    ExprError::Other("float() expects a number".into())
-                })?)),
-            }
-        }
-        "str" => {
-            arity(1)?;
-            Ok(Value::Str(args[0].to_string()))
-        }
-        "bool" => {
-            arity(1)?;
-            Ok(Value::Bool(args[0].truthy()))
-        }
-        "len" => {
-            arity(1)?;
-            match &args[0] {
-                Value::Str(s) => Ok(Value::Int(s.chars().count() as i64)),
-                Value::List(l) => Ok(Value::Int(l.len() as i64)),
-                other => err(format!(
-                    "object of type '{}' has no len()",
-                    other.type_name()
-                )),
-            }
-        }
-        "arg" => {
-            arity(1)?;
-            match &args[0] {
-                Value::Str(s) => names.arg(s),
-                _ => err("arg() expects a string"),
-            }
-        }
-        _ => Err(ExprError::Undefined(format!("{name}()"))),
+        n => err(format!("round() takes 1 or 2 arguments, {n} given")),
     }
+}
+
+/// `min(...)` when `smallest`, else `max(...)`: of the arguments, or of the items of a single
+/// list argument.
+fn extreme(smallest: bool, b: &Builtin<'_>) -> R<Value> {
+    let items = match b.args.as_slice() {
+        [Value::List(items)] => items.clone(),
+        _ => b.args.clone(),
+    };
+    let mut best: Option<Value> = None;
+    for item in items {
+        best = Some(match best {
+            None => item,
+            Some(current) => {
+                let better = if smallest {
+                    compare("<", &item, &current)?
+                } else {
+                    compare(">", &item, &current)?
+                };
+                if better { item } else { current }
+            }
+        });
+    }
+    best.ok_or_else(|| ExprError::Other(format!("{}() of an empty sequence", b.name)))
+}
+
+/// Type conversions, `len` and `arg`, or `None` when `bare` is none of them.
+fn conversion_function(bare: &str, b: &Builtin<'_>, names: &mut dyn Names) -> Option<R<Value>> {
+    Some(match bare {
+        "int" => b.arity(1).and_then(|()| match &b.args[0] {
+            Value::Str(s) => parse_python_int(s.trim())
+                .map(Value::Int)
+                .ok_or_else(|| ExprError::Other(format!("int(): invalid literal '{s}'"))),
+            other => other
+                .number()
+                .ok_or_else(|| ExprError::Other("int() expects a number".into()))
+                .and_then(|x| to_int(x.trunc(), b.name)),
+        }),
+        "float" => b.arity(1).and_then(|()| match &b.args[0] {
+            Value::Str(s) => parse_python_float(s.trim())
+                .map(Value::Float)
+                .ok_or_else(|| ExprError::Other(format!("float(): invalid literal '{s}'"))),
+            other => other
+                .number()
+                .map(Value::Float)
+                .ok_or_else(|| ExprError::Other("float() expects a number".into())),
+        }),
+        "str" => b.arity(1).map(|()| Value::Str(b.args[0].to_string())),
+        "bool" => b.arity(1).map(|()| Value::Bool(b.args[0].truthy())),
+        "len" => b.arity(1).and_then(|()| match &b.args[0] {
+            Value::Str(s) => Ok(Value::Int(s.chars().count() as i64)),
+            Value::List(l) => Ok(Value::Int(l.len() as i64)),
+            other => err(format!(
+                "object of type '{}' has no len()",
+                other.type_name()
+            )),
+        }),
+        "arg" => b.arity(1).and_then(|()| match &b.args[0] {
+            Value::Str(s) => names.arg(s),
+            _ => err("arg() expects a string"),
+        }),
+        _ => return None,
+    })
 }
 
 fn round_half_even(x: f64) -> f64 {

@@ -356,29 +356,7 @@ impl Expander<'_> {
                     ))),
                 }
             }
-            "element" => {
-                self.count_element()?;
-                let name_text = self.required(e, "xacro:name")?;
-                let name = self.eval_text(name_text, scope)?.to_string();
-                let mut elem_attrs = Vec::new();
-                for (n, v) in &e.attrs {
-                    if n != "xacro:name" {
-                        elem_attrs.push((n.clone(), self.eval_text(v, scope)?.to_string()));
-                    }
-                }
-                let mut children = Vec::new();
-                let mut extra = Vec::new();
-                self.process(&e.children, scope, &mut children, &mut extra)?;
-                set_attrs(&mut elem_attrs, extra);
-                out.push(ONode::Elem(OElem {
-                    name,
-                    attrs: elem_attrs,
-                    children,
-                    file: e.file,
-                    line: e.line,
-                }));
-                Ok(())
-            }
+            "element" => self.computed_element(e, scope, out),
             "attribute" => {
                 let name = self
                     .eval_text(self.required(e, "name")?, scope)?
@@ -401,6 +379,32 @@ impl Expander<'_> {
                 self.call_macro(&m, e, scope, out, &[])
             }
         }
+    }
+
+    /// `<xacro:element xacro:name="...">`: an element whose name is computed, with the other
+    /// attributes and the children expanded in `scope`, appended to `out`.
+    fn computed_element(&mut self, e: &XElem, scope: usize, out: &mut Vec<ONode>) -> Result<()> {
+        self.count_element()?;
+        let name_text = self.required(e, "xacro:name")?;
+        let name = self.eval_text(name_text, scope)?.to_string();
+        let mut elem_attrs = Vec::new();
+        for (n, v) in &e.attrs {
+            if n != "xacro:name" {
+                elem_attrs.push((n.clone(), self.eval_text(v, scope)?.to_string()));
+            }
+        }
+        let mut children = Vec::new();
+        let mut extra = Vec::new();
+        self.process(&e.children, scope, &mut children, &mut extra)?;
+        set_attrs(&mut elem_attrs, extra);
+        out.push(ONode::Elem(OElem {
+            name,
+            attrs: elem_attrs,
+            children,
+            file: e.file,
+            line: e.line,
+        }));
+        Ok(())
     }
 
     fn find_macro(&self, name: &str, scope: usize) -> Result<Rc<Macro>> {
@@ -597,6 +601,9 @@ impl Expander<'_> {
         Ok(params)
     }
 
+    /// Calls macro `m` for the element `call` written in `scope`: binds the parameters in a new
+    /// scope and expands the macro's body there into `out`. `skip_attrs` are attributes of
+    /// `call` that are no parameters (`macro` of `xacro:call`).
     fn call_macro(
         &mut self,
         m: &Macro,
@@ -616,6 +623,43 @@ impl Expander<'_> {
             parent: Some(scope),
             ..Default::default()
         };
+        self.bind_attribute_params(m, call, scope, skip_attrs, &mut inner)?;
+        // Blocks: the call's child elements, expanded in the caller's scope, in order.
+        let mut body = Vec::new();
+        let mut ignored = Vec::new();
+        self.process(&call.children, scope, &mut body, &mut ignored)?;
+        self.at = (file, line);
+        let mut blocks = body.into_iter().filter_map(|n| match n {
+            ONode::Elem(e) => Some(e),
+            ONode::Text(_) => None,
+        });
+        self.bind_other_params(m, scope, &mut blocks, &mut inner)?;
+        if let Some(extra) = blocks.next() {
+            return Err(self.error(format!(
+                "xacro:{}: unused block <{}> (the macro takes {} block parameter(s))",
+                m.name,
+                extra.name,
+                m.params
+                    .iter()
+                    .filter(|p| !matches!(p, Param::Plain { .. }))
+                    .count()
+            )));
+        }
+        self.expand_macro_body(m, inner, out)?;
+        self.at = (file, line);
+        Ok(())
+    }
+
+    /// Binds the parameters that `call` passes as attributes (evaluated in the caller's
+    /// `scope`) into `inner`; an attribute that names no plain parameter is an error.
+    fn bind_attribute_params(
+        &mut self,
+        m: &Macro,
+        call: &XElem,
+        scope: usize,
+        skip_attrs: &[&str],
+        inner: &mut Scope,
+    ) -> Result<()> {
         for (name, value) in &call.attrs {
             if skip_attrs.contains(&name.as_str()) {
                 continue;
@@ -634,15 +678,18 @@ impl Expander<'_> {
             let v = literal(self.eval_text(value, scope)?);
             inner.props.insert(name.clone(), Prop::Value(v));
         }
-        // Blocks: the call's child elements, expanded in the caller's scope, in order.
-        let mut body = Vec::new();
-        let mut ignored = Vec::new();
-        self.process(&call.children, scope, &mut body, &mut ignored)?;
-        self.at = (file, line);
-        let mut blocks = body.into_iter().filter_map(|n| match n {
-            ONode::Elem(e) => Some(e),
-            ONode::Text(_) => None,
-        });
+        Ok(())
+    }
+
+    /// Binds, in the macro's order, the block parameters to the call's next `blocks` and the
+    /// plain parameters the call left out to their defaults.
+    fn bind_other_params(
+        &mut self,
+        m: &Macro,
+        scope: usize,
+        blocks: &mut impl Iterator<Item = OElem>,
+        inner: &mut Scope,
+    ) -> Result<()> {
         for p in &m.params {
             match p {
                 Param::Block(name) | Param::BlockContents(name) => {
@@ -663,46 +710,50 @@ impl Expander<'_> {
                     if inner.props.contains_key(name) {
                         continue;
                     }
-                    let prop = match default {
-                        Some(ParamDefault::Text(text)) => Prop::Lazy(text.clone()),
-                        Some(ParamDefault::Inherit(fallback)) => match self.lookup(name, scope) {
-                            Some((_, Prop::Lazy(text))) => {
-                                Prop::Value(literal(self.eval_text(&text, scope)?))
-                            }
-                            Some((_, prop)) => prop,
-                            None => match fallback {
-                                Some(text) => Prop::Lazy(text.clone()),
-                                None => {
-                                    return Err(self.error(format!(
-                                        "xacro:{}: parameter \"{name}\" inherits (^) a property the caller does not have",
-                                        m.name
-                                    )));
-                                }
-                            },
-                        },
-                        None => {
-                            return Err(self.error(format!(
-                                "xacro:{}: missing parameter \"{name}\"; its parameters: {}",
-                                m.name,
-                                param_names(&m.params)
-                            )));
-                        }
-                    };
+                    let prop = self.param_default(m, name, default.as_ref(), scope)?;
                     inner.props.insert(name.clone(), prop);
                 }
             }
         }
-        if let Some(extra) = blocks.next() {
-            return Err(self.error(format!(
-                "xacro:{}: unused block <{}> (the macro takes {} block parameter(s))",
-                m.name,
-                extra.name,
-                m.params
-                    .iter()
-                    .filter(|p| !matches!(p, Param::Plain { .. }))
-                    .count()
-            )));
-        }
+        Ok(())
+    }
+
+    /// The value of plain parameter `name` of `m` that the call written in `scope` left out:
+    /// its default, the caller's property for `^`, or an error when there is neither.
+    fn param_default(
+        &mut self,
+        m: &Macro,
+        name: &str,
+        default: Option<&ParamDefault>,
+        scope: usize,
+    ) -> Result<Prop> {
+        Ok(match default {
+            Some(ParamDefault::Text(text)) => Prop::Lazy(text.clone()),
+            Some(ParamDefault::Inherit(fallback)) => match self.lookup(name, scope) {
+                Some((_, Prop::Lazy(text))) => Prop::Value(literal(self.eval_text(&text, scope)?)),
+                Some((_, prop)) => prop,
+                None => match fallback {
+                    Some(text) => Prop::Lazy(text.clone()),
+                    None => {
+                        return Err(self.error(format!(
+                            "xacro:{}: parameter \"{name}\" inherits (^) a property the caller does not have",
+                            m.name
+                        )));
+                    }
+                },
+            },
+            None => {
+                return Err(self.error(format!(
+                    "xacro:{}: missing parameter \"{name}\"; its parameters: {}",
+                    m.name,
+                    param_names(&m.params)
+                )));
+            }
+        })
+    }
+
+    /// Expands the body of `m` into `out` in the new scope `inner`, one macro level deeper.
+    fn expand_macro_body(&mut self, m: &Macro, inner: Scope, out: &mut Vec<ONode>) -> Result<()> {
         self.scopes.push(inner);
         let inner_scope = self.scopes.len() - 1;
         self.macro_depth += 1;
@@ -714,9 +765,7 @@ impl Expander<'_> {
         if self.scopes.len() == inner_scope + 1 {
             self.scopes.pop();
         }
-        result?;
-        self.at = (file, line);
-        Ok(())
+        result
     }
 
     fn lookup_exists(&self, name: &str, scope: usize) -> bool {
