@@ -39,9 +39,18 @@ fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
             "{krate}: expected several source files, found {}",
             sources.files.len()
         );
-        if let Some(cycle) = sources.find_cycle() {
-            let files: Vec<String> = cycle.iter().map(|p| p.display().to_string()).collect();
-            circles.push(format!("{krate}/src: {}", files.join(" -> ")));
+        let cycle = sources.find_cycle();
+        let known = NOT_YET_BROKEN.iter().find(|(k, _)| *k == krate);
+        match (cycle, known) {
+            (Some(cycle), Some((_, file))) if cycle.iter().any(|p| p.ends_with(file)) => {}
+            (Some(cycle), _) => {
+                let files: Vec<String> = cycle.iter().map(|p| p.display().to_string()).collect();
+                circles.push(format!("{krate}/src: {}", files.join(" -> ")));
+            }
+            (None, Some((_, file))) => circles.push(format!(
+                "{krate}/src: the known circle through {file} is gone: remove it from NOT_YET_BROKEN"
+            )),
+            (None, None) => {}
         }
     }
     assert!(

@@ -269,7 +269,9 @@ impl Checker<'_> {
 
     /// Finite coordinates within [`MAX_COORDINATE_M`] of the origin.
     fn coordinates(&self, key: &str, values: &[f64]) -> Result<()> {
-        self.finite(key, values)?;
+        if !values.iter().all(|v| v.is_finite()) {
+            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
+        }
         match values.iter().find(|v| v.abs() > MAX_COORDINATE_M) {
             Some(v) => Err(self.fail(
                 key,
@@ -282,20 +284,22 @@ impl Checker<'_> {
     }
 
     fn positive(&self, key: &str, values: &[f64], unit: &str) -> Result<()> {
-        self.finite(key, values)?;
+        if !values.iter().all(|v| v.is_finite()) {
+            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
+        }
         if !values.iter().all(|v| *v > 0.0) {
             return Err(self.fail(
                 key,
                 format!("expected positive numbers ({unit}), found {values:?}"),
             ));
         }
-        match values.iter().find(|v| unit == "m" && **v > MAX_SIZE_M) {
-            Some(v) => Err(self.fail(
+        if let Some(v) = values.iter().find(|v| unit == "m" && **v > MAX_SIZE_M) {
+            return Err(self.fail(
                 key,
                 format!("{v} m is out of range: expected sizes up to {MAX_SIZE_M:e} m"),
-            )),
-            None => Ok(()),
+            ));
         }
+        self.finite(key, values)
     }
 
     fn color(&self, key: &str, text: Option<&str>, default: Rgba) -> Result<Rgba> {
@@ -314,7 +318,7 @@ impl Checker<'_> {
 
     fn friction(&self, key: &str, value: Option<f64>) -> Result<f32> {
         let f = value.unwrap_or(0.8);
-        if f.is_finite() && f >= 0.0 && f <= MAX_MAGNITUDE {
+        if (0.0..=MAX_MAGNITUDE).contains(&f) {
             Ok(f as f32)
         } else {
             Err(self.fail(
