@@ -334,8 +334,7 @@ pub fn blank_literals(text: &str) -> String {
             }
             blank(&mut out, i, j);
             i = j;
-        } else if !ident_before && (b[i] == b'r' || b[i] == b'b') && raw_string_at(b, i).is_some() {
-            let end = raw_string_at(b, i).unwrap_or(b.len());
+        } else if let Some(end) = (!ident_before).then(|| raw_string_at(b, i)).flatten() {
             blank(&mut out, i, end);
             i = end;
         } else if b[i] == b'"' {
@@ -472,16 +471,19 @@ fn use_trees(code: &str) -> Vec<(bool, String)> {
         let Some(end) = code[at..].find(';').map(|p| at + p) else {
             break;
         };
+        // A re-export: `pub use` or `pub(crate) use` (`pub(super)`, `pub(in ...)`).
         let before = code[..at].trim_end();
-        let is_pub = before.ends_with("pub") || before.ends_with(')') && before.contains("pub(");
-        let is_pub = is_pub && {
-            // `pub use` or `pub(...) use` right before this `use`.
-            let tail = &before[before.len().saturating_sub(16)..];
-            tail.trim_end().ends_with("pub") || tail.contains("pub(")
-        };
+        let is_pub = before.ends_with("pub")
+            || before.ends_with(')')
+                && before
+                    .rfind("pub(")
+                    .is_some_and(|p| !before[p..].contains([';', '{', '}']));
         out.push((
             is_pub,
-            code[at + 3..end].split_whitespace().collect::<String>(),
+            code[at + 3..end]
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" "),
         ));
         i = end + 1;
     }
@@ -500,6 +502,7 @@ fn expand_tree(tree: &str) -> Vec<(Vec<String>, Option<String>)> {
             prefix.extend(
                 text[..open]
                     .split("::")
+                    .map(str::trim)
                     .filter(|s| !s.is_empty())
                     .map(str::to_owned),
             );
@@ -520,14 +523,17 @@ fn expand_tree(tree: &str) -> Vec<(Vec<String>, Option<String>)> {
             walk(&inner[start..], &prefix, out);
             return;
         }
-        let (path, alias) = match text.split_once("as") {
-            Some((p, a)) if !p.ends_with(':') && !a.is_empty() && !a.contains(':') => {
-                (p, Some(a.to_owned()))
-            }
-            _ => (text, None),
+        // Words are separated by single spaces here, so `as` is a word of its own.
+        let (path, alias) = match text.split_once(" as ") {
+            Some((p, a)) => (p, Some(a.trim().to_owned())),
+            None => (text, None),
         };
         let mut full = prefix.to_vec();
-        for seg in path.split("::").filter(|s| !s.is_empty() && *s != "*") {
+        for seg in path
+            .split("::")
+            .map(str::trim)
+            .filter(|s| !s.is_empty() && *s != "*")
+        {
             if seg == "self" && !full.is_empty() {
                 continue;
             }
@@ -597,12 +603,22 @@ mod tests {
 
     #[test]
     fn use_trees_expand_to_paths() {
-        let paths = expand_tree("crate::{a::{B,c::D},e as F,g::*}");
+        let paths = expand_tree("crate::{a::{B, c::D}, e as F, g::*}");
         let flat: Vec<String> = paths.iter().map(|(p, _)| p.join("::")).collect();
         assert_eq!(
             flat,
             ["crate::a::B", "crate::a::c::D", "crate::e", "crate::g"]
         );
         assert_eq!(paths[2].1.as_deref(), Some("F"));
+        // "as" inside a name is not a rename.
+        let laser = expand_tree("crate::sensors::{LaserScan, passes::Base}");
+        assert_eq!(
+            laser[0],
+            (
+                vec!["crate".into(), "sensors".into(), "LaserScan".into()],
+                None
+            )
+        );
+        assert_eq!(laser[1].0.join("::"), "crate::sensors::passes::Base");
     }
 }

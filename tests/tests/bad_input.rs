@@ -17,6 +17,33 @@ fn urdf_error(text: &str) -> String {
     }
 }
 
+/// Replaces `from` with `to` in the robot's URDF and checks the load error names the line of
+/// `to` and says `expect`.
+fn assert_edit_is_refused_at_its_line(
+    robot: &str,
+    from: &str,
+    to: &str,
+    expect: &str,
+) -> anyhow::Result<()> {
+    anyhow::ensure!(robot.contains(from), "my_robot.urdf has no {from}");
+    let text = robot.replacen(from, to, 1);
+    let message = urdf_error(&text);
+    let line = line_of(&text, to);
+    assert!(
+        message.contains(&format!("bad.urdf:{line}:")) && message.contains(expect),
+        "{message}"
+    );
+    Ok(())
+}
+
+/// The error loading a world file gives ("" when it loads).
+fn world_error(path: &Path) -> String {
+    World::load(path)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default()
+}
+
 fn line_of(text: &str, needle: &str) -> usize {
     text.lines()
         .position(|l| l.contains(needle))
@@ -368,10 +395,7 @@ fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Res
         &world,
         "<sdf version='1.6'>\n<world name='w'>\n<model name='m'>\n</world></sdf>",
     )?;
-    let message = World::load(&world)
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
+    let message = world_error(&world);
     assert!(message.contains("bad.world:4: malformed XML"), "{message}");
 
     std::fs::write(
@@ -393,10 +417,7 @@ fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Res
         &world,
         "<sdf version='1.6'><world name='w'><model name='m'><link name='l'>\n<visual name='v'><pose>0 0 one 0 0 0</pose><geometry><box><size>1 1 1</size></box></geometry></visual></link></model></world></sdf>",
     )?;
-    let message = World::load(&world)
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
+    let message = world_error(&world);
     assert!(
         message.contains("bad.world:2: <pose>0 0 one 0 0 0</pose>: expected 6 finite numbers"),
         "{message}"
@@ -426,14 +447,7 @@ fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()
             "<wheelSeparation> in the libgazebo_ros_diff_drive.so plugin: expected a number",
         ),
     ] {
-        anyhow::ensure!(robot.contains(from), "my_robot.urdf has no {from}");
-        let text = robot.replacen(from, to, 1);
-        let message = urdf_error(&text);
-        let line = line_of(&text, to);
-        assert!(
-            message.contains(&format!("bad.urdf:{line}:")) && message.contains(expect),
-            "{message}"
-        );
+        assert_edit_is_refused_at_its_line(&robot, from, to, expect)?;
     }
 
     let dir = tempfile::tempdir()?;
@@ -448,10 +462,7 @@ fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()
                 1,
             ),
         )?;
-        let message = World::load(&path)
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
+        let message = world_error(&path);
         assert!(
             message.contains("w.toml: at `person[0].position_m`: expected finite numbers")
                 && message.contains(shown),
@@ -464,10 +475,7 @@ fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()
         &sdf,
         "<sdf version='1.6'><world name='w'>\n<model name='m'><pose>1 nan 0 0 0 0</pose><link name='l'/></model></world></sdf>",
     )?;
-    let message = World::load(&sdf)
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
+    let message = world_error(&sdf);
     assert!(
         message.contains("nan.world:2:") && message.contains("expected 6 finite numbers"),
         "{message}"
@@ -505,7 +513,7 @@ fn nan_and_infinity_are_refused_at_load_with_the_key_path() -> anyhow::Result<()
 /// Finite but absurd magnitudes (a 1e30 m box, a robot 1e30 m from the origin, a 1e30 kg
 /// mass) are refused at load with the file and the element or key path, before they reach
 /// rapier and parry (whose contact code can fail on them). The accepted ranges: positions
-/// within 1e5 m of the origin, sizes up to 1e5 m, masses up to 1e6 kg (docs/WORLDS.md).
+/// within 1e5 m of the origin, sizes up to 1e5 m, masses up to 1e6 kg (docs/RELIABILITY.md).
 #[test]
 fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<()> {
     let robot = robot_text();
@@ -521,14 +529,7 @@ fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<(
             "is out of range: expected a mass (kg) up to 1e6",
         ),
     ] {
-        anyhow::ensure!(robot.contains(from), "my_robot.urdf has no {from}");
-        let text = robot.replacen(from, to, 1);
-        let message = urdf_error(&text);
-        let line = line_of(&text, to);
-        assert!(
-            message.contains(&format!("bad.urdf:{line}:")) && message.contains(expect),
-            "{message}"
-        );
+        assert_edit_is_refused_at_its_line(&robot, from, to, expect)?;
     }
     let message = urdf_error(&robot.replacen(
         "<box size=\"0.3 0.2 0.1\"/>",
@@ -557,10 +558,7 @@ fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<(
         anyhow::ensure!(world_text.contains(from), "playground.toml has no {from:?}");
         let path = dir.path().join("w.toml");
         std::fs::write(&path, world_text.replacen(from, to, 1))?;
-        let message = World::load(&path)
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
+        let message = world_error(&path);
         assert!(
             message.contains("w.toml: at `") && message.contains(expect),
             "{message}"
@@ -571,10 +569,7 @@ fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<(
         &path,
         "[[box]]\nsize_m = [1e30, 1.0, 1.0]\nposition_m = [0.0, 0.0]\n",
     )?;
-    let message = World::load(&path)
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
+    let message = world_error(&path);
     assert!(
         message.contains("at `box[0].size_m`") && message.contains("expected sizes up to 1e5 m"),
         "{message}"
@@ -585,13 +580,20 @@ fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<(
         &sdf,
         "<sdf version='1.6'><world name='w'>\n<model name='m'><pose>1e30 0 0 0 0 0</pose><link name='l'/></model></world></sdf>",
     )?;
-    let message = World::load(&sdf)
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
+    let message = world_error(&sdf);
     assert!(
         message.contains("far.world:2:")
-            && message.contains("expected 6 finite numbers of magnitude up to 1e5"),
+            && message.contains("expected 6 finite numbers of magnitude up to 1e6"),
+        "{message}"
+    );
+    std::fs::write(
+        &sdf,
+        "<sdf version='1.6'><world name='w'>\n<model name='m'><pose>0 5e5 0 0 0 0</pose><link name='l'/></model></world></sdf>",
+    )?;
+    let message = world_error(&sdf);
+    assert!(
+        message.contains("far.world:2:")
+            && message.contains("500000 m is out of range: expected positions within 1e5 m"),
         "{message}"
     );
     Ok(())

@@ -339,55 +339,44 @@ fn validate_numbers(doc: &roxmltree::Document<'_>, path: &Path) -> Result<()> {
                 | ("dynamics", "damping" | "friction") => 1,
                 _ => continue,
             };
+            let fail = |what: String| {
+                SimError::invalid(
+                    path,
+                    Some(line_of(doc, node)),
+                    format!("<{element} {}=\"{}\">: {what}", attr.name(), attr.value()),
+                )
+            };
             let tokens: Vec<&str> = attr.value().split_whitespace().collect();
-            let bad = tokens
+            let values: Vec<f64> = tokens
                 .iter()
-                .find(|t| t.parse::<f64>().map(|v| !v.is_finite()).unwrap_or(true));
-            let unit = if expected == 1 { "number" } else { "numbers" };
-            if tokens.len() != expected || bad.is_some() {
-                let found = match bad {
+                .filter_map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+                .collect();
+            if tokens.len() != expected || values.len() != tokens.len() {
+                let unit = if expected == 1 { "number" } else { "numbers" };
+                let found = match tokens
+                    .iter()
+                    .find(|t| t.parse::<f64>().map(|v| !v.is_finite()).unwrap_or(true))
+                {
                     Some(token) => format!("'{token}' is not a finite number"),
                     None => format!("found {} value(s)", tokens.len()),
                 };
-                return Err(SimError::invalid(
-                    path,
-                    Some(line_of(doc, node)),
-                    format!(
-                        "<{element} {}=\"{}\">: expected {expected} {unit}; {found}",
-                        attr.name(),
-                        attr.value()
-                    ),
-                ));
+                return Err(fail(format!("expected {expected} {unit}; {found}")));
             }
             if let Some((limit, what)) = magnitude_limit(element, attr.name())
-                && let Some(big) = tokens
-                    .iter()
-                    .find(|t| t.parse::<f64>().is_ok_and(|v| v.abs() > limit))
+                && let Some(i) = values.iter().position(|v| v.abs() > limit)
             {
-                return Err(SimError::invalid(
-                    path,
-                    Some(line_of(doc, node)),
-                    format!(
-                        "<{element} {}=\"{}\">: {big} is out of range: expected {what} up to {limit:e}",
-                        attr.name(),
-                        attr.value()
-                    ),
-                ));
+                return Err(fail(format!(
+                    "{} is out of range: expected {what} up to {limit:e}",
+                    tokens[i]
+                )));
             }
             if matches!(attr.name(), "radius" | "length" | "value" | "size")
-                && let Some(neg) = tokens
-                    .iter()
-                    .find(|t| t.parse::<f64>().is_ok_and(|v| v < 0.0))
+                && let Some(i) = values.iter().position(|v| *v < 0.0)
             {
-                return Err(SimError::invalid(
-                    path,
-                    Some(line_of(doc, node)),
-                    format!(
-                        "<{element} {}=\"{}\">: expected non-negative values, found {neg}",
-                        attr.name(),
-                        attr.value()
-                    ),
-                ));
+                return Err(fail(format!(
+                    "expected non-negative values, found {}",
+                    tokens[i]
+                )));
             }
         }
     }

@@ -15,15 +15,17 @@ use roxmltree::Node;
 use crate::description::resource::ResourcePaths;
 use crate::description::xml::{child, children, line_of, parse_xml};
 use crate::error::{Result, SimError};
-use crate::geometry::{Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of};
+use crate::geometry::{
+    MAX_COORDINATE_M, MAX_MAGNITUDE, Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of,
+};
 use crate::model::person::{Person, Walk};
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
 
-/// Largest magnitude of a number rover reads from an SDF world (poses, sizes, masses, gravity,
-/// step size): positions, sizes and masses far outside physical sense reach the physics engine
-/// otherwise, and parry's contact code can fail on them.
-const MAX_SDF_NUMBER: f64 = crate::geometry::MAX_COORDINATE_M;
+/// Largest magnitude of any number rover reads from an SDF world (sizes, masses, gravity, step
+/// size; positions are held to [`MAX_COORDINATE_M`] besides): values far outside physical sense
+/// would reach the physics engine, and parry's contact code can fail on them.
+const MAX_SDF_NUMBER: f64 = MAX_MAGNITUDE;
 
 /// Deepest `<include>` nesting followed (models including models).
 const MAX_INCLUDE_DEPTH: usize = 16;
@@ -270,6 +272,14 @@ impl Ctx<'_, '_> {
 
     fn pose(&self, node: Node<'_, '_>) -> Result<Pose> {
         let [x, y, z, roll, pitch, yaw] = self.numbers::<6>(node)?;
+        if let Some(v) = [x, y, z].into_iter().find(|v| v.abs() > MAX_COORDINATE_M) {
+            return Err(self.err(
+                node,
+                format!(
+                    "<pose>: {v} m is out of range: expected positions within {MAX_COORDINATE_M:e} m of the origin"
+                ),
+            ));
+        }
         Ok(pose_from_xyz_rpy([x, y, z], [roll, pitch, yaw]))
     }
 

@@ -254,10 +254,18 @@ impl Checker<'_> {
         SimError::invalid(self.path, None, format!("at `{key}`: {message}"))
     }
 
-    fn finite(&self, key: &str, values: &[f64]) -> Result<()> {
-        if !values.iter().all(|v| v.is_finite()) {
-            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
+    /// NaN and infinities, refused before any range is checked.
+    fn all_finite(&self, key: &str, values: &[f64]) -> Result<()> {
+        if values.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.fail(key, format!("expected finite numbers, found {values:?}")))
         }
+    }
+
+    /// Finite numbers of magnitude up to [`MAX_MAGNITUDE`].
+    fn finite(&self, key: &str, values: &[f64]) -> Result<()> {
+        self.all_finite(key, values)?;
         if let Some(v) = values.iter().find(|v| v.abs() > MAX_MAGNITUDE) {
             return Err(self.fail(
                 key,
@@ -269,9 +277,7 @@ impl Checker<'_> {
 
     /// Finite coordinates within [`MAX_COORDINATE_M`] of the origin.
     fn coordinates(&self, key: &str, values: &[f64]) -> Result<()> {
-        if !values.iter().all(|v| v.is_finite()) {
-            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
-        }
+        self.all_finite(key, values)?;
         match values.iter().find(|v| v.abs() > MAX_COORDINATE_M) {
             Some(v) => Err(self.fail(
                 key,
@@ -284,9 +290,7 @@ impl Checker<'_> {
     }
 
     fn positive(&self, key: &str, values: &[f64], unit: &str) -> Result<()> {
-        if !values.iter().all(|v| v.is_finite()) {
-            return Err(self.fail(key, format!("expected finite numbers, found {values:?}")));
-        }
+        self.all_finite(key, values)?;
         if !values.iter().all(|v| *v > 0.0) {
             return Err(self.fail(
                 key,
@@ -465,81 +469,110 @@ impl RawWorld {
     }
 }
 
+/// The [`SolidFields`] of a raw box, cylinder or sphere (their shared fields have one name).
+macro_rules! solid_fields {
+    ($raw:expr, $kind:literal, $index:expr) => {
+        SolidFields {
+            kind: $kind,
+            index: $index,
+            name: $raw.name,
+            position_m: &$raw.position_m,
+            color: $raw.color.as_deref(),
+            mass_kg: $raw.mass_kg,
+            friction: $raw.friction,
+        }
+    };
+}
+
+/// What boxes, cylinders and spheres share, checked in one order for all of them.
+struct SolidFields<'a> {
+    /// `box`, `cylinder` or `sphere`: the TOML table and the default name's prefix.
+    kind: &'static str,
+    index: usize,
+    name: Option<String>,
+    position_m: &'a [f64],
+    color: Option<&'a str>,
+    mass_kg: Option<f64>,
+    friction: Option<f64>,
+}
+
+impl Checker<'_> {
+    /// An object from its shared fields: position (resting on the ground at `half_height_m`
+    /// when only x, y are given), colour, mass, friction.
+    fn solid(
+        &self,
+        f: SolidFields<'_>,
+        shape: ObjectShape,
+        half_height_m: f64,
+        yaw_rad: f64,
+        default_color: Rgba,
+    ) -> Result<Object> {
+        let key = |field: &str| format!("{}[{}].{field}", f.kind, f.index);
+        Ok(Object {
+            name: f.name.unwrap_or_else(|| format!("{}_{}", f.kind, f.index)),
+            position_m: self.position(&key("position_m"), f.position_m, half_height_m)?,
+            shape,
+            yaw_rad,
+            color: self.color(&key("color"), f.color, default_color)?,
+            mass_kg: self.mass(&key("mass_kg"), f.mass_kg)?,
+            friction: self.friction(&key("friction"), f.friction)?,
+        })
+    }
+}
+
 impl RawBox {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
-        let b = self;
-        let key = |field: &str| format!("box[{i}].{field}");
-        c.positive(&key("size_m"), &b.size_m, "m")?;
-        c.finite(&key("yaw_deg"), &[b.yaw_deg])?;
-        Ok(Object {
-            name: b.name.unwrap_or_else(|| format!("box_{i}")),
-            position_m: c.position(&key("position_m"), &b.position_m, b.size_m[2] / 2.0)?,
-            shape: ObjectShape::Box { size_m: b.size_m },
-            yaw_rad: b.yaw_deg.to_radians(),
-            color: c.color(
-                &key("color"),
-                b.color.as_deref(),
-                Rgba::rgb(0.63, 0.42, 0.25),
-            )?,
-            mass_kg: c.mass(&key("mass_kg"), b.mass_kg)?,
-            friction: c.friction(&key("friction"), b.friction)?,
-        })
+        c.positive(&format!("box[{i}].size_m"), &self.size_m, "m")?;
+        c.finite(&format!("box[{i}].yaw_deg"), &[self.yaw_deg])?;
+        let fields = solid_fields!(self, "box", i);
+        let shape = ObjectShape::Box {
+            size_m: self.size_m,
+        };
+        let brown = Rgba::rgb(0.63, 0.42, 0.25);
+        c.solid(
+            fields,
+            shape,
+            self.size_m[2] / 2.0,
+            self.yaw_deg.to_radians(),
+            brown,
+        )
     }
 }
 
 impl RawCylinder {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
-        let cy = self;
-        let key = |field: &str| format!("cylinder[{i}].{field}");
-        c.positive(&key("radius_m"), &[cy.radius_m], "m")?;
-        c.positive(&key("length_m"), &[cy.length_m], "m")?;
-        Ok(Object {
-            name: cy.name.unwrap_or_else(|| format!("cylinder_{i}")),
-            position_m: c.position(&key("position_m"), &cy.position_m, cy.length_m / 2.0)?,
-            shape: ObjectShape::Cylinder {
-                radius_m: cy.radius_m,
-                length_m: cy.length_m,
-            },
-            yaw_rad: 0.0,
-            color: c.color(
-                &key("color"),
-                cy.color.as_deref(),
-                Rgba::rgb(0.8, 0.45, 0.1),
-            )?,
-            mass_kg: c.mass(&key("mass_kg"), cy.mass_kg)?,
-            friction: c.friction(&key("friction"), cy.friction)?,
-        })
+        c.positive(&format!("cylinder[{i}].radius_m"), &[self.radius_m], "m")?;
+        c.positive(&format!("cylinder[{i}].length_m"), &[self.length_m], "m")?;
+        let fields = solid_fields!(self, "cylinder", i);
+        let shape = ObjectShape::Cylinder {
+            radius_m: self.radius_m,
+            length_m: self.length_m,
+        };
+        let orange = Rgba::rgb(0.8, 0.45, 0.1);
+        c.solid(fields, shape, self.length_m / 2.0, 0.0, orange)
     }
 }
 
 impl RawSphere {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
-        let s = self;
-        let key = |field: &str| format!("sphere[{i}].{field}");
-        c.positive(&key("radius_m"), &[s.radius_m], "m")?;
-        Ok(Object {
-            name: s.name.unwrap_or_else(|| format!("sphere_{i}")),
-            position_m: c.position(&key("position_m"), &s.position_m, s.radius_m)?,
-            shape: ObjectShape::Sphere {
-                radius_m: s.radius_m,
-            },
-            yaw_rad: 0.0,
-            color: c.color(&key("color"), s.color.as_deref(), Rgba::rgb(0.85, 0.2, 0.2))?,
-            mass_kg: c.mass(&key("mass_kg"), s.mass_kg)?,
-            friction: c.friction(&key("friction"), s.friction)?,
-        })
+        c.positive(&format!("sphere[{i}].radius_m"), &[self.radius_m], "m")?;
+        let fields = solid_fields!(self, "sphere", i);
+        let shape = ObjectShape::Sphere {
+            radius_m: self.radius_m,
+        };
+        let red = Rgba::rgb(0.85, 0.2, 0.2);
+        c.solid(fields, shape, self.radius_m, 0.0, red)
     }
 }
 
 impl RawWall {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
-        let w = self;
         let key = |field: &str| format!("wall[{i}].{field}");
-        c.coordinates(&key("from_m"), &w.from_m)?;
-        c.coordinates(&key("to_m"), &w.to_m)?;
-        c.positive(&key("height_m"), &[w.height_m], "m")?;
-        c.positive(&key("thickness_m"), &[w.thickness_m], "m")?;
-        let (dx, dy) = (w.to_m[0] - w.from_m[0], w.to_m[1] - w.from_m[1]);
+        c.coordinates(&key("from_m"), &self.from_m)?;
+        c.coordinates(&key("to_m"), &self.to_m)?;
+        c.positive(&key("height_m"), &[self.height_m], "m")?;
+        c.positive(&key("thickness_m"), &[self.thickness_m], "m")?;
+        let (dx, dy) = (self.to_m[0] - self.from_m[0], self.to_m[1] - self.from_m[1]);
         let length = dx.hypot(dy);
         if length < 1e-3 {
             return Err(c.fail(
@@ -548,23 +581,23 @@ impl RawWall {
             ));
         }
         Ok(Object {
-            name: w.name.unwrap_or_else(|| format!("wall_{i}")),
+            name: self.name.unwrap_or_else(|| format!("wall_{i}")),
             shape: ObjectShape::Box {
-                size_m: [length, w.thickness_m, w.height_m],
+                size_m: [length, self.thickness_m, self.height_m],
             },
             position_m: [
-                (w.from_m[0] + w.to_m[0]) / 2.0,
-                (w.from_m[1] + w.to_m[1]) / 2.0,
-                w.height_m / 2.0,
+                (self.from_m[0] + self.to_m[0]) / 2.0,
+                (self.from_m[1] + self.to_m[1]) / 2.0,
+                self.height_m / 2.0,
             ],
             yaw_rad: dy.atan2(dx),
             color: c.color(
                 &key("color"),
-                w.color.as_deref(),
+                self.color.as_deref(),
                 Rgba::rgb(0.85, 0.83, 0.78),
             )?,
             mass_kg: None,
-            friction: c.friction(&key("friction"), w.friction)?,
+            friction: c.friction(&key("friction"), self.friction)?,
         })
     }
 }
