@@ -864,7 +864,7 @@ mod tests {
 
     #[test]
     fn the_tutorial_car_gets_gazebos_topic_names() -> Result<()> {
-        let robot = RobotModel::load(&rover_core::paths::default_robot())?;
+        let robot = RobotModel::load(&rover_core::default_robot_path())?;
         let plan = RosPlan::for_robot(&robot);
         assert_eq!(plan.cmd_topic, "/cmd_vel");
         assert_eq!(plan.odom_topic, "/odom");

@@ -10,13 +10,13 @@ use rover_sim::{ControlSample, LoadOptions, ResourcePaths, RobotModel, SimOption
 
 use crate::error::{CoreError, Result};
 use crate::follower::FollowerConfig;
-use crate::observers::{Fanout, RunFiles};
+use crate::input::{InputSource, NoInput};
+use crate::observer::{Fanout, NoObserver, Observer};
 use crate::paths;
 use crate::pilot::Mode;
+use crate::run_files::RunFiles;
 use crate::script::{Script, ScriptPlayer};
-use crate::session::{
-    DetectorMode, InputSource, NoInput, NoObserver, Observer, Session, SessionOptions,
-};
+use crate::session::{DetectorMode, Session, SessionOptions};
 
 /// Everything a headless run needs.
 #[derive(Debug, Clone, Default)]
@@ -127,85 +127,88 @@ impl RunSummary {
     }
 }
 
-/// Loads the world and robot a [`RunConfig`] names.
-pub fn load(config: &RunConfig) -> Result<(World, RobotModel)> {
-    let world_path = config.world.clone().unwrap_or_else(paths::default_world);
-    let mut world = World::load_with(&world_path, &resource_paths(config))?;
-    if let Some([x, y, yaw_deg]) = config.spawn {
-        world.robot.position_m = [x, y];
-        world.robot.yaw_rad = yaw_deg.to_radians();
+impl RunConfig {
+    /// Loads the world and robot this config names, with its spawn, drive and camera choices
+    /// applied.
+    pub fn load_world_and_robot(&self) -> Result<(World, RobotModel)> {
+        let world_path = self.world.clone().unwrap_or_else(paths::default_world);
+        let mut world = World::load_with(&world_path, &self.resource_paths())?;
+        if let Some([x, y, yaw_deg]) = self.spawn {
+            world.robot.position_m = [x, y];
+            world.robot.yaw_rad = yaw_deg.to_radians();
+        }
+        let robot_path = self
+            .robot
+            .clone()
+            .or_else(|| world.robot.urdf.clone())
+            .unwrap_or_else(paths::default_robot_path);
+        let mut robot = RobotModel::load_with(&robot_path, &self.robot_load_options(&world))?;
+        if let Some(spec) = self.drive.as_ref().or(world.robot.drive.as_ref()) {
+            robot.set_drive(spec)?;
+        }
+        if let Some(name) = &self.camera {
+            robot.select_camera(name)?;
+        } else if robot.cameras.len() > 1 {
+            tracing::info!(
+                "{}: {} cameras; rendering \"{}\" (choose with --camera NAME)",
+                robot.name,
+                robot.cameras.len(),
+                robot.cameras[0].name
+            );
+        }
+        Ok((world, robot))
     }
-    let robot_path = config
-        .robot
-        .clone()
-        .or_else(|| world.robot.urdf.clone())
-        .unwrap_or_else(paths::default_robot);
-    let mut robot = RobotModel::load_with(&robot_path, &robot_load_options(config, &world))?;
-    if let Some(spec) = config.drive.as_ref().or(world.robot.drive.as_ref()) {
-        robot.set_drive(spec)?;
-    }
-    if let Some(name) = &config.camera {
-        robot.select_camera(name)?;
-    } else if robot.cameras.len() > 1 {
-        tracing::info!(
-            "{}: {} cameras; rendering \"{}\" (choose with --camera NAME)",
-            robot.name,
-            robot.cameras.len(),
-            robot.cameras[0].name
-        );
-    }
-    Ok((world, robot))
-}
 
-/// Where packages and models are found: the config's folders first, then `ROS_PACKAGE_PATH`
-/// and `GAZEBO_MODEL_PATH`.
-pub fn resource_paths(config: &RunConfig) -> ResourcePaths {
-    let mine = &config.robot_options.resources;
-    let mut paths = ResourcePaths::from_env();
-    paths.packages.extend(mine.packages.clone());
-    paths
-        .package_search
-        .splice(0..0, mine.package_search.iter().cloned());
-    paths
-        .model_search
-        .splice(0..0, mine.model_search.iter().cloned());
-    paths
-}
-
-/// How the robot is read: [`resource_paths`], and xacro arguments from the world's `[robot]`,
-/// then the config's.
-pub fn robot_load_options(config: &RunConfig, world: &World) -> LoadOptions {
-    let mut xacro_args = world.robot.xacro_args.clone();
-    xacro_args.extend(config.robot_options.xacro_args.clone());
-    LoadOptions {
-        xacro_args,
-        resources: resource_paths(config),
+    /// Loads the script this config names (an empty one without).
+    pub fn load_script(&self) -> Result<Script> {
+        match &self.script {
+            Some(path) => Script::load(path),
+            None => Ok(Script::default()),
+        }
     }
-}
 
-/// Loads the script a [`RunConfig`] names (an empty one without).
-pub fn load_script(config: &RunConfig) -> Result<Script> {
-    match &config.script {
-        Some(path) => Script::load(path),
-        None => Ok(Script::default()),
+    /// Where packages and models are found: the config's folders first, then
+    /// `ROS_PACKAGE_PATH` and `GAZEBO_MODEL_PATH`.
+    fn resource_paths(&self) -> ResourcePaths {
+        let mine = &self.robot_options.resources;
+        let mut paths = ResourcePaths::from_env();
+        paths.packages.extend(mine.packages.clone());
+        paths
+            .package_search
+            .splice(0..0, mine.package_search.iter().cloned());
+        paths
+            .model_search
+            .splice(0..0, mine.model_search.iter().cloned());
+        paths
+    }
+
+    /// How the robot is read: the config's resource paths, and xacro arguments from the
+    /// world's `[robot]`, then the config's.
+    pub(crate) fn robot_load_options(&self, world: &World) -> LoadOptions {
+        let mut xacro_args = world.robot.xacro_args.clone();
+        xacro_args.extend(self.robot_options.xacro_args.clone());
+        LoadOptions {
+            xacro_args,
+            resources: self.resource_paths(),
+        }
     }
 }
 
 /// Runs headless and writes the trace, if asked. Deterministic: the same world, robot, script
 /// and seed give a byte-identical trace (detection runs in lockstep on sim time).
-pub fn run(config: &RunConfig) -> Result<RunSummary> {
-    run_observed(config, &mut NoObserver, false)
+pub fn run_headless(config: &RunConfig) -> Result<RunSummary> {
+    run_headless_observed(config, &mut NoObserver, false)
 }
 
-/// [`run`] with an observer (the Rerun recorder). `observer_wants_camera` turns the camera and
-/// detector on under [`Perception::Auto`].
-pub fn run_observed(
+/// [`run_headless`] with an observer (the Rerun recorder). `observer_wants_camera` turns the
+/// camera and detector on under [`Perception::Auto`].
+pub fn run_headless_observed(
     config: &RunConfig,
     observer: &mut dyn Observer,
     observer_wants_camera: bool,
 ) -> Result<RunSummary> {
-    let (world, robot) = load(config)?;
-    let script = load_script(config)?;
+    let (world, robot) = config.load_world_and_robot()?;
+    let script = config.load_script()?;
     run_loaded(
         config,
         world,
@@ -216,10 +219,11 @@ pub fn run_observed(
     )
 }
 
-/// [`run_loaded`] with input from outside (the ROS bridge's `/cmd_vel`), polled before every
-/// physics step after the script's due steps. Such runs are only as deterministic as their
-/// input's timing.
-pub fn run_driven(
+/// [`run_headless_observed`] with the world and robot already loaded (the config's paths for
+/// them are not read; its spawn, drive and camera choices are not applied) and input from
+/// outside (the ROS bridge's `/cmd_vel`), polled before every physics step after the script's
+/// due steps. Such runs are only as deterministic as their input's timing.
+pub fn run_headless_driven(
     config: &RunConfig,
     world: World,
     robot: RobotModel,
@@ -227,7 +231,7 @@ pub fn run_driven(
     observer_wants_camera: bool,
     inputs: &mut dyn InputSource,
 ) -> Result<RunSummary> {
-    let script = load_script(config)?;
+    let script = config.load_script()?;
     run_inner(
         config,
         world,
@@ -239,10 +243,10 @@ pub fn run_driven(
     )
 }
 
-/// [`run_observed`] with the world, robot and script already loaded (the config's paths for
-/// them are not read; its spawn, drive and camera choices are not applied): for tools that
-/// build them in memory, such as scenario files.
-pub fn run_loaded(
+/// [`run_headless_observed`] with the world, robot and script already loaded (the config's
+/// paths for them are not read; its spawn, drive and camera choices are not applied): for
+/// scenario files, built in memory.
+pub(crate) fn run_loaded(
     config: &RunConfig,
     world: World,
     robot: RobotModel,
@@ -270,29 +274,7 @@ fn run_inner(
     observer_wants_camera: bool,
     inputs: &mut dyn InputSource,
 ) -> Result<RunSummary> {
-    let duration_s = match config.duration_s {
-        Some(d) if d.is_finite() && d >= 0.0 => d,
-        Some(d) => {
-            return Err(CoreError::Option(format!(
-                "--duration must be a number of seconds >= 0, found {d}"
-            )));
-        }
-        None if config.script.is_some() || !script.steps.is_empty() => script.end_s() + 1.0,
-        None => 10.0,
-    };
-    let detect_hz = config.detect_hz.unwrap_or(DEFAULT_DETECT_HZ);
-    if !(detect_hz.is_finite() && detect_hz > 0.0) {
-        return Err(CoreError::Option(format!(
-            "--detect-hz must be a positive number, found {detect_hz}"
-        )));
-    }
-    if let Some(rtf) = config.real_time_factor
-        && !(rtf.is_finite() && rtf > 0.0)
-    {
-        return Err(CoreError::Option(format!(
-            "--rtf must be a positive factor, found {rtf}"
-        )));
-    }
+    let limits = RunLimits::check(config, &script)?;
     let mut player = ScriptPlayer::new(script);
     let perceive = match config.perception {
         Perception::On => true,
@@ -304,22 +286,14 @@ fn run_inner(
         config.save_frames.as_deref(),
         config.frame_every,
     )?;
-
     let world_name = world.name.clone();
     let robot_name = robot.name.clone();
+    let saves_frames = files.frames.is_some();
     let options = SessionOptions {
         sim: config.options.clone(),
-        camera: perceive || files.frames.is_some(),
-        every_frame: observer_wants_camera || files.frames.is_some(),
-        detector: if perceive && config.detector_thread {
-            DetectorMode::Worker
-        } else if perceive && config.serial_detection {
-            DetectorMode::Lockstep { rate_hz: detect_hz }
-        } else if perceive {
-            DetectorMode::Pipelined { rate_hz: detect_hz }
-        } else {
-            DetectorMode::Off
-        },
+        camera: perceive || saves_frames,
+        every_frame: observer_wants_camera || saves_frames,
+        detector: detector_mode(config, perceive, limits.detect_hz),
         detector_config: config.detector.clone(),
         follower: config.follower.clone(),
     };
@@ -327,11 +301,111 @@ fn run_inner(
     fan.push(&mut files);
     fan.push(observer);
     let mut session = Session::new(world, robot, &options, &mut fan)?;
+    let stepped = step_to_end(
+        config,
+        limits.duration_s,
+        &mut session,
+        &mut player,
+        inputs,
+        &mut fan,
+    )?;
+    drop(fan);
+    let written = files.finish()?;
+    Ok(RunSummary {
+        world: world_name,
+        robot: robot_name,
+        sim_time_s: session.sim().sim_time_s(),
+        steps: session.sim().step_index(),
+        wall_s: stepped.wall_s,
+        rows: written.rows,
+        frames_written: written.frames,
+        last: stepped.last,
+        mode: session.pilot().mode(),
+        interrupted: stepped.interrupted,
+    })
+}
+
+/// A run's length and detection rate, checked along with its pacing.
+struct RunLimits {
+    /// Sim seconds to run.
+    duration_s: f64,
+    /// Detections per sim second.
+    detect_hz: f64,
+}
+
+impl RunLimits {
+    /// The config's duration (default: the script's last step + 1 s, or 10 s without a
+    /// script), detection rate and real-time factor, each refused when out of range.
+    fn check(config: &RunConfig, script: &Script) -> Result<Self> {
+        let duration_s = match config.duration_s {
+            Some(d) if d.is_finite() && d >= 0.0 => d,
+            Some(d) => {
+                return Err(CoreError::Option(format!(
+                    "--duration must be a number of seconds >= 0, found {d}"
+                )));
+            }
+            None if config.script.is_some() || !script.steps.is_empty() => script.end_s() + 1.0,
+            None => 10.0,
+        };
+        let detect_hz = config.detect_hz.unwrap_or(DEFAULT_DETECT_HZ);
+        if !(detect_hz.is_finite() && detect_hz > 0.0) {
+            return Err(CoreError::Option(format!(
+                "--detect-hz must be a positive number, found {detect_hz}"
+            )));
+        }
+        if let Some(rtf) = config.real_time_factor
+            && !(rtf.is_finite() && rtf > 0.0)
+        {
+            return Err(CoreError::Option(format!(
+                "--rtf must be a positive factor, found {rtf}"
+            )));
+        }
+        Ok(Self {
+            duration_s,
+            detect_hz,
+        })
+    }
+}
+
+/// How a headless run detects: not at all without perception; else on a worker thread
+/// (`detector_thread`), serially on the loop's thread (`serial_detection`), or pipelined.
+fn detector_mode(config: &RunConfig, perceive: bool, detect_hz: f64) -> DetectorMode {
+    if perceive && config.detector_thread {
+        DetectorMode::Worker
+    } else if perceive && config.serial_detection {
+        DetectorMode::Lockstep { rate_hz: detect_hz }
+    } else if perceive {
+        DetectorMode::Pipelined { rate_hz: detect_hz }
+    } else {
+        DetectorMode::Off
+    }
+}
+
+/// What the stepping loop did.
+struct Stepped {
+    /// The last control sample.
+    last: Option<ControlSample>,
+    /// Wall time of the loop (s).
+    wall_s: f64,
+    /// Ended early through [`RunConfig::stop`].
+    interrupted: bool,
+}
+
+/// Steps the session until `duration_s` of sim time or a stop request: script steps and
+/// outside inputs first, then physics; paced to the real-time factor and reporting progress
+/// when the config asks. An observer's failure ends the run with its error.
+fn step_to_end(
+    config: &RunConfig,
+    duration_s: f64,
+    session: &mut Session,
+    player: &mut ScriptPlayer,
+    inputs: &mut dyn InputSource,
+    fan: &mut Fanout<'_>,
+) -> Result<Stepped> {
     let total_steps = (duration_s / session.sim().dt_s()).round() as u64;
     let mut last = None;
     let started = Instant::now();
     let mut last_report = started;
-
     let mut interrupted = false;
     while session.sim().step_index() < total_steps {
         if config
@@ -342,11 +416,11 @@ fn run_inner(
             interrupted = true;
             break;
         }
-        player.play(&mut session, &mut fan);
+        player.play(session, fan);
         while let Some(action) = inputs.poll() {
-            session.input(action, &mut fan);
+            session.input(action, fan);
         }
-        if let Some(sample) = session.step(&mut fan)? {
+        if let Some(sample) = session.step(fan)? {
             last = Some(sample);
         }
         if let Some(failure) = fan.failure() {
@@ -371,19 +445,9 @@ fn run_inner(
             );
         }
     }
-    let wall_s = started.elapsed().as_secs_f64();
-    drop(fan);
-    let written = files.finish()?;
-    Ok(RunSummary {
-        world: world_name,
-        robot: robot_name,
-        sim_time_s: session.sim().sim_time_s(),
-        steps: session.sim().step_index(),
-        wall_s,
-        rows: written.rows,
-        frames_written: written.frames,
+    Ok(Stepped {
         last,
-        mode: session.pilot().mode(),
+        wall_s: started.elapsed().as_secs_f64(),
         interrupted,
     })
 }

@@ -2,36 +2,48 @@
 //!
 //! Data flows one way: world + robot -> [`rover_sim`] -> camera -> [`rover_perception`] ->
 //! [`Pilot`] (teleop | [`Follower`]) -> cmd_vel -> sim. A [`Session`] advances that loop one
-//! physics step at a time; [`Observer`]s (trace writer, frame saver, and in the app the Rerun
-//! recorder and the window's HUD) only watch it, composed by a [`Fanout`]. [`ScriptPlayer`]
-//! feeds timed inputs to a session; [`headless::run`] paces it as fast as the CPU allows,
-//! deterministically.
+//! physics step at a time, driven by [`Action`]s (keys, scripted steps, an [`InputSource`]);
+//! [`Observer`]s (trace writer, frame saver, and in the app the Rerun recorder and the window's
+//! HUD) only watch it, composed by a [`Fanout`]. [`ScriptPlayer`] feeds timed inputs to a
+//! session; [`run_headless`] paces it as fast as the CPU allows, deterministically, and
+//! [`run_scenario`] judges the follower on a scenario file.
 //!
 //! Nothing here depends on winit, wgpu surfaces, rerun or gilrs: everything runs headless in
-//! tests.
+//! tests. The modules are private; this page lists the API.
 
 mod error;
-pub mod follower;
-pub mod headless;
-mod observers;
-pub mod paths;
+mod follower;
+mod headless;
+mod input;
+mod observer;
+mod paths;
 mod pilot;
-pub mod scenario;
-pub mod script;
+mod run_files;
+mod scenario;
+mod script;
 mod session;
-pub mod teleop;
-pub mod trace;
+mod teleop;
+mod trace;
 
 pub use error::{CoreError, Result};
-pub use follower::{CameraGeometry, FollowState, Follower, FollowerConfig, LaserMount};
-pub use headless::{DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary};
-pub use observers::{Fanout, FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
-pub use pilot::{Mode, Pilot};
-pub use scenario::{Scenario, ScenarioResult};
-pub use script::{Action, Script, ScriptPlayer, Step};
-pub use session::{
-    DetectorMode, EventLevel, InputSource, LoopStats, NoInput, NoObserver, Observer, Session,
-    SessionOptions,
+pub use follower::{
+    AvoidConfig, Avoided, CameraGeometry, FollowState, FollowTarget, Follower, FollowerConfig,
+    LaserMount, TargetFilter,
 };
-pub use teleop::{KeyAction, Teleop, key_action};
-pub use trace::{TRACE_HEADER, TraceRow, TraceWriter, parse_trace};
+pub use headless::{
+    DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary, run_headless, run_headless_driven,
+    run_headless_observed,
+};
+pub use input::{Action, InputSource, NoInput};
+pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
+pub use paths::{bundled_path, default_robot_path};
+pub use pilot::{Mode, Pilot};
+pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
+pub use scenario::{
+    Scenario, ScenarioCheck, ScenarioCriteria, ScenarioMetrics, ScenarioOptions, ScenarioResult,
+    collect_scenario_files, run_scenario,
+};
+pub use script::{Script, ScriptPlayer, Step};
+pub use session::{DetectorMode, Session, SessionOptions};
+pub use teleop::{KeyAction, TELEOP_KEYS, Teleop, key_action};
+pub use trace::{TRACE_HEADER, TraceParseError, TraceRow, TraceWriter, parse_trace};

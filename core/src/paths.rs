@@ -11,7 +11,7 @@ fn build_root() -> PathBuf {
 }
 
 /// Finds a bundled file: relative to the current directory first, then to the source tree.
-pub fn bundled(relative: &str) -> PathBuf {
+pub fn bundled_path(relative: &str) -> PathBuf {
     let here = PathBuf::from(relative);
     if here.exists() {
         return here;
@@ -21,11 +21,11 @@ pub fn bundled(relative: &str) -> PathBuf {
 }
 
 /// The default world, `worlds/playground.toml`.
-pub fn default_world() -> PathBuf {
-    bundled("worlds/playground.toml")
+pub(crate) fn default_world() -> PathBuf {
+    bundled_path("worlds/playground.toml")
 }
 
 /// The default robot, `assets/robots/my_robot.urdf`.
-pub fn default_robot() -> PathBuf {
-    bundled("assets/robots/my_robot.urdf")
+pub fn default_robot_path() -> PathBuf {
+    bundled_path("assets/robots/my_robot.urdf")
 }

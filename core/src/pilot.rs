@@ -2,8 +2,8 @@
 
 use rover_sim::Twist;
 
-use crate::script::Action;
-use crate::teleop::Teleop;
+use crate::input::Action;
+use crate::teleop::{KeyAction, Teleop};
 
 /// Control mode, as the trace's `mode` column shows it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -48,15 +48,15 @@ impl Pilot {
     /// Any manual input while following takes control back at once (safety first). Entering
     /// follow mode publishes a stop; the follower then commands the robot from detections, and
     /// with no detector available it holds still.
-    pub fn apply(&mut self, action: Action) -> Option<Twist> {
+    pub fn apply(&mut self, action: &Action) -> Option<Twist> {
         match action {
             Action::CmdVel(twist) => {
                 self.mode = Mode::Manual;
-                Some(twist)
+                Some(*twist)
             }
             Action::Key(key) => {
                 self.mode = Mode::Manual;
-                Some(self.teleop.press(key))
+                Some(self.teleop.press(*key))
             }
             Action::ToggleFollow => {
                 self.mode = match self.mode {
@@ -65,7 +65,7 @@ impl Pilot {
                 };
                 // Either way the robot stops: the teleop direction is cleared so that leaving
                 // follow mode does not resume an old key press.
-                self.teleop.press(crate::teleop::KeyAction::Stop);
+                self.teleop.press(KeyAction::Stop);
                 Some(Twist::ZERO)
             }
         }

@@ -1,7 +1,7 @@
 //! Scenarios: a world, a robot, when the follower is switched on, and what counts as success,
-//! in one TOML file (`scenarios/*.toml`, format in docs/FOLLOWER.md). [`run`] plays one headless
-//! and deterministically (lockstep detection on sim time) and measures it with a [`Probe`]; the
-//! app's `rover eval` runs many in parallel.
+//! in one TOML file (`scenarios/*.toml`, format in docs/FOLLOWER.md). [`run_scenario`] plays
+//! one headless and deterministically (lockstep detection on sim time) and measures it with a
+//! [`Probe`]; the app's `rover eval` runs many in parallel.
 //!
 //! ```toml
 //! [scenario]
@@ -31,16 +31,17 @@ use serde::{Deserialize, Serialize};
 use crate::error::{CoreError, Result};
 use crate::follower::FollowState;
 use crate::headless::{self, RunConfig};
+use crate::input::Action;
+use crate::observer::{LoopStats, Observer};
 use crate::paths;
 use crate::pilot::Mode;
-use crate::script::{Action, Script, Step};
-use crate::session::{LoopStats, Observer};
+use crate::script::{Script, Step};
 
 /// What a scenario must achieve. Every criterion is optional; `never_drive_while_searching` is
 /// on unless set to false.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
-pub struct Criteria {
+pub struct ScenarioCriteria {
     /// Range from the robot's base to the target at the end, [min, max] (m).
     pub final_range_m: Option<[f64; 2]>,
     /// The follower first tracks the target within this long after follow mode starts (s).
@@ -68,7 +69,7 @@ pub struct Criteria {
 struct RawScenarioFile {
     scenario: RawScenario,
     #[serde(default)]
-    criteria: Criteria,
+    criteria: ScenarioCriteria,
     world: Option<WorldFile>,
     world_file: Option<PathBuf>,
 }
@@ -114,7 +115,7 @@ pub struct Scenario {
     /// Free-form labels (e.g. "fast": the subset `cargo test` runs).
     pub tags: Vec<String>,
     /// What counts as success.
-    pub criteria: Criteria,
+    pub criteria: ScenarioCriteria,
     /// The world.
     pub world: World,
     /// The robot.
@@ -186,8 +187,8 @@ impl Scenario {
             .robot
             .map(|r| path.parent().unwrap_or(Path::new(".")).join(r))
             .or_else(|| world.robot.urdf.clone())
-            .unwrap_or_else(paths::default_robot);
-        let options = headless::robot_load_options(&RunConfig::default(), &world);
+            .unwrap_or_else(paths::default_robot_path);
+        let options = RunConfig::default().robot_load_options(&world);
         let mut robot = RobotModel::load_with(&robot_path, &options)?;
         if let Some(spec) = &world.robot.drive {
             robot.set_drive(spec)?;
@@ -213,7 +214,7 @@ impl Scenario {
     }
 }
 
-fn check_criteria(c: &Criteria) -> std::result::Result<(), (String, String)> {
+fn check_criteria(c: &ScenarioCriteria) -> std::result::Result<(), (String, String)> {
     let positive = |key: &str, v: Option<f64>| match v {
         Some(v) if !(v.is_finite() && v >= 0.0) => Err((
             key.to_owned(),
@@ -242,7 +243,7 @@ fn check_criteria(c: &Criteria) -> std::result::Result<(), (String, String)> {
 
 /// What a run measured (ground truth, not what the robot believed).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Metrics {
+pub struct ScenarioMetrics {
     /// Sim time run (s).
     pub sim_s: f64,
     /// Sim time of the first TRACKING after follow mode started (s).
@@ -277,7 +278,7 @@ pub struct Metrics {
 
 /// One criterion's verdict.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Check {
+pub struct ScenarioCheck {
     /// The criterion's key.
     pub name: String,
     /// What was required.
@@ -300,9 +301,9 @@ pub struct ScenarioResult {
     /// Every criterion held and the run finished.
     pub passed: bool,
     /// The verdicts.
-    pub checks: Vec<Check>,
+    pub checks: Vec<ScenarioCheck>,
     /// What was measured.
-    pub metrics: Metrics,
+    pub metrics: ScenarioMetrics,
     /// Why the run could not be done, if it could not.
     pub error: Option<String>,
     /// Wall-clock seconds the run took (the one field that differs between identical runs).
@@ -318,7 +319,7 @@ impl ScenarioResult {
             description: String::new(),
             passed: false,
             checks: Vec::new(),
-            metrics: Metrics::default(),
+            metrics: ScenarioMetrics::default(),
             error: Some(error),
             wall_s: 0.0,
         }
@@ -328,14 +329,14 @@ impl ScenarioResult {
 /// Measures a scenario run from the session's control updates (an observer: it never
 /// influences the run).
 #[derive(Debug)]
-pub struct Probe {
+struct Probe {
     target: Option<usize>,
     last_t: Option<f64>,
     last_xy: Option<[f64; 2]>,
     last_state: FollowState,
     last_state_following: bool,
     calm_from_s: Option<f64>,
-    metrics: Metrics,
+    metrics: ScenarioMetrics,
 }
 
 /// Clearances are measured up to this distance (m).
@@ -352,15 +353,15 @@ impl Probe {
             last_state: FollowState::Waiting,
             last_state_following: false,
             calm_from_s,
-            metrics: Metrics {
+            metrics: ScenarioMetrics {
                 min_clearance_m: f64::from(CLEARANCE_CAP_M),
-                ..Metrics::default()
+                ..ScenarioMetrics::default()
             },
         }
     }
 
     /// What was measured so far.
-    pub fn metrics(&self) -> &Metrics {
+    pub fn metrics(&self) -> &ScenarioMetrics {
         &self.metrics
     }
 }
@@ -433,10 +434,10 @@ impl Observer for Probe {
 }
 
 /// Judges measured metrics against criteria.
-pub fn judge(criteria: &Criteria, m: &Metrics, follow_at_s: f64) -> Vec<Check> {
+fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> Vec<ScenarioCheck> {
     let mut checks = Vec::new();
     let mut check = |name: &str, limit: String, value: String, passed: bool| {
-        checks.push(Check {
+        checks.push(ScenarioCheck {
             name: name.to_owned(),
             limit,
             value,
@@ -529,9 +530,9 @@ pub fn judge(criteria: &Criteria, m: &Metrics, follow_at_s: f64) -> Vec<Check> {
     checks
 }
 
-/// How [`run`] runs a scenario besides what the file says.
+/// How [`run_scenario`] runs a scenario besides what the file says.
 #[derive(Debug, Clone, Default)]
-pub struct RunOptions {
+pub struct ScenarioOptions {
     /// Detector settings (model, input size).
     pub detector: DetectorConfig,
     /// Write the run's trace CSV here.
@@ -540,9 +541,9 @@ pub struct RunOptions {
 
 /// Runs a scenario headless (deterministic) and judges it. `extra` watches the run too (the
 /// app's Rerun recorder); it never influences it.
-pub fn run(
+pub fn run_scenario(
     scenario: &Scenario,
-    options: &RunOptions,
+    options: &ScenarioOptions,
     extra: &mut dyn Observer,
 ) -> Result<ScenarioResult> {
     let config = RunConfig {
@@ -594,7 +595,7 @@ pub fn run(
 }
 
 /// The scenario files a list of paths names: files as given, folders' `*.toml` in name order.
-pub fn collect_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+pub fn collect_scenario_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {

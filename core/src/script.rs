@@ -14,22 +14,13 @@ use rover_sim::{ControlSample, SimError, Twist};
 use serde::Deserialize;
 
 use crate::error::Result;
-use crate::session::{Observer, Session};
-use crate::teleop::{KeyAction, TELEOP_KEYS, key_action};
-
-/// What a step does.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Action {
-    /// Publish a velocity command.
-    CmdVel(Twist),
-    /// Press a teleop key.
-    Key(KeyAction),
-    /// Flip between manual and follow mode.
-    ToggleFollow,
-}
+use crate::input::Action;
+use crate::observer::Observer;
+use crate::session::Session;
+use crate::teleop::{TELEOP_KEYS, key_action};
 
 /// One timed step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Step {
     /// Sim time at which it applies (s).
     pub at_s: f64,
@@ -164,7 +155,7 @@ impl ScriptPlayer {
             if step.at_s > now + half_step_s {
                 break;
             }
-            session.input(step.action, observer);
+            session.input(step.action.clone(), observer);
             self.next += 1;
         }
     }
@@ -184,6 +175,7 @@ impl ScriptPlayer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::teleop::KeyAction;
 
     fn parse(text: &str) -> crate::Result<Script> {
         Script::from_str(text, Path::new("s.toml"))

@@ -13,14 +13,15 @@ use rover_perception::{
     PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraInfo, CameraSensor, ControlSample, LaserScan, LaserSensor, Pose, RobotModel, SimOptions,
+    CameraFrame, CameraInfo, CameraSensor, ControlSample, LaserSensor, RobotModel, SimOptions,
     Simulation, World,
 };
 
 use crate::error::{CoreError, Result};
-use crate::follower::{CameraGeometry, FollowState, Follower, FollowerConfig, LaserMount};
+use crate::follower::{CameraGeometry, Follower, FollowerConfig, LaserMount};
+use crate::input::Action;
+use crate::observer::{EventLevel, LoopStats, Observer};
 use crate::pilot::{Mode, Pilot};
-use crate::script::Action;
 
 /// How detection runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,93 +78,6 @@ impl Default for SessionOptions {
     }
 }
 
-/// How bad an [`Observer::event`] is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EventLevel {
-    /// Information (mode changes).
-    Info,
-    /// Something the user should know (no detector, viewer gone).
-    Warn,
-}
-
-/// Loop figures for HUDs and recorders.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct LoopStats {
-    /// Control mode.
-    pub mode: Mode,
-    /// What the follower is doing.
-    pub follow_state: FollowState,
-    /// Detector results per wall second (worker) or per sim second (lockstep).
-    pub detector_hz: f64,
-    /// Latency of the newest detection (ms, from frame submission to result).
-    pub detector_latency_ms: f64,
-    /// Frames the detector skipped because a newer one arrived.
-    pub frames_dropped: u64,
-    /// Camera frames rendered.
-    pub frames: u64,
-    /// Whether a detector is running.
-    pub detector_ok: bool,
-    /// Whether the detector failed during the run (an error or a panic in it); it stays off.
-    pub detector_failed: bool,
-    /// Whether the follower is steering around an obstacle (it has a laser and something is in
-    /// the way of its own command).
-    pub avoiding: bool,
-}
-
-/// Watches a session without influencing it (the Rerun recorder, the window).
-pub trait Observer {
-    /// Once, when the session is set up: the scene, the camera's intrinsics and the detector's
-    /// class names.
-    fn start(&mut self, _sim: &Simulation, _camera: Option<&CameraInfo>, _labels: &[String]) {}
-    /// After every control update (100 Hz for the tutorial car).
-    fn control(&mut self, _sim: &Simulation, _sample: &ControlSample, _stats: &LoopStats) {}
-    /// A camera image, taken at `frame.sim_time_s` from `world_from_camera` (the camera link).
-    fn camera_frame(&mut self, _frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {}
-    /// Detections of an earlier camera image (see their `image_stamp`).
-    fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
-    /// A laser scan, taken from `world_from_laser` (the sensor's frame) at `scan.stamp_s`.
-    fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
-    /// A mode change, a warning.
-    fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
-    /// An observer that can no longer do its job (a trace or frame it cannot write) says so
-    /// here, once; the runner decides whether the run stops.
-    fn failure(&mut self) -> Option<CoreError> {
-        None
-    }
-}
-
-/// Two observers side by side, built on the stack where one is added for a moment (the
-/// window's HUD beside the fan-out): no allocation.
-impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
-    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
-        self.0.start(sim, camera, labels);
-        self.1.start(sim, camera, labels);
-    }
-    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
-        self.0.control(sim, sample, stats);
-        self.1.control(sim, sample, stats);
-    }
-    fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, world_from_camera: Pose) {
-        self.0.camera_frame(frame, world_from_camera);
-        self.1.camera_frame(frame, world_from_camera);
-    }
-    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
-        self.0.detections(boxes, labels);
-        self.1.detections(boxes, labels);
-    }
-    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
-        self.0.laser_scan(scan, world_from_laser);
-        self.1.laser_scan(scan, world_from_laser);
-    }
-    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
-        self.0.event(sim_time_s, level, text);
-        self.1.event(sim_time_s, level, text);
-    }
-    fn failure(&mut self) -> Option<CoreError> {
-        self.0.failure().or_else(|| self.1.failure())
-    }
-}
-
 /// Sends an event to the observer and to the log.
 fn emit(observer: &mut dyn Observer, sim_time_s: f64, level: EventLevel, text: &str) {
     match level {
@@ -173,29 +87,7 @@ fn emit(observer: &mut dyn Observer, sim_time_s: f64, level: EventLevel, text: &
     observer.event(sim_time_s, level, text);
 }
 
-/// Input from outside the loop that drives it like manual input: the ROS bridge's `/cmd_vel`.
-/// Polled before every physics step; it must not block.
-pub trait InputSource {
-    /// The next input waiting, if any.
-    fn poll(&mut self) -> Option<Action>;
-}
-
-/// No outside input.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct NoInput;
-
-impl InputSource for NoInput {
-    fn poll(&mut self) -> Option<Action> {
-        None
-    }
-}
-
-/// An observer that ignores everything.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct NoObserver;
-
-impl Observer for NoObserver {}
-
+/// The detector as the session runs it ([`DetectorMode`], once loaded).
 enum Detection {
     Off,
     Lockstep(Box<LockstepDetector>),
@@ -252,102 +144,24 @@ impl Session {
         observer: &mut dyn Observer,
     ) -> Result<Self> {
         let sim = Simulation::new(world, robot, &options.sim)?;
-        let camera_config = sim.robot().cameras.first().cloned();
         let wants_camera = options.camera || options.detector != DetectorMode::Off;
-        let camera = match (&camera_config, wants_camera) {
-            (Some(_), true) => {
-                let sensor = CameraSensor::new(&sim).map_err(CoreError::Camera)?;
-                tracing::info!(
-                    "camera: {}x{}, rendering on {}",
-                    sensor.info().width,
-                    sensor.info().height,
-                    sensor.renderer().adapter()
-                );
-                Some(sensor)
-            }
-            (None, true) => {
-                emit(
-                    observer,
-                    0.0,
-                    EventLevel::Warn,
-                    "the robot has no camera: no images, no detections, the follower holds still",
-                );
-                None
-            }
-            _ => None,
-        };
-        let camera_link = camera_config
-            .as_ref()
+        let camera = start_camera(&sim, wants_camera, observer)?;
+        let camera_link = sim
+            .robot()
+            .cameras
+            .first()
             .and_then(|c| sim.robot().link_index(&c.link))
             .unwrap_or(0);
+        let laser = start_laser(&sim)?;
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
-        // The first laser, if any: always on (casting a scan is cheap), for the follower's
-        // obstacles and target and for observers.
-        let laser = match sim.robot().lasers.first() {
-            Some(config) => {
-                let sensor = LaserSensor::new(&sim, 0)?;
-                tracing::info!(
-                    "laser: {} rays, {:.1}-{:.1} m at {} Hz",
-                    config.samples,
-                    config.range_min_m,
-                    config.range_max_m,
-                    config.update_rate_hz
-                );
-                Some(sensor)
-            }
-            None => None,
-        };
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
             let base_from_laser = sim.world_from_base().inverse() * l.world_from_sensor(&sim);
             follower = follower.with_laser(LaserMount::from_base_from_laser(base_from_laser));
         }
-        let mut labels = Vec::new();
-        let detection = match (options.detector, camera.is_some()) {
-            (DetectorMode::Off, _) | (_, false) => Detection::Off,
-            (mode, true) => match Detector::load(options.detector_config.clone()) {
-                Ok(detector) => {
-                    labels = detector.labels().to_vec();
-                    tracing::info!(
-                        "detector: {} at {}x{} on {}, {} thread(s)",
-                        detector.model_path().display(),
-                        detector.input_size().0,
-                        detector.input_size().1,
-                        detector.config().runtime.name(),
-                        detector.config().threads
-                    );
-                    match mode {
-                        DetectorMode::Lockstep { rate_hz } => {
-                            Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
-                        }
-                        DetectorMode::Pipelined { rate_hz } => {
-                            if !(rate_hz.is_finite() && rate_hz > 0.0) {
-                                return Err(CoreError::Option(format!(
-                                    "the detection rate must be a positive number of Hz, found {rate_hz}"
-                                )));
-                            }
-                            Detection::Pipelined(Box::new(Pipelined {
-                                worker: DetectorWorker::spawn(detector)?,
-                                period_s: 1.0 / rate_hz,
-                                next_s: 0.0,
-                                deliver_at_s: None,
-                            }))
-                        }
-                        _ => Detection::Worker(DetectorWorker::spawn(detector)?),
-                    }
-                }
-                Err(e) => {
-                    emit(
-                        observer,
-                        0.0,
-                        EventLevel::Warn,
-                        &format!(
-                            "no detector ({e}); manual driving works, the follower holds still"
-                        ),
-                    );
-                    Detection::Off
-                }
-            },
+        let (detection, labels) = match (options.detector, camera.is_some()) {
+            (DetectorMode::Off, _) | (_, false) => (Detection::Off, Vec::new()),
+            (mode, true) => start_detection(mode, &options.detector_config, observer)?,
         };
         let stats = LoopStats {
             detector_ok: !matches!(detection, Detection::Off),
@@ -415,7 +229,7 @@ impl Session {
     /// control back at once.
     pub fn input(&mut self, action: Action, observer: &mut dyn Observer) {
         let before = self.pilot.mode();
-        let cmd = self.pilot.apply(action);
+        let cmd = self.pilot.apply(&action);
         let after = self.pilot.mode();
         if before != after {
             self.follower.reset();
@@ -568,12 +382,13 @@ impl Session {
             sim_time_s: frame.sim_time_s,
             frame: frame.seq,
         };
-        let (w, h) = (frame.width as usize, frame.height as usize);
         let detected = match &mut self.detection {
             Detection::Off => None,
-            Detection::Lockstep(detector) => RgbView::new(w, h, frame.rgb)
-                .and_then(|view| detector.detect_if_due(view, stamp))
-                .transpose(),
+            Detection::Lockstep(detector) => {
+                RgbView::new(frame.width as usize, frame.height as usize, frame.rgb)
+                    .and_then(|view| detector.detect_if_due(view, stamp))
+                    .transpose()
+            }
             Detection::Pipelined(p) => {
                 if frame.sim_time_s + 1e-9 >= p.next_s {
                     p.next_s += p.period_s;
@@ -585,15 +400,8 @@ impl Session {
                     // sim time like everything else: never two results outstanding.
                     let still_out = p.deliver_at_s.take().is_some();
                     let earlier = std::mem::take(owed) || still_out;
-                    let mut pixels = p.worker.buffer();
-                    pixels.clear();
-                    pixels.extend_from_slice(frame.rgb);
-                    p.worker.submit_queued(Frame {
-                        pixels,
-                        width: w,
-                        height: h,
-                        stamp,
-                    });
+                    p.worker
+                        .submit_queued(worker_frame(&p.worker, &frame, stamp));
                     p.deliver_at_s = Some(frame.sim_time_s + p.period_s);
                     earlier.then(|| p.worker.wait())
                 } else {
@@ -601,16 +409,9 @@ impl Session {
                 }
             }
             Detection::Worker(worker) => {
-                let mut pixels = worker.buffer();
-                pixels.clear();
-                pixels.extend_from_slice(frame.rgb);
+                let detector_frame = worker_frame(worker, &frame, stamp);
                 self.detector_started.get_or_insert_with(Instant::now);
-                worker.submit(Frame {
-                    pixels,
-                    width: w,
-                    height: h,
-                    stamp,
-                });
+                worker.submit(detector_frame);
                 None
             }
         };
@@ -671,6 +472,118 @@ impl Session {
         self.follower.observe(&boxes);
         observer.detections(&boxes, &self.labels);
         self.last_boxes = Some(boxes);
+    }
+}
+
+/// The robot's first camera when one is wanted; a robot without a camera is a warning to
+/// `observer`, not an error.
+fn start_camera(
+    sim: &Simulation,
+    wanted: bool,
+    observer: &mut dyn Observer,
+) -> Result<Option<CameraSensor>> {
+    if !wanted {
+        return Ok(None);
+    }
+    if sim.robot().cameras.is_empty() {
+        emit(
+            observer,
+            0.0,
+            EventLevel::Warn,
+            "the robot has no camera: no images, no detections, the follower holds still",
+        );
+        return Ok(None);
+    }
+    let sensor = CameraSensor::new(sim).map_err(CoreError::Camera)?;
+    tracing::info!(
+        "camera: {}x{}, rendering on {}",
+        sensor.info().width,
+        sensor.info().height,
+        sensor.renderer().adapter()
+    );
+    Ok(Some(sensor))
+}
+
+/// The robot's first laser, if any: always on (casting a scan is cheap), for the follower's
+/// obstacles and target and for observers.
+fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
+    let Some(config) = sim.robot().lasers.first() else {
+        return Ok(None);
+    };
+    let sensor = LaserSensor::new(sim, 0)?;
+    tracing::info!(
+        "laser: {} rays, {:.1}-{:.1} m at {} Hz",
+        config.samples,
+        config.range_min_m,
+        config.range_max_m,
+        config.update_rate_hz
+    );
+    Ok(Some(sensor))
+}
+
+/// Loads the detector and starts it in `mode` (not [`DetectorMode::Off`]); returns it with its
+/// class names. A detector that cannot be loaded is a warning to `observer` and no detection;
+/// a bad pipelined rate is an error.
+fn start_detection(
+    mode: DetectorMode,
+    config: &DetectorConfig,
+    observer: &mut dyn Observer,
+) -> Result<(Detection, Vec<String>)> {
+    let detector = match Detector::load(config.clone()) {
+        Ok(detector) => detector,
+        Err(e) => {
+            emit(
+                observer,
+                0.0,
+                EventLevel::Warn,
+                &format!("no detector ({e}); manual driving works, the follower holds still"),
+            );
+            return Ok((Detection::Off, Vec::new()));
+        }
+    };
+    let labels = detector.labels().to_vec();
+    tracing::info!(
+        "detector: {} at {}x{} on {}, {} thread(s)",
+        detector.model_path().display(),
+        detector.input_size().0,
+        detector.input_size().1,
+        detector.config().runtime.name(),
+        detector.config().threads
+    );
+    let detection = match mode {
+        DetectorMode::Lockstep { rate_hz } => {
+            Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
+        }
+        DetectorMode::Pipelined { rate_hz } => {
+            if !(rate_hz.is_finite() && rate_hz > 0.0) {
+                return Err(CoreError::Option(format!(
+                    "the detection rate must be a positive number of Hz, found {rate_hz}"
+                )));
+            }
+            Detection::Pipelined(Box::new(Pipelined {
+                worker: DetectorWorker::spawn(detector)?,
+                period_s: 1.0 / rate_hz,
+                next_s: 0.0,
+                deliver_at_s: None,
+            }))
+        }
+        DetectorMode::Worker | DetectorMode::Off => {
+            Detection::Worker(DetectorWorker::spawn(detector)?)
+        }
+    };
+    Ok((detection, labels))
+}
+
+/// A camera image copied into one of `worker`'s recycled buffers, as the detector takes it.
+fn worker_frame(worker: &DetectorWorker, frame: &CameraFrame<'_>, stamp: FrameStamp) -> Frame {
+    let mut pixels = worker.buffer();
+    pixels.clear();
+    pixels.extend_from_slice(frame.rgb);
+    Frame {
+        pixels,
+        width: frame.width as usize,
+        height: frame.height as usize,
+        stamp,
     }
 }
 

@@ -10,9 +10,9 @@
 use rover_sim::Twist;
 
 /// Default linear speed (m/s), as teleop_twist_keyboard's `~speed`.
-pub const DEFAULT_SPEED_MPS: f64 = 0.5;
+const DEFAULT_SPEED_MPS: f64 = 0.5;
 /// Default turn rate (rad/s), as teleop_twist_keyboard's `~turn`.
-pub const DEFAULT_TURN_RADPS: f64 = 1.0;
+const DEFAULT_TURN_RADPS: f64 = 1.0;
 
 /// What a key does.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,7 +2,7 @@
 //! in lockstep on sim time, the follower driving through cmd_vel. Headless, deterministic.
 
 use anyhow::Result;
-use rover_core::{RunConfig, headless};
+use rover_core::{RunConfig, run_headless};
 use rover_core::{TraceRow, parse_trace};
 use rover_sim::World;
 use rover_tests::repo;
@@ -29,7 +29,7 @@ fn follow(dir: &std::path::Path, world: &std::path::Path, seconds: f64) -> Resul
     let script = dir.join("follow.toml");
     std::fs::write(&script, "steps = [ { at = 0.5, toggle = \"follow\" } ]\n")?;
     let trace = dir.join("trace.csv");
-    headless::run(&RunConfig {
+    run_headless(&RunConfig {
         world: Some(world.to_path_buf()),
         robot: Some(repo("assets/robots/my_robot.urdf")),
         script: Some(script),

@@ -9,7 +9,7 @@
 use std::path::Path;
 
 use anyhow::Result;
-use rover_core::{RunConfig, headless};
+use rover_core::{RunConfig, run_headless};
 use rover_sim::{CameraSensor, SimOptions, Simulation};
 use rover_tests::repo;
 
@@ -25,7 +25,7 @@ fn check(
 ) -> Result<()> {
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
-    headless::run(&RunConfig {
+    run_headless(&RunConfig {
         world: Some(repo(world)),
         robot: robot.map(repo),
         script: Some(repo(script)),

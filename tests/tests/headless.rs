@@ -1,7 +1,7 @@
 //! Headless scripted runs through the app library: traces, determinism, scripts with keys.
 
 use anyhow::Result;
-use rover_core::{RunConfig, headless};
+use rover_core::{RunConfig, run_headless, run_headless_observed};
 use rover_core::{TRACE_HEADER, parse_trace};
 use rover_sim::SimOptions;
 use rover_tests::repo;
@@ -34,7 +34,7 @@ fn run_to(dir: &std::path::Path, name: &str, seed: u64) -> Result<String> {
         },
         ..RunConfig::default()
     };
-    let summary = headless::run(&config)?;
+    let summary = run_headless(&config)?;
     assert_eq!(summary.rows, 600, "100 Hz control for 6 s");
     Ok(std::fs::read_to_string(trace)?)
 }
@@ -118,7 +118,7 @@ impl rover_core::Observer for Deliveries {
 
 fn deliveries(serial_detection: bool) -> Result<Vec<(f64, f64)>> {
     let mut seen = Deliveries::default();
-    headless::run_observed(
+    run_headless_observed(
         &RunConfig {
             world: Some(repo("worlds/playground.toml")),
             duration_s: Some(3.0),

@@ -244,7 +244,7 @@ fn tiago_loads_and_drives_with_robot_drive() -> Result<()> {
     )?;
     let script = tmp.path().join("drive.toml");
     std::fs::write(&script, "steps = [ { at = 0.5, cmd_vel = [0.3, 0.0] } ]\n")?;
-    let summary = rover_core::headless::run(&rover_core::RunConfig {
+    let summary = rover_core::run_headless(&rover_core::RunConfig {
         world: Some(world),
         robot: Some(urdf),
         script: Some(script),

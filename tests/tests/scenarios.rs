@@ -3,12 +3,12 @@
 //! runs with `rover eval scenarios/` (see docs/FOLLOWER.md).
 
 use anyhow::Result;
-use rover_core::scenario::{self, RunOptions, Scenario};
 use rover_core::{NoObserver, parse_trace};
+use rover_core::{Scenario, ScenarioOptions, collect_scenario_files, run_scenario};
 use rover_tests::repo;
 
 fn fast_scenarios() -> Result<Vec<Scenario>> {
-    let files = scenario::collect_files(&[repo("scenarios")])?;
+    let files = collect_scenario_files(&[repo("scenarios")])?;
     let mut all = Vec::new();
     for f in files {
         all.push(Scenario::load(&f)?);
@@ -28,11 +28,11 @@ fn run_named(name: &str) -> Result<()> {
         .ok_or_else(|| anyhow::anyhow!("no fast scenario {name}"))?;
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
-    let result = scenario::run(
+    let result = run_scenario(
         s,
-        &RunOptions {
+        &ScenarioOptions {
             trace: Some(trace.clone()),
-            ..RunOptions::default()
+            ..ScenarioOptions::default()
         },
         &mut NoObserver,
     )?;

@@ -108,7 +108,7 @@ fn the_tutorial_car_drives_in_the_turtlebot_playground() -> Result<()> {
         ..rover_core::RunConfig::default()
     };
     config.robot_options.resources = ResourcePaths::default().with_model_path(models);
-    let summary = rover_core::headless::run(&config)?;
+    let summary = rover_core::run_headless(&config)?;
     let last = summary
         .last
         .ok_or_else(|| anyhow::anyhow!("no control samples"))?;
@@ -205,7 +205,7 @@ fn follows_a_gazebo_person_in_an_sdf_world() -> Result<()> {
         ..rover_core::RunConfig::default()
     };
     let standoff_m = config.follower.standoff_m;
-    rover_core::headless::run(&config)?;
+    rover_core::run_headless(&config)?;
     let rows = rover_core::parse_trace(&std::fs::read_to_string(trace)?)?;
     let last = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
     let range = (4.0 - last.x_m).hypot(last.y_m);

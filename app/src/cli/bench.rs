@@ -5,8 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
-use rover_core::headless;
-use rover_core::{Perception, RunConfig};
+use rover_core::{Perception, RunConfig, run_headless, run_headless_driven, run_headless_observed};
 use rover_perception::DetectorConfig;
 use rover_sim::{SimOptions, Simulation, Twist};
 
@@ -44,7 +43,7 @@ pub fn physics(
     sim_s: f64,
     repeats: u32,
 ) -> Result<PhysicsBench> {
-    let (world, robot) = headless::load(config)?;
+    let (world, robot) = config.load_world_and_robot()?;
     let options = SimOptions {
         step_hz,
         ..config.options.clone()
@@ -268,7 +267,7 @@ pub struct CameraBench {
 /// Renders `frames` camera images of the world from the robot's camera while it drives a
 /// circle (render + readback + post-processing per frame, after one warm-up).
 pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
-    let (world, robot) = headless::load(config)?;
+    let (world, robot) = config.load_world_and_robot()?;
     let mut sim = Simulation::new(world, robot, &config.options)?;
     let mut sensor = rover_sim::CameraSensor::new(&sim)?;
     sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
@@ -313,7 +312,7 @@ pub struct LaserBench {
 /// that scan's obstacles, in the configured world with its robot (default: the playground and
 /// the tutorial car with its laser).
 pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
-    let (world, robot) = headless::load(config)?;
+    let (world, robot) = config.load_world_and_robot()?;
     anyhow::ensure!(
         !robot.lasers.is_empty(),
         "{}: the robot has no <sensor type=\"ray\">; try --robot assets/robots/my_robot_laser.urdf.xacro",
@@ -343,7 +342,7 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
     let mut follower_times = Vec::with_capacity(scans);
     let mut window_times = Vec::with_capacity(scans);
     let mut points: Vec<[f64; 2]> = Vec::new();
-    let avoid = rover_core::follower::AvoidConfig::default();
+    let avoid = rover_core::AvoidConfig::default();
     for _ in 0..scans.max(1) {
         for _ in 0..5 {
             if let Some(sample) = sim.step() {
@@ -364,15 +363,7 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
         let _ = follower.command(sim.sim_time_s(), sim.odometry(), true);
         follower_times.push(start.elapsed().as_secs_f64() * 1e6);
         let start = Instant::now();
-        let out = rover_core::follower::avoid::choose(
-            Twist::new(0.8, 0.0),
-            [4.0, 0.0],
-            &points,
-            0.8,
-            1.2,
-            0.0,
-            &avoid,
-        );
+        let out = avoid.choose(Twist::new(0.8, 0.0), [4.0, 0.0], &points, 0.8, 1.2, 0.0);
         window_times.push(start.elapsed().as_secs_f64() * 1e6);
         std::hint::black_box(out);
     }
@@ -439,7 +430,7 @@ pub fn record(
     let mut rrd_bytes = 0;
     for i in 0..repeats.max(1) {
         let started = Instant::now();
-        headless::run(&config)?;
+        run_headless(&config)?;
         plain = plain.min(started.elapsed().as_secs_f64());
         let path = dir.join(format!("bench-{i}.rrd"));
         let started = Instant::now();
@@ -450,7 +441,7 @@ pub fn record(
         };
         let mut rec = Recorder::start(&options)?
             .ok_or_else(|| anyhow::anyhow!("the recorder did not start"))?;
-        headless::run_observed(&config, &mut rec, true)?;
+        run_headless_observed(&config, &mut rec, true)?;
         if let Err(e) = rec.finish() {
             tracing::warn!("the recording was not written in full: {e}");
         }
@@ -570,7 +561,7 @@ pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
         real_time_factor: None,
         ..config.clone()
     };
-    let (world, robot) = headless::load(&config)?;
+    let (world, robot) = config.load_world_and_robot()?;
     let plan = crate::ros::RosPlan::for_robot(&robot);
     let image_topic = plan
         .image_topic
@@ -592,7 +583,7 @@ pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
     let mut bridge_loop_s = 0.0;
     for _ in 0..repeats.max(1) {
         let started = Instant::now();
-        headless::run(&config)?;
+        run_headless(&config)?;
         plain = plain.min(started.elapsed().as_secs_f64());
 
         let (mut bridge, mut cmd_vel) = crate::ros::RosBridge::start(&options, &robot)?;
@@ -625,7 +616,7 @@ pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
             (n, owned)
         });
         let started = Instant::now();
-        let run = headless::run_driven(
+        let run = run_headless_driven(
             &config,
             world.clone(),
             robot.clone(),

@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use rover_core::scenario::{self, RunOptions, Scenario, ScenarioResult};
+use rover_core::{Scenario, ScenarioOptions, ScenarioResult, collect_scenario_files, run_scenario};
 use serde::{Deserialize, Serialize};
 
 use super::args::EvalArgs;
@@ -58,11 +58,11 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
         return finish(&args, report, "eval.json");
     }
     let paths = if args.paths.is_empty() {
-        vec![rover_core::paths::bundled("scenarios")]
+        vec![rover_core::bundled_path("scenarios")]
     } else {
         args.paths.clone()
     };
-    let files = scenario::collect_files(&paths)?;
+    let files = collect_scenario_files(&paths)?;
     if files.is_empty() {
         bail!(
             "no scenario files (*.toml) in {}",
@@ -268,7 +268,7 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
     let result = match Scenario::load(file) {
         Err(e) => ScenarioResult::failed("?", &file.display().to_string(), e.to_string()),
         Ok(s) => {
-            let options = RunOptions {
+            let options = ScenarioOptions {
                 // `--jobs` workers already fill the cores.
                 detector: args.detector.config(1)?,
                 trace: args
@@ -283,16 +283,16 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
                 };
                 match Recorder::start(&rec_options)? {
                     Some(mut rec) => {
-                        let r = scenario::run(&s, &options, &mut rec);
+                        let r = run_scenario(&s, &options, &mut rec);
                         if let Err(e) = rec.finish() {
                             tracing::warn!("the recording was not written in full: {e}");
                         }
                         r
                     }
-                    None => scenario::run(&s, &options, &mut rover_core::NoObserver),
+                    None => run_scenario(&s, &options, &mut rover_core::NoObserver),
                 }
             } else {
-                scenario::run(&s, &options, &mut rover_core::NoObserver)
+                run_scenario(&s, &options, &mut rover_core::NoObserver)
             };
             outcome.unwrap_or_else(|e| {
                 ScenarioResult::failed(&s.name, &file.display().to_string(), e.to_string())

@@ -5,9 +5,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::Result;
-use rover_core::headless;
 use rover_core::{
     DetectorMode, Fanout, InputSource, NoInput, RunConfig, RunFiles, Session, SessionOptions,
+    run_headless, run_headless_driven, run_headless_observed,
 };
 
 use super::args::RunArgs;
@@ -56,13 +56,13 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     }
     let summary = match args.ros.options() {
         Some(ros) => {
-            let (world, robot) = headless::load(&config)?;
+            let (world, robot) = config.load_world_and_robot()?;
             let (mut bridge, mut cmd_vel) = RosBridge::start(&ros, &robot)?;
             let result = {
                 let mut fan = Fanout::default();
                 fan.push(&mut bridge);
                 fan.push_some(recorder.as_mut());
-                headless::run_driven(&config, world, robot, &mut fan, true, &mut cmd_vel)
+                run_headless_driven(&config, world, robot, &mut fan, true, &mut cmd_vel)
             };
             bridge.finish();
             if bridge.dropped() > 0 {
@@ -74,8 +74,8 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
             result
         }
         None => match recorder.as_mut() {
-            Some(rec) => headless::run_observed(&config, rec, true),
-            None => headless::run(&config),
+            Some(rec) => run_headless_observed(&config, rec, true),
+            None => run_headless(&config),
         },
     };
     let mut record_failed = None;
@@ -168,8 +168,8 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         script: args.script.clone(),
         ..args.world.run_config(args.cmd_timeout)
     };
-    let (world, robot) = headless::load(&config)?;
-    let script = headless::load_script(&config)?;
+    let (world, robot) = config.load_world_and_robot()?;
+    let script = config.load_script()?;
     let recorder_options = args.viewer.options(true)?;
     let mut recorder = match Recorder::start(&recorder_options) {
         Ok(r) => r,

@@ -4,8 +4,7 @@
 
 use std::collections::BTreeSet;
 
-use rover_core::teleop::TELEOP_KEYS;
-use rover_core::{Action, KeyAction, Mode, key_action};
+use rover_core::{Action, KeyAction, Mode, TELEOP_KEYS, key_action};
 
 /// Keyboard settings.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -17,7 +16,7 @@ pub struct KeyOptions {
 }
 
 /// What a key asks the station to do.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum KeyCommand {
     /// An input for the session (drive, speed, stop, follow).
     Input(Action),

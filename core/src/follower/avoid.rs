@@ -68,7 +68,7 @@ pub struct Avoided {
 }
 
 /// Smallest gap (m) between the robot circle and any obstacle where it is now.
-pub fn clearance_here_m(obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
+fn clearance_here_m(obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
     let nearest = obstacles
         .iter()
         .map(|o| o[0] * o[0] + o[1] * o[1])
@@ -78,7 +78,7 @@ pub fn clearance_here_m(obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
 
 /// Smallest gap (m) between the robot circle and any obstacle along the arc of `cmd`, from its
 /// first step on (where the robot is now is [`clearance_here_m`]; a turn in place stays there).
-pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
+fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig) -> f64 {
     if cmd.linear_mps == 0.0 {
         return clearance_here_m(obstacles, config);
     }
@@ -110,103 +110,106 @@ pub fn arc_clearance_m(cmd: Twist, obstacles: &[[f64; 2]], config: &AvoidConfig)
     nearest.sqrt() - config.robot_radius_m
 }
 
-/// Picks the command: `preferred` when its arc is free, else the best admissible arc toward
-/// `goal_m` (base frame) with forward speed at most `max_linear_mps` and turn rate within
-/// `max_turn_radps`. `side` (+1 left, -1 right, 0 none) is the way around the obstacle chosen
-/// before: keeping to it stops the robot from dithering between two equally good ways. With no
-/// admissible arc the robot turns in place toward a free direction, or stops.
-pub fn choose(
-    preferred: Twist,
-    goal_m: [f64; 2],
-    obstacles: &[[f64; 2]],
-    max_linear_mps: f64,
-    max_turn_radps: f64,
-    side: f64,
-    config: &AvoidConfig,
-) -> Avoided {
-    let own = arc_clearance_m(preferred, obstacles, config);
-    // While going around something (a side chosen), the follower's own command must be clearly
-    // free to take over again: no flipping between it and the detour.
-    let free = if side == 0.0 {
-        config.free_margin_m
-    } else {
-        config.free_margin_m + 0.3
-    };
-    if own >= free || (preferred.linear_mps == 0.0 && own >= 0.02 && side == 0.0) {
-        return Avoided {
-            cmd: preferred,
-            steering: false,
-            clearance_m: own,
+impl AvoidConfig {
+    /// Picks the command: `preferred` when its arc is free, else the best admissible arc toward
+    /// `goal_m` (base frame) with forward speed at most `max_linear_mps` and turn rate within
+    /// `max_turn_radps`. `side` (+1 left, -1 right, 0 none) is the way around the obstacle chosen
+    /// before: keeping to it stops the robot from dithering between two equally good ways. With no
+    /// admissible arc the robot turns in place toward a free direction, or stops.
+    pub fn choose(
+        &self,
+        preferred: Twist,
+        goal_m: [f64; 2],
+        obstacles: &[[f64; 2]],
+        max_linear_mps: f64,
+        max_turn_radps: f64,
+        side: f64,
+    ) -> Avoided {
+        let config = self;
+        let own = arc_clearance_m(preferred, obstacles, config);
+        // While going around something (a side chosen), the follower's own command must be clearly
+        // free to take over again: no flipping between it and the detour.
+        let free = if side == 0.0 {
+            config.free_margin_m
+        } else {
+            config.free_margin_m + 0.3
         };
-    }
-    if preferred.linear_mps < 0.0 {
-        // Backing away (from a person who comes too close) is only ever the follower's own
-        // straight-ish command: blocked behind, it stands (turning if that is free).
-        let turn = Twist::new(0.0, preferred.angular_radps);
+        if own >= free || (preferred.linear_mps == 0.0 && own >= 0.02 && side == 0.0) {
+            return Avoided {
+                cmd: preferred,
+                steering: false,
+                clearance_m: own,
+            };
+        }
+        if preferred.linear_mps < 0.0 {
+            // Backing away (from a person who comes too close) is only ever the follower's own
+            // straight-ish command: blocked behind, it stands (turning if that is free).
+            let turn = Twist::new(0.0, preferred.angular_radps);
+            let room = arc_clearance_m(turn, obstacles, config);
+            return Avoided {
+                cmd: if room >= 0.02 { turn } else { Twist::ZERO },
+                steering: true,
+                clearance_m: room,
+            };
+        }
+        let goal_distance = goal_m[0].hypot(goal_m[1]);
+        // Already inside the margin (pushed there, or the obstacle came closer): arcs that do not
+        // come closer still than now are the way out.
+        let here = clearance_here_m(obstacles, config);
+        let floor = config.hard_margin_m.min(here - 0.01);
+        let reach = config.lookahead_m.max(1e-3);
+        let mut best: Option<(f64, Twist, f64)> = None;
+        for fraction in SPEED_FRACTIONS {
+            let v = fraction * max_linear_mps.max(0.0);
+            for k in 0..TURN_SAMPLES {
+                let w = max_turn_radps * (2.0 * k as f64 / (TURN_SAMPLES - 1) as f64 - 1.0);
+                let cmd = Twist::new(v, w);
+                let clearance = arc_clearance_m(cmd, obstacles, config);
+                if v <= 0.0 || clearance < floor {
+                    continue;
+                }
+                // Where the arc ends (constant v, w over the rollout).
+                let t = rollout_s(v, config).max(config.horizon_s);
+                let (ex, ey, eyaw) = if w.abs() < 1e-6 {
+                    (v * t, 0.0, 0.0)
+                } else {
+                    let yaw = w * t;
+                    (v / w * yaw.sin(), v / w * (1.0 - yaw.cos()), yaw)
+                };
+                let to_goal = wrap_angle((goal_m[1] - ey).atan2(goal_m[0] - ex) - eyaw);
+                let heading = 1.0 - to_goal.abs() / std::f64::consts::PI;
+                let progress = (goal_distance - (goal_m[0] - ex).hypot(goal_m[1] - ey)) / reach;
+                let room = clearance.min(1.0);
+                let keep_side = if side != 0.0 && w.abs() > 1e-6 && w.signum() == side {
+                    0.3
+                } else {
+                    0.0
+                };
+                let score = heading + progress + 0.4 * room + 0.5 * fraction + keep_side
+                    - 0.1 * (w - preferred.angular_radps).abs() / max_turn_radps.max(1e-3);
+                if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
+                    best = Some((score, cmd, clearance));
+                }
+            }
+        }
+        if let Some((_, cmd, clearance_m)) = best {
+            return Avoided {
+                cmd,
+                steering: true,
+                clearance_m,
+            };
+        }
+        // No arc that moves is free from here: turn in place toward the free direction that leads
+        // most toward the target (a wall ahead: face along it, to its end), while nothing touches.
+        let heading = free_heading_rad(goal_m, obstacles, floor, side, config)
+            .unwrap_or_else(|| goal_m[1].atan2(goal_m[0]));
+        let turn = Twist::new(0.0, (2.0 * heading).clamp(-max_turn_radps, max_turn_radps));
         let room = arc_clearance_m(turn, obstacles, config);
-        return Avoided {
+        Avoided {
             cmd: if room >= 0.02 { turn } else { Twist::ZERO },
             steering: true,
             clearance_m: room,
-        };
-    }
-    let goal_distance = goal_m[0].hypot(goal_m[1]);
-    // Already inside the margin (pushed there, or the obstacle came closer): arcs that do not
-    // come closer still than now are the way out.
-    let here = clearance_here_m(obstacles, config);
-    let floor = config.hard_margin_m.min(here - 0.01);
-    let reach = config.lookahead_m.max(1e-3);
-    let mut best: Option<(f64, Twist, f64)> = None;
-    for fraction in SPEED_FRACTIONS {
-        let v = fraction * max_linear_mps.max(0.0);
-        for k in 0..TURN_SAMPLES {
-            let w = max_turn_radps * (2.0 * k as f64 / (TURN_SAMPLES - 1) as f64 - 1.0);
-            let cmd = Twist::new(v, w);
-            let clearance = arc_clearance_m(cmd, obstacles, config);
-            if v <= 0.0 || clearance < floor {
-                continue;
-            }
-            // Where the arc ends (constant v, w over the rollout).
-            let t = rollout_s(v, config).max(config.horizon_s);
-            let (ex, ey, eyaw) = if w.abs() < 1e-6 {
-                (v * t, 0.0, 0.0)
-            } else {
-                let yaw = w * t;
-                (v / w * yaw.sin(), v / w * (1.0 - yaw.cos()), yaw)
-            };
-            let to_goal = wrap_angle((goal_m[1] - ey).atan2(goal_m[0] - ex) - eyaw);
-            let heading = 1.0 - to_goal.abs() / std::f64::consts::PI;
-            let progress = (goal_distance - (goal_m[0] - ex).hypot(goal_m[1] - ey)) / reach;
-            let room = clearance.min(1.0);
-            let keep_side = if side != 0.0 && w.abs() > 1e-6 && w.signum() == side {
-                0.3
-            } else {
-                0.0
-            };
-            let score = heading + progress + 0.4 * room + 0.5 * fraction + keep_side
-                - 0.1 * (w - preferred.angular_radps).abs() / max_turn_radps.max(1e-3);
-            if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
-                best = Some((score, cmd, clearance));
-            }
         }
-    }
-    if let Some((_, cmd, clearance_m)) = best {
-        return Avoided {
-            cmd,
-            steering: true,
-            clearance_m,
-        };
-    }
-    // No arc that moves is free from here: turn in place toward the free direction that leads
-    // most toward the target (a wall ahead: face along it, to its end), while nothing touches.
-    let heading = free_heading_rad(goal_m, obstacles, floor, side, config)
-        .unwrap_or_else(|| goal_m[1].atan2(goal_m[0]));
-    let turn = Twist::new(0.0, (2.0 * heading).clamp(-max_turn_radps, max_turn_radps));
-    let room = arc_clearance_m(turn, obstacles, config);
-    Avoided {
-        cmd: if room >= 0.02 { turn } else { Twist::ZERO },
-        steering: true,
-        clearance_m: room,
     }
 }
 
@@ -216,7 +219,7 @@ const HEADINGS: usize = 72;
 /// The heading (rad, base frame) of a straight path that stays `floor` clear for the lookahead
 /// distance and points most toward `goal_m` (on `side` when one was chosen: +1 left, -1 right);
 /// None when every direction is blocked.
-pub fn free_heading_rad(
+fn free_heading_rad(
     goal_m: [f64; 2],
     obstacles: &[[f64; 2]],
     floor: f64,
@@ -267,15 +270,7 @@ mod tests {
     #[test]
     fn a_free_path_keeps_the_followers_command() {
         let cmd = Twist::new(0.5, 0.1);
-        let out = choose(
-            cmd,
-            [4.0, 0.0],
-            &[[0.0, 3.0]],
-            0.8,
-            1.0,
-            0.0,
-            &AvoidConfig::default(),
-        );
+        let out = AvoidConfig::default().choose(cmd, [4.0, 0.0], &[[0.0, 3.0]], 0.8, 1.0, 0.0);
         assert_eq!(out.cmd, cmd);
         assert!(!out.steering);
     }
@@ -286,7 +281,7 @@ mod tests {
         let obstacles = crate_ahead(1.2);
         let straight = Twist::new(0.8, 0.0);
         assert!(arc_clearance_m(straight, &obstacles, &config) < 0.0);
-        let out = choose(straight, [4.0, 0.0], &obstacles, 0.8, 1.0, 0.0, &config);
+        let out = config.choose(straight, [4.0, 0.0], &obstacles, 0.8, 1.0, 0.0);
         assert!(out.steering);
         assert!(out.cmd.angular_radps.abs() > 0.1, "{out:?}");
         assert!(out.clearance_m >= config.hard_margin_m, "{out:?}");
@@ -301,15 +296,7 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             ring.push([0.26 * a.cos(), 0.26 * a.sin()]);
         }
-        let out = choose(
-            Twist::new(0.5, 0.0),
-            [4.0, 0.0],
-            &ring,
-            0.8,
-            1.0,
-            0.0,
-            &config,
-        );
+        let out = config.choose(Twist::new(0.5, 0.0), [4.0, 0.0], &ring, 0.8, 1.0, 0.0);
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert_eq!(out.cmd.angular_radps, 0.0, "touching: not even a turn");
         // With room to turn but none to drive: turn toward the target.
@@ -318,15 +305,7 @@ mod tests {
             let a = f64::from(i) * 5f64.to_radians();
             wide.push([0.5 * a.cos(), 0.5 * a.sin()]);
         }
-        let out = choose(
-            Twist::new(0.5, 0.0),
-            [1.0, 4.0],
-            &wide,
-            0.8,
-            1.0,
-            0.0,
-            &config,
-        );
+        let out = config.choose(Twist::new(0.5, 0.0), [1.0, 4.0], &wide, 0.8, 1.0, 0.0);
         assert_eq!(out.cmd.linear_mps, 0.0);
         assert!(out.cmd.angular_radps > 0.0, "{out:?}");
     }
@@ -338,29 +317,13 @@ mod tests {
         let wall: Vec<[f64; 2]> = (0..=34)
             .map(|i| [0.45, -1.2 + 0.05 * f64::from(i)])
             .collect();
-        let out = choose(
-            Twist::new(0.5, 0.0),
-            [3.0, 0.0],
-            &wall,
-            0.8,
-            1.2,
-            0.0,
-            &config,
-        );
+        let out = config.choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, 0.0);
         assert!(
             out.cmd.angular_radps > 0.1,
             "turns left, to the open end: {out:?}"
         );
         // Having chosen to go right, it keeps to the right.
-        let out = choose(
-            Twist::new(0.5, 0.0),
-            [3.0, 0.0],
-            &wall,
-            0.8,
-            1.2,
-            -1.0,
-            &config,
-        );
+        let out = config.choose(Twist::new(0.5, 0.0), [3.0, 0.0], &wall, 0.8, 1.2, -1.0);
         assert!(out.cmd.angular_radps < -0.1, "keeps its side: {out:?}");
     }
 }

@@ -27,7 +27,11 @@ pub struct TargetFilter {
 
 /// Covariance (m^2) of a position measured at `range_m` along `heading_rad` (odometry frame)
 /// with the given range and cross-range standard deviations.
-pub fn polar_covariance(heading_rad: f64, range_sigma_m: f64, cross_sigma_m: f64) -> Matrix2<f64> {
+pub(crate) fn polar_covariance(
+    heading_rad: f64,
+    range_sigma_m: f64,
+    cross_sigma_m: f64,
+) -> Matrix2<f64> {
     let (s, c) = heading_rad.sin_cos();
     let rotation = Matrix2::new(c, -s, s, c);
     let local = Matrix2::new(range_sigma_m.powi(2), 0.0, 0.0, cross_sigma_m.powi(2));
@@ -36,7 +40,7 @@ pub fn polar_covariance(heading_rad: f64, range_sigma_m: f64, cross_sigma_m: f64
 
 impl TargetFilter {
     /// Starts at a measured position (standing still, velocity unknown).
-    pub fn new(time_s: f64, position_m: [f64; 2], position_cov: Matrix2<f64>) -> Self {
+    pub(crate) fn new(time_s: f64, position_m: [f64; 2], position_cov: Matrix2<f64>) -> Self {
         let mut covariance = Matrix4::zeros();
         covariance
             .fixed_view_mut::<2, 2>(0, 0)
@@ -84,7 +88,7 @@ impl TargetFilter {
     }
 
     /// Moves the estimate forward to `time_s` (no-op for an earlier time).
-    pub fn predict(&mut self, time_s: f64) {
+    pub(crate) fn predict(&mut self, time_s: f64) {
         let dt = time_s - self.time_s;
         if dt <= 0.0 {
             return;
@@ -111,21 +115,10 @@ impl TargetFilter {
         self.time_s = time_s;
     }
 
-    /// Squared Mahalanobis distance of a position measurement from the estimate at the filter's
-    /// time (call [`TargetFilter::predict`] first).
-    pub fn mahalanobis2(&self, position_m: [f64; 2], cov: &Matrix2<f64>) -> f64 {
-        let innovation = Vector2::new(position_m[0] - self.state[0], position_m[1] - self.state[1]);
-        let s = self.covariance.fixed_view::<2, 2>(0, 0) + cov;
-        match s.try_inverse() {
-            Some(inv) => (innovation.transpose() * inv * innovation)[(0, 0)],
-            None => f64::INFINITY,
-        }
-    }
-
     /// Folds in a position measurement taken at `time_s` with covariance `cov`. A measurement
     /// older than the estimate (a detection that arrives after a laser update) is applied at the
     /// estimate's time: the lag is a fraction of a second, inside its uncertainty.
-    pub fn update(&mut self, time_s: f64, position_m: [f64; 2], cov: &Matrix2<f64>) {
+    pub(crate) fn update(&mut self, time_s: f64, position_m: [f64; 2], cov: &Matrix2<f64>) {
         self.predict(time_s);
         let h = Matrix2x4::new(
             1.0, 0.0, 0.0, 0.0, //
@@ -147,6 +140,17 @@ impl TargetFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Squared Mahalanobis distance of a position measurement from the estimate at the filter's
+    /// time (call [`TargetFilter::predict`] first).
+    fn mahalanobis2(f: &TargetFilter, position_m: [f64; 2], cov: &Matrix2<f64>) -> f64 {
+        let innovation = Vector2::new(position_m[0] - f.state[0], position_m[1] - f.state[1]);
+        let s = f.covariance.fixed_view::<2, 2>(0, 0) + cov;
+        match s.try_inverse() {
+            Some(inv) => (innovation.transpose() * inv * innovation)[(0, 0)],
+            None => f64::INFINITY,
+        }
+    }
 
     #[test]
     fn a_target_walking_at_constant_speed_is_estimated_and_predicted() {
@@ -182,9 +186,9 @@ mod tests {
         let [vx, vy] = f.velocity_mps();
         assert!(vx.abs() < 0.2 && vy.abs() < 0.05, "{vx} {vy}");
         let jump = [2.0, 1.5];
-        let soon = f.mahalanobis2(jump, &cov);
+        let soon = mahalanobis2(&f, jump, &cov);
         f.predict(10.0);
-        let later = f.mahalanobis2(jump, &cov);
+        let later = mahalanobis2(&f, jump, &cov);
         assert!(later < soon, "{later} vs {soon}");
         assert!(f.position_sigma_m() > 0.5);
     }

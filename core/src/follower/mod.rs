@@ -15,13 +15,13 @@
 //!   prediction, then sweep; never drives), STALE (detector messages stopped: stop), NO DETECTOR,
 //!   WAITING (nothing heard yet).
 //! - **Obstacles**: with a laser, commands whose arcs come near a return are replaced by the best
-//!   free arc toward the target ([`avoid`]). Without a laser the follower cannot see obstacles.
+//!   free arc toward the target ([`AvoidConfig::choose`]). Without a laser the follower cannot see obstacles.
 //!
 //! Pure library code on sim time: no threads, no clocks, no UI, no allocation per update once
 //! the buffers have grown.
 
-pub mod avoid;
-pub mod filter;
+mod avoid;
+mod filter;
 
 use std::collections::VecDeque;
 
@@ -45,7 +45,7 @@ pub struct FollowerConfig {
     /// Assumed real height of the target (m), for range from box height.
     pub target_height_m: f64,
     /// Forward speed limit (m/s); backing away from a target that comes too close is limited to
-    /// [`REVERSE_FRACTION`] of it.
+    /// 0.6 times this.
     pub max_speed_mps: f64,
     /// Turn rate limit (rad/s).
     pub max_turn_radps: f64,
@@ -200,7 +200,7 @@ impl FollowState {
 
 /// The followed target, in the odometry frame.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Target {
+pub struct FollowTarget {
     /// Track id (increments each time a new target is picked).
     pub id: u32,
     /// Position/velocity estimate.
@@ -219,7 +219,7 @@ pub struct Target {
     pub close_and_centred: bool,
 }
 
-impl Target {
+impl FollowTarget {
     /// Estimated position now-ish (m, odometry frame): the filter's prediction at `time_s`.
     pub fn position_at(&self, time_s: f64) -> [f64; 2] {
         self.filter
@@ -228,7 +228,7 @@ impl Target {
 }
 
 /// Backing away is limited to this fraction of the forward speed limit.
-pub const REVERSE_FRACTION: f64 = 0.6;
+const REVERSE_FRACTION: f64 = 0.6;
 /// How far ahead a lost target's motion is extrapolated (s).
 const PREDICTION_HORIZON_S: f64 = 2.0;
 /// Pose history length: enough for a few seconds of control updates at 100 Hz.
@@ -281,7 +281,7 @@ pub struct Follower {
     config: FollowerConfig,
     camera: CameraGeometry,
     laser: Option<LaserMount>,
-    target: Option<Target>,
+    target: Option<FollowTarget>,
     next_id: u32,
     last_message_s: Option<f64>,
     last_cmd: Twist,
@@ -350,7 +350,7 @@ impl Follower {
     }
 
     /// The current target, if any.
-    pub fn target(&self) -> Option<&Target> {
+    pub fn target(&self) -> Option<&FollowTarget> {
         self.target.as_ref()
     }
 
@@ -503,7 +503,7 @@ impl Follower {
             }
             _ => {
                 self.next_id += 1;
-                self.target = Some(Target {
+                self.target = Some(FollowTarget {
                     id: self.next_id,
                     filter: TargetFilter::new(t_image, position, cov),
                     camera_s: t_image,
@@ -768,14 +768,13 @@ impl Follower {
         if now_s - self.detour_s > DETOUR_MEMORY_S {
             self.detour_side = 0.0;
         }
-        let out = avoid::choose(
+        let out = self.config.avoid.choose(
             preferred,
             goal,
             &self.obstacles_base,
             speed_cap_mps.min(self.config.max_speed_mps),
             self.config.max_turn_radps,
             self.detour_side,
-            &self.config.avoid,
         );
         if out.steering {
             self.detour_s = now_s;

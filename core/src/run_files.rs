@@ -1,87 +1,22 @@
-//! Observers every runner composes: the trace writer and the frame saver, and the [`Fanout`]
-//! that hands one session's events to several observers. Headless runs and the window use the
-//! same ones; they differ only in pacing and detector mode.
+//! The files a run writes, as observers every runner composes: the trace CSV
+//! ([`TraceObserver`]), the camera frames ([`FrameSaver`]), and [`RunFiles`], both opened and
+//! finished the same way by headless runs and the window.
 
 use std::fs::File;
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
+use rover_sim::{CameraFrame, ControlSample, Pose, Simulation};
 
 use crate::error::{CoreError, Result};
-use crate::session::{EventLevel, LoopStats, Observer};
+use crate::observer::{LoopStats, Observer};
 use crate::trace::TraceWriter;
-
-/// Hands every event to each of its observers, in the order they were added.
-#[derive(Default)]
-pub struct Fanout<'a> {
-    observers: Vec<&'a mut dyn Observer>,
-}
-
-impl std::fmt::Debug for Fanout<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Fanout")
-            .field("observers", &self.observers.len())
-            .finish()
-    }
-}
-
-impl<'a> Fanout<'a> {
-    /// Adds an observer.
-    pub fn push(&mut self, observer: &'a mut dyn Observer) {
-        self.observers.push(observer);
-    }
-
-    /// Adds an observer if there is one.
-    pub fn push_some<O: Observer>(&mut self, observer: Option<&'a mut O>) {
-        if let Some(o) = observer {
-            self.observers.push(o);
-        }
-    }
-}
-
-impl Observer for Fanout<'_> {
-    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
-        for o in &mut self.observers {
-            o.start(sim, camera, labels);
-        }
-    }
-    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
-        for o in &mut self.observers {
-            o.control(sim, sample, stats);
-        }
-    }
-    fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
-        for o in &mut self.observers {
-            o.camera_frame(frame, world_from_camera);
-        }
-    }
-    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
-        for o in &mut self.observers {
-            o.detections(boxes, labels);
-        }
-    }
-    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
-        for o in &mut self.observers {
-            o.laser_scan(scan, world_from_laser);
-        }
-    }
-    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
-        for o in &mut self.observers {
-            o.event(sim_time_s, level, text);
-        }
-    }
-    fn failure(&mut self) -> Option<CoreError> {
-        self.observers.iter_mut().find_map(|o| o.failure())
-    }
-}
 
 /// A buffered file that only ever holds whole lines: it writes its buffer up to the last
 /// newline, and when a write fails (disk full) it cuts the file back to the end of the last
 /// line written in full, so a trace stays readable up to its last complete row.
 #[derive(Debug)]
-pub struct RowFile {
+struct RowFile {
     file: File,
     buffer: Vec<u8>,
     /// Bytes of whole lines in the file.
@@ -94,7 +29,7 @@ impl RowFile {
     const CHUNK: usize = 64 << 10;
 
     /// Wraps a file opened for writing (at its start).
-    pub fn new(file: File) -> Self {
+    fn new(file: File) -> Self {
         Self {
             file,
             buffer: Vec::with_capacity(Self::CHUNK * 2),
@@ -104,7 +39,7 @@ impl RowFile {
     }
 
     /// Lines written to the file in full so far.
-    pub fn lines_in_file(&self) -> u64 {
+    fn lines_in_file(&self) -> u64 {
         self.lines
     }
 
@@ -141,7 +76,7 @@ impl Write for RowFile {
     }
 }
 
-/// Writes the trace CSV: one row per control update ([`crate::trace::TRACE_HEADER`]).
+/// Writes the trace CSV: one row per control update ([`TRACE_HEADER`](crate::TRACE_HEADER)).
 #[derive(Debug)]
 pub struct TraceObserver {
     path: PathBuf,

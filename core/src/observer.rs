@@ -1,0 +1,168 @@
+//! The one-way hook on a run: an [`Observer`] watches a [`Session`](crate::Session) (the trace
+//! writer, the frame saver, the Rerun recorder, the window's HUD, the ROS bridge) and never
+//! influences it. [`Fanout`] hands one session's events to several observers; [`LoopStats`] are
+//! the loop figures they are shown.
+
+use rover_perception::BoundingBoxes;
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
+
+use crate::error::CoreError;
+use crate::follower::FollowState;
+use crate::pilot::Mode;
+
+/// How bad an [`Observer::event`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventLevel {
+    /// Information (mode changes).
+    Info,
+    /// Something the user should know (no detector, viewer gone).
+    Warn,
+}
+
+/// Loop figures for HUDs and recorders.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LoopStats {
+    /// Control mode.
+    pub mode: Mode,
+    /// What the follower is doing.
+    pub follow_state: FollowState,
+    /// Detector results per wall second (worker) or per sim second (lockstep).
+    pub detector_hz: f64,
+    /// Latency of the newest detection (ms, from frame submission to result).
+    pub detector_latency_ms: f64,
+    /// Frames the detector skipped because a newer one arrived.
+    pub frames_dropped: u64,
+    /// Camera frames rendered.
+    pub frames: u64,
+    /// Whether a detector is running.
+    pub detector_ok: bool,
+    /// Whether the detector failed during the run (an error or a panic in it); it stays off.
+    pub detector_failed: bool,
+    /// Whether the follower is steering around an obstacle (it has a laser and something is in
+    /// the way of its own command).
+    pub avoiding: bool,
+}
+
+/// Watches a session without influencing it (the Rerun recorder, the window).
+pub trait Observer {
+    /// Once, when the session is set up: the scene, the camera's intrinsics and the detector's
+    /// class names.
+    fn start(&mut self, _sim: &Simulation, _camera: Option<&CameraInfo>, _labels: &[String]) {}
+    /// After every control update (100 Hz for the tutorial car).
+    fn control(&mut self, _sim: &Simulation, _sample: &ControlSample, _stats: &LoopStats) {}
+    /// A camera image, taken at `frame.sim_time_s` from `world_from_camera` (the camera link).
+    fn camera_frame(&mut self, _frame: &CameraFrame<'_>, _world_from_camera: Pose) {}
+    /// Detections of an earlier camera image (see their `image_stamp`).
+    fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
+    /// A laser scan, taken from `world_from_laser` (the sensor's frame) at `scan.stamp_s`.
+    fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
+    /// A mode change, a warning.
+    fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
+    /// An observer that can no longer do its job (a trace or frame it cannot write) says so
+    /// here, once; the runner decides whether the run stops.
+    fn failure(&mut self) -> Option<CoreError> {
+        None
+    }
+}
+
+/// Two observers side by side, built on the stack where one is added for a moment (the
+/// window's HUD beside the fan-out): no allocation.
+impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        self.0.start(sim, camera, labels);
+        self.1.start(sim, camera, labels);
+    }
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        self.0.control(sim, sample, stats);
+        self.1.control(sim, sample, stats);
+    }
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
+        self.0.camera_frame(frame, world_from_camera);
+        self.1.camera_frame(frame, world_from_camera);
+    }
+    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
+        self.0.detections(boxes, labels);
+        self.1.detections(boxes, labels);
+    }
+    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
+        self.0.laser_scan(scan, world_from_laser);
+        self.1.laser_scan(scan, world_from_laser);
+    }
+    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
+        self.0.event(sim_time_s, level, text);
+        self.1.event(sim_time_s, level, text);
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.0.failure().or_else(|| self.1.failure())
+    }
+}
+
+/// An observer that ignores everything.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {}
+
+/// Hands every event to each of its observers, in the order they were added.
+#[derive(Default)]
+pub struct Fanout<'a> {
+    observers: Vec<&'a mut dyn Observer>,
+}
+
+impl std::fmt::Debug for Fanout<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Fanout")
+            .field("observers", &self.observers.len())
+            .finish()
+    }
+}
+
+impl<'a> Fanout<'a> {
+    /// Adds an observer.
+    pub fn push(&mut self, observer: &'a mut dyn Observer) {
+        self.observers.push(observer);
+    }
+
+    /// Adds an observer if there is one.
+    pub fn push_some<O: Observer>(&mut self, observer: Option<&'a mut O>) {
+        if let Some(o) = observer {
+            self.observers.push(o);
+        }
+    }
+}
+
+impl Observer for Fanout<'_> {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        for o in &mut self.observers {
+            o.start(sim, camera, labels);
+        }
+    }
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+        for o in &mut self.observers {
+            o.control(sim, sample, stats);
+        }
+    }
+    fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
+        for o in &mut self.observers {
+            o.camera_frame(frame, world_from_camera);
+        }
+    }
+    fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
+        for o in &mut self.observers {
+            o.detections(boxes, labels);
+        }
+    }
+    fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
+        for o in &mut self.observers {
+            o.laser_scan(scan, world_from_laser);
+        }
+    }
+    fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
+        for o in &mut self.observers {
+            o.event(sim_time_s, level, text);
+        }
+    }
+    fn failure(&mut self) -> Option<CoreError> {
+        self.observers.iter_mut().find_map(|o| o.failure())
+    }
+}
