@@ -24,7 +24,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rover_perception::DetectorConfig;
+use rover_perception::{DetectorConfig, InjectedFault};
 use rover_sim::{ControlSample, RobotModel, SimError, Simulation, World, WorldFile, wrap_angle};
 use serde::{Deserialize, Serialize};
 
@@ -534,6 +534,8 @@ pub fn judge(criteria: &Criteria, m: &Metrics, follow_at_s: f64) -> Vec<Check> {
 pub struct RunOptions {
     /// Detector settings (model, input size).
     pub detector: DetectorConfig,
+    /// Make the detector fail on purpose ([`crate::SessionOptions::inject_fault`]).
+    pub inject_fault: Option<InjectedFault>,
     /// Write the run's trace CSV here.
     pub trace: Option<PathBuf>,
 }
@@ -549,6 +551,7 @@ pub fn run(
         duration_s: Some(scenario.duration_s),
         trace: options.trace.clone(),
         detector: options.detector.clone(),
+        inject_fault: options.inject_fault,
         options: rover_sim::SimOptions {
             seed: scenario.seed,
             ..rover_sim::SimOptions::default()

@@ -9,8 +9,8 @@
 use std::time::Instant;
 
 use rover_perception::{
-    BoundingBoxes, Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, LockstepDetector,
-    PerceptionError, RgbView, WorkerStats,
+    BoundingBoxes, Detect, Detector, DetectorConfig, DetectorWorker, FaultInjector, Frame,
+    FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
     CameraInfo, CameraSensor, ControlSample, LaserScan, LaserSensor, Pose, RobotModel, SimOptions,
@@ -60,6 +60,9 @@ pub struct SessionOptions {
     pub detector: DetectorMode,
     /// Detector settings (model, input size, thresholds).
     pub detector_config: DetectorConfig,
+    /// Make the detector fail on purpose (`--inject-fault`, for tests of the failure policy):
+    /// the loaded detector is wrapped in a [`FaultInjector`]; `None` in normal use.
+    pub inject_fault: Option<InjectedFault>,
     /// Follower settings.
     pub follower: FollowerConfig,
 }
@@ -72,6 +75,7 @@ impl Default for SessionOptions {
             every_frame: true,
             detector: DetectorMode::Off,
             detector_config: DetectorConfig::default(),
+            inject_fault: None,
             follower: FollowerConfig::default(),
         }
     }
@@ -316,6 +320,10 @@ impl Session {
                         detector.config().runtime.name(),
                         detector.config().threads
                     );
+                    let detector: Box<dyn Detect> = match options.inject_fault {
+                        Some(fault) => Box::new(FaultInjector::new(detector, fault)),
+                        None => Box::new(detector),
+                    };
                     match mode {
                         DetectorMode::Lockstep { rate_hz } => {
                             Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
