@@ -247,7 +247,7 @@ fn a_missing_onnxruntime_library_is_a_clear_error() -> Result<()> {
     );
 
     // Nowhere to be found: the error says what to install and lists the folders searched.
-    let model = rover_perception::fetch::ensure_default_model()?;
+    let model = rover_perception::ensure_default_model()?;
     let home = dir.path().join("home");
     std::fs::create_dir_all(home.join(".local/lib/python3.11/site-packages"))?;
     let out = Command::new(env!("CARGO_BIN_EXE_rover"))

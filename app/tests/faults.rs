@@ -277,7 +277,7 @@ fn a_failing_detector_stops_the_follower_and_manual_driving_goes_on() -> Result<
 /// keeps tracking, no detector error); a corrupt file at start is a clear error naming it.
 #[test]
 fn a_model_file_corrupted_mid_run_does_not_touch_the_run() -> Result<()> {
-    let model = rover_perception::fetch::ensure_default_model()?;
+    let model = rover_perception::ensure_default_model()?;
     let dir = tempfile::tempdir()?;
     let copy = dir.path().join("model.onnx");
     std::fs::copy(&model, &copy)?;

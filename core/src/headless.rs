@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use rover_perception::DetectorConfig;
+use rover_perception::{DetectorConfig, InjectedFault};
 use rover_sim::{ControlSample, LoadOptions, ResourcePaths, RobotModel, SimOptions, World};
 
 use crate::error::{CoreError, Result};
@@ -55,6 +55,8 @@ pub struct RunConfig {
     pub detect_hz: Option<f64>,
     /// Detector settings.
     pub detector: DetectorConfig,
+    /// Make the detector fail on purpose ([`SessionOptions::inject_fault`]).
+    pub inject_fault: Option<InjectedFault>,
     /// Run the detector on its own thread on the newest frame, as the window does, instead of
     /// in lockstep on sim time: for real-time runs with outside peers (`--ros`), where the loop
     /// must keep pace with the wall clock. Detections then depend on the machine's speed, so
@@ -295,6 +297,7 @@ fn run_inner(
         every_frame: observer_wants_camera || saves_frames,
         detector: detector_mode(config, perceive, limits.detect_hz),
         detector_config: config.detector.clone(),
+        inject_fault: config.inject_fault,
         follower: config.follower.clone(),
     };
     let mut fan = Fanout::default();

@@ -24,7 +24,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rover_perception::DetectorConfig;
+use rover_perception::{DetectorConfig, InjectedFault};
 use rover_sim::{ControlSample, RobotModel, SimError, Simulation, World, WorldFile, wrap_angle};
 use serde::{Deserialize, Serialize};
 
@@ -535,6 +535,8 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
 pub struct ScenarioOptions {
     /// Detector settings (model, input size).
     pub detector: DetectorConfig,
+    /// Make the detector fail on purpose ([`crate::SessionOptions::inject_fault`]).
+    pub inject_fault: Option<InjectedFault>,
     /// Write the run's trace CSV here.
     pub trace: Option<PathBuf>,
 }
@@ -550,6 +552,7 @@ pub fn run_scenario(
         duration_s: Some(scenario.duration_s),
         trace: options.trace.clone(),
         detector: options.detector.clone(),
+        inject_fault: options.inject_fault,
         options: rover_sim::SimOptions {
             seed: scenario.seed,
             ..rover_sim::SimOptions::default()

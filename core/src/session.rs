@@ -9,8 +9,8 @@
 use std::time::Instant;
 
 use rover_perception::{
-    BoundingBoxes, Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, LockstepDetector,
-    PerceptionError, RgbView, WorkerStats,
+    BoundingBoxes, Detect, Detector, DetectorConfig, DetectorWorker, FaultInjector, Frame,
+    FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
     CameraFrame, CameraInfo, CameraSensor, ControlSample, LaserSensor, RobotModel, SimOptions,
@@ -61,6 +61,9 @@ pub struct SessionOptions {
     pub detector: DetectorMode,
     /// Detector settings (model, input size, thresholds).
     pub detector_config: DetectorConfig,
+    /// Make the detector fail on purpose (`--inject-fault`, for tests of the failure policy):
+    /// the loaded detector is wrapped in a [`FaultInjector`]; `None` in normal use.
+    pub inject_fault: Option<InjectedFault>,
     /// Follower settings.
     pub follower: FollowerConfig,
 }
@@ -73,6 +76,7 @@ impl Default for SessionOptions {
             every_frame: true,
             detector: DetectorMode::Off,
             detector_config: DetectorConfig::default(),
+            inject_fault: None,
             follower: FollowerConfig::default(),
         }
     }
@@ -161,7 +165,7 @@ impl Session {
         }
         let (detection, labels) = match (options.detector, camera.is_some()) {
             (DetectorMode::Off, _) | (_, false) => (Detection::Off, Vec::new()),
-            (mode, true) => start_detection(mode, &options.detector_config, observer)?,
+            (mode, true) => start_detection(mode, &options.detector_config, options.inject_fault, observer)?,
         };
         let stats = LoopStats {
             detector_ok: !matches!(detection, Detection::Off),
@@ -527,6 +531,7 @@ fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
 fn start_detection(
     mode: DetectorMode,
     config: &DetectorConfig,
+    inject_fault: Option<InjectedFault>,
     observer: &mut dyn Observer,
 ) -> Result<(Detection, Vec<String>)> {
     let detector = match Detector::load(config.clone()) {
@@ -550,6 +555,10 @@ fn start_detection(
         detector.config().runtime.name(),
         detector.config().threads
     );
+    let detector: Box<dyn Detect> = match inject_fault {
+        Some(fault) => Box::new(FaultInjector::new(detector, fault)),
+        None => Box::new(detector),
+    };
     let detection = match mode {
         DetectorMode::Lockstep { rate_hz } => {
             Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))

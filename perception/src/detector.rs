@@ -1,6 +1,6 @@
 //! The YOLO detector on tract-onnx: loaded and optimised once, reused for every frame.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -14,7 +14,7 @@ use crate::graph;
 use crate::head::{self, Candidate, Head};
 use crate::labels::{COCO80, read_labels_file};
 use crate::messages::{BoundingBox, BoundingBoxes, FrameStamp};
-use crate::onnxruntime::{OrtSession, Runtime};
+use crate::onnxruntime::{OrtSession, Runtime, find_onnxruntime_library};
 use crate::preprocess::{LetterboxPlan, RgbView};
 
 /// Input size the default model runs at: the camera's 4:3 aspect, so camera frames need no
@@ -45,34 +45,12 @@ pub struct DetectorConfig {
     pub max_boxes: usize,
     /// `frame_id` stamped on results.
     pub frame_id: String,
-    /// A fault to inject, for tests of what a failing detector does to a run
-    /// (`--inject-fault`); `None` in normal use.
-    pub fault: Option<InjectedFault>,
     /// Threads for one detection: tract splits its matrix products across a pool of this many
     /// (1 = on the calling thread only). The results are bit-identical whatever the count: each
     /// output tile is computed whole by one thread, in the same order.
     pub threads: usize,
     /// The runtime: tract (default) or onnxruntime's shared library (`--runtime onnxruntime`).
     pub runtime: Runtime,
-}
-
-/// A detector fault injected on purpose: after `after_detections` good detections, every
-/// further call panics or returns an error, as a bug in tract or a model it cannot run would.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct InjectedFault {
-    /// Good detections before the fault.
-    pub after_detections: u64,
-    /// What happens then.
-    pub kind: FaultKind,
-}
-
-/// How an [`InjectedFault`] fails.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FaultKind {
-    /// The detection panics.
-    Panic,
-    /// The detection returns an error.
-    Error,
 }
 
 impl Default for DetectorConfig {
@@ -85,7 +63,6 @@ impl Default for DetectorConfig {
             nms_iou: DEFAULT_NMS_IOU,
             max_boxes: 100,
             frame_id: "camera_link_optical".to_owned(),
-            fault: None,
             threads: 1,
             runtime: Runtime::Tract,
         }
@@ -122,6 +99,27 @@ pub struct OpProfile {
     pub tract_ops: Vec<(String, f64)>,
 }
 
+/// One detection of one image: what [`crate::DetectorWorker`] and [`crate::LockstepDetector`]
+/// run. [`Detector`] is the real one; [`crate::FaultInjector`] wraps it to fail on purpose
+/// (`--inject-fault`), so the detector's own path never checks for injected faults.
+/// `Send`: a detector moves onto the worker's thread.
+pub trait Detect: Send {
+    /// Detects objects in an RGB8 image; the result carries `stamp` (the frame it came from).
+    fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes>;
+}
+
+impl<D: Detect + ?Sized> Detect for Box<D> {
+    fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes> {
+        (**self).detect(image, stamp)
+    }
+}
+
+impl Detect for Detector {
+    fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes> {
+        Detector::detect(self, image, stamp)
+    }
+}
+
 /// A loaded YOLO model.
 pub struct Detector {
     plan: Arc<TypedRunnableModel>,
@@ -138,8 +136,6 @@ pub struct Detector {
     model_path: PathBuf,
     proto: tract_onnx::pb::ModelProto,
     last_times: StageTimes,
-    /// Detections run (for [`DetectorConfig::fault`]).
-    detections: u64,
     /// tract's thread pool when [`DetectorConfig::threads`] > 1.
     executor: Option<Executor>,
     /// The onnxruntime session when [`DetectorConfig::runtime`] asks for it (tract's plan is
@@ -163,65 +159,15 @@ impl std::fmt::Debug for Detector {
 impl Detector {
     /// Loads, checks and optimises the model (once; detection reuses everything).
     pub fn load(config: DetectorConfig) -> Result<Self> {
-        let (model_path, requested) = match &config.model {
-            Some(p) => (p.clone(), config.input_size),
-            None => (
-                fetch::ensure_default_model()?,
-                Some(config.input_size.unwrap_or(DEFAULT_INPUT_SIZE)),
-            ),
-        };
-        if !model_path.is_file() {
-            return Err(PerceptionError::model(&model_path, "no such model file"));
-        }
-        if config.threads == 0 {
-            return Err(PerceptionError::model(
-                &model_path,
-                "the detector needs at least one thread",
-            ));
-        }
+        let (model_path, requested) = resolve_model(&config)?;
         // Before tract's plan is built (seconds): a missing library is said at once.
         let ort_library = match config.runtime {
             Runtime::Tract => None,
-            Runtime::OnnxRuntime => Some(crate::onnxruntime::find_library()?),
+            Runtime::OnnxRuntime => Some(find_onnxruntime_library()?),
         };
         let prepared = graph::prepare(&model_path, requested)?;
         let (input_w, input_h) = prepared.input_size;
-        let fail = |stage: &str, e: TractError| {
-            PerceptionError::model(&model_path, format!("{stage}: {e:#}"))
-        };
-        let mut model = tract_onnx::onnx()
-            .model_for_proto_model(&prepared.proto)
-            .map_err(|e| fail("tract cannot load it", e))?
-            .with_input_fact(0, f32::fact([1, 3, input_h, input_w]).into())
-            .map_err(|e| fail("setting the input shape", e))?;
-        // Concatenations before 1x1 convolutions stay whole (see graph.rs): tract leaves them
-        // alone when they are outputs. Output 0 stays the head; the extra ones are ignored.
-        let mut outlets = model
-            .output_outlets()
-            .map_err(|e| fail("its outputs", e))?
-            .to_vec();
-        for name in &prepared.whole_concats {
-            if let Some(node) = model.nodes().iter().find(|n| &n.name == name) {
-                outlets.push(OutletId::new(node.id, 0));
-            }
-        }
-        model
-            .select_output_outlets(&outlets)
-            .map_err(|e| fail("setting its outputs", e))?;
-        let plan = model
-            .into_optimized()
-            .map_err(|e| fail("tract cannot optimise it", e))?
-            .into_runnable()
-            .map_err(|e| fail("tract cannot plan it", e))?;
-        let output_shape: Vec<usize> = plan
-            .model()
-            .output_fact(0)
-            .ok()
-            .and_then(|f| f.shape.as_concrete().map(|s| s.to_vec()))
-            .ok_or_else(|| {
-                PerceptionError::model(&model_path, "the model's output shape is not fixed")
-            })?;
-
+        let (plan, output_shape) = build_plan(&prepared, &model_path)?;
         let labels = match &config.labels {
             Some(file) => read_labels_file(file)?,
             None => prepared
@@ -229,53 +175,14 @@ impl Detector {
                 .clone()
                 .unwrap_or_else(|| COCO80.iter().map(|s| (*s).to_owned()).collect()),
         };
-        let (head, num_classes) = match prepared.head.clone() {
-            Some(Head::Dfl { reg_max, strides }) => {
-                let classes = output_shape
-                    .get(1)
-                    .copied()
-                    .unwrap_or(0)
-                    .saturating_sub(4 * reg_max);
-                (Head::Dfl { reg_max, strides }, classes)
-            }
-            Some(other) => (other, labels.len()),
-            None => match Head::from_shape(&output_shape) {
-                Some((head, Some(classes))) => (head, classes),
-                Some((head, None)) => (head, labels.len()),
-                None => {
-                    return Err(PerceptionError::UnknownHead {
-                        path: model_path,
-                        shape: output_shape,
-                    });
-                }
-            },
-        };
-        if labels.len() != num_classes {
-            return Err(PerceptionError::Labels(format!(
-                "{}: the model predicts {num_classes} classes but {} class names were found ({}); pass --labels with one name per line",
-                model_path.display(),
-                labels.len(),
-                match &config.labels {
-                    Some(f) => format!("from {}", f.display()),
-                    None if prepared.metadata_names.is_some() =>
-                        "from the model's metadata".to_owned(),
-                    None => "COCO's default 80".to_owned(),
-                }
-            )));
-        }
-        let executor = match (config.threads, config.runtime) {
-            (0 | 1, _) | (_, Runtime::OnnxRuntime) => None,
-            (n, Runtime::Tract) => Some(
-                ThreadPoolBuilder::new()
-                    .thread_name(|i| format!("rover-detect-{i}"))
-                    .num_threads(n)
-                    .build()
-                    .map(|pool| Executor::MultiThread(Arc::new(pool)))
-                    .map_err(|e| {
-                        PerceptionError::Inference(format!("starting {n} detector threads: {e}"))
-                    })?,
-            ),
-        };
+        let (head, num_classes) = resolve_head(
+            prepared.head.clone(),
+            output_shape,
+            labels.len(),
+            &model_path,
+        )?;
+        check_label_count(&config, &prepared, &model_path, num_classes, labels.len())?;
+        let executor = thread_pool(config.threads, config.runtime)?;
         let ort = match &ort_library {
             None => None,
             Some(library) => {
@@ -311,7 +218,6 @@ impl Detector {
             model_path,
             proto: prepared.proto,
             last_times: StageTimes::default(),
-            detections: 0,
             executor,
             ort,
             ort_output: (Vec::new(), Vec::new()),
@@ -528,19 +434,6 @@ impl Detector {
     /// Detects objects in an RGB8 image. Boxes are in the image's pixels; the result carries
     /// `stamp` (the frame it came from).
     pub fn detect(&mut self, image: RgbView<'_>, stamp: FrameStamp) -> Result<BoundingBoxes> {
-        if let Some(fault) = self.config.fault
-            && self.detections >= fault.after_detections
-        {
-            let what = format!(
-                "injected fault after {} detections (--inject-fault)",
-                fault.after_detections
-            );
-            match fault.kind {
-                FaultKind::Panic => panic!("{what}"),
-                FaultKind::Error => return Err(PerceptionError::model(&self.model_path, what)),
-            }
-        }
-        self.detections += 1;
         let start = Instant::now();
         let (_, lb) = self.preprocess(image)?;
         let preprocessed = Instant::now();
@@ -574,5 +467,141 @@ impl Detector {
         };
         result.latency_ms = (done - start).as_secs_f64() * 1e3;
         Ok(result)
+    }
+}
+
+/// The model file a configuration names (the default model, fetched when needed) and the
+/// input size asked for (the default model's [`DEFAULT_INPUT_SIZE`] unless given); refuses a
+/// missing file and zero threads.
+fn resolve_model(config: &DetectorConfig) -> Result<(PathBuf, Option<(usize, usize)>)> {
+    let (model_path, requested) = match &config.model {
+        Some(p) => (p.clone(), config.input_size),
+        None => (
+            fetch::ensure_default_model()?,
+            Some(config.input_size.unwrap_or(DEFAULT_INPUT_SIZE)),
+        ),
+    };
+    if !model_path.is_file() {
+        return Err(PerceptionError::model(&model_path, "no such model file"));
+    }
+    if config.threads == 0 {
+        return Err(PerceptionError::model(
+            &model_path,
+            "the detector needs at least one thread",
+        ));
+    }
+    Ok((model_path, requested))
+}
+
+/// tract's optimised, runnable plan of the prepared graph at its input size, and the shape of
+/// its first output (the head).
+fn build_plan(
+    prepared: &graph::Prepared,
+    model_path: &Path,
+) -> Result<(Arc<TypedRunnableModel>, Vec<usize>)> {
+    let (input_w, input_h) = prepared.input_size;
+    let fail =
+        |stage: &str, e: TractError| PerceptionError::model(model_path, format!("{stage}: {e:#}"));
+    let mut model = tract_onnx::onnx()
+        .model_for_proto_model(&prepared.proto)
+        .map_err(|e| fail("tract cannot load it", e))?
+        .with_input_fact(0, f32::fact([1, 3, input_h, input_w]).into())
+        .map_err(|e| fail("setting the input shape", e))?;
+    // Concatenations before 1x1 convolutions stay whole (see graph.rs): tract leaves them
+    // alone when they are outputs. Output 0 stays the head; the extra ones are ignored.
+    let mut outlets = model
+        .output_outlets()
+        .map_err(|e| fail("its outputs", e))?
+        .to_vec();
+    for name in &prepared.whole_concats {
+        if let Some(node) = model.nodes().iter().find(|n| &n.name == name) {
+            outlets.push(OutletId::new(node.id, 0));
+        }
+    }
+    model
+        .select_output_outlets(&outlets)
+        .map_err(|e| fail("setting its outputs", e))?;
+    let plan = model
+        .into_optimized()
+        .map_err(|e| fail("tract cannot optimise it", e))?
+        .into_runnable()
+        .map_err(|e| fail("tract cannot plan it", e))?;
+    let output_shape: Vec<usize> = plan
+        .model()
+        .output_fact(0)
+        .ok()
+        .and_then(|f| f.shape.as_concrete().map(|s| s.to_vec()))
+        .ok_or_else(|| {
+            PerceptionError::model(model_path, "the model's output shape is not fixed")
+        })?;
+    Ok((plan, output_shape))
+}
+
+/// The head to decode and its class count: the one graph surgery found (a raw Ultralytics
+/// head, classes from the output's channels), else the one the output shape says (classes
+/// from the shape, or from the labels where the shape does not tell).
+fn resolve_head(
+    prepared: Option<Head>,
+    output_shape: Vec<usize>,
+    label_count: usize,
+    model_path: &Path,
+) -> Result<(Head, usize)> {
+    Ok(match prepared {
+        Some(Head::Dfl { reg_max, strides }) => {
+            let classes = output_shape
+                .get(1)
+                .copied()
+                .unwrap_or(0)
+                .saturating_sub(4 * reg_max);
+            (Head::Dfl { reg_max, strides }, classes)
+        }
+        Some(other) => (other, label_count),
+        None => match Head::from_shape(&output_shape) {
+            Some((head, Some(classes))) => (head, classes),
+            Some((head, None)) => (head, label_count),
+            None => {
+                return Err(PerceptionError::UnknownHead {
+                    path: model_path.to_path_buf(),
+                    shape: output_shape,
+                });
+            }
+        },
+    })
+}
+
+/// Refuses class names that do not match the model's class count, saying where the names
+/// came from.
+fn check_label_count(
+    config: &DetectorConfig,
+    prepared: &graph::Prepared,
+    model_path: &Path,
+    num_classes: usize,
+    label_count: usize,
+) -> Result<()> {
+    if label_count == num_classes {
+        return Ok(());
+    }
+    Err(PerceptionError::Labels(format!(
+        "{}: the model predicts {num_classes} classes but {label_count} class names were found ({}); pass --labels with one name per line",
+        model_path.display(),
+        match &config.labels {
+            Some(f) => format!("from {}", f.display()),
+            None if prepared.metadata_names.is_some() => "from the model's metadata".to_owned(),
+            None => "COCO's default 80".to_owned(),
+        }
+    )))
+}
+
+/// tract's own thread pool for `threads` > 1 (none for one thread, or for onnxruntime, which
+/// has its own).
+fn thread_pool(threads: usize, runtime: Runtime) -> Result<Option<Executor>> {
+    match (threads, runtime) {
+        (0 | 1, _) | (_, Runtime::OnnxRuntime) => Ok(None),
+        (n, Runtime::Tract) => ThreadPoolBuilder::new()
+            .thread_name(|i| format!("rover-detect-{i}"))
+            .num_threads(n)
+            .build()
+            .map(|pool| Some(Executor::MultiThread(Arc::new(pool))))
+            .map_err(|e| PerceptionError::Inference(format!("starting {n} detector threads: {e}"))),
     }
 }

@@ -9,17 +9,17 @@ use std::process::Command;
 use crate::error::{PerceptionError, Result};
 
 /// Crate that carries the default model.
-pub const MODEL_CRATE: &str = "easy-yolo";
+const MODEL_CRATE: &str = "easy-yolo";
 /// Its pinned version.
-pub const MODEL_CRATE_VERSION: &str = "0.1.3";
+const MODEL_CRATE_VERSION: &str = "0.1.3";
 /// File name of the default model in the cache.
-pub const MODEL_FILE: &str = "yolov12n.onnx";
+const MODEL_FILE: &str = "yolov12n.onnx";
 /// Licence of the default model's weights.
-pub const MODEL_LICENSE: &str =
+const MODEL_LICENSE: &str =
     "AGPL-3.0 (Ultralytics YOLOv12n weights, shipped in the crates.io package easy-yolo 0.1.3)";
 
 /// rover's cache folder: `$ROVER_CACHE_DIR`, else `$XDG_CACHE_HOME/rover`, else `~/.cache/rover`.
-pub fn cache_dir() -> PathBuf {
+pub(crate) fn cache_dir() -> PathBuf {
     if let Some(dir) = std::env::var_os("ROVER_CACHE_DIR") {
         return PathBuf::from(dir);
     }

@@ -46,7 +46,7 @@ impl Head {
 
 /// A decoded box before NMS, in model-input pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Candidate {
+pub(crate) struct Candidate {
     /// Class index.
     pub class: usize,
     /// Confidence.
@@ -78,7 +78,7 @@ impl Candidate {
 
 /// What decoding needs besides the output itself.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DecodeSpec {
+pub(crate) struct DecodeSpec {
     /// Model input width (px).
     pub input_w: usize,
     /// Model input height (px).
@@ -90,10 +90,55 @@ pub struct DecodeSpec {
 }
 
 /// Decodes `output` (row-major, `shape`) into `out` (cleared first).
-pub fn decode(
+pub(crate) fn decode(
     head: &Head,
     output: &[f32],
     shape: &[usize],
+    spec: DecodeSpec,
+    out: &mut Vec<Candidate>,
+) -> Result<()> {
+    out.clear();
+    let layout = Layout {
+        head,
+        output,
+        shape,
+    };
+    if output.len() != shape.iter().product::<usize>() {
+        return Err(layout.mismatch("as many values as the shape holds".into()));
+    }
+    match head {
+        Head::Dfl { reg_max, strides } => decode_dfl(layout, *reg_max, strides, spec, out),
+        Head::AnchorFree => decode_anchor_free(layout, spec, out),
+        Head::Objectness => decode_objectness(layout, spec, out),
+        Head::EndToEnd => decode_end_to_end(layout, spec, out),
+    }
+}
+
+/// A model output with the head it is decoded as.
+#[derive(Clone, Copy)]
+struct Layout<'a> {
+    head: &'a Head,
+    output: &'a [f32],
+    shape: &'a [usize],
+}
+
+impl Layout<'_> {
+    /// The error for an output that does not fit its head; `expected` says what would.
+    fn mismatch(&self, expected: String) -> PerceptionError {
+        PerceptionError::Inference(format!(
+            "model output {:?} does not match its head ({}): expected {expected}",
+            self.shape,
+            self.head.name()
+        ))
+    }
+}
+
+/// [`Head::Dfl`]: class logits per anchor, then distribution-focal distances of the four box
+/// sides from the anchor's centre, in strides.
+fn decode_dfl(
+    layout: Layout<'_>,
+    reg_max: usize,
+    strides: &[usize],
     spec: DecodeSpec,
     out: &mut Vec<Candidate>,
 ) -> Result<()> {
@@ -103,139 +148,163 @@ pub fn decode(
         num_classes,
         threshold,
     } = spec;
-    out.clear();
-    let bad = |expected: String| {
-        PerceptionError::Inference(format!(
-            "model output {shape:?} does not match its head ({}): expected {expected}",
-            head.name()
-        ))
-    };
-    if output.len() != shape.iter().product::<usize>() {
-        return Err(bad("as many values as the shape holds".into()));
+    let n: usize = strides.iter().map(|s| (input_w / s) * (input_h / s)).sum();
+    let channels = 4 * reg_max + num_classes;
+    if layout.shape != [1, channels, n] {
+        return Err(layout.mismatch(format!("[1, {channels}, {n}]")));
     }
-    match head {
-        Head::Dfl { reg_max, strides } => {
-            let n: usize = strides.iter().map(|s| (input_w / s) * (input_h / s)).sum();
-            let channels = 4 * reg_max + num_classes;
-            if shape != [1, channels, n] {
-                return Err(bad(format!("[1, {channels}, {n}]")));
-            }
-            // Class scores are logits here: compare against the threshold's logit so that the
-            // box softmax runs only for anchors that can pass.
-            let t = threshold.clamp(1e-6, 1.0 - 1e-6);
-            let logit_threshold = (t / (1.0 - t)).ln();
-            let at = |c: usize, a: usize| output[c * n + a];
-            let mut anchor = 0;
-            for &stride in strides {
-                let (gw, gh) = (input_w / stride, input_h / stride);
-                for gy in 0..gh {
-                    for gx in 0..gw {
-                        let a = anchor;
-                        anchor += 1;
-                        let (mut best, mut best_logit) = (0, f32::NEG_INFINITY);
-                        for c in 0..num_classes {
-                            let v = at(4 * reg_max + c, a);
-                            if v > best_logit {
-                                best_logit = v;
-                                best = c;
-                            }
-                        }
-                        if best_logit < logit_threshold {
-                            continue;
-                        }
-                        let mut dist = [0f32; 4];
-                        for (side, d) in dist.iter_mut().enumerate() {
-                            let base = side * reg_max;
-                            let max = (0..*reg_max)
-                                .map(|j| at(base + j, a))
-                                .fold(f32::NEG_INFINITY, f32::max);
-                            let (mut sum, mut weighted) = (0f32, 0f32);
-                            for j in 0..*reg_max {
-                                let e = (at(base + j, a) - max).exp();
-                                sum += e;
-                                weighted += e * j as f32;
-                            }
-                            *d = weighted / sum;
-                        }
-                        let (cx, cy) = (gx as f32 + 0.5, gy as f32 + 0.5);
-                        let s = stride as f32;
-                        out.push(Candidate {
-                            class: best,
-                            score: 1.0 / (1.0 + (-best_logit).exp()),
-                            x1: (cx - dist[0]) * s,
-                            y1: (cy - dist[1]) * s,
-                            x2: (cx + dist[2]) * s,
-                            y2: (cy + dist[3]) * s,
-                        });
-                    }
-                }
-            }
-        }
-        Head::AnchorFree => {
-            let [1, rows, n] = *shape else {
-                return Err(bad("[1, 4+C, N]".into()));
-            };
-            if rows != 4 + num_classes {
-                return Err(bad(format!("[1, {}, N]", 4 + num_classes)));
-            }
-            for a in 0..n {
-                let (mut best, mut score) = (0, f32::NEG_INFINITY);
+    // Class scores are logits here: compare against the threshold's logit so that the box
+    // softmax runs only for anchors that can pass.
+    let t = threshold.clamp(1e-6, 1.0 - 1e-6);
+    let logit_threshold = (t / (1.0 - t)).ln();
+    let output = layout.output;
+    let at = |c: usize, a: usize| output[c * n + a];
+    let mut anchor = 0;
+    for &stride in strides {
+        let (gw, gh) = (input_w / stride, input_h / stride);
+        for gy in 0..gh {
+            for gx in 0..gw {
+                let a = anchor;
+                anchor += 1;
+                let (mut best, mut best_logit) = (0, f32::NEG_INFINITY);
                 for c in 0..num_classes {
-                    let v = output[(4 + c) * n + a];
-                    if v > score {
-                        score = v;
+                    let v = at(4 * reg_max + c, a);
+                    if v > best_logit {
+                        best_logit = v;
                         best = c;
                     }
                 }
-                if score < threshold {
+                if best_logit < logit_threshold {
                     continue;
                 }
-                let [cx, cy, w, h] = [0, 1, 2, 3].map(|r| output[r * n + a]);
-                out.push(centre_box(best, score, cx, cy, w, h));
+                let dist = dfl_distances(|c| at(c, a), reg_max);
+                let (cx, cy) = (gx as f32 + 0.5, gy as f32 + 0.5);
+                let s = stride as f32;
+                out.push(Candidate {
+                    class: best,
+                    score: 1.0 / (1.0 + (-best_logit).exp()),
+                    x1: (cx - dist[0]) * s,
+                    y1: (cy - dist[1]) * s,
+                    x2: (cx + dist[2]) * s,
+                    y2: (cy + dist[3]) * s,
+                });
             }
         }
-        Head::Objectness => {
-            let [1, n, cols] = *shape else {
-                return Err(bad("[1, N, 5+C]".into()));
-            };
-            if cols != 5 + num_classes {
-                return Err(bad(format!("[1, N, {}]", 5 + num_classes)));
-            }
-            for row in output.chunks_exact(cols).take(n) {
-                let objectness = row[4];
-                if objectness < threshold {
-                    continue;
-                }
-                let (mut best, mut cls) = (0, f32::NEG_INFINITY);
-                for (c, v) in row[5..].iter().enumerate() {
-                    if *v > cls {
-                        cls = *v;
-                        best = c;
-                    }
-                }
-                let score = objectness * cls;
-                if score >= threshold {
-                    out.push(centre_box(best, score, row[0], row[1], row[2], row[3]));
-                }
+    }
+    Ok(())
+}
+
+/// The expected bin (in strides) of each box side's softmax over `reg_max` bins; `channel`
+/// reads one channel of the anchor (side `s`, bin `j` at channel `s * reg_max + j`).
+fn dfl_distances(channel: impl Fn(usize) -> f32, reg_max: usize) -> [f32; 4] {
+    let mut dist = [0f32; 4];
+    for (side, d) in dist.iter_mut().enumerate() {
+        let base = side * reg_max;
+        let max = (0..reg_max)
+            .map(|j| channel(base + j))
+            .fold(f32::NEG_INFINITY, f32::max);
+        let (mut sum, mut weighted) = (0f32, 0f32);
+        for j in 0..reg_max {
+            let e = (channel(base + j) - max).exp();
+            sum += e;
+            weighted += e * j as f32;
+        }
+        *d = weighted / sum;
+    }
+    dist
+}
+
+/// [`Head::AnchorFree`]: `[1, 4+C, N]`, one column per anchor.
+fn decode_anchor_free(
+    layout: Layout<'_>,
+    spec: DecodeSpec,
+    out: &mut Vec<Candidate>,
+) -> Result<()> {
+    let DecodeSpec {
+        num_classes,
+        threshold,
+        ..
+    } = spec;
+    let [1, rows, n] = *layout.shape else {
+        return Err(layout.mismatch("[1, 4+C, N]".into()));
+    };
+    if rows != 4 + num_classes {
+        return Err(layout.mismatch(format!("[1, {}, N]", 4 + num_classes)));
+    }
+    let output = layout.output;
+    for a in 0..n {
+        let (mut best, mut score) = (0, f32::NEG_INFINITY);
+        for c in 0..num_classes {
+            let v = output[(4 + c) * n + a];
+            if v > score {
+                score = v;
+                best = c;
             }
         }
-        Head::EndToEnd => {
-            let [1, k, 6] = *shape else {
-                return Err(bad("[1, K, 6]".into()));
-            };
-            for row in output.chunks_exact(6).take(k) {
-                let class = row[5].round();
-                if row[4] >= threshold && class >= 0.0 && (class as usize) < num_classes {
-                    out.push(Candidate {
-                        class: class as usize,
-                        score: row[4],
-                        x1: row[0],
-                        y1: row[1],
-                        x2: row[2],
-                        y2: row[3],
-                    });
-                }
+        if score < threshold {
+            continue;
+        }
+        let [cx, cy, w, h] = [0, 1, 2, 3].map(|r| output[r * n + a]);
+        out.push(centre_box(best, score, cx, cy, w, h));
+    }
+    Ok(())
+}
+
+/// [`Head::Objectness`]: `[1, N, 5+C]`, one row per anchor; the score is objectness times the
+/// best class score.
+fn decode_objectness(layout: Layout<'_>, spec: DecodeSpec, out: &mut Vec<Candidate>) -> Result<()> {
+    let DecodeSpec {
+        num_classes,
+        threshold,
+        ..
+    } = spec;
+    let [1, n, cols] = *layout.shape else {
+        return Err(layout.mismatch("[1, N, 5+C]".into()));
+    };
+    if cols != 5 + num_classes {
+        return Err(layout.mismatch(format!("[1, N, {}]", 5 + num_classes)));
+    }
+    for row in layout.output.chunks_exact(cols).take(n) {
+        let objectness = row[4];
+        if objectness < threshold {
+            continue;
+        }
+        let (mut best, mut cls) = (0, f32::NEG_INFINITY);
+        for (c, v) in row[5..].iter().enumerate() {
+            if *v > cls {
+                cls = *v;
+                best = c;
             }
+        }
+        let score = objectness * cls;
+        if score >= threshold {
+            out.push(centre_box(best, score, row[0], row[1], row[2], row[3]));
+        }
+    }
+    Ok(())
+}
+
+/// [`Head::EndToEnd`]: `[1, K, 6]`, boxes already decoded and suppressed.
+fn decode_end_to_end(layout: Layout<'_>, spec: DecodeSpec, out: &mut Vec<Candidate>) -> Result<()> {
+    let DecodeSpec {
+        num_classes,
+        threshold,
+        ..
+    } = spec;
+    let [1, k, 6] = *layout.shape else {
+        return Err(layout.mismatch("[1, K, 6]".into()));
+    };
+    for row in layout.output.chunks_exact(6).take(k) {
+        let class = row[5].round();
+        if row[4] >= threshold && class >= 0.0 && (class as usize) < num_classes {
+            out.push(Candidate {
+                class: class as usize,
+                score: row[4],
+                x1: row[0],
+                y1: row[1],
+                x2: row[2],
+                y2: row[3],
+            });
         }
     }
     Ok(())
@@ -254,7 +323,7 @@ fn centre_box(class: usize, score: f32, cx: f32, cy: f32, w: f32, h: f32) -> Can
 
 /// Class-wise greedy non-maximum suppression: `candidates` is sorted by score (in place) and
 /// the survivors, at most `max_boxes`, go to `keep` (cleared first), highest score first.
-pub fn nms(
+pub(crate) fn nms(
     candidates: &mut [Candidate],
     iou_threshold: f32,
     max_boxes: usize,

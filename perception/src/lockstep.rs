@@ -2,29 +2,39 @@
 //! calling thread at a fixed rate on sim time, so the same run always sees the same boxes at the
 //! same sim times (the threaded [`crate::DetectorWorker`] depends on wall-clock speed).
 
-use crate::detector::Detector;
+use crate::detector::Detect;
 use crate::error::{PerceptionError, Result};
 use crate::messages::{BoundingBoxes, FrameStamp};
 use crate::preprocess::RgbView;
+use crate::worker::panic_text;
 
 /// A detector called synchronously at a fixed sim-time rate.
-#[derive(Debug)]
 pub struct LockstepDetector {
-    detector: Detector,
+    detector: Box<dyn Detect>,
     period_s: f64,
     next_s: f64,
 }
 
+impl std::fmt::Debug for LockstepDetector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LockstepDetector")
+            .field("period_s", &self.period_s)
+            .field("next_s", &self.next_s)
+            .finish_non_exhaustive()
+    }
+}
+
 impl LockstepDetector {
-    /// Detects at `rate_hz` on sim time (the first frame at or after t = 0 is detected).
-    pub fn new(detector: Detector, rate_hz: f64) -> Result<Self> {
+    /// Runs `detector` (a [`crate::Detector`], or one wrapped in a [`crate::FaultInjector`]) at
+    /// `rate_hz` on sim time (the first frame at or after t = 0 is detected).
+    pub fn new(detector: impl Detect + 'static, rate_hz: f64) -> Result<Self> {
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
             return Err(PerceptionError::Inference(format!(
                 "lockstep detection rate must be a positive number of Hz, found {rate_hz}"
             )));
         }
         Ok(Self {
-            detector,
+            detector: Box::new(detector),
             period_s: 1.0 / rate_hz,
             next_s: 0.0,
         })
@@ -54,14 +64,7 @@ impl LockstepDetector {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             self.detector.detect(image, stamp)
         }))
-        .map_err(|payload| {
-            crate::PerceptionError::Panicked(crate::worker::panic_text(payload.as_ref()))
-        })?
+        .map_err(|payload| PerceptionError::Panicked(panic_text(payload.as_ref())))?
         .map(Some)
-    }
-
-    /// The wrapped detector.
-    pub fn detector(&self) -> &Detector {
-        &self.detector
     }
 }

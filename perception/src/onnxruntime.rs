@@ -18,7 +18,7 @@ pub enum Runtime {
     /// tract-onnx, pure Rust, in the binary (the default).
     #[default]
     Tract,
-    /// onnxruntime's shared library, found at run time ([`find_library`]).
+    /// onnxruntime's shared library, found at run time ([`find_onnxruntime_library`]).
     OnnxRuntime,
 }
 
@@ -39,7 +39,7 @@ pub(crate) struct OrtSession {
 }
 
 impl OrtSession {
-    /// Loads `library` (once per process; see [`find_library`]) and builds a session on
+    /// Loads `library` (once per process; see [`find_onnxruntime_library`]) and builds a session on
     /// `model_bytes` with `threads` intra-op threads.
     pub(crate) fn new(
         library: &Path,
@@ -114,10 +114,10 @@ fn environment(library: &Path) -> std::result::Result<ort::environment::Environm
 
 /// Where onnxruntime's library is: `ORT_DYLIB_PATH` (ort's variable) when set, else the
 /// `onnxruntime/capi/libonnxruntime.so*` of a pip install in `$VIRTUAL_ENV`, the venv in rover's
-/// cache ([`crate::fetch::cache_dir`], where `scripts/setup.sh` puts it), `~/.local` or the
+/// cache (`~/.cache/rover/venv`, where `scripts/setup.sh` puts it), `~/.local` or the
 /// system's Python. The error lists every place
 /// searched.
-pub fn find_library() -> Result<PathBuf> {
+pub fn find_onnxruntime_library() -> Result<PathBuf> {
     if let Some(path) = std::env::var_os("ORT_DYLIB_PATH") {
         let path = PathBuf::from(path);
         return if path.is_file() {

@@ -77,19 +77,7 @@ impl Letterbox {
 }
 
 /// Grey of the padding (Ultralytics' 114).
-pub const PAD_VALUE: f32 = 114.0 / 255.0;
-
-/// Writes `image` letterboxed into `input` (`[3, dst_h, dst_w]`, f32, RGB, 0..1) with bilinear
-/// sampling (pixel centres aligned, like OpenCV's INTER_LINEAR). Builds its sampling tables
-/// each call; the detector keeps a [`LetterboxPlan`] instead, which allocates nothing.
-pub fn letterbox_into(
-    image: RgbView<'_>,
-    input: &mut [f32],
-    dst_w: usize,
-    dst_h: usize,
-) -> Result<Letterbox> {
-    LetterboxPlan::default().letterbox_into(image, input, dst_w, dst_h)
-}
+const PAD_VALUE: f32 = 114.0 / 255.0;
 
 /// Where one output column (or row) samples the source: the two neighbours and the weight of
 /// the second.
@@ -104,7 +92,7 @@ struct Tap {
 /// per-pixel work is then four loads and a few multiply-adds per channel. Values are the same,
 /// bit for bit, as computing each pixel's position on its own.
 #[derive(Debug, Clone, Default)]
-pub struct LetterboxPlan {
+pub(crate) struct LetterboxPlan {
     key: Option<(usize, usize, usize, usize)>,
     cols: Vec<Tap>,
     rows: Vec<Tap>,
@@ -138,8 +126,11 @@ impl LetterboxPlan {
         lb
     }
 
-    /// [`letterbox_into`] with this plan's tables (rebuilt only when a size changes).
-    pub fn letterbox_into(
+    /// Writes `image` letterboxed into `input` (`[3, dst_h, dst_w]`, f32, RGB, 0..1) with
+    /// bilinear sampling (pixel centres aligned, like OpenCV's INTER_LINEAR), using this plan's
+    /// tables (rebuilt only when a size changes): the detector keeps one plan and allocates
+    /// nothing per frame.
+    pub(crate) fn letterbox_into(
         &mut self,
         image: RgbView<'_>,
         input: &mut [f32],
@@ -250,7 +241,7 @@ mod tests {
         pixels[0] = 255; // top-left red
         let image = RgbView::new(4, 2, &pixels)?;
         let mut input = vec![0f32; 3 * 16];
-        let lb = letterbox_into(image, &mut input, 4, 4)?;
+        let lb = LetterboxPlan::default().letterbox_into(image, &mut input, 4, 4)?;
         assert_eq!((lb.pad_x, lb.pad_y), (0.0, 1.0));
         assert_eq!(input[0], PAD_VALUE, "top row padded");
         assert_eq!(input[4], 1.0, "source (0,0) red lands at input (0,1)");
@@ -259,7 +250,7 @@ mod tests {
         // Downscaling averages.
         let flat = vec![200u8; 8 * 8 * 3];
         let mut small = vec![0f32; 3 * 4 * 4];
-        letterbox_into(RgbView::new(8, 8, &flat)?, &mut small, 4, 4)?;
+        LetterboxPlan::default().letterbox_into(RgbView::new(8, 8, &flat)?, &mut small, 4, 4)?;
         assert!(small.iter().all(|v| (v - 200.0 / 255.0).abs() < 1e-6));
         assert!(RgbView::new(4, 4, &flat).is_err());
         Ok(())

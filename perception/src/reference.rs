@@ -29,7 +29,7 @@ pub struct OrtRun {
 
 /// Runs `model` on `input` (`shape`, f32) with onnxruntime, `threads` intra-op threads,
 /// `runs` times. Needs `python3` with `onnxruntime` and `numpy`.
-pub fn onnxruntime(
+pub fn onnxruntime_reference(
     model: &Path,
     input: &[f32],
     shape: &[usize],
@@ -48,8 +48,8 @@ pub fn onnxruntime(
     result
 }
 
-/// [`onnxruntime`] on one thread with its profiler on: [`OrtRun::ops`] says where the time goes.
-pub fn onnxruntime_profiled(
+/// [`onnxruntime_reference`] on one thread with its profiler on: [`OrtRun::ops`] says where the time goes.
+pub fn onnxruntime_reference_profiled(
     model: &Path,
     input: &[f32],
     shape: &[usize],

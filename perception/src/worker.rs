@@ -7,7 +7,7 @@ use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
-use crate::detector::Detector;
+use crate::detector::Detect;
 use crate::error::{PerceptionError, Result};
 use crate::messages::{BoundingBoxes, FrameStamp};
 use crate::preprocess::RgbView;
@@ -69,13 +69,14 @@ fn lock(shared: &Shared) -> std::sync::MutexGuard<'_, Slot> {
 }
 
 impl DetectorWorker {
-    /// Moves `detector` onto a new thread.
-    pub fn spawn(mut detector: Detector) -> Result<Self> {
+    /// Moves `detector` (a [`crate::Detector`], or one wrapped in a [`crate::FaultInjector`])
+    /// onto a new thread.
+    pub fn spawn(mut detector: impl Detect + 'static) -> Result<Self> {
         Self::spawn_with(move |view, stamp| detector.detect(view, stamp))
     }
 
-    /// Runs any detection function on a new thread (a [`Detector`], or a stand-in in tests).
-    pub fn spawn_with<F>(mut detect: F) -> Result<Self>
+    /// Runs any detection function on a new thread (a detector, or a stand-in in tests).
+    fn spawn_with<F>(mut detect: F) -> Result<Self>
     where
         F: FnMut(RgbView<'_>, FrameStamp) -> Result<BoundingBoxes> + Send + 'static,
     {

@@ -681,9 +681,9 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             input_path: dir.join("classes.names"),
             load: Box::new(|p| {
                 if let Ok(text) = std::fs::read_to_string(p) {
-                    let _ = rover_perception::labels::parse_metadata_names(&text);
+                    let _ = rover_perception::parse_metadata_names(&text);
                 }
-                outcome(rover_perception::labels::read_labels_file(p))
+                outcome(rover_perception::read_labels_file(p))
             }),
             hang_limit: text_limit,
         });
@@ -704,7 +704,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             name: "image_jpeg",
             seeds: read_all(&photos)?,
             input_path: dir.join("photo.jpg"),
-            load: Box::new(|p| outcome(rover_perception::preprocess::load_rgb(p))),
+            load: Box::new(|p| outcome(rover_perception::load_rgb(p))),
             hang_limit: text_limit,
         });
     }
@@ -712,12 +712,12 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         name: "image_png",
         seeds: read_all(&[crate::repo("docs/turtlebot3-burger.png")])?,
         input_path: dir.join("photo.png"),
-        load: Box::new(|p| outcome(rover_perception::preprocess::load_rgb(p))),
+        load: Box::new(|p| outcome(rover_perception::load_rgb(p))),
         hang_limit: text_limit,
     });
 
     // ONNX model bytes (the default model; loading a valid one takes seconds in a debug build).
-    let model = rover_perception::fetch::default_model_path();
+    let model = rover_perception::default_model_path();
     if model.is_file() {
         let dir = work.join("onnx");
         std::fs::create_dir_all(&dir)?;

@@ -2,10 +2,9 @@
 //! and decoding.
 
 use anyhow::Result;
-use rover_perception::preprocess::load_rgb;
-use rover_perception::reference::onnxruntime;
 use rover_perception::{
-    Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView, Runtime,
+    Detector, DetectorConfig, DetectorWorker, Frame, FrameStamp, RgbView, Runtime, load_rgb,
+    onnxruntime_reference,
 };
 use rover_tests::photo;
 
@@ -42,7 +41,7 @@ fn default_model_finds_the_expected_objects_like_onnxruntime() -> Result<()> {
         // onnxruntime on exactly the graph, input tensor and decoder rover uses.
         let (input, letterbox) = detector.preprocess(view)?;
         let input = input.to_vec();
-        let reference = onnxruntime(&model, &input, &[1, 3, h, w], 1, 1)?;
+        let reference = onnxruntime_reference(&model, &input, &[1, 3, h, w], 1, 1)?;
         let theirs = detector.decode_raw(&reference.output, &reference.shape, letterbox, stamp)?;
         assert!(
             !theirs.bounding_boxes.is_empty(),
@@ -115,7 +114,7 @@ fn several_detector_threads_give_bit_identical_outputs() -> Result<()> {
 /// IoU >= 0.9, and the other way round). Skips where no onnxruntime library is installed.
 #[test]
 fn the_onnxruntime_runtime_gives_the_same_boxes_as_tract() -> Result<()> {
-    if let Err(e) = rover_perception::onnxruntime::find_library() {
+    if let Err(e) = rover_perception::find_onnxruntime_library() {
         eprintln!("skipped: {e}");
         return Ok(());
     }
@@ -290,6 +289,70 @@ fn lockstep_detection_runs_at_its_sim_rate_and_repeats_exactly() -> Result<()> {
     Ok(())
 }
 
+/// `--inject-fault`'s wrapper around the real detector: good detections first, then a panic
+/// on the worker's thread becomes `Panicked`, one on the lockstep's (calling) thread is caught
+/// the same way, and an error is returned as it is.
+#[test]
+fn an_injected_fault_fails_where_a_real_one_would() -> Result<()> {
+    use rover_perception::{
+        FaultInjector, FaultKind, InjectedFault, LockstepDetector, PerceptionError,
+    };
+    let dir = tempfile::tempdir()?;
+    let (width, height, pixels) = load_rgb(&photo("person", dir.path())?)?;
+    let faulty = |after_detections, kind| -> Result<FaultInjector> {
+        let fault = InjectedFault {
+            after_detections,
+            kind,
+        };
+        Ok(FaultInjector::new(
+            Detector::load(DetectorConfig::default())?,
+            fault,
+        ))
+    };
+    let frame = |n: u64| Frame {
+        pixels: pixels.clone(),
+        width,
+        height,
+        stamp: FrameStamp {
+            sim_time_s: n as f64,
+            frame: n,
+        },
+    };
+    let worker = DetectorWorker::spawn(faulty(1, FaultKind::Panic)?)?;
+    worker.submit_queued(frame(0));
+    worker.submit_queued(frame(1));
+    assert_eq!(worker.wait()?.image_stamp.frame, 0);
+    match worker.wait() {
+        Err(PerceptionError::Panicked(text)) => {
+            assert!(text.contains("injected fault after 1 detections"), "{text}")
+        }
+        other => panic!("expected Panicked, got {other:?}"),
+    }
+
+    let view = RgbView::new(width, height, &pixels)?;
+    let stamp = |n: u64| FrameStamp {
+        sim_time_s: n as f64,
+        frame: n,
+    };
+    let mut lockstep = LockstepDetector::new(faulty(0, FaultKind::Panic)?, 1.0)?;
+    assert!(matches!(
+        lockstep.detect_if_due(view, stamp(0)),
+        Err(PerceptionError::Panicked(_))
+    ));
+    let mut lockstep = LockstepDetector::new(faulty(1, FaultKind::Error)?, 1.0)?;
+    assert!(lockstep.detect_if_due(view, stamp(0))?.is_some());
+    let err = lockstep
+        .detect_if_due(view, stamp(1))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("injected fault after 1 detections (--inject-fault)"),
+        "{err}"
+    );
+    Ok(())
+}
+
 /// `rover bench detect --profile`'s two halves on the real model: every tract node is timed and
 /// attributed to an ONNX op type (convolutions dominate, as they do in onnxruntime's own
 /// profile), and onnxruntime's profiler reports the same graph's op types.
@@ -329,7 +392,7 @@ fn the_per_op_profile_attributes_tract_and_onnxruntime_time_to_onnx_ops() -> Res
     let (w, h) = detector.input_size();
     let (input, _) = detector.preprocess(view)?;
     let input = input.to_vec();
-    let run = rover_perception::reference::onnxruntime_profiled(&model, &input, &[1, 3, h, w], 1)?;
+    let run = rover_perception::onnxruntime_reference_profiled(&model, &input, &[1, 3, h, w], 1)?;
     let ort_conv = run
         .ops
         .iter()

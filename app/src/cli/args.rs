@@ -497,8 +497,19 @@ impl DetectorArgs {
         args
     }
 
+    /// The detector's settings for a command that runs no session (`rover detect`, `rover
+    /// bench detect`), where `--inject-fault` has nothing to act on and is refused.
+    pub(crate) fn tool_config(&self, default_threads: usize) -> anyhow::Result<DetectorConfig> {
+        anyhow::ensure!(
+            self.inject_fault.is_none(),
+            "--inject-fault applies to runs (headless, the window, eval), not to this command"
+        );
+        self.config(default_threads)
+    }
+
     /// The detector's settings; `default_threads` where `--detect-threads` was not given (see
-    /// [`spare_detect_threads`]).
+    /// [`spare_detect_threads`]). `--inject-fault` is not among them: runs hand
+    /// [`DetectorArgs::inject_fault`] to the session, which wraps the detector.
     pub(crate) fn config(&self, default_threads: usize) -> anyhow::Result<DetectorConfig> {
         anyhow::ensure!(
             (0.0..=1.0).contains(&self.threshold),
@@ -516,7 +527,6 @@ impl DetectorArgs {
             input_size: self.input_size,
             threshold: self.threshold,
             nms_iou: self.nms,
-            fault: self.inject_fault,
             threads: self.detect_threads.map_or(default_threads, usize::from),
             runtime: self.runtime.into(),
             ..DetectorConfig::default()

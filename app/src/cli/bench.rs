@@ -107,8 +107,7 @@ pub fn detector(
     image: &std::path::Path,
     runs: usize,
 ) -> Result<DetectorBench> {
-    use rover_perception::preprocess::load_rgb;
-    use rover_perception::{Detector, FrameStamp, RgbView};
+    use rover_perception::{Detector, FrameStamp, RgbView, load_rgb};
 
     let mut detector = Detector::load(config)?;
     let (w, h, pixels) = load_rgb(image)?;
@@ -149,8 +148,7 @@ fn profile_detector(
     image: &std::path::Path,
     runs: usize,
 ) -> Result<()> {
-    use rover_perception::preprocess::load_rgb;
-    use rover_perception::{Detector, FrameStamp, RgbView};
+    use rover_perception::{Detector, FrameStamp, RgbView, load_rgb};
     let mut detector = Detector::load(config)?;
     let (w, h, pixels) = load_rgb(image)?;
     let view = RgbView::new(w, h, &pixels)?;
@@ -164,7 +162,7 @@ fn profile_detector(
         .map_err(anyhow::Error::from)
         .and_then(|()| {
             let (input, _) = detector.preprocess(view)?;
-            Ok(rover_perception::reference::onnxruntime_profiled(
+            Ok(rover_perception::onnxruntime_reference_profiled(
                 &model,
                 input,
                 &[1, 3, ih, iw],
@@ -237,7 +235,7 @@ fn onnxruntime_median(
         .map_err(|e| e.to_string())
         .and_then(|()| {
             let (input, _) = detector.preprocess(view).map_err(|e| e.to_string())?;
-            rover_perception::reference::onnxruntime(
+            rover_perception::onnxruntime_reference(
                 &model,
                 input,
                 &[1, 3, h, w],

@@ -4,8 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use image::RgbImage;
-use rover_perception::preprocess::load_rgb;
-use rover_perception::{BoundingBox, Detector, DetectorConfig, FrameStamp, RgbView};
+use rover_perception::{BoundingBox, Detector, DetectorConfig, FrameStamp, RgbView, load_rgb};
 use serde::Serialize;
 
 /// Options of `rover detect`.

@@ -99,7 +99,7 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
     }
     if args.detector.model.is_none() {
         // Fetch the default model once, before the workers race for it.
-        rover_perception::fetch::ensure_default_model()?;
+        rover_perception::ensure_default_model()?;
     }
     let jobs = args
         .jobs
@@ -271,6 +271,7 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
             let options = ScenarioOptions {
                 // `--jobs` workers already fill the cores.
                 detector: args.detector.config(1)?,
+                inject_fault: args.detector.inject_fault,
                 trace: args
                     .traces
                     .then(|| args.out.join(format!("{}.csv", s.name))),

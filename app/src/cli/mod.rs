@@ -42,7 +42,7 @@ pub fn main() -> ExitCode {
                 }),
             ..
         }) => detector
-            .config(args::spare_detect_threads())
+            .tool_config(args::spare_detect_threads())
             .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
@@ -84,7 +84,7 @@ pub fn main() -> ExitCode {
             json,
             out,
         }) => detector
-            .config(args::spare_detect_threads())
+            .tool_config(args::spare_detect_threads())
             .and_then(|config| {
                 detect::run(&DetectOptions {
                     images,

@@ -34,6 +34,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         // Pipelined or serial detection waits for the detector at each result, so it gets the
         // core the loop thread leaves free.
         detector: args.detector.config(super::args::spare_detect_threads())?,
+        inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
         // ROS peers expect real time: --ros paces headless runs unless --rtf says otherwise.
         real_time_factor: args.window.rtf.or(args.ros.ros.then_some(1.0)),
@@ -199,6 +200,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         // Measured under Xvfb on 2 vCPU: two threads raise the detector from 12 to 14-15 Hz
         // and the loop stays at 1.00x real time.
         detector_config: args.detector.config(super::args::spare_detect_threads())?,
+        inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
     };
     let mut ros = args
