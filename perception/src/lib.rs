@@ -11,6 +11,7 @@
 //! No UI or viewer code: everything runs headless in tests.
 
 pub mod detector;
+mod draw;
 pub mod error;
 pub mod fetch;
 mod graph;
@@ -27,6 +28,7 @@ pub use detector::{
     DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detector, DetectorConfig, FaultKind,
     InjectedFault, OpProfile, StageTimes,
 };
+pub use draw::{PixelRect, box_outline, draw_box_rgb8};
 pub use error::{PerceptionError, Result};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
