@@ -165,7 +165,12 @@ impl Session {
         }
         let (detection, labels) = match (options.detector, camera.is_some()) {
             (DetectorMode::Off, _) | (_, false) => (Detection::Off, Vec::new()),
-            (mode, true) => start_detection(mode, &options.detector_config, options.inject_fault, observer)?,
+            (mode, true) => start_detection(
+                mode,
+                &options.detector_config,
+                options.inject_fault,
+                observer,
+            )?,
         };
         let stats = LoopStats {
             detector_ok: !matches!(detection, Detection::Off),

@@ -18,6 +18,7 @@
 //! whole public surface.
 
 mod detector;
+mod draw;
 mod error;
 mod fault;
 mod fetch;
@@ -35,6 +36,7 @@ pub use detector::{
     DEFAULT_INPUT_SIZE, DEFAULT_NMS_IOU, DEFAULT_THRESHOLD, Detect, Detector, DetectorConfig,
     OpProfile, StageTimes,
 };
+pub use draw::{PixelRect, box_outline, draw_box_rgb8};
 pub use error::{PerceptionError, Result};
 pub use fault::{FaultInjector, FaultKind, InjectedFault};
 pub use fetch::{default_model_path, ensure_default_model};

@@ -11,20 +11,6 @@ const CRATES: [&str; 6] = ["sim", "perception", "core", "ros1", "app", "tests"];
 /// Longest function allowed outside tests (lines from `fn` to its closing brace).
 const MAX_FUNCTION_LINES: usize = 120;
 
-/// Functions over the limit that issue 23 has not split yet, with their length today: the
-/// test fails when one grows or a new one appears, and when one is split (so the entry goes).
-const NOT_YET_SPLIT: &[(&str, &str, usize)] = &[
-    ("perception/src/detector.rs", "load", 155),
-    ("perception/src/head.rs", "decode", 150),
-    ("app/src/viewer/scene.rs", "log_scene", 149),
-    ("core/src/headless.rs", "run_inner", 126),
-    ("core/src/session.rs", "new", 125),
-];
-
-/// Import circles issue 23 has not broken yet (crate, a file on the circle): the test fails
-/// when another crate has one, and when this one is gone (so the entry goes).
-const NOT_YET_BROKEN: &[(&str, &str)] = &[("core", "session.rs")];
-
 fn sources(krate: &str) -> anyhow::Result<CrateSources> {
     Ok(CrateSources::read(&repo(&format!("{krate}/src")))?)
 }
@@ -39,18 +25,9 @@ fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
             "{krate}: expected several source files, found {}",
             sources.files.len()
         );
-        let cycle = sources.find_cycle();
-        let known = NOT_YET_BROKEN.iter().find(|(k, _)| *k == krate);
-        match (cycle, known) {
-            (Some(cycle), Some((_, file))) if cycle.iter().any(|p| p.ends_with(file)) => {}
-            (Some(cycle), _) => {
-                let files: Vec<String> = cycle.iter().map(|p| p.display().to_string()).collect();
-                circles.push(format!("{krate}/src: {}", files.join(" -> ")));
-            }
-            (None, Some((_, file))) => circles.push(format!(
-                "{krate}/src: the known circle through {file} is gone: remove it from NOT_YET_BROKEN"
-            )),
-            (None, None) => {}
+        if let Some(cycle) = sources.find_cycle() {
+            let files: Vec<String> = cycle.iter().map(|p| p.display().to_string()).collect();
+            circles.push(format!("{krate}/src: {}", files.join(" -> ")));
         }
     }
     assert!(
@@ -115,27 +92,15 @@ fn sim_src_top_level_has_at_most_ten_entries() -> anyhow::Result<()> {
 #[test]
 fn no_function_outside_tests_is_longer_than_the_limit() -> anyhow::Result<()> {
     let mut long = Vec::new();
-    let mut still_long = Vec::new();
     // The tests crate is test code itself.
     for krate in CRATES.iter().filter(|k| **k != "tests") {
         for f in sources(krate)?.long_functions(MAX_FUNCTION_LINES) {
-            let file = format!("{krate}/src/{}", f.file.display());
-            let known = NOT_YET_SPLIT
-                .iter()
-                .find(|(k_file, name, _)| *k_file == file && *name == f.name);
-            match known {
-                Some((_, _, lines)) if f.lines <= *lines => still_long.push((file, f.name)),
-                _ => long.push(format!(
-                    "{file}:{} fn {} is {} lines",
-                    f.line, f.name, f.lines
-                )),
-            }
-        }
-    }
-    for (file, name, _) in NOT_YET_SPLIT {
-        if !still_long.iter().any(|(f, n)| f == file && n == name) {
             long.push(format!(
-                "{file} fn {name} is split now: remove it from NOT_YET_SPLIT"
+                "{krate}/src/{}:{} fn {} is {} lines",
+                f.file.display(),
+                f.line,
+                f.name,
+                f.lines
             ));
         }
     }

@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use image::RgbImage;
-use rover_perception::{BoundingBox, Detector, DetectorConfig, FrameStamp, RgbView, load_rgb};
+use rover_perception::{
+    BoundingBox, Detector, DetectorConfig, FrameStamp, RgbView, draw_box_rgb8, load_rgb,
+};
 use serde::Serialize;
 
 /// Options of `rover detect`.
@@ -55,7 +57,7 @@ pub fn run(options: &DetectOptions) -> Result<()> {
             .with_context(|| format!("cannot create folder {}", out.display()))?;
     }
     for (i, path) in options.images.iter().enumerate() {
-        let (width, height, pixels) = load_rgb(path)?;
+        let (width, height, mut pixels) = load_rgb(path)?;
         let view = RgbView::new(width, height, &pixels)?;
         let stamp = FrameStamp {
             sim_time_s: 0.0,
@@ -91,9 +93,14 @@ pub fn run(options: &DetectOptions) -> Result<()> {
             } else {
                 out.clone()
             };
-            let mut canvas = RgbImage::from_raw(width as u32, height as u32, pixels)
+            draw_boxes(
+                &mut pixels,
+                width as u32,
+                height as u32,
+                &result.bounding_boxes,
+            );
+            let canvas = RgbImage::from_raw(width as u32, height as u32, pixels)
                 .context("image buffer size mismatch")?;
-            draw_boxes(&mut canvas, &result.bounding_boxes);
             canvas
                 .save(&target)
                 .with_context(|| format!("cannot write {}", target.display()))?;
@@ -105,25 +112,11 @@ pub fn run(options: &DetectOptions) -> Result<()> {
     Ok(())
 }
 
-/// Draws 2-px box outlines.
-pub fn draw_boxes(canvas: &mut RgbImage, boxes: &[BoundingBox]) {
-    let (w, h) = (i64::from(canvas.width()), i64::from(canvas.height()));
+/// Draws 2-px box outlines in the class colours into a packed RGB8 image, by
+/// [`draw_box_rgb8`]'s rule (the ROS detection image's too).
+fn draw_boxes(rgb: &mut [u8], width: u32, height: u32, boxes: &[BoundingBox]) {
     for b in boxes {
-        let color = crate::palette::class_color(b.id);
-        for t in 0..2 {
-            let (x0, y0) = ((b.xmin + t).clamp(0, w - 1), (b.ymin + t).clamp(0, h - 1));
-            let (x1, y1) = (
-                (b.xmax - 1 - t).clamp(0, w - 1),
-                (b.ymax - 1 - t).clamp(0, h - 1),
-            );
-            for x in x0..=x1 {
-                canvas.put_pixel(x as u32, y0 as u32, color);
-                canvas.put_pixel(x as u32, y1 as u32, color);
-            }
-            for y in y0..=y1 {
-                canvas.put_pixel(x0 as u32, y as u32, color);
-                canvas.put_pixel(x1 as u32, y as u32, color);
-            }
-        }
+        let colour = crate::palette::class_color(b.id).0;
+        draw_box_rgb8(rgb, width, height, b, 2, colour);
     }
 }

@@ -1,4 +1,6 @@
-//! The station's CPU canvas: 0RGB pixels as softbuffer shows them, with rectangles and text.
+//! The station's CPU canvas: 0RGB pixels as softbuffer shows them, with filled rectangles and
+//! text (detection boxes' outlines are `rover_perception::box_outline`'s rectangles, the rule
+//! every picture of boxes follows).
 //! Text comes from embedded-graphics' mono fonts (ASCII with lower case and punctuation, a
 //! well-kept crate with no system font lookup), drawn through its `DrawTarget`.
 
@@ -62,14 +64,6 @@ impl Canvas<'_> {
             let start = row as usize * self.width;
             self.pixels[start + x0 as usize..start + x1 as usize].fill(px);
         }
-    }
-
-    /// Draws a rectangle outline `thickness` pixels wide.
-    pub fn rect(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, thickness: i64, rgb: Rgb) {
-        self.fill(x0, y0, x1 - x0, thickness, rgb);
-        self.fill(x0, y1 - thickness, x1 - x0, thickness, rgb);
-        self.fill(x0, y0, thickness, y1 - y0, rgb);
-        self.fill(x1 - thickness, y0, thickness, y1 - y0, rgb);
     }
 
     /// Draws `text` in [`FONT`] with its top-left corner at (x, y). Returns the x after the

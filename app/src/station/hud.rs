@@ -1,6 +1,7 @@
 //! The station's picture: the camera image, its boxes and the HUD under it.
 
 use rover_core::{Mode, Session};
+use rover_perception::box_outline;
 
 use super::canvas::{CHAR_W, Canvas, Rgb};
 
@@ -9,6 +10,9 @@ pub(super) const HUD_H: usize = 112;
 
 /// The HUD's background, also the margin colour when the window is scaled.
 pub(super) const BACKGROUND: Rgb = [24, 26, 30];
+
+/// Outline width of a detection box (px).
+const BOX_THICKNESS_PX: u32 = 2;
 
 /// Characters per HUD line at 640 px.
 const LINE_CHARS: usize = 64;
@@ -49,7 +53,13 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
             } else {
                 [80, 200, 255]
             };
-            canvas.rect(b.xmin, b.ymin, b.xmax, b.ymax, 2, color);
+            // The ROS detection image's and `rover detect`'s outline, on the camera image.
+            let outline = box_outline(w as u32, img_h as u32, b, BOX_THICKNESS_PX);
+            for r in outline.into_iter().flatten() {
+                let (x, y) = (i64::from(r.x0), i64::from(r.y0));
+                let (rw, rh) = (i64::from(r.x1 - r.x0), i64::from(r.y1 - r.y0));
+                canvas.fill(x, y, rw, rh, color);
+            }
             let label = format!("{} {:.2}", b.class, b.probability);
             let lw = label.len() as i64 * CHAR_W + 4;
             let ly = (b.ymin - 20).max(0);

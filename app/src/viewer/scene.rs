@@ -3,8 +3,8 @@
 
 use rerun::RecordingStream;
 use rover_sim::{
-    CameraInfo, MeshData, Pose, Rgba, Simulation, link_from_optical, object_mesh, person_parts,
-    shape_mesh,
+    CameraInfo, MeshData, Pose, Rgba, Simulation, Visual, link_from_optical, object_mesh,
+    person_parts, shape_mesh,
 };
 
 use super::images::{IMAGE_PATH, ImageOptions};
@@ -29,18 +29,61 @@ pub(super) fn log_scene(
     labels: &[String],
     images: &ImageOptions,
 ) -> ScenePaths {
-    let log = |path: &str, data: &dyn rerun::AsComponents| {
-        if let Err(e) = rec.log_static(path, data) {
-            tracing::warn!("rerun: {path}: {e}");
-        }
-    };
-    let world = sim.world();
-    let robot = sim.robot();
-    log("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
+    log(rec, "world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
     // The 3D view's origin is the robot (see blueprint.rs): it needs the up axis too.
-    log("world/robot", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
+    log(
+        rec,
+        "world/robot",
+        &rerun::ViewCoordinates::RIGHT_HAND_Z_UP(),
+    );
+    let paths = ScenePaths {
+        moving_model_links: log_world(rec, sim),
+        people: log_people(rec, sim),
+        links: log_robot(rec, sim),
+    };
+    if let Some(info) = camera {
+        log_camera(rec, sim, info, images);
+    }
+    if !labels.is_empty() {
+        log(
+            rec,
+            IMAGE_PATH,
+            &rerun::AnnotationContext::new(labels.iter().enumerate().map(|(i, name)| {
+                let image::Rgb([r, g, b]) =
+                    crate::palette::class_color(i16::try_from(i).unwrap_or(i16::MAX));
+                (i as u16, name.as_str(), rerun::Rgba32::from_rgb(r, g, b))
+            })),
+        );
+    }
+    log_plot_series(rec);
+    paths
+}
+
+/// Logs static data, with a warning when Rerun refuses it.
+fn log(rec: &RecordingStream, path: &str, data: &dyn rerun::AsComponents) {
+    if let Err(e) = rec.log_static(path, data) {
+        tracing::warn!("rerun: {path}: {e}");
+    }
+}
+
+/// Logs one link's visuals under `path`, as meshes.
+fn log_visuals(rec: &RecordingStream, path: &str, visuals: &[Visual]) {
+    for (v, visual) in visuals.iter().enumerate() {
+        let vpath = format!("{path}/visual_{v}");
+        if let Ok(m) = shape_mesh(&visual.shape) {
+            log(rec, &vpath, &transform(visual.link_from_shape));
+            log(rec, &vpath, &mesh(&m, visual.display_color(&m)));
+        }
+    }
+}
+
+/// The ground, the world's objects and its SDF models; returns the model links that move (with
+/// their index among all model links) and their paths.
+fn log_world(rec: &RecordingStream, sim: &Simulation) -> Vec<(usize, String)> {
+    let world = sim.world();
     let [gx, gy] = world.ground.size_m;
     log(
+        rec,
         "world/ground",
         &rerun::Boxes3D::from_centers_and_sizes(
             [[0.0f32, 0.0, -0.01]],
@@ -51,10 +94,10 @@ pub(super) fn log_scene(
     );
     for object in &world.objects {
         let path = format!("world/objects/{}", object.name);
-        log(&path, &transform(object.world_from_object()));
-        log(&path, &mesh(&object_mesh(&object.shape), object.color));
+        log(rec, &path, &transform(object.world_from_object()));
+        log(rec, &path, &mesh(&object_mesh(&object.shape), object.color));
     }
-    let mut paths = ScenePaths::default();
+    let mut moving = Vec::new();
     let model_links = world
         .models
         .iter()
@@ -63,20 +106,20 @@ pub(super) fn log_scene(
         let path = format!("world/models/{}/{}", model.name, link.name);
         // Moving links get their transform per tick (static data would shadow it).
         if !link.is_dynamic(model) {
-            log(&path, &transform(link.world_from_link));
+            log(rec, &path, &transform(link.world_from_link));
         }
-        for (v, visual) in link.visuals.iter().enumerate() {
-            let vpath = format!("{path}/visual_{v}");
-            if let Ok(m) = shape_mesh(&visual.shape) {
-                log(&vpath, &transform(visual.link_from_shape));
-                log(&vpath, &mesh(&m, visual.display_color(&m)));
-            }
-        }
+        log_visuals(rec, &path, &link.visuals);
         if link.is_dynamic(model) {
-            paths.moving_model_links.push((i, path));
+            moving.push((i, path));
         }
     }
-    for (i, person) in world.people.iter().enumerate() {
+    moving
+}
+
+/// The people, each one mesh of its parts; returns their paths.
+fn log_people(rec: &RecordingStream, sim: &Simulation) -> Vec<String> {
+    let mut paths = Vec::new();
+    for (i, person) in sim.world().people.iter().enumerate() {
         let path = format!("world/people/{}", person.name);
         let mut positions = Vec::new();
         let mut normals = Vec::new();
@@ -97,6 +140,7 @@ pub(super) fn log_scene(
             );
         }
         log(
+            rec,
             &format!("{path}/body"),
             &rerun::Mesh3D::new(positions)
                 .with_vertex_normals(normals)
@@ -104,63 +148,66 @@ pub(super) fn log_scene(
                 .with_triangle_indices(triangles),
         );
         if person.walk.is_none() {
-            log(&path, &transform(sim.world_from_person(i)));
+            log(rec, &path, &transform(sim.world_from_person(i)));
         }
-        paths.people.push(path);
+        paths.push(path);
     }
-    // The robot: one entity per link under world/robot, visuals as meshes.
-    for link in &robot.links {
-        let path = format!("world/robot/{}", link.name);
-        for (v, visual) in link.visuals.iter().enumerate() {
-            let vpath = format!("{path}/visual_{v}");
-            if let Ok(m) = shape_mesh(&visual.shape) {
-                log(&vpath, &transform(visual.link_from_shape));
-                log(&vpath, &mesh(&m, visual.display_color(&m)));
-            }
-        }
-        paths.links.push(path);
-    }
-    if let Some(info) = camera {
-        let link = robot
-            .cameras
-            .first()
-            .and_then(|c| robot.link_index(&c.link))
-            .unwrap_or(robot.root);
-        let base_from_link = sim.world_from_base().inverse() * sim.world_from_link(link);
-        let base_from_optical = base_from_link * Pose::from_rotation(link_from_optical());
-        log("world/robot/camera", &transform(base_from_optical));
-        let k = images.scale();
-        let proj = rerun::components::PinholeProjection::from_focal_length_and_principal_point(
-            [info.k[0] as f32 / k, info.k[4] as f32 / k],
-            [info.k[2] as f32 / k, info.k[5] as f32 / k],
-        );
-        let (w, h) = images.scaled_size(info.width, info.height);
-        log(
-            IMAGE_PATH,
-            &rerun::Pinhole::new(proj)
-                .with_resolution([w as f32, h as f32])
-                .with_image_plane_distance(0.5f32),
-        );
-    }
-    if !labels.is_empty() {
-        log(
-            IMAGE_PATH,
-            &rerun::AnnotationContext::new(labels.iter().enumerate().map(|(i, name)| {
-                let image::Rgb([r, g, b]) =
-                    crate::palette::class_color(i16::try_from(i).unwrap_or(i16::MAX));
-                (i as u16, name.as_str(), rerun::Rgba32::from_rgb(r, g, b))
-            })),
-        );
-    }
+    paths
+}
+
+/// The robot: one entity per link under world/robot, visuals as meshes; returns their paths.
+fn log_robot(rec: &RecordingStream, sim: &Simulation) -> Vec<String> {
+    sim.robot()
+        .links
+        .iter()
+        .map(|link| {
+            let path = format!("world/robot/{}", link.name);
+            log_visuals(rec, &path, &link.visuals);
+            path
+        })
+        .collect()
+}
+
+/// The camera's optical frame on the robot and its pinhole, at the logged images' scale.
+fn log_camera(rec: &RecordingStream, sim: &Simulation, info: &CameraInfo, images: &ImageOptions) {
+    let robot = sim.robot();
+    let link = robot
+        .cameras
+        .first()
+        .and_then(|c| robot.link_index(&c.link))
+        .unwrap_or(robot.root);
+    let base_from_link = sim.world_from_base().inverse() * sim.world_from_link(link);
+    let base_from_optical = base_from_link * Pose::from_rotation(link_from_optical());
+    log(rec, "world/robot/camera", &transform(base_from_optical));
+    let k = images.scale();
+    let proj = rerun::components::PinholeProjection::from_focal_length_and_principal_point(
+        [info.k[0] as f32 / k, info.k[4] as f32 / k],
+        [info.k[2] as f32 / k, info.k[5] as f32 / k],
+    );
+    let (w, h) = images.scaled_size(info.width, info.height);
     log(
+        rec,
+        IMAGE_PATH,
+        &rerun::Pinhole::new(proj)
+            .with_resolution([w as f32, h as f32])
+            .with_image_plane_distance(0.5f32),
+    );
+}
+
+/// The plots' series names.
+fn log_plot_series(rec: &RecordingStream) {
+    log(
+        rec,
         "plots/velocity/linear",
         &rerun::SeriesLines::new().with_names(["cmd linear.x (m/s)", "measured (m/s)"]),
     );
     log(
+        rec,
         "plots/velocity/angular",
         &rerun::SeriesLines::new().with_names(["cmd angular.z (rad/s)", "measured (rad/s)"]),
     );
     log(
+        rec,
         "plots/wheels",
         &rerun::SeriesLines::new().with_names([
             "left target (rad/s)",
@@ -169,7 +216,6 @@ pub(super) fn log_scene(
             "right measured (rad/s)",
         ]),
     );
-    paths
 }
 
 /// A pose as a Rerun transform.

@@ -1,0 +1,103 @@
+//! The camera's image (sensor_msgs/Image, `rgb8`) and its calibration (sensor_msgs/CameraInfo)
+//! on `/<cameraName>/<imageTopicName>` and `/<cameraName>/<cameraInfoTopicName>`, with every
+//! image.
+
+use anyhow::Result;
+use rover_ros1::msgs;
+use rover_ros1::{Node, Publisher};
+use rover_sim::CameraFrame;
+
+use super::convert::header;
+use super::events::{ImageFrame, Start, TopicFamily};
+use super::plan::RosPlan;
+
+/// Publishes the camera's topics (none when the robot has no camera).
+pub(super) struct Camera {
+    image: Option<Publisher<msgs::Image>>,
+    info: Option<Publisher<msgs::CameraInfo>>,
+    /// Whether the run has a camera (its calibration is in `info_msg`).
+    calibrated: bool,
+    image_msg: msgs::Image,
+    info_msg: msgs::CameraInfo,
+}
+
+impl Camera {
+    /// Advertises the plan's camera topics.
+    pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
+        Ok(Self {
+            image: plan
+                .image_topic
+                .as_deref()
+                .map(|t| node.advertise(t, 2, false))
+                .transpose()?,
+            info: plan
+                .info_topic
+                .as_deref()
+                .map(|t| node.advertise(t, 10, false))
+                .transpose()?,
+            calibrated: false,
+            image_msg: msgs::Image {
+                encoding: "rgb8".into(),
+                ..msgs::Image::default()
+            },
+            info_msg: msgs::CameraInfo::default(),
+        })
+    }
+}
+
+impl TopicFamily for Camera {
+    fn start(&mut self, start: &Start) {
+        if let Some(c) = &start.camera {
+            self.info_msg = msgs::CameraInfo {
+                header: header(&c.frame_id),
+                height: c.height,
+                width: c.width,
+                distortion_model: c.distortion_model.to_owned(),
+                d: c.d.to_vec(),
+                k: c.k,
+                r: c.r,
+                p: c.p,
+            };
+            self.image_msg.header.frame_id = c.frame_id.clone();
+        }
+        self.calibrated = start.camera.is_some();
+    }
+
+    fn image(&mut self, image: &mut ImageFrame) {
+        // The camera's frame number, which the boxes' image_header names too.
+        let seq = image.seq as u32;
+        if self.calibrated
+            && let Some(p) = self.info.as_mut()
+        {
+            self.info_msg.header.seq = seq;
+            self.info_msg.header.stamp_s = image.stamp_s;
+            p.publish(&self.info_msg);
+        }
+        let Some(p) = self.image.as_mut() else {
+            return;
+        };
+        let msg = &mut self.image_msg;
+        msg.header.seq = seq;
+        msg.header.stamp_s = image.stamp_s;
+        msg.width = image.width;
+        msg.height = image.height;
+        msg.step = image.width * 3;
+        // Published from the event's buffer, which stays with the event.
+        std::mem::swap(&mut msg.data, &mut image.pixels);
+        p.publish(msg);
+        std::mem::swap(&mut msg.data, &mut image.pixels);
+    }
+}
+
+/// The image to hand over (on the loop thread): `frame` copied into the recycled `pixels`.
+pub(super) fn capture(frame: &CameraFrame<'_>, mut pixels: Vec<u8>) -> ImageFrame {
+    pixels.clear();
+    pixels.extend_from_slice(frame.rgb);
+    ImageFrame {
+        stamp_s: frame.sim_time_s,
+        seq: frame.seq,
+        width: frame.width,
+        height: frame.height,
+        pixels,
+    }
+}

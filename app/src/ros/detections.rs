@@ -1,0 +1,214 @@
+//! darknet_ros's topics: `/darknet_ros/bounding_boxes` (darknet_ros_msgs/BoundingBoxes, when
+//! there are boxes), `/darknet_ros/found_object` (darknet_ros_msgs/ObjectCount, after every
+//! detection) and the latched `/darknet_ros/detection_image` (the detected image with the boxes
+//! drawn, 2 px in the class colour, by [`rover_perception::draw_box_rgb8`]'s rule).
+
+use anyhow::Result;
+use rover_perception::{BoundingBox, BoundingBoxes, draw_box_rgb8};
+use rover_ros1::msgs;
+use rover_ros1::{Node, Publisher};
+
+use super::convert::{header, seq_of};
+use super::events::{Detections, ImageFrame, Start, TopicFamily};
+use super::plan::RosPlan;
+
+/// darknet_ros's boxes.
+const BOUNDING_BOXES_TOPIC: &str = "/darknet_ros/bounding_boxes";
+/// darknet_ros's per-image object count.
+const FOUND_OBJECT_TOPIC: &str = "/darknet_ros/found_object";
+/// darknet_ros's image with boxes drawn (latched).
+const DETECTION_IMAGE_TOPIC: &str = "/darknet_ros/detection_image";
+
+/// Images kept for drawing the detection image (detections arrive after their image).
+const IMAGE_RING: usize = 4;
+
+/// Outline width in the detection image (px).
+const BOX_THICKNESS_PX: u32 = 2;
+
+/// An image kept for the detection image.
+struct KeptImage {
+    seq: u64,
+    width: u32,
+    height: u32,
+    pixels: Vec<u8>,
+}
+
+/// Publishes darknet_ros's topics.
+pub(super) struct DarknetTopics {
+    boxes: Publisher<msgs::BoundingBoxes>,
+    found: Publisher<msgs::ObjectCount>,
+    detection_image: Publisher<msgs::Image>,
+    /// The newest images, oldest first.
+    images: Vec<KeptImage>,
+    boxes_msg: msgs::BoundingBoxes,
+    found_msg: msgs::ObjectCount,
+    detection_msg: msgs::Image,
+}
+
+impl DarknetTopics {
+    /// Advertises darknet_ros's topics.
+    pub fn advertise(node: &Node, _plan: &RosPlan) -> Result<Self> {
+        Ok(Self {
+            boxes: node.advertise(BOUNDING_BOXES_TOPIC, 10, false)?,
+            found: node.advertise(FOUND_OBJECT_TOPIC, 10, false)?,
+            detection_image: node.advertise(DETECTION_IMAGE_TOPIC, 2, true)?,
+            images: Vec::with_capacity(IMAGE_RING),
+            boxes_msg: msgs::BoundingBoxes {
+                header: header("detection"),
+                ..msgs::BoundingBoxes::default()
+            },
+            found_msg: msgs::ObjectCount {
+                header: header("detection"),
+                count: 0,
+            },
+            detection_msg: msgs::Image {
+                encoding: "rgb8".into(),
+                ..msgs::Image::default()
+            },
+        })
+    }
+
+    /// Draws the boxes on their image, if it is still kept, and publishes it.
+    fn publish_detection_image(&mut self, image_seq: u64, boxes: &[BoundingBox]) {
+        let Some(image) = self.images.iter().find(|i| i.seq == image_seq) else {
+            return;
+        };
+        let d = &mut self.detection_msg;
+        d.header.clone_from(&self.boxes_msg.image_header);
+        d.width = image.width;
+        d.height = image.height;
+        d.step = image.width * 3;
+        d.data.clear();
+        d.data.extend_from_slice(&image.pixels);
+        for b in boxes {
+            let colour = crate::palette::class_color(b.id).0;
+            draw_box_rgb8(
+                &mut d.data,
+                image.width,
+                image.height,
+                b,
+                BOX_THICKNESS_PX,
+                colour,
+            );
+        }
+        self.detection_image.publish(d);
+    }
+}
+
+impl TopicFamily for DarknetTopics {
+    fn start(&mut self, start: &Start) {
+        if let Some(c) = &start.camera {
+            self.boxes_msg.image_header.frame_id = c.frame_id.clone();
+        }
+    }
+
+    fn image(&mut self, image: &mut ImageFrame) {
+        // Kept; the oldest kept image's buffer goes back in its place.
+        let oldest = (self.images.len() >= IMAGE_RING).then(|| self.images.remove(0));
+        self.images.push(KeptImage {
+            seq: u64::from(image.seq as u32),
+            width: image.width,
+            height: image.height,
+            pixels: std::mem::replace(
+                &mut image.pixels,
+                oldest.map(|o| o.pixels).unwrap_or_default(),
+            ),
+        });
+    }
+
+    fn detections(&mut self, detections: &mut Detections) {
+        self.found_msg.header.seq = seq_of(&self.found);
+        self.found_msg.header.stamp_s = detections.stamp_s;
+        self.found_msg.count = i8::try_from(detections.boxes.len()).unwrap_or(i8::MAX);
+        self.found.publish(&self.found_msg);
+
+        let out = &mut self.boxes_msg;
+        out.header.seq = seq_of(&self.boxes);
+        out.header.stamp_s = detections.stamp_s;
+        out.image_header.seq = detections.image_seq as u32;
+        out.image_header.stamp_s = detections.image_stamp_s;
+        // Class strings keep their capacity: no allocation once warm.
+        out.bounding_boxes
+            .resize_with(detections.boxes.len(), msgs::BoundingBox::default);
+        for (m, b) in out.bounding_boxes.iter_mut().zip(&detections.boxes) {
+            m.probability = b.probability;
+            m.xmin = b.xmin;
+            m.ymin = b.ymin;
+            m.xmax = b.xmax;
+            m.ymax = b.ymax;
+            m.id = b.id;
+            m.class.clone_from(&b.class);
+        }
+        if !out.bounding_boxes.is_empty() {
+            self.boxes.publish(out);
+        }
+        self.publish_detection_image(detections.image_seq, &detections.boxes);
+    }
+}
+
+/// The detections to hand over (on the loop thread), published at `now_s` (never before their
+/// image): `boxes` copied into the recycled `out`, whose class strings keep their capacity.
+pub(super) fn capture(boxes: &BoundingBoxes, now_s: f64, mut out: Vec<BoundingBox>) -> Detections {
+    let src = &boxes.bounding_boxes;
+    out.truncate(src.len());
+    let reused = out.len();
+    for (m, b) in out.iter_mut().zip(src) {
+        m.probability = b.probability;
+        m.xmin = b.xmin;
+        m.ymin = b.ymin;
+        m.xmax = b.xmax;
+        m.ymax = b.ymax;
+        m.id = b.id;
+        m.class.clone_from(&b.class);
+    }
+    out.extend(src.iter().skip(reused).cloned());
+    Detections {
+        stamp_s: now_s.max(boxes.image_stamp.sim_time_s),
+        image_stamp_s: boxes.image_stamp.sim_time_s,
+        image_seq: boxes.image_stamp.frame,
+        boxes: out,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rover_perception::FrameStamp;
+
+    fn person(xmin: i64) -> BoundingBox {
+        BoundingBox {
+            class: "person".into(),
+            probability: 0.5,
+            xmin,
+            ymin: 1,
+            xmax: xmin + 3,
+            ymax: 4,
+            id: 0,
+        }
+    }
+
+    #[test]
+    fn captured_boxes_reuse_the_recycled_buffer() {
+        let boxes = BoundingBoxes {
+            image_stamp: FrameStamp {
+                sim_time_s: 2.0,
+                frame: 7,
+            },
+            bounding_boxes: vec![person(1), person(5)],
+            ..BoundingBoxes::default()
+        };
+        let recycled = vec![person(0), person(0), person(0)];
+        let first_class = recycled[0].class.as_ptr();
+        let d = capture(&boxes, 1.5, recycled);
+        assert_eq!(d.boxes, boxes.bounding_boxes);
+        assert_eq!(
+            d.boxes[0].class.as_ptr(),
+            first_class,
+            "the string was reused"
+        );
+        assert_eq!((d.stamp_s, d.image_stamp_s, d.image_seq), (2.0, 2.0, 7));
+        let d = capture(&boxes, 3.0, Vec::new());
+        assert_eq!(d.boxes, boxes.bounding_boxes);
+        assert_eq!(d.stamp_s, 3.0);
+    }
+}

@@ -1,0 +1,110 @@
+//! `/joint_states` (sensor_msgs/JointState): every moving joint of the plan, in its order, with
+//! its angle and measured speed, every control update.
+
+use anyhow::Result;
+use rover_ros1::msgs;
+use rover_ros1::{Node, Publisher};
+use rover_sim::{ControlSample, Simulation};
+
+use super::convert::{header, seq_of};
+use super::events::{ControlUpdate, JointSample, TopicFamily};
+use super::plan::{MovingJoint, RosPlan};
+
+/// Publishes `/joint_states`.
+pub(super) struct JointStates {
+    publisher: Publisher<msgs::JointState>,
+    joints: Vec<MovingJoint>,
+    msg: msgs::JointState,
+}
+
+impl JointStates {
+    /// Advertises `/joint_states`.
+    pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
+        Ok(Self {
+            publisher: node.advertise("/joint_states", 50, false)?,
+            joints: plan.joints.clone(),
+            msg: msgs::JointState {
+                header: header(""),
+                name: plan.joints.iter().map(|j| j.name.clone()).collect(),
+                ..msgs::JointState::default()
+            },
+        })
+    }
+}
+
+/// The joint's angle: its rotation since its rest pose, about its axis (rad).
+fn angle_rad(joint: &MovingJoint, now: &JointSample) -> f64 {
+    let rel = joint.parent_from_child_at_rest.rotation.inverse() * now.parent_from_child.rotation;
+    let along = glam::Vec3::new(rel.x, rel.y, rel.z).dot(joint.axis);
+    2.0 * f64::from(along).atan2(f64::from(rel.w))
+}
+
+impl TopicFamily for JointStates {
+    fn control(&mut self, update: &ControlUpdate) {
+        if self.msg.name.is_empty() {
+            return;
+        }
+        self.msg.position.clear();
+        self.msg.velocity.clear();
+        for (joint, now) in self.joints.iter().zip(&update.joints) {
+            self.msg.position.push(angle_rad(joint, now));
+            self.msg.velocity.push(now.velocity_radps);
+        }
+        self.msg.header.seq = seq_of(&self.publisher);
+        self.msg.header.stamp_s = update.sample.sim_time_s;
+        self.publisher.publish(&self.msg);
+    }
+}
+
+/// Samples every joint of `joints` at a control update (on the loop thread), into `out`.
+pub(super) fn sample(
+    sim: &Simulation,
+    sample: &ControlSample,
+    joints: &[MovingJoint],
+    out: &mut Vec<JointSample>,
+) {
+    out.clear();
+    out.extend(joints.iter().map(|j| JointSample {
+        parent_from_child: sim.world_from_link(j.parent).inverse() * sim.world_from_link(j.child),
+        velocity_radps: j.source.velocity_radps(sample),
+    }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros::plan::JointSource;
+    use rover_sim::Pose;
+
+    #[test]
+    fn a_joints_angle_is_its_turn_about_its_axis_since_rest() {
+        let at_rest = Pose::from_parts(
+            glam::Vec3::new(0.0, 0.2, 0.0),
+            glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        );
+        let joint = MovingJoint {
+            name: "left_wheel_joint".into(),
+            parent: 0,
+            child: 1,
+            parent_link: "base_link".into(),
+            child_link: "left_wheel".into(),
+            parent_from_child_at_rest: at_rest,
+            axis: glam::Vec3::Z,
+            source: JointSource::Wheel { side: 0 },
+        };
+        for turn_rad in [0.0f32, 0.3, -1.2, 3.0] {
+            let now = JointSample {
+                parent_from_child: Pose::from_parts(
+                    at_rest.translation,
+                    at_rest.rotation * glam::Quat::from_rotation_z(turn_rad),
+                ),
+                velocity_radps: 1.0,
+            };
+            let angle = angle_rad(&joint, &now);
+            assert!(
+                (angle - f64::from(turn_rad)).abs() < 1e-6,
+                "{angle} for {turn_rad}"
+            );
+        }
+    }
+}

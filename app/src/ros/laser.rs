@@ -1,0 +1,75 @@
+//! The first laser's scans (sensor_msgs/LaserScan on its `topicName`, in its `frameName`), at
+//! its update rate.
+
+use anyhow::Result;
+use rover_ros1::msgs;
+use rover_ros1::{Node, Publisher};
+use rover_sim::LaserScan;
+
+use super::events::{Scan, TopicFamily};
+use super::plan::RosPlan;
+
+/// Publishes the laser's topic (nothing when the robot has no laser).
+pub(super) struct Laser {
+    publisher: Option<Publisher<msgs::LaserScan>>,
+    msg: msgs::LaserScan,
+}
+
+impl Laser {
+    /// Advertises the plan's scan topic, if any.
+    pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
+        Ok(Self {
+            publisher: plan
+                .scan_topic
+                .as_deref()
+                .map(|t| node.advertise(t, 10, false))
+                .transpose()?,
+            msg: msgs::LaserScan::default(),
+        })
+    }
+}
+
+impl TopicFamily for Laser {
+    fn scan(&mut self, scan: &mut Scan) {
+        let Some(p) = self.publisher.as_mut() else {
+            return;
+        };
+        let msg = &mut self.msg;
+        msg.header.seq = scan.seq as u32;
+        msg.header.stamp_s = scan.stamp_s;
+        if msg.header.frame_id != scan.frame_id {
+            msg.header.frame_id = scan.frame_id.clone();
+        }
+        msg.angle_min = scan.angle_min_rad;
+        msg.angle_max = scan.angle_max_rad;
+        msg.angle_increment = scan.angle_increment_rad;
+        msg.time_increment = scan.time_increment_s;
+        msg.scan_time = scan.scan_time_s;
+        msg.range_min = scan.range_min_m;
+        msg.range_max = scan.range_max_m;
+        // Published from the event's buffer, which stays with the event.
+        std::mem::swap(&mut msg.ranges, &mut scan.ranges_m);
+        p.publish(msg);
+        std::mem::swap(&mut msg.ranges, &mut scan.ranges_m);
+    }
+}
+
+/// The scan to hand over (on the loop thread): `scan` copied, its ranges into the recycled
+/// `ranges_m`.
+pub(super) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> Scan {
+    ranges_m.clear();
+    ranges_m.extend_from_slice(&scan.ranges_m);
+    Scan {
+        stamp_s: scan.stamp_s,
+        seq: scan.seq,
+        frame_id: scan.frame_id.clone(),
+        angle_min_rad: scan.angle_min_rad,
+        angle_max_rad: scan.angle_max_rad,
+        angle_increment_rad: scan.angle_increment_rad,
+        time_increment_s: scan.time_increment_s,
+        scan_time_s: scan.scan_time_s,
+        range_min_m: scan.range_min_m,
+        range_max_m: scan.range_max_m,
+        ranges_m,
+    }
+}

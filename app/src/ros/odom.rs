@@ -1,0 +1,64 @@
+//! The diff drive's odometry (nav_msgs/Odometry on `odometryTopic`), every control update, with
+//! gazebo_ros_diff_drive's covariance.
+
+use anyhow::Result;
+use rover_ros1::msgs::{self, Quaternion, Vector3};
+use rover_ros1::{Node, Publisher};
+use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
+
+use super::convert::{header, seq_of};
+use super::events::{ControlUpdate, TopicFamily};
+use super::plan::RosPlan;
+
+/// Publishes the odometry topic.
+pub(super) struct Odom {
+    publisher: Publisher<msgs::Odometry>,
+    msg: msgs::Odometry,
+}
+
+/// A 6x6 row-major covariance with `diagonal` on its diagonal.
+fn covariance(diagonal: [f64; 6]) -> [f64; 36] {
+    let mut c = [0.0; 36];
+    for (i, d) in diagonal.iter().enumerate() {
+        c[i * 7] = *d;
+    }
+    c
+}
+
+impl Odom {
+    /// Advertises the plan's odometry topic.
+    pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
+        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
+        Ok(Self {
+            publisher: node.advertise(&plan.odom_topic, 50, false)?,
+            msg: msgs::Odometry {
+                header: header(&plan.odom_frame),
+                child_frame_id: plan.base_frame.clone(),
+                position: Vector3::default(),
+                orientation: Quaternion::default(),
+                pose_covariance: cov,
+                linear: Vector3::default(),
+                angular: Vector3::default(),
+                twist_covariance: cov,
+            },
+        })
+    }
+}
+
+impl TopicFamily for Odom {
+    fn control(&mut self, update: &ControlUpdate) {
+        let o = update.sample.odometry;
+        let msg = &mut self.msg;
+        msg.header.seq = seq_of(&self.publisher);
+        msg.header.stamp_s = update.sample.sim_time_s;
+        msg.position = Vector3 {
+            x: o.x_m,
+            y: o.y_m,
+            z: 0.0,
+        };
+        msg.orientation = Quaternion::from_yaw(o.yaw_rad);
+        msg.linear.x = o.linear_mps;
+        msg.angular.z = o.angular_radps;
+        self.publisher.publish(msg);
+    }
+}
