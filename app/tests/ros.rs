@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail, ensure};
 use rover_core::{TraceRow, parse_trace};
 use rover_ros1::Value;
-use rover_ros1::xmlrpc::ros_call;
+use rover_ros1::ros_call;
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 

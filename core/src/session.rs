@@ -13,8 +13,8 @@ use rover_perception::{
     FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraFrame, CameraInfo, CameraSensor, ControlSample, LaserSensor, RobotModel, SimOptions,
-    Simulation, World,
+    CameraFrame, CameraInfo, CameraSensor, ControlSample, LaserSensor, LinkId, RobotModel,
+    SimOptions, Simulation, World,
 };
 
 use crate::error::{CoreError, Result};
@@ -114,7 +114,7 @@ struct Pipelined {
 pub struct Session {
     sim: Simulation,
     camera: Option<CameraSensor>,
-    camera_link: usize,
+    camera_link: LinkId,
     laser: Option<LaserSensor>,
     detection: Detection,
     labels: Vec<String>,
@@ -154,8 +154,8 @@ impl Session {
             .robot()
             .cameras
             .first()
-            .and_then(|c| sim.robot().link_index(&c.link))
-            .unwrap_or(0);
+            .and_then(|c| sim.robot().link_id(&c.link))
+            .unwrap_or(sim.robot().root);
         let laser = start_laser(&sim)?;
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
@@ -607,7 +607,7 @@ fn worker_frame(worker: &DetectorWorker, frame: &CameraFrame<'_>, stamp: FrameSt
 fn camera_geometry(
     sim: &Simulation,
     info: Option<&CameraInfo>,
-    camera_link: usize,
+    camera_link: LinkId,
 ) -> CameraGeometry {
     let world_from_camera = sim.world_from_link(camera_link);
     let base_from_camera = sim.world_from_base().inverse() * world_from_camera;

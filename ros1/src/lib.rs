@@ -10,13 +10,13 @@
 //! thousand lines on `std::net`, no new dependencies but an MD5.
 
 mod error;
-pub mod msg;
+mod msg;
 pub mod msgs;
 mod node;
-pub mod tcpros;
-pub mod xmlrpc;
+mod tcpros;
+mod xmlrpc;
 
 pub use error::{Error, Result};
 pub use msg::{Decode, Message, full_definition, md5sum};
 pub use node::{Node, NodeOptions, Publisher, Subscriber, global_name};
-pub use xmlrpc::Value;
+pub use xmlrpc::{Value, ros_call};

@@ -80,7 +80,7 @@ impl SimError {
 pub type Result<T, E = SimError> = std::result::Result<T, E>;
 
 /// The message of a caught panic (`catch_unwind`'s payload), for errors that report it.
-pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> &str {
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> &str {
     payload
         .downcast_ref::<String>()
         .map(String::as_str)

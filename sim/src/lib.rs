@@ -30,20 +30,18 @@ pub use description::{
     Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, WorldFile, expand_xacro, load_mesh,
     load_toml, parse_toml, uses_xacro,
 };
-pub use error::{Location, Result, SimError, panic_message};
+pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
     CameraConfig, CameraInfo, Collision, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
-    GaussianNoise, Ground, Inertial, Joint, JointKind, LaserConfig, Link, MAX_LASER_SAMPLES,
-    MeshData, MeshVertex, Model, ModelLink, Object, ObjectShape, OdometrySource, Person, Physics,
-    PixelFormat, RobotModel, RobotSpawn, STEP_HZ_RANGE, Visual, Walk, World, check_step_hz,
-    link_from_optical,
+    GaussianNoise, Ground, Inertial, Joint, JointId, JointKind, LaserConfig, Link, LinkId,
+    MAX_LASER_SAMPLES, MeshData, MeshVertex, Model, ModelLink, Object, OdometrySource, Person,
+    Physics, PixelFormat, RobotModel, RobotSpawn, STEP_HZ_RANGE, Visual, Walk, World,
+    check_step_hz, link_from_optical,
 };
 pub use physics::{
     ControlSample, DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry,
     SimOptions, Simulation, Twist, WheelSpeeds, wrap_angle,
 };
-/// nalgebra, the version rapier uses: for estimation and general matrices (one copy in the build).
-pub use rapier3d::na as nalgebra;
 pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
 pub use sensors::{CameraFrame, CameraSensor, LaserScan, LaserSensor};

@@ -470,7 +470,11 @@ pub fn check_one(target: &Target, bytes: &[u8]) -> Result<Option<String>, String
     match outcome {
         Err(payload) => Err(format!(
             "panicked: {}",
-            rover_sim::panic_message(payload.as_ref())
+            payload
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| payload.downcast_ref::<&str>().copied())
+                .unwrap_or("a panic without a message")
         )),
         Ok(Ok(())) => Ok(None),
         Ok(Err(text)) if text.trim().is_empty() => Err("an empty error message".into()),

@@ -92,7 +92,7 @@ pub fn person_sweep(
         .ok_or_else(|| anyhow::anyhow!("my_robot.urdf has no camera"))?;
     let info = CameraInfo::from_config(&camera);
     let camera_link = robot
-        .link_index(&camera.link)
+        .link_id(&camera.link)
         .ok_or_else(|| anyhow::anyhow!("camera link {} missing", camera.link))?;
     // Camera height of the car at rest on flat ground.
     let mut sim = Simulation::new(World::flat()?, robot.clone(), &SimOptions::default())?;

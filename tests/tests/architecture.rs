@@ -111,3 +111,35 @@ fn no_function_outside_tests_is_longer_than_the_limit() -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+/// Public modules each library may have (a namespace whose items are not re-exported at the
+/// root, so nothing is reachable by two paths).
+const PUBLIC_MODULES: &[(&str, &[&str])] = &[
+    ("sim", &[]),
+    ("perception", &[]),
+    ("core", &[]),
+    ("ros1", &["msgs"]),
+];
+
+#[test]
+fn libraries_keep_modules_private_behind_one_curated_surface() -> anyhow::Result<()> {
+    let mut found = Vec::new();
+    for (krate, allowed) in PUBLIC_MODULES {
+        let lib = std::fs::read_to_string(repo(&format!("{krate}/src/lib.rs")))?;
+        for line in lib.lines() {
+            let Some(name) = line.trim().strip_prefix("pub mod ") else {
+                continue;
+            };
+            let name = name.trim_end_matches(';').trim();
+            if !allowed.contains(&name) {
+                found.push(format!("{krate}/src/lib.rs: pub mod {name}"));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "public modules (make them private and re-export the API from lib.rs):\n{}",
+        found.join("\n")
+    );
+    Ok(())
+}

@@ -74,9 +74,7 @@ fn the_bundled_robot_loads_with_its_plugins() -> anyhow::Result<()> {
         (30.0, 1.3962634)
     );
     assert_eq!((cam.clip_near_m, cam.clip_far_m), (0.02, 300.0));
-    let caster = robot
-        .link_index("caster_link")
-        .map(|i| robot.links[i].friction);
+    let caster = robot.link_id("caster_link").map(|i| robot.link(i).friction);
     assert_eq!(caster, Some(Some(0.0)), "mu1/mu2 from <gazebo reference>");
     Ok(())
 }

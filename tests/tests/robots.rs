@@ -33,7 +33,7 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
     ] {
         assert!(names.contains(&link), "missing link {link}: {names:?}");
     }
-    assert_eq!(robot.links[robot.root].name, "base_footprint");
+    assert_eq!(robot.link(robot.root).name, "base_footprint");
     // Element text survives expansion: the diff drive plugin keeps every parameter.
     let dd = robot
         .diff_drive
@@ -43,14 +43,18 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
     assert_eq!(dd.wheel_diameter_m, 0.066);
     assert_eq!(dd.left_joint, "wheel_left_joint");
     assert_eq!(dd.update_rate_hz, 30.0);
-    let wheel = &robot.joints[robot
-        .joint_index("wheel_left_joint")
-        .ok_or_else(|| anyhow::anyhow!("no wheel joint"))?];
+    let wheel = robot.joint(
+        robot
+            .joint_id("wheel_left_joint")
+            .ok_or_else(|| anyhow::anyhow!("no wheel joint"))?,
+    );
     assert_eq!(wheel.kind, JointKind::Continuous);
     // Millimetre STL meshes through package://, scaled to metres: the base is ~14 cm across.
-    let base = &robot.links[robot
-        .link_index("base_link")
-        .ok_or_else(|| anyhow::anyhow!("no base_link"))?];
+    let base = robot.link(
+        robot
+            .link_id("base_link")
+            .ok_or_else(|| anyhow::anyhow!("no base_link"))?,
+    );
     let Shape::Mesh { path, scale } = &base.visuals[0].shape else {
         anyhow::bail!(
             "base_link visual is not a mesh: {:?}",
@@ -186,9 +190,9 @@ fn pybullet_r2d2_husky_and_racecar_load_and_simulate() -> Result<()> {
     // would (the defaults, as the variables are unset here).
     let husky = RobotModel::load_with(&data.join("husky/husky.urdf"), &LoadOptions::default())?;
     let imu = husky
-        .joint_index("imu_joint")
+        .joint_id("imu_joint")
         .ok_or_else(|| anyhow::anyhow!("husky has no imu_joint"))?;
-    let t = husky.joints[imu].parent_from_child.translation;
+    let t = husky.joint(imu).parent_from_child.translation;
     assert!(
         (t - glam::Vec3::new(0.19, 0.0, 0.149)).length() < 1e-6,
         "imu at {t}"

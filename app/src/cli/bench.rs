@@ -542,7 +542,7 @@ pub struct RosBench {
 pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
     use rover_ros1::{Node, NodeOptions};
     let master = NodeOptions::from_env("rover_bench")?;
-    rover_ros1::xmlrpc::ros_call(
+    rover_ros1::ros_call(
         &master.master_uri,
         "getPid",
         &[rover_ros1::Value::from("/rover_bench")],

@@ -77,15 +77,17 @@ mod tests {
     use rover_sim::Pose;
 
     #[test]
-    fn a_joints_angle_is_its_turn_about_its_axis_since_rest() {
+    fn a_joints_angle_is_its_turn_about_its_axis_since_rest() -> anyhow::Result<()> {
+        // The links only name the joint's frames; the angle depends on the poses alone.
+        let robot = rover_sim::RobotModel::load(&rover_core::default_robot_path())?;
         let at_rest = Pose::from_parts(
             glam::Vec3::new(0.0, 0.2, 0.0),
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
         let joint = MovingJoint {
             name: "left_wheel_joint".into(),
-            parent: 0,
-            child: 1,
+            parent: robot.root,
+            child: robot.root,
             parent_link: "base_link".into(),
             child_link: "left_wheel".into(),
             parent_from_child_at_rest: at_rest,
@@ -106,5 +108,6 @@ mod tests {
                 "{angle} for {turn_rad}"
             );
         }
+        Ok(())
     }
 }

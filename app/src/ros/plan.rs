@@ -1,7 +1,7 @@
 //! The names and frames the bridge uses for a robot, as Gazebo's plugins would choose them, and
 //! the moving joints it reports.
 
-use rover_sim::{ControlSample, DiffDriveConfig, Pose, RobotModel};
+use rover_sim::{ControlSample, DiffDriveConfig, LinkId, Pose, RobotModel};
 
 /// Topic names and frames, from the robot's Gazebo plugins.
 #[derive(Debug, Clone)]
@@ -34,10 +34,10 @@ pub struct RosPlan {
 pub(super) struct MovingJoint {
     /// Joint name.
     pub name: String,
-    /// Parent link index.
-    pub parent: usize,
-    /// Child link index.
-    pub child: usize,
+    /// Parent link.
+    pub parent: LinkId,
+    /// Child link.
+    pub child: LinkId,
     /// Parent link name (the TF parent frame).
     pub parent_link: String,
     /// Child link name (the TF child frame).
@@ -114,13 +114,7 @@ impl RosPlan {
 
 /// The robot's moving joints that the session reports: today the drive's wheels (left, right).
 fn moving_joints(robot: &RobotModel, drive: &DiffDriveConfig) -> Vec<MovingJoint> {
-    let link_name = |i: usize| {
-        robot
-            .links
-            .get(i)
-            .map(|l| l.name.clone())
-            .unwrap_or_default()
-    };
+    let link_name = |id: LinkId| robot.link(id).name.clone();
     [&drive.left_joint, &drive.right_joint]
         .into_iter()
         .enumerate()

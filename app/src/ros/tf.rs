@@ -104,15 +104,9 @@ pub(super) fn static_transforms(
         .joints
         .iter()
         .filter(|j| matches!(j.kind, JointKind::Fixed))
-        .filter_map(|j| {
-            let parent = robot.links.get(j.parent)?;
-            let child = robot.links.get(j.child)?;
-            Some(transform(
-                &parent.name,
-                &child.name,
-                0.0,
-                j.parent_from_child,
-            ))
+        .map(|j| {
+            let (parent, child) = (robot.link(j.parent), robot.link(j.child));
+            transform(&parent.name, &child.name, 0.0, j.parent_from_child)
         })
         .collect();
     if let (Some(info), Some(link)) = (camera, camera_link) {

@@ -183,8 +183,8 @@ impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
         self.paths = scene::log_scene(&self.rec, sim, camera, labels, self.images.options());
         self.laser = sim.robot().lasers.first().and_then(|l| {
-            let link = sim.robot().link_index(&l.link)?;
-            let path = self.paths.links.get(link)?;
+            let link = sim.robot().link_id(&l.link)?;
+            let path = self.paths.links.get(link.index())?;
             Some((format!("{path}/scan"), l.link_from_sensor))
         });
     }
@@ -194,15 +194,9 @@ impl Observer for Recorder {
         self.set_time(sample.sim_time_s);
         self.log("world/robot", &transform(sim.world_from_base()));
         let base_from_world = sim.world_from_base().inverse();
-        for (i, path) in self
-            .paths
-            .links
-            .iter()
-            .enumerate()
-            .take(sim.robot().links.len())
-        {
-            if i != sim.robot().root {
-                self.log(path, &transform(base_from_world * sim.world_from_link(i)));
+        for ((id, _), path) in sim.robot().link_ids().zip(&self.paths.links) {
+            if id != sim.robot().root {
+                self.log(path, &transform(base_from_world * sim.world_from_link(id)));
             }
         }
         if !self.paths.moving_model_links.is_empty() {

@@ -95,7 +95,10 @@ fn log_world(rec: &RecordingStream, sim: &Simulation) -> Vec<(usize, String)> {
     for object in &world.objects {
         let path = format!("world/objects/{}", object.name);
         log(rec, &path, &transform(object.world_from_object()));
-        log(rec, &path, &mesh(&object_mesh(&object.shape), object.color));
+        match object_mesh(&object.shape) {
+            Ok(m) => log(rec, &path, &mesh(&m, object.color)),
+            Err(e) => tracing::warn!("viewer: object \"{}\" not drawn: {e}", object.name),
+        }
     }
     let mut moving = Vec::new();
     let model_links = world
@@ -174,7 +177,7 @@ fn log_camera(rec: &RecordingStream, sim: &Simulation, info: &CameraInfo, images
     let link = robot
         .cameras
         .first()
-        .and_then(|c| robot.link_index(&c.link))
+        .and_then(|c| robot.link_id(&c.link))
         .unwrap_or(robot.root);
     let base_from_link = sim.world_from_base().inverse() * sim.world_from_link(link);
     let base_from_optical = base_from_link * Pose::from_rotation(link_from_optical());

@@ -6,7 +6,7 @@
 //! a person who stops is soon predicted to stand still, and a flickering detector does not let a
 //! noisy velocity carry the prediction away.
 
-use rover_sim::nalgebra::{Matrix2, Matrix2x4, Matrix4, Vector2, Vector4};
+use nalgebra::{Matrix2, Matrix2x4, Matrix4, Vector2, Vector4};
 
 /// Standard deviation of the target's acceleration (m/s^2): people start, stop and turn.
 const ACCEL_SIGMA_MPS2: f64 = 1.2;

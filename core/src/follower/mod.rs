@@ -25,8 +25,8 @@ mod filter;
 
 use std::collections::VecDeque;
 
+use nalgebra::Matrix2;
 use rover_perception::{BoundingBox, BoundingBoxes};
-use rover_sim::nalgebra::Matrix2;
 use rover_sim::{CameraInfo, LaserScan, Odometry, Twist, wrap_angle};
 
 pub use avoid::{AvoidConfig, Avoided};

@@ -20,7 +20,9 @@ use crate::geometry::{
     MAX_COORDINATE_M, MAX_INERTIA_KGM2, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape,
     pose_from_xyz_rpy, vec3,
 };
-use crate::model::robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
+use crate::model::robot::{
+    Collision, Inertial, Joint, JointKind, Link, LinkId, RobotModel, Visual,
+};
 
 /// How to read a robot description: xacro arguments and where ROS packages are.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -224,16 +226,27 @@ fn read_joints(
             ));
         }
         parent_of[child] = Some(joints.len());
-        joints.push(convert_joint(joint, parent, child, path, line)?);
+        joints.push(convert_joint(
+            joint,
+            LinkId(parent),
+            LinkId(child),
+            path,
+            line,
+        )?);
     }
 
     Ok(joints)
 }
 
 /// The one link that is no joint's child; every link must be reachable from it.
-fn find_root(links: &[Link], joints: &[Joint], path: &Path, lines: &ElementLines) -> Result<usize> {
+fn find_root(
+    links: &[Link],
+    joints: &[Joint],
+    path: &Path,
+    lines: &ElementLines,
+) -> Result<LinkId> {
     let roots: Vec<usize> = (0..links.len())
-        .filter(|&i| !joints.iter().any(|j| j.child == i))
+        .filter(|&i| !joints.iter().any(|j| j.child.0 == i))
         .collect();
     let root = match roots.as_slice() {
         [single] => *single,
@@ -262,8 +275,8 @@ fn find_root(links: &[Link], joints: &[Joint], path: &Path, lines: &ElementLines
     while changed {
         changed = false;
         for j in joints {
-            if reachable[j.parent] && !reachable[j.child] {
-                reachable[j.child] = true;
+            if reachable[j.parent.0] && !reachable[j.child.0] {
+                reachable[j.child.0] = true;
                 changed = true;
             }
         }
@@ -279,7 +292,7 @@ fn find_root(links: &[Link], joints: &[Joint], path: &Path, lines: &ElementLines
         ));
     }
 
-    Ok(root)
+    Ok(LinkId(root))
 }
 
 fn rgba(c: [f64; 4]) -> Rgba {
@@ -508,8 +521,8 @@ fn convert_geometry(
 
 fn convert_joint(
     joint: &urdf::JointEl,
-    parent: usize,
-    child: usize,
+    parent: LinkId,
+    child: LinkId,
     path: &Path,
     line: Option<u32>,
 ) -> Result<Joint> {

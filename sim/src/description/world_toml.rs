@@ -8,11 +8,11 @@ use serde::Deserialize;
 use crate::description::resource::ResourcePaths;
 use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
-use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba};
+use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
 use crate::model::drive::DriveSpec;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_STEP_HZ, Ground, Object, ObjectShape, Physics, RobotSpawn, World, check_step_hz,
+    DEFAULT_STEP_HZ, Ground, Object, Physics, RobotSpawn, World, check_step_hz,
 };
 
 impl World {
@@ -502,7 +502,7 @@ impl Checker<'_> {
     fn solid(
         &self,
         f: SolidFields<'_>,
-        shape: ObjectShape,
+        shape: Shape,
         half_height_m: f64,
         yaw_rad: f64,
         default_color: Rgba,
@@ -525,8 +525,8 @@ impl RawBox {
         c.positive(&format!("box[{i}].size_m"), &self.size_m, "m")?;
         c.finite(&format!("box[{i}].yaw_deg"), &[self.yaw_deg])?;
         let fields = solid_fields!(self, "box", i);
-        let shape = ObjectShape::Box {
-            size_m: self.size_m,
+        let shape = Shape::Box {
+            size_m: vec3_f32(self.size_m),
         };
         let brown = Rgba::rgb(0.63, 0.42, 0.25);
         c.solid(
@@ -544,9 +544,9 @@ impl RawCylinder {
         c.positive(&format!("cylinder[{i}].radius_m"), &[self.radius_m], "m")?;
         c.positive(&format!("cylinder[{i}].length_m"), &[self.length_m], "m")?;
         let fields = solid_fields!(self, "cylinder", i);
-        let shape = ObjectShape::Cylinder {
-            radius_m: self.radius_m,
-            length_m: self.length_m,
+        let shape = Shape::Cylinder {
+            radius_m: self.radius_m as f32,
+            length_m: self.length_m as f32,
         };
         let orange = Rgba::rgb(0.8, 0.45, 0.1);
         c.solid(fields, shape, self.length_m / 2.0, 0.0, orange)
@@ -557,8 +557,8 @@ impl RawSphere {
     fn into_object(self, i: usize, c: &Checker<'_>) -> Result<Object> {
         c.positive(&format!("sphere[{i}].radius_m"), &[self.radius_m], "m")?;
         let fields = solid_fields!(self, "sphere", i);
-        let shape = ObjectShape::Sphere {
-            radius_m: self.radius_m,
+        let shape = Shape::Sphere {
+            radius_m: self.radius_m as f32,
         };
         let red = Rgba::rgb(0.85, 0.2, 0.2);
         c.solid(fields, shape, self.radius_m, 0.0, red)
@@ -582,8 +582,8 @@ impl RawWall {
         }
         Ok(Object {
             name: self.name.unwrap_or_else(|| format!("wall_{i}")),
-            shape: ObjectShape::Box {
-                size_m: [length, self.thickness_m, self.height_m],
+            shape: Shape::Box {
+                size_m: vec3_f32([length, self.thickness_m, self.height_m]),
             },
             position_m: [
                 (self.from_m[0] + self.to_m[0]) / 2.0,
@@ -678,6 +678,11 @@ impl RawPerson {
             )?,
         })
     }
+}
+
+/// A size in metres as the model stores it (f32, like URDF shapes).
+fn vec3_f32(v: [f64; 3]) -> glam::Vec3 {
+    glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
 #[cfg(test)]

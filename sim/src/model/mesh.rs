@@ -5,9 +5,9 @@ use glam::Vec3;
 
 use crate::geometry::{Pose, Rgba};
 
-/// One vertex: position and normal.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+/// One vertex: position and normal, in the mesh's own frame. Plain data: the renderer copies
+/// it into its own GPU layout when it uploads the mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshVertex {
     /// Position (m).
     pub position: [f32; 3],

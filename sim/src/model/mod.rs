@@ -14,11 +14,11 @@ pub use camera_info::{CameraInfo, link_from_optical};
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
 pub use mesh::{MeshData, MeshVertex};
 pub use person::{Person, Walk};
-pub use robot::{Collision, Inertial, Joint, JointKind, Link, RobotModel, Visual};
+pub use robot::{Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, RobotModel, Visual};
 pub use sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
 };
 pub use world::{
-    DEFAULT_STEP_HZ, Ground, Model, ModelLink, Object, ObjectShape, Physics, RobotSpawn,
-    STEP_HZ_RANGE, World, check_step_hz,
+    DEFAULT_STEP_HZ, Ground, Model, ModelLink, Object, Physics, RobotSpawn, STEP_HZ_RANGE, World,
+    check_step_hz,
 };

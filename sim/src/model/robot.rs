@@ -96,17 +96,41 @@ pub enum JointKind {
     Floating,
 }
 
-/// A URDF joint, with links referred to by index into [`RobotModel::links`].
+/// A link of a [`RobotModel`]: its place in [`RobotModel::links`] (URDF order), which is also
+/// its place in every per-link list (link poses). Made only by the model that owns the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LinkId(pub(crate) usize);
+
+impl LinkId {
+    /// Position in [`RobotModel::links`] and in per-link lists.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+/// A joint of a [`RobotModel`]: its place in [`RobotModel::joints`] (URDF order). Made only
+/// by the model that owns the joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct JointId(pub(crate) usize);
+
+impl JointId {
+    /// Position in [`RobotModel::joints`] and in per-joint lists.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+/// A URDF joint between two links of its [`RobotModel`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Joint {
     /// Joint name.
     pub name: String,
     /// Kind and limits.
     pub kind: JointKind,
-    /// Parent link index.
-    pub parent: usize,
-    /// Child link index.
-    pub child: usize,
+    /// Parent link.
+    pub parent: LinkId,
+    /// Child link.
+    pub child: LinkId,
     /// Joint origin: the child link frame expressed in the parent link frame at zero position.
     pub parent_from_child: Pose,
     /// Unit axis in the joint (= child link) frame.
@@ -126,8 +150,8 @@ pub struct RobotModel {
     pub links: Vec<Link>,
     /// Joints in file order.
     pub joints: Vec<Joint>,
-    /// Index of the root link (the one that is no joint's child).
-    pub root: usize,
+    /// The root link (the one that is no joint's child).
+    pub root: LinkId,
     /// The `libgazebo_ros_diff_drive.so` plugin, if present.
     pub diff_drive: Option<DiffDriveConfig>,
     /// Camera sensors (`<sensor type="camera">`).
@@ -149,7 +173,7 @@ impl RobotModel {
         let setup =
             |m: String| SimError::Setup(format!("[robot.drive] for \"{}\": {m}", self.name));
         let joint = |name: &str| {
-            self.joint_index(name).ok_or_else(|| {
+            self.joint_id(name).ok_or_else(|| {
                 setup(format!(
                     "no joint \"{name}\"; joints in this robot: {}",
                     names(self.joints.iter().map(|j| &j.name))
@@ -161,15 +185,15 @@ impl RobotModel {
         let separation = match spec.wheel_separation_m {
             Some(s) => s,
             None => f64::from(
-                poses[self.joints[left].child]
+                poses[self.joint(left).child.index()]
                     .translation
-                    .distance(poses[self.joints[right].child].translation),
+                    .distance(poses[self.joint(right).child.index()].translation),
             ),
         };
         let diameter = match spec.wheel_diameter_m {
             Some(d) => d,
             None => {
-                let wheel = &self.links[self.joints[left].child];
+                let wheel = self.link(self.joint(left).child);
                 let radius = wheel.collisions.iter().find_map(|c| match c.shape {
                     Shape::Cylinder { radius_m, .. } | Shape::Sphere { radius_m } => {
                         Some(f64::from(radius_m))
@@ -234,26 +258,41 @@ impl RobotModel {
         Ok(())
     }
 
-    /// Index of the link called `name`.
-    pub fn link_index(&self, name: &str) -> Option<usize> {
-        self.links.iter().position(|l| l.name == name)
+    /// The link called `name`.
+    pub fn link_id(&self, name: &str) -> Option<LinkId> {
+        self.links.iter().position(|l| l.name == name).map(LinkId)
     }
 
-    /// Index of the joint called `name`.
-    pub fn joint_index(&self, name: &str) -> Option<usize> {
-        self.joints.iter().position(|j| j.name == name)
+    /// The joint called `name`.
+    pub fn joint_id(&self, name: &str) -> Option<JointId> {
+        self.joints.iter().position(|j| j.name == name).map(JointId)
+    }
+
+    /// A link of this model.
+    pub fn link(&self, id: LinkId) -> &Link {
+        &self.links[id.0]
+    }
+
+    /// A joint of this model.
+    pub fn joint(&self, id: JointId) -> &Joint {
+        &self.joints[id.0]
+    }
+
+    /// Every link with its id, in URDF order.
+    pub fn link_ids(&self) -> impl Iterator<Item = (LinkId, &Link)> {
+        self.links.iter().enumerate().map(|(i, l)| (LinkId(i), l))
     }
 
     /// Pose of every link in the root link's frame with all joints at zero.
     pub fn root_from_links(&self) -> Vec<Pose> {
         let mut poses = vec![None; self.links.len()];
-        poses[self.root] = Some(Pose::IDENTITY);
+        poses[self.root.0] = Some(Pose::IDENTITY);
         let mut pending = true;
         while pending {
             pending = false;
             for j in &self.joints {
-                if let (Some(parent), None) = (poses[j.parent], poses[j.child]) {
-                    poses[j.child] = Some(parent * j.parent_from_child);
+                if let (Some(parent), None) = (poses[j.parent.0], poses[j.child.0]) {
+                    poses[j.child.0] = Some(parent * j.parent_from_child);
                     pending = true;
                 }
             }
@@ -275,7 +314,7 @@ impl RobotModel {
             .into_iter()
             .chain(extras)
             {
-                let Some(index) = self.joint_index(name) else {
+                let Some(id) = self.joint_id(name) else {
                     return Err(SimError::invalid(
                         path,
                         dd.line,
@@ -285,7 +324,7 @@ impl RobotModel {
                         ),
                     ));
                 };
-                let joint = &self.joints[index];
+                let joint = self.joint(id);
                 if !matches!(
                     joint.kind,
                     JointKind::Continuous | JointKind::Revolute { .. }
@@ -312,7 +351,7 @@ impl RobotModel {
             }
         }
         for laser in &self.lasers {
-            if self.link_index(&laser.link).is_none() {
+            if self.link_id(&laser.link).is_none() {
                 return Err(SimError::invalid(
                     path,
                     laser.line,
@@ -325,7 +364,7 @@ impl RobotModel {
             }
         }
         for camera in &self.cameras {
-            if self.link_index(&camera.link).is_none() {
+            if self.link_id(&camera.link).is_none() {
                 return Err(SimError::invalid(
                     path,
                     camera.line,

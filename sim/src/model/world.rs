@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
+use crate::geometry::{Pose, Rgba, Shape, pose_from_position_yaw};
 use crate::model::drive::DriveSpec;
 use crate::model::person::Person;
 use crate::model::robot::{Collision, Visual};
@@ -75,35 +75,14 @@ pub struct Ground {
     pub checker_size_m: f64,
 }
 
-/// Shape of a world object.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ObjectShape {
-    /// Box with full side lengths (m).
-    Box {
-        /// Side lengths along the object's x, y, z (m).
-        size_m: [f64; 3],
-    },
-    /// Upright cylinder.
-    Cylinder {
-        /// Radius (m).
-        radius_m: f64,
-        /// Height (m).
-        length_m: f64,
-    },
-    /// Sphere.
-    Sphere {
-        /// Radius (m).
-        radius_m: f64,
-    },
-}
-
 /// A static or dynamic object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Object {
     /// Name (unique within the world).
     pub name: String,
-    /// Shape.
-    pub shape: ObjectShape,
+    /// Shape, centred on `position_m` (world TOML makes boxes, cylinders along z and
+    /// spheres).
+    pub shape: Shape,
     /// Centre position (m, world frame).
     pub position_m: [f64; 3],
     /// Heading about +z (rad).

@@ -10,7 +10,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Shape, pose_from_position_yaw};
 use crate::model::person::Person;
 use crate::model::robot::{JointKind, RobotModel};
-use crate::model::world::{ObjectShape, World};
+use crate::model::world::World;
 
 /// Collision group of the robot's own colliders (the robot does not collide with itself,
 /// like Gazebo's default `self_collide = false`).
@@ -74,7 +74,7 @@ pub(crate) fn add_models(
 pub(crate) fn add_world(
     physics: &mut PhysicsWorld,
     world: &World,
-) -> (RigidBodyHandle, Vec<RigidBodyHandle>) {
+) -> Result<(RigidBodyHandle, Vec<RigidBodyHandle>)> {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
     let [sx, sy] = world.ground.size_m;
@@ -92,18 +92,9 @@ pub(crate) fn add_world(
             None => RigidBodyBuilder::fixed(),
         };
         let body = physics.insert_body(builder.pose(pose));
-        let shape = match object.shape {
-            ObjectShape::Box { size_m } => ColliderBuilder::cuboid(
-                size_m[0] as f32 / 2.0,
-                size_m[1] as f32 / 2.0,
-                size_m[2] as f32 / 2.0,
-            ),
-            ObjectShape::Cylinder { radius_m, length_m } => {
-                ColliderBuilder::cylinder(length_m as f32 / 2.0, radius_m as f32)
-                    .rotation(Vec3::X * std::f32::consts::FRAC_PI_2)
-            }
-            ObjectShape::Sphere { radius_m } => ColliderBuilder::ball(radius_m as f32),
-        };
+        let fixed = object.mass_kg.is_none();
+        let (shape, fix) = collider_shape(&object.shape, &world.source, &object.name, fixed)?;
+        let shape = ColliderBuilder::new(shape).position(fix);
         let shape = match object.mass_kg {
             Some(mass) => shape.mass(mass as f32),
             None => shape,
@@ -130,7 +121,7 @@ pub(crate) fn add_world(
         );
         people.push(body);
     }
-    (ground, people)
+    Ok((ground, people))
 }
 
 pub(crate) struct RobotBodies {
@@ -243,18 +234,18 @@ fn weld_fixed_links(robot: &RobotModel) -> (Vec<usize>, Vec<Pose>) {
     let mut body_root: Vec<usize> = (0..n).collect();
     let mut body_from_link = vec![Pose::IDENTITY; n];
     let mut settled = vec![false; n];
-    settled[robot.root] = true;
+    settled[robot.root.0] = true;
     let mut progress = true;
     while progress {
         progress = false;
         for joint in &robot.joints {
-            if settled[joint.parent] && !settled[joint.child] {
+            if settled[joint.parent.0] && !settled[joint.child.0] {
                 if joint.kind == JointKind::Fixed {
-                    body_root[joint.child] = body_root[joint.parent];
-                    body_from_link[joint.child] =
-                        body_from_link[joint.parent] * joint.parent_from_child;
+                    body_root[joint.child.0] = body_root[joint.parent.0];
+                    body_from_link[joint.child.0] =
+                        body_from_link[joint.parent.0] * joint.parent_from_child;
                 }
-                settled[joint.child] = true;
+                settled[joint.child.0] = true;
                 progress = true;
             }
         }
@@ -358,10 +349,10 @@ fn add_joints(
 ) -> Vec<Option<ImpulseJointHandle>> {
     let mut joints = vec![None; robot.joints.len()];
     for (index, joint) in robot.joints.iter().enumerate() {
-        let (parent, child) = (link_body[joint.parent], link_body[joint.child]);
+        let (parent, child) = (link_body[joint.parent.0], link_body[joint.child.0]);
         let axis_frame = Pose::from_rotation(Quat::from_rotation_arc(Vec3::X, joint.axis));
-        let frame1 = body_from_link[joint.parent] * joint.parent_from_child * axis_frame;
-        let frame2 = body_from_link[joint.child] * axis_frame;
+        let frame1 = body_from_link[joint.parent.0] * joint.parent_from_child * axis_frame;
+        let frame2 = body_from_link[joint.child.0] * axis_frame;
         let builder = match joint.kind {
             JointKind::Fixed | JointKind::Floating => continue,
             JointKind::Continuous => GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES),
@@ -404,9 +395,9 @@ pub(crate) fn joint_mass_ratio(robot: &RobotModel, bodies: &RobotBodies) -> f32 
     robot
         .joints
         .iter()
-        .filter(|j| bodies.link_body[j.parent] != bodies.link_body[j.child])
+        .filter(|j| bodies.link_body[j.parent.0] != bodies.link_body[j.child.0])
         .map(|j| {
-            let (a, b) = (mass(j.parent), mass(j.child));
+            let (a, b) = (mass(j.parent.0), mass(j.child.0));
             if a.min(b) > 0.0 {
                 a.max(b) / a.min(b)
             } else {

@@ -7,7 +7,7 @@ use rapier3d::prelude::*;
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, yaw_of};
 use crate::model::drive::OdometrySource;
-use crate::model::robot::RobotModel;
+use crate::model::robot::{LinkId, RobotModel};
 use crate::model::world::{World, check_step_hz};
 use crate::physics::build::{
     STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, add_models, add_robot, add_world,
@@ -120,7 +120,7 @@ impl Simulation {
         physics.integration_parameters.dt = dt_s as f32;
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
 
-        let (ground, people) = add_world(&mut physics, &world);
+        let (ground, people) = add_world(&mut physics, &world)?;
         let model_links = add_models(&mut physics, &world)?;
         let robot_bodies = add_robot(&mut physics, &world, &robot)?;
         let ratio = joint_mass_ratio(&robot, &robot_bodies);
@@ -138,20 +138,20 @@ impl Simulation {
         }
 
         let wheel = |name: &str, side: usize| -> Result<WheelJoint> {
-            let index = robot.joint_index(name).ok_or_else(|| {
+            let id = robot.joint_id(name).ok_or_else(|| {
                 SimError::Setup(format!(
                     "diff drive joint \"{name}\" missing from the robot"
                 ))
             })?;
-            let joint = &robot.joints[index];
-            let handle = robot_bodies.joints[index].ok_or_else(|| {
+            let joint = robot.joint(id);
+            let handle = robot_bodies.joints[id.index()].ok_or_else(|| {
                 SimError::Setup(format!("diff drive joint \"{name}\" is not a wheel joint"))
             })?;
-            let child_from_link = robot_bodies.body_from_link[joint.child];
+            let child_from_link = robot_bodies.body_from_link[joint.child.index()];
             Ok(WheelJoint {
                 joint: handle,
-                parent: robot_bodies.link_body[joint.parent],
-                child: robot_bodies.link_body[joint.child],
+                parent: robot_bodies.link_body[joint.parent.index()],
+                child: robot_bodies.link_body[joint.child.index()],
                 axis_child: child_from_link.rotation * joint.axis,
                 side,
             })
@@ -176,7 +176,7 @@ impl Simulation {
             }
         }
 
-        let base = robot_bodies.link_body[robot.root];
+        let base = robot_bodies.link_body[robot.root.index()];
         let start = planar(
             physics
                 .bodies
@@ -358,8 +358,9 @@ impl Simulation {
         self.world_from_link(self.robot.root)
     }
 
-    /// Pose of URDF link `index` in the world.
-    pub fn world_from_link(&self, index: usize) -> Pose {
+    /// Pose of a link of the robot in the world.
+    pub fn world_from_link(&self, link: LinkId) -> Pose {
+        let index = link.index();
         let body = self
             .physics
             .bodies
@@ -373,7 +374,11 @@ impl Simulation {
     /// `out` has the capacity).
     pub fn link_poses_into(&self, out: &mut Vec<Pose>) {
         out.clear();
-        out.extend((0..self.robot.links.len()).map(|i| self.world_from_link(i)));
+        out.extend(
+            self.robot
+                .link_ids()
+                .map(|(id, _)| self.world_from_link(id)),
+        );
     }
 
     /// World pose of every SDF model link (models in world order, then their links) into

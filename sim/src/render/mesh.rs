@@ -8,7 +8,6 @@ use crate::error::Result;
 use crate::geometry::{Pose, Rgba, Shape};
 use crate::model::mesh::MeshData;
 use crate::model::person::Person;
-use crate::model::world::ObjectShape;
 
 /// A box with full side lengths, centred.
 pub(crate) fn cuboid(size: Vec3) -> MeshData {
@@ -103,11 +102,25 @@ pub(crate) fn capsule(radius: f32, length: f32) -> MeshData {
     m
 }
 
-/// The mesh of a URDF shape.
+/// Sides of a URDF cylinder's mesh.
+const SHAPE_CYLINDER_SEGMENTS: u32 = 24;
+/// Sides of a world object's cylinder (drawn finer: objects are bigger and seen closer).
+const OBJECT_CYLINDER_SEGMENTS: u32 = 32;
+
+/// The mesh of a robot's or a model's shape, in the shape's frame.
 pub fn shape_mesh(shape: &Shape) -> Result<MeshData> {
+    mesh_of(shape, SHAPE_CYLINDER_SEGMENTS)
+}
+
+/// The mesh of a world object, centred on its position: [`shape_mesh`] with finer cylinders.
+pub fn object_mesh(shape: &Shape) -> Result<MeshData> {
+    mesh_of(shape, OBJECT_CYLINDER_SEGMENTS)
+}
+
+fn mesh_of(shape: &Shape, cylinder_segments: u32) -> Result<MeshData> {
     Ok(match shape {
         Shape::Box { size_m } => cuboid(*size_m),
-        Shape::Cylinder { radius_m, length_m } => cylinder(*radius_m, *length_m, 24),
+        Shape::Cylinder { radius_m, length_m } => cylinder(*radius_m, *length_m, cylinder_segments),
         Shape::Sphere { radius_m } => sphere(*radius_m),
         Shape::Capsule { radius_m, length_m } => capsule(*radius_m, *length_m),
         Shape::Mesh { path, scale } => {
@@ -129,21 +142,6 @@ pub fn shape_mesh(shape: &Shape) -> Result<MeshData> {
             m
         }
     })
-}
-
-/// The mesh of a world object (box, cylinder, sphere), centred on its position.
-pub fn object_mesh(shape: &ObjectShape) -> MeshData {
-    match *shape {
-        ObjectShape::Box { size_m } => cuboid(Vec3::new(
-            size_m[0] as f32,
-            size_m[1] as f32,
-            size_m[2] as f32,
-        )),
-        ObjectShape::Cylinder { radius_m, length_m } => {
-            cylinder(radius_m as f32, length_m as f32, 32)
-        }
-        ObjectShape::Sphere { radius_m } => sphere(radius_m as f32),
-    }
 }
 
 /// A coloured part of a figure, in the figure's frame.

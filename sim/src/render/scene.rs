@@ -34,6 +34,15 @@ fn matrix(pose: Pose) -> [[f32; 4]; 4] {
     Mat4::from_rotation_translation(pose.rotation, pose.translation).to_cols_array_2d()
 }
 
+/// One vertex as the passes read it (location 0: position, 1: normal). The model's
+/// [`MeshData`] stays plain data; this layout is the renderer's own.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct GpuVertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+}
+
 /// One uploaded mesh.
 pub(crate) struct GpuMesh {
     pub(crate) vertices: wgpu::Buffer,
@@ -71,10 +80,18 @@ struct Builder<'d> {
 impl Builder<'_> {
     fn add(&mut self, mesh: &MeshData, pose: Pose, color: Rgba) -> usize {
         let device = self.device;
+        let vertices: Vec<GpuVertex> = mesh
+            .vertices
+            .iter()
+            .map(|v| GpuVertex {
+                position: v.position,
+                normal: v.normal,
+            })
+            .collect();
         self.meshes.push(GpuMesh {
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: None,
-                contents: bytemuck::cast_slice(&mesh.vertices),
+                contents: bytemuck::cast_slice(&vertices),
                 usage: wgpu::BufferUsages::VERTEX,
             }),
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -112,7 +129,7 @@ impl Scene {
             ground_color,
         );
         for object in &world.objects {
-            let mesh = object_mesh(&object.shape);
+            let mesh = object_mesh(&object.shape)?;
             b.add(&mesh, object.world_from_object(), object.color);
         }
         let models = add_models(&mut b, world)?;

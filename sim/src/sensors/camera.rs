@@ -3,6 +3,7 @@
 use crate::error::SimError;
 use crate::geometry::Pose;
 use crate::model::camera_info::CameraInfo;
+use crate::model::robot::LinkId;
 use crate::physics::simulation::Simulation;
 use crate::render::gpu::RenderError;
 use crate::render::renderer::CameraRenderer;
@@ -26,7 +27,7 @@ pub struct CameraFrame<'a> {
 #[derive(Debug)]
 pub struct CameraSensor {
     renderer: CameraRenderer,
-    link: usize,
+    link: LinkId,
     period_s: f64,
     next_s: f64,
     seq: u64,
@@ -44,7 +45,7 @@ impl CameraSensor {
                 robot.source.display()
             )))
         })?;
-        let link = robot.link_index(&config.link).ok_or_else(|| {
+        let link = robot.link_id(&config.link).ok_or_else(|| {
             RenderError::Scene(SimError::Setup(format!(
                 "camera link {} missing",
                 config.link
@@ -115,7 +116,7 @@ impl CameraSensor {
     /// Renders an image now.
     pub fn capture(&mut self, sim: &Simulation) -> Result<CameraFrame<'_>, RenderError> {
         sim.link_poses_into(&mut self.link_poses);
-        let camera = self.link_poses[self.link];
+        let camera = self.link_poses[self.link.index()];
         let seq = self.seq;
         self.seq += 1;
         self.renderer.seed_frame(seq);

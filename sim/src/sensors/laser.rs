@@ -12,6 +12,7 @@ use glam::Vec3;
 
 use crate::error::{Result, SimError};
 use crate::geometry::Pose;
+use crate::model::robot::LinkId;
 use crate::model::sensors::LaserConfig;
 use crate::noise::Rng;
 use crate::physics::simulation::Simulation;
@@ -66,7 +67,7 @@ impl LaserScan {
 #[derive(Debug)]
 pub struct LaserSensor {
     config: LaserConfig,
-    link: usize,
+    link: LinkId,
     period_s: f64,
     next_s: f64,
     rng: Rng,
@@ -88,7 +89,7 @@ impl LaserSensor {
             ))
         })?;
         let link = robot
-            .link_index(&config.link)
+            .link_id(&config.link)
             .ok_or_else(|| SimError::Setup(format!("laser link \"{}\" missing", config.link)))?;
         let increment = config.angle_increment_rad();
         let directions = (0..config.samples)
@@ -133,8 +134,8 @@ impl LaserSensor {
         &self.config
     }
 
-    /// The robot link it is mounted on (index into the robot's links).
-    pub fn link(&self) -> usize {
+    /// The robot link it is mounted on.
+    pub fn link(&self) -> LinkId {
         self.link
     }
 

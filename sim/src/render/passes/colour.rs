@@ -4,8 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::geometry::{Pose, Rgba};
-use crate::model::mesh::MeshVertex;
-use crate::render::scene::{Instance, Scene};
+use crate::render::scene::{GpuVertex, Instance, Scene};
 
 const SKY: [f32; 3] = [0.62, 0.75, 0.9];
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -170,7 +169,7 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
         immediate_size: 0,
     });
     let vertex_layout = wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<MeshVertex>() as u64,
+        array_stride: std::mem::size_of::<GpuVertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
     };
