@@ -535,6 +535,26 @@ fn load_and_simulate(path: &Path, options: &rover_sim::LoadOptions) -> Result<()
     Ok(())
 }
 
+/// Loads a world file and simulates a few steps in it with `robot` (parse errors and setup
+/// errors alike must be clean): absurd sizes, positions and masses show up only once the
+/// physics engine gets them.
+fn load_world_and_simulate(
+    path: &Path,
+    resources: &rover_sim::ResourcePaths,
+    robot: &rover_sim::RobotModel,
+) -> Result<(), String> {
+    let world = rover_sim::World::load_with(path, resources).map_err(|e| e.to_string())?;
+    let mut sim =
+        rover_sim::Simulation::new(world, robot.clone(), &rover_sim::SimOptions::default())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+    sim.set_cmd_vel(rover_sim::Twist::new(0.5, 0.5))
+        .map_err(|e| e.to_string())?;
+    for _ in 0..5 {
+        sim.step();
+    }
+    Ok(())
+}
+
 /// Every parser rover has, with its seeds, laid out under `work` (a scratch folder). Targets
 /// whose seeds are absent (no ../shared, no darknet photos, no model) are left out with a line
 /// on stderr saying so.
@@ -593,11 +613,17 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     // World TOML files.
     let dir = work.join("world");
     std::fs::create_dir_all(&dir)?;
+    // Worlds are simulated with the tutorial car.
+    let car = rover_sim::RobotModel::load(&crate::repo("assets/robots/my_robot.urdf"))?;
+    let no_resources = ResourcePaths::from_env();
     out.push(Target {
         name: "world_toml",
         seeds: read_all(&files_with(&crate::repo("worlds"), "toml"))?,
         input_path: dir.join("world.toml"),
-        load: Box::new(|p| outcome(rover_sim::World::load(p))),
+        load: Box::new({
+            let car = car.clone();
+            move |p| load_world_and_simulate(p, &no_resources, &car)
+        }),
         hang_limit: text_limit,
     });
 
@@ -610,7 +636,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             name: "sdf",
             seeds: read_all(&[c.join("turtlebot_gazebo/worlds/playground.world")])?,
             input_path: dir.join("input.world"),
-            load: Box::new(move |p| outcome(rover_sim::World::load_with(p, &resources))),
+            load: Box::new(move |p| load_world_and_simulate(p, &resources, &car)),
             hang_limit: text_limit,
         });
     }
