@@ -90,6 +90,33 @@ fn regressions() -> Vec<(&'static str, Input, &'static str)> {
             },
             "the mesh parser failed",
         ),
+        // Finite but absurd magnitudes: with the accepted ranges switched off, the long run
+        // found both within 11k inputs (a 1e30 m box panicked inside parry's contact code,
+        // "index out of bounds: the len is 2 but the index is 2"). Now refused at load.
+        (
+            "world_toml",
+            Input::Mutated {
+                seed: 1,
+                edits: vec![Mutation::Token {
+                    at: 13633582643840294286,
+                    // TOKENS[64] = "1e30", inserted after a box's "0.6": 0.61e30 m.
+                    token: 64,
+                }],
+            },
+            "size_m",
+        ),
+        (
+            "sdf",
+            Input::Mutated {
+                seed: 0,
+                edits: vec![Mutation::Token {
+                    at: 13918990864701965999,
+                    // TOKENS[72] = "<size>1e30 1e30 1e30</size>".
+                    token: 72,
+                }],
+            },
+            "<size>",
+        ),
     ]
 }
 
