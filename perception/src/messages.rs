@@ -13,7 +13,7 @@ pub struct FrameStamp {
 }
 
 /// One detection, as darknet_ros_msgs/BoundingBox.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, PartialEq, Serialize)]
 pub struct BoundingBox {
     /// Class name (darknet_ros's `Class`).
     #[serde(rename = "Class")]
@@ -30,6 +30,23 @@ pub struct BoundingBox {
     pub ymax: i64,
     /// Class index.
     pub id: i16,
+}
+
+impl Clone for BoundingBox {
+    fn clone(&self) -> Self {
+        Self {
+            class: self.class.clone(),
+            ..*self
+        }
+    }
+
+    /// Copies `source` keeping this box's class string (and its capacity), so refilling a
+    /// recycled `Vec<BoundingBox>` with `clone_from` allocates nothing once warm.
+    fn clone_from(&mut self, source: &Self) {
+        let mut class = std::mem::take(&mut self.class);
+        class.clone_from(&source.class);
+        *self = Self { class, ..*source };
+    }
 }
 
 impl BoundingBox {

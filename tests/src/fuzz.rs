@@ -525,14 +525,7 @@ fn files_with(dir: &Path, ext: &str) -> Vec<PathBuf> {
 fn load_and_simulate(path: &Path, options: &rover_sim::LoadOptions) -> Result<(), String> {
     let robot = rover_sim::RobotModel::load_with(path, options).map_err(|e| e.to_string())?;
     let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
-    let mut sim = rover_sim::Simulation::new(world, robot, &rover_sim::SimOptions::default())
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    sim.set_cmd_vel(rover_sim::Twist::new(0.5, 0.5))
-        .map_err(|e| e.to_string())?;
-    for _ in 0..5 {
-        sim.step();
-    }
-    Ok(())
+    simulate(path, world, robot)
 }
 
 /// Loads a world file and simulates a few steps in it with `robot` (parse errors and setup
@@ -544,9 +537,17 @@ fn load_world_and_simulate(
     robot: &rover_sim::RobotModel,
 ) -> Result<(), String> {
     let world = rover_sim::World::load_with(path, resources).map_err(|e| e.to_string())?;
-    let mut sim =
-        rover_sim::Simulation::new(world, robot.clone(), &rover_sim::SimOptions::default())
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+    simulate(path, world, robot.clone())
+}
+
+/// Builds the simulation (a setup error names `path`) and drives it for five steps.
+fn simulate(
+    path: &Path,
+    world: rover_sim::World,
+    robot: rover_sim::RobotModel,
+) -> Result<(), String> {
+    let mut sim = rover_sim::Simulation::new(world, robot, &rover_sim::SimOptions::default())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     sim.set_cmd_vel(rover_sim::Twist::new(0.5, 0.5))
         .map_err(|e| e.to_string())?;
     for _ in 0..5 {

@@ -149,19 +149,7 @@ impl TopicFamily for DarknetTopics {
 /// The detections to hand over (on the loop thread), published at `now_s` (never before their
 /// image): `boxes` copied into the recycled `out`, whose class strings keep their capacity.
 pub(super) fn capture(boxes: &BoundingBoxes, now_s: f64, mut out: Vec<BoundingBox>) -> Detections {
-    let src = &boxes.bounding_boxes;
-    out.truncate(src.len());
-    let reused = out.len();
-    for (m, b) in out.iter_mut().zip(src) {
-        m.probability = b.probability;
-        m.xmin = b.xmin;
-        m.ymin = b.ymin;
-        m.xmax = b.xmax;
-        m.ymax = b.ymax;
-        m.id = b.id;
-        m.class.clone_from(&b.class);
-    }
-    out.extend(src.iter().skip(reused).cloned());
+    out.clone_from(&boxes.bounding_boxes);
     Detections {
         stamp_s: now_s.max(boxes.image_stamp.sim_time_s),
         image_stamp_s: boxes.image_stamp.sim_time_s,

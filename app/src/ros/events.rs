@@ -10,7 +10,7 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use rover_perception::BoundingBox;
 use rover_ros1::msgs::TransformStamped;
-use rover_sim::{CameraInfo, ControlSample, Pose};
+use rover_sim::{CameraInfo, ControlSample, LaserScan, Pose};
 
 /// The run starts.
 pub(super) struct Start {
@@ -63,32 +63,6 @@ pub(super) struct Detections {
     pub boxes: Vec<BoundingBox>,
 }
 
-/// A laser scan.
-pub(super) struct Scan {
-    /// Sim time (s).
-    pub stamp_s: f64,
-    /// Scan number.
-    pub seq: u64,
-    /// The laser's frame.
-    pub frame_id: String,
-    /// First ray's angle (rad).
-    pub angle_min_rad: f32,
-    /// Last ray's angle (rad).
-    pub angle_max_rad: f32,
-    /// Angle between rays (rad).
-    pub angle_increment_rad: f32,
-    /// Time between rays (s).
-    pub time_increment_s: f32,
-    /// Time between scans (s).
-    pub scan_time_s: f32,
-    /// Shortest range measured (m).
-    pub range_min_m: f32,
-    /// Longest range measured (m).
-    pub range_max_m: f32,
-    /// One range per ray (m).
-    pub ranges_m: Vec<f32>,
-}
-
 /// One observer callback's worth of data, on its way to the publishing thread.
 pub(super) enum Event {
     /// [`Start`].
@@ -99,8 +73,8 @@ pub(super) enum Event {
     Image(ImageFrame),
     /// [`Detections`].
     Detections(Detections),
-    /// [`Scan`].
-    Scan(Scan),
+    /// A laser scan (its ranges in a recycled buffer).
+    Scan(LaserScan),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -117,7 +91,7 @@ pub(super) trait TopicFamily: Send {
     /// Detections.
     fn detections(&mut self, _detections: &mut Detections) {}
     /// A laser scan.
-    fn scan(&mut self, _scan: &mut Scan) {}
+    fn scan(&mut self, _scan: &mut LaserScan) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in

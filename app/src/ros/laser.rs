@@ -6,7 +6,7 @@ use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
 use rover_sim::LaserScan;
 
-use super::events::{Scan, TopicFamily};
+use super::events::TopicFamily;
 use super::plan::RosPlan;
 
 /// Publishes the laser's topic (nothing when the robot has no laser).
@@ -30,7 +30,7 @@ impl Laser {
 }
 
 impl TopicFamily for Laser {
-    fn scan(&mut self, scan: &mut Scan) {
+    fn scan(&mut self, scan: &mut LaserScan) {
         let Some(p) = self.publisher.as_mut() else {
             return;
         };
@@ -56,20 +56,11 @@ impl TopicFamily for Laser {
 
 /// The scan to hand over (on the loop thread): `scan` copied, its ranges into the recycled
 /// `ranges_m`.
-pub(super) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> Scan {
-    ranges_m.clear();
-    ranges_m.extend_from_slice(&scan.ranges_m);
-    Scan {
-        stamp_s: scan.stamp_s,
-        seq: scan.seq,
+pub(super) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> LaserScan {
+    ranges_m.clone_from(&scan.ranges_m);
+    LaserScan {
         frame_id: scan.frame_id.clone(),
-        angle_min_rad: scan.angle_min_rad,
-        angle_max_rad: scan.angle_max_rad,
-        angle_increment_rad: scan.angle_increment_rad,
-        time_increment_s: scan.time_increment_s,
-        scan_time_s: scan.scan_time_s,
-        range_min_m: scan.range_min_m,
-        range_max_m: scan.range_max_m,
         ranges_m,
+        ..*scan
     }
 }
