@@ -119,7 +119,7 @@ fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
     assert_eq!(strip(&serial_json), strip(&parallel_json));
     let csv = std::fs::read_to_string(dir.path().join("serial/eval.csv"))?;
     assert_eq!(csv.lines().count(), 3, "{csv}");
-    assert!(csv.starts_with("scenario,passed,"), "{csv}");
+    assert!(csv.starts_with("scenario,robot,result,"), "{csv}");
 
     // Shards: 0/2 and 1/2 each run one scenario; merged they are the whole.
     let (s0, j0) = run("1", "shards", &["--shard", "0/2"])?;

@@ -89,6 +89,37 @@ struct RawScenario {
     seed: u64,
     #[serde(default)]
     tags: Vec<String>,
+    #[serde(default)]
+    needs: Vec<Sensor>,
+}
+
+/// A sensor a scenario needs the robot to have (`needs = ["laser"]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Sensor {
+    /// A camera (`<sensor type="camera">`): every follower scenario needs one.
+    Camera,
+    /// A range sensor: a 2D laser (`<sensor type="ray">`), to see obstacles and keep a close
+    /// target the camera cannot see whole.
+    Laser,
+}
+
+impl Sensor {
+    /// The name used in scenario files and messages.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Sensor::Camera => "camera",
+            Sensor::Laser => "laser",
+        }
+    }
+
+    /// Whether `robot` carries this kind of sensor.
+    pub fn on(self, robot: &RobotModel) -> bool {
+        match self {
+            Sensor::Camera => !robot.cameras.is_empty(),
+            Sensor::Laser => !robot.lasers.is_empty(),
+        }
+    }
 }
 
 fn default_follow_at() -> f64 {
@@ -114,17 +145,28 @@ pub struct Scenario {
     pub seed: u64,
     /// Free-form labels (e.g. "fast": the subset `cargo test` runs).
     pub tags: Vec<String>,
+    /// Sensors the robot must have for the scenario to mean anything (the camera always).
+    pub needs: Vec<Sensor>,
     /// What counts as success.
     pub criteria: ScenarioCriteria,
     /// The world.
     pub world: World,
     /// The robot.
     pub robot: RobotModel,
+    /// The robot's short name (its file name without `.urdf`/`.xacro`/`.sdf`).
+    pub robot_name: String,
 }
 
 impl Scenario {
     /// Loads and validates a scenario file (world, robot, target, criteria).
     pub fn load(path: &Path) -> Result<Self> {
+        Self::load_with_robot(path, None)
+    }
+
+    /// [`Scenario::load`], with `robot` (a URDF, xacro or SDF file) in place of the robot the
+    /// scenario names: the same world, people, spawn pose and criteria for another robot. The
+    /// scenario's `xacro_args` and `[robot.drive]` belong to its own robot and are not applied.
+    pub fn load_with_robot(path: &Path, robot: Option<&Path>) -> Result<Self> {
         let raw: RawScenarioFile = rover_sim::load_toml(path)?;
         let bad = |key: &str, message: String| -> CoreError {
             SimError::invalid(path, None, format!("at `{key}`: {message}")).into()
@@ -183,16 +225,30 @@ impl Scenario {
             ),
             None => None,
         };
-        let robot_path = s
-            .robot
-            .map(|r| path.parent().unwrap_or(Path::new(".")).join(r))
-            .or_else(|| world.robot.urdf.clone())
-            .unwrap_or_else(paths::default_robot_path);
-        let options = RunConfig::default().robot_load_options(&world);
-        let mut robot = RobotModel::load_with(&robot_path, &options)?;
-        if let Some(spec) = &world.robot.drive {
-            robot.set_drive(spec)?;
-        }
+        let (robot, robot_path) = match robot {
+            Some(other) => {
+                let mut own = world.clone();
+                own.robot.xacro_args.clear();
+                let options = RunConfig::default().robot_load_options(&own);
+                (RobotModel::load_with(other, &options)?, other.to_path_buf())
+            }
+            None => {
+                let robot_path = s
+                    .robot
+                    .map(|r| path.parent().unwrap_or(Path::new(".")).join(r))
+                    .or_else(|| world.robot.urdf.clone())
+                    .unwrap_or_else(paths::default_robot_path);
+                let options = RunConfig::default().robot_load_options(&world);
+                let mut robot = RobotModel::load_with(&robot_path, &options)?;
+                if let Some(spec) = &world.robot.drive {
+                    robot.set_drive(spec)?;
+                }
+                (robot, robot_path)
+            }
+        };
+        let mut needs = s.needs;
+        needs.sort_unstable();
+        needs.dedup();
         let name = s.name.unwrap_or_else(|| {
             path.file_stem()
                 .map(|n| n.to_string_lossy().into_owned())
@@ -207,11 +263,43 @@ impl Scenario {
             target,
             seed: s.seed,
             tags: s.tags,
+            needs,
             criteria: raw.criteria,
             world,
             robot,
+            robot_name: robot_name(&robot_path),
         })
     }
+
+    /// Why this scenario cannot be run with its robot (a sensor it needs is missing), if so.
+    pub fn unmet_needs(&self) -> Option<String> {
+        let missing: Vec<&str> = std::iter::once(Sensor::Camera)
+            .chain(self.needs.iter().copied())
+            .filter(|n| !n.on(&self.robot))
+            .map(Sensor::as_str)
+            .collect();
+        (!missing.is_empty()).then(|| {
+            format!(
+                "needs a {}; {} has none",
+                missing.join(" and a "),
+                self.robot_name
+            )
+        })
+    }
+}
+
+/// A robot's short name: its file name without the `.urdf`, `.xacro`, `.sdf` extensions.
+pub fn robot_name(path: &Path) -> String {
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "robot".into());
+    for ext in [".xacro", ".urdf", ".sdf", ".xml"] {
+        if let Some(stem) = name.strip_suffix(ext) {
+            name = stem.to_owned();
+        }
+    }
+    name
 }
 
 fn check_criteria(c: &ScenarioCriteria) -> std::result::Result<(), (String, String)> {
@@ -294,6 +382,9 @@ pub struct ScenarioCheck {
 pub struct ScenarioResult {
     /// Scenario name.
     pub name: String,
+    /// The robot's short name ([`robot_name`]).
+    #[serde(default)]
+    pub robot: String,
     /// Its file, as given.
     pub file: String,
     /// Its description.
@@ -306,22 +397,43 @@ pub struct ScenarioResult {
     pub metrics: ScenarioMetrics,
     /// Why the run could not be done, if it could not.
     pub error: Option<String>,
+    /// Why the scenario was not run with this robot (a sensor it needs is missing): neither
+    /// passed nor failed.
+    #[serde(default)]
+    pub skipped: Option<String>,
     /// Wall-clock seconds the run took (the one field that differs between identical runs).
     pub wall_s: f64,
 }
 
 impl ScenarioResult {
     /// A result for a scenario that could not be loaded or run.
-    pub fn failed(name: &str, file: &str, error: String) -> Self {
+    pub fn failed(name: &str, robot: &str, file: &str, error: String) -> Self {
         Self {
             name: name.to_owned(),
+            robot: robot.to_owned(),
             file: file.to_owned(),
             description: String::new(),
             passed: false,
             checks: Vec::new(),
             metrics: ScenarioMetrics::default(),
             error: Some(error),
+            skipped: None,
             wall_s: 0.0,
+        }
+    }
+
+    /// A result for a scenario not run with this robot, and why.
+    pub fn skipped(scenario: &Scenario, reason: String) -> Self {
+        Self {
+            description: scenario.description.clone(),
+            error: None,
+            skipped: Some(reason),
+            ..Self::failed(
+                &scenario.name,
+                &scenario.robot_name,
+                &scenario.source.display().to_string(),
+                String::new(),
+            )
         }
     }
 }
@@ -587,12 +699,14 @@ pub fn run_scenario(
     let checks = judge(&scenario.criteria, &metrics, scenario.follow_at_s);
     Ok(ScenarioResult {
         name: scenario.name.clone(),
+        robot: scenario.robot_name.clone(),
         file: scenario.source.display().to_string(),
         description: scenario.description.clone(),
         passed: checks.iter().all(|c| c.passed),
         checks,
         metrics,
         error: None,
+        skipped: None,
         wall_s,
     })
 }

@@ -636,12 +636,18 @@ pub(crate) struct EvalArgs {
     pub(crate) shard: Option<(usize, usize)>,
 
     /// Merge shards' result files into OUT/eval.json and eval.csv instead of running anything
-    #[arg(long, value_name = "JSON", num_args = 1.., conflicts_with_all = ["jobs", "rrd", "shard", "paths"])]
+    #[arg(long, value_name = "JSON", num_args = 1.., conflicts_with_all = ["jobs", "rrd", "shard", "paths", "robot"])]
     pub(crate) merge: Vec<PathBuf>,
 
     /// Run only scenarios with this tag (repeatable), e.g. --tag fast
     #[arg(long, value_name = "TAG")]
     pub(crate) tag: Vec<String>,
+
+    /// Run every scenario with this robot (URDF or xacro) instead of the one it names
+    /// (repeatable: every scenario for every robot, and a robots x scenarios table). A scenario
+    /// whose `needs` the robot lacks (e.g. a laser for obstacles) is skipped with the reason
+    #[arg(long, value_name = "FILE")]
+    pub(crate) robot: Vec<PathBuf>,
 
     #[command(flatten)]
     pub(crate) detector: DetectorArgs,
@@ -696,8 +702,8 @@ pub(crate) enum Command {
     ///
     /// Each scenario file (scenarios/*.toml; format in docs/FOLLOWER.md) runs deterministically
     /// in its own process, --jobs at a time. Prints a table, writes OUT/eval.json and
-    /// OUT/eval.csv, and exits 1 when a scenario fails. --shard and --merge split a suite over
-    /// machines.
+    /// OUT/eval.csv, and exits 1 when a scenario fails. --robot (repeatable) runs the suite on
+    /// other robots; --shard and --merge split a suite over machines.
     Eval(EvalArgs),
 
     /// Benchmarks: physics-only real-time factor (default), or `bench detect`

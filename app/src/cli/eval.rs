@@ -24,10 +24,13 @@ use crate::viewer::{Recorder, RecorderOptions};
 /// What `eval.json` holds.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EvalReport {
-    /// Scenarios run.
+    /// Runs done (scenario x robot; skipped ones not counted).
     pub scenarios: usize,
-    /// Scenarios whose criteria all held.
+    /// Runs whose criteria all held.
     pub passed: usize,
+    /// Runs skipped: the robot lacks a sensor the scenario needs.
+    #[serde(default)]
+    pub skipped: usize,
     /// passed / scenarios.
     pub pass_rate: f64,
     /// One result per scenario, in name order.
@@ -73,39 +76,74 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
                 .join(", ")
         );
     }
-    // Load them all first: a bad file is reported before anything runs.
-    let mut scenarios = Vec::with_capacity(files.len());
+    // Load them all first: a bad file is reported before anything runs. Every scenario runs
+    // for every --robot (or for its own robot).
+    let robots: Vec<Option<&Path>> = if args.robot.is_empty() {
+        vec![None]
+    } else {
+        args.robot.iter().map(|r| Some(r.as_path())).collect()
+    };
+    let mut jobs = Vec::with_capacity(files.len() * robots.len());
     for f in &files {
-        let s = Scenario::load(f).with_context(|| format!("scenario {}", f.display()))?;
-        if args.tag.is_empty() || args.tag.iter().any(|t| s.tags.contains(t)) {
-            scenarios.push((f.clone(), s.name.clone(), s.duration_s));
+        for robot in &robots {
+            let s = Scenario::load_with_robot(f, *robot).with_context(|| match robot {
+                Some(r) => format!("scenario {} with robot {}", f.display(), r.display()),
+                None => format!("scenario {}", f.display()),
+            })?;
+            if args.tag.is_empty() || args.tag.iter().any(|t| s.tags.contains(t)) {
+                jobs.push(Job {
+                    file: f.clone(),
+                    robot: robot.map(Path::to_path_buf),
+                    duration_s: s.duration_s,
+                    skip: s.unmet_needs().map(|why| ScenarioResult::skipped(&s, why)),
+                    name: s.name,
+                    robot_name: s.robot_name,
+                });
+            }
         }
     }
-    let mut names: Vec<&str> = scenarios.iter().map(|s| s.1.as_str()).collect();
+    let mut robot_names: Vec<(&str, &Path)> = args
+        .robot
+        .iter()
+        .map(|r| (jobs_robot_name(r), r.as_path()))
+        .collect();
+    robot_names.sort_unstable();
+    if let Some(w) = robot_names.windows(2).find(|w| w[0].0 == w[1].0) {
+        bail!(
+            "two robots are named \"{}\" ({} and {}); rename one: results are keyed by the file name",
+            w[0].0,
+            w[0].1.display(),
+            w[1].1.display()
+        );
+    }
+    let mut names: Vec<(&str, &str)> = jobs
+        .iter()
+        .map(|j| (j.name.as_str(), j.robot_name.as_str()))
+        .collect();
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-        bail!("two scenarios are named \"{}\"; names must be unique", w[0]);
+        bail!("two scenarios are named \"{}\"; names must be unique", w[0].0);
     }
     if let Some((index, count)) = args.shard {
-        scenarios = scenarios
+        jobs = jobs
             .into_iter()
             .enumerate()
             .filter(|(i, _)| i % count == index)
             .map(|(_, s)| s)
             .collect();
     }
-    if scenarios.is_empty() {
+    if jobs.is_empty() {
         bail!("no scenarios to run (check --tag and --shard)");
     }
     if args.detector.model.is_none() {
         // Fetch the default model once, before the workers race for it.
         rover_perception::ensure_default_model()?;
     }
-    let jobs = args
+    let workers = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .clamp(1, scenarios.len());
-    let report = run_all(&args, &scenarios, jobs)?;
+        .clamp(1, jobs.len());
+    let report = run_all(&args, &jobs, workers)?;
     let name = match args.shard {
         Some((i, n)) => format!("eval-shard-{i}-of-{n}.json"),
         None => "eval.json".to_owned(),
@@ -113,14 +151,44 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
     finish(&args, report, &name)
 }
 
+/// One scenario with one robot.
+struct Job {
+    file: PathBuf,
+    name: String,
+    /// The robot in place of the scenario's own (`--robot`).
+    robot: Option<PathBuf>,
+    robot_name: String,
+    duration_s: f64,
+    /// The result, when the robot lacks a sensor the scenario needs: not run.
+    skip: Option<ScenarioResult>,
+}
+
+impl Job {
+    /// "name" or "name @ robot" when several robots run.
+    fn label(&self) -> String {
+        match self.robot {
+            Some(_) => format!("{} @ {}", self.name, self.robot_name),
+            None => self.name.clone(),
+        }
+    }
+}
+
+fn jobs_robot_name(path: &Path) -> &str {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .map_or("robot", |n| {
+            n.split_once('.').map_or(n, |(stem, _)| stem)
+        })
+}
+
 /// Runs the scenarios in child processes, `jobs` at a time, longest first.
-fn run_all(
-    args: &EvalArgs,
-    scenarios: &[(PathBuf, String, f64)],
-    jobs: usize,
-) -> Result<EvalReport> {
+fn run_all(args: &EvalArgs, scenarios: &[Job], jobs: usize) -> Result<EvalReport> {
     let exe = std::env::current_exe().context("cannot find rover's own executable")?;
-    let total_sim_s: f64 = scenarios.iter().map(|s| s.2).sum();
+    let total_sim_s: f64 = scenarios
+        .iter()
+        .filter(|s| s.skip.is_none())
+        .map(|s| s.duration_s)
+        .sum();
     let bar = ProgressBar::new(scenarios.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -131,7 +199,12 @@ fn run_all(
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
     // Longest first: the last job to finish is a short one.
     let mut order: Vec<usize> = (0..scenarios.len()).collect();
-    order.sort_by(|&a, &b| scenarios[b].2.total_cmp(&scenarios[a].2).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| {
+        scenarios[b]
+            .duration_s
+            .total_cmp(&scenarios[a].duration_s)
+            .then(a.cmp(&b))
+    });
     let queue = Mutex::new(order.into_iter());
     let results: Mutex<Vec<Option<ScenarioResult>>> = Mutex::new(vec![None; scenarios.len()]);
     let running: Mutex<Vec<String>> = Mutex::new(Vec::new());
@@ -143,17 +216,21 @@ fn run_all(
                 loop {
                     let next = queue.lock().ok().and_then(|mut q| q.next());
                     let Some(i) = next else { break };
-                    let (file, name, _) = &scenarios[i];
+                    let job = &scenarios[i];
+                    let name = job.label();
                     if let Ok(mut r) = running.lock() {
                         r.push(name.clone());
                         bar.set_message(r.join(", "));
                     }
                     let json = scratch.path().join(format!("{i}.json"));
-                    let result = run_child(&exe, args, file, name, &json);
+                    let result = match &job.skip {
+                        Some(skipped) => skipped.clone(),
+                        None => run_child(&exe, args, job, &json),
+                    };
                     let line = format!(
-                        "{} {:<28} {:>6.1} s",
-                        if result.passed { "pass" } else { "FAIL" },
-                        result.name,
+                        "{} {:<40} {:>6.1} s",
+                        verdict(&result),
+                        name,
                         result.wall_s
                     );
                     if bar.is_hidden() {
@@ -164,7 +241,7 @@ fn run_all(
                     }
                     bar.inc(1);
                     if let Ok(mut r) = running.lock() {
-                        r.retain(|n| n != name);
+                        r.retain(|n| *n != name);
                         bar.set_message(r.join(", "));
                     }
                     if let Ok(mut all) = results.lock() {
@@ -192,16 +269,29 @@ fn run_all(
     ))
 }
 
+/// "pass", "FAIL" or "skip".
+fn verdict(r: &ScenarioResult) -> &'static str {
+    if r.skipped.is_some() {
+        "skip"
+    } else if r.passed {
+        "pass"
+    } else {
+        "FAIL"
+    }
+}
+
 fn report_of(mut results: Vec<ScenarioResult>, timing: Timing) -> EvalReport {
-    results.sort_by(|a, b| a.name.cmp(&b.name));
+    results.sort_by(|a, b| a.name.cmp(&b.name).then_with(|| a.robot.cmp(&b.robot)));
+    let run = results.iter().filter(|r| r.skipped.is_none()).count();
     let passed = results.iter().filter(|r| r.passed).count();
     EvalReport {
-        scenarios: results.len(),
+        scenarios: run,
         passed,
-        pass_rate: if results.is_empty() {
+        skipped: results.len() - run,
+        pass_rate: if run == 0 {
             0.0
         } else {
-            passed as f64 / results.len() as f64
+            passed as f64 / run as f64
         },
         results,
         timing,
@@ -210,15 +300,19 @@ fn report_of(mut results: Vec<ScenarioResult>, timing: Timing) -> EvalReport {
 
 /// One scenario in a child process; a child that fails to start, crashes or writes no result
 /// becomes a failed result carrying its last words.
-fn run_child(exe: &Path, args: &EvalArgs, file: &Path, name: &str, json: &Path) -> ScenarioResult {
+fn run_child(exe: &Path, args: &EvalArgs, job: &Job, json: &Path) -> ScenarioResult {
+    let (file, name) = (&job.file, job.name.as_str());
     let mut cmd = Command::new(exe);
     cmd.arg("eval")
         .arg("--worker")
         .arg(json)
         .arg("--out")
         .arg(&args.out)
-        .args(args.detector.to_args())
-        .arg(file)
+        .args(args.detector.to_args());
+    if let Some(robot) = &job.robot {
+        cmd.arg("--robot").arg(robot);
+    }
+    cmd.arg(file)
         .env("LP_NUM_THREADS", "1")
         .env(
             "RUST_LOG",
@@ -236,7 +330,14 @@ fn run_child(exe: &Path, args: &EvalArgs, file: &Path, name: &str, json: &Path) 
     let file_text = file.display().to_string();
     let output = match cmd.output() {
         Ok(o) => o,
-        Err(e) => return ScenarioResult::failed(name, &file_text, format!("cannot start: {e}")),
+        Err(e) => {
+            return ScenarioResult::failed(
+                name,
+                &job.robot_name,
+                &file_text,
+                format!("cannot start: {e}"),
+            );
+        }
     };
     let stderr = String::from_utf8_lossy(&output.stderr);
     match std::fs::read_to_string(json)
@@ -249,6 +350,7 @@ fn run_child(exe: &Path, args: &EvalArgs, file: &Path, name: &str, json: &Path) 
             let tail: Vec<&str> = tail.into_iter().rev().collect();
             ScenarioResult::failed(
                 name,
+                &job.robot_name,
                 &file_text,
                 format!(
                     "the run ended without a result ({}): {}",
@@ -265,19 +367,33 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
     let [file] = args.paths.as_slice() else {
         bail!("--worker runs exactly one scenario file");
     };
-    let result = match Scenario::load(file) {
-        Err(e) => ScenarioResult::failed("?", &file.display().to_string(), e.to_string()),
+    let robot = args.robot.first().map(PathBuf::as_path);
+    if args.robot.len() > 1 {
+        bail!("--worker runs with at most one --robot");
+    }
+    let result = match Scenario::load_with_robot(file, robot) {
+        Err(e) => ScenarioResult::failed(
+            "?",
+            robot.map_or("?", jobs_robot_name),
+            &file.display().to_string(),
+            e.to_string(),
+        ),
         Ok(s) => {
+            // Files of a run with several robots carry the robot's name.
+            let stem = match robot {
+                Some(_) => format!("{}@{}", s.name, s.robot_name),
+                None => s.name.clone(),
+            };
             let options = ScenarioOptions {
                 // `--jobs` workers already fill the cores.
                 detector: args.detector.config(1)?,
                 inject_fault: args.detector.inject_fault,
                 trace: args
                     .traces
-                    .then(|| args.out.join(format!("{}.csv", s.name))),
+                    .then(|| args.out.join(format!("{stem}.csv"))),
             };
             let outcome = if args.rrd {
-                let rrd = args.out.join(format!("{}.rrd", s.name));
+                let rrd = args.out.join(format!("{stem}.rrd"));
                 let rec_options = RecorderOptions {
                     record: Some(rrd),
                     ..RecorderOptions::default()
@@ -296,7 +412,12 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
                 run_scenario(&s, &options, &mut rover_core::NoObserver)
             };
             outcome.unwrap_or_else(|e| {
-                ScenarioResult::failed(&s.name, &file.display().to_string(), e.to_string())
+                ScenarioResult::failed(
+                    &s.name,
+                    &s.robot_name,
+                    &file.display().to_string(),
+                    e.to_string(),
+                )
             })
         }
     };
@@ -315,11 +436,15 @@ fn merge(files: &[PathBuf]) -> Result<EvalReport> {
         let report: EvalReport = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a rover eval report", f.display()))?;
         for r in report.results {
-            if results.iter().any(|o| o.name == r.name) {
+            if results
+                .iter()
+                .any(|o| o.name == r.name && o.robot == r.robot)
+            {
                 bail!(
-                    "{}: scenario \"{}\" is in more than one shard",
+                    "{}: scenario \"{}\" (robot {}) is in more than one shard",
                     f.display(),
-                    r.name
+                    r.name,
+                    r.robot
                 );
             }
             results.push(r);
@@ -346,10 +471,15 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
     writeln!(
         stdout,
-        "\n{}/{} scenarios passed ({:.0}%); {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",
+        "\n{}/{} scenarios passed ({:.0}%){}; {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",
         report.passed,
         report.scenarios,
         100.0 * report.pass_rate,
+        if report.skipped > 0 {
+            format!(", {} skipped (a sensor they need is missing)", report.skipped)
+        } else {
+            String::new()
+        },
         report.timing.jobs,
         report.timing.wall_s,
         report.timing.sim_per_wall,
@@ -370,12 +500,20 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("-".to_owned(), |v| format!("{v:.digits$}"))
 }
 
-/// The human table: one row per scenario, the measured figures and what failed.
+/// The human table: one row per run (scenario x robot), the measured figures and what failed
+/// (or why it was skipped); then, with several robots, the robots x scenarios matrix.
 pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
+    let robot_width = report
+        .results
+        .iter()
+        .map(|r| r.robot.len())
+        .chain([5])
+        .max()
+        .unwrap_or(5);
     writeln!(
         out,
-        "{:<26} {:<6} {:>8} {:>8} {:>8} {:>9} {:>7} {:>6}  failed",
-        "scenario", "result", "acq s", "final m", "max m", "clear m", "avoid s", "wall s"
+        "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6}  failed",
+        "scenario", "robot", "result", "acq s", "final m", "max m", "clear m", "avoid s", "wall s"
     )?;
     for r in &report.results {
         let m = &r.metrics;
@@ -385,12 +523,31 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
             .filter(|c| !c.passed)
             .map(|c| format!("{} ({}; want {})", c.name, c.value, c.limit))
             .chain(r.error.iter().cloned())
+            .chain(r.skipped.iter().cloned())
             .collect();
+        if r.skipped.is_some() {
+            writeln!(
+                out,
+                "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6}  {}",
+                r.name,
+                r.robot,
+                "skip",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                failed.join("; ")
+            )?;
+            continue;
+        }
         writeln!(
             out,
-            "{:<26} {:<6} {:>8} {:>8} {:>8} {:>9.3} {:>7.1} {:>6.1}  {}",
+            "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7.3} {:>7.1} {:>6.1}  {}",
             r.name,
-            if r.passed { "pass" } else { "FAIL" },
+            r.robot,
+            verdict(r),
             opt(m.acquired_at_s, 1),
             opt(m.final_range_m, 2),
             opt(m.max_range_after_acquire_m, 2),
@@ -400,14 +557,53 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
             failed.join("; ")
         )?;
     }
+    let mut robots: Vec<&str> = report.results.iter().map(|r| r.robot.as_str()).collect();
+    robots.sort_unstable();
+    robots.dedup();
+    if robots.len() > 1 {
+        write_matrix(out, report, &robots)?;
+    }
     Ok(())
 }
 
-/// One CSV row per scenario.
+/// Scenarios down, robots across: pass, FAIL or skip in each cell, and each robot's total.
+fn write_matrix(out: &mut dyn Write, report: &EvalReport, robots: &[&str]) -> std::io::Result<()> {
+    let widths: Vec<usize> = robots.iter().map(|r| r.len().max(6)).collect();
+    write!(out, "\n{:<24}", "scenario")?;
+    for (robot, w) in robots.iter().zip(&widths) {
+        write!(out, " {robot:>w$}")?;
+    }
+    writeln!(out)?;
+    let mut names: Vec<&str> = report.results.iter().map(|r| r.name.as_str()).collect();
+    names.dedup();
+    for name in &names {
+        write!(out, "{name:<24}")?;
+        for (robot, w) in robots.iter().zip(&widths) {
+            let cell = report
+                .results
+                .iter()
+                .find(|r| r.name == *name && r.robot == *robot)
+                .map_or("-", verdict);
+            write!(out, " {cell:>w$}")?;
+        }
+        writeln!(out)?;
+    }
+    write!(out, "{:<24}", "passed")?;
+    for (robot, w) in robots.iter().zip(&widths) {
+        let mine = report.results.iter().filter(|r| r.robot == *robot);
+        let run = mine.clone().filter(|r| r.skipped.is_none()).count();
+        let passed = mine.filter(|r| r.passed).count();
+        let cell = format!("{passed}/{run}");
+        write!(out, " {cell:>w$}")?;
+    }
+    writeln!(out)
+}
+
+/// One CSV row per run (scenario x robot).
 fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
     writeln!(
         out,
-        "scenario,passed,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,wall_s,failed"
+        "scenario,robot,result,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,wall_s,failed"
     )?;
     for r in &report.results {
         let m = &r.metrics;
@@ -420,9 +616,10 @@ fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
             .collect();
         writeln!(
             out,
-            "{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{}",
+            "{},{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{}",
             r.name,
-            r.passed,
+            r.robot,
+            verdict(r),
             opt(m.acquired_at_s, 3),
             opt(m.final_range_m, 4),
             opt(m.max_range_after_acquire_m, 4),
