@@ -41,6 +41,11 @@ pub struct LoopStats {
     /// Whether the follower is steering around an obstacle (it has a laser and something is in
     /// the way of its own command).
     pub avoiding: bool,
+    /// The follower's estimate of its target (odometry frame, m), while it has one.
+    pub follow_target_m: Option<[f64; 2]>,
+    /// The point the follower is driving to (odometry frame, m): the target while it is seen,
+    /// where it was last going once it is lost (PURSUING).
+    pub follow_goal_m: Option<[f64; 2]>,
 }
 
 /// Watches a session without influencing it (the Rerun recorder, the window).

@@ -311,6 +311,13 @@ impl Session {
             }
             self.stats.mode = self.pilot.mode();
             self.stats.follow_state = self.follower.state();
+            let following = self.stats.mode == Mode::Follow;
+            self.stats.follow_target_m = self
+                .follower
+                .target()
+                .filter(|_| following)
+                .map(|t| t.position_at(sample.sim_time_s));
+            self.stats.follow_goal_m = self.follower.goal_m().filter(|_| following);
             observer.control(&self.sim, sample, &self.stats);
         }
         Ok(sample)
@@ -613,23 +620,32 @@ fn camera_geometry(
     let base_from_camera = sim.world_from_base().inverse() * world_from_camera;
     let height_m = f64::from(world_from_camera.translation.z);
     let forward_m = f64::from(base_from_camera.translation.x);
+    let left_m = f64::from(base_from_camera.translation.y);
     // Gazebo cameras look along their link's +x.
-    let look = world_from_camera.rotation * glam::Vec3::X;
-    let pitch_down_rad = f64::from((-look.z).clamp(-1.0, 1.0).asin());
+    let look_world = world_from_camera.rotation * glam::Vec3::X;
+    let pitch_down_rad = f64::from((-look_world.z).clamp(-1.0, 1.0).asin());
+    let look_base = base_from_camera.rotation * glam::Vec3::X;
+    let yaw_rad = f64::from(look_base.y.atan2(look_base.x));
+    let mount = |g: CameraGeometry| CameraGeometry {
+        left_m,
+        yaw_rad,
+        pitch_down_rad,
+        ..g
+    };
     match info {
-        Some(info) => CameraGeometry {
-            pitch_down_rad,
-            ..CameraGeometry::new(info, height_m, forward_m)
-        },
-        None => CameraGeometry {
+        Some(info) => mount(CameraGeometry::new(info, height_m, forward_m)),
+        None => mount(CameraGeometry {
             fx: 1.0,
             fy: 1.0,
             cx: 0.0,
             cy: 0.0,
+            width_px: 1.0,
             height_px: 1.0,
             height_m,
             forward_m,
+            left_m,
+            yaw_rad,
             pitch_down_rad,
-        },
+        }),
     }
 }

@@ -327,9 +327,12 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
         fy: 381.0,
         cx: 320.5,
         cy: 240.5,
+        width_px: 640.0,
         height_px: 480.0,
         height_m: 0.18,
         forward_m: 0.15,
+        left_m: 0.0,
+        yaw_rad: 0.0,
         pitch_down_rad: 0.0,
     };
     let mut follower = rover_core::Follower::new(rover_core::FollowerConfig::default(), geometry)

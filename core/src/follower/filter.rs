@@ -75,6 +75,11 @@ impl TargetFilter {
         ((self.covariance[(0, 0)] + self.covariance[(1, 1)]) / 2.0).sqrt()
     }
 
+    /// Covariance of the position estimate at the filter's time (m^2).
+    pub(crate) fn position_covariance(&self) -> Matrix2<f64> {
+        self.covariance.fixed_view::<2, 2>(0, 0).into_owned()
+    }
+
     /// Where the target is expected at `time_s`, extrapolating at most `horizon_s` past the
     /// estimate (a lost target is not followed into the distance forever).
     pub fn predicted_position_m(&self, time_s: f64, horizon_s: f64) -> [f64; 2] {

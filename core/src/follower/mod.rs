@@ -10,10 +10,11 @@
 //!   a close target whose head the low camera cannot see). Its prediction leads moving targets,
 //!   centres the gate and aims the search.
 //! - **States** ([`FollowState`]): TRACKING (seen lately: steer to centre it, regulate the range
-//!   to the standoff, calm inside a deadband), HOLDING (lost briefly: stay, face the prediction;
-//!   longer for a close, centred target that only flickers), SEARCHING (turn toward the
-//!   prediction, then sweep; never drives), STALE (detector messages stopped: stop), NO DETECTOR,
-//!   WAITING (nothing heard yet).
+//!   to the standoff, calm inside a deadband), PURSUING (lost: drive to the standoff from where
+//!   the track last was, predicted with its velocity for a bounded time, and look there; a close
+//!   standing target the camera cannot see whole is finished on the track), SEARCHING (nothing
+//!   there on arrival: turn toward the prediction, then sweep; never drives), STALE (detector
+//!   messages stopped: stop), NO DETECTOR, WAITING (nothing heard yet).
 //! - **Obstacles**: with a laser, commands whose arcs come near a return are replaced by the best
 //!   free arc toward the target ([`AvoidConfig::choose`]). Without a laser the follower cannot see obstacles.
 //!
@@ -38,12 +39,18 @@ use filter::polar_covariance;
 pub struct FollowerConfig {
     /// Class to follow (darknet_ros `Class`).
     pub target_class: String,
-    /// Minimum detection probability for a target.
+    /// Minimum detection probability for a new target.
     pub min_probability: f64,
+    /// Minimum detection probability for a detection inside the target's gate to keep it
+    /// (a person partly out of view scores lower, and is still the same person).
+    pub keep_probability: f64,
     /// Distance to keep from the target (m).
     pub standoff_m: f64,
     /// Assumed real height of the target (m), for range from box height.
     pub target_height_m: f64,
+    /// Assumed width of the target's box (m: shoulders and arms), for range from box width
+    /// when the box is cut off; each target's own width is learned from its whole boxes.
+    pub target_width_m: f64,
     /// Forward speed limit (m/s); backing away from a target that comes too close is limited to
     /// 0.6 times this.
     pub max_speed_mps: f64,
@@ -57,13 +64,17 @@ pub struct FollowerConfig {
     pub search_turn_radps: f64,
     /// Stop when the newest detector message is older than this (s of sim time).
     pub stale_after_s: f64,
-    /// TRACKING becomes HOLDING when the target has not been seen for this long (s).
+    /// TRACKING becomes PURSUING when the target has not been seen for this long (s).
     pub lost_after_s: f64,
-    /// HOLDING becomes SEARCHING after this long without the target (s).
-    pub hold_s: f64,
-    /// ... or after this long when the target was last seen close and centred (s): at the
-    /// standoff a low camera sees only legs and detections flicker; that is no reason to search.
+    /// PURSUING becomes SEARCHING this long after arriving where the target was expected
+    /// without seeing it again (s).
+    pub reacquire_s: f64,
+    /// ... or this long after arriving when the target is a standing person the camera cannot
+    /// see whole from the standoff (s): a low camera sees only legs there and detections
+    /// flicker; that is no reason to search.
     pub close_hold_s: f64,
+    /// A pursuit that has not arrived after this long gives up and searches (s).
+    pub pursue_for_s: f64,
     /// A target not seen by the camera for this long is forgotten: the next person of the class
     /// becomes a new target wherever it is (s).
     pub forget_after_s: f64,
@@ -89,8 +100,10 @@ impl Default for FollowerConfig {
         Self {
             target_class: "person".into(),
             min_probability: 0.4,
+            keep_probability: 0.3,
             standoff_m: 1.5,
             target_height_m: 1.75,
+            target_width_m: 0.55,
             max_speed_mps: 0.8,
             max_turn_radps: 1.2,
             max_accel_mps2: 0.8,
@@ -98,8 +111,9 @@ impl Default for FollowerConfig {
             search_turn_radps: 0.6,
             stale_after_s: 1.0,
             lost_after_s: 0.6,
-            hold_s: 2.0,
-            close_hold_s: 12.0,
+            reacquire_s: 2.0,
+            close_hold_s: 30.0,
+            pursue_for_s: 12.0,
             forget_after_s: 8.0,
             laser_confirm_s: 10.0,
             turn_gain: 1.8,
@@ -111,7 +125,8 @@ impl Default for FollowerConfig {
         }
     }
 }
-/// Where the camera is and how it projects, as the follower needs it.
+/// Where the camera is and how it projects, as the follower needs it: the robot's own
+/// camera_info and mount, so a low, pitched, narrow or offset camera works.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraGeometry {
     /// Focal length (px).
@@ -122,29 +137,62 @@ pub struct CameraGeometry {
     pub cx: f64,
     /// Principal point (px).
     pub cy: f64,
+    /// Image width (px).
+    pub width_px: f64,
     /// Image height (px).
     pub height_px: f64,
     /// Camera height above the ground (m).
     pub height_m: f64,
     /// Camera position ahead of the base origin (m).
     pub forward_m: f64,
+    /// Camera position left of the base origin (m).
+    pub left_m: f64,
+    /// Where the optical axis points, counter-clockwise from the base's +x (rad).
+    pub yaw_rad: f64,
     /// How far the optical axis looks below the horizon (rad; a TurtleBot3's camera: 0.174).
     pub pitch_down_rad: f64,
 }
 
 impl CameraGeometry {
-    /// From a CameraInfo and the camera's mounting (height above ground, offset ahead of base).
+    /// From a CameraInfo and the camera's mounting (height above ground, offset ahead of base),
+    /// looking straight ahead and level.
     pub fn new(info: &CameraInfo, height_m: f64, forward_m: f64) -> Self {
         Self {
             fx: info.k[0],
             fy: info.k[4],
             cx: info.k[2],
             cy: info.k[5],
+            width_px: f64::from(info.width),
             height_px: f64::from(info.height),
             height_m,
             forward_m,
+            left_m: 0.0,
+            yaw_rad: 0.0,
             pitch_down_rad: 0.0,
         }
+    }
+
+    /// How far below the horizon the ray through image row `v` points (rad; negative above).
+    fn dip_rad(&self, v: f64) -> f64 {
+        ((v - self.cy) / self.fy).atan() + self.pitch_down_rad
+    }
+
+    /// Horizontal distance (m) from the camera at which a standing person of `height_m` just
+    /// fills the image from its bottom edge to its top edge: nearer, some of them is cut off.
+    pub fn whole_view_range_m(&self, height_m: f64) -> f64 {
+        let up = -self.dip_rad(0.0);
+        let down = self.dip_rad(self.height_px);
+        let from_top = if up > 1e-3 {
+            (height_m - self.height_m).max(0.0) / up.tan()
+        } else {
+            f64::INFINITY
+        };
+        let from_bottom = if down > 1e-3 {
+            self.height_m / down.tan()
+        } else {
+            f64::INFINITY
+        };
+        from_top.max(from_bottom)
     }
 }
 
@@ -158,8 +206,8 @@ pub enum FollowState {
     NoDetector,
     /// Following a target seen lately.
     Tracking,
-    /// Target lost briefly: staying, facing where it is expected.
-    Holding,
+    /// Target lost: driving to the standoff from where it was last going, looking there.
+    Pursuing,
     /// Target lost: turning toward where it is expected, then sweeping on the spot.
     Searching,
     /// Detections are stale: stopped.
@@ -173,7 +221,7 @@ impl FollowState {
             FollowState::Waiting => "waiting",
             FollowState::NoDetector => "no_detector",
             FollowState::Tracking => "tracking",
-            FollowState::Holding => "holding",
+            FollowState::Pursuing => "pursuing",
             FollowState::Searching => "searching",
             FollowState::Stale => "stale",
         }
@@ -184,7 +232,7 @@ impl FollowState {
         FollowState::Waiting,
         FollowState::NoDetector,
         FollowState::Tracking,
-        FollowState::Holding,
+        FollowState::Pursuing,
         FollowState::Searching,
         FollowState::Stale,
     ];
@@ -215,8 +263,12 @@ pub struct FollowTarget {
     pub bearing_rad: f64,
     /// Detection probability.
     pub probability: f64,
-    /// Whether it was close and centred when last seen (a flickering target at the standoff).
+    /// Whether it was last seen near, centred and too close for the camera to see whole (at the
+    /// standoff a low camera sees legs only and detections flicker).
     pub close_and_centred: bool,
+    /// The width of its box in the world (m), learned from its whole boxes: the range of a box
+    /// cut off at the top or bottom comes from its width.
+    pub width_m: f64,
 }
 
 impl FollowTarget {
@@ -227,8 +279,40 @@ impl FollowTarget {
     }
 }
 
+/// A box edge this close to the image edge (px) is cut off there.
+const EDGE_PX: i64 = 2;
+
+/// How quickly a target's learned width follows its whole boxes (fraction per box).
+const WIDTH_LEARNING: f64 = 0.2;
+
+/// A person in a detector message, placed in the odometry frame.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    position: [f64; 2],
+    /// Bearing from the base's heading (rad, positive left).
+    bearing_rad: f64,
+    probability: f64,
+    seen: Measured,
+}
+
+/// What one box says about where a person is.
+#[derive(Debug, Clone, Copy)]
+struct Measured {
+    /// Horizontal range from the camera (m).
+    range_m: f64,
+    /// Bearing from the optical axis (rad, positive left).
+    bearing_rad: f64,
+    /// The box's width in the world (m), when the box is whole.
+    width_m: Option<f64>,
+}
+
 /// Backing away is limited to this fraction of the forward speed limit.
 const REVERSE_FRACTION: f64 = 0.6;
+/// A target faster than this is moving (m/s): no calm deadbands, lead it.
+const MOVING_MPS: f64 = 0.25;
+/// A pursuit has arrived when the pursued point is at most this far off the heading (rad) and
+/// within the standoff band.
+const ARRIVED_BEARING_RAD: f64 = 0.15;
 /// How far ahead a lost target's motion is extrapolated (s).
 const PREDICTION_HORIZON_S: f64 = 2.0;
 /// Pose history length: enough for a few seconds of control updates at 100 Hz.
@@ -236,6 +320,8 @@ const HISTORY: usize = 512;
 /// Laser returns within this distance of the target's prediction are taken to be the target
 /// (m), and returns this close to it are not obstacles.
 const LASER_GATE_M: f64 = 0.4;
+/// A track the laser picks up again may be this far from the returns (m), at most.
+const LASER_PICKUP_M: f64 = 1.0;
 /// The target's returns are its near surface: the centre is about this much further (m).
 const BODY_DEPTH_M: f64 = 0.1;
 /// Laser returns keep following a target seen this recently (s): a few scans.
@@ -291,6 +377,8 @@ pub struct Follower {
     poses: VecDeque<(f64, Odometry)>,
     /// Which way to sweep when searching (+1 left, -1 right).
     search_sign: f64,
+    /// Whether the search is still turning to face the prediction (before it sweeps).
+    search_facing: bool,
     /// The newest scan's returns in the odometry frame, and its time.
     returns_odom: Vec<[f64; 2]>,
     scan_s: Option<f64>,
@@ -305,6 +393,11 @@ pub struct Follower {
     /// last steered (s).
     detour_side: f64,
     detour_s: f64,
+    /// When the current pursuit started and when it arrived at the pursued point (s).
+    pursuit_since_s: f64,
+    arrived_s: Option<f64>,
+    /// The point driven to at the last command (odometry frame, m).
+    goal: Option<[f64; 2]>,
 }
 
 impl Follower {
@@ -322,6 +415,7 @@ impl Follower {
             state: FollowState::Waiting,
             poses: VecDeque::with_capacity(HISTORY),
             search_sign: 1.0,
+            search_facing: false,
             returns_odom: Vec::new(),
             scan_s: None,
             obstacles_base: Vec::new(),
@@ -330,6 +424,9 @@ impl Follower {
             avoided: None,
             detour_side: 0.0,
             detour_s: f64::NEG_INFINITY,
+            pursuit_since_s: 0.0,
+            arrived_s: None,
+            goal: None,
         }
     }
 
@@ -375,6 +472,8 @@ impl Follower {
         self.heading_settled = false;
         self.avoided = None;
         self.detour_side = 0.0;
+        self.arrived_s = None;
+        self.goal = None;
     }
 
     /// Records the robot's odometry at a control update. Call it at every control update in
@@ -389,27 +488,60 @@ impl Follower {
         self.poses.push_back((now_s, odom));
     }
 
-    /// Range (m) and bearing (rad, positive left) of a box, seen from the camera.
+    /// Range (m, horizontal, from the camera) and bearing (rad, positive left, from the
+    /// camera's optical axis) of a box, for a person of the configured height and width.
     pub fn range_bearing(&self, b: &BoundingBox) -> (f64, f64) {
+        let seen = self.measure(b, self.config.target_width_m);
+        (seen.range_m, seen.bearing_rad)
+    }
+
+    /// Where a box puts a person whose box is `width_m` wide in the world.
+    ///
+    /// Range: for a whole box, from the person's height between the rays through its top and
+    /// bottom (exact for a pitched camera too). For a box cut off at the top or bottom (a low
+    /// camera near a person sees the torso or the legs), from where the feet meet the ground
+    /// (the camera's height and pitch) when the box's bottom is below the horizon, else from
+    /// its width.
+    fn measure(&self, b: &BoundingBox, width_m: f64) -> Measured {
         let c = &self.camera;
         let u = (b.xmin + b.xmax) as f64 / 2.0;
-        let bearing = ((c.cx - u) / c.fx).atan();
-        let height_px = (b.ymax - b.ymin).max(1) as f64;
-        let from_height = c.fy * self.config.target_height_m / height_px;
-        // A box cut off at the top underestimates the height (overestimates the range): use
-        // where the feet meet the ground instead, when they are below the horizon.
-        let clipped_top = b.ymin <= 2;
-        // The feet's ray dips below the horizon by the camera's pitch plus its angle below the
-        // optical axis.
-        let feet_dip_rad = ((b.ymax as f64 - c.cy) / c.fy).atan() + c.pitch_down_rad;
-        let from_feet = (feet_dip_rad > (1.0 / c.fy).atan() && (b.ymax as f64) < c.height_px - 2.0)
-            .then(|| c.height_m / feet_dip_rad.tan());
-        let along_axis = match (clipped_top, from_feet) {
-            (true, Some(d)) => d,
-            (true, None) => from_height.min(self.config.standoff_m),
-            (false, _) => from_height,
+        let (top, bottom) = (b.ymin as f64, b.ymax as f64);
+        // The ray through the box's bottom centre, turned from the optical frame into a level
+        // frame: forward is the axis tipped by the pitch.
+        let (x_right, y_down) = ((u - c.cx) / c.fx, (bottom - c.cy) / c.fy);
+        let (sp, cp) = c.pitch_down_rad.sin_cos();
+        let forward = cp - sp * y_down;
+        let bearing_rad = (-x_right).atan2(forward.max(1e-6));
+        // Rows and columns measure depth along the optical axis: a person off the axis is
+        // further than that.
+        let off_axis = bearing_rad.cos().max(0.2);
+        let up = -c.dip_rad(top);
+        let down = c.dip_rad(bottom);
+        let span = up.tan() + down.tan();
+        let from_height = (span > 1e-6).then(|| self.config.target_height_m / span);
+        let clipped_top = b.ymin <= EDGE_PX;
+        let clipped_bottom = bottom >= c.height_px - 1.0 - EDGE_PX as f64;
+        let clipped_side = b.xmin <= EDGE_PX || b.xmax as f64 >= c.width_px - 1.0 - EDGE_PX as f64;
+        let width_px = (b.xmax - b.xmin).max(1) as f64;
+        let from_width = (!clipped_side).then(|| c.fx * width_m / width_px);
+        let from_feet = (!clipped_bottom && down > (1.0 / c.fy).atan())
+            .then(|| c.height_m / down.tan());
+        let whole = !clipped_top && !clipped_bottom;
+        let depth_m = match (whole, from_height, from_feet, from_width) {
+            (true, Some(h), _, _) => h,
+            // A box's bottom below the horizon is the feet (the hem of a torso box is above a
+            // low camera): the feet are exact, the width depends on how the person stands.
+            (false, _, Some(f), _) => f,
+            (false, _, None, Some(w)) => w,
+            _ => from_height.unwrap_or(self.config.standoff_m).min(self.config.standoff_m),
         };
-        (along_axis / bearing.cos(), bearing)
+        let range_m = depth_m / off_axis;
+        Measured {
+            range_m,
+            bearing_rad,
+            // The width a whole, uncut box shows, for boxes cut off later.
+            width_m: (whole && !clipped_side).then(|| width_px * depth_m / c.fx),
+        }
     }
 
     /// Takes one detector message (possibly with no boxes: darknet_ros' ObjectCount = 0).
@@ -420,53 +552,63 @@ impl Follower {
             return;
         };
         let (sin, cos) = pose.yaw_rad.sin_cos();
-        let camera_x = pose.x_m + cos * self.camera.forward_m;
-        let camera_y = pose.y_m + sin * self.camera.forward_m;
+        let (ahead, left) = (self.camera.forward_m, self.camera.left_m);
+        let camera_x = pose.x_m + cos * ahead - sin * left;
+        let camera_y = pose.y_m + sin * ahead + cos * left;
+        let camera_yaw = pose.yaw_rad + self.camera.yaw_rad;
         let keep = self
             .target
             .as_ref()
             .filter(|t| t_image - t.camera_s < self.config.forget_after_s);
-        // People of the target class in this message: (position in the odom frame, range,
-        // bearing, probability).
+        // People of the target class in this message, placed in the odometry frame (a kept
+        // target's boxes measured with its own learned width). Weaker detections only keep a
+        // target.
         let this: &Self = self;
-        let candidates = || {
+        let width_m = keep.map_or(this.config.target_width_m, |t| t.width_m);
+        let floor = if keep.is_some() {
+            this.config.keep_probability.min(this.config.min_probability)
+        } else {
+            this.config.min_probability
+        };
+        let candidates = move |floor: f64, width_m: f64| {
             message
                 .bounding_boxes
                 .iter()
-                .filter(move |b| {
-                    b.class == this.config.target_class
-                        && b.probability >= this.config.min_probability
-                })
+                .filter(move |b| b.class == this.config.target_class && b.probability >= floor)
                 .map(move |b| {
-                    let (range_m, bearing_rad) = this.range_bearing(b);
-                    let heading = pose.yaw_rad + bearing_rad;
-                    let position = [
-                        camera_x + range_m * heading.cos(),
-                        camera_y + range_m * heading.sin(),
-                    ];
-                    (position, range_m, bearing_rad, b.probability)
+                    let seen = this.measure(b, width_m);
+                    let heading = camera_yaw + seen.bearing_rad;
+                    Candidate {
+                        position: [
+                            camera_x + seen.range_m * heading.cos(),
+                            camera_y + seen.range_m * heading.sin(),
+                        ],
+                        bearing_rad: wrap_angle(heading - pose.yaw_rad),
+                        probability: b.probability,
+                        seen,
+                    }
                 })
         };
         // Best candidate: inside the gate around the target's prediction (nearest to it), or,
         // with no target to keep, the nearest person.
-        let mut best: Option<(f64, [f64; 2], f64, f64, f64)> = None;
-        for (position, range_m, bearing_rad, probability) in candidates() {
+        let mut best: Option<(f64, Candidate)> = None;
+        for c in candidates(floor, width_m) {
             let score = match keep {
                 Some(t) => {
                     let expected = t.position_at(t_image);
-                    let gap = (position[0] - expected[0]).hypot(position[1] - expected[1]);
+                    let gap = (c.position[0] - expected[0]).hypot(c.position[1] - expected[1]);
                     let unseen_s = (t_image - t.seen_s).max(0.0);
                     // Range from a box is good to ~15%: the gate scales with range too.
-                    let gate = (0.7 + 0.15 * range_m + 0.8 * unseen_s).min(2.5);
+                    let gate = (0.7 + 0.15 * c.seen.range_m + 0.8 * unseen_s).min(2.5);
                     if gap > gate {
                         continue;
                     }
                     gap
                 }
-                None => range_m,
+                None => c.seen.range_m,
             };
-            if best.as_ref().is_none_or(|(s, ..)| score < *s) {
-                best = Some((score, position, range_m, bearing_rad, probability));
+            if best.as_ref().is_none_or(|(s, _)| score < *s) {
+                best = Some((score, c));
             }
         }
         let mut keeping = keep.is_some();
@@ -476,18 +618,24 @@ impl Follower {
             // The camera has not confirmed the target for long (the laser alone kept it) and
             // now sees people elsewhere: trust the camera, take the nearest as a new target.
             keeping = false;
-            best = candidates().min_by(|a, b| a.1.total_cmp(&b.1)).map(
-                |(position, range_m, bearing_rad, probability)| {
-                    (range_m, position, range_m, bearing_rad, probability)
-                },
-            );
+            best = candidates(self.config.min_probability, self.config.target_width_m)
+                .min_by(|a, b| a.seen.range_m.total_cmp(&b.seen.range_m))
+                .map(|c| (c.seen.range_m, c));
         }
-        let Some((_, position, range_m, bearing_rad, probability)) = best else {
+        let Some((_, c)) = best else {
             return;
         };
+        let (position, range_m, bearing_rad) = (c.position, c.seen.range_m, c.bearing_rad);
         let heading = pose.yaw_rad + bearing_rad;
         let cov = polar_covariance(heading, 0.05 + 0.1 * range_m, 0.05 + 0.02 * range_m);
-        let close_and_centred = range_m < self.config.standoff_m + 0.8 && bearing_rad.abs() < 0.3;
+        let near_m = (self.config.standoff_m + 0.8)
+            .max(self.camera.whole_view_range_m(self.config.target_height_m) + 0.3);
+        let close_and_centred = range_m < near_m && bearing_rad.abs() < 0.3;
+        // Only confident whole boxes teach the width.
+        let learned_width = c
+            .seen
+            .width_m
+            .filter(|_| c.probability >= self.config.min_probability);
         match (keeping, self.target.as_mut()) {
             (true, Some(t)) => {
                 t.filter.update(t_image, position, &cov);
@@ -498,8 +646,11 @@ impl Follower {
                 t.seen_s = t.seen_s.max(t_image);
                 t.range_m = range_m;
                 t.bearing_rad = bearing_rad;
-                t.probability = probability;
+                t.probability = c.probability;
                 t.close_and_centred = close_and_centred;
+                if let Some(w) = learned_width {
+                    t.width_m += WIDTH_LEARNING * (w - t.width_m);
+                }
             }
             _ => {
                 self.next_id += 1;
@@ -510,8 +661,9 @@ impl Follower {
                     seen_s: t_image,
                     range_m,
                     bearing_rad,
-                    probability,
+                    probability: c.probability,
                     close_and_centred,
+                    width_m: learned_width.unwrap_or(self.config.target_width_m),
                 });
             }
         }
@@ -555,15 +707,43 @@ impl Follower {
             return;
         }
         let expected = t.position_at(scan.stamp_s);
+        // A track the laser follows scan after scan moves little between scans: a tight gate.
+        // A track the laser picks up (the camera lost the person on the way in, the pursuit
+        // brought them into range) may be off by its own uncertainty: the gate grows with it,
+        // and only a compact cluster (a person, not a wall) is taken.
+        let picking_up = scan.stamp_s - t.seen_s > LASER_CONTINUITY_S;
+        let reach_m = if picking_up {
+            let cov = t.filter.position_covariance();
+            let sigma_m = cov[(0, 0)].max(cov[(1, 1)]).max(0.0).sqrt();
+            (3.0 * sigma_m).clamp(LASER_GATE_M, LASER_PICKUP_M)
+        } else {
+            LASER_GATE_M
+        };
+        let distance = |p: &[f64; 2]| (p[0] - expected[0]).hypot(p[1] - expected[1]);
+        let Some(seed) = self
+            .returns_odom
+            .iter()
+            .filter(|p| distance(p) <= reach_m)
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .copied()
+        else {
+            return;
+        };
+        let around = if picking_up { seed } else { expected };
         let (mut sx, mut sy, mut n) = (0.0, 0.0, 0usize);
+        let mut spread_m: f64 = 0.0;
         for p in &self.returns_odom {
-            if (p[0] - expected[0]).hypot(p[1] - expected[1]) <= LASER_GATE_M {
+            let gap = (p[0] - around[0]).hypot(p[1] - around[1]);
+            if gap <= LASER_GATE_M {
                 sx += p[0];
                 sy += p[1];
                 n += 1;
             }
+            if gap <= LASER_GATE_M + 0.2 {
+                spread_m = spread_m.max(gap);
+            }
         }
-        if n < 2 {
+        if n < 2 || (picking_up && spread_m > LASER_GATE_M) {
             return;
         }
         let (cx, cy) = (sx / n as f64, sy / n as f64);
@@ -594,39 +774,23 @@ impl Follower {
         } else if !fresh {
             FollowState::Stale
         } else {
-            match &self.target {
-                Some(t) => {
-                    let unseen_s = now_s - t.seen_s;
-                    let hold_s = if self.occluded(t.position_at(now_s), now_s, odom) {
-                        // Behind an obstacle: searching on the spot cannot help; keep going
-                        // toward where it is expected until it is forgotten.
-                        self.config.forget_after_s
-                    } else if t.close_and_centred {
-                        self.config.close_hold_s
-                    } else {
-                        self.config.hold_s
-                    };
-                    if unseen_s <= self.config.lost_after_s {
-                        FollowState::Tracking
-                    } else if unseen_s <= hold_s {
-                        FollowState::Holding
-                    } else {
-                        FollowState::Searching
-                    }
-                }
-                None => FollowState::Searching,
-            }
+            self.follow_state(now_s, odom)
         };
+        if state == FollowState::Pursuing && self.state != FollowState::Pursuing {
+            self.pursuit_since_s = now_s;
+            self.arrived_s = None;
+        }
         if state == FollowState::Searching && self.state != FollowState::Searching {
             self.aim_search(now_s, odom);
         }
         self.state = state;
+        self.goal = None;
         let wanted = match state {
-            FollowState::Tracking | FollowState::Holding => self.pursue(now_s, odom, state),
+            FollowState::Tracking | FollowState::Pursuing => self.pursue(now_s, odom, state),
             FollowState::Searching => self.search(now_s, odom),
             _ => Twist::ZERO,
         };
-        let cmd = if matches!(state, FollowState::Tracking | FollowState::Holding) {
+        let cmd = if matches!(state, FollowState::Tracking | FollowState::Pursuing) {
             self.limit(wanted, dt)
         } else if state == FollowState::Searching {
             // Searching never drives: the forward command drops to zero at once.
@@ -638,6 +802,53 @@ impl Follower {
         self.last_cmd = cmd;
         self.last_cmd_s = Some(now_s);
         cmd
+    }
+
+    /// The point the follower is driving to (odometry frame, m): where it aims at the target
+    /// while TRACKING, the pursued point while PURSUING; None otherwise.
+    pub fn goal_m(&self) -> Option<[f64; 2]> {
+        self.goal
+    }
+
+    /// TRACKING while the target is seen; once lost, PURSUING until the pursuit arrived and
+    /// looked for `reacquire_s` (longer for a close standing target the camera cannot see
+    /// whole) or ran out of time; then SEARCHING until it is seen again.
+    fn follow_state(&self, now_s: f64, odom: Odometry) -> FollowState {
+        let c = &self.config;
+        let Some(t) = &self.target else {
+            return FollowState::Searching;
+        };
+        if now_s - t.seen_s <= c.lost_after_s {
+            return FollowState::Tracking;
+        }
+        match self.state {
+            FollowState::Searching => FollowState::Searching,
+            FollowState::Pursuing => {
+                // Standing, or lost long enough that the prediction has stopped moving.
+                let [vx, vy] = t.filter.velocity_mps();
+                let standing = vx.hypot(vy) <= MOVING_MPS
+                    || now_s - t.filter.time_s() > PREDICTION_HORIZON_S;
+                let look_s = if t.close_and_centred && standing {
+                    c.close_hold_s
+                } else {
+                    c.reacquire_s
+                };
+                let done = match self.arrived_s {
+                    Some(arrived) => now_s - arrived > look_s,
+                    // Behind an obstacle the laser sees: keep going round it until forgotten.
+                    None if self.occluded(t.position_at(now_s), now_s, odom) => {
+                        now_s - t.seen_s > c.forget_after_s
+                    }
+                    None => now_s - self.pursuit_since_s > c.pursue_for_s,
+                };
+                if done {
+                    FollowState::Searching
+                } else {
+                    FollowState::Pursuing
+                }
+            }
+            _ => FollowState::Pursuing,
+        }
     }
 
     /// Whether the laser shows an obstacle on the line of sight from the robot to `target`
@@ -666,8 +877,10 @@ impl Follower {
         (dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad))
     }
 
-    /// TRACKING and HOLDING: face the target (leading it when it moves) and, when tracking,
-    /// regulate the range to the standoff; calm inside the deadbands; around obstacles.
+    /// TRACKING and PURSUING: face the target (leading it when it moves and is seen) and
+    /// regulate the range to the standoff; calm inside the deadbands; around obstacles. While
+    /// PURSUING the goal is the track's prediction (bounded in time) and the car never backs
+    /// away: once at the standoff from it and facing it, it has arrived and looks.
     fn pursue(&mut self, now_s: f64, odom: Odometry, state: FollowState) -> Twist {
         let Some(t) = &self.target else {
             return Twist::ZERO;
@@ -675,25 +888,30 @@ impl Follower {
         let c = &self.config;
         let here = t.position_at(now_s);
         let [vx, vy] = t.filter.velocity_mps();
-        let moving = vx.hypot(vy) > 0.25;
-        let lead = if state == FollowState::Tracking && moving {
-            c.lead_s
-        } else {
-            0.0
-        };
+        let moving = vx.hypot(vy) > MOVING_MPS;
+        let tracking = state == FollowState::Tracking;
+        let lead = if tracking && moving { c.lead_s } else { 0.0 };
         let aim = [here[0] + vx * lead, here[1] + vy * lead];
+        self.goal = Some(aim);
         let (range, _) = Self::relative(here, odom);
         let (_, bearing) = Self::relative(aim, odom);
+        let range_error = range - c.standoff_m;
+        if !tracking
+            && self.arrived_s.is_none()
+            && range_error < c.standoff_band_m
+            && bearing.abs() < ARRIVED_BEARING_RAD
+        {
+            self.arrived_s = Some(now_s);
+        }
         // Hysteresis: once centred and at the standoff, stay still until the error is clear.
         if bearing.abs() < 0.03 {
             self.heading_settled = true;
-        } else if bearing.abs() > c.bearing_deadband_rad || moving {
+        } else if bearing.abs() > c.bearing_deadband_rad || (moving && tracking) {
             self.heading_settled = false;
         }
-        let range_error = range - c.standoff_m;
         if range_error.abs() < 0.05 {
             self.range_settled = true;
-        } else if range_error.abs() > c.standoff_band_m || moving {
+        } else if range_error.abs() > c.standoff_band_m || (moving && tracking) {
             self.range_settled = false;
         }
         let angular = if self.heading_settled {
@@ -702,24 +920,23 @@ impl Follower {
             (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps)
         };
         let mut speed_cap = 0.0;
-        // HOLDING still approaches the estimate (1) of a standing target last seen close and
-        // centred (the low camera loses the head near the standoff: finish the approach), and
-        // (2) of a target hidden behind an obstacle the laser sees (go around it to see again).
-        let close_and_still = t.close_and_centred && !moving;
-        let approach = state == FollowState::Tracking
-            || (state == FollowState::Holding
-                && (close_and_still || self.occluded(here, now_s, odom)));
-        let linear = if approach && !self.range_settled {
+        let linear = if !self.range_settled {
             // The target's speed along the line of sight, fed forward: keep up with people
-            // walking away, give way to people walking closer.
+            // walking away, give way to people walking closer (also when the camera lost them
+            // close by: the prediction still walks on for a bounded time).
             let (dx, dy) = (here[0] - odom.x_m, here[1] - odom.y_m);
             let radial = if moving && range > 1e-6 {
                 (vx * dx + vy * dy) / range
             } else {
                 0.0
             };
-            let law = (c.speed_gain * range_error + radial)
-                .clamp(-c.max_speed_mps * REVERSE_FRACTION, c.max_speed_mps);
+            // Backing away is for a person who comes too close, not for a standing lost one.
+            let reverse = if tracking || moving {
+                c.max_speed_mps * REVERSE_FRACTION
+            } else {
+                0.0
+            };
+            let law = (c.speed_gain * range_error + radial).clamp(-reverse, c.max_speed_mps);
             speed_cap = law.max(0.0);
             if law >= 0.0 {
                 // Drive only while the target is roughly ahead; full speed when centred.
@@ -789,6 +1006,7 @@ impl Follower {
     /// Sets the sweep direction when a search starts: the way the target was moving around
     /// the robot, else the side it was last seen on.
     fn aim_search(&mut self, now_s: f64, odom: Odometry) {
+        self.search_facing = true;
         if let Some(t) = &self.target {
             let here = t.position_at(now_s);
             let [vx, vy] = t.filter.velocity_mps();
@@ -801,16 +1019,20 @@ impl Follower {
     }
 
     /// SEARCHING: first face where the target is expected; once facing it (and still nothing),
-    /// sweep the way it was going. Never drives.
+    /// sweep the way it was going, without turning back. Never drives.
     fn search(&mut self, now_s: f64, odom: Odometry) -> Twist {
         let c = &self.config;
-        if let Some(t) = &self.target {
+        if self.search_facing
+            && let Some(t) = &self.target
+        {
             let (_, bearing) = Self::relative(t.position_at(now_s), odom);
             if bearing.abs() > 0.15 && now_s - t.seen_s < c.forget_after_s {
                 let angular = (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps);
                 return Twist::new(0.0, angular);
             }
         }
+        // Facing where it was expected (or nowhere to face): sweep from here on.
+        self.search_facing = false;
         Twist::new(0.0, self.search_sign * c.search_turn_radps)
     }
 
@@ -868,9 +1090,12 @@ mod tests {
             fy: 381.36,
             cx: 320.5,
             cy: 240.5,
+            width_px: 640.0,
             height_px: 480.0,
             height_m: 0.18,
             forward_m: 0.15,
+            left_m: 0.0,
+            yaw_rad: 0.0,
             pitch_down_rad: 0.0,
         }
     }
