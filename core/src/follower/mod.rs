@@ -279,6 +279,8 @@ impl FollowTarget {
     }
 }
 
+/// A walking person is followed at most this much further than the standoff (m).
+const MAX_EXTRA_STANDOFF_M: f64 = 1.5;
 /// A box edge this close to the image edge (px) is cut off there.
 const EDGE_PX: i64 = 2;
 
@@ -300,6 +302,8 @@ struct Candidate {
 struct Measured {
     /// Horizontal range from the camera (m).
     range_m: f64,
+    /// Its 1-sigma uncertainty (m): the way it was measured and how far.
+    range_sigma_m: f64,
     /// Bearing from the optical axis (rad, positive left).
     bearing_rad: f64,
     /// The box's width in the world (m), when the box is whole.
@@ -527,17 +531,29 @@ impl Follower {
         let from_feet = (!clipped_bottom && down > (1.0 / c.fy).atan())
             .then(|| c.height_m / down.tan());
         let whole = !clipped_top && !clipped_bottom;
-        let depth_m = match (whole, from_height, from_feet, from_width) {
-            (true, Some(h), _, _) => h,
+        // Each way's 1-sigma error (m) at depth d: a box edge is good to ~2 px; people's
+        // heights vary by ~5%, and how wide they look by far more (arms, turned sideways).
+        let pixel_rad = 2.0 / c.fy;
+        let (depth_m, sigma_m) = match (whole, from_height, from_feet, from_width) {
+            (true, Some(d), _, _) => (
+                d,
+                0.05 + 0.05 * d + d * d * pixel_rad / self.config.target_height_m,
+            ),
             // A box's bottom below the horizon is the feet (the hem of a torso box is above a
             // low camera): the feet are exact, the width depends on how the person stands.
-            (false, _, Some(f), _) => f,
-            (false, _, None, Some(w)) => w,
-            _ => from_height.unwrap_or(self.config.standoff_m).min(self.config.standoff_m),
+            (false, _, Some(d), _) => (d, 0.05 + d * d * pixel_rad / c.height_m.max(0.05)),
+            (false, _, None, Some(d)) => (d, 0.05 + 0.3 * d),
+            _ => {
+                let d = from_height
+                    .unwrap_or(self.config.standoff_m)
+                    .min(self.config.standoff_m);
+                (d, 0.05 + 0.5 * d)
+            }
         };
         let range_m = depth_m / off_axis;
         Measured {
             range_m,
+            range_sigma_m: sigma_m / off_axis,
             bearing_rad,
             // The width a whole, uncut box shows, for boxes cut off later.
             width_m: (whole && !clipped_side).then(|| width_px * depth_m / c.fx),
@@ -598,8 +614,9 @@ impl Follower {
                     let expected = t.position_at(t_image);
                     let gap = (c.position[0] - expected[0]).hypot(c.position[1] - expected[1]);
                     let unseen_s = (t_image - t.seen_s).max(0.0);
-                    // Range from a box is good to ~15%: the gate scales with range too.
-                    let gate = (0.7 + 0.15 * c.seen.range_m + 0.8 * unseen_s).min(2.5);
+                    // The gate: the person's size, twice the range's uncertainty, and how far
+                    // they may have walked unseen.
+                    let gate = (0.5 + 2.0 * c.seen.range_sigma_m + 0.8 * unseen_s).min(2.5);
                     if gap > gate {
                         continue;
                     }
@@ -627,7 +644,7 @@ impl Follower {
         };
         let (position, range_m, bearing_rad) = (c.position, c.seen.range_m, c.bearing_rad);
         let heading = pose.yaw_rad + bearing_rad;
-        let cov = polar_covariance(heading, 0.05 + 0.1 * range_m, 0.05 + 0.02 * range_m);
+        let cov = polar_covariance(heading, c.seen.range_sigma_m, 0.05 + 0.02 * range_m);
         let near_m = (self.config.standoff_m + 0.8)
             .max(self.camera.whole_view_range_m(self.config.target_height_m) + 0.3);
         let close_and_centred = range_m < near_m && bearing_rad.abs() < 0.3;
@@ -895,7 +912,7 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = Self::relative(here, odom);
         let (_, bearing) = Self::relative(aim, odom);
-        let range_error = range - c.standoff_m;
+        let range_error = range - self.standoff_m(moving);
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -950,6 +967,19 @@ impl Follower {
         };
         let preferred = Twist::new(linear, angular);
         self.avoid(preferred, here, speed_cap, now_s, odom)
+    }
+
+    /// The range to keep from the target (m, from the base). A walking person is followed
+    /// from where the camera sees them whole, unless a laser keeps them at the standoff: a low
+    /// camera that closes in on a walking person loses them at every step. Once they stand,
+    /// the car closes in to the standoff.
+    fn standoff_m(&self, moving: bool) -> f64 {
+        let c = &self.config;
+        if !moving || self.laser.is_some() {
+            return c.standoff_m;
+        }
+        let whole_m = self.camera.whole_view_range_m(c.target_height_m) + self.camera.forward_m;
+        whole_m.clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M)
     }
 
     /// Replaces `preferred` by a free arc when the laser shows an obstacle in its way.
