@@ -912,7 +912,16 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = Self::relative(here, odom);
         let (_, bearing) = Self::relative(aim, odom);
-        let range_error = range - self.standoff_m(moving);
+        // Inside the band between the standoff and where the camera sees a walking person
+        // whole (no laser), the range is right: the car turns with them and stays put.
+        let (near_m, far_m) = (c.standoff_m, self.standoff_m(moving));
+        let range_error = if range > far_m {
+            range - far_m
+        } else if range < near_m {
+            range - near_m
+        } else {
+            0.0
+        };
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -969,10 +978,10 @@ impl Follower {
         self.avoid(preferred, here, speed_cap, now_s, odom)
     }
 
-    /// The range to keep from the target (m, from the base). A walking person is followed
-    /// from where the camera sees them whole, unless a laser keeps them at the standoff: a low
-    /// camera that closes in on a walking person loses them at every step. Once they stand,
-    /// the car closes in to the standoff.
+    /// The furthest range to keep from the target (m, from the base). A walking person is
+    /// followed from anywhere between the standoff and where the camera sees them whole,
+    /// unless a laser keeps them at the standoff: a low camera that closes in on a walking
+    /// person loses them at every step. Once they stand, the car closes in to the standoff.
     fn standoff_m(&self, moving: bool) -> f64 {
         let c = &self.config;
         if !moving || self.laser.is_some() {
