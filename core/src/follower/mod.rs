@@ -530,19 +530,28 @@ impl Follower {
         let from_width = (!clipped_side).then(|| c.fx * width_m / width_px);
         let from_feet = (!clipped_bottom && down > (1.0 / c.fy).atan())
             .then(|| c.height_m / down.tan());
-        let whole = !clipped_top && !clipped_bottom;
+        // A bottom edge above the horizon is not a person's feet (the camera is above the
+        // ground): something hides their legs, and the top of their head gives the range.
+        let feet_hidden = down <= 0.0 && !clipped_top;
+        let from_head = (feet_hidden && up > 1e-3)
+            .then(|| (self.config.target_height_m - c.height_m).max(0.1) / up.tan());
+        let whole = !clipped_top && !clipped_bottom && !feet_hidden;
         // Each way's 1-sigma error (m) at depth d: a box edge is good to ~2 px; people's
         // heights vary by ~5%, and how wide they look by far more (arms, turned sideways).
         let pixel_rad = 2.0 / c.fy;
-        let (depth_m, sigma_m) = match (whole, from_height, from_feet, from_width) {
-            (true, Some(d), _, _) => (
+        let (depth_m, sigma_m) = match (whole, from_height, from_feet, from_head, from_width) {
+            (true, Some(d), ..) => (
                 d,
                 0.05 + 0.05 * d + d * d * pixel_rad / self.config.target_height_m,
             ),
             // A box's bottom below the horizon is the feet (the hem of a torso box is above a
             // low camera): the feet are exact, the width depends on how the person stands.
-            (false, _, Some(d), _) => (d, 0.05 + d * d * pixel_rad / c.height_m.max(0.05)),
-            (false, _, None, Some(d)) => (d, 0.05 + 0.3 * d),
+            (false, _, Some(d), ..) => (d, 0.05 + d * d * pixel_rad / c.height_m.max(0.05)),
+            (false, _, None, Some(d), _) => (
+                d,
+                0.05 + 0.1 * d + d * d * pixel_rad / self.config.target_height_m,
+            ),
+            (false, _, None, None, Some(d)) => (d, 0.05 + 0.3 * d),
             _ => {
                 let d = from_height
                     .unwrap_or(self.config.standoff_m)
