@@ -149,6 +149,78 @@ fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
     Ok(())
 }
 
+/// `--robot A --robot B`: every scenario for every robot, a robots x scenarios table, a
+/// scenario that needs a laser skipped with the reason on the camera-only car; the same JSON
+/// twice.
+#[test]
+fn several_robots_run_every_scenario_and_skip_what_they_cannot_sense() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    write_scenarios(dir.path())?;
+    let laser_only = dir.path().join("c_needs_laser.toml");
+    std::fs::write(
+        &laser_only,
+        "[scenario]\nduration_s = 2.0\nneeds = [\"laser\"]\n[criteria]\nmax_travel_m = 0.05\n[world]\nname = \"c\"\n",
+    )?;
+    let camera_only = repo("assets/robots/my_robot.urdf").display().to_string();
+    let with_laser = repo("assets/robots/my_robot_laser.urdf.xacro")
+        .display()
+        .to_string();
+    let folder = dir.path().display().to_string();
+    let run = |out: &str| -> Result<(Output, String)> {
+        let o = rover(
+            &[
+                "eval",
+                folder.as_str(),
+                "--jobs",
+                "2",
+                "--out",
+                out,
+                "--robot",
+                camera_only.as_str(),
+                "--robot",
+                with_laser.as_str(),
+            ],
+            dir.path(),
+        )?;
+        let json = std::fs::read_to_string(dir.path().join(out).join("eval.json"))?;
+        Ok((o, json))
+    };
+    let (first, first_json) = run("first")?;
+    let table = text(&first.stdout);
+    assert!(first.status.success(), "{table}{}", text(&first.stderr));
+    // The matrix: scenarios down, robots across, each robot's total.
+    let header = table
+        .lines()
+        .find(|l| l.starts_with("scenario") && !l.contains("result"))
+        .unwrap_or_default();
+    assert!(
+        header.contains("my_robot") && header.contains("my_robot_laser"),
+        "{table}"
+    );
+    let skipped = table
+        .lines()
+        .find(|l| l.starts_with("c_needs_laser") && l.contains("skip"))
+        .unwrap_or_default();
+    assert!(
+        skipped.contains("needs a laser; my_robot has none"),
+        "{table}"
+    );
+    assert!(table.contains("5/5 scenarios passed"), "{table}");
+    assert!(table.contains("1 skipped"), "{table}");
+    let report: serde_json::Value = serde_json::from_str(&first_json)?;
+    let results = report["results"].as_array().cloned().unwrap_or_default();
+    assert_eq!(results.len(), 6, "{first_json}");
+    assert_eq!(report["skipped"], 1);
+    // Deterministic: a second evaluation gives the same results.
+    let (second, second_json) = run("second")?;
+    assert!(second.status.success(), "{}", text(&second.stderr));
+    assert_eq!(
+        without_timings(&first_json)?,
+        without_timings(&second_json)?
+    );
+    Ok(())
+}
+
 #[test]
 fn a_failing_scenario_fails_the_evaluation_and_says_why() -> Result<()> {
     let dir = tempfile::tempdir()?;

@@ -60,6 +60,9 @@ pub struct ScenarioCriteria {
     pub calm_last_s: Option<f64>,
     /// Turn-rate bound for `calm_last_s` (rad/s; default 0.05).
     pub calm_turn_radps: Option<f64>,
+    /// After the first TRACKING, the target is never lost (not TRACKING) for longer than this
+    /// at a stretch (s): how soon the follower sees a person again after losing them.
+    pub max_lost_s: Option<f64>,
     /// At the end the robot faces the target within this angle (deg).
     pub final_facing_deg: Option<f64>,
 }
@@ -326,6 +329,7 @@ fn check_criteria(c: &ScenarioCriteria) -> std::result::Result<(), (String, Stri
     positive("calm_last_s", c.calm_last_s)?;
     positive("calm_turn_radps", c.calm_turn_radps)?;
     positive("final_facing_deg", c.final_facing_deg)?;
+    positive("max_lost_s", c.max_lost_s)?;
     Ok(())
 }
 
@@ -362,6 +366,10 @@ pub struct ScenarioMetrics {
     pub final_state: String,
     /// Sim seconds steering around an obstacle.
     pub avoiding_s: f64,
+    /// Longest stretch without TRACKING after the first TRACKING (s): from losing the target to
+    /// seeing it again (or to the end).
+    #[serde(default)]
+    pub longest_lost_s: f64,
 }
 
 /// One criterion's verdict.
@@ -448,6 +456,8 @@ struct Probe {
     last_state: FollowState,
     last_state_following: bool,
     calm_from_s: Option<f64>,
+    /// When the target was last lost after the first TRACKING (s).
+    lost_since_s: Option<f64>,
     metrics: ScenarioMetrics,
 }
 
@@ -465,6 +475,7 @@ impl Probe {
             last_state: FollowState::Waiting,
             last_state_following: false,
             calm_from_s,
+            lost_since_s: None,
             metrics: ScenarioMetrics {
                 min_clearance_m: f64::from(CLEARANCE_CAP_M),
                 ..ScenarioMetrics::default()
@@ -531,6 +542,14 @@ impl Observer for Probe {
             }
             if stats.avoiding {
                 m.avoiding_s += dt;
+            }
+            if m.acquired_at_s.is_some() {
+                if state == FollowState::Tracking {
+                    self.lost_since_s = None;
+                } else {
+                    let since = *self.lost_since_s.get_or_insert(t);
+                    m.longest_lost_s = m.longest_lost_s.max(t - since);
+                }
             }
         }
         if self.calm_from_s.is_some_and(|from| t >= from) {
@@ -629,6 +648,14 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
                     .map_or("?", |s| if s { "yes" } else { "no" })
             ),
             ok,
+        );
+    }
+    if let Some(limit) = criteria.max_lost_s {
+        check(
+            "max_lost_s",
+            format!("<= {limit:.1} s"),
+            format!("{:.2} s", m.longest_lost_s),
+            m.longest_lost_s <= limit,
         );
     }
     if let Some(limit) = criteria.final_facing_deg {

@@ -512,8 +512,17 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         .unwrap_or(5);
     writeln!(
         out,
-        "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6}  failed",
-        "scenario", "robot", "result", "acq s", "final m", "max m", "clear m", "avoid s", "wall s"
+        "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6}  failed",
+        "scenario",
+        "robot",
+        "result",
+        "acq s",
+        "final m",
+        "max m",
+        "clear m",
+        "avoid s",
+        "lost s",
+        "wall s"
     )?;
     for r in &report.results {
         let m = &r.metrics;
@@ -528,10 +537,11 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         if r.skipped.is_some() {
             writeln!(
                 out,
-                "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6}  {}",
+                "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6}  {}",
                 r.name,
                 r.robot,
                 "skip",
+                "",
                 "",
                 "",
                 "",
@@ -544,7 +554,7 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         }
         writeln!(
             out,
-            "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7.3} {:>7.1} {:>6.1}  {}",
+            "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7.3} {:>7.1} {:>6.1} {:>6.1}  {}",
             r.name,
             r.robot,
             verdict(r),
@@ -553,6 +563,7 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
             opt(m.max_range_after_acquire_m, 2),
             m.min_clearance_m,
             m.avoiding_s,
+            m.longest_lost_s,
             r.wall_s,
             failed.join("; ")
         )?;
@@ -603,7 +614,7 @@ fn write_matrix(out: &mut dyn Write, report: &EvalReport, robots: &[&str]) -> st
 fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
     writeln!(
         out,
-        "scenario,robot,result,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,wall_s,failed"
+        "scenario,robot,result,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,longest_lost_s,wall_s,failed"
     )?;
     for r in &report.results {
         let m = &r.metrics;
@@ -616,7 +627,7 @@ fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
             .collect();
         writeln!(
             out,
-            "{},{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{}",
+            "{},{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{:.2},{}",
             r.name,
             r.robot,
             verdict(r),
@@ -631,6 +642,7 @@ fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
             m.transitions,
             m.final_state,
             m.avoiding_s,
+            m.longest_lost_s,
             r.wall_s,
             failed.join(" ")
         )?;

@@ -1,6 +1,6 @@
 //! The station's picture: the camera image, its boxes and the HUD under it.
 
-use rover_core::{Mode, Session};
+use rover_core::{LoopStats, Mode, Session};
 use rover_perception::box_outline;
 
 use super::canvas::{CHAR_W, Canvas, Rgb};
@@ -75,8 +75,9 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
         Mode::Manual => ("MANUAL".to_owned(), [120, 220, 120]),
         Mode::Follow => (
             format!(
-                "FOLLOW ({}{})",
+                "FOLLOW ({}{}{})",
                 stats.follow_state.as_str().to_uppercase(),
+                goal_text(&stats, session.sim().odometry()),
                 if stats.avoiding { ", avoiding" } else { "" }
             ),
             [255, 170, 60],
@@ -167,5 +168,17 @@ mod tests {
             ("no detector (model", "missing); manual driving works")
         );
         assert_eq!(split_line("abcdefghij", 4), ("abcd", "efghij"));
+    }
+}
+
+/// " 2.3 m +12 deg": where the point the follower drives to is from the robot (odometry).
+fn goal_text(stats: &LoopStats, odom: rover_sim::Odometry) -> String {
+    match stats.follow_goal_m {
+        Some([x, y]) => {
+            let (dx, dy) = (x - odom.x_m, y - odom.y_m);
+            let bearing = rover_sim::wrap_angle(dy.atan2(dx) - odom.yaw_rad);
+            format!(" {:.1} m {:+.0} deg", dx.hypot(dy), bearing.to_degrees())
+        }
+        None => String::new(),
     }
 }

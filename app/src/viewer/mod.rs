@@ -18,6 +18,8 @@
 //! world/robot/camera/image               Pinhole (Gazebo's K), Image, AnnotationContext
 //! world/robot/camera/image/detections    Boxes2D "person 0.87" with class ids
 //! world/odometry                         Points3D (odometry position) + trail LineStrips3D
+//! world/odometry/follower/{target,goal}  Points3D: the follower's target estimate, the point it
+//!                                        drives to (the pursued point once the target is lost)
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -249,6 +251,22 @@ impl Observer for Recorder {
             self.log(
                 "plots/follower/state",
                 &rerun::Scalars::single(stats.follow_state.index() as f64),
+            );
+            // The target estimate and the point driven to (the pursued point once lost), in
+            // the odometry frame like the odometry itself; none logged = cleared.
+            let point = |p: Option<[f64; 2]>| p.map(|[x, y]| [x as f32, y as f32, 0.05]);
+            self.log(
+                "world/odometry/follower/target",
+                &rerun::Points3D::new(point(stats.follow_target_m))
+                    .with_radii([0.08f32])
+                    .with_colors([rerun::Color::from_rgb(255, 170, 60)]),
+            );
+            self.log(
+                "world/odometry/follower/goal",
+                &rerun::Points3D::new(point(stats.follow_goal_m))
+                    .with_radii([0.06f32])
+                    .with_colors([rerun::Color::from_rgb(90, 200, 255)])
+                    .with_labels([stats.follow_state.as_str()]),
             );
         }
         if stats.detector_ok {
