@@ -122,7 +122,10 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
         .collect();
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-        bail!("two scenarios are named \"{}\"; names must be unique", w[0].0);
+        bail!(
+            "two scenarios are named \"{}\"; names must be unique",
+            w[0].0
+        );
     }
     if let Some((index, count)) = args.shard {
         jobs = jobs
@@ -176,9 +179,7 @@ impl Job {
 fn jobs_robot_name(path: &Path) -> &str {
     path.file_name()
         .and_then(|n| n.to_str())
-        .map_or("robot", |n| {
-            n.split_once('.').map_or(n, |(stem, _)| stem)
-        })
+        .map_or("robot", |n| n.split_once('.').map_or(n, |(stem, _)| stem))
 }
 
 /// Runs the scenarios in child processes, `jobs` at a time, longest first.
@@ -227,12 +228,8 @@ fn run_all(args: &EvalArgs, scenarios: &[Job], jobs: usize) -> Result<EvalReport
                         Some(skipped) => skipped.clone(),
                         None => run_child(&exe, args, job, &json),
                     };
-                    let line = format!(
-                        "{} {:<40} {:>6.1} s",
-                        verdict(&result),
-                        name,
-                        result.wall_s
-                    );
+                    let line =
+                        format!("{} {:<40} {:>6.1} s", verdict(&result), name, result.wall_s);
                     if bar.is_hidden() {
                         // Not a terminal (CI, a pipe): plain lines instead of the bar.
                         eprintln!("{line}");
@@ -388,9 +385,7 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
                 // `--jobs` workers already fill the cores.
                 detector: args.detector.config(1)?,
                 inject_fault: args.detector.inject_fault,
-                trace: args
-                    .traces
-                    .then(|| args.out.join(format!("{stem}.csv"))),
+                trace: args.traces.then(|| args.out.join(format!("{stem}.csv"))),
             };
             let outcome = if args.rrd {
                 let rrd = args.out.join(format!("{stem}.rrd"));
@@ -476,7 +471,10 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
         report.scenarios,
         100.0 * report.pass_rate,
         if report.skipped > 0 {
-            format!(", {} skipped (a sensor they need is missing)", report.skipped)
+            format!(
+                ", {} skipped (a sensor they need is missing)",
+                report.skipped
+            )
         } else {
             String::new()
         },

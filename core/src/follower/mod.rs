@@ -528,8 +528,8 @@ impl Follower {
         let clipped_side = b.xmin <= EDGE_PX || b.xmax as f64 >= c.width_px - 1.0 - EDGE_PX as f64;
         let width_px = (b.xmax - b.xmin).max(1) as f64;
         let from_width = (!clipped_side).then(|| c.fx * width_m / width_px);
-        let from_feet = (!clipped_bottom && down > (1.0 / c.fy).atan())
-            .then(|| c.height_m / down.tan());
+        let from_feet =
+            (!clipped_bottom && down > (1.0 / c.fy).atan()).then(|| c.height_m / down.tan());
         // A bottom edge above the horizon is not a person's feet (the camera is above the
         // ground): something hides their legs, and the top of their head gives the range.
         let feet_hidden = down <= 0.0 && !clipped_top;
@@ -591,7 +591,9 @@ impl Follower {
         let this: &Self = self;
         let width_m = keep.map_or(this.config.target_width_m, |t| t.width_m);
         let floor = if keep.is_some() {
-            this.config.keep_probability.min(this.config.min_probability)
+            this.config
+                .keep_probability
+                .min(this.config.min_probability)
         } else {
             this.config.min_probability
         };
@@ -852,8 +854,8 @@ impl Follower {
             FollowState::Pursuing => {
                 // Standing, or lost long enough that the prediction has stopped moving.
                 let [vx, vy] = t.filter.velocity_mps();
-                let standing = vx.hypot(vy) <= MOVING_MPS
-                    || now_s - t.filter.time_s() > PREDICTION_HORIZON_S;
+                let standing =
+                    vx.hypot(vy) <= MOVING_MPS || now_s - t.filter.time_s() > PREDICTION_HORIZON_S;
                 let look_s = if t.close_and_centred && standing {
                     c.close_hold_s
                 } else {
@@ -1293,7 +1295,10 @@ mod tests {
             drive(&mut odom, cmd, 0.01);
         }
         assert_eq!(f.state(), FollowState::Searching);
-        assert!(cmd.angular_radps < 0.0, "sweeps right, the way it went: {cmd:?}");
+        assert!(
+            cmd.angular_radps < 0.0,
+            "sweeps right, the way it went: {cmd:?}"
+        );
         assert!(cmd.linear_mps.abs() < 1e-9, "never drives while searching");
         // No messages for more than a second: stop.
         let cmd = f.command(10.0 + 1.01, odom, true);
@@ -1448,7 +1453,11 @@ mod tests {
         let t = f.target().expect("target");
         assert_eq!(t.id, id, "a new person took over");
         assert_eq!(f.state(), FollowState::Pursuing);
-        assert!(t.position_at(2.0)[1].abs() < 0.1, "{:?}", t.position_at(2.0));
+        assert!(
+            t.position_at(2.0)[1].abs() < 0.1,
+            "{:?}",
+            t.position_at(2.0)
+        );
     }
 
     #[test]
