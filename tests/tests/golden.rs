@@ -4,7 +4,7 @@
 //! when the follower gained its states, estimator and laser.
 //!
 //! Regenerate (only when a change is meant to alter behaviour, and say so in the commit):
-//! `ROVER_BLESS=1 cargo test -p rover-tests --test golden`.
+//! `ROVER_BLESS=1 cargo test --workspace --test golden`.
 
 use std::path::Path;
 
