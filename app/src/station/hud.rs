@@ -156,6 +156,18 @@ fn split_line(text: &str, chars: usize) -> (&str, &str) {
     (&text[..at], text[at..].trim_start())
 }
 
+/// " 2.3 m +12 deg": where the point the follower drives to is from the robot (odometry).
+fn goal_text(stats: &LoopStats, odom: rover_sim::Odometry) -> String {
+    match stats.follow_goal_m {
+        Some([x, y]) => {
+            let (dx, dy) = (x - odom.x_m, y - odom.y_m);
+            let bearing = rover_sim::wrap_angle(dy.atan2(dx) - odom.yaw_rad);
+            format!(" {:.1} m {:+.0} deg", dx.hypot(dy), bearing.to_degrees())
+        }
+        None => String::new(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -168,17 +180,5 @@ mod tests {
             ("no detector (model", "missing); manual driving works")
         );
         assert_eq!(split_line("abcdefghij", 4), ("abcd", "efghij"));
-    }
-}
-
-/// " 2.3 m +12 deg": where the point the follower drives to is from the robot (odometry).
-fn goal_text(stats: &LoopStats, odom: rover_sim::Odometry) -> String {
-    match stats.follow_goal_m {
-        Some([x, y]) => {
-            let (dx, dy) = (x - odom.x_m, y - odom.y_m);
-            let bearing = rover_sim::wrap_angle(dy.atan2(dx) - odom.yaw_rad);
-            format!(" {:.1} m {:+.0} deg", dx.hypot(dy), bearing.to_degrees())
-        }
-        None => String::new(),
     }
 }
