@@ -653,8 +653,13 @@ impl Follower {
         let Some((_, c)) = best else {
             return;
         };
+        self.fold_in(t_image, pose.yaw_rad, keeping, &c);
+    }
+
+    /// Folds a chosen detection into the target (`keeping`), or makes it a new target.
+    fn fold_in(&mut self, t_image: f64, yaw_rad: f64, keeping: bool, c: &Candidate) {
         let (position, range_m, bearing_rad) = (c.position, c.seen.range_m, c.bearing_rad);
-        let heading = pose.yaw_rad + bearing_rad;
+        let heading = yaw_rad + bearing_rad;
         let cov = polar_covariance(heading, c.seen.range_sigma_m, 0.05 + 0.02 * range_m);
         let near_m = (self.config.standoff_m + 0.8)
             .max(self.camera.whole_view_range_m(self.config.target_height_m) + 0.3);
