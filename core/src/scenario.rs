@@ -170,6 +170,22 @@ impl Scenario {
     /// scenario names: the same world, people, spawn pose and criteria for another robot. The
     /// scenario's `xacro_args` and `[robot.drive]` belong to its own robot and are not applied.
     pub fn load_with_robot(path: &Path, robot: Option<&Path>) -> Result<Self> {
+        match robot {
+            Some(file) => Self::load_with_model(path, Some((file, &Self::load_robot(file)?))),
+            None => Self::load_with_model(path, None),
+        }
+    }
+
+    /// Loads a robot to run scenarios with ([`Scenario::load_with_model`]): once for many
+    /// scenarios (`rover eval --robot`), with its xacro defaults.
+    pub fn load_robot(file: &Path) -> Result<RobotModel> {
+        let options = RunConfig::default().robot_load_options(&World::flat()?);
+        Ok(RobotModel::load_with(file, &options)?)
+    }
+
+    /// [`Scenario::load_with_robot`] with the robot already loaded from `file`
+    /// ([`Scenario::load_robot`]).
+    pub fn load_with_model(path: &Path, robot: Option<(&Path, &RobotModel)>) -> Result<Self> {
         let raw: RawScenarioFile = rover_sim::load_toml(path)?;
         let bad = |key: &str, message: String| -> CoreError {
             SimError::invalid(path, None, format!("at `{key}`: {message}")).into()
@@ -229,12 +245,7 @@ impl Scenario {
             None => None,
         };
         let (robot, robot_path) = match robot {
-            Some(other) => {
-                let mut own = world.clone();
-                own.robot.xacro_args.clear();
-                let options = RunConfig::default().robot_load_options(&own);
-                (RobotModel::load_with(other, &options)?, other.to_path_buf())
-            }
+            Some((file, model)) => (model.clone(), file.to_path_buf()),
             None => {
                 let robot_path = s
                     .robot

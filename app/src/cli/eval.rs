@@ -78,22 +78,27 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
     }
     // Load them all first: a bad file is reported before anything runs. Every scenario runs
     // for every --robot (or for its own robot).
-    let robots: Vec<Option<&Path>> = if args.robot.is_empty() {
+    let mut models = Vec::with_capacity(args.robot.len());
+    for r in &args.robot {
+        let model = Scenario::load_robot(r).with_context(|| format!("robot {}", r.display()))?;
+        models.push((r.as_path(), model));
+    }
+    let robots: Vec<Option<(&Path, &rover_sim::RobotModel)>> = if models.is_empty() {
         vec![None]
     } else {
-        args.robot.iter().map(|r| Some(r.as_path())).collect()
+        models.iter().map(|(p, m)| Some((*p, m))).collect()
     };
     let mut jobs = Vec::with_capacity(files.len() * robots.len());
     for f in &files {
         for robot in &robots {
-            let s = Scenario::load_with_robot(f, *robot).with_context(|| match robot {
-                Some(r) => format!("scenario {} with robot {}", f.display(), r.display()),
+            let s = Scenario::load_with_model(f, *robot).with_context(|| match robot {
+                Some((r, _)) => format!("scenario {} with robot {}", f.display(), r.display()),
                 None => format!("scenario {}", f.display()),
             })?;
             if args.tag.is_empty() || args.tag.iter().any(|t| s.tags.contains(t)) {
                 jobs.push(Job {
                     file: f.clone(),
-                    robot: robot.map(Path::to_path_buf),
+                    robot: robot.map(|(p, _)| p.to_path_buf()),
                     duration_s: s.duration_s,
                     skip: s.unmet_needs().map(|why| ScenarioResult::skipped(&s, why)),
                     name: s.name,
