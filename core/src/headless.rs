@@ -187,7 +187,14 @@ impl RunConfig {
     /// How the robot is read: the config's resource paths, and xacro arguments from the
     /// world's `[robot]`, then the config's.
     pub(crate) fn robot_load_options(&self, world: &World) -> LoadOptions {
-        let mut xacro_args = world.robot.xacro_args.clone();
+        self.robot_load_options_with(world.robot.xacro_args.clone())
+    }
+
+    /// [`RunConfig::robot_load_options`] with these xacro arguments in place of a world's.
+    pub(crate) fn robot_load_options_with(
+        &self,
+        mut xacro_args: std::collections::BTreeMap<String, String>,
+    ) -> LoadOptions {
         xacro_args.extend(self.robot_options.xacro_args.clone());
         LoadOptions {
             xacro_args,

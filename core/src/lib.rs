@@ -28,7 +28,7 @@ mod trace;
 pub use error::{CoreError, Result};
 pub use follower::{
     AvoidConfig, Avoided, CameraGeometry, FollowState, FollowTarget, Follower, FollowerConfig,
-    LaserMount, TargetFilter,
+    LaserMount, TargetFilter, range_bearing_from,
 };
 pub use headless::{
     DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary, run_headless, run_headless_driven,

@@ -25,11 +25,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rover_perception::{DetectorConfig, InjectedFault};
-use rover_sim::{ControlSample, RobotModel, SimError, Simulation, World, WorldFile, wrap_angle};
+use rover_sim::{ControlSample, RobotModel, SimError, Simulation, World, WorldFile};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
-use crate::follower::FollowState;
+use crate::follower::{FollowState, range_bearing_from};
 use crate::headless::{self, RunConfig};
 use crate::input::Action;
 use crate::observer::{LoopStats, Observer};
@@ -156,7 +156,7 @@ pub struct Scenario {
     pub world: World,
     /// The robot.
     pub robot: RobotModel,
-    /// The robot's short name (its file name without `.urdf`/`.xacro`/`.sdf`).
+    /// The robot's short name (its file name without `.urdf`/`.xacro`).
     pub robot_name: String,
 }
 
@@ -166,7 +166,7 @@ impl Scenario {
         Self::load_with_robot(path, None)
     }
 
-    /// [`Scenario::load`], with `robot` (a URDF, xacro or SDF file) in place of the robot the
+    /// [`Scenario::load`], with `robot` (a URDF or xacro file) in place of the robot the
     /// scenario names: the same world, people, spawn pose and criteria for another robot. The
     /// scenario's `xacro_args` and `[robot.drive]` belong to its own robot and are not applied.
     pub fn load_with_robot(path: &Path, robot: Option<&Path>) -> Result<Self> {
@@ -179,7 +179,7 @@ impl Scenario {
     /// Loads a robot to run scenarios with ([`Scenario::load_with_model`]): once for many
     /// scenarios (`rover eval --robot`), with its xacro defaults.
     pub fn load_robot(file: &Path) -> Result<RobotModel> {
-        let options = RunConfig::default().robot_load_options(&World::flat()?);
+        let options = RunConfig::default().robot_load_options_with(Default::default());
         Ok(RobotModel::load_with(file, &options)?)
     }
 
@@ -302,13 +302,13 @@ impl Scenario {
     }
 }
 
-/// A robot's short name: its file name without the `.urdf`, `.xacro`, `.sdf` extensions.
+/// A robot's short name: its file name without the `.urdf` and `.xacro` extensions.
 pub fn robot_name(path: &Path) -> String {
     let mut name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "robot".into());
-    for ext in [".xacro", ".urdf", ".sdf", ".xml"] {
+    for ext in [".xacro", ".urdf"] {
         if let Some(stem) = name.strip_suffix(ext) {
             name = stem.to_owned();
         }
@@ -518,12 +518,11 @@ impl Observer for Probe {
             .min(f64::from(sim.obstacle_clearance_m(CLEARANCE_CAP_M)));
         for (i, p) in sim.world().people.iter().enumerate() {
             let (px, py, _) = p.pose_at(t);
-            let range = (px - g.x_m).hypot(py - g.y_m);
+            let (range, bearing) = range_bearing_from(g, [px, py]);
             m.min_person_range_m = Some(m.min_person_range_m.map_or(range, |r| r.min(range)));
             if Some(i) == self.target {
                 m.final_range_m = Some(range);
-                let facing = wrap_angle((py - g.y_m).atan2(px - g.x_m) - g.yaw_rad);
-                m.final_facing_deg = Some(facing.to_degrees().abs());
+                m.final_facing_deg = Some(bearing.to_degrees().abs());
                 if m.acquired_at_s.is_some() {
                     m.max_range_after_acquire_m =
                         Some(m.max_range_after_acquire_m.map_or(range, |r| r.max(range)));

@@ -626,15 +626,14 @@ fn camera_geometry(
     let pitch_down_rad = f64::from((-look_world.z).clamp(-1.0, 1.0).asin());
     let look_base = base_from_camera.rotation * glam::Vec3::X;
     let yaw_rad = f64::from(look_base.y.atan2(look_base.x));
-    let mount = |g: CameraGeometry| CameraGeometry {
-        left_m,
-        yaw_rad,
-        pitch_down_rad,
-        ..g
-    };
     match info {
-        Some(info) => mount(CameraGeometry::new(info, height_m, forward_m)),
-        None => mount(CameraGeometry {
+        Some(info) => CameraGeometry {
+            left_m,
+            yaw_rad,
+            pitch_down_rad,
+            ..CameraGeometry::new(info, height_m, forward_m)
+        },
+        None => CameraGeometry {
             fx: 1.0,
             fy: 1.0,
             cx: 0.0,
@@ -646,6 +645,6 @@ fn camera_geometry(
             left_m,
             yaw_rad,
             pitch_down_rad,
-        }),
+        },
     }
 }

@@ -6,18 +6,20 @@
 //! `cargo run -p rover-tests --example follow_log SCENARIO.toml [ROBOT.urdf[.xacro]]`
 use std::path::PathBuf;
 
-use rover_core::{LoopStats, Observer, Scenario, ScenarioOptions, run_scenario};
+use rover_core::{
+    LoopStats, Observer, Scenario, ScenarioOptions, range_bearing_from, run_scenario,
+};
 use rover_perception::BoundingBoxes;
-use rover_sim::{ControlSample, Simulation, wrap_angle};
+use rover_sim::{ControlSample, Odometry, Simulation};
 
 #[derive(Default)]
 struct Log {
     target: Option<usize>,
     class: String,
-    /// (sim time, ground truth x, y, yaw, true range, true bearing, target person pose).
+    /// (sim time, ground truth x, y, yaw, true range and bearing to the target).
     truth: Option<(f64, f64, f64, f64, f64, f64)>,
     stats: LoopStats,
-    odom: [f64; 3],
+    odom: Odometry,
 }
 
 impl Observer for Log {
@@ -26,17 +28,13 @@ impl Observer for Log {
         let (range, bearing) = match self.target {
             Some(i) => {
                 let (px, py, _) = sim.world().people[i].pose_at(sample.sim_time_s);
-                (
-                    (px - g.x_m).hypot(py - g.y_m),
-                    wrap_angle((py - g.y_m).atan2(px - g.x_m) - g.yaw_rad),
-                )
+                range_bearing_from(g, [px, py])
             }
             None => (f64::NAN, f64::NAN),
         };
         self.truth = Some((sample.sim_time_s, g.x_m, g.y_m, g.yaw_rad, range, bearing));
         self.stats = *stats;
-        let o = sample.odometry;
-        self.odom = [o.x_m, o.y_m, o.yaw_rad];
+        self.odom = sample.odometry;
     }
 
     fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
@@ -44,13 +42,9 @@ impl Observer for Log {
             return;
         };
         let rel = |p: Option<[f64; 2]>| {
-            p.map_or("-".to_owned(), |[px, py]| {
-                let (dx, dy) = (px - self.odom[0], py - self.odom[1]);
-                format!(
-                    "{:.2}m {:+.0}deg",
-                    dx.hypot(dy),
-                    wrap_angle(dy.atan2(dx) - self.odom[2]).to_degrees()
-                )
+            p.map_or("-".to_owned(), |p| {
+                let (range_m, bearing_rad) = range_bearing_from(self.odom, p);
+                format!("{range_m:.2}m {:+.0}deg", bearing_rad.to_degrees())
             })
         };
         let people: Vec<String> = boxes

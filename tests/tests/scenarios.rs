@@ -3,7 +3,7 @@
 //! runs with `rover eval scenarios/` (see docs/FOLLOWER.md).
 
 use anyhow::Result;
-use rover_core::{FollowState, LoopStats, NoObserver, Observer, parse_trace};
+use rover_core::{FollowState, LoopStats, NoObserver, Observer, parse_trace, range_bearing_from};
 use rover_core::{Scenario, ScenarioOptions, collect_scenario_files, run_scenario};
 use rover_perception::BoundingBoxes;
 use rover_sim::{ControlSample, Simulation};
@@ -101,9 +101,8 @@ struct CameraReach {
 
 impl Observer for CameraReach {
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
-        let g = sample.ground_truth;
         let (px, py, _) = sim.world().people[self.target].pose_at(sample.sim_time_s);
-        self.true_range_m = (px - g.x_m).hypot(py - g.y_m);
+        self.true_range_m = range_bearing_from(sample.ground_truth, [px, py]).0;
         self.final_state = Some(stats.follow_state);
     }
 

@@ -15,7 +15,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use rover_core::{Scenario, ScenarioOptions, ScenarioResult, collect_scenario_files, run_scenario};
+use rover_core::{
+    Scenario, ScenarioOptions, ScenarioResult, collect_scenario_files, robot_name, run_scenario,
+};
 use serde::{Deserialize, Serialize};
 
 use super::args::EvalArgs;
@@ -76,6 +78,20 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
                 .join(", ")
         );
     }
+    let mut robot_names: Vec<(String, &Path)> = args
+        .robot
+        .iter()
+        .map(|r| (robot_name(r), r.as_path()))
+        .collect();
+    robot_names.sort_unstable();
+    if let Some(w) = robot_names.windows(2).find(|w| w[0].0 == w[1].0) {
+        bail!(
+            "two robots are named \"{}\" ({} and {}); rename one: results are keyed by the file name",
+            w[0].0,
+            w[0].1.display(),
+            w[1].1.display()
+        );
+    }
     // Load them all first: a bad file is reported before anything runs. Every scenario runs
     // for every --robot (or for its own robot).
     let mut models = Vec::with_capacity(args.robot.len());
@@ -106,20 +122,6 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
                 });
             }
         }
-    }
-    let mut robot_names: Vec<(&str, &Path)> = args
-        .robot
-        .iter()
-        .map(|r| (jobs_robot_name(r), r.as_path()))
-        .collect();
-    robot_names.sort_unstable();
-    if let Some(w) = robot_names.windows(2).find(|w| w[0].0 == w[1].0) {
-        bail!(
-            "two robots are named \"{}\" ({} and {}); rename one: results are keyed by the file name",
-            w[0].0,
-            w[0].1.display(),
-            w[1].1.display()
-        );
     }
     let mut names: Vec<(&str, &str)> = jobs
         .iter()
@@ -181,21 +183,15 @@ impl Job {
     }
 }
 
-fn jobs_robot_name(path: &Path) -> &str {
-    path.file_name()
-        .and_then(|n| n.to_str())
-        .map_or("robot", |n| n.split_once('.').map_or(n, |(stem, _)| stem))
-}
-
-/// Runs the scenarios in child processes, `jobs` at a time, longest first.
-fn run_all(args: &EvalArgs, scenarios: &[Job], jobs: usize) -> Result<EvalReport> {
+/// Runs the jobs in child processes, `workers` at a time, longest first.
+fn run_all(args: &EvalArgs, jobs: &[Job], workers: usize) -> Result<EvalReport> {
     let exe = std::env::current_exe().context("cannot find rover's own executable")?;
-    let total_sim_s: f64 = scenarios
+    let total_sim_s: f64 = jobs
         .iter()
         .filter(|s| s.skip.is_none())
         .map(|s| s.duration_s)
         .sum();
-    let bar = ProgressBar::new(scenarios.len() as u64);
+    let bar = ProgressBar::new(jobs.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} scenarios  {msg}",
@@ -204,25 +200,25 @@ fn run_all(args: &EvalArgs, scenarios: &[Job], jobs: usize) -> Result<EvalReport
     );
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
     // Longest first: the last job to finish is a short one.
-    let mut order: Vec<usize> = (0..scenarios.len()).collect();
+    let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by(|&a, &b| {
-        scenarios[b]
+        jobs[b]
             .duration_s
-            .total_cmp(&scenarios[a].duration_s)
+            .total_cmp(&jobs[a].duration_s)
             .then(a.cmp(&b))
     });
     let queue = Mutex::new(order.into_iter());
-    let results: Mutex<Vec<Option<ScenarioResult>>> = Mutex::new(vec![None; scenarios.len()]);
+    let results: Mutex<Vec<Option<ScenarioResult>>> = Mutex::new(vec![None; jobs.len()]);
     let running: Mutex<Vec<String>> = Mutex::new(Vec::new());
     let scratch = tempfile::tempdir().context("cannot create a temporary folder")?;
     let started = Instant::now();
     std::thread::scope(|scope| {
-        for _ in 0..jobs {
+        for _ in 0..workers {
             scope.spawn(|| {
                 loop {
                     let next = queue.lock().ok().and_then(|mut q| q.next());
                     let Some(i) = next else { break };
-                    let job = &scenarios[i];
+                    let job = &jobs[i];
                     let name = job.label();
                     if let Ok(mut r) = running.lock() {
                         r.push(name.clone());
@@ -264,7 +260,7 @@ fn run_all(args: &EvalArgs, scenarios: &[Job], jobs: usize) -> Result<EvalReport
     Ok(report_of(
         results,
         Timing {
-            jobs,
+            jobs: workers,
             wall_s,
             sim_per_wall: total_sim_s / wall_s.max(1e-9),
         },
@@ -369,14 +365,14 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
     let [file] = args.paths.as_slice() else {
         bail!("--worker runs exactly one scenario file");
     };
-    let robot = args.robot.first().map(PathBuf::as_path);
     if args.robot.len() > 1 {
         bail!("--worker runs with at most one --robot");
     }
+    let robot = args.robot.first().map(PathBuf::as_path);
     let result = match Scenario::load_with_robot(file, robot) {
         Err(e) => ScenarioResult::failed(
             "?",
-            robot.map_or("?", jobs_robot_name),
+            &robot.map_or_else(|| "?".to_owned(), robot_name),
             &file.display().to_string(),
             e.to_string(),
         ),

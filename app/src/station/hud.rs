@@ -1,6 +1,6 @@
 //! The station's picture: the camera image, its boxes and the HUD under it.
 
-use rover_core::{LoopStats, Mode, Session};
+use rover_core::{LoopStats, Mode, Session, range_bearing_from};
 use rover_perception::box_outline;
 
 use super::canvas::{CHAR_W, Canvas, Rgb};
@@ -77,7 +77,7 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
             format!(
                 "FOLLOW ({}{}{})",
                 stats.follow_state.as_str().to_uppercase(),
-                goal_text(&stats, session.sim().odometry()),
+                GoalText::new(&stats, session.sim().odometry()),
                 if stats.avoiding { ", avoiding" } else { "" }
             ),
             [255, 170, 60],
@@ -156,15 +156,24 @@ fn split_line(text: &str, chars: usize) -> (&str, &str) {
     (&text[..at], text[at..].trim_start())
 }
 
-/// " 2.3 m +12 deg": where the point the follower drives to is from the robot (odometry).
-fn goal_text(stats: &LoopStats, odom: rover_sim::Odometry) -> String {
-    match stats.follow_goal_m {
-        Some([x, y]) => {
-            let (dx, dy) = (x - odom.x_m, y - odom.y_m);
-            let bearing = rover_sim::wrap_angle(dy.atan2(dx) - odom.yaw_rad);
-            format!(" {:.1} m {:+.0} deg", dx.hypot(dy), bearing.to_degrees())
+/// " 2.3 m +12 deg": where the point the follower drives to is from the robot (odometry);
+/// nothing without one. Written straight into the HUD's line.
+struct GoalText(Option<(f64, f64)>);
+
+impl GoalText {
+    fn new(stats: &LoopStats, odom: rover_sim::Odometry) -> Self {
+        Self(stats.follow_goal_m.map(|p| range_bearing_from(odom, p)))
+    }
+}
+
+impl std::fmt::Display for GoalText {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some((range_m, bearing_rad)) => {
+                write!(f, " {range_m:.1} m {:+.0} deg", bearing_rad.to_degrees())
+            }
+            None => Ok(()),
         }
-        None => String::new(),
     }
 }
 

@@ -310,6 +310,13 @@ struct Measured {
     width_m: Option<f64>,
 }
 
+/// Range (m) and bearing (rad, positive left) of `point` (odometry frame) from a robot at
+/// `odom`: where the follower's target or goal is, as the HUD and the scenario probe show it.
+pub fn range_bearing_from(odom: Odometry, point: [f64; 2]) -> (f64, f64) {
+    let (dx, dy) = (point[0] - odom.x_m, point[1] - odom.y_m);
+    (dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad))
+}
+
 /// Backing away is limited to this fraction of the forward speed limit.
 const REVERSE_FRACTION: f64 = 0.6;
 /// A target faster than this is moving (m/s): no calm deadbands, lead it.
@@ -402,11 +409,14 @@ pub struct Follower {
     arrived_s: Option<f64>,
     /// The point driven to at the last command (odometry frame, m).
     goal: Option<[f64; 2]>,
+    /// From how far the camera sees a person of the target height whole (m, from the camera).
+    whole_view_m: f64,
 }
 
 impl Follower {
     /// A follower for a camera with this geometry (no laser).
     pub fn new(config: FollowerConfig, camera: CameraGeometry) -> Self {
+        let whole_view_m = camera.whole_view_range_m(config.target_height_m);
         Self {
             config,
             camera,
@@ -431,6 +441,7 @@ impl Follower {
             pursuit_since_s: 0.0,
             arrived_s: None,
             goal: None,
+            whole_view_m,
         }
     }
 
@@ -505,7 +516,8 @@ impl Follower {
     /// bottom (exact for a pitched camera too). For a box cut off at the top or bottom (a low
     /// camera near a person sees the torso or the legs), from where the feet meet the ground
     /// (the camera's height and pitch) when the box's bottom is below the horizon, else from
-    /// its width.
+    /// its width. A box whose bottom is above the horizon (legs hidden) takes its range from
+    /// the top of the head.
     fn measure(&self, b: &BoundingBox, width_m: f64) -> Measured {
         let c = &self.camera;
         let u = (b.xmin + b.xmax) as f64 / 2.0;
@@ -661,8 +673,7 @@ impl Follower {
         let (position, range_m, bearing_rad) = (c.position, c.seen.range_m, c.bearing_rad);
         let heading = yaw_rad + bearing_rad;
         let cov = polar_covariance(heading, c.seen.range_sigma_m, 0.05 + 0.02 * range_m);
-        let near_m = (self.config.standoff_m + 0.8)
-            .max(self.camera.whole_view_range_m(self.config.target_height_m) + 0.3);
+        let near_m = (self.config.standoff_m + 0.8).max(self.whole_view_m + 0.3);
         let close_and_centred = range_m < near_m && bearing_rad.abs() < 0.3;
         // Only confident whole boxes teach the width.
         let learned_width = c
@@ -904,16 +915,11 @@ impl Follower {
         })
     }
 
-    /// Range (m) and bearing (rad) of a point in the odometry frame from the robot's base now.
-    fn relative(point: [f64; 2], odom: Odometry) -> (f64, f64) {
-        let (dx, dy) = (point[0] - odom.x_m, point[1] - odom.y_m);
-        (dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad))
-    }
-
     /// TRACKING and PURSUING: face the target (leading it when it moves and is seen) and
     /// regulate the range to the standoff; calm inside the deadbands; around obstacles. While
-    /// PURSUING the goal is the track's prediction (bounded in time) and the car never backs
-    /// away: once at the standoff from it and facing it, it has arrived and looks.
+    /// PURSUING the goal is the track's prediction (bounded in time) and the car backs away
+    /// only from a person predicted to walk closer: once at the standoff from it and facing
+    /// it, it has arrived and looks.
     fn pursue(&mut self, now_s: f64, odom: Odometry, state: FollowState) -> Twist {
         let Some(t) = &self.target else {
             return Twist::ZERO;
@@ -926,8 +932,8 @@ impl Follower {
         let lead = if tracking && moving { c.lead_s } else { 0.0 };
         let aim = [here[0] + vx * lead, here[1] + vy * lead];
         self.goal = Some(aim);
-        let (range, _) = Self::relative(here, odom);
-        let (_, bearing) = Self::relative(aim, odom);
+        let (range, _) = range_bearing_from(odom, here);
+        let (_, bearing) = range_bearing_from(odom, aim);
         // Inside the band between the standoff and where the camera sees a walking person
         // whole (no laser), the range is right: the car turns with them and stays put.
         let (near_m, far_m) = (c.standoff_m, self.standoff_m(moving));
@@ -1003,8 +1009,8 @@ impl Follower {
         if !moving || self.laser.is_some() {
             return c.standoff_m;
         }
-        let whole_m = self.camera.whole_view_range_m(c.target_height_m) + self.camera.forward_m;
-        whole_m.clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M)
+        (self.whole_view_m + self.camera.forward_m)
+            .clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M)
     }
 
     /// Replaces `preferred` by a free arc when the laser shows an obstacle in its way.
@@ -1080,7 +1086,7 @@ impl Follower {
         if self.search_facing
             && let Some(t) = &self.target
         {
-            let (_, bearing) = Self::relative(t.position_at(now_s), odom);
+            let (_, bearing) = range_bearing_from(odom, t.position_at(now_s));
             if bearing.abs() > 0.15 && now_s - t.seen_s < c.forget_after_s {
                 let angular = (c.turn_gain * bearing).clamp(-c.max_turn_radps, c.max_turn_radps);
                 return Twist::new(0.0, angular);
@@ -1328,7 +1334,7 @@ mod tests {
         f.command(0.2, turned, true);
         f.observe(&message(0.0, vec![person_box(4.0, 0.0)]));
         let here = f.target().expect("target").position_at(0.2);
-        let (_, bearing) = Follower::relative(here, turned);
+        let (_, bearing) = range_bearing_from(turned, here);
         assert!((bearing + 0.3).abs() < 0.05, "{bearing}");
     }
 
