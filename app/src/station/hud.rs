@@ -190,4 +190,24 @@ mod tests {
         );
         assert_eq!(split_line("abcdefghij", 4), ("abcd", "efghij"));
     }
+
+    #[test]
+    fn the_pursued_point_is_shown_from_the_robot() {
+        let odom = rover_sim::Odometry {
+            x_m: 1.0,
+            yaw_rad: std::f64::consts::FRAC_PI_2,
+            ..rover_sim::Odometry::default()
+        };
+        let stats = LoopStats {
+            follow_goal_m: Some([1.0, 2.0]),
+            ..LoopStats::default()
+        };
+        assert_eq!(GoalText::new(&stats, odom).to_string(), " 2.0 m +0 deg");
+        let left = LoopStats {
+            follow_goal_m: Some([0.0, 0.0]),
+            ..LoopStats::default()
+        };
+        assert_eq!(GoalText::new(&left, odom).to_string(), " 1.0 m +90 deg");
+        assert_eq!(GoalText::new(&LoopStats::default(), odom).to_string(), "");
+    }
 }
