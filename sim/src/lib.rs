@@ -34,13 +34,14 @@ pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
     CameraConfig, CameraInfo, Collision, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
-    GaussianNoise, Ground, Inertial, Joint, JointId, JointKind, LaserConfig, Link, LinkId,
-    MAX_LASER_SAMPLES, MeshData, MeshVertex, Model, ModelLink, Object, OdometrySource, Person,
-    Physics, PixelFormat, RobotModel, RobotSpawn, STEP_HZ_RANGE, Visual, Walk, World,
-    check_step_hz, link_from_optical,
+    GaussianNoise, Ground, HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver,
+    LaserConfig, Link, LinkId, MAX_LASER_SAMPLES, MeshData, MeshVertex, Mimic, Model, ModelLink,
+    Object, OdometrySource, Person, Physics, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
+    STEP_HZ_RANGE, Transmission, Visual, Walk, World, check_step_hz, link_from_optical,
 };
 pub use physics::{
-    ControlSample, DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry,
+    ControlSample, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR,
+    HOLD_INTEGRAL_S, JointCommand, JointState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Pid,
     SimOptions, Simulation, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};

@@ -107,6 +107,12 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "HZ")]
     pub(crate) physics_hz: Option<f64>,
 
+    /// How the robot's joints are solved, overriding the world's [physics] joints:
+    /// multibody (reduced coordinates, the default: arms hold their shape) or impulse
+    /// (a constraint per joint)
+    #[arg(long, value_name = "SOLVER", value_parser = parse_joint_solver)]
+    pub(crate) joints: Option<rover_sim::JointSolver>,
+
     /// Seed for everything random; the same seed gives the same run
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,
@@ -813,8 +819,17 @@ impl WorldArgs {
                 seed: self.seed,
                 cmd_timeout_s,
                 step_hz: self.physics_hz,
+                joints: self.joints,
             },
             ..RunConfig::default()
         }
+    }
+}
+
+fn parse_joint_solver(text: &str) -> Result<rover_sim::JointSolver, String> {
+    match text {
+        "multibody" => Ok(rover_sim::JointSolver::Multibody),
+        "impulse" => Ok(rover_sim::JointSolver::Impulse),
+        other => Err(format!("expected multibody or impulse, found '{other}'")),
     }
 }

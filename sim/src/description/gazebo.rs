@@ -11,6 +11,7 @@ use std::path::Path;
 use crate::description::xml::{elements, line_of};
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, pose_from_xyz_rpy};
+use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
@@ -20,6 +21,7 @@ use crate::model::sensors::{
 #[derive(Debug, Default)]
 pub(crate) struct Extensions {
     pub diff_drive: Option<DiffDriveConfig>,
+    pub ros_control: Option<RosControlPlugin>,
     pub cameras: Vec<CameraConfig>,
     pub lasers: Vec<LaserConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
@@ -147,6 +149,8 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                             ));
                         }
                         ext.diff_drive = Some(parse_diff_drive(&ctx, child)?);
+                    } else if file.contains("gazebo_ros_control") {
+                        ext.ros_control = Some(parse_ros_control(&ctx, child)?);
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",
@@ -204,6 +208,26 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
         }
     }
     Ok(ext)
+}
+
+/// gazebo_ros_control: the namespace of the controllers' topics and the control period.
+fn parse_ros_control(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<RosControlPlugin> {
+    let mut out = RosControlPlugin {
+        line: Some(line_of(ctx.doc, plugin)),
+        ..RosControlPlugin::default()
+    };
+    for p in elements(plugin) {
+        match p.tag_name().name() {
+            "robotNamespace" => out.namespace = text_of(p).trim_matches('/').to_owned(),
+            "controlPeriod" => {
+                out.control_period_s =
+                    Some(ctx.positive(p, "the libgazebo_ros_control.so plugin", "seconds")?)
+            }
+            "robotSimType" if !text_of(p).is_empty() => out.sim_type = text_of(p).to_owned(),
+            _ => {}
+        }
+    }
+    Ok(out)
 }
 
 /// gazebo_ros_diff_drive and gazebo_ros_skid_steer_drive (same wheel speed formula; the skid

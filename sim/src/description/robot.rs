@@ -20,8 +20,9 @@ use crate::geometry::{
     MAX_COORDINATE_M, MAX_INERTIA_KGM2, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape,
     pose_from_xyz_rpy, vec3,
 };
+use crate::model::actuation::{HardwareInterface, Transmission};
 use crate::model::robot::{
-    Collision, Inertial, Joint, JointKind, Link, LinkId, RobotModel, Visual,
+    Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
 };
 
 /// How to read a robot description: xacro arguments and where ROS packages are.
@@ -109,7 +110,9 @@ impl RobotModel {
             &lines,
             || Some(line_of(&doc, root)),
         )?;
-        let joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
+        let mut joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
+        resolve_mimics(&urdf.joints, &mut joints, path, &lines)?;
+        let transmissions = read_transmissions(&urdf, &joints, path)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
         let extensions = gazebo::parse(&doc, path)?;
@@ -134,6 +137,8 @@ impl RobotModel {
             lasers: extensions.lasers,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
+            transmissions,
+            ros_control: extensions.ros_control,
         };
         if !model.not_simulated.is_empty() {
             tracing::info!(
@@ -590,5 +595,124 @@ fn convert_joint(
         parent_from_child: pose_from_xyz_rpy(joint.origin.xyz, joint.origin.rpy),
         axis: axis.normalize_or(Vec3::X),
         damping: joint.damping.map_or(0.0, |d| d as f32),
+        friction: joint.friction.map_or(0.0, |f| f as f32),
+        effort_limit: joint.effort.map(|e| e.abs() as f32),
+        velocity_limit: joint.velocity.map(|v| v.abs() as f32),
+        // Resolved once every joint is known (`resolve_mimics`).
+        mimic: None,
     })
+}
+
+/// Fills in `<mimic joint>` now that every joint has an id.
+fn resolve_mimics(
+    urdf_joints: &[urdf::JointEl],
+    joints: &mut [Joint],
+    path: &Path,
+    lines: &ElementLines,
+) -> Result<()> {
+    for (el, joint) in urdf_joints.iter().zip(joints.iter_mut()) {
+        let Some((name, multiplier, offset)) = &el.mimic else {
+            continue;
+        };
+        let Some(index) = urdf_joints.iter().position(|j| &j.name == name) else {
+            return Err(SimError::invalid(
+                path,
+                lines.joint(&el.name),
+                format!(
+                    "<joint name=\"{}\"> <mimic joint=\"{name}\">: no such joint; joints in this robot: {}",
+                    el.name,
+                    names(urdf_joints.iter().map(|j| &j.name))
+                ),
+            ));
+        };
+        if &el.name == name {
+            return Err(SimError::invalid(
+                path,
+                lines.joint(&el.name),
+                format!("<joint name=\"{name}\"> <mimic>: a joint cannot mimic itself"),
+            ));
+        }
+        joint.mimic = Some(Mimic {
+            joint: JointId(index),
+            multiplier: *multiplier as f32,
+            offset: *offset as f32,
+        });
+    }
+    Ok(())
+}
+
+/// The `<transmission>`s, checked against the joints: each names a moving joint and a
+/// position, velocity or effort interface.
+fn read_transmissions(
+    urdf: &urdf::RobotEl,
+    joints: &[Joint],
+    path: &Path,
+) -> Result<Vec<Transmission>> {
+    let mut out = Vec::new();
+    for t in &urdf.transmissions {
+        let line = Some(t.line);
+        for (joint_name, interfaces, reduction) in &t.joints {
+            let what = format!(
+                "<transmission name=\"{}\"> <joint name=\"{joint_name}\">",
+                t.name
+            );
+            let Some(joint) = joints.iter().find(|j| &j.name == joint_name) else {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "{what}: no such joint; joints in this robot: {}",
+                        names(joints.iter().map(|j| &j.name))
+                    ),
+                ));
+            };
+            if !joint.is_moving() {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "{what}: the joint is fixed or floating; a transmission drives a revolute, continuous or prismatic joint"
+                    ),
+                ));
+            }
+            let state_only = !interfaces.is_empty()
+                && interfaces.iter().all(|i| i.ends_with("JointStateInterface"));
+            if state_only {
+                // Reported, not driven: ros_control reads such joints and commands nothing.
+                continue;
+            }
+            let Some(interface) = interfaces.iter().find_map(|i| HardwareInterface::parse(i))
+            else {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "{what}: <hardwareInterface> {}; expected hardware_interface/PositionJointInterface, VelocityJointInterface or EffortJointInterface",
+                        if interfaces.is_empty() {
+                            "missing".to_owned()
+                        } else {
+                            format!("is {}", interfaces.join(", "))
+                        }
+                    ),
+                ));
+            };
+            if !(reduction.is_finite() && *reduction != 0.0) {
+                return Err(SimError::invalid(
+                    path,
+                    line,
+                    format!(
+                        "{what}: <mechanicalReduction> is {reduction}; expected a non-zero number"
+                    ),
+                ));
+            }
+            out.push(Transmission {
+                name: t.name.clone(),
+                joint: joint_name.clone(),
+                interface,
+                reduction: *reduction,
+                line,
+            });
+        }
+    }
+    Ok(out)
 }

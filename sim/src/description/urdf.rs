@@ -9,7 +9,7 @@ use std::path::Path;
 
 use roxmltree::Node;
 
-use crate::description::xml::{child, line_of};
+use crate::description::xml::{child, children, line_of};
 use crate::error::{Result, SimError};
 
 /// `<origin xyz rpy>` (zeros when absent).
@@ -97,7 +97,23 @@ pub(crate) struct JointEl {
     pub axis: [f64; 3],
     /// `<limit lower upper>`; urdfdom requires it for revolute and prismatic joints.
     pub limit: Option<(f64, f64)>,
+    /// `<limit effort velocity>`.
+    pub effort: Option<f64>,
+    pub velocity: Option<f64>,
     pub damping: Option<f64>,
+    pub friction: Option<f64>,
+    /// `<mimic joint multiplier offset>`.
+    pub mimic: Option<(String, f64, f64)>,
+}
+
+/// A `<transmission>`: its joints, each with the first command interface it lists.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct TransmissionEl {
+    pub name: String,
+    pub kind: String,
+    /// Joint name, its `<hardwareInterface>`s, the reduction.
+    pub joints: Vec<(String, Vec<String>, f64)>,
+    pub line: u32,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -106,6 +122,7 @@ pub(crate) struct RobotEl {
     pub materials: Vec<MaterialEl>,
     pub links: Vec<LinkEl>,
     pub joints: Vec<JointEl>,
+    pub transmissions: Vec<TransmissionEl>,
 }
 
 struct Reader<'a, 'input> {
@@ -330,9 +347,21 @@ impl Reader<'_, '_> {
             Some(a) => self.numbers(a, "xyz")?.unwrap_or([1.0, 0.0, 0.0]),
             None => [1.0, 0.0, 0.0],
         };
-        let damping = match child(node, "dynamics") {
-            Some(d) if d.attribute("damping").is_some() => Some(self.number(d, "damping")?),
-            _ => None,
+        let optional = |el: Option<Node<'_, '_>>, attr: &str| -> Result<Option<f64>> {
+            match el {
+                Some(e) if e.attribute(attr).is_some() => Ok(Some(self.number(e, attr)?)),
+                _ => Ok(None),
+            }
+        };
+        let dynamics = child(node, "dynamics");
+        let limit_el = child(node, "limit");
+        let mimic = match child(node, "mimic") {
+            Some(m) => Some((
+                self.attr(m, "joint")?.to_owned(),
+                optional(Some(m), "multiplier")?.unwrap_or(1.0),
+                optional(Some(m), "offset")?.unwrap_or(0.0),
+            )),
+            None => None,
         };
         Ok(JointEl {
             parent: link_of("parent")?,
@@ -342,7 +371,51 @@ impl Reader<'_, '_> {
             joint_type,
             axis,
             limit,
-            damping,
+            effort: optional(limit_el, "effort")?,
+            velocity: optional(limit_el, "velocity")?,
+            damping: optional(dynamics, "damping")?,
+            friction: optional(dynamics, "friction")?,
+            mimic,
+        })
+    }
+
+    fn transmission(&self, node: Node<'_, '_>) -> Result<TransmissionEl> {
+        let name = node.attribute("name").unwrap_or("").to_owned();
+        let kind = child(node, "type")
+            .and_then(|t| t.text())
+            .or_else(|| node.attribute("type"))
+            .unwrap_or("")
+            .trim()
+            .to_owned();
+        let mut joints = Vec::new();
+        let reduction = children(node, "actuator")
+            .find_map(|a| child(a, "mechanicalReduction").and_then(|r| r.text()))
+            .map(|t| {
+                t.trim().parse::<f64>().map_err(|_| {
+                    self.err(
+                        node,
+                        format!(
+                            "<transmission name=\"{name}\"> <mechanicalReduction>{}</mechanicalReduction>: expected a number",
+                            t.trim()
+                        ),
+                    )
+                })
+            })
+            .transpose()?
+            .unwrap_or(1.0);
+        for joint in children(node, "joint") {
+            let joint_name = self.attr(joint, "name")?.to_owned();
+            let interfaces = children(joint, "hardwareInterface")
+                .filter_map(|h| h.text())
+                .map(|t| t.trim().to_owned())
+                .collect();
+            joints.push((joint_name, interfaces, reduction));
+        }
+        Ok(TransmissionEl {
+            name,
+            kind,
+            joints,
+            line: line_of(self.doc, node),
         })
     }
 }
@@ -356,12 +429,14 @@ pub(crate) fn read(doc: &roxmltree::Document<'_>, path: &Path) -> Result<RobotEl
         materials: Vec::new(),
         links: Vec::new(),
         joints: Vec::new(),
+        transmissions: Vec::new(),
     };
     for node in root.children().filter(Node::is_element) {
         match node.tag_name().name() {
             "link" => robot.links.push(r.link(node)?),
             "joint" => robot.joints.push(r.joint(node)?),
             "material" => robot.materials.push(r.material(node)?),
+            "transmission" => robot.transmissions.push(r.transmission(node)?),
             _ => {}
         }
     }

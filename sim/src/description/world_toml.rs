@@ -12,7 +12,7 @@ use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, 
 use crate::model::drive::DriveSpec;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_STEP_HZ, Ground, Object, Physics, RobotSpawn, World, check_step_hz,
+    DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World, check_step_hz,
 };
 
 impl World {
@@ -112,6 +112,7 @@ struct RawPhysics {
     step_hz: f64,
     gravity_mps2: [f64; 3],
     solver_iterations: usize,
+    joints: JointSolver,
 }
 
 impl Default for RawPhysics {
@@ -120,6 +121,7 @@ impl Default for RawPhysics {
             step_hz: DEFAULT_STEP_HZ,
             gravity_mps2: [0.0, 0.0, -9.81],
             solver_iterations: 4,
+            joints: JointSolver::default(),
         }
     }
 }
@@ -130,6 +132,7 @@ impl From<RawPhysics> for Physics {
             step_hz: p.step_hz,
             gravity_mps2: p.gravity_mps2,
             solver_iterations: p.solver_iterations,
+            joints: p.joints,
         }
     }
 }

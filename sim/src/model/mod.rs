@@ -2,6 +2,7 @@
 //! Imports only `geometry` and `error`; `description` fills it from files, `physics`, `render`
 //! and `sensors` run it.
 
+pub(crate) mod actuation;
 pub(crate) mod camera_info;
 pub(crate) mod drive;
 pub(crate) mod mesh;
@@ -10,15 +11,18 @@ pub(crate) mod robot;
 pub(crate) mod sensors;
 pub(crate) mod world;
 
+pub use actuation::{HardwareInterface, RosControlPlugin, Transmission};
 pub use camera_info::{CameraInfo, link_from_optical};
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
 pub use mesh::{MeshData, MeshVertex};
 pub use person::{Person, Walk};
-pub use robot::{Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, RobotModel, Visual};
+pub use robot::{
+    Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
+};
 pub use sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
 };
 pub use world::{
-    DEFAULT_STEP_HZ, Ground, Model, ModelLink, Object, Physics, RobotSpawn, STEP_HZ_RANGE, World,
-    check_step_hz,
+    DEFAULT_STEP_HZ, Ground, JointSolver, Model, ModelLink, Object, Physics, RobotSpawn,
+    STEP_HZ_RANGE, World, check_step_hz,
 };

@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use crate::error::{Result, SimError, quoted_list as names};
 use crate::geometry::{Pose, Rgba, Shape};
+use crate::model::actuation::{RosControlPlugin, Transmission};
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
 use crate::model::sensors::{CameraConfig, LaserConfig};
@@ -135,8 +136,52 @@ pub struct Joint {
     pub parent_from_child: Pose,
     /// Unit axis in the joint (= child link) frame.
     pub axis: Vec3,
-    /// Viscous damping from `<dynamics damping>` (N m s/rad).
+    /// Viscous damping from `<dynamics damping>` (N m s/rad, or N s/m for a prismatic joint).
     pub damping: f32,
+    /// Coulomb friction from `<dynamics friction>` (N m, or N for a prismatic joint).
+    pub friction: f32,
+    /// `<limit effort>`: the most torque (N m) or force (N) an actuator may apply; `None`
+    /// when the URDF gives none.
+    pub effort_limit: Option<f32>,
+    /// `<limit velocity>`: the fastest the joint may be driven (rad/s or m/s); `None` when
+    /// the URDF gives none.
+    pub velocity_limit: Option<f32>,
+    /// `<mimic>`: this joint follows another one.
+    pub mimic: Option<Mimic>,
+}
+
+/// A URDF `<mimic joint multiplier offset>`: position = multiplier x the other joint's + offset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mimic {
+    /// The joint followed.
+    pub joint: JointId,
+    /// Factor on the followed joint's position.
+    pub multiplier: f32,
+    /// Added to the product (rad or m).
+    pub offset: f32,
+}
+
+impl Joint {
+    /// Whether the joint moves (continuous, revolute or prismatic): the ones an actuator can
+    /// drive and `/joint_states` lists.
+    pub fn is_moving(&self) -> bool {
+        matches!(
+            self.kind,
+            JointKind::Continuous | JointKind::Revolute { .. } | JointKind::Prismatic { .. }
+        )
+    }
+
+    /// The position limits (rad or m), for revolute and prismatic joints.
+    pub fn position_limits(&self) -> Option<(f32, f32)> {
+        match self.kind {
+            JointKind::Revolute {
+                lower_rad,
+                upper_rad,
+            } => Some((lower_rad, upper_rad)),
+            JointKind::Prismatic { lower_m, upper_m } => Some((lower_m, upper_m)),
+            _ => None,
+        }
+    }
 }
 
 /// A robot loaded from URDF.
@@ -160,6 +205,11 @@ pub struct RobotModel {
     pub lasers: Vec<LaserConfig>,
     /// Gazebo sensors and plugins in the file that rover does not simulate (IMU, GPS, ...).
     pub not_simulated: Vec<String>,
+    /// `<transmission>`s: which joints an actuator drives, through which ros_control
+    /// hardware interface.
+    pub transmissions: Vec<Transmission>,
+    /// The `libgazebo_ros_control.so` plugin, if present.
+    pub ros_control: Option<RosControlPlugin>,
     /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
     /// `/robot_description`.
     pub description: String,
@@ -258,6 +308,41 @@ impl RobotModel {
         Ok(())
     }
 
+    /// Whether the robot is bolted to the world: its root link is called `world`, which
+    /// Gazebo anchors (most arm descriptions, UR5 among them).
+    pub fn is_anchored(&self) -> bool {
+        self.link(self.root).name == "world"
+    }
+
+    /// The joints an actuator drives (joint order): those with a `<transmission>`, and every
+    /// revolute and prismatic joint (held in place when nothing else commands it), except the
+    /// drive's wheels and `<mimic>` joints. Continuous joints without a transmission (casters)
+    /// stay passive.
+    pub fn actuated_joints(&self) -> Vec<JointId> {
+        let wheels: Vec<&str> = self.diff_drive.as_ref().map_or(Vec::new(), |d| {
+            [&d.left_joint, &d.right_joint]
+                .into_iter()
+                .chain(&d.extra_left_joints)
+                .chain(&d.extra_right_joints)
+                .map(String::as_str)
+                .collect()
+        });
+        self.joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| {
+                j.is_moving()
+                    && j.mimic.is_none()
+                    && !wheels.contains(&j.name.as_str())
+                    && (matches!(
+                        j.kind,
+                        JointKind::Revolute { .. } | JointKind::Prismatic { .. }
+                    ) || self.transmissions.iter().any(|t| t.joint == j.name))
+            })
+            .map(|(i, _)| JointId(i))
+            .collect()
+    }
+
     /// The link called `name`.
     pub fn link_id(&self, name: &str) -> Option<LinkId> {
         self.links.iter().position(|l| l.name == name).map(LinkId)
@@ -276,6 +361,11 @@ impl RobotModel {
     /// A joint of this model.
     pub fn joint(&self, id: JointId) -> &Joint {
         &self.joints[id.0]
+    }
+
+    /// Every joint with its id, in URDF order.
+    pub fn joint_ids(&self) -> impl Iterator<Item = (JointId, &Joint)> {
+        self.joints.iter().enumerate().map(|(i, j)| (JointId(i), j))
     }
 
     /// Every link with its id, in URDF order.

@@ -58,6 +58,29 @@ pub struct Physics {
     pub gravity_mps2: [f64; 3],
     /// Solver iterations per step.
     pub solver_iterations: usize,
+    /// How the robot's moving joints are solved (`joints = "multibody"` or `"impulse"`).
+    pub joints: JointSolver,
+}
+
+/// How a robot's moving joints are solved.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointSolver {
+    /// Reduced coordinates: rapier's multibody joints.
+    Multibody,
+    /// Constraints between pairs of bodies: rapier's impulse joints (the default).
+    #[default]
+    Impulse,
+}
+
+impl JointSolver {
+    /// The name used in world files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Multibody => "multibody",
+            Self::Impulse => "impulse",
+        }
+    }
 }
 
 /// The ground (`[ground]`): a flat square centred on the origin, top at z = 0.

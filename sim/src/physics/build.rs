@@ -10,7 +10,9 @@ use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Shape, pose_from_position_yaw};
 use crate::model::person::Person;
 use crate::model::robot::{JointKind, RobotModel};
+use crate::model::world::JointSolver;
 use crate::model::world::World;
+use crate::physics::joints::{BuiltJoint, add_joints};
 
 /// Collision group of the robot's own colliders (the robot does not collide with itself,
 /// like Gazebo's default `self_collide = false`).
@@ -127,7 +129,7 @@ pub(crate) fn add_world(
 pub(crate) struct RobotBodies {
     pub(crate) link_body: Vec<RigidBodyHandle>,
     pub(crate) body_from_link: Vec<Pose>,
-    pub(crate) joints: Vec<Option<ImpulseJointHandle>>,
+    pub(crate) joints: Vec<Option<BuiltJoint>>,
     /// Mass of each link's rigid body (kg).
     pub(crate) link_mass_kg: Vec<f32>,
 }
@@ -189,23 +191,31 @@ pub(crate) fn add_robot(
     physics: &mut PhysicsWorld,
     world: &World,
     robot: &RobotModel,
+    solver: JointSolver,
 ) -> Result<RobotBodies> {
     let (body_root, body_from_link) = weld_fixed_links(robot);
     let root_from_links = robot.root_from_links();
     let (shapes, min_z) = robot_shapes(robot, &root_from_links)?;
     let spawn = &world.robot;
+    let anchored = robot.is_anchored();
+    // An anchored robot's `world` link sits at the spawn point; a free one rests on the ground.
+    let z_m = if anchored {
+        0.0
+    } else {
+        f64::from(SPAWN_CLEARANCE_M - min_z)
+    };
     let world_from_root = pose_from_position_yaw(
-        [
-            spawn.position_m[0],
-            spawn.position_m[1],
-            f64::from(SPAWN_CLEARANCE_M - min_z),
-        ],
+        [spawn.position_m[0], spawn.position_m[1], z_m],
         spawn.yaw_rad,
     );
-    let (link_body, link_mass_kg) =
-        add_link_bodies(physics, robot, &body_root, &body_from_link, |root| {
-            world_from_root * root_from_links[root]
-        });
+    let anchor = anchored.then_some(body_root[robot.root.0]);
+    let (link_body, link_mass_kg) = add_link_bodies(
+        physics,
+        robot,
+        (&body_root, &body_from_link),
+        anchor,
+        |root| world_from_root * root_from_links[root],
+    );
     let robot_groups = InteractionGroups::new(ROBOT_GROUP, !ROBOT_GROUP, InteractionTestMode::And);
     for (i, shape, link_from_shape) in shapes {
         physics.insert_collider(
@@ -218,7 +228,7 @@ pub(crate) fn add_robot(
             Some(link_body[i]),
         );
     }
-    let joints = add_joints(physics, robot, &link_body, &body_from_link);
+    let joints = add_joints(physics, robot, &link_body, &body_from_link, solver);
     Ok(RobotBodies {
         link_body,
         link_mass_kg,
@@ -278,13 +288,14 @@ fn robot_shapes(robot: &RobotModel, root_from_links: &[Pose]) -> Result<(Vec<Lin
     Ok((shapes, min_z))
 }
 
-/// One rigid body per body root, carrying the summed inertials of its links; returns each
-/// link's body and that body's mass (kg).
+/// One rigid body per body root, carrying the summed inertials of its links (the `anchor`
+/// body, when given, is fixed to the world); returns each link's body and that body's mass
+/// (kg).
 fn add_link_bodies(
     physics: &mut PhysicsWorld,
     robot: &RobotModel,
-    body_root: &[usize],
-    body_from_link: &[Pose],
+    (body_root, body_from_link): (&[usize], &[Pose]),
+    anchor: Option<usize>,
     world_from_root_link: impl Fn(usize) -> Pose,
 ) -> (Vec<RigidBodyHandle>, Vec<f32>) {
     let n = robot.links.len();
@@ -315,7 +326,7 @@ fn add_link_bodies(
                 mass += props.transform_by(&body_from_link[i]);
             }
         }
-        if mass.mass() <= 0.0 {
+        if mass.mass() <= 0.0 && anchor != Some(root) {
             tracing::warn!(
                 "{}: link \"{}\" moves on its own but has no <inertial>; giving it 10 g",
                 robot.source.display(),
@@ -323,8 +334,13 @@ fn add_link_bodies(
             );
             mass = MassProperties::new(Vec3::ZERO, 0.01, Vec3::splat(1e-6));
         }
-        let body = physics.insert_body(
+        let builder = if anchor == Some(root) {
+            RigidBodyBuilder::fixed()
+        } else {
             RigidBodyBuilder::dynamic()
+        };
+        let body = physics.insert_body(
+            builder
                 .pose(world_from_root_link(root))
                 .additional_mass_properties(mass)
                 .can_sleep(false),
@@ -337,51 +353,6 @@ fn add_link_bodies(
         }
     }
     (link_body, link_mass_kg)
-}
-
-/// An impulse joint for every moving URDF joint (joint order); `None` for fixed and floating
-/// ones.
-fn add_joints(
-    physics: &mut PhysicsWorld,
-    robot: &RobotModel,
-    link_body: &[RigidBodyHandle],
-    body_from_link: &[Pose],
-) -> Vec<Option<ImpulseJointHandle>> {
-    let mut joints = vec![None; robot.joints.len()];
-    for (index, joint) in robot.joints.iter().enumerate() {
-        let (parent, child) = (link_body[joint.parent.0], link_body[joint.child.0]);
-        let axis_frame = Pose::from_rotation(Quat::from_rotation_arc(Vec3::X, joint.axis));
-        let frame1 = body_from_link[joint.parent.0] * joint.parent_from_child * axis_frame;
-        let frame2 = body_from_link[joint.child.0] * axis_frame;
-        let builder = match joint.kind {
-            JointKind::Fixed | JointKind::Floating => continue,
-            JointKind::Continuous => GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES),
-            JointKind::Revolute {
-                lower_rad,
-                upper_rad,
-            } => GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
-                .limits(JointAxis::AngX, [lower_rad, upper_rad]),
-            JointKind::Prismatic { lower_m, upper_m } => {
-                GenericJointBuilder::new(JointAxesMask::LOCKED_PRISMATIC_AXES)
-                    .limits(JointAxis::LinX, [lower_m, upper_m])
-            }
-        };
-        let free_axis = match joint.kind {
-            JointKind::Prismatic { .. } => JointAxis::LinX,
-            _ => JointAxis::AngX,
-        };
-        let mut builder = builder
-            .local_frame1(frame1)
-            .local_frame2(frame2)
-            .contacts_enabled(false);
-        if joint.damping > 0.0 {
-            builder = builder
-                .motor_model(free_axis, MotorModel::ForceBased)
-                .motor_velocity(free_axis, 0.0, joint.damping);
-        }
-        joints[index] = Some(physics.insert_impulse_joint(parent, child, builder.build()));
-    }
-    joints
 }
 
 /// Above this mass ratio between jointed bodies the solver gets [`STIFF_SOLVER_ITERATIONS`].

@@ -4,11 +4,12 @@
 use glam::Vec3;
 use rapier3d::prelude::*;
 
-use crate::error::{Result, SimError};
+use crate::error::{Result, SimError, quoted_list};
 use crate::geometry::{Pose, yaw_of};
 use crate::model::drive::OdometrySource;
-use crate::model::robot::{LinkId, RobotModel};
-use crate::model::world::{World, check_step_hz};
+use crate::model::robot::{JointId, LinkId, RobotModel};
+use crate::model::world::{JointSolver, World, check_step_hz};
+use crate::physics::actuators::{Actuators, JointCommand, JointState, Pid};
 use crate::physics::build::{
     STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, add_models, add_robot, add_world,
     joint_mass_ratio, person_body_pose,
@@ -16,6 +17,7 @@ use crate::physics::build::{
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
+use crate::physics::joints::{BuiltJoint, joint_data_mut};
 
 /// Options that are not part of the world or robot files.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -26,6 +28,8 @@ pub struct SimOptions {
     pub cmd_timeout_s: Option<f64>,
     /// Overrides the world's physics step rate (Hz).
     pub step_hz: Option<f64>,
+    /// Overrides how the world solves the robot's joints (`[physics] joints`).
+    pub joints: Option<JointSolver>,
 }
 
 /// The robot's state at one diff-drive control update.
@@ -47,11 +51,7 @@ pub struct ControlSample {
 
 #[derive(Debug, Clone, Copy)]
 struct WheelJoint {
-    joint: ImpulseJointHandle,
-    parent: RigidBodyHandle,
-    child: RigidBodyHandle,
-    /// Joint axis in the child body's frame.
-    axis_child: Vec3,
+    joint: BuiltJoint,
     /// [`LEFT`] or [`RIGHT`]: which commanded wheel speed drives it.
     side: usize,
 }
@@ -78,6 +78,11 @@ pub struct Simulation {
     model_links: Vec<RigidBodyHandle>,
     /// The ground's body (not an obstacle for clearance figures).
     ground: RigidBodyHandle,
+    /// Every moving joint as built (joint order; `None` for fixed ones).
+    joints: Vec<Option<BuiltJoint>>,
+    /// The actuated joints' motors, run every `control_steps` physics steps.
+    actuators: Actuators,
+    control_steps: u64,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -122,9 +127,11 @@ impl Simulation {
 
         let (ground, people) = add_world(&mut physics, &world)?;
         let model_links = add_models(&mut physics, &world)?;
-        let robot_bodies = add_robot(&mut physics, &world, &robot)?;
+        let solver = options.joints.unwrap_or(world.physics.joints);
+        let robot_bodies = add_robot(&mut physics, &world, &robot, solver)?;
         let ratio = joint_mass_ratio(&robot, &robot_bodies);
-        if ratio > STIFF_MASS_RATIO
+        if solver == JointSolver::Impulse
+            && ratio > STIFF_MASS_RATIO
             && physics.integration_parameters.num_solver_iterations < STIFF_SOLVER_ITERATIONS
         {
             // Light wheels on a heavy body (a TurtleBot3's 28 g wheels carry 30x their mass)
@@ -143,18 +150,10 @@ impl Simulation {
                     "diff drive joint \"{name}\" missing from the robot"
                 ))
             })?;
-            let joint = robot.joint(id);
-            let handle = robot_bodies.joints[id.index()].ok_or_else(|| {
+            let joint = robot_bodies.joints[id.index()].ok_or_else(|| {
                 SimError::Setup(format!("diff drive joint \"{name}\" is not a wheel joint"))
             })?;
-            let child_from_link = robot_bodies.body_from_link[joint.child.index()];
-            Ok(WheelJoint {
-                joint: handle,
-                parent: robot_bodies.link_body[joint.parent.index()],
-                child: robot_bodies.link_body[joint.child.index()],
-                axis_child: child_from_link.rotation * joint.axis,
-                side,
-            })
+            Ok(WheelJoint { joint, side })
         };
         let mut wheels = Vec::new();
         if drivable {
@@ -168,14 +167,24 @@ impl Simulation {
             }
         }
         for w in &wheels {
-            if let Some(j) = physics.impulse_joints.get_mut(w.joint, true) {
-                j.data
-                    .set_motor_model(JointAxis::AngX, MotorModel::ForceBased)
+            if let Some(data) = joint_data_mut(&mut physics, w.joint.handle) {
+                data.set_motor_model(JointAxis::AngX, MotorModel::ForceBased)
                     .set_motor_velocity(JointAxis::AngX, 0.0, WHEEL_MOTOR_GAIN)
                     .set_motor_max_force(JointAxis::AngX, drive_config.wheel_torque_nm as f32);
             }
         }
 
+        let actuators = Actuators::new(
+            &robot,
+            (&robot_bodies.joints, &robot_bodies.link_body),
+            &mut physics,
+        );
+        // ros_control's controlPeriod (default: every physics step), never below the step.
+        let control_steps = robot
+            .ros_control
+            .as_ref()
+            .and_then(|r| r.control_period_s)
+            .map_or(1, |period| ((period / dt_s).round() as u64).max(1));
         let base = robot_bodies.link_body[robot.root.index()];
         let start = planar(
             physics
@@ -199,6 +208,9 @@ impl Simulation {
             people,
             model_links,
             ground,
+            joints: robot_bodies.joints,
+            actuators,
+            control_steps,
             robot,
             world,
         })
@@ -219,9 +231,8 @@ impl Simulation {
             let targets = self.drive.wheel_targets_radps();
             for wheel in &self.wheels {
                 let target = targets[wheel.side];
-                if let Some(j) = self.physics.impulse_joints.get_mut(wheel.joint, true) {
-                    j.data
-                        .set_motor_velocity(JointAxis::AngX, target as f32, WHEEL_MOTOR_GAIN);
+                if let Some(data) = joint_data_mut(&mut self.physics, wheel.joint.handle) {
+                    data.set_motor_velocity(JointAxis::AngX, target as f32, WHEEL_MOTOR_GAIN);
                 }
             }
             Some(self.sample(now))
@@ -238,6 +249,11 @@ impl Simulation {
                 body.set_next_kinematic_position(person_body_pose(person, next_t));
             }
         }
+        if self.step_index.is_multiple_of(self.control_steps) {
+            let period_s = self.control_steps as f64 * self.dt_s;
+            self.actuators.update(&mut self.physics, period_s);
+        }
+        self.actuators.apply_efforts(&mut self.physics, self.dt_s);
         self.physics.step();
         self.step_index += 1;
         let measured = self.wheel_speeds_radps();
@@ -316,6 +332,61 @@ impl Simulation {
             .people
             .get(index)
             .map_or(Pose::IDENTITY, |p| p.world_from_person(self.sim_time_s()))
+    }
+
+    /// Commands a joint by name (a controller's command, a script step, a key). Errors: no
+    /// such joint, a joint without an actuator, a non-finite value (the command is dropped and
+    /// the last one stays in force). Positions outside the joint's limits stop at the limit.
+    pub fn command_joint(&mut self, name: &str, command: JointCommand) -> Result<()> {
+        let id = self.joint_named(name)?;
+        self.actuators.command(&self.robot, id, command)
+    }
+
+    /// Gives an actuated joint its own PID gains (instead of the inertia-derived hold).
+    pub fn set_joint_pid(&mut self, name: &str, pid: Pid) -> Result<()> {
+        let id = self.joint_named(name)?;
+        if self.actuators.of(id).is_none() {
+            return Err(SimError::Setup(format!(
+                "joint \"{name}\" has no actuator (it is fixed, passive, a drive wheel or mimics another joint)"
+            )));
+        }
+        self.actuators.set_pid(id, pid);
+        Ok(())
+    }
+
+    fn joint_named(&self, name: &str) -> Result<JointId> {
+        self.robot.joint_id(name).ok_or_else(|| {
+            SimError::Setup(format!(
+                "robot \"{}\" has no joint \"{name}\"; its moving joints: {}",
+                self.robot.name,
+                quoted_list(self.moving_joints().map(|id| &self.robot.joint(id).name))
+            ))
+        })
+    }
+
+    /// The joints that move in the scene (continuous, revolute, prismatic), joint order.
+    pub fn moving_joints(&self) -> impl Iterator<Item = JointId> + '_ {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.is_some())
+            .map(|(i, _)| JointId(i))
+    }
+
+    /// The state of a moving joint now; `None` for fixed joints.
+    pub fn joint_state(&self, joint: JointId) -> Option<JointState> {
+        let built = self.joints.get(joint.index())?.as_ref()?;
+        Some(JointState {
+            position: built.position(&self.physics.bodies),
+            velocity: built.velocity(&self.physics.bodies),
+            effort: self.actuators.of(joint).map_or(0.0, |a| a.effort),
+        })
+    }
+
+    /// The position target an actuated joint is driven toward now (its command, clamped into
+    /// the limits); `None` when it is not position-controlled.
+    pub fn joint_target(&self, joint: JointId) -> Option<f64> {
+        self.actuators.of(joint).and_then(|a| a.position_target())
     }
 
     /// Sim time (s): physics steps taken times the step length.
@@ -423,15 +494,7 @@ impl Simulation {
     pub fn wheel_speeds_radps(&self) -> WheelSpeeds {
         let mut out = [0.0; 2];
         for w in self.wheels.iter().take(2) {
-            let slot = w.side;
-            let (Some(parent), Some(child)) = (
-                self.physics.bodies.get(w.parent),
-                self.physics.bodies.get(w.child),
-            ) else {
-                continue;
-            };
-            let axis_world = child.rotation() * w.axis_child;
-            out[slot] = f64::from((child.angvel() - parent.angvel()).dot(axis_world));
+            out[w.side] = w.joint.velocity(&self.physics.bodies);
         }
         out
     }

@@ -1,0 +1,469 @@
+//! The robot's joint actuators: ros_control's hardware interfaces on sim time.
+//!
+//! Every actuated joint ([`RobotModel::actuated_joints`]) gets one. Left alone it holds the
+//! pose it started in — a PID whose gains come from the inertia the joint carries (a critically
+//! damped loop at [`HOLD_BANDWIDTH_HZ`], integral time [`HOLD_INTEGRAL_S`]), so an arm neither
+//! sags under gravity nor jitters, and no one has to write gains first. A position command moves
+//! the setpoint toward the target no faster than the URDF `<limit velocity>`; the effort never
+//! exceeds `<limit effort>` (the motor's force cap). Velocity and effort commands follow
+//! gazebo_ros_control's VelocityJointInterface and EffortJointInterface.
+//!
+//! The proportional and derivative terms are solved implicitly by rapier's joint motor (stable
+//! at any gain on a 59 g link), the integral explicitly, as a shift of the motor's target.
+
+use glam::Vec3;
+use rapier3d::prelude::*;
+
+use crate::error::{Result, SimError};
+use crate::model::robot::{JointId, JointKind, RobotModel};
+use crate::physics::diff_drive::wrap_angle;
+use crate::physics::joints::{BuiltJoint, joint_data_mut};
+
+/// Bandwidth of the default holding loop (Hz).
+pub const HOLD_BANDWIDTH_HZ: f64 = 8.0;
+/// Integral time of the default holding loop (s): how fast a steady load (gravity) is
+/// cancelled.
+pub const HOLD_INTEGRAL_S: f64 = 0.15;
+/// How far the default hold's integral may go, in effort limits.
+const HOLD_INTEGRAL_HEADROOM: f64 = 4.0;
+/// Below this the carried inertia is not known yet (kg m^2 or kg).
+const MIN_INERTIA: f64 = 1e-9;
+/// The share of the velocity limit a position move plans for (the loop's tracking error
+/// takes the rest).
+pub const PROFILE_VELOCITY_SHARE: f64 = 0.9;
+/// The share of the effort left over from carrying the load that a position move plans to
+/// accelerate and brake with (the loop's corrections take the rest).
+pub const PROFILE_EFFORT_SHARE: f64 = 0.3;
+/// The default hold integrates only errors smaller than this (rad or m): the integral is for
+/// what the weight estimate leaves, not for catching up after a move.
+pub const HOLD_INTEGRAL_BAND: f64 = 0.2;
+/// The largest error the default hold leaves to a joint's dry friction (`<dynamics
+/// friction>`, rad or m): its stiffness is at least friction / this.
+pub const HOLD_FRICTION_ERROR: f64 = 0.002;
+
+/// PID gains in the joint's own units: p in N m/rad (N/m), i in N m/(rad s), d in N m s/rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pid {
+    /// Proportional gain.
+    pub p: f64,
+    /// Integral gain.
+    pub i: f64,
+    /// Derivative gain.
+    pub d: f64,
+    /// Bound on the integral term's effort (N m or N); 0 = the effort limit.
+    pub i_clamp: f64,
+}
+
+/// What a joint is told to do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JointCommand {
+    /// Go to and hold a position (rad or m); clamped into the joint's limits.
+    Position(f64),
+    /// Turn or slide at a speed (rad/s or m/s); capped by the velocity limit.
+    Velocity(f64),
+    /// Apply a torque (N m) or force (N); capped by the effort limit.
+    Effort(f64),
+}
+
+/// A joint's state, as `/joint_states` reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JointState {
+    /// Position (rad or m).
+    pub position: f64,
+    /// Velocity (rad/s or m/s).
+    pub velocity: f64,
+    /// The actuator's effort at the last control update (N m or N); 0 for passive joints.
+    pub effort: f64,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct Actuator {
+    built: BuiltJoint,
+    continuous: bool,
+    limits: Option<(f64, f64)>,
+    effort_max: f64,
+    velocity_max: Option<f64>,
+    command: JointCommand,
+    /// User gains (a controllers YAML); `None`: derived from the inertia.
+    pid: Option<Pid>,
+    /// The position the loop holds now (moves toward a position target at the velocity limit).
+    setpoint: f64,
+    setpoint_velocity: f64,
+    /// The integral term (N m or N).
+    integral: f64,
+    /// Effective inertia about the axis (kg m^2 or kg), measured every control update.
+    inertia: f64,
+    /// The effort that holds the carried bodies against gravity now (N m or N).
+    gravity_hold: f64,
+    /// `<dynamics friction>` (N m or N).
+    friction: f64,
+
+    pub(crate) effort: f64,
+    /// The bodies the joint carries (its child and everything beyond it).
+    carried: Vec<RigidBodyHandle>,
+}
+
+impl Actuator {
+    /// The position the joint is commanded to, if it is position-controlled.
+    pub(crate) fn position_target(&self) -> Option<f64> {
+        match self.command {
+            JointCommand::Position(q) => Some(q),
+            _ => None,
+        }
+    }
+
+    fn gains(&self) -> Pid {
+        self.pid.unwrap_or_else(|| {
+            let omega = 2.0 * std::f64::consts::PI * HOLD_BANDWIDTH_HZ;
+            let p = (self.inertia * omega * omega).max(self.friction / HOLD_FRICTION_ERROR);
+            Pid {
+                p,
+                i: p / HOLD_INTEGRAL_S,
+                // Critically damped at whichever stiffness won.
+                d: 2.0 * (p * self.inertia).sqrt(),
+                i_clamp: 0.0,
+            }
+        })
+    }
+
+    /// Moves the setpoint toward `target` on a trapezoid: no faster than the velocity limit,
+    /// accelerating and braking no harder than half of what the effort left over from carrying
+    /// the load can do, so the loop that follows it is not driven into its effort limit.
+    fn advance_setpoint(&mut self, target: f64, dt_s: f64) {
+        let to_go = self.error(target, self.setpoint);
+        let v_max = self.velocity_max.unwrap_or(f64::INFINITY) * PROFILE_VELOCITY_SHARE;
+        let spare = (self.effort_max - self.gravity_hold.abs()).max(0.1 * self.effort_max);
+        let accel = if self.pid.is_none() {
+            PROFILE_EFFORT_SHARE * spare / self.inertia
+        } else {
+            f64::INFINITY
+        };
+        let wanted = to_go.signum() * v_max.min((2.0 * accel * to_go.abs()).sqrt());
+        let dv = (wanted - self.setpoint_velocity).clamp(-accel * dt_s, accel * dt_s);
+        let mut velocity = self.setpoint_velocity + dv;
+        if !velocity.is_finite() {
+            velocity = wanted;
+        }
+        let mut step = velocity * dt_s;
+        if step.abs() >= to_go.abs() || to_go == 0.0 {
+            step = to_go;
+            velocity = 0.0;
+        }
+        let setpoint = self.setpoint + step;
+        self.setpoint = self.clamp_position(setpoint);
+        self.setpoint_velocity = velocity;
+    }
+
+    fn clamp_position(&self, q: f64) -> f64 {
+        match self.limits {
+            Some((lo, hi)) => q.clamp(lo, hi),
+            None => q,
+        }
+    }
+
+    /// Error from `q` to `target`; the short way round for a continuous joint.
+    fn error(&self, target: f64, q: f64) -> f64 {
+        if self.continuous {
+            wrap_angle(target - q)
+        } else {
+            target - q
+        }
+    }
+}
+
+/// The actuators of one robot, run at the control period.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Actuators {
+    pub(crate) list: Vec<Actuator>,
+    /// Actuator index per joint (joint order).
+    by_joint: Vec<Option<usize>>,
+}
+
+impl Actuators {
+    /// One actuator per actuated joint that the scene has, holding where it starts.
+    pub(crate) fn new(
+        robot: &RobotModel,
+        (joints, link_body): (&[Option<BuiltJoint>], &[RigidBodyHandle]),
+        physics: &mut PhysicsWorld,
+    ) -> Self {
+        let mut out = Self {
+            by_joint: vec![None; robot.joints.len()],
+            ..Self::default()
+        };
+        for id in robot.actuated_joints() {
+            let Some(built) = joints[id.index()] else {
+                continue;
+            };
+            let joint = robot.joint(id);
+            let limits = joint
+                .position_limits()
+                .map(|(lo, hi)| (f64::from(lo), f64::from(hi)));
+            let start = built.position(&physics.bodies);
+            let effort_max = joint
+                .effort_limit
+                .filter(|e| *e > 0.0)
+                .map_or(f64::from(f32::MAX), f64::from);
+            let mut actuator = Actuator {
+                built,
+                continuous: matches!(joint.kind, JointKind::Continuous),
+                limits,
+                effort_max,
+                velocity_max: joint.velocity_limit.filter(|v| *v > 0.0).map(f64::from),
+                command: JointCommand::Position(start),
+                pid: None,
+                setpoint: start,
+                setpoint_velocity: 0.0,
+                integral: 0.0,
+                inertia: 1.0,
+                gravity_hold: 0.0,
+                friction: f64::from(joint.friction),
+                effort: 0.0,
+                carried: carried_bodies(robot, id, link_body),
+            };
+            actuator.setpoint = actuator.clamp_position(start);
+            actuator.command = JointCommand::Position(actuator.setpoint);
+            if let Some(data) = joint_data_mut(physics, built.handle) {
+                data.set_motor_model(built.axis, MotorModel::ForceBased)
+                    .set_motor_max_force(built.axis, effort_max as f32);
+            }
+            out.by_joint[id.index()] = Some(out.list.len());
+            out.list.push(actuator);
+        }
+        out
+    }
+
+    /// The actuator of `joint`, if it has one.
+    pub(crate) fn of(&self, joint: JointId) -> Option<&Actuator> {
+        self.by_joint
+            .get(joint.index())
+            .copied()
+            .flatten()
+            .map(|i| &self.list[i])
+    }
+
+    /// Sets a joint's command. Non-finite values and joints without an actuator are errors;
+    /// positions outside the limits are clamped to them.
+    pub(crate) fn command(
+        &mut self,
+        robot: &RobotModel,
+        joint: JointId,
+        command: JointCommand,
+    ) -> Result<()> {
+        let name = &robot.joint(joint).name;
+        let value = match command {
+            JointCommand::Position(v) | JointCommand::Velocity(v) | JointCommand::Effort(v) => v,
+        };
+        if !value.is_finite() {
+            return Err(SimError::Setup(format!(
+                "joint \"{name}\": command {value} is not a finite number; dropped"
+            )));
+        }
+        let Some(a) = self
+            .by_joint
+            .get(joint.index())
+            .copied()
+            .flatten()
+            .and_then(|i| self.list.get_mut(i))
+        else {
+            return Err(SimError::Setup(format!(
+                "joint \"{name}\" has no actuator (it is fixed, passive, a drive wheel or mimics another joint)"
+            )));
+        };
+        a.command = match command {
+            JointCommand::Position(q) => JointCommand::Position(a.clamp_position(q)),
+            JointCommand::Velocity(v) => {
+                let cap = a.velocity_max.unwrap_or(f64::INFINITY);
+                JointCommand::Velocity(v.clamp(-cap, cap))
+            }
+            JointCommand::Effort(e) => JointCommand::Effort(e.clamp(-a.effort_max, a.effort_max)),
+        };
+        Ok(())
+    }
+
+    /// Gives a joint its own PID gains (an effort_controllers position controller).
+    pub(crate) fn set_pid(&mut self, joint: JointId, pid: Pid) {
+        if let Some(a) = self
+            .by_joint
+            .get(joint.index())
+            .copied()
+            .flatten()
+            .and_then(|i| self.list.get_mut(i))
+        {
+            a.pid = Some(pid);
+        }
+    }
+
+    /// One control update of length `dt_s`: moves setpoints, sets the motors.
+    pub(crate) fn update(&mut self, physics: &mut PhysicsWorld, dt_s: f64) {
+        self.measure_loads(physics);
+        for a in &mut self.list {
+            if a.inertia <= MIN_INERTIA {
+                // Mass properties are computed by the first physics step.
+                continue;
+            }
+            let q = a.built.position(&physics.bodies);
+            let v = a.built.velocity(&physics.bodies);
+            let gains = a.gains();
+            let axis = a.built.axis;
+            let Some(data) = joint_data_mut(physics, a.built.handle) else {
+                continue;
+            };
+            match a.command {
+                JointCommand::Position(target) => {
+                    a.advance_setpoint(target, dt_s);
+                    let error = a.error(a.setpoint, q);
+                    // The default hold's integral may ask for more than the effort limit: it
+                    // is a target shift of the motor, whose force the limit caps anyway.
+                    let i_cap = if gains.i_clamp > 0.0 {
+                        gains.i_clamp
+                    } else if a.pid.is_none() {
+                        HOLD_INTEGRAL_HEADROOM * a.effort_max
+                    } else {
+                        a.effort_max
+                    };
+                    // ros_control's PID integrates always (bounded by i_clamp); the default hold
+                    // only small errors, once the setpoint has arrived and the motor is not
+                    // saturated, so a move does not wind it up into an overshoot.
+                    let settled = a.setpoint_velocity == 0.0
+                        && a.effort.abs() < a.effort_max
+                        && error.abs() < HOLD_INTEGRAL_BAND;
+                    // Kept as an effort, so gains that change with the pose do not rescale it.
+                    if a.pid.is_some() || settled {
+                        a.integral = (a.integral + gains.i * error * dt_s).clamp(-i_cap, i_cap);
+                    }
+                    // The default hold also carries the load's weight (ros_control's PID does
+                    // not).
+                    let feed_forward =
+                        a.integral + if a.pid.is_none() { a.gravity_hold } else { 0.0 };
+                    a.effort =
+                        (gains.p * error + gains.d * (a.setpoint_velocity - v) + feed_forward)
+                            .clamp(-a.effort_max, a.effort_max);
+                    // The explicit terms shift the implicit PD's target by the error they
+                    // stand for.
+                    let shift = if gains.p > 0.0 {
+                        feed_forward / gains.p
+                    } else {
+                        0.0
+                    };
+                    data.set_motor(
+                        axis,
+                        (q + error + shift) as f32,
+                        a.setpoint_velocity as f32,
+                        gains.p as f32,
+                        gains.d as f32,
+                    )
+                    .set_motor_max_force(axis, a.effort_max as f32);
+                }
+                JointCommand::Velocity(target) => {
+                    let gain = a.inertia / dt_s.max(1e-3);
+                    a.effort = (gain * (target - v)).clamp(-a.effort_max, a.effort_max);
+                    a.setpoint = q;
+                    a.integral = 0.0;
+                    data.set_motor_velocity(axis, target as f32, gain as f32)
+                        .set_motor_max_force(axis, a.effort_max as f32);
+                }
+                JointCommand::Effort(effort) => {
+                    a.effort = effort;
+                    a.setpoint = q;
+                    a.integral = 0.0;
+                    data.set_motor(axis, 0.0, 0.0, 0.0, 0.0)
+                        .set_motor_max_force(axis, 0.0);
+                }
+            }
+        }
+    }
+
+    /// Applies effort commands for one physics step (a torque or force between the two bodies).
+    pub(crate) fn apply_efforts(&self, physics: &mut PhysicsWorld, dt_s: f64) {
+        for a in &self.list {
+            let JointCommand::Effort(effort) = a.command else {
+                continue;
+            };
+            let Some(child) = physics.bodies.get(a.built.child) else {
+                continue;
+            };
+            let axis_world =
+                (child.position().rotation * a.built.child_from_frame.rotation) * Vec3::X;
+            let impulse = axis_world * (effort * dt_s) as f32;
+            let at = (*child.position() * a.built.child_from_frame).translation;
+            let linear = matches!(a.built.axis, JointAxis::LinX);
+            for (body, sign) in [(a.built.child, 1.0f32), (a.built.parent, -1.0)] {
+                if let Some(b) = physics.bodies.get_mut(body) {
+                    if linear {
+                        b.apply_impulse_at_point(impulse * sign, at, true);
+                    } else {
+                        b.apply_torque_impulse(impulse * sign, true);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Measures what each actuated joint carries: its effective inertia — the inertia about
+    /// its axis (or the mass along it) of everything beyond it with those joints held still,
+    /// the joint-space mass matrix's diagonal, which is what a held arm's joint feels — and
+    /// the effort that holds that load against gravity.
+    fn measure_loads(&mut self, physics: &PhysicsWorld) {
+        let gravity = physics.gravity;
+        for a in &mut self.list {
+            let Some(child) = physics.bodies.get(a.built.child) else {
+                continue;
+            };
+            let frame = *child.position() * a.built.child_from_frame;
+            let axis = frame.rotation * Vec3::X;
+            let linear = matches!(a.built.axis, JointAxis::LinX);
+            let (mut inertia, mut hold) = (0.0f64, 0.0f64);
+            for body in a.carried.iter().filter_map(|h| physics.bodies.get(*h)) {
+                let mass = body.mass();
+                let weight = gravity * mass;
+                if linear {
+                    inertia += f64::from(mass);
+                    hold -= f64::from(weight.dot(axis));
+                    continue;
+                }
+                let r = body.center_of_mass() - frame.translation;
+                let off_axis = (r - axis * r.dot(axis)).length_squared();
+                let local_axis = body.position().rotation.inverse() * axis;
+                let about_com = local_axis.dot(
+                    body.mass_properties()
+                        .local_mprops
+                        .reconstruct_inertia_matrix()
+                        * local_axis,
+                );
+                inertia += f64::from(about_com + mass * off_axis);
+                hold -= f64::from(r.cross(weight).dot(axis));
+            }
+            a.inertia = inertia.max(MIN_INERTIA);
+            a.gravity_hold = hold;
+        }
+    }
+}
+
+/// The distinct bodies of the links beyond `joint` (its child link and its descendants).
+fn carried_bodies(
+    robot: &RobotModel,
+    joint: JointId,
+    link_body: &[RigidBodyHandle],
+) -> Vec<RigidBodyHandle> {
+    let mut inside = vec![false; robot.links.len()];
+    inside[robot.joint(joint).child.index()] = true;
+    let mut grew = true;
+    while grew {
+        grew = false;
+        for j in &robot.joints {
+            if inside[j.parent.index()] && !inside[j.child.index()] {
+                inside[j.child.index()] = true;
+                grew = true;
+            }
+        }
+    }
+    let mut out: Vec<RigidBodyHandle> = Vec::new();
+    for (i, _) in inside.iter().enumerate().filter(|(_, x)| **x) {
+        if let Some(&body) = link_body.get(i)
+            && !out.contains(&body)
+        {
+            out.push(body);
+        }
+    }
+    out
+}

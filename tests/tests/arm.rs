@@ -1,0 +1,236 @@
+//! Actuated joints with ros_control's meaning, on real third-party arms: PAL's TIAGo
+//! (`tiago_no_hand.urdf`) and Universal Robots' UR5, both from PyPI `example-robot-data`
+//! 6.0.0, fetched into the cache at test time (skipped, with the reason, when unavailable).
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use rover_sim::{
+    DriveSpec, JointCommand, JointSolver, LoadOptions, RobotModel, SimOptions, Simulation, Twist,
+    World,
+};
+
+fn example_robot_data(file: &str) -> Option<PathBuf> {
+    let Some(wheel) = rover_tests::pypi("example-robot-data", "6.0.0") else {
+        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+        return None;
+    };
+    Some(
+        wheel
+            .join("cmeel.prefix/share/example-robot-data/robots")
+            .join(file),
+    )
+}
+
+/// TIAGo without its hand, its wheels driven like gazebo_ros_diff_drive.
+fn tiago(solver: JointSolver) -> Result<Option<Simulation>> {
+    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
+        return Ok(None);
+    };
+    let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+    robot.set_drive(&DriveSpec {
+        left_joint: "wheel_left_joint".into(),
+        right_joint: "wheel_right_joint".into(),
+        wheel_separation_m: None,
+        wheel_diameter_m: None,
+        wheel_torque_nm: None,
+    })?;
+    let options = SimOptions {
+        joints: Some(solver),
+        cmd_timeout_s: Some(0.0),
+        ..SimOptions::default()
+    };
+    Ok(Some(Simulation::new(World::flat()?, robot, &options)?))
+}
+
+/// TIAGo's arm "home" pose (arm_1..arm_7).
+const HOME: [(&str, f64); 7] = [
+    ("arm_1_joint", 0.2),
+    ("arm_2_joint", -1.34),
+    ("arm_3_joint", -0.2),
+    ("arm_4_joint", 1.94),
+    ("arm_5_joint", -1.57),
+    ("arm_6_joint", 1.37),
+    ("arm_7_joint", 0.0),
+];
+
+fn worst_error(sim: &Simulation, targets: &[(&str, f64)]) -> Result<(String, f64)> {
+    let mut worst = (String::new(), 0.0f64);
+    for (name, target) in targets {
+        let id = sim
+            .robot()
+            .joint_id(name)
+            .ok_or_else(|| anyhow::anyhow!("no joint {name}"))?;
+        let q = sim
+            .joint_state(id)
+            .ok_or_else(|| anyhow::anyhow!("{name} does not move"))?
+            .position;
+        if (q - target).abs() >= worst.1 {
+            worst = ((*name).to_owned(), (q - target).abs());
+        }
+    }
+    Ok(worst)
+}
+
+fn run_for(sim: &mut Simulation, seconds: f64) {
+    let end = sim.sim_time_s() + seconds;
+    while sim.sim_time_s() < end {
+        sim.step();
+    }
+}
+
+/// Hold: the home pose is reached within 0.01 rad by 2 s and held for 10 s; then driving
+/// 0.3 m/s for 3.5 s turns the base less than 1 degree.
+#[test]
+fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
+    {
+        let Some(mut sim) = tiago(JointSolver::default())? else {
+            return Ok(());
+        };
+        for (name, q) in HOME {
+            sim.command_joint(name, JointCommand::Position(q))?;
+        }
+        run_for(&mut sim, 2.0);
+        let at_2s = worst_error(&sim, &HOME)?;
+        let mut held = at_2s.clone();
+        for _ in 0..100 {
+            run_for(&mut sim, 0.1);
+            let e = worst_error(&sim, &HOME)?;
+            if e.1 > held.1 {
+                held = e;
+            }
+        }
+        let yaw0 = sim.world_from_base().rotation;
+        sim.set_cmd_vel(Twist {
+            linear_mps: 0.3,
+            angular_radps: 0.0,
+        })?;
+        run_for(&mut sim, 3.5);
+        let turn_deg = (yaw0.inverse() * sim.world_from_base().rotation)
+            .to_euler(glam::EulerRot::ZYX)
+            .0
+            .to_degrees();
+        let driving = worst_error(&sim, &HOME)?;
+        println!(
+            "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {:?}",
+            sim.world_from_base().translation
+        );
+        assert!(at_2s.1 < 0.01, "by 2 s: {at_2s:?}");
+        assert!(held.1 < 0.01, "while held: {held:?}");
+        assert!(driving.1 < 0.01, "while driving: {driving:?}");
+        assert!(turn_deg.abs() < 1.0, "the base turned {turn_deg} degrees");
+        assert!(
+            sim.world_from_base().translation.x > 0.8,
+            "drove to {:?}",
+            sim.world_from_base().translation
+        );
+    }
+    Ok(())
+}
+
+/// Step: arm_2 from the home pose's -1.34 to -0.8 rad is there within 0.02 rad by 2 s,
+/// overshoots less than 0.05 rad, and never turns faster than its URDF velocity limit nor
+/// pushes harder than its effort limit.
+#[test]
+fn tiago_arm_2_steps_within_its_limits() -> Result<()> {
+    {
+        let Some(mut sim) = tiago(JointSolver::default())? else {
+            return Ok(());
+        };
+        for (name, q) in HOME {
+            sim.command_joint(name, JointCommand::Position(q))?;
+        }
+        run_for(&mut sim, 3.0);
+        let id = sim
+            .robot()
+            .joint_id("arm_2_joint")
+            .ok_or_else(|| anyhow::anyhow!("no arm_2_joint"))?;
+        let joint = sim.robot().joint(id).clone();
+        let (effort_limit, velocity_limit) = (
+            f64::from(joint.effort_limit.unwrap_or(f32::MAX)),
+            f64::from(joint.velocity_limit.unwrap_or(f32::MAX)),
+        );
+        sim.command_joint("arm_2_joint", JointCommand::Position(-0.8))?;
+        let start = sim.sim_time_s();
+        let (mut fastest, mut hardest, mut highest) = (0.0f64, 0.0f64, f64::NEG_INFINITY);
+        let mut at_2s = f64::NAN;
+        while sim.sim_time_s() - start < 4.0 {
+            sim.step();
+            let s = sim
+                .joint_state(id)
+                .ok_or_else(|| anyhow::anyhow!("arm_2 does not move"))?;
+            fastest = fastest.max(s.velocity.abs());
+            hardest = hardest.max(s.effort.abs());
+            highest = highest.max(s.position);
+            if at_2s.is_nan() && sim.sim_time_s() - start >= 2.0 {
+                at_2s = s.position;
+            }
+        }
+        println!(
+            "arm_2 at 2 s: {at_2s:.4} rad; highest {highest:.4}; fastest {fastest:.3} rad/s (limit {velocity_limit}); hardest {hardest:.2} N m (limit {effort_limit})"
+        );
+        assert!((at_2s + 0.8).abs() < 0.02, "arm_2 at {at_2s} by 2 s");
+        assert!(highest + 0.8 < 0.05, "overshoot to {highest}");
+        assert!(fastest <= velocity_limit * 1.02, "{fastest} rad/s");
+        assert!(hardest <= effort_limit + 1e-9, "{hardest} N m");
+    }
+    Ok(())
+}
+
+/// UR5 (root link `world`): anchored like Gazebo anchors it, it follows a joint command and
+/// then holds that pose. (Its start from the outstretched zero pose takes longer than 5 s
+/// to settle within 0.01 rad: measured and printed, not yet asserted — issue 25.)
+#[test]
+fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
+    let Some(urdf) = example_robot_data("ur_description/urdf/ur5_robot.urdf") else {
+        return Ok(());
+    };
+    let robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+    assert!(robot.is_anchored());
+    let options = SimOptions {
+        joints: Some(JointSolver::Multibody),
+        ..SimOptions::default()
+    };
+    let mut sim = Simulation::new(World::flat()?, robot, &options)?;
+    let base = sim
+        .robot()
+        .link_id("base_link")
+        .ok_or_else(|| anyhow::anyhow!("no base_link"))?;
+    let base_start = sim.world_from_link(base).translation;
+    let mut target: Vec<(&str, f64)> = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
+    .into_iter()
+    .map(|j| (j, 0.0))
+    .collect();
+    run_for(&mut sim, 5.0);
+    let from_zero = worst_error(&sim, &target)?;
+    target[1].1 = -1.0;
+    sim.command_joint("shoulder_lift_joint", JointCommand::Position(-1.0))?;
+    run_for(&mut sim, 3.0);
+    let moved = worst_error(&sim, &target)?;
+    let mut held = moved.clone();
+    for _ in 0..50 {
+        run_for(&mut sim, 0.1);
+        let e = worst_error(&sim, &target)?;
+        if e.1 > held.1 {
+            held = e;
+        }
+    }
+    let base_moved_m = sim.world_from_link(base).translation.distance(base_start);
+    println!(
+        "UR5: zero pose after 5 s {from_zero:?}; 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
+    );
+    assert!(
+        base_moved_m < 0.001,
+        "the anchored base moved {base_moved_m} m"
+    );
+    assert!(moved.1 < 0.02, "after shoulder_lift -> -1: {moved:?}");
+    assert!(held.1 < 0.01, "while held: {held:?}");
+    Ok(())
+}
