@@ -596,3 +596,64 @@ fn absurd_magnitudes_are_refused_at_load_with_the_key_path() -> anyhow::Result<(
     );
     Ok(())
 }
+
+/// A `<transmission>` names a joint that is missing, a fixed joint, or no command interface;
+/// a `<mimic>` names a missing joint: each refused at its line.
+#[test]
+fn transmissions_and_mimics_that_make_no_sense() -> anyhow::Result<()> {
+    let robot = robot_text();
+    let transmission = |joint: &str, interface: &str| {
+        format!(
+            "<transmission name=\"t\"><type>transmission_interface/SimpleTransmission</type><joint name=\"{joint}\"><hardwareInterface>{interface}</hardwareInterface></joint><actuator name=\"m\"><mechanicalReduction>1</mechanicalReduction></actuator></transmission></robot>"
+        )
+    };
+    for (joint, interface, expect) in [
+        (
+            "elbow",
+            "hardware_interface/PositionJointInterface",
+            "<joint name=\"elbow\">: no such joint; joints in this robot:",
+        ),
+        (
+            "caster_joint",
+            "hardware_interface/PositionJointInterface",
+            "the joint is fixed or floating; a transmission drives a revolute, continuous or prismatic joint",
+        ),
+        (
+            "left_wheel_joint",
+            "hardware_interface/TorqueInterface",
+            "<hardwareInterface> is hardware_interface/TorqueInterface; expected hardware_interface/PositionJointInterface",
+        ),
+    ] {
+        assert_edit_is_refused_at_its_line(
+            &robot,
+            "</robot>",
+            &transmission(joint, interface),
+            expect,
+        )?;
+    }
+    assert_edit_is_refused_at_its_line(
+        &robot,
+        "<joint name=\"right_wheel_joint\" type=\"continuous\">",
+        "<joint name=\"right_wheel_joint\" type=\"continuous\"><mimic joint=\"wrist\"/>",
+        "<mimic joint=\"wrist\">: no such joint",
+    )?;
+    Ok(())
+}
+
+/// A joint command that is not a number, or names a joint without an actuator, is refused
+/// with the reason; the last command stays in force.
+#[test]
+fn joint_commands_that_make_no_sense() -> anyhow::Result<()> {
+    let robot = RobotModel::load(&repo("assets/robots/my_robot.urdf"))?;
+    let mut sim =
+        rover_sim::Simulation::new(World::flat()?, robot, &rover_sim::SimOptions::default())?;
+    let err = |r: rover_sim::Result<()>| r.err().map(|e| e.to_string()).unwrap_or_default();
+    let missing = err(sim.command_joint("elbow", rover_sim::JointCommand::Position(1.0)));
+    assert!(
+        missing.contains("has no joint \"elbow\"; its moving joints: \"left_wheel_joint\""),
+        "{missing}"
+    );
+    let wheel = err(sim.command_joint("left_wheel_joint", rover_sim::JointCommand::Position(1.0)));
+    assert!(wheel.contains("has no actuator"), "{wheel}");
+    Ok(())
+}

@@ -676,7 +676,9 @@ fn read_transmissions(
                 ));
             }
             let state_only = !interfaces.is_empty()
-                && interfaces.iter().all(|i| i.ends_with("JointStateInterface"));
+                && interfaces
+                    .iter()
+                    .all(|i| i.ends_with("JointStateInterface"));
             if state_only {
                 // Reported, not driven: ros_control reads such joints and commands nothing.
                 continue;
