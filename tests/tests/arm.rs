@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use rover_sim::{
-    DriveSpec, JointCommand, JointSolver, LoadOptions, RobotModel, SimOptions, Simulation, Twist,
-    World,
+    DriveSpec, JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel,
+    SimOptions, Simulation, Twist, World,
 };
 
 fn example_robot_data(file: &str) -> Option<PathBuf> {
@@ -54,19 +54,41 @@ const HOME: [(&str, f64); 7] = [
     ("arm_7_joint", 0.0),
 ];
 
+fn joint_id(sim: &Simulation, name: &str) -> Result<JointId> {
+    sim.robot()
+        .joint_id(name)
+        .ok_or_else(|| anyhow::anyhow!("no joint {name}"))
+}
+
+fn state(sim: &Simulation, name: &str) -> Result<JointState> {
+    sim.joint_state(joint_id(sim, name)?)
+        .ok_or_else(|| anyhow::anyhow!("{name} does not move"))
+}
+
+/// The joint furthest from its target, and how far (rad).
 fn worst_error(sim: &Simulation, targets: &[(&str, f64)]) -> Result<(String, f64)> {
     let mut worst = (String::new(), 0.0f64);
     for (name, target) in targets {
-        let id = sim
-            .robot()
-            .joint_id(name)
-            .ok_or_else(|| anyhow::anyhow!("no joint {name}"))?;
-        let q = sim
-            .joint_state(id)
-            .ok_or_else(|| anyhow::anyhow!("{name} does not move"))?
-            .position;
-        if (q - target).abs() >= worst.1 {
-            worst = ((*name).to_owned(), (q - target).abs());
+        let error = (state(sim, name)?.position - target).abs();
+        if error >= worst.1 {
+            worst = ((*name).to_owned(), error);
+        }
+    }
+    Ok(worst)
+}
+
+/// The largest [`worst_error`] seen, every 0.1 s for `seconds`.
+fn worst_error_over(
+    sim: &mut Simulation,
+    targets: &[(&str, f64)],
+    seconds: f64,
+) -> Result<(String, f64)> {
+    let mut worst = worst_error(sim, targets)?;
+    for _ in 0..(seconds * 10.0).round() as usize {
+        run_for(sim, 0.1);
+        let e = worst_error(sim, targets)?;
+        if e.1 > worst.1 {
+            worst = e;
         }
     }
     Ok(worst)
@@ -79,52 +101,47 @@ fn run_for(sim: &mut Simulation, seconds: f64) {
     }
 }
 
+/// TIAGo told to go to its home pose, after `seconds`.
+fn tiago_sent_home(seconds: f64) -> Result<Option<Simulation>> {
+    let Some(mut sim) = tiago(JointSolver::default())? else {
+        return Ok(None);
+    };
+    for (name, q) in HOME {
+        sim.command_joint(name, JointCommand::Position(q))?;
+    }
+    run_for(&mut sim, seconds);
+    Ok(Some(sim))
+}
+
 /// Hold: the home pose is reached within 0.01 rad by 2 s and held for 10 s; then driving
 /// 0.3 m/s for 3.5 s turns the base less than 1 degree.
 #[test]
 fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
-    {
-        let Some(mut sim) = tiago(JointSolver::default())? else {
-            return Ok(());
-        };
-        for (name, q) in HOME {
-            sim.command_joint(name, JointCommand::Position(q))?;
-        }
-        run_for(&mut sim, 2.0);
-        let at_2s = worst_error(&sim, &HOME)?;
-        let mut held = at_2s.clone();
-        for _ in 0..100 {
-            run_for(&mut sim, 0.1);
-            let e = worst_error(&sim, &HOME)?;
-            if e.1 > held.1 {
-                held = e;
-            }
-        }
-        let yaw0 = sim.world_from_base().rotation;
-        sim.set_cmd_vel(Twist {
-            linear_mps: 0.3,
-            angular_radps: 0.0,
-        })?;
-        run_for(&mut sim, 3.5);
-        let turn_deg = (yaw0.inverse() * sim.world_from_base().rotation)
-            .to_euler(glam::EulerRot::ZYX)
-            .0
-            .to_degrees();
-        let driving = worst_error(&sim, &HOME)?;
-        println!(
-            "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {:?}",
-            sim.world_from_base().translation
-        );
-        assert!(at_2s.1 < 0.01, "by 2 s: {at_2s:?}");
-        assert!(held.1 < 0.01, "while held: {held:?}");
-        assert!(driving.1 < 0.01, "while driving: {driving:?}");
-        assert!(turn_deg.abs() < 1.0, "the base turned {turn_deg} degrees");
-        assert!(
-            sim.world_from_base().translation.x > 0.8,
-            "drove to {:?}",
-            sim.world_from_base().translation
-        );
-    }
+    let Some(mut sim) = tiago_sent_home(2.0)? else {
+        return Ok(());
+    };
+    let at_2s = worst_error(&sim, &HOME)?;
+    let held = worst_error_over(&mut sim, &HOME, 10.0)?;
+    let yaw0 = sim.world_from_base().rotation;
+    sim.set_cmd_vel(Twist {
+        linear_mps: 0.3,
+        angular_radps: 0.0,
+    })?;
+    run_for(&mut sim, 3.5);
+    let turn_deg = (yaw0.inverse() * sim.world_from_base().rotation)
+        .to_euler(glam::EulerRot::ZYX)
+        .0
+        .to_degrees();
+    let driving = worst_error(&sim, &HOME)?;
+    let base_m = sim.world_from_base().translation;
+    println!(
+        "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {base_m:?}"
+    );
+    assert!(at_2s.1 < 0.01, "by 2 s: {at_2s:?}");
+    assert!(held.1 < 0.01, "while held: {held:?}");
+    assert!(driving.1 < 0.01, "while driving: {driving:?}");
+    assert!(turn_deg.abs() < 1.0, "the base turned {turn_deg} degrees");
+    assert!(base_m.x > 0.8, "drove to {base_m:?}");
     Ok(())
 }
 
@@ -133,47 +150,35 @@ fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
 /// pushes harder than its effort limit.
 #[test]
 fn tiago_arm_2_steps_within_its_limits() -> Result<()> {
-    {
-        let Some(mut sim) = tiago(JointSolver::default())? else {
-            return Ok(());
-        };
-        for (name, q) in HOME {
-            sim.command_joint(name, JointCommand::Position(q))?;
+    let Some(mut sim) = tiago_sent_home(3.0)? else {
+        return Ok(());
+    };
+    let joint = sim.robot().joint(joint_id(&sim, "arm_2_joint")?).clone();
+    let (effort_limit, velocity_limit) = (
+        f64::from(joint.effort_limit.unwrap_or(f32::MAX)),
+        f64::from(joint.velocity_limit.unwrap_or(f32::MAX)),
+    );
+    sim.command_joint("arm_2_joint", JointCommand::Position(-0.8))?;
+    let start = sim.sim_time_s();
+    let (mut fastest, mut hardest, mut highest) = (0.0f64, 0.0f64, f64::NEG_INFINITY);
+    let mut at_2s = f64::NAN;
+    while sim.sim_time_s() - start < 4.0 {
+        sim.step();
+        let s = state(&sim, "arm_2_joint")?;
+        fastest = fastest.max(s.velocity.abs());
+        hardest = hardest.max(s.effort.abs());
+        highest = highest.max(s.position);
+        if at_2s.is_nan() && sim.sim_time_s() - start >= 2.0 {
+            at_2s = s.position;
         }
-        run_for(&mut sim, 3.0);
-        let id = sim
-            .robot()
-            .joint_id("arm_2_joint")
-            .ok_or_else(|| anyhow::anyhow!("no arm_2_joint"))?;
-        let joint = sim.robot().joint(id).clone();
-        let (effort_limit, velocity_limit) = (
-            f64::from(joint.effort_limit.unwrap_or(f32::MAX)),
-            f64::from(joint.velocity_limit.unwrap_or(f32::MAX)),
-        );
-        sim.command_joint("arm_2_joint", JointCommand::Position(-0.8))?;
-        let start = sim.sim_time_s();
-        let (mut fastest, mut hardest, mut highest) = (0.0f64, 0.0f64, f64::NEG_INFINITY);
-        let mut at_2s = f64::NAN;
-        while sim.sim_time_s() - start < 4.0 {
-            sim.step();
-            let s = sim
-                .joint_state(id)
-                .ok_or_else(|| anyhow::anyhow!("arm_2 does not move"))?;
-            fastest = fastest.max(s.velocity.abs());
-            hardest = hardest.max(s.effort.abs());
-            highest = highest.max(s.position);
-            if at_2s.is_nan() && sim.sim_time_s() - start >= 2.0 {
-                at_2s = s.position;
-            }
-        }
-        println!(
-            "arm_2 at 2 s: {at_2s:.4} rad; highest {highest:.4}; fastest {fastest:.3} rad/s (limit {velocity_limit}); hardest {hardest:.2} N m (limit {effort_limit})"
-        );
-        assert!((at_2s + 0.8).abs() < 0.02, "arm_2 at {at_2s} by 2 s");
-        assert!(highest + 0.8 < 0.05, "overshoot to {highest}");
-        assert!(fastest <= velocity_limit * 1.02, "{fastest} rad/s");
-        assert!(hardest <= effort_limit + 1e-9, "{hardest} N m");
     }
+    println!(
+        "arm_2 at 2 s: {at_2s:.4} rad; highest {highest:.4}; fastest {fastest:.3} rad/s (limit {velocity_limit}); hardest {hardest:.2} N m (limit {effort_limit})"
+    );
+    assert!((at_2s + 0.8).abs() < 0.02, "arm_2 at {at_2s} by 2 s");
+    assert!(highest + 0.8 < 0.05, "overshoot to {highest}");
+    assert!(fastest <= velocity_limit * 1.02, "{fastest} rad/s");
+    assert!(hardest <= effort_limit + 1e-9, "{hardest} N m");
     Ok(())
 }
 
@@ -214,14 +219,7 @@ fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     sim.command_joint("shoulder_lift_joint", JointCommand::Position(-1.0))?;
     run_for(&mut sim, 3.0);
     let moved = worst_error(&sim, &target)?;
-    let mut held = moved.clone();
-    for _ in 0..50 {
-        run_for(&mut sim, 0.1);
-        let e = worst_error(&sim, &target)?;
-        if e.1 > held.1 {
-            held = e;
-        }
-    }
+    let held = worst_error_over(&mut sim, &target, 5.0)?;
     let base_moved_m = sim.world_from_link(base).translation.distance(base_start);
     println!(
         "UR5: zero pose after 5 s {from_zero:?}; 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
@@ -232,5 +230,30 @@ fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     );
     assert!(moved.1 < 0.02, "after shoulder_lift -> -1: {moved:?}");
     assert!(held.1 < 0.01, "while held: {held:?}");
+    Ok(())
+}
+
+/// Gains of an effort_controllers/JointPositionController (`pid: {p, i, d, i_clamp}`) replace
+/// the default hold: TIAGo's head pan reaches 0.5 rad within its effort limit, and a drive
+/// wheel (no actuator) refuses gains.
+#[test]
+fn tiago_head_follows_a_command_with_its_own_pid_gains() -> Result<()> {
+    let Some(mut sim) = tiago(JointSolver::default())? else {
+        return Ok(());
+    };
+    let pid = Pid {
+        p: 20.0,
+        i: 10.0,
+        d: 0.5,
+        i_clamp: 3.0,
+    };
+    sim.set_joint_pid("head_1_joint", pid)?;
+    assert!(sim.set_joint_pid("wheel_left_joint", pid).is_err());
+    sim.command_joint("head_1_joint", JointCommand::Position(0.5))?;
+    run_for(&mut sim, 3.0);
+    let s = state(&sim, "head_1_joint")?;
+    println!("head_1 with p 20 i 10 d 0.5 after 3 s: {s:?}");
+    assert!((s.position - 0.5).abs() < 0.01, "{s:?}");
+    assert!(s.effort.abs() <= 5.197 + 1e-6, "{s:?}");
     Ok(())
 }

@@ -110,7 +110,6 @@ pub(crate) struct JointEl {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct TransmissionEl {
     pub name: String,
-    pub kind: String,
     /// Joint name, its `<hardwareInterface>`s, the reduction.
     pub joints: Vec<(String, Vec<String>, f64)>,
     pub line: u32,
@@ -381,12 +380,6 @@ impl Reader<'_, '_> {
 
     fn transmission(&self, node: Node<'_, '_>) -> Result<TransmissionEl> {
         let name = node.attribute("name").unwrap_or("").to_owned();
-        let kind = child(node, "type")
-            .and_then(|t| t.text())
-            .or_else(|| node.attribute("type"))
-            .unwrap_or("")
-            .trim()
-            .to_owned();
         let mut joints = Vec::new();
         let reduction = children(node, "actuator")
             .find_map(|a| child(a, "mechanicalReduction").and_then(|r| r.text()))
@@ -413,7 +406,6 @@ impl Reader<'_, '_> {
         }
         Ok(TransmissionEl {
             name,
-            kind,
             joints,
             line: line_of(self.doc, node),
         })

@@ -44,7 +44,8 @@ pub struct Transmission {
     pub joint: String,
     /// The command interface (the first of position, velocity, effort listed).
     pub interface: HardwareInterface,
-    /// `<mechanicalReduction>` of the actuator (1 when absent).
+    /// `<mechanicalReduction>` of the transmission's first actuator (1 when absent); rover
+    /// drives joints directly, so it is kept for reference and not applied.
     pub reduction: f64,
     /// Line of the `<transmission>` in the description.
     pub line: Option<u32>,

@@ -73,16 +73,6 @@ pub enum JointSolver {
     Impulse,
 }
 
-impl JointSolver {
-    /// The name used in world files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Multibody => "multibody",
-            Self::Impulse => "impulse",
-        }
-    }
-}
-
 /// The ground (`[ground]`): a flat square centred on the origin, top at z = 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ground {

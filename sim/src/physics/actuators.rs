@@ -2,14 +2,16 @@
 //!
 //! Every actuated joint ([`RobotModel::actuated_joints`]) gets one. Left alone it holds the
 //! pose it started in — a PID whose gains come from the inertia the joint carries (a critically
-//! damped loop at [`HOLD_BANDWIDTH_HZ`], integral time [`HOLD_INTEGRAL_S`]), so an arm neither
-//! sags under gravity nor jitters, and no one has to write gains first. A position command moves
-//! the setpoint toward the target no faster than the URDF `<limit velocity>`; the effort never
-//! exceeds `<limit effort>` (the motor's force cap). Velocity and effort commands follow
+//! damped loop at [`HOLD_BANDWIDTH_HZ`], integral time [`HOLD_INTEGRAL_S`]) with the carried
+//! weight fed forward, so an arm neither sags under gravity nor jitters, and no one has to
+//! write gains first. A position command moves the setpoint toward the target on a trapezoid
+//! within the URDF `<limit velocity>` and the effort the load leaves; the effort never exceeds
+//! `<limit effort>` (the motor's force cap). Velocity and effort commands follow
 //! gazebo_ros_control's VelocityJointInterface and EffortJointInterface.
 //!
 //! The proportional and derivative terms are solved implicitly by rapier's joint motor (stable
-//! at any gain on a 59 g link), the integral explicitly, as a shift of the motor's target.
+//! at any gain on a 59 g link), the integral and weight terms explicitly, as a shift of the
+//! motor's target.
 
 use glam::Vec3;
 use rapier3d::prelude::*;
@@ -30,13 +32,13 @@ const HOLD_INTEGRAL_HEADROOM: f64 = 4.0;
 const MIN_INERTIA: f64 = 1e-9;
 /// The share of the velocity limit a position move plans for (the loop's tracking error
 /// takes the rest).
-pub const PROFILE_VELOCITY_SHARE: f64 = 0.9;
+const PROFILE_VELOCITY_SHARE: f64 = 0.9;
 /// The share of the effort left over from carrying the load that a position move plans to
 /// accelerate and brake with (the loop's corrections take the rest).
-pub const PROFILE_EFFORT_SHARE: f64 = 0.3;
+const PROFILE_EFFORT_SHARE: f64 = 0.3;
 /// The default hold integrates only errors smaller than this (rad or m): the integral is for
 /// what the weight estimate leaves, not for catching up after a move.
-pub const HOLD_INTEGRAL_BAND: f64 = 0.2;
+const HOLD_INTEGRAL_BAND: f64 = 0.2;
 /// The largest error the default hold leaves to a joint's dry friction (`<dynamics
 /// friction>`, rad or m): its stiffness is at least friction / this.
 pub const HOLD_FRICTION_ERROR: f64 = 0.002;
@@ -51,6 +53,8 @@ pub struct Pid {
     /// Derivative gain.
     pub d: f64,
     /// Bound on the integral term's effort (N m or N); 0 = the effort limit.
+    /// (The default hold's integral may reach four effort limits: it only
+    /// shifts the motor's target, whose force the limit caps.)
     pub i_clamp: f64,
 }
 
@@ -97,21 +101,13 @@ pub(crate) struct Actuator {
     gravity_hold: f64,
     /// `<dynamics friction>` (N m or N).
     friction: f64,
-
+    /// The effort at the last control update (N m or N).
     pub(crate) effort: f64,
     /// The bodies the joint carries (its child and everything beyond it).
     carried: Vec<RigidBodyHandle>,
 }
 
 impl Actuator {
-    /// The position the joint is commanded to, if it is position-controlled.
-    pub(crate) fn position_target(&self) -> Option<f64> {
-        match self.command {
-            JointCommand::Position(q) => Some(q),
-            _ => None,
-        }
-    }
-
     fn gains(&self) -> Pid {
         self.pid.unwrap_or_else(|| {
             let omega = 2.0 * std::f64::consts::PI * HOLD_BANDWIDTH_HZ;
@@ -126,9 +122,10 @@ impl Actuator {
         })
     }
 
-    /// Moves the setpoint toward `target` on a trapezoid: no faster than the velocity limit,
-    /// accelerating and braking no harder than half of what the effort left over from carrying
-    /// the load can do, so the loop that follows it is not driven into its effort limit.
+    /// Moves the setpoint toward `target` on a trapezoid: at [`PROFILE_VELOCITY_SHARE`] of the
+    /// velocity limit at most, accelerating and braking with [`PROFILE_EFFORT_SHARE`] of the
+    /// effort left over from carrying the load, so the loop that follows it is not driven into
+    /// its effort limit. User gains get no acceleration bound (ros_control has none).
     fn advance_setpoint(&mut self, target: f64, dt_s: f64) {
         let to_go = self.error(target, self.setpoint);
         let v_max = self.velocity_max.unwrap_or(f64::INFINITY) * PROFILE_VELOCITY_SHARE;
@@ -149,8 +146,7 @@ impl Actuator {
             step = to_go;
             velocity = 0.0;
         }
-        let setpoint = self.setpoint + step;
-        self.setpoint = self.clamp_position(setpoint);
+        self.setpoint = self.clamp_position(self.setpoint + step);
         self.setpoint_velocity = velocity;
     }
 
@@ -174,7 +170,7 @@ impl Actuator {
 /// The actuators of one robot, run at the control period.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Actuators {
-    pub(crate) list: Vec<Actuator>,
+    list: Vec<Actuator>,
     /// Actuator index per joint (joint order).
     by_joint: Vec<Option<usize>>,
 }
@@ -241,6 +237,11 @@ impl Actuators {
             .map(|i| &self.list[i])
     }
 
+    fn of_mut(&mut self, joint: JointId) -> Option<&mut Actuator> {
+        let i = self.by_joint.get(joint.index()).copied().flatten()?;
+        self.list.get_mut(i)
+    }
+
     /// Sets a joint's command. Non-finite values and joints without an actuator are errors;
     /// positions outside the limits are clamped to them.
     pub(crate) fn command(
@@ -258,13 +259,7 @@ impl Actuators {
                 "joint \"{name}\": command {value} is not a finite number; dropped"
             )));
         }
-        let Some(a) = self
-            .by_joint
-            .get(joint.index())
-            .copied()
-            .flatten()
-            .and_then(|i| self.list.get_mut(i))
-        else {
+        let Some(a) = self.of_mut(joint) else {
             return Err(SimError::Setup(format!(
                 "joint \"{name}\" has no actuator (it is fixed, passive, a drive wheel or mimics another joint)"
             )));
@@ -282,13 +277,7 @@ impl Actuators {
 
     /// Gives a joint its own PID gains (an effort_controllers position controller).
     pub(crate) fn set_pid(&mut self, joint: JointId, pid: Pid) {
-        if let Some(a) = self
-            .by_joint
-            .get(joint.index())
-            .copied()
-            .flatten()
-            .and_then(|i| self.list.get_mut(i))
-        {
+        if let Some(a) = self.of_mut(joint) {
             a.pid = Some(pid);
         }
     }
@@ -312,8 +301,6 @@ impl Actuators {
                 JointCommand::Position(target) => {
                     a.advance_setpoint(target, dt_s);
                     let error = a.error(a.setpoint, q);
-                    // The default hold's integral may ask for more than the effort limit: it
-                    // is a target shift of the motor, whose force the limit caps anyway.
                     let i_cap = if gains.i_clamp > 0.0 {
                         gains.i_clamp
                     } else if a.pid.is_none() {

@@ -1,11 +1,11 @@
 //! The robot's moving joints in rapier: built as multibody (reduced-coordinate) joints or as
 //! impulse joints, read back as positions and velocities, and given motors.
 //!
-//! Multibody joints are the default for arm joints (actuated ones, and those that mimic
-//! them; wheels and passive joints stay impulse joints): an articulated chain is solved in joint space, so a light
-//! end link on a long arm (TIAGo's 59 g arm_7) cannot stretch its joints apart, and a joint
-//! motor sees the inertia of everything it carries. Impulse joints solve each joint between two
-//! bodies on their own; they stay available (`[physics] joints = "impulse"`) to compare.
+//! Impulse joints (the default) solve each joint between its two bodies. With `[physics]
+//! joints = "multibody"` the arm joints (actuated ones and those that mimic them) are solved
+//! in joint space instead, so a joint motor pushes everything it carries (UR5's outstretched
+//! arm needs that); wheels and passive joints stay impulse joints either way, so a car drives
+//! the same. docs/ARM.md has the measured comparison.
 
 use glam::{Quat, Vec3};
 use rapier3d::prelude::*;
@@ -228,6 +228,21 @@ fn set_multibody_dynamics(
             mb.damping_mut()[dof] = joint.damping;
             mb.frictions_mut()[dof] = joint.friction;
         }
+    }
+    // Once per multibody: its root's free dofs come first.
+    let mut roots = Vec::new();
+    for built in joints.iter().flatten() {
+        let JointRef::Multibody(h) = built.handle else {
+            continue;
+        };
+        let Some((mb, _)) = physics.multibody_joints.get_mut(h) else {
+            continue;
+        };
+        let root = mb.root().rigid_body_handle();
+        if roots.contains(&root) {
+            continue;
+        }
+        roots.push(root);
         let root_dofs = mb.link(1).map_or(0, |l| l.assembly_id());
         for i in 0..root_dofs.min(mb.damping().len()) {
             mb.damping_mut()[i] = 0.0;

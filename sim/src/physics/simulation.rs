@@ -383,12 +383,6 @@ impl Simulation {
         })
     }
 
-    /// The position target an actuated joint is driven toward now (its command, clamped into
-    /// the limits); `None` when it is not position-controlled.
-    pub fn joint_target(&self, joint: JointId) -> Option<f64> {
-        self.actuators.of(joint).and_then(|a| a.position_target())
-    }
-
     /// Sim time (s): physics steps taken times the step length.
     pub fn sim_time_s(&self) -> f64 {
         self.step_index as f64 * self.dt_s
