@@ -27,13 +27,14 @@ mod render;
 mod sensors;
 
 pub use description::{
-    Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, WorldFile, expand_xacro, load_mesh,
-    load_toml, parse_toml, uses_xacro,
+    Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, WorldFile, expand_xacro,
+    load_controllers, load_mesh, load_toml, parse_controllers, parse_toml, uses_xacro,
 };
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
-    CameraConfig, CameraInfo, Collision, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
+    CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig, ControllerKind,
+    ControllerSpec, NamedPose, Pid, TrajectoryConstraints, TrajectorySpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
     GaussianNoise, Ground, HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver,
     LaserConfig, Link, LinkId, MAX_LASER_SAMPLES, MeshData, MeshVertex, Mimic, Model, ModelLink,
     Object, OdometrySource, Person, Physics, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
@@ -41,7 +42,7 @@ pub use model::{
 };
 pub use physics::{
     ControlSample, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR,
-    HOLD_INTEGRAL_S, JointCommand, JointState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Pid,
+    HOLD_INTEGRAL_S, JointCommand, JointState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry,
     SimOptions, Simulation, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};

@@ -72,6 +72,13 @@ impl RobotModel {
         Self::parse(&text, path, &options.resources)
     }
 
+    /// Reads a ros_control controllers YAML for this robot (checked against its joints) and
+    /// makes it the robot's controllers.
+    pub fn load_controllers(&mut self, path: &Path) -> Result<()> {
+        self.controllers = Some(super::controllers::load_controllers(path, self)?);
+        Ok(())
+    }
+
     /// Parses URDF text; `path` is used for messages and to resolve relative mesh files.
     pub fn from_str(text: &str, path: &Path) -> Result<Self> {
         Self::parse(text, path, &ResourcePaths::from_env())
@@ -139,6 +146,7 @@ impl RobotModel {
             not_simulated: extensions.ignored,
             transmissions,
             ros_control: extensions.ros_control,
+            controllers: None,
         };
         if !model.not_simulated.is_empty() {
             tracing::info!(

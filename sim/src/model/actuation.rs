@@ -76,3 +76,18 @@ impl Default for RosControlPlugin {
         }
     }
 }
+
+/// PID gains in the joint's own units: p in N m/rad (N/m), i in N m/(rad s), d in N m s/rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pid {
+    /// Proportional gain.
+    pub p: f64,
+    /// Integral gain.
+    pub i: f64,
+    /// Derivative gain.
+    pub d: f64,
+    /// Bound on the integral term's effort (N m or N); 0 = the effort limit.
+    /// (The default hold's integral may reach four effort limits: it only
+    /// shifts the motor's target, whose force the limit caps.)
+    pub i_clamp: f64,
+}

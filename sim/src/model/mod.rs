@@ -4,6 +4,7 @@
 
 pub(crate) mod actuation;
 pub(crate) mod camera_info;
+pub(crate) mod controllers;
 pub(crate) mod drive;
 pub(crate) mod mesh;
 pub(crate) mod person;
@@ -11,7 +12,11 @@ pub(crate) mod robot;
 pub(crate) mod sensors;
 pub(crate) mod world;
 
-pub use actuation::{HardwareInterface, RosControlPlugin, Transmission};
+pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
+pub use controllers::{
+    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose, TrajectoryConstraints,
+    TrajectorySpec,
+};
 pub use camera_info::{CameraInfo, link_from_optical};
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
 pub use mesh::{MeshData, MeshVertex};

@@ -8,6 +8,7 @@ use glam::Vec3;
 use crate::error::{Result, SimError, quoted_list as names};
 use crate::geometry::{Pose, Rgba, Shape};
 use crate::model::actuation::{RosControlPlugin, Transmission};
+use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
 use crate::model::sensors::{CameraConfig, LaserConfig};
@@ -210,6 +211,10 @@ pub struct RobotModel {
     pub transmissions: Vec<Transmission>,
     /// The `libgazebo_ros_control.so` plugin, if present.
     pub ros_control: Option<RosControlPlugin>,
+    /// The controllers file the robot runs (`--controllers`, a world's `controllers`): which
+    /// controller drives which joint. `None`: every actuated joint holds its pose and takes
+    /// commands by joint name.
+    pub controllers: Option<ControllerConfig>,
     /// The URDF text the model was read from (xacro already expanded): what ROS tools expect in
     /// `/robot_description`.
     pub description: String,

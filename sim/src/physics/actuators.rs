@@ -17,6 +17,7 @@ use glam::Vec3;
 use rapier3d::prelude::*;
 
 use crate::error::{Result, SimError};
+use crate::model::actuation::Pid;
 use crate::model::robot::{JointId, JointKind, RobotModel};
 use crate::physics::diff_drive::wrap_angle;
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
@@ -42,21 +43,6 @@ const HOLD_INTEGRAL_BAND: f64 = 0.2;
 /// The largest error the default hold leaves to a joint's dry friction (`<dynamics
 /// friction>`, rad or m): its stiffness is at least friction / this.
 pub const HOLD_FRICTION_ERROR: f64 = 0.002;
-
-/// PID gains in the joint's own units: p in N m/rad (N/m), i in N m/(rad s), d in N m s/rad.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pid {
-    /// Proportional gain.
-    pub p: f64,
-    /// Integral gain.
-    pub i: f64,
-    /// Derivative gain.
-    pub d: f64,
-    /// Bound on the integral term's effort (N m or N); 0 = the effort limit.
-    /// (The default hold's integral may reach four effort limits: it only
-    /// shifts the motor's target, whose force the limit caps.)
-    pub i_clamp: f64,
-}
 
 /// What a joint is told to do.
 #[derive(Debug, Clone, Copy, PartialEq)]

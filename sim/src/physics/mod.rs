@@ -9,7 +9,7 @@ pub(crate) mod joints;
 pub(crate) mod simulation;
 
 pub use actuators::{
-    HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, Pid,
+    HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
 };
 pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,

@@ -9,7 +9,8 @@ use crate::geometry::{Pose, yaw_of};
 use crate::model::drive::OdometrySource;
 use crate::model::robot::{JointId, LinkId, RobotModel};
 use crate::model::world::{JointSolver, World, check_step_hz};
-use crate::physics::actuators::{Actuators, JointCommand, JointState, Pid};
+use crate::model::actuation::Pid;
+use crate::physics::actuators::{Actuators, JointCommand, JointState};
 use crate::physics::build::{
     STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, add_models, add_robot, add_world,
     joint_mass_ratio, person_body_pose,
