@@ -34,16 +34,18 @@ pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
     CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig, ControllerKind,
-    ControllerSpec, NamedPose, Pid, TrajectoryConstraints, TrajectorySpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
-    GaussianNoise, Ground, HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver,
-    LaserConfig, Link, LinkId, MAX_LASER_SAMPLES, MeshData, MeshVertex, Mimic, Model, ModelLink,
-    Object, OdometrySource, Person, Physics, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
-    STEP_HZ_RANGE, Transmission, Visual, Walk, World, check_step_hz, link_from_optical,
+    ControllerSpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec, GaussianNoise, Ground,
+    HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver, LaserConfig, Link, LinkId,
+    MAX_LASER_SAMPLES, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose, Object,
+    OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
+    STEP_HZ_RANGE, TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World,
+    check_step_hz, link_from_optical,
 };
 pub use physics::{
-    ControlSample, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR,
-    HOLD_INTEGRAL_S, JointCommand, JointState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry,
-    SimOptions, Simulation, Twist, WheelSpeeds, wrap_angle,
+    ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
+    HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory,
+    ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, SimOptions, Simulation, TrajectoryPoint,
+    TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
 pub use sensors::{CameraFrame, CameraSensor, LaserScan, LaserSensor};

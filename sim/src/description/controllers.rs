@@ -200,9 +200,7 @@ impl Reader<'_> {
             } else if node.get("joint").is_some() || node.get("joints").is_some() {
                 return Err(self.error(
                     node.line,
-                    format!(
-                        "controller `{key}` has no `type`; expected one of: {SUPPORTED}"
-                    ),
+                    format!("controller `{key}` has no `type`; expected one of: {SUPPORTED}"),
                 ));
             } else if top && node.is_map() {
                 self.level(node, key, false)?;
@@ -250,7 +248,10 @@ impl Reader<'_> {
             Value::Number(x) if x.is_finite() => Ok(x),
             _ => Err(self.error(
                 node.line,
-                format!("`{what}` must be a finite number, found {}", node.describe()),
+                format!(
+                    "`{what}` must be a finite number, found {}",
+                    node.describe()
+                ),
             )),
         }
     }
@@ -274,13 +275,18 @@ impl Reader<'_> {
         if !node.is_map() {
             return Err(self.error(
                 node.line,
-                format!("`{what}` must be gains {{p: ..., i: ..., d: ..., i_clamp: ...}}, found {}", node.describe()),
+                format!(
+                    "`{what}` must be gains {{p: ..., i: ..., d: ..., i_clamp: ...}}, found {}",
+                    node.describe()
+                ),
             ));
         }
         let Some(p) = node.get("p") else {
             return Err(self.error(
                 node.line,
-                format!("`{what}` has no `p` gain; expected {{p: ..., i: ..., d: ..., i_clamp: ...}}"),
+                format!(
+                    "`{what}` has no `p` gain; expected {{p: ..., i: ..., d: ..., i_clamp: ...}}"
+                ),
             ));
         };
         let pid = Pid {
@@ -293,10 +299,7 @@ impl Reader<'_> {
             },
         };
         if pid.p < 0.0 || pid.i < 0.0 || pid.d < 0.0 || pid.i_clamp < 0.0 {
-            return Err(self.error(
-                node.line,
-                format!("`{what}`: gains must not be negative"),
-            ));
+            return Err(self.error(node.line, format!("`{what}`: gains must not be negative")));
         }
         Ok(pid)
     }
@@ -398,7 +401,10 @@ impl Reader<'_> {
         let Value::List(items) = &list.value else {
             return Err(self.error(
                 list.line,
-                format!("`joints` must be a list of joint names, found {}", list.describe()),
+                format!(
+                    "`joints` must be a list of joint names, found {}",
+                    list.describe()
+                ),
             ));
         };
         if items.is_empty() {
@@ -550,16 +556,34 @@ mod tests {
 
     #[test]
     fn bad_files_get_located_errors() {
-        let unknown_joint = error_of("c:\n  type: position_controllers/JointPositionController\n  joint: elbow\n");
-        assert!(unknown_joint.contains("c.yaml:3") && unknown_joint.contains("no joint \"elbow\"") && unknown_joint.contains("j1, j2"), "{unknown_joint}");
-        let unknown_type = error_of("c:\n  type: effort_controllers/JointGroupPositionController\n  joint: j1\n");
-        assert!(unknown_type.contains("c.yaml:2") && unknown_type.contains("not one rover runs"), "{unknown_type}");
-        let no_gains = error_of("c:\n  type: effort_controllers/JointPositionController\n  joint: j1\n");
+        let unknown_joint =
+            error_of("c:\n  type: position_controllers/JointPositionController\n  joint: elbow\n");
+        assert!(
+            unknown_joint.contains("c.yaml:3")
+                && unknown_joint.contains("no joint \"elbow\"")
+                && unknown_joint.contains("j1, j2"),
+            "{unknown_joint}"
+        );
+        let unknown_type =
+            error_of("c:\n  type: effort_controllers/JointGroupPositionController\n  joint: j1\n");
+        assert!(
+            unknown_type.contains("c.yaml:2") && unknown_type.contains("not one rover runs"),
+            "{unknown_type}"
+        );
+        let no_gains =
+            error_of("c:\n  type: effort_controllers/JointPositionController\n  joint: j1\n");
         assert!(no_gains.contains("needs `pid"), "{no_gains}");
-        let no_p = error_of("c:\n  type: effort_controllers/JointPositionController\n  joint: j1\n  pid: {d: 1}\n");
+        let no_p = error_of(
+            "c:\n  type: effort_controllers/JointPositionController\n  joint: j1\n  pid: {d: 1}\n",
+        );
         assert!(no_p.contains("no `p` gain"), "{no_p}");
-        let twice = error_of("a:\n  type: position_controllers/JointPositionController\n  joint: j1\nb:\n  type: velocity_controllers/JointVelocityController\n  joint: j1\n");
-        assert!(twice.contains("c.yaml:4") && twice.contains("already drives"), "{twice}");
+        let twice = error_of(
+            "a:\n  type: position_controllers/JointPositionController\n  joint: j1\nb:\n  type: velocity_controllers/JointVelocityController\n  joint: j1\n",
+        );
+        assert!(
+            twice.contains("c.yaml:4") && twice.contains("already drives"),
+            "{twice}"
+        );
         let not_yaml = error_of("c: [unclosed\n");
         assert!(not_yaml.contains("not valid YAML"), "{not_yaml}");
         let no_type = error_of("c:\n  joint: j1\n");

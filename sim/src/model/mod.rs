@@ -13,11 +13,11 @@ pub(crate) mod sensors;
 pub(crate) mod world;
 
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
-pub use controllers::{
-    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose, TrajectoryConstraints,
-    TrajectorySpec,
-};
 pub use camera_info::{CameraInfo, link_from_optical};
+pub use controllers::{
+    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose,
+    TrajectoryConstraints, TrajectorySpec,
+};
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
 pub use mesh::{MeshData, MeshVertex};
 pub use person::{Person, Walk};

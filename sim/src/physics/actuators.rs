@@ -53,6 +53,24 @@ pub enum JointCommand {
     Velocity(f64),
     /// Apply a torque (N m) or force (N); capped by the effort limit.
     Effort(f64),
+    /// Follow a moving setpoint (a trajectory controller's sample): held at `position` now,
+    /// moving at `velocity`, with no profile of rover's own. Clamped into the limits.
+    Track {
+        /// Where the joint should be now (rad or m).
+        position: f64,
+        /// How fast the setpoint moves (rad/s or m/s).
+        velocity: f64,
+    },
+}
+
+impl JointCommand {
+    /// Whether every number in it is finite.
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            Self::Position(v) | Self::Velocity(v) | Self::Effort(v) => v.is_finite(),
+            Self::Track { position, velocity } => position.is_finite() && velocity.is_finite(),
+        }
+    }
 }
 
 /// A joint's state, as `/joint_states` reports it.
@@ -89,6 +107,8 @@ pub(crate) struct Actuator {
     friction: f64,
     /// The effort at the last control update (N m or N).
     pub(crate) effort: f64,
+    /// Position and velocity measured at the last control update.
+    measured: (f64, f64),
     /// The bodies the joint carries (its child and everything beyond it).
     carried: Vec<RigidBodyHandle>,
 }
@@ -200,6 +220,7 @@ impl Actuators {
                 gravity_hold: 0.0,
                 friction: f64::from(joint.friction),
                 effort: 0.0,
+                measured: (start, 0.0),
                 carried: carried_bodies(robot, id, link_body),
             };
             actuator.setpoint = actuator.clamp_position(start);
@@ -237,12 +258,9 @@ impl Actuators {
         command: JointCommand,
     ) -> Result<()> {
         let name = &robot.joint(joint).name;
-        let value = match command {
-            JointCommand::Position(v) | JointCommand::Velocity(v) | JointCommand::Effort(v) => v,
-        };
-        if !value.is_finite() {
+        if !command.is_finite() {
             return Err(SimError::Setup(format!(
-                "joint \"{name}\": command {value} is not a finite number; dropped"
+                "joint \"{name}\": command {command:?} is not finite; dropped"
             )));
         }
         let Some(a) = self.of_mut(joint) else {
@@ -257,8 +275,35 @@ impl Actuators {
                 JointCommand::Velocity(v.clamp(-cap, cap))
             }
             JointCommand::Effort(e) => JointCommand::Effort(e.clamp(-a.effort_max, a.effort_max)),
+            JointCommand::Track { position, velocity } => {
+                let cap = a.velocity_max.unwrap_or(f64::INFINITY);
+                JointCommand::Track {
+                    position: a.clamp_position(position),
+                    velocity: velocity.clamp(-cap, cap),
+                }
+            }
         };
         Ok(())
+    }
+
+    /// The position the actuator holds now (its setpoint; rad or m); 0 without an actuator.
+    pub(crate) fn setpoint(&self, joint: JointId) -> f64 {
+        self.of(joint).map_or(0.0, |a| a.setpoint)
+    }
+
+    /// How fast the setpoint moves now; 0 without an actuator.
+    pub(crate) fn setpoint_velocity(&self, joint: JointId) -> f64 {
+        self.of(joint).map_or(0.0, |a| a.setpoint_velocity)
+    }
+
+    /// The joint's position at the last control update.
+    pub(crate) fn position(&self, joint: JointId) -> f64 {
+        self.of(joint).map_or(0.0, |a| a.measured.0)
+    }
+
+    /// The joint's velocity at the last control update.
+    pub(crate) fn velocity(&self, joint: JointId) -> f64 {
+        self.of(joint).map_or(0.0, |a| a.measured.1)
     }
 
     /// Gives a joint its own PID gains (an effort_controllers position controller).
@@ -278,14 +323,20 @@ impl Actuators {
             }
             let q = a.built.position(&physics.bodies);
             let v = a.built.velocity(&physics.bodies);
+            a.measured = (q, v);
             let gains = a.gains();
             let axis = a.built.axis;
             let Some(data) = joint_data_mut(physics, a.built.handle) else {
                 continue;
             };
             match a.command {
-                JointCommand::Position(target) => {
-                    a.advance_setpoint(target, dt_s);
+                JointCommand::Position(_) | JointCommand::Track { .. } => {
+                    if let JointCommand::Track { position, velocity } = a.command {
+                        a.setpoint = position;
+                        a.setpoint_velocity = velocity;
+                    } else if let JointCommand::Position(target) = a.command {
+                        a.advance_setpoint(target, dt_s);
+                    }
                     let error = a.error(a.setpoint, q);
                     let i_cap = if gains.i_clamp > 0.0 {
                         gains.i_clamp

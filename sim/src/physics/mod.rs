@@ -1,9 +1,11 @@
 //! Physics: the rapier scene built from the model (`build.rs`), stepped at a fixed rate
 //! (`simulation.rs`), the wheels driven by gazebo_ros_diff_drive's controller
-//! (`diff_drive.rs`). Joint controllers go beside the diff drive.
+//! (`diff_drive.rs`); the robot's joints (`joints.rs`), their actuators (`actuators.rs`) and
+//! the ros_control controllers that command them (`controllers.rs`).
 
 pub(crate) mod actuators;
 pub(crate) mod build;
+pub(crate) mod controllers;
 pub(crate) mod diff_drive;
 pub(crate) mod joints;
 pub(crate) mod simulation;
@@ -11,6 +13,7 @@ pub(crate) mod simulation;
 pub use actuators::{
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
 };
+pub use controllers::{ControllerCommandState, JointTrajectory, TrajectoryPoint, TrajectoryState};
 pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
     WheelSpeeds, wrap_angle,

@@ -6,14 +6,17 @@ use rapier3d::prelude::*;
 
 use crate::error::{Result, SimError, quoted_list};
 use crate::geometry::{Pose, yaw_of};
+use crate::model::actuation::Pid;
 use crate::model::drive::OdometrySource;
 use crate::model::robot::{JointId, LinkId, RobotModel};
 use crate::model::world::{JointSolver, World, check_step_hz};
-use crate::model::actuation::Pid;
 use crate::physics::actuators::{Actuators, JointCommand, JointState};
 use crate::physics::build::{
     STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, add_models, add_robot, add_world,
     joint_mass_ratio, person_body_pose,
+};
+use crate::physics::controllers::{
+    ControllerCommandState, Controllers, JointTrajectory, TrajectoryState,
 };
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
@@ -83,6 +86,8 @@ pub struct Simulation {
     joints: Vec<Option<BuiltJoint>>,
     /// The actuated joints' motors, run every `control_steps` physics steps.
     actuators: Actuators,
+    /// The controllers file's controllers (none without one).
+    controllers: Controllers,
     control_steps: u64,
 }
 
@@ -175,11 +180,15 @@ impl Simulation {
             }
         }
 
-        let actuators = Actuators::new(
+        let mut actuators = Actuators::new(
             &robot,
             (&robot_bodies.joints, &robot_bodies.link_body),
             &mut physics,
         );
+        let controllers = match &robot.controllers {
+            Some(config) => Controllers::new(config, &robot, &mut actuators)?,
+            None => Controllers::default(),
+        };
         // ros_control's controlPeriod (default: every physics step), never below the step.
         let control_steps = robot
             .ros_control
@@ -211,6 +220,7 @@ impl Simulation {
             ground,
             joints: robot_bodies.joints,
             actuators,
+            controllers,
             control_steps,
             robot,
             world,
@@ -252,6 +262,8 @@ impl Simulation {
         }
         if self.step_index.is_multiple_of(self.control_steps) {
             let period_s = self.control_steps as f64 * self.dt_s;
+            self.controllers
+                .update(&self.robot, &mut self.actuators, now);
             self.actuators.update(&mut self.physics, period_s);
         }
         self.actuators.apply_efforts(&mut self.physics, self.dt_s);
@@ -353,6 +365,70 @@ impl Simulation {
         }
         self.actuators.set_pid(id, pid);
         Ok(())
+    }
+
+    /// Sends a command to a single-joint controller of the robot's controllers file (what its
+    /// `command` topic carries: a position, velocity or effort, per its type).
+    pub fn command_controller(&mut self, name: &str, value: f64) -> Result<()> {
+        self.controllers
+            .command(name, value, &self.robot, &mut self.actuators)
+    }
+
+    /// Starts `trajectory` on the joint trajectory controller `name`; the outcome (goal
+    /// reached, a tolerance violated) comes from [`Simulation::drain_controller_events`].
+    pub fn follow_trajectory(&mut self, name: &str, trajectory: &JointTrajectory) -> Result<()> {
+        let now = self.sim_time_s();
+        self.controllers
+            .follow(name, trajectory, &self.robot, (&mut self.actuators, now))
+    }
+
+    /// Moves every joint of the controllers file's pose `name` there (each at its own pace,
+    /// within its limits).
+    pub fn go_to_named_pose(&mut self, name: &str) -> Result<()> {
+        let config = self.robot.controllers.as_ref();
+        let Some(pose) = config.and_then(|c| c.named_pose(name)).cloned() else {
+            let known: Vec<String> = config
+                .map(|c| c.named_poses.iter().map(|p| p.name.clone()).collect())
+                .unwrap_or_default();
+            return Err(SimError::Setup(format!(
+                "no named pose \"{name}\"; known: {}",
+                if known.is_empty() {
+                    "none (give `named_poses` in a controllers file)".to_owned()
+                } else {
+                    quoted_list(known.iter())
+                }
+            )));
+        };
+        for (joint, q) in &pose.joints {
+            self.command_joint(joint, JointCommand::Position(*q))?;
+        }
+        Ok(())
+    }
+
+    /// Calls `f` with each controller event since the last call (a trajectory reached its goal
+    /// or violated a tolerance), oldest first.
+    pub fn drain_controller_events(&mut self, mut f: impl FnMut(&str)) {
+        for event in self.controllers.drain_events() {
+            f(&event);
+        }
+    }
+
+    /// The state of the joint trajectory controller `name` (its `state` topic).
+    pub fn trajectory_state(&self, name: &str) -> Option<&TrajectoryState> {
+        self.controllers.trajectory_state(name)
+    }
+
+    /// The joint and last command of the single-joint controller `name` (its `state` topic).
+    pub fn controller_command_state(&self, name: &str) -> Option<ControllerCommandState> {
+        self.controllers.command_state(name)
+    }
+
+    /// The position the actuator of `joint` holds now (rad or m): where a position command
+    /// has brought the setpoint so far. `None` for joints without an actuator.
+    pub fn joint_setpoint(&self, joint: JointId) -> Option<f64> {
+        self.actuators
+            .of(joint)
+            .map(|_| self.actuators.setpoint(joint))
     }
 
     fn joint_named(&self, name: &str) -> Result<JointId> {

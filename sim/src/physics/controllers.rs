@@ -1,0 +1,585 @@
+//! The robot's ros_control controllers on sim time: single-joint controllers turn a command
+//! (a number, as std_msgs/Float64 carries it) into a joint command, and joint trajectory
+//! controllers sample a trajectory_msgs/JointTrajectory every control update and feed the
+//! samples to the actuators, checking the path and goal tolerances as ros_control's
+//! joint_trajectory_controller does — except that a failure names the joint, its error and the
+//! tolerance.
+//!
+//! Between two points a joint moves as ros_control interpolates: linearly when the points give
+//! positions only, on a cubic when they give velocities, on a quintic when they give
+//! accelerations too. A trajectory starts from where the joints are held now.
+
+use crate::error::{Result, SimError};
+use crate::model::controllers::{
+    CommandKind, ControllerConfig, ControllerKind, TrajectoryConstraints,
+};
+use crate::model::robot::{JointId, RobotModel};
+use crate::physics::actuators::{Actuators, JointCommand};
+
+/// A trajectory for a joint trajectory controller (trajectory_msgs/JointTrajectory).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointTrajectory {
+    /// When it starts (sim time, s); 0: on arrival (`header.stamp` zero, as rostopic sends).
+    pub start_s: f64,
+    /// The joints each point lists, in the points' order.
+    pub joint_names: Vec<String>,
+    /// The points, in time order.
+    pub points: Vec<TrajectoryPoint>,
+}
+
+/// One point of a [`JointTrajectory`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TrajectoryPoint {
+    /// Positions (rad or m), one per joint.
+    pub positions: Vec<f64>,
+    /// Velocities, one per joint, or empty.
+    pub velocities: Vec<f64>,
+    /// Accelerations, one per joint, or empty.
+    pub accelerations: Vec<f64>,
+    /// When the point is due after the trajectory's start (s).
+    pub time_from_start_s: f64,
+}
+
+/// What a trajectory controller is doing, for its `state` topic.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TrajectoryState {
+    /// Its joints, in the controller's order.
+    pub joints: Vec<JointId>,
+    /// Where the trajectory wants each joint now (rad or m).
+    pub desired_positions: Vec<f64>,
+    /// How fast it wants each joint to move now.
+    pub desired_velocities: Vec<f64>,
+    /// Whether a trajectory is running.
+    pub active: bool,
+}
+
+/// A controller's setpoint, for the `state` topic of a single-joint controller.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ControllerCommandState {
+    /// The joint it drives.
+    pub joint: Option<JointId>,
+    /// The last command (rad, rad/s or N m, per the controller's type).
+    pub command: f64,
+}
+
+#[derive(Debug, Clone)]
+enum Running {
+    JointState,
+    Joint {
+        joint: JointId,
+        command: CommandKind,
+        last: f64,
+    },
+    Trajectory(Box<TrajectoryRun>),
+}
+
+#[derive(Debug, Clone)]
+struct TrajectoryRun {
+    joints: Vec<JointId>,
+    constraints: TrajectoryConstraints,
+    /// Absolute knots: the start state, then the points (sim time).
+    knots: Vec<Knot>,
+    state: TrajectoryState,
+    /// When the last point is due (sim time); `None` when idle.
+    end_s: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Knot {
+    t_s: f64,
+    positions: Vec<f64>,
+    velocities: Option<Vec<f64>>,
+    accelerations: Option<Vec<f64>>,
+}
+
+/// The controllers of one robot, in the file's order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Controllers {
+    names: Vec<String>,
+    list: Vec<Running>,
+    /// What happened since the last drain (a trajectory reached its goal or failed).
+    events: Vec<String>,
+}
+
+impl Controllers {
+    /// Sets up `config`'s controllers on the actuators (their gains; commands start where the
+    /// joints are).
+    pub(crate) fn new(
+        config: &ControllerConfig,
+        robot: &RobotModel,
+        actuators: &mut Actuators,
+    ) -> Result<Self> {
+        let id_of = |actuators: &Actuators, name: &str| -> Result<JointId> {
+            let id = robot.joint_id(name).ok_or_else(|| {
+                SimError::Setup(format!(
+                    "{}: no joint \"{name}\" in robot \"{}\"",
+                    config.source.display(),
+                    robot.name
+                ))
+            })?;
+            if actuators.of(id).is_none() {
+                return Err(SimError::Setup(format!(
+                    "{}: joint \"{name}\" has no actuator in the scene",
+                    config.source.display()
+                )));
+            }
+            Ok(id)
+        };
+        for (joint, pid) in &config.pid_gains {
+            actuators.set_pid(id_of(actuators, joint)?, *pid);
+        }
+        let mut out = Self::default();
+        for spec in &config.controllers {
+            let running = match &spec.kind {
+                ControllerKind::JointState { .. } => Running::JointState,
+                ControllerKind::Joint { joint, command } => {
+                    let id = id_of(actuators, joint)?;
+                    let last = match command {
+                        CommandKind::PositionPid(pid) => {
+                            actuators.set_pid(id, *pid);
+                            actuators.setpoint(id)
+                        }
+                        CommandKind::Position => actuators.setpoint(id),
+                        CommandKind::Velocity | CommandKind::Effort => {
+                            let c = if matches!(command, CommandKind::Velocity) {
+                                JointCommand::Velocity(0.0)
+                            } else {
+                                JointCommand::Effort(0.0)
+                            };
+                            actuators.command(robot, id, c)?;
+                            0.0
+                        }
+                    };
+                    Running::Joint {
+                        joint: id,
+                        command: *command,
+                        last,
+                    }
+                }
+                ControllerKind::Trajectory(t) => {
+                    let joints = t
+                        .joints
+                        .iter()
+                        .map(|j| id_of(actuators, j))
+                        .collect::<Result<Vec<_>>>()?;
+                    if let Some(gains) = &t.gains {
+                        for (id, pid) in joints.iter().zip(gains) {
+                            actuators.set_pid(*id, *pid);
+                        }
+                    }
+                    let n = joints.len();
+                    Running::Trajectory(Box::new(TrajectoryRun {
+                        state: TrajectoryState {
+                            desired_positions: joints
+                                .iter()
+                                .map(|j| actuators.setpoint(*j))
+                                .collect(),
+                            desired_velocities: vec![0.0; n],
+                            joints: joints.clone(),
+                            active: false,
+                        },
+                        joints,
+                        constraints: t.constraints.clone(),
+                        knots: Vec::new(),
+                        end_s: None,
+                    }))
+                }
+            };
+            out.names.push(spec.name.clone());
+            out.list.push(running);
+        }
+        Ok(out)
+    }
+
+    fn index(&self, name: &str) -> Result<usize> {
+        self.names.iter().position(|n| n == name).ok_or_else(|| {
+            SimError::Setup(format!(
+                "no controller \"{name}\"; the robot's controllers: {}",
+                crate::error::quoted_list(self.names.iter())
+            ))
+        })
+    }
+
+    /// A single-joint controller's command (its `command` topic).
+    pub(crate) fn command(
+        &mut self,
+        name: &str,
+        value: f64,
+        robot: &RobotModel,
+        actuators: &mut Actuators,
+    ) -> Result<()> {
+        let i = self.index(name)?;
+        let Running::Joint {
+            joint,
+            command,
+            last,
+        } = &mut self.list[i]
+        else {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\" takes no single command (it is a joint state or trajectory controller)"
+            )));
+        };
+        let c = match command {
+            CommandKind::PositionPid(_) | CommandKind::Position => JointCommand::Position(value),
+            CommandKind::Velocity => JointCommand::Velocity(value),
+            CommandKind::Effort => JointCommand::Effort(value),
+        };
+        actuators.command(robot, *joint, c)?;
+        *last = value;
+        Ok(())
+    }
+
+    /// Starts a trajectory on a trajectory controller (its `command` topic). A trajectory
+    /// with no points stops the one running and holds where the joints are.
+    pub(crate) fn follow(
+        &mut self,
+        name: &str,
+        trajectory: &JointTrajectory,
+        robot: &RobotModel,
+        (actuators, now_s): (&mut Actuators, f64),
+    ) -> Result<()> {
+        let i = self.index(name)?;
+        let Running::Trajectory(run) = &mut self.list[i] else {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\" is not a joint trajectory controller"
+            )));
+        };
+        let order = check_trajectory(name, trajectory, &run.joints, robot)?;
+        let start_s = if trajectory.start_s > 0.0 {
+            trajectory.start_s
+        } else {
+            now_s
+        };
+        let n = run.joints.len();
+        let mut knots = Vec::with_capacity(trajectory.points.len() + 1);
+        knots.push(Knot {
+            t_s: now_s,
+            positions: run.joints.iter().map(|j| actuators.setpoint(*j)).collect(),
+            velocities: Some(
+                run.joints
+                    .iter()
+                    .map(|j| actuators.setpoint_velocity(*j))
+                    .collect(),
+            ),
+            accelerations: Some(vec![0.0; n]),
+        });
+        let pick = |values: &[f64]| -> Vec<f64> { order.iter().map(|&k| values[k]).collect() };
+        for p in &trajectory.points {
+            let t_s = start_s + p.time_from_start_s;
+            if t_s <= now_s {
+                continue;
+            }
+            knots.push(Knot {
+                t_s,
+                positions: pick(&p.positions),
+                velocities: (!p.velocities.is_empty()).then(|| pick(&p.velocities)),
+                accelerations: (!p.accelerations.is_empty() && !p.velocities.is_empty())
+                    .then(|| pick(&p.accelerations)),
+            });
+        }
+        if trajectory.points.is_empty() {
+            run.stop(robot, actuators, true);
+            return Ok(());
+        }
+        if knots.len() < 2 {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\": every point of the trajectory is already past (sim time {now_s:.3} s); dropped"
+            )));
+        }
+        run.end_s = knots.last().map(|k| k.t_s);
+        run.knots = knots;
+        run.state.active = true;
+        Ok(())
+    }
+
+    /// One control update: samples running trajectories into the actuators' commands, checks
+    /// their tolerances.
+    pub(crate) fn update(&mut self, robot: &RobotModel, actuators: &mut Actuators, now_s: f64) {
+        for (name, running) in self.names.iter().zip(&mut self.list) {
+            let Running::Trajectory(run) = running else {
+                continue;
+            };
+            let Some(end_s) = run.end_s else {
+                continue;
+            };
+            if let Some((event, hold_here)) = run.update(name, robot, actuators, now_s, end_s) {
+                run.stop(robot, actuators, hold_here);
+                self.events.push(event);
+            }
+        }
+    }
+
+    /// Takes what happened since the last call (trajectory outcomes), oldest first.
+    pub(crate) fn drain_events(&mut self) -> std::vec::Drain<'_, String> {
+        self.events.drain(..)
+    }
+
+    /// The state of the trajectory controller `name`.
+    pub(crate) fn trajectory_state(&self, name: &str) -> Option<&TrajectoryState> {
+        let i = self.index(name).ok()?;
+        match &self.list[i] {
+            Running::Trajectory(run) => Some(&run.state),
+            _ => None,
+        }
+    }
+
+    /// The joint and last command of the single-joint controller `name`.
+    pub(crate) fn command_state(&self, name: &str) -> Option<ControllerCommandState> {
+        let i = self.index(name).ok()?;
+        match &self.list[i] {
+            Running::Joint { joint, last, .. } => Some(ControllerCommandState {
+                joint: Some(*joint),
+                command: *last,
+            }),
+            Running::JointState | Running::Trajectory(_) => None,
+        }
+    }
+}
+
+impl TrajectoryRun {
+    /// Samples the trajectory at `now_s`, commands the joints, and checks the tolerances;
+    /// returns what ended it, if it ended, and whether the joints should stop where they are.
+    fn update(
+        &mut self,
+        name: &str,
+        robot: &RobotModel,
+        actuators: &mut Actuators,
+        now_s: f64,
+        end_s: f64,
+    ) -> Option<(String, bool)> {
+        let t = now_s.min(end_s);
+        let seg = self
+            .knots
+            .windows(2)
+            .position(|w| t <= w[1].t_s)
+            .unwrap_or(self.knots.len().saturating_sub(2));
+        let (a, b) = (&self.knots[seg], &self.knots[seg + 1]);
+        for (k, joint) in self.joints.iter().enumerate() {
+            let (q, v) = interpolate(a, b, k, t);
+            self.state.desired_positions[k] = q;
+            self.state.desired_velocities[k] = v;
+            let command = if now_s >= end_s {
+                JointCommand::Position(q)
+            } else {
+                JointCommand::Track {
+                    position: q,
+                    velocity: v,
+                }
+            };
+            // The joints were checked when the controller was set up; a failure here is a bug,
+            // and the joint keeps its last command.
+            let _ = actuators.command(robot, *joint, command);
+        }
+        let c = &self.constraints;
+        let worst = |tolerances: &[f64]| {
+            self.joints
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| tolerances[*k] > 0.0)
+                .map(|(k, j)| {
+                    let q = actuators.position(*j);
+                    (k, (self.state.desired_positions[k] - q).abs())
+                })
+                .find(|(k, e)| *e > tolerances[*k])
+        };
+        let joint_name = |k: usize| robot.joint(self.joints[k]).name.clone();
+        if now_s < end_s {
+            let (k, error) = worst(&c.trajectory)?;
+            return Some((
+                format!(
+                    "controller {name}: PATH_TOLERANCE_VIOLATED: joint {} is {error:.4} from the trajectory, tolerance {:.4}; holding where it is",
+                    joint_name(k),
+                    c.trajectory[k]
+                ),
+                true,
+            ));
+        }
+        let moving = self
+            .joints
+            .iter()
+            .enumerate()
+            .find(|(_, j)| {
+                c.stopped_velocity_tolerance > 0.0
+                    && actuators.velocity(**j).abs() > c.stopped_velocity_tolerance
+            })
+            .map(|(k, _)| k);
+        let off = worst(&c.goal);
+        if off.is_none() && moving.is_none() {
+            return Some((
+                format!("controller {name}: trajectory reached its goal at {now_s:.3} s"),
+                false,
+            ));
+        }
+        if now_s <= end_s + c.goal_time_s {
+            return None;
+        }
+        let message = match (off, moving) {
+            (Some((k, error)), _) => format!(
+                "controller {name}: GOAL_TOLERANCE_VIOLATED: joint {} ended {error:.4} from its goal {:.4}, tolerance {:.4} (goal_time {:.2} s)",
+                joint_name(k),
+                self.state.desired_positions[k],
+                c.goal[k],
+                c.goal_time_s
+            ),
+            (None, Some(k)) => format!(
+                "controller {name}: GOAL_TOLERANCE_VIOLATED: joint {} still moving at {:.4}, stopped_velocity_tolerance {:.4} (goal_time {:.2} s)",
+                joint_name(k),
+                actuators.velocity(self.joints[k]),
+                c.stopped_velocity_tolerance,
+                c.goal_time_s
+            ),
+            (None, None) => format!("controller {name}: trajectory ended"),
+        };
+        Some((message, false))
+    }
+
+    /// Ends the trajectory; the joints hold its last sample, or where they are.
+    fn stop(&mut self, robot: &RobotModel, actuators: &mut Actuators, hold_here: bool) {
+        self.end_s = None;
+        self.knots.clear();
+        self.state.active = false;
+        if hold_here {
+            for j in &self.joints {
+                let q = actuators.position(*j);
+                let _ = actuators.command(robot, *j, JointCommand::Position(q));
+            }
+        }
+    }
+}
+
+/// Checks a trajectory against the controller's joints; returns, for each of the controller's
+/// joints, its index in the trajectory's `joint_names`.
+fn check_trajectory(
+    name: &str,
+    trajectory: &JointTrajectory,
+    joints: &[JointId],
+    robot: &RobotModel,
+) -> Result<Vec<usize>> {
+    let bad =
+        |m: String| SimError::Setup(format!("controller \"{name}\": {m}; trajectory dropped"));
+    let mut order = Vec::with_capacity(joints.len());
+    for j in joints {
+        let joint = &robot.joint(*j).name;
+        let k = trajectory
+            .joint_names
+            .iter()
+            .position(|n| n == joint)
+            .ok_or_else(|| bad(format!("the trajectory does not list joint \"{joint}\"")))?;
+        order.push(k);
+    }
+    if let Some(extra) = trajectory
+        .joint_names
+        .iter()
+        .find(|n| !joints.iter().any(|j| &robot.joint(*j).name == *n))
+    {
+        return Err(bad(format!("joint \"{extra}\" is not one of its joints")));
+    }
+    let n = trajectory.joint_names.len();
+    let mut last_t = -1.0;
+    for (i, p) in trajectory.points.iter().enumerate() {
+        if p.positions.len() != n
+            || !(p.velocities.is_empty() || p.velocities.len() == n)
+            || !(p.accelerations.is_empty() || p.accelerations.len() == n)
+        {
+            return Err(bad(format!(
+                "point {i} must give {n} positions (and 0 or {n} velocities and accelerations), found {}, {}, {}",
+                p.positions.len(),
+                p.velocities.len(),
+                p.accelerations.len()
+            )));
+        }
+        let all = p
+            .positions
+            .iter()
+            .chain(&p.velocities)
+            .chain(&p.accelerations);
+        if !all.clone().all(|x| x.is_finite()) || !p.time_from_start_s.is_finite() {
+            return Err(bad(format!(
+                "point {i} has a value that is not a finite number"
+            )));
+        }
+        if p.time_from_start_s <= last_t {
+            return Err(bad(format!(
+                "point {i}: time_from_start {:.3} s must be later than the point before",
+                p.time_from_start_s
+            )));
+        }
+        last_t = p.time_from_start_s;
+    }
+    Ok(order)
+}
+
+/// Position and velocity of joint `k` at `t` between knots `a` and `b`.
+fn interpolate(a: &Knot, b: &Knot, k: usize, t: f64) -> (f64, f64) {
+    let duration = (b.t_s - a.t_s).max(1e-9);
+    let s = (t - a.t_s).clamp(0.0, duration);
+    let (p0, p1) = (a.positions[k], b.positions[k]);
+    let Some(bv) = &b.velocities else {
+        let v = (p1 - p0) / duration;
+        return (p0 + v * s, v);
+    };
+    let v0 = a.velocities.as_ref().map_or(0.0, |v| v[k]);
+    let v1 = bv[k];
+    let (a0, a1) = match (&a.accelerations, &b.accelerations) {
+        (Some(x), Some(y)) => (x[k], y[k]),
+        (None, Some(y)) => (0.0, y[k]),
+        _ => {
+            // Cubic through both positions and velocities.
+            let t = duration;
+            let c2 = (3.0 * (p1 - p0) - (2.0 * v0 + v1) * t) / (t * t);
+            let c3 = (2.0 * (p0 - p1) + (v0 + v1) * t) / (t * t * t);
+            return (
+                p0 + v0 * s + c2 * s * s + c3 * s * s * s,
+                v0 + 2.0 * c2 * s + 3.0 * c3 * s * s,
+            );
+        }
+    };
+    // Quintic through positions, velocities and accelerations.
+    let t = duration;
+    let (t2, t3, t4, t5) = (t * t, t * t * t, t * t * t * t, t * t * t * t * t);
+    let c3 = (20.0 * (p1 - p0) - (8.0 * v1 + 12.0 * v0) * t - (3.0 * a0 - a1) * t2) / (2.0 * t3);
+    let c4 =
+        (30.0 * (p0 - p1) + (14.0 * v1 + 16.0 * v0) * t + (3.0 * a0 - 2.0 * a1) * t2) / (2.0 * t4);
+    let c5 = (12.0 * (p1 - p0) - (6.0 * v1 + 6.0 * v0) * t - (a0 - a1) * t2) / (2.0 * t5);
+    let c2 = a0 / 2.0;
+    (
+        p0 + v0 * s + c2 * s * s + c3 * s.powi(3) + c4 * s.powi(4) + c5 * s.powi(5),
+        v0 + 2.0 * c2 * s + 3.0 * c3 * s * s + 4.0 * c4 * s.powi(3) + 5.0 * c5 * s.powi(4),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn knot(t_s: f64, p: f64, v: Option<f64>, a: Option<f64>) -> Knot {
+        Knot {
+            t_s,
+            positions: vec![p],
+            velocities: v.map(|v| vec![v]),
+            accelerations: a.map(|a| vec![a]),
+        }
+    }
+
+    #[test]
+    fn segments_meet_their_ends_for_every_kind_of_point() {
+        let start = knot(1.0, 0.5, Some(0.2), Some(0.0));
+        for end in [
+            knot(3.0, -1.0, None, None),
+            knot(3.0, -1.0, Some(0.3), None),
+            knot(3.0, -1.0, Some(0.3), Some(-0.1)),
+        ] {
+            let (q0, _) = interpolate(&start, &end, 0, 1.0);
+            let (q1, v1) = interpolate(&start, &end, 0, 3.0);
+            assert!((q0 - 0.5).abs() < 1e-12, "{q0}");
+            assert!((q1 + 1.0).abs() < 1e-9, "{q1}");
+            if let Some(v) = &end.velocities {
+                assert!((v1 - v[0]).abs() < 1e-9, "{v1}");
+                let (_, v0) = interpolate(&start, &end, 0, 1.0);
+                assert!((v0 - 0.2).abs() < 1e-9, "{v0}");
+            } else {
+                assert!((v1 + 0.75).abs() < 1e-12, "{v1}");
+            }
+        }
+    }
+}
