@@ -1,7 +1,7 @@
 //! What drives the loop from outside: an [`Action`] (a script step, a key, a gamepad command,
 //! ROS `/cmd_vel`), and [`InputSource`], polled for actions before every physics step.
 
-use rover_sim::Twist;
+use rover_sim::{JointCommand, JointTrajectory, Twist};
 
 use crate::teleop::KeyAction;
 
@@ -15,6 +15,37 @@ pub enum Action {
     Key(KeyAction),
     /// Flip between manual and follow mode.
     ToggleFollow,
+    /// Move the robot's joints (the arm); the base's mode does not change.
+    Joint(JointAction),
+}
+
+/// An input for the robot's joints: from a script, the driver's station, or a controller's
+/// topic over ROS.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointAction {
+    /// Command one actuated joint by name.
+    Command {
+        /// Joint name.
+        joint: String,
+        /// What it should do.
+        command: JointCommand,
+    },
+    /// A single-joint controller's command (what its `command` topic carries).
+    Controller {
+        /// Controller name.
+        name: String,
+        /// Position, velocity or effort, per the controller's type.
+        value: f64,
+    },
+    /// A trajectory for a joint trajectory controller.
+    Trajectory {
+        /// Controller name.
+        controller: String,
+        /// The trajectory.
+        trajectory: Box<JointTrajectory>,
+    },
+    /// Go to a named pose of the controllers file.
+    Pose(String),
 }
 
 /// Input from outside the loop that drives it like manual input: the ROS bridge's `/cmd_vel`.

@@ -34,7 +34,7 @@ pub use headless::{
     DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary, run_headless, run_headless_driven,
     run_headless_observed,
 };
-pub use input::{Action, InputSource, NoInput};
+pub use input::{Action, InputSource, JointAction, NoInput};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
 pub use pilot::{Mode, Pilot};
@@ -46,4 +46,4 @@ pub use scenario::{
 pub use script::{Script, ScriptPlayer, Step};
 pub use session::{DetectorMode, Session, SessionOptions};
 pub use teleop::{KeyAction, TELEOP_KEYS, Teleop, key_action};
-pub use trace::{TRACE_HEADER, TraceParseError, TraceRow, TraceWriter, parse_trace};
+pub use trace::{TRACE_HEADER, TraceParseError, TraceRow, TraceWriter, parse_trace, trace_joints};

@@ -68,6 +68,8 @@ impl Pilot {
                 self.teleop.press(KeyAction::Stop);
                 Some(Twist::ZERO)
             }
+            // The arm moves in either mode; the base is not touched.
+            Action::Joint(_) => None,
         }
     }
 }

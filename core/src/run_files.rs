@@ -6,7 +6,7 @@ use std::fs::File;
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-use rover_sim::{CameraFrame, ControlSample, Pose, Simulation};
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
 
 use crate::error::{CoreError, Result};
 use crate::observer::{LoopStats, Observer};
@@ -80,19 +80,24 @@ impl Write for RowFile {
 #[derive(Debug)]
 pub struct TraceObserver {
     path: PathBuf,
+    /// The file until the run starts (the header needs the robot's joints).
+    file: Option<RowFile>,
     writer: Option<TraceWriter<RowFile>>,
+    /// The actuated joints, in column order.
+    joints: Vec<rover_sim::JointId>,
     failed: Option<CoreError>,
     rows: u64,
 }
 
 impl TraceObserver {
-    /// Creates (truncates) the trace file and writes its header.
+    /// Creates (truncates) the trace file; the header is written when the run starts.
     pub fn create(path: &Path) -> Result<Self> {
         let file = File::create(path).map_err(|e| CoreError::write(path, e))?;
-        let writer = TraceWriter::new(RowFile::new(file)).map_err(|e| CoreError::write(path, e))?;
         Ok(Self {
             path: path.to_path_buf(),
-            writer: Some(writer),
+            file: Some(RowFile::new(file)),
+            writer: None,
+            joints: Vec::new(),
             failed: None,
             rows: 0,
         })
@@ -105,6 +110,11 @@ impl TraceObserver {
 
     /// Flushes the file; returns the number of rows.
     pub fn finish(mut self) -> Result<u64> {
+        if let Some(file) = self.file.take() {
+            // The run never started: the header alone.
+            self.writer =
+                Some(TraceWriter::new(file).map_err(|e| CoreError::write(&self.path, e))?);
+        }
         if let Some(w) = self.writer.take() {
             let mut file = w.into_inner();
             file.flush().map_err(|e| self.write_failed(e, &file))?;
@@ -126,9 +136,30 @@ impl TraceObserver {
 }
 
 impl Observer for TraceObserver {
-    fn control(&mut self, _sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
+    fn start(&mut self, sim: &Simulation, _camera: Option<&CameraInfo>, _labels: &[String]) {
+        let Some(file) = self.file.take() else {
+            return;
+        };
+        let robot = sim.robot();
+        self.joints = robot.actuated_joints();
+        let names: Vec<&str> = self
+            .joints
+            .iter()
+            .map(|j| robot.joint(*j).name.as_str())
+            .collect();
+        match TraceWriter::with_joints(file, &names) {
+            Ok(w) => self.writer = Some(w),
+            Err(e) => self.failed = Some(CoreError::write(&self.path, e)),
+        }
+    }
+
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         if let Some(w) = self.writer.as_mut() {
-            match w.row(sample, stats.mode, stats.follow_state) {
+            let joints = self
+                .joints
+                .iter()
+                .map(|j| sim.joint_state(*j).unwrap_or_default());
+            match w.row_with_joints(sample, (stats.mode, stats.follow_state), joints) {
                 Ok(()) => self.rows += 1,
                 Err(e) => {
                     if let Some(w) = self.writer.take() {

@@ -5,16 +5,22 @@
 //!   { at = 0.0, cmd_vel = [0.5, 0.0] },   # linear.x m/s, angular.z rad/s
 //!   { at = 2.0, key = "j" },              # a teleop_twist_keyboard key
 //!   { at = 3.0, toggle = "follow" },      # flip between manual and follow mode
+//!   { at = 4.0, joint = "arm_2_joint", position = -0.8 },  # or velocity = / effort =
+//!   { at = 6.0, pose = "home" },          # a named pose of the controllers file
+//!   { at = 8.0, controller = "gripper_controller", command = 0.02 },  # its `command` topic
 //! ]
 //! ```
+//!
+//! Joint, pose and controller names are checked against the robot when the step runs: an
+//! unknown one is reported once as a warning and the step is dropped.
 
 use std::path::Path;
 
-use rover_sim::{ControlSample, SimError, Twist};
+use rover_sim::{ControlSample, JointCommand, SimError, Twist};
 use serde::Deserialize;
 
 use crate::error::Result;
-use crate::input::Action;
+use crate::input::{Action, JointAction};
 use crate::observer::Observer;
 use crate::session::Session;
 use crate::teleop::{TELEOP_KEYS, key_action};
@@ -49,6 +55,64 @@ struct RawStep {
     cmd_vel: Option<[f64; 2]>,
     key: Option<String>,
     toggle: Option<String>,
+    joint: Option<String>,
+    position: Option<f64>,
+    velocity: Option<f64>,
+    effort: Option<f64>,
+    pose: Option<String>,
+    controller: Option<String>,
+    command: Option<f64>,
+}
+
+impl RawStep {
+    /// A joint, pose or controller step, if this is one; `Err` names what is wrong.
+    fn joint_action(&self) -> Option<std::result::Result<JointAction, String>> {
+        let values = [self.position, self.velocity, self.effort];
+        let given = values.iter().filter(|v| v.is_some()).count();
+        if let Some(joint) = &self.joint {
+            let command = match (self.position, self.velocity, self.effort) {
+                (Some(q), None, None) => JointCommand::Position(q),
+                (None, Some(v), None) => JointCommand::Velocity(v),
+                (None, None, Some(e)) => JointCommand::Effort(e),
+                _ => {
+                    return Some(Err(format!(
+                        "joint \"{joint}\" needs exactly one of `position`, `velocity` or `effort`, found {given}"
+                    )));
+                }
+            };
+            if !command.is_finite() {
+                return Some(Err(format!(
+                    "joint \"{joint}\": the command must be a finite number"
+                )));
+            }
+            return Some(Ok(JointAction::Command {
+                joint: joint.clone(),
+                command,
+            }));
+        }
+        if given > 0 {
+            return Some(Err(
+                "`position`, `velocity` and `effort` go with `joint = \"<name>\"`".into(),
+            ));
+        }
+        if let Some(pose) = &self.pose {
+            return Some(Ok(JointAction::Pose(pose.clone())));
+        }
+        match (&self.controller, self.command) {
+            (Some(name), Some(value)) if value.is_finite() => Some(Ok(JointAction::Controller {
+                name: name.clone(),
+                value,
+            })),
+            (Some(name), Some(_)) => Some(Err(format!(
+                "controller \"{name}\": `command` must be a finite number"
+            ))),
+            (Some(name), None) => Some(Err(format!(
+                "controller \"{name}\" needs `command = <number>`"
+            ))),
+            (None, Some(_)) => Some(Err("`command` goes with `controller = \"<name>\"`".into())),
+            (None, None) => None,
+        }
+    }
 }
 
 impl Script {
@@ -76,37 +140,48 @@ impl Script {
                     s.at
                 ));
             }
-            let action = match (s.cmd_vel, s.key, s.toggle) {
-                (Some([linear, angular]), None, None) => {
-                    let twist = Twist::new(linear, angular);
-                    if !twist.is_finite() {
-                        return bail(format!(
-                            "cmd_vel must be two finite numbers [linear.x m/s, angular.z rad/s], found [{linear}, {angular}]"
-                        ));
-                    }
-                    Action::CmdVel(twist)
-                }
-                (None, Some(key), None) => match key_action(&key) {
-                    Some(a) => Action::Key(a),
-                    None => {
-                        return bail(format!(
-                            "key \"{key}\" is not a teleop key; expected one of: {TELEOP_KEYS}"
-                        ));
-                    }
-                },
-                (None, None, Some(mode)) => match mode.as_str() {
-                    "follow" => Action::ToggleFollow,
-                    other => {
-                        return bail(format!(
-                            "toggle \"{other}\" is unknown; expected \"follow\""
-                        ));
-                    }
-                },
-                _ => {
+            let joint = s.joint_action();
+            let base_given = s.cmd_vel.is_some() || s.key.is_some() || s.toggle.is_some();
+            let action = match (joint, s.cmd_vel, s.key, s.toggle) {
+                (Some(_), _, _, _) if base_given => {
                     return bail(
-                        "expected exactly one of `cmd_vel`, `key` or `toggle` besides `at`".into(),
+                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose` or `controller` besides `at`".into(),
                     );
                 }
+                (Some(Ok(action)), ..) => Action::Joint(action),
+                (Some(Err(message)), ..) => return bail(message),
+                (None, cmd_vel, key, toggle) => match (cmd_vel, key, toggle) {
+                    (Some([linear, angular]), None, None) => {
+                        let twist = Twist::new(linear, angular);
+                        if !twist.is_finite() {
+                            return bail(format!(
+                                "cmd_vel must be two finite numbers [linear.x m/s, angular.z rad/s], found [{linear}, {angular}]"
+                            ));
+                        }
+                        Action::CmdVel(twist)
+                    }
+                    (None, Some(key), None) => match key_action(&key) {
+                        Some(a) => Action::Key(a),
+                        None => {
+                            return bail(format!(
+                                "key \"{key}\" is not a teleop key; expected one of: {TELEOP_KEYS}"
+                            ));
+                        }
+                    },
+                    (None, None, Some(mode)) => match mode.as_str() {
+                        "follow" => Action::ToggleFollow,
+                        other => {
+                            return bail(format!(
+                                "toggle \"{other}\" is unknown; expected \"follow\""
+                            ));
+                        }
+                    },
+                    _ => {
+                        return bail(
+                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose` or `controller` besides `at`".into(),
+                    );
+                    }
+                },
             };
             steps.push(Step { at_s: s.at, action });
         }
@@ -207,5 +282,39 @@ mod tests {
         assert!(
             err("steps = [ { at = 1.0, toggle = \"dance\" } ]").contains("expected \"follow\"")
         );
+        let both = err("steps = [ { at = 1.0, joint = \"a\", position = 1.0, velocity = 2.0 } ]");
+        assert!(both.contains("exactly one of `position`"), "{both}");
+        let nan = err("steps = [ { at = 1.0, joint = \"a\", position = nan } ]");
+        assert!(nan.contains("finite"), "{nan}");
+        let stray = err("steps = [ { at = 1.0, position = 1.0 } ]");
+        assert!(stray.contains("go with `joint"), "{stray}");
+        let mixed = err("steps = [ { at = 1.0, key = \"k\", pose = \"home\" } ]");
+        assert!(mixed.contains("exactly one of"), "{mixed}");
+    }
+
+    #[test]
+    fn parses_joint_pose_and_controller_steps() -> crate::Result<()> {
+        let s = parse(
+            "steps = [ { at = 1.0, joint = \"arm_2_joint\", position = -0.8 }, { at = 2.0, pose = \"home\" }, { at = 3.0, controller = \"grip\", command = 0.02 } ]",
+        )?;
+        assert_eq!(
+            s.steps[0].action,
+            Action::Joint(JointAction::Command {
+                joint: "arm_2_joint".into(),
+                command: JointCommand::Position(-0.8)
+            })
+        );
+        assert_eq!(
+            s.steps[1].action,
+            Action::Joint(JointAction::Pose("home".into()))
+        );
+        assert_eq!(
+            s.steps[2].action,
+            Action::Joint(JointAction::Controller {
+                name: "grip".into(),
+                value: 0.02
+            })
+        );
+        Ok(())
     }
 }

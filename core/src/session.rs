@@ -19,7 +19,7 @@ use rover_sim::{
 
 use crate::error::{CoreError, Result};
 use crate::follower::{CameraGeometry, Follower, FollowerConfig, LaserMount};
-use crate::input::Action;
+use crate::input::{Action, JointAction};
 use crate::observer::{EventLevel, LoopStats, Observer};
 use crate::pilot::{Mode, Pilot};
 
@@ -237,6 +237,10 @@ impl Session {
     /// Applies a user input (script step, key, gamepad). Manual input while following takes
     /// control back at once.
     pub fn input(&mut self, action: Action, observer: &mut dyn Observer) {
+        if let Action::Joint(joint) = action {
+            self.joint_input(joint, observer);
+            return;
+        }
         let before = self.pilot.mode();
         let cmd = self.pilot.apply(&action);
         let after = self.pilot.mode();
@@ -264,6 +268,28 @@ impl Session {
         self.stats.mode = after;
     }
 
+    /// A joint input: applied to the simulation; a bad one (an unknown joint or controller,
+    /// a number that is not finite, a trajectory that does not fit) is dropped with a warning.
+    fn joint_input(&mut self, action: JointAction, observer: &mut dyn Observer) {
+        let result = match &action {
+            JointAction::Command { joint, command } => self.sim.command_joint(joint, *command),
+            JointAction::Controller { name, value } => self.sim.command_controller(name, *value),
+            JointAction::Trajectory {
+                controller,
+                trajectory,
+            } => self.sim.follow_trajectory(controller, trajectory),
+            JointAction::Pose(name) => self.sim.go_to_named_pose(name),
+        };
+        if let Err(e) = result {
+            emit(
+                observer,
+                self.sim.sim_time_s(),
+                EventLevel::Warn,
+                &format!("{e}; command dropped"),
+            );
+        }
+    }
+
     /// The laser scanner, when the robot has one.
     pub fn laser(&self) -> Option<&LaserSensor> {
         self.laser.as_ref()
@@ -274,6 +300,15 @@ impl Session {
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<Option<ControlSample>> {
         self.camera_and_detection(observer)?;
         let sample = self.sim.step();
+        let now_s = self.sim.sim_time_s();
+        self.sim.drain_controller_events(|text| {
+            let level = if text.contains("VIOLATED") {
+                EventLevel::Warn
+            } else {
+                EventLevel::Info
+            };
+            emit(observer, now_s, level, text);
+        });
         if let Some(sample) = &sample {
             // Every mode: detections are placed with the pose at their image's time.
             self.follower

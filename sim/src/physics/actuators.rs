@@ -260,7 +260,7 @@ impl Actuators {
         let name = &robot.joint(joint).name;
         if !command.is_finite() {
             return Err(SimError::Setup(format!(
-                "joint \"{name}\": command {command:?} is not finite; dropped"
+                "joint \"{name}\": command {command:?} is not finite"
             )));
         }
         let Some(a) = self.of_mut(joint) else {

@@ -283,7 +283,7 @@ impl Controllers {
         }
         if knots.len() < 2 {
             return Err(SimError::Setup(format!(
-                "controller \"{name}\": every point of the trajectory is already past (sim time {now_s:.3} s); dropped"
+                "controller \"{name}\": every point of the trajectory is already past (sim time {now_s:.3} s)"
             )));
         }
         run.end_s = knots.last().map(|k| k.t_s);
@@ -455,8 +455,7 @@ fn check_trajectory(
     joints: &[JointId],
     robot: &RobotModel,
 ) -> Result<Vec<usize>> {
-    let bad =
-        |m: String| SimError::Setup(format!("controller \"{name}\": {m}; trajectory dropped"));
+    let bad = |m: String| SimError::Setup(format!("controller \"{name}\": {m}"));
     let mut order = Vec::with_capacity(joints.len());
     for j in joints {
         let joint = &robot.joint(*j).name;
