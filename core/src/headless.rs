@@ -34,6 +34,8 @@ pub struct RunConfig {
     pub drive: Option<rover_sim::DriveSpec>,
     /// Which camera to render when the robot has several (default: the first in the file).
     pub camera: Option<String>,
+    /// A ros_control controllers YAML for the robot (overrides the world's `controllers`).
+    pub controllers: Option<PathBuf>,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -147,6 +149,13 @@ impl RunConfig {
         let mut robot = RobotModel::load_with(&robot_path, &self.robot_load_options(&world))?;
         if let Some(spec) = self.drive.as_ref().or(world.robot.drive.as_ref()) {
             robot.set_drive(spec)?;
+        }
+        if let Some(path) = self
+            .controllers
+            .as_ref()
+            .or(world.robot.controllers.as_ref())
+        {
+            robot.load_controllers(path)?;
         }
         if let Some(name) = &self.camera {
             robot.select_camera(name)?;

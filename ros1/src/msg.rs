@@ -76,6 +76,23 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities",
     ),
     ("rosgraph_msgs/Clock", "time clock"),
+    ("std_msgs/Float64", "float64 data"),
+    (
+        "trajectory_msgs/JointTrajectoryPoint",
+        "float64[] positions\nfloat64[] velocities\nfloat64[] accelerations\nfloat64[] effort\nduration time_from_start",
+    ),
+    (
+        "trajectory_msgs/JointTrajectory",
+        "Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint[] points",
+    ),
+    (
+        "control_msgs/JointControllerState",
+        "Header header\nfloat64 set_point\nfloat64 process_value\nfloat64 process_value_dot\nfloat64 error\nfloat64 time_step\nfloat64 command\nfloat64 p\nfloat64 i\nfloat64 d\nfloat64 i_clamp\nbool antiwindup",
+    ),
+    (
+        "control_msgs/JointTrajectoryControllerState",
+        "Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint desired\ntrajectory_msgs/JointTrajectoryPoint actual\ntrajectory_msgs/JointTrajectoryPoint error",
+    ),
     (
         "darknet_ros_msgs/BoundingBox",
         "float64 probability\nint64 xmin\nint64 ymin\nint64 xmax\nint64 ymax\nint16 id\nstring Class",
@@ -255,6 +272,15 @@ pub mod wire {
         u32(out, s);
         u32(out, ns);
     }
+    /// A `duration` from seconds (i32 s + i32 ns, the nanoseconds in 0..1e9).
+    pub fn duration(out: &mut Vec<u8>, t_s: f64) {
+        let t_s = if t_s.is_finite() { t_s } else { 0.0 };
+        let total_ns = (t_s * 1e9).round() as i64;
+        let secs = total_ns.div_euclid(1_000_000_000);
+        let nsecs = total_ns.rem_euclid(1_000_000_000);
+        out.extend_from_slice(&(i32::try_from(secs).unwrap_or(i32::MAX)).to_le_bytes());
+        out.extend_from_slice(&(nsecs as i32).to_le_bytes());
+    }
     /// A fixed array of f64 (no length prefix).
     pub fn f64_fixed(out: &mut Vec<u8>, v: &[f64]) {
         for x in v {
@@ -319,5 +345,55 @@ impl<'a> Reader<'a> {
         let mut a = [0u8; 8];
         a.copy_from_slice(b);
         Ok(f64::from_le_bytes(a))
+    }
+
+    /// A u32.
+    pub fn u32(&mut self) -> Result<u32> {
+        let b = self.take(4)?;
+        let mut a = [0u8; 4];
+        a.copy_from_slice(b);
+        Ok(u32::from_le_bytes(a))
+    }
+
+    /// An i32.
+    pub fn i32(&mut self) -> Result<i32> {
+        Ok(self.u32()? as i32)
+    }
+
+    /// A length prefix, checked against what is left (each element at least `min_size`
+    /// bytes), so a corrupt length cannot ask for a huge allocation.
+    pub fn len(&mut self, min_size: usize) -> Result<usize> {
+        let n = self.u32()? as usize;
+        if n.saturating_mul(min_size.max(1)) > self.bytes.len() {
+            return Err(Error::protocol("array longer than the message"));
+        }
+        Ok(n)
+    }
+
+    /// A string (UTF-8; invalid bytes are replaced).
+    pub fn string(&mut self) -> Result<String> {
+        let n = self.len(1)?;
+        Ok(String::from_utf8_lossy(self.take(n)?).into_owned())
+    }
+
+    /// A variable-length array of f64.
+    pub fn f64_array(&mut self) -> Result<Vec<f64>> {
+        let n = self.len(8)?;
+        (0..n).map(|_| self.f64()).collect()
+    }
+
+    /// A `time` or `duration` in seconds (secs + nsecs).
+    pub fn time_s(&mut self, signed: bool) -> Result<f64> {
+        let secs = if signed {
+            f64::from(self.i32()?)
+        } else {
+            f64::from(self.u32()?)
+        };
+        let nsecs = if signed {
+            f64::from(self.i32()?)
+        } else {
+            f64::from(self.u32()?)
+        };
+        Ok(secs + nsecs * 1e-9)
     }
 }

@@ -21,6 +21,13 @@ impl Header {
         wire::time(out, self.stamp_s);
         wire::string(out, &self.frame_id);
     }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            seq: r.u32()?,
+            stamp_s: r.time_s(false)?,
+            frame_id: r.string()?,
+        })
+    }
 }
 
 /// `geometry_msgs/Vector3` and `Point`.
@@ -303,6 +310,189 @@ impl Message for JointState {
     }
 }
 
+/// `std_msgs/Float64`: what a ros_control joint controller's `command` topic takes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Float64 {
+    /// The value.
+    pub data: f64,
+}
+
+impl Message for Float64 {
+    const TYPE: &'static str = "std_msgs/Float64";
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::f64(out, self.data);
+    }
+}
+
+impl Decode for Float64 {
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        Ok(Self {
+            data: Reader::new(bytes).f64()?,
+        })
+    }
+}
+
+/// `trajectory_msgs/JointTrajectoryPoint`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointTrajectoryPoint {
+    /// Positions (rad or m).
+    pub positions: Vec<f64>,
+    /// Velocities; may be empty.
+    pub velocities: Vec<f64>,
+    /// Accelerations; may be empty.
+    pub accelerations: Vec<f64>,
+    /// Efforts; may be empty.
+    pub effort: Vec<f64>,
+    /// When the point is due after the trajectory's start (s).
+    pub time_from_start_s: f64,
+}
+
+impl JointTrajectoryPoint {
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::f64_array(out, &self.positions);
+        wire::f64_array(out, &self.velocities);
+        wire::f64_array(out, &self.accelerations);
+        wire::f64_array(out, &self.effort);
+        wire::duration(out, self.time_from_start_s);
+    }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            positions: r.f64_array()?,
+            velocities: r.f64_array()?,
+            accelerations: r.f64_array()?,
+            effort: r.f64_array()?,
+            time_from_start_s: r.time_s(true)?,
+        })
+    }
+}
+
+/// `trajectory_msgs/JointTrajectory`: what a joint trajectory controller's `command` topic
+/// takes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointTrajectory {
+    /// Stamp: when it starts (0: on arrival).
+    pub header: Header,
+    /// The joints each point lists.
+    pub joint_names: Vec<String>,
+    /// The points.
+    pub points: Vec<JointTrajectoryPoint>,
+}
+
+impl Message for JointTrajectory {
+    const TYPE: &'static str = "trajectory_msgs/JointTrajectory";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::len(out, self.joint_names.len());
+        for n in &self.joint_names {
+            wire::string(out, n);
+        }
+        wire::len(out, self.points.len());
+        for p in &self.points {
+            p.encode(out);
+        }
+    }
+}
+
+impl Decode for JointTrajectory {
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes);
+        let header = Header::decode(&mut r)?;
+        let n = r.len(4)?;
+        let joint_names = (0..n).map(|_| r.string()).collect::<Result<_>>()?;
+        // Each point is at least its four array lengths and a duration.
+        let n = r.len(24)?;
+        let points = (0..n)
+            .map(|_| JointTrajectoryPoint::decode(&mut r))
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            header,
+            joint_names,
+            points,
+        })
+    }
+}
+
+/// `control_msgs/JointControllerState`: a single-joint position controller's `state`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointControllerState {
+    /// Stamp.
+    pub header: Header,
+    /// The setpoint (rad or m).
+    pub set_point: f64,
+    /// The joint's position.
+    pub process_value: f64,
+    /// The joint's velocity.
+    pub process_value_dot: f64,
+    /// set_point - process_value.
+    pub error: f64,
+    /// Control period (s).
+    pub time_step: f64,
+    /// The effort commanded.
+    pub command: f64,
+    /// Gains.
+    pub p: f64,
+    /// Gains.
+    pub i: f64,
+    /// Gains.
+    pub d: f64,
+    /// Integral bound.
+    pub i_clamp: f64,
+    /// Anti-windup (rover's loop always bounds its integral).
+    pub antiwindup: bool,
+}
+
+impl Message for JointControllerState {
+    const TYPE: &'static str = "control_msgs/JointControllerState";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::f64_fixed(
+            out,
+            &[
+                self.set_point,
+                self.process_value,
+                self.process_value_dot,
+                self.error,
+                self.time_step,
+                self.command,
+                self.p,
+                self.i,
+                self.d,
+                self.i_clamp,
+            ],
+        );
+        wire::u8(out, u8::from(self.antiwindup));
+    }
+}
+
+/// `control_msgs/JointTrajectoryControllerState`: a joint trajectory controller's `state`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointTrajectoryControllerState {
+    /// Stamp.
+    pub header: Header,
+    /// Its joints.
+    pub joint_names: Vec<String>,
+    /// Where the trajectory wants the joints.
+    pub desired: JointTrajectoryPoint,
+    /// Where they are.
+    pub actual: JointTrajectoryPoint,
+    /// desired - actual.
+    pub error: JointTrajectoryPoint,
+}
+
+impl Message for JointTrajectoryControllerState {
+    const TYPE: &'static str = "control_msgs/JointTrajectoryControllerState";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::len(out, self.joint_names.len());
+        for n in &self.joint_names {
+            wire::string(out, n);
+        }
+        self.desired.encode(out);
+        self.actual.encode(out);
+        self.error.encode(out);
+    }
+}
+
 /// `sensor_msgs/LaserScan` (no intensities).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LaserScan {
@@ -442,6 +632,19 @@ mod tests {
             ("sensor_msgs/JointState", "3066dcd76a6cfaef579bd0f34173e9fd"),
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
             ("std_msgs/Header", "2176decaecbce78abc3b96ef049fabed"),
+            ("std_msgs/Float64", "fdb28210bfa9d7c91146260178d9a584"),
+            (
+                "trajectory_msgs/JointTrajectoryPoint",
+                "f3cd1e1c4d320c79d6985c904ae5dcd3",
+            ),
+            (
+                "trajectory_msgs/JointTrajectory",
+                "65b4f94a94d1ed67169da35a02f33d3f",
+            ),
+            (
+                "control_msgs/JointControllerState",
+                "987ad85e4756f3aef7f1e5e7fe0595d1",
+            ),
         ] {
             assert_eq!(md5sum(t)?, sum, "{t}");
         }
@@ -461,6 +664,33 @@ mod tests {
             assert_eq!(text.matches(dep).count(), 1, "{dep} in\n{text}");
         }
         assert!(md5sum("nope/Nothing").is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn joint_trajectory_round_trips_and_a_lying_length_is_an_error() -> Result<()> {
+        let t = JointTrajectory {
+            header: Header {
+                seq: 3,
+                stamp_s: 0.0,
+                frame_id: String::new(),
+            },
+            joint_names: vec!["arm_1_joint".into(), "arm_2_joint".into()],
+            points: vec![JointTrajectoryPoint {
+                positions: vec![0.1, -0.8],
+                velocities: vec![0.0, 0.0],
+                time_from_start_s: 1.5,
+                ..JointTrajectoryPoint::default()
+            }],
+        };
+        let mut bytes = Vec::new();
+        t.encode(&mut bytes);
+        assert_eq!(JointTrajectory::decode(&bytes)?, t);
+        // A joint count of a billion in a short message.
+        let mut lying = bytes.clone();
+        lying[16..20].copy_from_slice(&1_000_000_000u32.to_le_bytes());
+        assert!(JointTrajectory::decode(&lying).is_err());
+        assert!(Float64::decode(&[0, 0, 0]).is_err());
         Ok(())
     }
 

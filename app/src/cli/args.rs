@@ -107,11 +107,18 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "HZ")]
     pub(crate) physics_hz: Option<f64>,
 
-    /// How the robot's joints are solved, overriding the world's [physics] joints:
-    /// multibody (reduced coordinates, the default: arms hold their shape) or impulse
-    /// (a constraint per joint)
+    /// How the robot's joints are solved, overriding the world's [physics] joints: impulse
+    /// (a constraint per joint, the default) or multibody (reduced coordinates: long arms
+    /// with light links, fixed-base arms)
     #[arg(long, value_name = "SOLVER", value_parser = parse_joint_solver)]
     pub(crate) joints: Option<rover_sim::JointSolver>,
+
+    /// A ros_control controllers YAML for the robot (overrides the world's [robot]
+    /// controllers): joint_state_controller, Joint{Position,Velocity,Effort}Controller and
+    /// JointTrajectoryController, gazebo_ros_control/pid_gains, and rover's named_poses.
+    /// Without one every actuated joint holds its pose and takes commands by joint name
+    #[arg(long, value_name = "FILE.yaml")]
+    pub(crate) controllers: Option<PathBuf>,
 
     /// Seed for everything random; the same seed gives the same run
     #[arg(long, default_value_t = 0)]
@@ -815,6 +822,7 @@ impl WorldArgs {
             spawn: self.spawn,
             drive: self.drive.clone(),
             camera: self.camera.clone(),
+            controllers: self.controllers.clone(),
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,

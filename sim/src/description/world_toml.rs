@@ -104,6 +104,7 @@ struct RawRobot {
     xacro_args: std::collections::BTreeMap<String, String>,
     #[serde(default)]
     drive: Option<DriveSpec>,
+    controllers: Option<PathBuf>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -414,6 +415,7 @@ impl RawWorld {
             yaw_rad: raw_robot.yaw_deg.to_radians(),
             xacro_args: raw_robot.xacro_args,
             drive: raw_robot.drive,
+            controllers: raw_robot.controllers.map(|c| base_dir.join(c)),
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

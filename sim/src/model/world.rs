@@ -47,6 +47,9 @@ pub struct RobotSpawn {
     pub xacro_args: std::collections::BTreeMap<String, String>,
     /// `[robot.drive]`: how to drive a robot whose URDF names no drive plugin.
     pub drive: Option<DriveSpec>,
+    /// `controllers`: a ros_control controllers YAML for the robot, resolved against the world
+    /// file's folder.
+    pub controllers: Option<PathBuf>,
 }
 
 /// Physics settings (`[physics]`).
