@@ -35,6 +35,10 @@ pub(super) struct JointSample {
     pub parent_from_child: Pose,
     /// Measured speed (rad/s).
     pub velocity_radps: f64,
+    /// The joint's position (rad or m) from the simulation; wheels' angles come from the poses.
+    pub position: f64,
+    /// The actuator's effort (N m or N); 0 for passive joints and wheels.
+    pub effort: f64,
 }
 
 /// A camera image.

@@ -1,5 +1,6 @@
 //! `/joint_states` (sensor_msgs/JointState): every moving joint of the plan, in its order, with
-//! its angle and measured speed, every control update.
+//! its position, velocity and effort, every control update (or at a joint_state_controller's
+//! `publish_rate`).
 
 use anyhow::Result;
 use rover_ros1::msgs;
@@ -8,13 +9,17 @@ use rover_sim::{ControlSample, Simulation};
 
 use super::convert::{header, seq_of};
 use super::events::{ControlUpdate, JointSample, TopicFamily};
-use super::plan::{MovingJoint, RosPlan};
+use super::plan::{JointSource, MovingJoint, RosPlan};
 
 /// Publishes `/joint_states`.
 pub(super) struct JointStates {
     publisher: Publisher<msgs::JointState>,
     joints: Vec<MovingJoint>,
     msg: msgs::JointState,
+    /// Seconds between messages (0: every control update).
+    period_s: f64,
+    /// Sim time of the next message.
+    next_s: f64,
 }
 
 impl JointStates {
@@ -23,6 +28,8 @@ impl JointStates {
         Ok(Self {
             publisher: node.advertise("/joint_states", 50, false)?,
             joints: plan.joints.clone(),
+            period_s: plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz),
+            next_s: 0.0,
             msg: msgs::JointState {
                 header: header(""),
                 name: plan.joints.iter().map(|j| j.name.clone()).collect(),
@@ -41,14 +48,22 @@ fn angle_rad(joint: &MovingJoint, now: &JointSample) -> f64 {
 
 impl TopicFamily for JointStates {
     fn control(&mut self, update: &ControlUpdate) {
-        if self.msg.name.is_empty() {
+        let now_s = update.sample.sim_time_s;
+        if self.msg.name.is_empty() || now_s + 1e-9 < self.next_s {
             return;
         }
+        self.next_s = now_s + self.period_s;
         self.msg.position.clear();
         self.msg.velocity.clear();
+        self.msg.effort.clear();
         for (joint, now) in self.joints.iter().zip(&update.joints) {
-            self.msg.position.push(angle_rad(joint, now));
+            let position = match joint.source {
+                JointSource::Wheel { .. } => angle_rad(joint, now),
+                JointSource::Joint(_) => now.position,
+            };
+            self.msg.position.push(position);
             self.msg.velocity.push(now.velocity_radps);
+            self.msg.effort.push(now.effort);
         }
         self.msg.header.seq = seq_of(&self.publisher);
         self.msg.header.stamp_s = update.sample.sim_time_s;
@@ -64,9 +79,21 @@ pub(super) fn sample(
     out: &mut Vec<JointSample>,
 ) {
     out.clear();
-    out.extend(joints.iter().map(|j| JointSample {
-        parent_from_child: sim.world_from_link(j.parent).inverse() * sim.world_from_link(j.child),
-        velocity_radps: j.source.velocity_radps(sample),
+    out.extend(joints.iter().map(|j| {
+        let state = match j.source {
+            JointSource::Joint(id) => sim.joint_state(id).unwrap_or_default(),
+            JointSource::Wheel { .. } => rover_sim::JointState {
+                velocity: j.source.velocity_radps(sample),
+                ..rover_sim::JointState::default()
+            },
+        };
+        JointSample {
+            parent_from_child: sim.world_from_link(j.parent).inverse()
+                * sim.world_from_link(j.child),
+            velocity_radps: state.velocity,
+            position: state.position,
+            effort: state.effort,
+        }
     }));
 }
 
@@ -101,6 +128,8 @@ mod tests {
                     at_rest.rotation * glam::Quat::from_rotation_z(turn_rad),
                 ),
                 velocity_radps: 1.0,
+                position: 0.0,
+                effort: 0.0,
             };
             let angle = angle_rad(&joint, &now);
             assert!(

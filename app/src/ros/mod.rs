@@ -1,15 +1,15 @@
 //! The ROS 1 bridge (`rover --ros`): an adapter at the edge of the loop, like the window and
 //! the recorder. As an [`Observer`] it hands what the session does to a publishing thread,
 //! under the names Gazebo's plugins and darknet_ros would use for this robot; as an
-//! [`InputSource`](rover_core::InputSource) ([`RosCmdVel`]) it feeds `/cmd_vel` to the session
-//! like manual input.
+//! [`InputSource`](rover_core::InputSource) ([`RosInput`]) it feeds `/cmd_vel` to the session
+//! like manual input, and the controllers' `command` topics to the robot's joints.
 //!
 //! The loop thread only copies (into recycled buffers) and never waits: when the publishing
 //! thread falls behind, events are dropped and counted. Stamps are sim time.
 //!
 //! One file per topic family, as OpenRR's arci-ros has one adapter per family: `clock.rs`,
 //! `odom.rs`, `tf.rs` (`/tf`, `/tf_static`), `joint_states.rs`, `camera.rs` (image,
-//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, and `cmd_vel.rs` in. Each publishing
+//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, and `cmd_vel.rs` and `controllers.rs` (the controllers' `command` topics) in. Each publishing
 //! family implements `TopicFamily` (`events.rs`, with what travels between the threads) and is
 //! listed once in `families` below; `plan.rs` names the topics, frames and moving joints,
 //! `publisher.rs` is the thread. A new topic is a new file beside them and a line in `families`.
@@ -17,6 +17,7 @@
 mod camera;
 mod clock;
 mod cmd_vel;
+mod controllers;
 mod convert;
 mod detections;
 mod events;
@@ -31,12 +32,13 @@ use std::sync::mpsc::{SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
-use rover_core::{LoopStats, Observer};
+use rover_core::{Action, InputSource, LoopStats, Observer};
 use rover_perception::BoundingBoxes;
 use rover_ros1::{Node, NodeOptions, Value};
 use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, RobotModel, Simulation};
 
 pub use cmd_vel::RosCmdVel;
+use controllers::ControllerCommands;
 pub use plan::RosPlan;
 
 use events::{BufferPool, ControlUpdate, Event, Start, TopicFamily};
@@ -65,6 +67,19 @@ fn families(node: &Node, plan: &RosPlan) -> Result<Vec<Box<dyn TopicFamily>>> {
     ])
 }
 
+/// The input half of the bridge: `/cmd_vel` and the controllers' `command` topics.
+#[derive(Debug)]
+pub struct RosInput {
+    cmd_vel: RosCmdVel,
+    controllers: ControllerCommands,
+}
+
+impl InputSource for RosInput {
+    fn poll(&mut self) -> Option<Action> {
+        self.cmd_vel.poll().or_else(|| self.controllers.poll())
+    }
+}
+
 /// The observer half of the bridge.
 pub struct RosBridge {
     tx: Option<SyncSender<Event>>,
@@ -91,7 +106,7 @@ impl RosBridge {
     /// Starts the node (registering with `ROS_MASTER_URI` as soon as a master answers),
     /// advertises the robot's topics, sets `/robot_description` (and `/use_sim_time`), and
     /// subscribes to its command topic.
-    pub fn start(options: &RosOptions, robot: &RobotModel) -> Result<(Self, RosCmdVel)> {
+    pub fn start(options: &RosOptions, robot: &RobotModel) -> Result<(Self, RosInput)> {
         let node_options = NodeOptions::from_env(&options.name)?;
         let node = Node::start(node_options).context("starting the ROS node")?;
         let plan = RosPlan::for_robot(robot);
@@ -101,6 +116,19 @@ impl RosBridge {
         }
         let families = families(&node, &plan)?;
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
+        let controllers = ControllerCommands::subscribe(&node, &plan)?;
+        for c in &plan.controllers {
+            tracing::info!(
+                "ROS: controller {} takes {} on {}",
+                c.name,
+                if c.trajectory {
+                    "trajectory_msgs/JointTrajectory"
+                } else {
+                    "std_msgs/Float64"
+                },
+                c.command_topic
+            );
+        }
         tracing::info!(
             "ROS: node {} at {}; master {}; cmd_vel on {}, odometry on {}{}",
             node.name(),
@@ -128,7 +156,10 @@ impl RosBridge {
                 warned: false,
                 busy: std::time::Duration::ZERO,
             },
-            cmd,
+            RosInput {
+                cmd_vel: cmd,
+                controllers,
+            },
         ))
     }
 

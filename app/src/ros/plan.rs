@@ -1,7 +1,9 @@
 //! The names and frames the bridge uses for a robot, as Gazebo's plugins would choose them, and
 //! the moving joints it reports.
 
-use rover_sim::{ControlSample, DiffDriveConfig, LinkId, Pose, RobotModel};
+use rover_sim::{
+    ControlSample, ControllerKind, DiffDriveConfig, JointId, LinkId, Pose, RobotModel,
+};
 
 /// Topic names and frames, from the robot's Gazebo plugins.
 #[derive(Debug, Clone)]
@@ -26,6 +28,22 @@ pub struct RosPlan {
     pub scan_topic: Option<String>,
     /// Every moving joint the session reports, in `/joint_states` order.
     pub(super) joints: Vec<MovingJoint>,
+    /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
+    /// every control update.
+    pub joint_states_hz: Option<f64>,
+    /// The controllers file's command topics.
+    pub(super) controllers: Vec<ControllerTopic>,
+}
+
+/// A controller's topics (`/<namespace>/<controller>/command`).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct ControllerTopic {
+    /// Controller name.
+    pub name: String,
+    /// Its `command` topic.
+    pub command_topic: String,
+    /// Whether the command is a trajectory_msgs/JointTrajectory (else std_msgs/Float64).
+    pub trajectory: bool,
 }
 
 /// A moving joint the bridge reports (`/joint_states`; `/tf` for wheels with
@@ -58,6 +76,8 @@ pub(super) enum JointSource {
         /// 0 for the left wheel, 1 for the right.
         side: usize,
     },
+    /// Any other moving joint (an arm's, a head's, a caster's): the simulation's joint state.
+    Joint(JointId),
 }
 
 impl JointSource {
@@ -69,6 +89,7 @@ impl JointSource {
                 .get(side)
                 .copied()
                 .unwrap_or_default(),
+            Self::Joint(_) => 0.0,
         }
     }
 }
@@ -108,30 +129,85 @@ impl RosPlan {
             info_topic: camera_topic(camera.map_or("camera_info", |c| c.info_topic.as_str())),
             scan_topic: robot.lasers.first().map(|l| topic(&l.topic)),
             joints: moving_joints(robot, &drive),
+            joint_states_hz: robot.controllers.as_ref().and_then(|c| {
+                c.controllers.iter().find_map(|s| match s.kind {
+                    ControllerKind::JointState { publish_rate_hz } => Some(publish_rate_hz),
+                    _ => None,
+                })
+            }),
+            controllers: controller_topics(robot),
         }
     }
 }
 
-/// The robot's moving joints that the session reports: today the drive's wheels (left, right).
-fn moving_joints(robot: &RobotModel, drive: &DiffDriveConfig) -> Vec<MovingJoint> {
-    let link_name = |id: LinkId| robot.link(id).name.clone();
-    [&drive.left_joint, &drive.right_joint]
-        .into_iter()
-        .enumerate()
-        .filter_map(|(side, name)| {
-            let j = robot.joints.iter().find(|j| &j.name == name)?;
-            Some(MovingJoint {
-                name: j.name.clone(),
-                parent: j.parent,
-                child: j.child,
-                parent_link: link_name(j.parent),
-                child_link: link_name(j.child),
-                parent_from_child_at_rest: j.parent_from_child,
-                axis: j.axis,
-                source: JointSource::Wheel { side },
-            })
+/// The command topics of the robot's controllers: `/<namespace>/<controller>/command`, the
+/// namespace being the one the controllers file puts them under, else the gazebo_ros_control
+/// plugin's `robotNamespace`.
+fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
+    let Some(config) = &robot.controllers else {
+        return Vec::new();
+    };
+    let plugin_ns = robot
+        .ros_control
+        .as_ref()
+        .map_or("", |r| r.namespace.trim_matches('/'));
+    config
+        .controllers
+        .iter()
+        .filter(|c| !matches!(c.kind, ControllerKind::JointState { .. }))
+        .map(|c| {
+            let ns = if c.namespace.is_empty() {
+                plugin_ns
+            } else {
+                c.namespace.trim_matches('/')
+            };
+            let prefix = if ns.is_empty() {
+                String::new()
+            } else {
+                format!("/{ns}")
+            };
+            ControllerTopic {
+                name: c.name.clone(),
+                command_topic: format!("{prefix}/{}/command", c.name),
+                trajectory: matches!(c.kind, ControllerKind::Trajectory(_)),
+            }
         })
         .collect()
+}
+
+/// The robot's moving joints that the session reports: the drive's wheels (left, right),
+/// then every other revolute, continuous or prismatic joint in file order.
+fn moving_joints(robot: &RobotModel, drive: &DiffDriveConfig) -> Vec<MovingJoint> {
+    let link_name = |id: LinkId| robot.link(id).name.clone();
+    let entry = |id: JointId, source: JointSource| {
+        let j = robot.joint(id);
+        MovingJoint {
+            name: j.name.clone(),
+            parent: j.parent,
+            child: j.child,
+            parent_link: link_name(j.parent),
+            child_link: link_name(j.child),
+            parent_from_child_at_rest: j.parent_from_child,
+            axis: j.axis,
+            source,
+        }
+    };
+    let wheels: Vec<JointId> = [&drive.left_joint, &drive.right_joint]
+        .into_iter()
+        .filter_map(|name| robot.joint_id(name))
+        .collect();
+    let mut out: Vec<MovingJoint> = wheels
+        .iter()
+        .enumerate()
+        .map(|(side, id)| entry(*id, JointSource::Wheel { side }))
+        .collect();
+    out.extend(
+        robot
+            .joint_ids()
+            .filter(|(id, j)| j.is_moving() && !wheels.contains(id))
+            .map(|(id, _)| entry(id, JointSource::Joint(id))),
+    );
+    out
 }
 
 #[cfg(test)]

@@ -37,8 +37,10 @@ impl Tf {
         }
         let mut joints_on_tf = Vec::new();
         for (i, j) in plan.joints.iter().enumerate() {
+            // Wheels as publishWheelTF says; every other moving joint's link always, as
+            // robot_state_publisher would from /joint_states.
             let wheel = matches!(j.source, JointSource::Wheel { .. });
-            if wheel && plan.wheel_tf {
+            if !wheel || plan.wheel_tf {
                 joints_on_tf.push(i);
                 transforms.push(transform(
                     &j.parent_link,

@@ -1,0 +1,91 @@
+//! The controllers' `command` topics in: std_msgs/Float64 for single-joint controllers,
+//! trajectory_msgs/JointTrajectory for joint trajectory controllers, as rover input
+//! ([`JointAction`]). A command the simulation refuses (an unknown joint, a value that is not
+//! finite) is dropped with a warning by the session.
+
+use anyhow::Result;
+use rover_core::{Action, InputSource, JointAction};
+use rover_ros1::msgs;
+use rover_ros1::{Node, Subscriber};
+use rover_sim::{JointTrajectory, TrajectoryPoint};
+
+use super::plan::RosPlan;
+
+enum Topic {
+    Value(Subscriber<msgs::Float64>),
+    Trajectory(Subscriber<msgs::JointTrajectory>),
+}
+
+/// The subscriptions to every controller's `command` topic.
+pub(super) struct ControllerCommands {
+    topics: Vec<(String, Topic)>,
+    /// Where the next poll starts, so that every topic gets its turn.
+    next: usize,
+}
+
+impl std::fmt::Debug for ControllerCommands {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ControllerCommands")
+            .field("topics", &self.topics.len())
+            .finish()
+    }
+}
+
+impl ControllerCommands {
+    /// Subscribes to the plan's controller topics.
+    pub fn subscribe(node: &Node, plan: &RosPlan) -> Result<Self> {
+        let mut topics = Vec::with_capacity(plan.controllers.len());
+        for c in &plan.controllers {
+            let topic = if c.trajectory {
+                Topic::Trajectory(node.subscribe(&c.command_topic, 10)?)
+            } else {
+                Topic::Value(node.subscribe(&c.command_topic, 10)?)
+            };
+            topics.push((c.name.clone(), topic));
+        }
+        Ok(Self { topics, next: 0 })
+    }
+}
+
+/// A trajectory message as the simulation takes it.
+fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
+    JointTrajectory {
+        start_s: msg.header.stamp_s,
+        joint_names: msg.joint_names,
+        points: msg
+            .points
+            .into_iter()
+            .map(|p| TrajectoryPoint {
+                positions: p.positions,
+                velocities: p.velocities,
+                accelerations: p.accelerations,
+                time_from_start_s: p.time_from_start_s,
+            })
+            .collect(),
+    }
+}
+
+impl InputSource for ControllerCommands {
+    fn poll(&mut self) -> Option<Action> {
+        let n = self.topics.len();
+        for k in 0..n {
+            let i = (self.next + k) % n;
+            let (name, topic) = &self.topics[i];
+            let action = match topic {
+                Topic::Value(sub) => sub.try_recv().map(|m| JointAction::Controller {
+                    name: name.clone(),
+                    value: m.data,
+                }),
+                Topic::Trajectory(sub) => sub.try_recv().map(|m| JointAction::Trajectory {
+                    controller: name.clone(),
+                    trajectory: Box::new(trajectory(m)),
+                }),
+            };
+            if let Some(action) = action {
+                self.next = (i + 1) % n;
+                return Some(Action::Joint(action));
+            }
+        }
+        None
+    }
+}
