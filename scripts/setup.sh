@@ -30,7 +30,7 @@ if [ "$purpose" = test ]; then
   # recorder), and tmux for teleop_twist_keyboard's terminal.
   packages+=(python3-rosmaster python3-rospy python3-rostopic python3-rosbag ros-std-msgs
     python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
-    python3-rosgraph-msgs python3-roslib python3-genpy tmux)
+    python3-rosgraph-msgs python3-roslib python3-genpy python3-trajectory-msgs tmux)
 fi
 missing=()
 if command -v dpkg-query >/dev/null 2>&1; then

@@ -623,3 +623,153 @@ fn rover_survives_a_roscore_restart_and_publishes_again() -> Result<()> {
     assert!(log.contains("registered again"), "{log}");
     Ok(())
 }
+
+/// TIAGo (example-robot-data 6.0.0) with a controllers file: `/joint_states` lists its 12
+/// moving joints every control update, `rostopic pub` of a Float64 moves the torso (and an
+/// over-limit command stops at its limit), and a two-point JointTrajectory sent with rostopic
+/// is followed within the controller's tolerances.
+#[test]
+fn rostopic_drives_tiagos_torso_and_arm_through_its_controllers() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let ok = Command::new(PYTHON)
+        .args(["-c", "import trajectory_msgs.msg, std_msgs.msg"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        return skip("python3-trajectory-msgs is not installed (./test installs it)");
+    }
+    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
+        return skip("PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+    };
+    let urdf = data.join(
+        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
+    );
+    let controllers = repo().join("assets/controllers/tiago_no_hand.yaml");
+    let mut graph = RosGraph::start()?;
+    let robot_args = [
+        "--robot",
+        &urdf.to_string_lossy(),
+        "--drive",
+        "wheel_left_joint,wheel_right_joint",
+        "--controllers",
+        &controllers.to_string_lossy(),
+        "--no-detector",
+    ]
+    .map(str::to_owned);
+    let args: Vec<&str> = robot_args.iter().map(String::as_str).collect();
+    graph.spawn_rover(26.0, &args)?;
+
+    // /joint_states as a rospy node sees it: names and stamps of 20 messages.
+    let listener = graph.dir.path().join("joint_states.py");
+    std::fs::write(
+        &listener,
+        "import threading, rospy\nfrom sensor_msgs.msg import JointState\nrospy.init_node('joint_states_check')\ngot = []\ndone = threading.Event()\ndef keep(m):\n    got.append(m)\n    if len(got) >= 20:\n        done.set()\nrospy.Subscriber('/joint_states', JointState, keep, queue_size=100)\ndone.wait(30)\nfor m in got[:20]:\n    print('%.6f %d %d %d %s' % (m.header.stamp.to_sec(), len(m.name), len(m.position), len(m.effort), ','.join(m.name)))\n",
+    )?;
+    let mut c = graph.command(PYTHON);
+    c.arg(&listener);
+    let states = graph.run(c, Duration::from_secs(40))?;
+    let lines: Vec<Vec<&str>> = states
+        .lines()
+        .map(|l| l.split(' ').collect::<Vec<_>>())
+        .filter(|f| f.len() == 5)
+        .collect();
+    ensure!(
+        lines.len() == 20,
+        "expected 20 /joint_states messages:\n{states}"
+    );
+    for f in &lines {
+        ensure!(
+            f[1] == "12" && f[2] == "12" && f[3] == "12",
+            "a /joint_states message without all 12 joints: {f:?}"
+        );
+    }
+    for name in [
+        "torso_lift_joint",
+        "head_2_joint",
+        "arm_7_joint",
+        "wheel_left_joint",
+    ] {
+        ensure!(
+            lines[0][4].contains(name),
+            "{name} missing: {}",
+            lines[0][4]
+        );
+    }
+    let stamps: Vec<f64> = lines.iter().filter_map(|f| f[0].parse().ok()).collect();
+    // The drive's control update (100 Hz) carries it: no gap longer than three of them.
+    let worst_gap = stamps.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    ensure!(
+        worst_gap <= 0.03 + 1e-6,
+        "a /joint_states gap of {worst_gap:.3} s:\n{states}"
+    );
+
+    let publish = |topic: &str, kind: &str, value: &str| -> Result<String> {
+        let mut c = graph.command("/usr/bin/rostopic");
+        c.args(["pub", "-1", topic, kind, value]);
+        graph.run(c, Duration::from_secs(20))
+    };
+    let torso = "/torso_controller/command";
+    publish(torso, "std_msgs/Float64", "data: 0.2")?;
+    std::thread::sleep(Duration::from_secs(3));
+    publish(torso, "std_msgs/Float64", "data: 0.6")?;
+    let arm: Vec<String> = (1..=7).map(|i| format!("arm_{i}_joint")).collect();
+    let first = [0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0];
+    let second = [0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0];
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let trajectory = format!(
+        "{{joint_names: [{}], points: [{{positions: [{}], time_from_start: {{secs: 2, nsecs: 0}}}}, {{positions: [{}], time_from_start: {{secs: 4, nsecs: 0}}}}]}}",
+        arm.join(", "),
+        list(&first),
+        list(&second)
+    );
+    let sent = publish(
+        "/arm_controller/command",
+        "trajectory_msgs/JointTrajectory",
+        &trajectory,
+    )?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let log = graph.log("rover");
+    let names = rover_core::trace_joints(&std::fs::read_to_string(graph.trace_path())?);
+    let column = |joint: &str| -> Result<Vec<(f64, f64)>> {
+        let k = names
+            .iter()
+            .position(|n| n == joint)
+            .with_context(|| format!("no {joint} column in {names:?}"))?;
+        Ok(rows
+            .iter()
+            .map(|r| (r.sim_time_s, r.joints[k].position))
+            .collect())
+    };
+    let torso_q = column("torso_lift_joint")?;
+    ensure!(
+        torso_q.iter().any(|(_, q)| (q - 0.2).abs() < 0.005),
+        "the torso never reached 0.2 m; rover:\n{log}"
+    );
+    let highest = torso_q.iter().map(|(_, q)| *q).fold(f64::MIN, f64::max);
+    let last = torso_q.last().map_or(0.0, |(_, q)| *q);
+    ensure!(
+        (last - 0.35).abs() < 0.005 && highest < 0.355,
+        "0.6 m should stop at the 0.35 m limit: ended at {last:.4}, highest {highest:.4}"
+    );
+    ensure!(
+        log.contains("controller arm_controller: trajectory reached its goal")
+            && !log.contains("VIOLATED"),
+        "the trajectory was not followed within its tolerances (rostopic: {sent}); rover:\n{log}"
+    );
+    for (joint, goal) in arm.iter().zip(second) {
+        let q = column(joint)?.last().map_or(f64::NAN, |(_, q)| *q);
+        ensure!(
+            (q - goal).abs() < 0.02,
+            "{joint} ended at {q:.4}, goal {goal}"
+        );
+    }
+    Ok(())
+}

@@ -287,6 +287,11 @@ impl RunFiles {
 }
 
 impl Observer for RunFiles {
+    fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        if let Some(t) = self.trace.as_mut() {
+            t.start(sim, camera, labels);
+        }
+    }
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         if let Some(t) = self.trace.as_mut() {
             t.control(sim, sample, stats);
