@@ -7,10 +7,26 @@ use std::path::Path;
 use std::process::Command;
 
 use anyhow::Result;
-use rover_core::parse_trace;
+use rover_core::{TraceRow, parse_trace, trace_joints};
 
-#[test]
-fn keys_sent_to_the_real_window_drive_the_car_and_switch_mode() -> Result<()> {
+/// What a window run left: the trace's rows and joint names, the screenshot, rover's log.
+struct WindowRun {
+    rows: Vec<TraceRow>,
+    joints: Vec<String>,
+    shot: image::DynamicImage,
+    log: String,
+    _dir: tempfile::TempDir,
+}
+
+/// Runs rover's window on `world` for `duration_s` under xvfb-run; once the window shows,
+/// `keys` (xdotool lines, `$wid` is the window) runs, then rover's end is awaited. The image
+/// the window shows last is kept (and copied to `keep_shot`, when given).
+fn run_window(
+    world: &str,
+    duration_s: u32,
+    keys: &str,
+    keep_shot: Option<&Path>,
+) -> Result<WindowRun> {
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
     let shot = dir.path().join("window.png");
@@ -18,27 +34,25 @@ fn keys_sent_to_the_real_window_drive_the_car_and_switch_mode() -> Result<()> {
     // Inside the virtual display: start rover, wait for its window, focus it, then keys.
     std::fs::write(
         &script,
-        r#"set -eu
-"$ROVER" --world "$WORLD" --duration 14 --trace "$TRACE" --screenshot "$SHOT" \
+        format!(
+            r#"set -eu
+"$ROVER" --world "$WORLD" --duration {duration_s} --trace "$TRACE" --screenshot "$SHOT" \
     --viewer none --no-detector 2> "$LOG" &
 pid=$!
 wid=$(timeout 120 xdotool search --sync --onlyvisible --name "driver's station" | head -n 1)
 sleep 2
 xdotool windowfocus --sync "$wid"
-xdotool keydown i
-sleep 2
-xdotool keyup i
-sleep 2
-xdotool key f
+{keys}
 wait "$pid"
-"#,
+"#
+        ),
     )?;
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x800x24", "bash"])
         .arg(&script)
         .env("ROVER", env!("CARGO_BIN_EXE_rover"))
-        .env("WORLD", repo.join("worlds/playground.toml"))
+        .env("WORLD", repo.join(world))
         .env("TRACE", &trace)
         .env("SHOT", &shot)
         .env("LOG", dir.path().join("rover.log"))
@@ -53,7 +67,28 @@ wait "$pid"
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    let rows = parse_trace(&std::fs::read_to_string(&trace)?)?;
+    let text = std::fs::read_to_string(&trace)?;
+    if let Some(keep) = keep_shot {
+        std::fs::copy(&shot, keep)?;
+    }
+    Ok(WindowRun {
+        rows: parse_trace(&text)?,
+        joints: trace_joints(&text),
+        shot: image::open(&shot)?,
+        log,
+        _dir: dir,
+    })
+}
+
+#[test]
+fn keys_sent_to_the_real_window_drive_the_car_and_switch_mode() -> Result<()> {
+    let run = run_window(
+        "worlds/playground.toml",
+        14,
+        "xdotool keydown i\nsleep 2\nxdotool keyup i\nsleep 2\nxdotool key f",
+        None,
+    )?;
+    let (rows, log) = (&run.rows, &run.log);
     assert_eq!(rows.len(), 1400, "14 s of 100 Hz control updates");
     // While `i` was held the car drove forward at teleop's 0.5 m/s...
     let driving: Vec<_> = rows.iter().filter(|r| r.cmd_linear_mps == 0.5).collect();
@@ -85,7 +120,52 @@ wait "$pid"
     assert_eq!(rows[0].mode, "manual");
     assert_eq!(end.mode, "follow");
     // The window's image was written at exit.
-    let shot = image::open(&shot)?;
-    assert_eq!((shot.width(), shot.height()), (640, 592));
+    assert_eq!((run.shot.width(), run.shot.height()), (640, 592));
+    Ok(())
+}
+
+/// The example car with an arm (worlds/arm_car.toml): the teleop keys drive it, `2` picks the
+/// shoulder lift, five presses of `]` jog it 0.5 rad, `h` brings it home — the trace records
+/// all of it. The window's last image is docs/arm-car-window.png when ROVER_UPDATE_DOCS is set.
+#[test]
+fn the_arm_car_drives_with_keys_and_its_arm_jogs() -> Result<()> {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let keep = std::env::var_os("ROVER_UPDATE_DOCS").map(|_| repo.join("docs/arm-car-window.png"));
+    let run = run_window(
+        "worlds/arm_car.toml",
+        16,
+        "xdotool keydown i\nsleep 2\nxdotool keyup i\nsleep 1\nxdotool key 2\nfor n in 1 2 3 4 5; do xdotool key bracketright; sleep 0.3; done\nsleep 4\nxdotool key 3\nxdotool key bracketright\nsleep 2",
+        keep.as_deref(),
+    )?;
+    let (rows, log) = (&run.rows, &run.log);
+    let end = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
+    assert!(
+        end.x_m > 0.3,
+        "the car did not drive: x {:.3} m; log:\n{log}",
+        end.x_m
+    );
+    let k = run
+        .joints
+        .iter()
+        .position(|j| j == "shoulder_lift_joint")
+        .ok_or_else(|| anyhow::anyhow!("no shoulder_lift_joint in {:?}", run.joints))?;
+    let lift: Vec<f64> = rows.iter().map(|r| r.joints[k].position).collect();
+    let highest = lift.iter().copied().fold(f64::MIN, f64::max);
+    let held = end.joints[k].position;
+    assert!(
+        (held - 0.5).abs() < 0.03 && highest < 0.6,
+        "five jogs of 0.1 rad should bring the lift to 0.5 rad: it ends at {held:.3}, highest {highest:.3}; log:\n{log}"
+    );
+    let elbow = run
+        .joints
+        .iter()
+        .position(|j| j == "elbow_joint")
+        .ok_or_else(|| anyhow::anyhow!("no elbow_joint"))?;
+    let elbow_end = end.joints[elbow].position;
+    assert!(
+        (elbow_end - 0.1).abs() < 0.03,
+        "3 then ] should move the elbow to 0.1 rad: {elbow_end:.3}"
+    );
+    assert_eq!((run.shot.width(), run.shot.height()), (640, 592));
     Ok(())
 }

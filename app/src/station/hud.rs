@@ -31,6 +31,8 @@ pub(super) struct HudState<'a> {
     pub paused: bool,
     /// Measured sim seconds per wall second.
     pub real_time_factor: f64,
+    /// The arm keys' line (robots with actuated joints).
+    pub arm: Option<String>,
 }
 
 /// Composes camera image, boxes and HUD into `canvas`.
@@ -134,12 +136,15 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
                 "i , j l u o m . drive   k stop   q/z speed   f follow",
                 [160, 170, 180],
             );
-            canvas.text(
-                8,
-                y0 + 86,
-                "p pause   pad: hold LB + sticks, A follow   Esc quit",
-                [160, 170, 180],
-            );
+            match &hud.arm {
+                Some(arm) => canvas.text(8, y0 + 86, arm, [255, 200, 120]),
+                None => canvas.text(
+                    8,
+                    y0 + 86,
+                    "p pause   pad: hold LB + sticks, A follow   Esc quit",
+                    [160, 170, 180],
+                ),
+            };
         }
     }
 }

@@ -24,6 +24,12 @@ pub enum KeyCommand {
     TogglePause,
     /// One control update while paused.
     StepOnce,
+    /// Pick the arm's Nth actuated joint (0-based; keys 1-9).
+    SelectJoint(usize),
+    /// Jog the picked joint one step down (-1, `[`) or up (+1, `]`).
+    Jog(i8),
+    /// Go to the controllers file's "home" pose (`h`).
+    Home,
 }
 
 /// Turns key presses and releases into commands. Key names are winit's logical keys: the
@@ -54,6 +60,15 @@ fn teleop_name(name: &str, wasd: bool) -> Option<&'static str> {
         (_, "f") => "f",
         (_, "p") => "p",
         (_, "n") => "n",
+        // The arm's: pick a joint, jog it, home.
+        (_, "[") => "[",
+        (_, "]") => "]",
+        (_, "h") => "h",
+        (_, digit @ ("1" | "2" | "3" | "4" | "5" | "6" | "7" | "8" | "9")) => {
+            ["1", "2", "3", "4", "5", "6", "7", "8", "9"]
+                .into_iter()
+                .find(|d| *d == digit)?
+        }
         (_, other) => TELEOP_KEYS.split(' ').find(|k| *k == other)?,
     })
 }
@@ -98,6 +113,12 @@ impl KeyTeleop {
             "f" => Some(KeyCommand::Input(Action::ToggleFollow)),
             "p" => Some(KeyCommand::TogglePause),
             "n" => Some(KeyCommand::StepOnce),
+            "[" => Some(KeyCommand::Jog(-1)),
+            "]" => Some(KeyCommand::Jog(1)),
+            "h" => Some(KeyCommand::Home),
+            digit if digit.len() == 1 && digit.as_bytes()[0].is_ascii_digit() => Some(
+                KeyCommand::SelectJoint(usize::from(digit.as_bytes()[0] - b'1')),
+            ),
             other => {
                 let action = key_action(other)?;
                 if is_move(other) {
@@ -119,6 +140,19 @@ mod tests {
     }
     const STOP: Option<KeyCommand> = Some(KeyCommand::Input(Action::Key(KeyAction::Stop)));
     const MANUAL: Mode = Mode::Manual;
+
+    #[test]
+    fn digits_pick_a_joint_brackets_jog_it_and_h_goes_home() {
+        let mut k = KeyTeleop::new(KeyOptions::default());
+        assert_eq!(k.key("1", true, MANUAL), Some(KeyCommand::SelectJoint(0)));
+        assert_eq!(k.key("5", true, MANUAL), Some(KeyCommand::SelectJoint(4)));
+        assert_eq!(k.key("]", true, MANUAL), Some(KeyCommand::Jog(1)));
+        assert_eq!(k.key("[", true, MANUAL), Some(KeyCommand::Jog(-1)));
+        assert_eq!(k.key("h", true, MANUAL), Some(KeyCommand::Home));
+        assert_eq!(k.key("0", true, MANUAL), None);
+        // Releases do nothing.
+        assert_eq!(k.key("]", false, MANUAL), None);
+    }
 
     #[test]
     fn hold_to_drive_stops_on_release() {

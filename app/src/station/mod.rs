@@ -7,6 +7,7 @@
 //! GPU device next to the camera's, and nothing to fail on machines where a Vulkan surface
 //! cannot be presented.
 
+mod arm;
 pub mod canvas;
 pub mod gamepad;
 mod hud;
@@ -19,8 +20,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use rover_core::{
-    Action, CoreError, EventLevel, Fanout, InputSource, LoopStats, Mode, Observer, Script,
-    ScriptPlayer, Session,
+    Action, CoreError, EventLevel, Fanout, InputSource, JointAction, LoopStats, Mode, Observer,
+    Script, ScriptPlayer, Session,
 };
 use rover_sim::{CameraFrame, ControlSample, Pose, Simulation, Twist};
 use winit::application::ApplicationHandler;
@@ -29,6 +30,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
+use arm::ArmKeys;
 use canvas::{Canvas, pack, unpack};
 use gamepad::{Gamepads, PadCommand};
 use keys::{KeyCommand, KeyOptions, KeyTeleop};
@@ -121,6 +123,8 @@ struct App<'a, 'o> {
     external: &'a mut dyn InputSource,
     player: ScriptPlayer,
     keys: KeyTeleop,
+    /// The arm keys' picked joint.
+    arm: ArmKeys,
     options: WindowOptions,
     window: Option<Arc<Window>>,
     surface: Option<Surface>,
@@ -173,7 +177,16 @@ impl App<'_, '_> {
                 self.anchor = (Instant::now(), self.session.sim().sim_time_s());
             }
             Some(KeyCommand::StepOnce) if self.paused => self.step_once = true,
-            Some(KeyCommand::StepOnce) | None => {}
+            Some(KeyCommand::SelectJoint(i)) => self.arm.select(i),
+            Some(KeyCommand::Jog(direction)) => {
+                if let Some(action) = self.arm.jog(self.session.sim(), direction) {
+                    self.input(action);
+                }
+            }
+            Some(KeyCommand::Home) if !self.arm.is_empty() => {
+                self.input(Action::Joint(JointAction::Pose("home".into())));
+            }
+            Some(KeyCommand::StepOnce | KeyCommand::Home) | None => {}
         }
     }
 
@@ -257,6 +270,7 @@ impl App<'_, '_> {
                 session: &self.session,
                 paused: self.paused,
                 real_time_factor: self.rtf,
+                arm: self.arm.status(self.session.sim()),
             },
         );
     }
@@ -439,7 +453,9 @@ pub fn run(
             None
         }
     };
+    let arm = ArmKeys::new(session.sim());
     let mut app = App {
+        arm,
         session,
         feed: Feed {
             image: Vec::with_capacity(w * h),

@@ -1,0 +1,74 @@
+//! The driver's station's arm keys: pick one of the robot's actuated joints (1-9), jog it a
+//! step at a time (`[` and `]`; held keys repeat), go home (`h`). Jogging moves the joint's
+//! target from where its actuator holds it now, so repeated presses add up and the joint's
+//! limits and the actuator's velocity and effort limits still apply.
+
+use rover_core::{Action, JointAction};
+use rover_sim::{JointCommand, JointId, JointKind, Simulation};
+
+/// One jog step of a revolute joint (rad).
+pub(super) const JOG_RAD: f64 = 0.1;
+/// One jog step of a prismatic joint (m).
+pub(super) const JOG_M: f64 = 0.01;
+
+/// Which joint the keys move.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ArmKeys {
+    joints: Vec<JointId>,
+    selected: usize,
+}
+
+impl ArmKeys {
+    /// The robot's actuated joints, in file order.
+    pub fn new(sim: &Simulation) -> Self {
+        Self {
+            joints: sim.robot().actuated_joints(),
+            selected: 0,
+        }
+    }
+
+    /// Whether the robot has joints to jog.
+    pub fn is_empty(&self) -> bool {
+        self.joints.is_empty()
+    }
+
+    /// Picks joint `index` (0-based) when there is one.
+    pub fn select(&mut self, index: usize) {
+        if index < self.joints.len() {
+            self.selected = index;
+        }
+    }
+
+    /// The command that jogs the picked joint one step in `direction` (-1 or +1).
+    pub fn jog(&self, sim: &Simulation, direction: i8) -> Option<Action> {
+        let id = *self.joints.get(self.selected)?;
+        let joint = sim.robot().joint(id);
+        let step = match joint.kind {
+            JointKind::Prismatic { .. } => JOG_M,
+            _ => JOG_RAD,
+        };
+        let from = sim.joint_setpoint(id)?;
+        Some(Action::Joint(JointAction::Command {
+            joint: joint.name.clone(),
+            command: JointCommand::Position(from + f64::from(direction) * step),
+        }))
+    }
+
+    /// The HUD's arm line: the picked joint, where it is, and the keys.
+    pub fn status(&self, sim: &Simulation) -> Option<String> {
+        let id = *self.joints.get(self.selected)?;
+        let joint = sim.robot().joint(id);
+        let unit = match joint.kind {
+            JointKind::Prismatic { .. } => "m",
+            _ => "rad",
+        };
+        let q = sim.joint_state(id).map_or(0.0, |s| s.position);
+        Some(format!(
+            "arm {}/{} {} {q:+.2} {unit}  [ ] jog  1-{} pick  h home",
+            self.selected + 1,
+            self.joints.len(),
+            joint.name.trim_end_matches("_joint"),
+            self.joints.len().min(9)
+        ))
+    }
+}
