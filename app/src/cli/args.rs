@@ -549,6 +549,24 @@ impl DetectorArgs {
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum BenchKind {
+    /// Physics-only real-time factor (what plain `rover bench` measures): the robot drives a
+    /// figure of eight while its arm, if it has one, holds its pose
+    Physics {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Sim seconds per measurement
+        #[arg(long, default_value_t = 60.0, value_name = "SECS")]
+        sim_seconds: f64,
+
+        /// Repeats per measurement (the fastest counts)
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
+
+        /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
+        #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
+        rates: Vec<f64>,
+    },
     /// Rerun recording overhead: the same headless run (camera + detector) without and with
     /// --record
     Record {

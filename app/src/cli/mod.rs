@@ -77,6 +77,16 @@ pub fn main() -> ExitCode {
             sim_seconds,
             repeats,
             rates,
+        })
+        | Some(Command::Bench {
+            kind:
+                Some(BenchKind::Physics {
+                    world,
+                    sim_seconds,
+                    repeats,
+                    rates,
+                }),
+            ..
         }) => bench::bench_cmd(world, sim_seconds, repeats, rates),
         Some(Command::Detect {
             images,
