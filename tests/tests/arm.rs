@@ -257,3 +257,76 @@ fn tiago_head_follows_a_command_with_its_own_pid_gains() -> Result<()> {
     assert!(s.effort.abs() <= 5.197 + 1e-6, "{s:?}");
     Ok(())
 }
+
+/// The step again, as a user runs it: `rover --headless` with a script (home pose, then arm_2
+/// to -0.8 rad at 3 s) and a trace; the trace's joint columns show it there within 0.02 rad
+/// 2 s later, overshooting less than 0.05 rad, never faster than the URDF velocity limit nor
+/// harder than the effort limit.
+#[test]
+fn tiago_arm_2_step_as_the_trace_records_it() -> Result<()> {
+    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let script = dir.path().join("step.toml");
+    let mut steps: Vec<String> = HOME
+        .iter()
+        .map(|(joint, q)| format!("  {{ at = 0.0, joint = \"{joint}\", position = {q} }},"))
+        .collect();
+    steps.push("  { at = 3.0, joint = \"arm_2_joint\", position = -0.8 },".into());
+    std::fs::write(&script, format!("steps = [\n{}\n]\n", steps.join("\n")))?;
+    let trace = dir.path().join("trace.csv");
+    let config = rover_core::RunConfig {
+        robot: Some(urdf),
+        drive: Some(DriveSpec {
+            left_joint: "wheel_left_joint".into(),
+            right_joint: "wheel_right_joint".into(),
+            wheel_separation_m: None,
+            wheel_diameter_m: None,
+            wheel_torque_nm: None,
+        }),
+        script: Some(script),
+        duration_s: Some(7.0),
+        trace: Some(trace.clone()),
+        perception: rover_core::Perception::Off,
+        ..rover_core::RunConfig::default()
+    };
+    rover_core::run_headless(&config)?;
+    let text = std::fs::read_to_string(&trace)?;
+    let names = rover_core::trace_joints(&text);
+    let k = names
+        .iter()
+        .position(|n| n == "arm_2_joint")
+        .ok_or_else(|| anyhow::anyhow!("no arm_2_joint column in {names:?}"))?;
+    let rows = rover_core::parse_trace(&text)?;
+    let after: Vec<JointState> = rows
+        .iter()
+        .filter(|r| r.sim_time_s >= 3.0)
+        .map(|r| r.joints[k])
+        .collect();
+    let at_5s = rows
+        .iter()
+        .find(|r| r.sim_time_s >= 5.0 - 1e-9)
+        .map_or(f64::NAN, |r| r.joints[k].position);
+    let highest = after.iter().map(|s| s.position).fold(f64::MIN, f64::max);
+    let fastest = after.iter().map(|s| s.velocity.abs()).fold(0.0, f64::max);
+    let hardest = after.iter().map(|s| s.effort.abs()).fold(0.0, f64::max);
+    let robot = RobotModel::load(config.robot.as_deref().unwrap_or(std::path::Path::new("")))?;
+    let joint = robot
+        .joint_id("arm_2_joint")
+        .map(|id| robot.joint(id).clone())
+        .ok_or_else(|| anyhow::anyhow!("no arm_2_joint"))?;
+    let velocity_limit = f64::from(joint.velocity_limit.unwrap_or(f32::MAX));
+    let effort_limit = f64::from(joint.effort_limit.unwrap_or(f32::MAX));
+    println!(
+        "trace: arm_2 at 5 s {at_5s:.4}, highest {highest:.4}, fastest {fastest:.3} rad/s (limit {velocity_limit}), hardest {hardest:.2} N m (limit {effort_limit})"
+    );
+    assert!(
+        (at_5s + 0.8).abs() < 0.02,
+        "arm_2 at {at_5s} 2 s after the step"
+    );
+    assert!(highest + 0.8 < 0.05, "overshoot to {highest}");
+    assert!(fastest <= velocity_limit, "{fastest} rad/s");
+    assert!(hardest <= effort_limit + 1e-6, "{hardest} N m");
+    Ok(())
+}
