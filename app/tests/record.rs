@@ -129,3 +129,54 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
     assert!(get("/log")?.timed_rows >= 1);
     Ok(())
 }
+
+/// The arm car (worlds/arm_car.toml): every arm link moves in 3D and every actuated joint's
+/// position and target are plotted, once per control update.
+#[test]
+fn a_recorded_arm_moves_its_links_and_plots_its_joints() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let rrd = dir.path().join("arm.rrd");
+    let script = dir.path().join("script.toml");
+    std::fs::write(&script, "steps = [ { at = 0.2, pose = \"reach\" } ]\n")?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args([
+            "--headless",
+            "--world",
+            "worlds/arm_car.toml",
+            "--duration",
+            "2",
+            "--no-detector",
+            "--record",
+        ])
+        .arg(&rrd)
+        .arg("--script")
+        .arg(&script)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()?;
+    assert!(
+        out.status.success(),
+        "rover failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let entities = read_rrd(&rrd)?;
+    let names: Vec<_> = entities.keys().cloned().collect();
+    let timed = |path: &str| {
+        entities
+            .get(path)
+            .map(|e| e.timed_rows)
+            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
+    };
+    // 2 s of 100 Hz control updates.
+    for joint in [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_pitch_joint",
+        "wrist_roll_joint",
+    ] {
+        assert_eq!(timed(&format!("/plots/joints/{joint}"))?, 200, "{joint}");
+    }
+    assert_eq!(timed("/world/robot/upper_arm_link")?, 200);
+    assert_eq!(timed("/world/robot/hand_link")?, 200);
+    Ok(())
+}

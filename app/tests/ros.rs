@@ -706,6 +706,27 @@ fn rostopic_drives_tiagos_torso_and_arm_through_its_controllers() -> Result<()> 
         "a /joint_states gap of {worst_gap:.3} s:\n{states}"
     );
 
+    // The controllers' state topics, as the master lists them (Debian has no control_msgs
+    // for rostopic echo).
+    for (topic, kind) in [
+        (
+            "/torso_controller/state",
+            "control_msgs/JointControllerState",
+        ),
+        (
+            "/arm_controller/state",
+            "control_msgs/JointTrajectoryControllerState",
+        ),
+    ] {
+        let mut c = graph.command("/usr/bin/rostopic");
+        c.args(["info", topic]);
+        let info = graph.run(c, Duration::from_secs(20))?;
+        ensure!(
+            info.contains(&format!("Type: {kind}")) && info.contains("/rover"),
+            "{topic}: {info}"
+        );
+    }
+
     let publish = |topic: &str, kind: &str, value: &str| -> Result<String> {
         let mut c = graph.command("/usr/bin/rostopic");
         c.args(["pub", "-1", topic, kind, value]);

@@ -96,7 +96,8 @@ fn regressions() -> Vec<(&'static str, Input, &'static str)> {
         (
             "world_toml",
             Input::Mutated {
-                seed: 1,
+                // walking.toml (the seeds are the worlds in name order).
+                seed: 2,
                 edits: vec![Mutation::Token {
                     at: 13633582643840294286,
                     // TOKENS[64] = "1e30", inserted after a box's "0.6": 0.61e30 m.

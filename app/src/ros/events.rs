@@ -39,6 +39,9 @@ pub(super) struct JointSample {
     pub position: f64,
     /// The actuator's effort (N m or N); 0 for passive joints and wheels.
     pub effort: f64,
+    /// Where the actuator holds the joint now (its target); the position for joints without
+    /// one.
+    pub setpoint: f64,
 }
 
 /// A camera image.

@@ -87,12 +87,17 @@ pub(super) fn sample(
                 ..rover_sim::JointState::default()
             },
         };
+        let setpoint = match j.source {
+            JointSource::Joint(id) => sim.joint_setpoint(id).unwrap_or(state.position),
+            JointSource::Wheel { .. } => state.position,
+        };
         JointSample {
             parent_from_child: sim.world_from_link(j.parent).inverse()
                 * sim.world_from_link(j.child),
             velocity_radps: state.velocity,
             position: state.position,
             effort: state.effort,
+            setpoint,
         }
     }));
 }
@@ -130,6 +135,7 @@ mod tests {
                 velocity_radps: 1.0,
                 position: 0.0,
                 effort: 0.0,
+                setpoint: 0.0,
             };
             let angle = angle_rad(&joint, &now);
             assert!(

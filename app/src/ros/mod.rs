@@ -9,7 +9,7 @@
 //!
 //! One file per topic family, as OpenRR's arci-ros has one adapter per family: `clock.rs`,
 //! `odom.rs`, `tf.rs` (`/tf`, `/tf_static`), `joint_states.rs`, `camera.rs` (image,
-//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, and `cmd_vel.rs` and `controllers.rs` (the controllers' `command` topics) in. Each publishing
+//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, `controller_states.rs` (the controllers' `state`), and `cmd_vel.rs` and `controllers.rs` (the controllers' `command` topics) in. Each publishing
 //! family implements `TopicFamily` (`events.rs`, with what travels between the threads) and is
 //! listed once in `families` below; `plan.rs` names the topics, frames and moving joints,
 //! `publisher.rs` is the thread. A new topic is a new file beside them and a line in `families`.
@@ -17,6 +17,7 @@
 mod camera;
 mod clock;
 mod cmd_vel;
+mod controller_states;
 mod controllers;
 mod convert;
 mod detections;
@@ -64,6 +65,7 @@ fn families(node: &Node, plan: &RosPlan) -> Result<Vec<Box<dyn TopicFamily>>> {
         Box::new(camera::Camera::advertise(node, plan)?),
         Box::new(detections::DarknetTopics::advertise(node, plan)?),
         Box::new(laser::Laser::advertise(node, plan)?),
+        Box::new(controller_states::ControllerStates::advertise(node, plan)?),
     ])
 }
 

@@ -2,7 +2,7 @@
 //! the moving joints it reports.
 
 use rover_sim::{
-    ControlSample, ControllerKind, DiffDriveConfig, JointId, LinkId, Pose, RobotModel,
+    CommandKind, ControlSample, ControllerKind, DiffDriveConfig, JointId, LinkId, Pose, RobotModel,
 };
 
 /// Topic names and frames, from the robot's Gazebo plugins.
@@ -44,6 +44,15 @@ pub(super) struct ControllerTopic {
     pub command_topic: String,
     /// Whether the command is a trajectory_msgs/JointTrajectory (else std_msgs/Float64).
     pub trajectory: bool,
+    /// Its `state` topic (control_msgs/JointTrajectoryControllerState for trajectory
+    /// controllers, control_msgs/JointControllerState for position controllers).
+    pub state_topic: Option<String>,
+    /// Its joints, as indices into the plan's `joints`.
+    pub joints: Vec<usize>,
+    /// The gains a position controller reports in its state.
+    pub pid: Option<rover_sim::Pid>,
+    /// How often `state` goes out (Hz).
+    pub state_hz: f64,
 }
 
 /// A moving joint the bridge reports (`/joint_states`; `/tf` for wheels with
@@ -135,10 +144,33 @@ impl RosPlan {
                     _ => None,
                 })
             }),
-            controllers: controller_topics(robot),
+            controllers: Vec::new(),
         }
+        .with_controllers(robot)
+    }
+
+    /// The controllers' topics, their joints found among the plan's.
+    fn with_controllers(mut self, robot: &RobotModel) -> Self {
+        let mut topics = controller_topics(robot);
+        for t in &mut topics {
+            let names: Vec<String> = robot
+                .controllers
+                .as_ref()
+                .and_then(|c| c.controller(&t.name))
+                .map(|c| c.joints().to_vec())
+                .unwrap_or_default();
+            t.joints = names
+                .iter()
+                .filter_map(|n| self.joints.iter().position(|j| &j.name == n))
+                .collect();
+        }
+        self.controllers = topics;
+        self
     }
 }
+
+/// How often a position controller's `state` goes out (Hz).
+const STATE_HZ: f64 = 50.0;
 
 /// The command topics of the robot's controllers: `/<namespace>/<controller>/command`, the
 /// namespace being the one the controllers file puts them under, else the gazebo_ros_control
@@ -166,10 +198,26 @@ fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
             } else {
                 format!("/{ns}")
             };
+            let (state, pid, state_hz) = match &c.kind {
+                ControllerKind::Trajectory(t) => (true, None, t.state_publish_rate_hz),
+                ControllerKind::Joint {
+                    command: CommandKind::PositionPid(pid),
+                    ..
+                } => (true, Some(*pid), STATE_HZ),
+                ControllerKind::Joint {
+                    command: CommandKind::Position,
+                    ..
+                } => (true, None, STATE_HZ),
+                _ => (false, None, STATE_HZ),
+            };
             ControllerTopic {
                 name: c.name.clone(),
                 command_topic: format!("{prefix}/{}/command", c.name),
                 trajectory: matches!(c.kind, ControllerKind::Trajectory(_)),
+                state_topic: state.then(|| format!("{prefix}/{}/state", c.name)),
+                joints: Vec::new(),
+                pid,
+                state_hz,
             }
         })
         .collect()

@@ -33,8 +33,11 @@ pub fn blueprint() -> Blueprint {
             TimeSeriesView::new("Detector")
                 .with_origin("plots/detector")
                 .into(),
+            TimeSeriesView::new("Joints (position, target)")
+                .with_origin("plots/joints")
+                .into(),
         ])
-        .with_row_shares([3.0f32, 1.0, 1.0, 1.0])
+        .with_row_shares([3.0f32, 1.0, 1.0, 1.0, 1.0])
         .into(),
     ]))
     .with_time_panel(TimePanel::new().with_timeline("sim_time"))

@@ -20,6 +20,7 @@
 //! world/odometry                         Points3D (odometry position) + trail LineStrips3D
 //! world/odometry/follower/{target,goal}  Points3D: the follower's target estimate, the point it
 //!                                        drives to (the pursued point once the target is lost)
+//! plots/joints/<joint>                   Scalars: an actuated joint's position and target
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -227,6 +228,11 @@ impl Observer for Recorder {
                 "world/odometry/trail",
                 &rerun::LineStrips3D::new([self.trail.as_slice()]).with_radii([0.01f32]),
             );
+        }
+        for (id, path) in &self.paths.joints {
+            if let (Some(state), Some(target)) = (sim.joint_state(*id), sim.joint_setpoint(*id)) {
+                self.log(path, &rerun::Scalars::new([state.position, target]));
+            }
         }
         let gt = sample.ground_truth;
         self.log(

@@ -19,6 +19,8 @@ pub(super) struct ScenePaths {
     /// `world/models/<model>/<link>` of SDF model links that move, with their index among all
     /// model links.
     pub moving_model_links: Vec<(usize, String)>,
+    /// `plots/joints/<joint>` per actuated joint: its position and its actuator's target.
+    pub joints: Vec<(rover_sim::JointId, String)>,
 }
 
 /// Logs the static scene and returns the paths per-tick logging uses.
@@ -40,6 +42,7 @@ pub(super) fn log_scene(
         moving_model_links: log_world(rec, sim),
         people: log_people(rec, sim),
         links: log_robot(rec, sim),
+        joints: log_joint_series(rec, sim),
     };
     if let Some(info) = camera {
         log_camera(rec, sim, info, images);
@@ -195,6 +198,26 @@ fn log_camera(rec: &RecordingStream, sim: &Simulation, info: &CameraInfo, images
             .with_resolution([w as f32, h as f32])
             .with_image_plane_distance(0.5f32),
     );
+}
+
+/// The actuated joints' plot paths, with their series named.
+fn log_joint_series(rec: &RecordingStream, sim: &Simulation) -> Vec<(rover_sim::JointId, String)> {
+    let robot = sim.robot();
+    robot
+        .actuated_joints()
+        .into_iter()
+        .map(|id| {
+            let name = &robot.joint(id).name;
+            let path = format!("plots/joints/{name}");
+            log(
+                rec,
+                &path,
+                &rerun::SeriesLines::new()
+                    .with_names([format!("{name} position"), format!("{name} target")]),
+            );
+            (id, path)
+        })
+        .collect()
 }
 
 /// The plots' series names.

@@ -101,6 +101,21 @@ impl std::fmt::Debug for Simulation {
     }
 }
 
+/// The actuators of the robot's actuated joints and the controllers file's controllers on
+/// them.
+fn actuate(
+    robot: &RobotModel,
+    bodies: (&[Option<BuiltJoint>], &[RigidBodyHandle]),
+    physics: &mut PhysicsWorld,
+) -> Result<(Actuators, Controllers)> {
+    let mut actuators = Actuators::new(robot, bodies, physics);
+    let controllers = match &robot.controllers {
+        Some(config) => Controllers::new(config, robot, &mut actuators)?,
+        None => Controllers::default(),
+    };
+    Ok((actuators, controllers))
+}
+
 impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
@@ -180,15 +195,11 @@ impl Simulation {
             }
         }
 
-        let mut actuators = Actuators::new(
+        let (actuators, controllers) = actuate(
             &robot,
             (&robot_bodies.joints, &robot_bodies.link_body),
             &mut physics,
-        );
-        let controllers = match &robot.controllers {
-            Some(config) => Controllers::new(config, &robot, &mut actuators)?,
-            None => Controllers::default(),
-        };
+        )?;
         // ros_control's controlPeriod (default: every physics step), never below the step.
         let control_steps = robot
             .ros_control
