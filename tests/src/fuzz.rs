@@ -628,6 +628,24 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         hang_limit: text_limit,
     });
 
+    // Controllers YAML, on the arm car it is written for (parsed, checked, then simulated:
+    // gains and tolerances reach the physics).
+    let dir = work.join("controllers");
+    std::fs::create_dir_all(&dir)?;
+    let arm = rover_sim::RobotModel::load(&crate::repo("assets/robots/my_robot_arm.urdf.xacro"))?;
+    out.push(Target {
+        name: "controllers_yaml",
+        seeds: read_all(&[crate::repo("assets/controllers/my_robot_arm.yaml")])?,
+        input_path: dir.join("controllers.yaml"),
+        load: Box::new(move |p| {
+            let mut robot = arm.clone();
+            robot.load_controllers(p).map_err(|e| e.to_string())?;
+            let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
+            simulate(p, world, robot)
+        }),
+        hang_limit: text_limit,
+    });
+
     // SDF: playground.world with its models.
     if let Some(c) = corpus.as_ref() {
         let dir = work.join("sdf");
