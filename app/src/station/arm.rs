@@ -1,5 +1,6 @@
-//! The driver's station's arm keys: pick one of the robot's actuated joints (1-9), jog it a
-//! step at a time (`[` and `]`; held keys repeat), go home (`h`). Jogging moves the joint's
+//! The driver's station's arm keys: pick one of the robot's actuated joints (1-9; the gamepad's
+//! D-pad left and right), jog it a step at a time (`[` and `]`, held keys repeat; D-pad down
+//! and up), go home (`h`; the pad's North button). Jogging moves the joint's
 //! target from where its actuator holds it now, so repeated presses add up and the joint's
 //! limits and the actuator's velocity and effort limits still apply.
 
@@ -36,6 +37,15 @@ impl ArmKeys {
     pub fn select(&mut self, index: usize) {
         if index < self.joints.len() {
             self.selected = index;
+        }
+    }
+
+    /// Picks the next (`step` +1) or previous (-1) joint, wrapping around.
+    pub fn select_next(&mut self, step: i8) {
+        let n = self.joints.len();
+        if n > 0 {
+            let step = if step >= 0 { 1 } else { n - 1 };
+            self.selected = (self.selected + step) % n;
         }
     }
 

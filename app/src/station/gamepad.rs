@@ -15,6 +15,24 @@ pub enum PadCommand {
     Stop,
     /// Toggle follow mode.
     ToggleFollow,
+    /// Pick the arm's next (+1) or previous (-1) joint (D-pad right / left).
+    NextJoint(i8),
+    /// Jog the picked joint up (+1) or down (-1) one step (D-pad up / down).
+    Jog(i8),
+    /// Go to the "home" pose (Y / North).
+    Home,
+}
+
+/// The arm's buttons: the D-pad picks and jogs a joint, North goes home.
+pub fn arm_button(button: gilrs::Button) -> Option<PadCommand> {
+    match button {
+        gilrs::Button::DPadRight => Some(PadCommand::NextJoint(1)),
+        gilrs::Button::DPadLeft => Some(PadCommand::NextJoint(-1)),
+        gilrs::Button::DPadUp => Some(PadCommand::Jog(1)),
+        gilrs::Button::DPadDown => Some(PadCommand::Jog(-1)),
+        gilrs::Button::North => Some(PadCommand::Home),
+        _ => None,
+    }
 }
 
 /// The state the pad logic needs from one pad, for testing without hardware.
@@ -102,6 +120,7 @@ impl Gamepads {
     pub fn poll(&mut self, speed_mps: f64, turn_radps: f64) -> Option<PadCommand> {
         let mut toggle = false;
         let mut stop = None;
+        let mut arm = None;
         while let Some(gilrs::Event { id, event, .. }) = self.gilrs.next_event() {
             match event {
                 gilrs::EventType::Connected => {
@@ -115,6 +134,9 @@ impl Gamepads {
                     }
                 }
                 gilrs::EventType::ButtonPressed(gilrs::Button::South, _) => toggle = true,
+                gilrs::EventType::ButtonPressed(button, _) if arm_button(button).is_some() => {
+                    arm = arm.or(arm_button(button));
+                }
                 gilrs::EventType::ButtonPressed(gilrs::Button::LeftTrigger, _) => {
                     self.active = Some(id);
                 }
@@ -126,6 +148,9 @@ impl Gamepads {
         }
         if stop.is_some() {
             return stop;
+        }
+        if arm.is_some() {
+            return arm;
         }
         let state = self.active.map_or(PadState::default(), |id| {
             let pad = self.gilrs.gamepad(id);
@@ -142,6 +167,25 @@ impl Gamepads {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_d_pad_picks_and_jogs_a_joint_and_north_goes_home() {
+        assert_eq!(
+            arm_button(gilrs::Button::DPadRight),
+            Some(PadCommand::NextJoint(1))
+        );
+        assert_eq!(
+            arm_button(gilrs::Button::DPadLeft),
+            Some(PadCommand::NextJoint(-1))
+        );
+        assert_eq!(arm_button(gilrs::Button::DPadUp), Some(PadCommand::Jog(1)));
+        assert_eq!(
+            arm_button(gilrs::Button::DPadDown),
+            Some(PadCommand::Jog(-1))
+        );
+        assert_eq!(arm_button(gilrs::Button::North), Some(PadCommand::Home));
+        assert_eq!(arm_button(gilrs::Button::South), None);
+    }
 
     #[test]
     fn deadman_gates_driving_and_release_or_unplug_stops() {

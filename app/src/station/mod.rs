@@ -152,6 +152,20 @@ impl App<'_, '_> {
         self.session.input(action, &mut obs);
     }
 
+    /// Jogs the arm's picked joint one step.
+    fn jog(&mut self, direction: i8) {
+        if let Some(action) = self.arm.jog(self.session.sim(), direction) {
+            self.input(action);
+        }
+    }
+
+    /// Sends the arm to its "home" pose, when the robot has an arm.
+    fn home(&mut self) {
+        if !self.arm.is_empty() {
+            self.input(Action::Joint(JointAction::Pose("home".into())));
+        }
+    }
+
     /// One physics step (with the script's due inputs); an observer that fails (a trace it
     /// cannot write) is said once in the log and the HUD, and the run goes on.
     fn step(&mut self) -> Result<Option<ControlSample>> {
@@ -178,15 +192,9 @@ impl App<'_, '_> {
             }
             Some(KeyCommand::StepOnce) if self.paused => self.step_once = true,
             Some(KeyCommand::SelectJoint(i)) => self.arm.select(i),
-            Some(KeyCommand::Jog(direction)) => {
-                if let Some(action) = self.arm.jog(self.session.sim(), direction) {
-                    self.input(action);
-                }
-            }
-            Some(KeyCommand::Home) if !self.arm.is_empty() => {
-                self.input(Action::Joint(JointAction::Pose("home".into())));
-            }
-            Some(KeyCommand::StepOnce | KeyCommand::Home) | None => {}
+            Some(KeyCommand::Jog(direction)) => self.jog(direction),
+            Some(KeyCommand::Home) => self.home(),
+            Some(KeyCommand::StepOnce) | None => {}
         }
     }
 
@@ -200,6 +208,9 @@ impl App<'_, '_> {
                 Some(PadCommand::Stop) if self.session.pilot().mode() == Mode::Manual => {
                     self.input(Action::CmdVel(Twist::ZERO));
                 }
+                Some(PadCommand::NextJoint(step)) => self.arm.select_next(step),
+                Some(PadCommand::Jog(direction)) => self.jog(direction),
+                Some(PadCommand::Home) => self.home(),
                 Some(PadCommand::Stop) | None => {}
             }
         }
