@@ -330,3 +330,40 @@ fn tiago_arm_2_step_as_the_trace_records_it() -> Result<()> {
     assert!(hardest <= effort_limit + 1e-6, "{hardest} N m");
     Ok(())
 }
+
+/// An effort command (EffortJointInterface, effort_controllers/JointEffortController) turns
+/// the joint with either joint solver: 100 N m lifts UR5's outstretched arm (about 61 N m of
+/// weight) off the ground within 0.3 s, 40 N m does not.
+#[test]
+fn an_effort_command_lifts_ur5s_arm_with_either_solver() -> Result<()> {
+    let Some(urdf) = example_robot_data("ur_description/urdf/ur5_robot.urdf") else {
+        return Ok(());
+    };
+    for solver in [JointSolver::Impulse, JointSolver::Multibody] {
+        let mut lifted = Vec::new();
+        for torque in [-40.0, -100.0] {
+            let robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+            let options = SimOptions {
+                joints: Some(solver),
+                ..SimOptions::default()
+            };
+            let mut sim = Simulation::new(World::flat()?, robot, &options)?;
+            // Negative shoulder_lift raises the arm.
+            sim.command_joint("shoulder_lift_joint", JointCommand::Effort(torque))?;
+            run_for(&mut sim, 0.3);
+            lifted.push(state(&sim, "shoulder_lift_joint")?.position);
+        }
+        println!("{solver:?}: shoulder_lift after 0.3 s of 40 / 100 N m: {lifted:?}");
+        assert!(
+            lifted[0] > -0.2,
+            "{solver:?}: 40 N m lifted the arm to {}",
+            lifted[0]
+        );
+        assert!(
+            lifted[1] < -0.3,
+            "{solver:?}: 100 N m left the arm at {}",
+            lifted[1]
+        );
+    }
+    Ok(())
+}

@@ -20,7 +20,7 @@ use crate::error::{Result, SimError};
 use crate::model::actuation::Pid;
 use crate::model::robot::{JointId, JointKind, RobotModel};
 use crate::physics::diff_drive::wrap_angle;
-use crate::physics::joints::{BuiltJoint, joint_data_mut};
+use crate::physics::joints::{BuiltJoint, JointRef, joint_data_mut};
 
 /// Bandwidth of the default holding loop (Hz).
 pub const HOLD_BANDWIDTH_HZ: f64 = 8.0;
@@ -29,6 +29,11 @@ pub const HOLD_BANDWIDTH_HZ: f64 = 8.0;
 pub const HOLD_INTEGRAL_S: f64 = 0.15;
 /// How far the default hold's integral may go, in effort limits.
 const HOLD_INTEGRAL_HEADROOM: f64 = 4.0;
+/// The speed an effort command's motor chases on a multibody joint (rad/s or m/s): far beyond
+/// any joint's, so the motor always pushes with its force cap, the commanded effort.
+const EFFORT_CHASE_SPEED: f64 = 1.0e4;
+/// That motor's damping (N m s/rad): large enough to saturate at any speed a joint reaches.
+const EFFORT_CHASE_DAMPING: f32 = 1.0e6;
 /// Below this the carried inertia is not known yet (kg m^2 or kg).
 const MIN_INERTIA: f64 = 1e-9;
 /// The share of the velocity limit a position move plans for (the loop's tracking error
@@ -390,8 +395,23 @@ impl Actuators {
                     a.effort = effort;
                     a.setpoint = q;
                     a.integral = 0.0;
-                    data.set_motor(axis, 0.0, 0.0, 0.0, 0.0)
-                        .set_motor_max_force(axis, 0.0);
+                    if matches!(a.built.handle, JointRef::Multibody(_)) {
+                        // A multibody recomputes its links' velocities from its own
+                        // coordinates, so impulses on the bodies are lost: the motor applies
+                        // the effort instead, chasing an unreachable speed with exactly the
+                        // effort as its force cap.
+                        data.set_motor(
+                            axis,
+                            0.0,
+                            (effort.signum() * EFFORT_CHASE_SPEED) as f32,
+                            0.0,
+                            EFFORT_CHASE_DAMPING,
+                        )
+                        .set_motor_max_force(axis, effort.abs() as f32);
+                    } else {
+                        data.set_motor(axis, 0.0, 0.0, 0.0, 0.0)
+                            .set_motor_max_force(axis, 0.0);
+                    }
                 }
             }
         }
@@ -403,6 +423,10 @@ impl Actuators {
             let JointCommand::Effort(effort) = a.command else {
                 continue;
             };
+            if matches!(a.built.handle, JointRef::Multibody(_)) {
+                // Applied by the joint's motor (see `update`).
+                continue;
+            }
             let Some(child) = physics.bodies.get(a.built.child) else {
                 continue;
             };
