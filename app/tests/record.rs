@@ -47,21 +47,20 @@ fn read_rrd(path: &std::path::Path) -> Result<BTreeMap<String, Entity>> {
     Ok(out)
 }
 
-#[test]
-fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
+/// Runs `rover --headless --record` with `args` and a script of `steps`; returns the
+/// recording's entities and the folder (which holds `run.rrd` and `trace.csv`).
+fn record(args: &[&str], steps: &str) -> Result<(BTreeMap<String, Entity>, tempfile::TempDir)> {
     let dir = tempfile::tempdir()?;
     let rrd = dir.path().join("run.rrd");
-    let trace = dir.path().join("trace.csv");
     let script = dir.path().join("script.toml");
-    std::fs::write(
-        &script,
-        "steps = [ { at = 0.0, cmd_vel = [0.3, 0.2] }, { at = 1.0, toggle = \"follow\" } ]\n",
-    )?;
+    std::fs::write(&script, format!("steps = [ {steps} ]\n"))?;
     let out = Command::new(env!("CARGO_BIN_EXE_rover"))
-        .args(["--headless", "--duration", "2", "--record"])
+        .arg("--headless")
+        .args(args)
+        .arg("--record")
         .arg(&rrd)
         .arg("--trace")
-        .arg(&trace)
+        .arg(dir.path().join("trace.csv"))
         .arg("--script")
         .arg(&script)
         .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
@@ -71,7 +70,16 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
         "rover failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let entities = read_rrd(&rrd)?;
+    Ok((read_rrd(&rrd)?, dir))
+}
+
+#[test]
+fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
+    let (entities, dir) = record(
+        &["--duration", "2"],
+        "{ at = 0.0, cmd_vel = [0.3, 0.2] }, { at = 1.0, toggle = \"follow\" }",
+    )?;
+    let trace = dir.path().join("trace.csv");
     let names: Vec<_> = entities.keys().cloned().collect();
     println!("{names:#?}");
     let get = |path: &str| {
@@ -134,31 +142,16 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
 /// position and target are plotted, once per control update.
 #[test]
 fn a_recorded_arm_moves_its_links_and_plots_its_joints() -> Result<()> {
-    let dir = tempfile::tempdir()?;
-    let rrd = dir.path().join("arm.rrd");
-    let script = dir.path().join("script.toml");
-    std::fs::write(&script, "steps = [ { at = 0.2, pose = \"reach\" } ]\n")?;
-    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
-        .args([
-            "--headless",
+    let (entities, _dir) = record(
+        &[
             "--world",
             "worlds/arm_car.toml",
             "--duration",
             "2",
             "--no-detector",
-            "--record",
-        ])
-        .arg(&rrd)
-        .arg("--script")
-        .arg(&script)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()?;
-    assert!(
-        out.status.success(),
-        "rover failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let entities = read_rrd(&rrd)?;
+        ],
+        "{ at = 0.2, pose = \"reach\" }",
+    )?;
     let names: Vec<_> = entities.keys().cloned().collect();
     let timed = |path: &str| {
         entities

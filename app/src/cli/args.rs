@@ -555,17 +555,8 @@ pub(crate) enum BenchKind {
         #[command(flatten)]
         world: WorldArgs,
 
-        /// Sim seconds per measurement
-        #[arg(long, default_value_t = 60.0, value_name = "SECS")]
-        sim_seconds: f64,
-
-        /// Repeats per measurement (the fastest counts)
-        #[arg(long, default_value_t = 3)]
-        repeats: u32,
-
-        /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
-        #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
-        rates: Vec<f64>,
+        #[command(flatten)]
+        physics: PhysicsBenchArgs,
     },
     /// Rerun recording overhead: the same headless run (camera + detector) without and with
     /// --record
@@ -745,18 +736,25 @@ pub(crate) enum Command {
         #[command(flatten)]
         world: WorldArgs,
 
-        /// Sim seconds per measurement
-        #[arg(long, default_value_t = 60.0, value_name = "SECS")]
-        sim_seconds: f64,
-
-        /// Repeats per measurement (the fastest counts)
-        #[arg(long, default_value_t = 3)]
-        repeats: u32,
-
-        /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
-        #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
-        rates: Vec<f64>,
+        #[command(flatten)]
+        physics: PhysicsBenchArgs,
     },
+}
+
+/// The physics benchmark's settings (`rover bench`, `rover bench physics`).
+#[derive(Debug, Args)]
+pub(crate) struct PhysicsBenchArgs {
+    /// Sim seconds per measurement
+    #[arg(long, default_value_t = 60.0, value_name = "SECS")]
+    pub(crate) sim_seconds: f64,
+
+    /// Repeats per measurement (the fastest counts)
+    #[arg(long, default_value_t = 3)]
+    pub(crate) repeats: u32,
+
+    /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
+    #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
+    pub(crate) rates: Vec<f64>,
 }
 
 /// `NAME:=VALUE` (xacro's own spelling; `NAME=VALUE` is accepted too).

@@ -74,20 +74,12 @@ pub fn main() -> ExitCode {
         Some(Command::Bench {
             kind: None,
             world,
-            sim_seconds,
-            repeats,
-            rates,
+            physics,
         })
         | Some(Command::Bench {
-            kind:
-                Some(BenchKind::Physics {
-                    world,
-                    sim_seconds,
-                    repeats,
-                    rates,
-                }),
+            kind: Some(BenchKind::Physics { world, physics }),
             ..
-        }) => bench::bench_cmd(world, sim_seconds, repeats, rates),
+        }) => bench::bench_cmd(world, physics.sim_seconds, physics.repeats, physics.rates),
         Some(Command::Detect {
             images,
             detector,
