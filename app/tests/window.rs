@@ -9,6 +9,9 @@ use std::process::Command;
 use anyhow::Result;
 use rover_core::{TraceRow, parse_trace, trace_joints};
 
+/// The window tests run one at a time: each renders on the CPU in real time.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// What a window run left: the trace's rows and joint names, the screenshot, rover's log.
 struct WindowRun {
     rows: Vec<TraceRow>,
@@ -27,6 +30,7 @@ fn run_window(
     keys: &str,
     keep_shot: Option<&Path>,
 ) -> Result<WindowRun> {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
     let shot = dir.path().join("window.png");

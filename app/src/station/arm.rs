@@ -1,8 +1,8 @@
 //! The driver's station's arm keys: pick one of the robot's actuated joints (1-9; the gamepad's
 //! D-pad left and right), jog it a step at a time (`[` and `]`, held keys repeat; D-pad down
-//! and up), go home (`h`; the pad's North button). Jogging moves the joint's
-//! target from where its actuator holds it now, so repeated presses add up and the joint's
-//! limits and the actuator's velocity and effort limits still apply.
+//! and up), go home (`h`; the pad's North button). Jogging moves the joint's target one step
+//! from its current target, so quick repeated presses add up exactly however fast the joint
+//! follows; the joint's limits and the actuator's velocity and effort limits still apply.
 
 use rover_core::{Action, JointAction};
 use rover_sim::{JointCommand, JointId, JointKind, Simulation};
@@ -57,7 +57,7 @@ impl ArmKeys {
             JointKind::Prismatic { .. } => JOG_M,
             _ => JOG_RAD,
         };
-        let from = sim.joint_setpoint(id)?;
+        let from = sim.joint_target(id)?;
         Some(Action::Joint(JointAction::Command {
             joint: joint.name.clone(),
             command: JointCommand::Position(from + f64::from(direction) * step),

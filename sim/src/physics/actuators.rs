@@ -296,6 +296,16 @@ impl Actuators {
         self.of(joint).map_or(0.0, |a| a.setpoint)
     }
 
+    /// Where the joint's command sends it (rad or m): a position command's target, a
+    /// trajectory's sample, else the setpoint; 0 without an actuator.
+    pub(crate) fn target(&self, joint: JointId) -> f64 {
+        self.of(joint).map_or(0.0, |a| match a.command {
+            JointCommand::Position(q) => q,
+            JointCommand::Track { position, .. } => position,
+            JointCommand::Velocity(_) | JointCommand::Effort(_) => a.setpoint,
+        })
+    }
+
     /// How fast the setpoint moves now; 0 without an actuator.
     pub(crate) fn setpoint_velocity(&self, joint: JointId) -> f64 {
         self.of(joint).map_or(0.0, |a| a.setpoint_velocity)

@@ -442,6 +442,15 @@ impl Simulation {
             .map(|_| self.actuators.setpoint(joint))
     }
 
+    /// Where the command of `joint`'s actuator sends it (rad or m): a position command's target
+    /// (reached at the actuator's pace), a trajectory's sample, else where it is held. `None`
+    /// for joints without an actuator.
+    pub fn joint_target(&self, joint: JointId) -> Option<f64> {
+        self.actuators
+            .of(joint)
+            .map(|_| self.actuators.target(joint))
+    }
+
     fn joint_named(&self, name: &str) -> Result<JointId> {
         self.robot.joint_id(name).ok_or_else(|| {
             SimError::Setup(format!(
