@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::error::{PerceptionError, Result};
 
 /// COCO's 80 class names in YOLO order.
-pub(crate) const COCO80: [&str; 80] = [
+pub const COCO80: [&str; 80] = [
     "person",
     "bicycle",
     "car",

@@ -41,7 +41,7 @@ pub use error::{PerceptionError, Result};
 pub use fault::{FaultInjector, FaultKind, InjectedFault};
 pub use fetch::{default_model_path, ensure_default_model};
 pub use head::Head;
-pub use labels::{parse_metadata_names, read_labels_file};
+pub use labels::{COCO80, parse_metadata_names, read_labels_file};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
 pub use onnxruntime::{Runtime, find_onnxruntime_library};

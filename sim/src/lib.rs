@@ -33,13 +33,14 @@ pub use description::{
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
-    CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig, ControllerKind,
-    ControllerSpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec, GaussianNoise, Ground,
-    HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver, LaserConfig, Link, LinkId,
-    MAX_LASER_SAMPLES, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose, Object,
-    OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
-    STEP_HZ_RANGE, TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World,
-    check_step_hz, link_from_optical,
+    COCO_CLASSES, CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig,
+    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
+    GaussianNoise, Ground, HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver,
+    LaserConfig, Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MeshData, MeshVertex, Mimic,
+    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
+    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TrajectoryConstraints, TrajectorySpec,
+    Transmission, Visual, Walk, World, check_step_hz, class_of_model, is_known_class,
+    link_from_optical,
 };
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,

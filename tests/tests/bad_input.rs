@@ -183,6 +183,25 @@ fn a_missing_file_names_it() {
     );
 }
 
+/// A world object's `class` must be a COCO class: the error names the key and lists them.
+#[test]
+fn a_world_object_of_an_unknown_class_is_refused_with_the_known_ones() -> anyhow::Result<()> {
+    let text = "[[box]]\nsize_m = [1.0, 1.0, 1.0]\nposition_m = [5.0, 0.0]\nclass = \"hydrant\"\n";
+    let err = World::from_str(text, Path::new("w.toml"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("at `box[0].class`: \"hydrant\" is not a COCO class")
+            && err.contains("fire hydrant, stop sign"),
+        "{err}"
+    );
+    let ok = "[[cylinder]]\nradius_m = 0.2\nlength_m = 0.6\nposition_m = [3.0, 1.0]\nclass = \"fire hydrant\"\n";
+    let world = World::from_str(ok, Path::new("w.toml"))?;
+    assert_eq!(world.objects[0].class.as_deref(), Some("fire hydrant"));
+    Ok(())
+}
+
 #[test]
 fn world_unknown_keys_and_bad_values_name_the_key_path() {
     let err = |text: &str| {

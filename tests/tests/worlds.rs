@@ -220,3 +220,51 @@ fn follows_a_gazebo_person_in_an_sdf_world() -> Result<()> {
     );
     Ok(())
 }
+
+/// Gazebo's textured street models carry their COCO class from their `model://` name (and a
+/// renamed include keeps it); a model the table does not know is unlabelled.
+#[test]
+fn gazebo_models_carry_their_coco_class() -> Result<()> {
+    let Some(models) = shared("corpus/gazebo_models") else {
+        eprintln!("SKIPPED: ../shared/corpus/gazebo_models not found");
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("street.world");
+    std::fs::write(
+        &path,
+        r#"<sdf version="1.6"><world name="street">
+  <include><uri>model://hatchback</uri><name>parked_car</name><pose>5 0 0 0 0 0</pose></include>
+  <include><uri>model://stop_sign</uri><pose>6 2 0 0 0 0</pose></include>
+  <include><uri>model://fire_hydrant</uri><pose>4 -2 0 0 0 0</pose></include>
+  <include><uri>model://cafe_table</uri><pose>8 0 0 0 0 0</pose></include>
+  <include><uri>model://dumpster</uri><pose>9 3 0 0 0 0</pose></include>
+</world></sdf>"#,
+    )?;
+    let world = World::load_with(&path, &ResourcePaths::default().with_model_path(models))?;
+    let classes: Vec<(&str, Option<&str>)> = world
+        .models
+        .iter()
+        .map(|m| (m.name.as_str(), m.class.as_deref()))
+        .collect();
+    assert_eq!(
+        classes,
+        [
+            ("parked_car", Some("car")),
+            ("Stop Sign", Some("stop sign")),
+            ("fire_hydrant", Some("fire hydrant")),
+            ("cafe_table", Some("dining table")),
+            ("Dumpster", None),
+        ]
+    );
+    Ok(())
+}
+
+/// The classes a world may name are the detector's default labels, in the same order.
+#[test]
+fn world_classes_are_the_detectors_default_labels() {
+    assert_eq!(rover_sim::COCO_CLASSES, rover_perception::COCO80);
+    for (_, class) in rover_sim::MODEL_CLASSES {
+        assert!(rover_sim::is_known_class(class), "{class}");
+    }
+}

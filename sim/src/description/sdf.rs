@@ -18,6 +18,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::{
     MAX_COORDINATE_M, MAX_MAGNITUDE, Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of,
 };
+use crate::model::classes::class_of_model;
 use crate::model::person::{Person, Walk};
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
@@ -301,6 +302,8 @@ struct Loader<'r> {
 struct Overrides {
     name: Option<String>,
     is_static: Option<bool>,
+    /// The `model://` name the `<include>` used (its class, if it is one).
+    uri_name: Option<String>,
 }
 
 impl Loader<'_> {
@@ -314,6 +317,12 @@ impl Loader<'_> {
         depth: usize,
     ) -> Result<()> {
         let own_name = node.attribute("name").unwrap_or("model").to_owned();
+        let class = overrides
+            .as_ref()
+            .and_then(|o| o.uri_name.as_deref())
+            .and_then(class_of_model)
+            .or_else(|| class_of_model(&own_name))
+            .map(str::to_owned);
         let (name, static_override) = match overrides {
             Some(o) => (o.name.unwrap_or(own_name), o.is_static),
             None => (own_name, None),
@@ -326,6 +335,7 @@ impl Loader<'_> {
             is_static,
             world_from_model,
             links: Vec::new(),
+            class,
         };
         let base = ctx.path.parent().unwrap_or(Path::new("."));
         for item in node.children().filter(Node::is_element) {
@@ -346,6 +356,7 @@ impl Loader<'_> {
                         Some(Overrides {
                             name: Some(nested_name),
                             is_static: is_static.then_some(true),
+                            uri_name: None,
                         }),
                         out,
                         depth + 1,
@@ -572,6 +583,9 @@ impl Loader<'_> {
                 .and_then(|n| n.text())
                 .map(|s| s.trim().to_owned()),
             is_static: child(node, "static").map(|s| ctx.flag(s)),
+            uri_name: uri
+                .strip_prefix("model://")
+                .map(|n| n.trim_end_matches('/').to_owned()),
         };
         self.model(&inner, model, placed, Some(overrides), out, depth)
     }

@@ -9,6 +9,7 @@ use crate::description::resource::ResourcePaths;
 use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
+use crate::model::classes::{COCO_CLASSES, is_known_class};
 use crate::model::drive::DriveSpec;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
@@ -164,6 +165,7 @@ impl Default for RawGround {
 #[serde(deny_unknown_fields)]
 struct RawBox {
     name: Option<String>,
+    class: Option<String>,
     size_m: [f64; 3],
     position_m: Vec<f64>,
     #[serde(default)]
@@ -177,6 +179,7 @@ struct RawBox {
 #[serde(deny_unknown_fields)]
 struct RawCylinder {
     name: Option<String>,
+    class: Option<String>,
     radius_m: f64,
     length_m: f64,
     position_m: Vec<f64>,
@@ -189,6 +192,7 @@ struct RawCylinder {
 #[serde(deny_unknown_fields)]
 struct RawSphere {
     name: Option<String>,
+    class: Option<String>,
     radius_m: f64,
     position_m: Vec<f64>,
     color: Option<String>,
@@ -481,6 +485,7 @@ macro_rules! solid_fields {
             kind: $kind,
             index: $index,
             name: $raw.name,
+            class: $raw.class,
             position_m: &$raw.position_m,
             color: $raw.color.as_deref(),
             mass_kg: $raw.mass_kg,
@@ -495,6 +500,7 @@ struct SolidFields<'a> {
     kind: &'static str,
     index: usize,
     name: Option<String>,
+    class: Option<String>,
     position_m: &'a [f64],
     color: Option<&'a str>,
     mass_kg: Option<f64>,
@@ -521,7 +527,22 @@ impl Checker<'_> {
             color: self.color(&key("color"), f.color, default_color)?,
             mass_kg: self.mass(&key("mass_kg"), f.mass_kg)?,
             friction: self.friction(&key("friction"), f.friction)?,
+            class: self.class(&key("class"), f.class)?,
         })
+    }
+
+    /// A COCO class name, checked.
+    fn class(&self, key: &str, class: Option<String>) -> Result<Option<String>> {
+        match class {
+            Some(c) if !is_known_class(&c) => Err(self.fail(
+                key,
+                format!(
+                    "\"{c}\" is not a COCO class; expected one of: {}",
+                    COCO_CLASSES.join(", ")
+                ),
+            )),
+            other => Ok(other),
+        }
     }
 }
 
@@ -603,6 +624,7 @@ impl RawWall {
             )?,
             mass_kg: None,
             friction: c.friction(&key("friction"), self.friction)?,
+            class: None,
         })
     }
 }

@@ -4,6 +4,7 @@
 
 pub(crate) mod actuation;
 pub(crate) mod camera_info;
+pub(crate) mod classes;
 pub(crate) mod controllers;
 pub(crate) mod drive;
 pub(crate) mod mesh;
@@ -14,6 +15,7 @@ pub(crate) mod world;
 
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
 pub use camera_info::{CameraInfo, link_from_optical};
+pub use classes::{COCO_CLASSES, MODEL_CLASSES, class_of_model, is_known_class};
 pub use controllers::{
     CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose,
     TrajectoryConstraints, TrajectorySpec,

@@ -109,6 +109,8 @@ pub struct Object {
     pub mass_kg: Option<f64>,
     /// Friction coefficient.
     pub friction: f32,
+    /// The COCO class it is (`class = "..."`); `None`: unlabelled.
+    pub class: Option<String>,
 }
 
 /// Physics step rates rover accepts (Hz), from world files and `--physics-hz` alike.
@@ -145,6 +147,9 @@ pub struct Model {
     pub world_from_model: Pose,
     /// Links, each a rigid body.
     pub links: Vec<ModelLink>,
+    /// The COCO class it is: from [`MODEL_CLASSES`](crate::model::classes::MODEL_CLASSES) by
+    /// its `model://` name (or its own name); `None`: unlabelled.
+    pub class: Option<String>,
 }
 
 /// One link of a [`Model`].
