@@ -49,4 +49,6 @@ pub use physics::{
     TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
-pub use sensors::{CameraFrame, CameraSensor, LaserScan, LaserSensor};
+pub use sensors::{
+    CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, Labelled, LaserScan, LaserSensor,
+};

@@ -1,8 +1,11 @@
 //! Sensors on sim time: the camera (`camera.rs`, rendering through `render`) and the 2D laser
-//! (`laser.rs`, ray casts against the physics scene), both with seeded noise.
+//! (`laser.rs`, ray casts against the physics scene), both with seeded noise, and the camera's
+//! ground truth (`ground_truth.rs`: where each labelled thing is in the image).
 
 pub(crate) mod camera;
+pub(crate) mod ground_truth;
 pub(crate) mod laser;
 
 pub use camera::{CameraFrame, CameraSensor};
+pub use ground_truth::{GroundTruth, GroundTruthBox, Labelled};
 pub use laser::{LaserScan, LaserSensor};
