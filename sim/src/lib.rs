@@ -27,20 +27,21 @@ mod render;
 mod sensors;
 
 pub use description::{
-    Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, WorldFile, expand_xacro,
-    load_controllers, load_mesh, load_toml, parse_controllers, parse_toml, uses_xacro,
+    Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, TriMeshPart, WorldFile, expand_xacro,
+    load_controllers, load_mesh, load_texture, load_toml, parse_controllers, parse_toml,
+    uses_xacro,
 };
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
     COCO_CLASSES, CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig,
-    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DiffDriveConfig, Distortion, DriveSpec,
-    GaussianNoise, Ground, HardwareInterface, Inertial, Joint, JointId, JointKind, JointSolver,
-    LaserConfig, Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MeshData, MeshVertex, Mimic,
-    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
-    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TrajectoryConstraints, TrajectorySpec,
-    Transmission, Visual, Walk, World, check_step_hz, class_of_model, is_known_class,
-    link_from_optical,
+    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DiffDriveConfig,
+    Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface, Inertial, Joint,
+    JointId, JointKind, JointSolver, Labelled, LaserConfig, Link, LinkId, MAX_LASER_SAMPLES,
+    MODEL_CLASSES, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose, Object,
+    OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
+    STEP_HZ_RANGE, TextureImage, TexturedRun, TrajectoryConstraints, TrajectorySpec, Transmission,
+    Visual, Walk, World, check_step_hz, class_of_model, is_known_class, link_from_optical,
 };
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
@@ -48,7 +49,11 @@ pub use physics::{
     ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, SimOptions, Simulation, TrajectoryPoint,
     TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
-pub use render::{CameraRenderer, PersonPart, RenderError, object_mesh, person_parts, shape_mesh};
+pub use render::{
+    CameraRenderer, EntityImage, PersonPart, RenderError, object_mesh, person_parts, shape_mesh,
+    visual_mesh,
+};
 pub use sensors::{
-    CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, Labelled, LaserScan, LaserSensor,
+    CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, LaserScan, LaserSensor, MIN_VISIBILITY,
+    MIN_VISIBLE_PX, PixelBox,
 };

@@ -1,13 +1,18 @@
-//! Ground truth from the camera's point of view, checked against what the real renderer draws.
+//! Ground truth from the camera's point of view, checked against what the real renderer draws
+//! and against the pinhole projection through camera_info's K.
 
 use std::path::Path;
 
-use anyhow::Result;
-use rover_sim::{CameraSensor, GroundTruth, RobotModel, SimOptions, Simulation, World};
+use anyhow::{Context, Result};
+use glam::Vec3;
+use rover_sim::{
+    CameraInfo, CameraSensor, Distortion, GroundTruthBox, Pose, RobotModel, SimOptions, Simulation,
+    World, link_from_optical,
+};
 
-/// The tutorial car at the origin and a pure red 1 m cube labelled `suitcase` 5 m ahead.
-const CUBE_WORLD: &str = r##"
-name = "cube"
+/// A pure red 1 m cube labelled `suitcase` 5 m ahead of the tutorial car, turned 25 degrees so
+/// three faces show.
+const CUBE: &str = r##"
 [[box]]
 name = "cube"
 size_m = [1.0, 1.0, 1.0]
@@ -17,54 +22,254 @@ color = "#ff0000"
 class = "suitcase"
 "##;
 
-/// The bounding box (edges, px) of the pixels where red dominates.
-fn red_pixels_box(rgb: &[u8], width: usize) -> Option<[f64; 4]> {
-    let mut b = [usize::MAX, usize::MAX, 0, 0];
-    let mut any = false;
-    for (i, px) in rgb.chunks_exact(3).enumerate() {
-        let (r, g, bl) = (f64::from(px[0]), f64::from(px[1]), f64::from(px[2]));
-        if r > 60.0 && r > 2.0 * g && r > 2.0 * bl {
-            let (x, y) = (i % width, i / width);
-            b = [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)];
-            any = true;
-        }
-    }
-    any.then(|| b.map(|v| v as f64))
+/// An unlabelled grey pillar 3 m ahead that hides the cube's left part.
+const PILLAR: &str = r##"
+[[box]]
+name = "pillar"
+size_m = [0.2, 0.2, 2.0]
+position_m = [3.0, 0.55]
+color = "#808080"
+"##;
+
+/// A grey wall 2 m ahead that hides the whole cube.
+const WALL: &str = r##"
+[[box]]
+name = "wall"
+size_m = [0.2, 4.0, 2.0]
+position_m = [2.0, 0.0]
+color = "#808080"
+"##;
+
+/// One frame of the tutorial car's camera in a world made of `parts`, with ground truth; the
+/// camera's lens distortion replaced by `lens` when given.
+struct Shot {
+    rgb: Vec<u8>,
+    ids: Vec<u32>,
+    width: usize,
+    truth: Vec<GroundTruthBox>,
+    info: CameraInfo,
+    world_from_optical: Pose,
 }
 
-/// Projection: the labelled cube's full box is where the renderer draws it, within 1 px on
-/// every edge (no distortion, nothing in front; the cube turned so three faces show).
-#[test]
-fn a_labelled_cubes_full_box_is_where_the_renderer_draws_it() -> Result<()> {
-    let world = World::from_str(CUBE_WORLD, Path::new("cube.toml"))?;
-    let robot = RobotModel::load(&rover_tests::repo("assets/robots/my_robot.urdf"))?;
+fn shoot(parts: &[&str], lens: Option<Distortion>) -> Result<Shot> {
+    let toml = format!("name = \"gt\"\n{}", parts.concat());
+    let world = World::from_str(&toml, Path::new("gt.toml"))?;
+    let mut robot = RobotModel::load(&rover_tests::repo("assets/robots/my_robot.urdf"))?;
+    if let Some(lens) = lens {
+        robot.cameras[0].distortion = lens;
+    }
     let mut sim = Simulation::new(world, robot, &SimOptions::default())?;
     sim.step();
     let mut camera = CameraSensor::new(&sim)?;
+    camera.enable_ground_truth(&sim)?;
     let info = camera.info().clone();
-    let frame = camera.capture(&sim)?;
-    let drawn = red_pixels_box(frame.rgb, frame.width as usize)
-        .ok_or_else(|| anyhow::anyhow!("no red pixels: the cube is not in view"))?;
     let link = sim
         .robot()
         .link_id(&sim.robot().cameras[0].link)
-        .ok_or_else(|| anyhow::anyhow!("no camera link"))?;
-    let mut truth = GroundTruth::new(sim.world())?;
-    let mut boxes = Vec::new();
-    truth.full_boxes(&sim, &info, sim.world_from_link(link), &mut boxes);
-    assert_eq!(boxes.len(), 1, "{boxes:?}");
-    let b = &boxes[0];
-    assert_eq!(
-        (b.class.as_str(), b.name.as_str(), b.truncated),
-        ("suitcase", "cube", false)
-    );
-    let truth_box = [b.xmin, b.ymin, b.xmax, b.ymax];
-    println!("drawn {drawn:?}, ground truth {truth_box:?}");
-    for (d, t) in drawn.iter().zip(truth_box) {
-        assert!(
-            (d - t).abs() <= 1.0,
-            "drawn {drawn:?} vs ground truth {truth_box:?}"
-        );
+        .context("no camera link")?;
+    let world_from_optical = sim.world_from_link(link) * Pose::from_rotation(link_from_optical());
+    let frame = camera.capture(&sim)?;
+    let entities = frame.entities.context("no entity image")?;
+    Ok(Shot {
+        rgb: frame.rgb.to_vec(),
+        ids: entities.ids.clone(),
+        width: frame.width as usize,
+        truth: frame.ground_truth.to_vec(),
+        info,
+        world_from_optical,
+    })
+}
+
+fn is_red(px: &[u8]) -> bool {
+    let (r, g, b) = (f64::from(px[0]), f64::from(px[1]), f64::from(px[2]));
+    r > 60.0 && r > 2.0 * g && r > 2.0 * b
+}
+
+/// The bounding box (edges, px) of the pixels where red dominates, and how many there are.
+fn red_pixels(rgb: &[u8], width: usize) -> Option<([f64; 4], usize)> {
+    let mut b = [usize::MAX, usize::MAX, 0, 0];
+    let mut count = 0;
+    for (i, px) in rgb.chunks_exact(3).enumerate() {
+        if is_red(px) {
+            let (x, y) = (i % width, i / width);
+            b = [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)];
+            count += 1;
+        }
     }
+    (count > 0).then(|| (b.map(|v| v as f64), count))
+}
+
+/// The pixel-edge bounds of the corners of a box of `size` centred at `centre` (turned
+/// `yaw_deg`), projected through K (pinhole).
+fn projected_corners(shot: &Shot, centre: Vec3, size: Vec3, yaw_deg: f32) -> [f64; 4] {
+    let optical_from_world = shot.world_from_optical.inverse();
+    let turn = glam::Quat::from_rotation_z(yaw_deg.to_radians());
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for i in 0..8 {
+        let sign = |bit: u32| if i & (1 << bit) != 0 { 0.5 } else { -0.5 };
+        let corner = centre + turn * (size * Vec3::new(sign(0), sign(1), sign(2)));
+        let p = optical_from_world * corner;
+        let (u, v) = shot
+            .info
+            .project(f64::from(p.x), f64::from(p.y), f64::from(p.z))
+            .unwrap_or((f64::NAN, f64::NAN));
+        // K has pixel centres at integer coordinates: edges are half a pixel further.
+        b = [
+            b[0].min(u + 0.5),
+            b[1].min(v + 0.5),
+            b[2].max(u + 0.5),
+            b[3].max(v + 0.5),
+        ];
+    }
+    b
+}
+
+fn edges(b: &rover_sim::PixelBox) -> [f64; 4] {
+    [b.xmin, b.ymin, b.xmax, b.ymax]
+}
+
+fn assert_within_1px(what: &str, got: [f64; 4], want: [f64; 4]) {
+    println!("{what}: {got:?} vs {want:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!((g - w).abs() <= 1.0, "{what}: {got:?} vs {want:?}");
+    }
+}
+
+/// Projection: the labelled cube's full box is the pinhole projection of its corners through
+/// K within 1 px, and both it and the visible box are where the renderer draws it.
+#[test]
+fn a_labelled_cubes_boxes_are_its_projection_and_where_it_is_drawn() -> Result<()> {
+    let shot = shoot(&[CUBE], None)?;
+    let (drawn, red) = red_pixels(&shot.rgb, shot.width).context("the cube is not in view")?;
+    assert_eq!(shot.truth.len(), 1, "{:?}", shot.truth);
+    let b = &shot.truth[0];
+    assert_eq!(
+        (b.class.as_str(), b.name.as_str(), b.truncated, b.ignore),
+        ("suitcase", "cube", false, false)
+    );
+    let k = projected_corners(&shot, Vec3::new(5.0, 0.3, 0.5), Vec3::ONE, 25.0);
+    assert_within_1px("full box vs K", edges(&b.full), k);
+    assert_within_1px("full box vs drawn", edges(&b.full), drawn);
+    let visible = b.visible.context("cube not visible")?;
+    assert_within_1px("visible box vs drawn", edges(&visible), drawn);
+    // The id image and the colour image agree on which pixels are the cube.
+    println!(
+        "visible {} px, red {red} px, visibility {}",
+        b.visible_px, b.visibility
+    );
+    assert!((b.visible_px as f64 - red as f64).abs() <= 0.01 * red as f64);
+    // Unoccluded, it is all visible: at most a pixel or two where its bottom edge meets the
+    // ground goes to the ground in the depth test.
+    assert!(b.visibility > 0.999, "{}", b.visibility);
+    assert!(b.unoccluded_px - b.visible_px <= 2, "{b:?}");
+    Ok(())
+}
+
+/// Occlusion: with a pillar in front, the visible box's left edge sits at the pillar's right
+/// edge (K projection of its corners) within 1 px, the full box is unchanged, and the
+/// visibility fraction is the ratio of the cube's drawn pixels with and without the pillar.
+#[test]
+fn a_pillar_in_front_cuts_the_visible_box_at_its_edge() -> Result<()> {
+    let alone = shoot(&[CUBE], None)?;
+    let hidden = shoot(&[CUBE, PILLAR], None)?;
+    let (_, red_alone) = red_pixels(&alone.rgb, alone.width).context("cube not in view")?;
+    let (drawn, red_hidden) =
+        red_pixels(&hidden.rgb, hidden.width).context("cube hidden entirely")?;
+    let b = &hidden.truth[0];
+    let pillar = projected_corners(
+        &hidden,
+        Vec3::new(3.0, 0.55, 1.0),
+        Vec3::new(0.2, 0.2, 2.0),
+        0.0,
+    );
+    let visible = b.visible.context("cube not visible")?;
+    println!("pillar {pillar:?}, visible {visible:?}, drawn {drawn:?}");
+    assert!(
+        (visible.xmin - pillar[2]).abs() <= 1.0,
+        "visible box starts at {} but the pillar ends at {}",
+        visible.xmin,
+        pillar[2]
+    );
+    assert_within_1px("visible box vs drawn", edges(&visible), drawn);
+    assert_eq!(
+        b.full, alone.truth[0].full,
+        "the full box ignores occluders"
+    );
+    let counted = red_hidden as f64 / red_alone as f64;
+    println!(
+        "visibility {:.4} ({} of {} px); drawn red {red_hidden} of {red_alone} = {counted:.4}",
+        b.visibility, b.visible_px, b.unoccluded_px
+    );
+    assert!(
+        b.visibility > 0.2 && b.visibility < 0.9,
+        "the pillar should hide part of the cube"
+    );
+    assert!(
+        (b.visibility - counted).abs() < 0.01,
+        "{} vs {counted}",
+        b.visibility
+    );
+    assert_eq!(b.unoccluded_px, alone.truth[0].unoccluded_px);
+    assert!(!b.ignore);
+    Ok(())
+}
+
+/// A cube wholly behind a wall is reported with its full box, no visible pixels, and as an
+/// ignore region (neither a miss nor a false positive for a detector).
+#[test]
+fn a_hidden_cube_is_an_ignore_region() -> Result<()> {
+    let shot = shoot(&[CUBE, WALL], None)?;
+    assert!(
+        red_pixels(&shot.rgb, shot.width).is_none(),
+        "the wall should hide the cube"
+    );
+    let b = &shot.truth[0];
+    assert_eq!((b.visible_px, b.visible, b.ignore), (0, None, true));
+    assert!(b.full.area() > 1000.0 && b.unoccluded_px > 1000, "{b:?}");
+    assert_eq!(b.visibility, 0.0);
+    Ok(())
+}
+
+/// With lens distortion the ids land where the colour image shows the cube (>= 99.9 % of the
+/// pixels agree), and the full box follows the distortion.
+#[test]
+fn with_lens_distortion_ids_land_where_the_colour_image_shows_the_cube() -> Result<()> {
+    let lens = Distortion {
+        k1: -0.25,
+        k2: 0.12,
+        k3: -0.02,
+        p1: 0.001,
+        p2: -0.0015,
+    };
+    let plain = shoot(&[CUBE], None)?;
+    let shot = shoot(&[CUBE], Some(lens))?;
+    let id = shot.truth[0].id;
+    let mut agree = 0usize;
+    let mut cube_px = 0usize;
+    for (px, &pid) in shot.rgb.chunks_exact(3).zip(&shot.ids) {
+        let red = is_red(px);
+        cube_px += usize::from(red);
+        agree += usize::from(red == (pid == id));
+    }
+    let share = agree as f64 / shot.ids.len() as f64;
+    println!(
+        "ids agree with the colour image on {agree} of {} px ({share:.5}); cube {cube_px} px",
+        shot.ids.len()
+    );
+    assert!(share >= 0.999, "{share}");
+    let (drawn, _) = red_pixels(&shot.rgb, shot.width).context("cube not in view")?;
+    let b = &shot.truth[0];
+    assert_ne!(b.full, plain.truth[0].full, "distortion moves the full box");
+    assert_within_1px("distorted full box vs drawn", edges(&b.full), drawn);
+    assert_within_1px(
+        "distorted visible box vs drawn",
+        edges(&b.visible.context("not visible")?),
+        drawn,
+    );
     Ok(())
 }

@@ -260,17 +260,26 @@ pub struct CameraBench {
     pub median_ms: f64,
     /// Fastest frame (ms).
     pub best_ms: f64,
+    /// Median with ground truth on: id image and silhouettes read back, boxes measured (ms).
+    pub truth_median_ms: f64,
+    /// Labelled things in the world.
+    pub labelled: usize,
 }
 
 /// Renders `frames` camera images of the world from the robot's camera while it drives a
-/// circle (render + readback + post-processing per frame, after one warm-up).
+/// circle (render + readback + post-processing per frame, after one warm-up), interleaving a
+/// camera without and one with ground truth so both see the same machine load.
 pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
     let (world, robot) = config.load_world_and_robot()?;
     let mut sim = Simulation::new(world, robot, &config.options)?;
     let mut sensor = rover_sim::CameraSensor::new(&sim)?;
+    let mut truth = rover_sim::CameraSensor::new(&sim)?;
+    truth.enable_ground_truth(&sim)?;
     sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
     sensor.capture(&sim)?;
+    truth.capture(&sim)?;
     let mut times = Vec::with_capacity(frames);
+    let mut truth_times = Vec::with_capacity(frames);
     for _ in 0..frames.max(1) {
         for _ in 0..5 {
             sim.step();
@@ -278,6 +287,9 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         let start = Instant::now();
         sensor.capture(&sim)?;
         times.push(start.elapsed().as_secs_f64() * 1e3);
+        let start = Instant::now();
+        truth.capture(&sim)?;
+        truth_times.push(start.elapsed().as_secs_f64() * 1e3);
     }
     let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
     Ok(CameraBench {
@@ -285,6 +297,8 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         size: (sensor.info().width, sensor.info().height),
         median_ms: median(&mut times),
         best_ms,
+        truth_median_ms: median(&mut truth_times),
+        labelled: rover_sim::EntityIds::new(sim.world()).len(),
     })
 }
 
@@ -681,6 +695,12 @@ pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
     println!(
         "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",
         b.size.0, b.size.1, b.adapter, b.median_ms, b.best_ms
+    );
+    println!(
+        "with ground truth ({} labelled things: id image, silhouettes, boxes): median {:.2} ms, +{:.2} ms",
+        b.labelled,
+        b.truth_median_ms,
+        b.truth_median_ms - b.median_ms
     );
     Ok(())
 }

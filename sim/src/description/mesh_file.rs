@@ -5,12 +5,13 @@
 //! transforms and tells binary STL files that begin with "solid" from ASCII ones. rover adds the
 //! URDF `scale`, merges the file's meshes and checks the result.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
 use crate::error::{Result, SimError};
 use crate::geometry::Rgba;
+use crate::model::mesh::TextureImage;
 
 /// Largest mesh file accepted (a 231k-triangle COLLADA file is ~20 MB).
 const MAX_MESH_BYTES: u64 = 512 << 20;
@@ -20,10 +21,79 @@ const MAX_MESH_BYTES: u64 = 512 << 20;
 pub struct TriMesh {
     /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Texture coordinates per position (u right, v down the image), when the file has them
+    /// (empty otherwise).
+    pub uvs: Vec<[f32; 2]>,
     /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
     /// The diffuse colour of the file's first material, when it names one.
     pub color: Option<Rgba>,
+    /// The file's meshes in order, each a run of `triangles` with its own material.
+    pub parts: Vec<TriMeshPart>,
+}
+
+/// A run of a [`TriMesh`]'s triangles that share one material.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMeshPart {
+    /// First triangle (index into `triangles`).
+    pub first_triangle: usize,
+    /// Number of triangles.
+    pub triangles: usize,
+    /// The material's diffuse colour, if it has one.
+    pub color: Option<Rgba>,
+    /// The material's diffuse texture (COLLADA `<image><init_from>`, OBJ `map_Kd`) found on
+    /// disk: next to the mesh, else in the model's `materials/textures` folder (where Gazebo
+    /// looks); `None` when the part has no texture coordinates or no texture.
+    pub texture: Option<PathBuf>,
+}
+
+/// Where a texture a mesh file names is: the path as written (relative to the mesh), else
+/// its file name next to the mesh, in `../materials/textures` or `../materials` (Gazebo's
+/// model layout; OBJ files often name `model://` paths or bare names that live there).
+pub(crate) fn find_texture(mesh: &Path, named: &Path) -> Option<PathBuf> {
+    if named.is_file() {
+        return Some(named.to_path_buf());
+    }
+    let file = named.file_name()?;
+    let dir = mesh.parent()?;
+    [
+        dir.to_path_buf(),
+        dir.join("../materials/textures"),
+        dir.join("../materials"),
+    ]
+    .into_iter()
+    .map(|d| d.join(file))
+    .find(|p| p.is_file())
+}
+
+/// Largest texture file accepted.
+const MAX_TEXTURE_BYTES: u64 = 64 << 20;
+/// Largest texture side accepted (px).
+const MAX_TEXTURE_SIDE: u32 = 8192;
+
+/// Decodes a texture image (PNG or JPEG) into RGBA8.
+pub fn load_texture(path: &Path) -> Result<TextureImage> {
+    let bytes = crate::io::read_bounded(path, MAX_TEXTURE_BYTES)?;
+    let image = image::load_from_memory(&bytes)
+        .map_err(|e| SimError::invalid(path, None, format!("cannot decode texture: {e}")))?;
+    if image.width() > MAX_TEXTURE_SIDE || image.height() > MAX_TEXTURE_SIDE {
+        return Err(SimError::invalid(
+            path,
+            None,
+            format!(
+                "texture is {}x{} px: expected at most {MAX_TEXTURE_SIDE} px a side",
+                image.width(),
+                image.height()
+            ),
+        ));
+    }
+    let rgba = image.into_rgba8();
+    Ok(TextureImage {
+        path: path.to_path_buf(),
+        width: rgba.width(),
+        height: rgba.height(),
+        rgba: rgba.into_raw(),
+    })
 }
 
 /// Loads an STL, OBJ or COLLADA file and applies a per-axis scale.
@@ -71,7 +141,20 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
             .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
         ..TriMesh::default()
     };
-    for part in &scene.meshes {
+    for (index, part) in scene.meshes.iter().enumerate() {
+        let material = scene.materials.get(index);
+        let has_uvs = part.texcoords[0].len() == part.vertices.len() && !part.vertices.is_empty();
+        mesh.parts.push(TriMeshPart {
+            first_triangle: mesh.triangles.len(),
+            triangles: part.faces.len(),
+            color: material
+                .and_then(|m| m.color.diffuse)
+                .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
+            texture: material
+                .and_then(|m| m.texture.diffuse.as_deref())
+                .filter(|_| has_uvs)
+                .and_then(|named| find_texture(path, named)),
+        });
         let offset = u32::try_from(mesh.positions.len())
             .map_err(|_| SimError::invalid(path, None, "mesh has more than 2^32 vertices"))?;
         let count = part.vertices.len() as u32;
@@ -102,6 +185,16 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
             }
             mesh.positions.push(p);
         }
+        if has_uvs {
+            // Pad meshes without coordinates so the table lines up with `positions`.
+            mesh.uvs.resize(offset as usize, [0.0, 0.0]);
+            // Files have v up the image; textures are stored top row first.
+            mesh.uvs
+                .extend(part.texcoords[0].iter().map(|t| [t[0], 1.0 - t[1]]));
+        }
+    }
+    if !mesh.uvs.is_empty() {
+        mesh.uvs.resize(mesh.positions.len(), [0.0, 0.0]);
     }
     if mesh.triangles.is_empty() {
         return Err(SimError::invalid(

@@ -1,6 +1,7 @@
 //! File formats -> model: ros_control controllers YAML (`controllers.rs`), URDF (`robot.rs` with `urdf.rs` for the elements and `gazebo.rs` for
 //! the `<gazebo>` extensions), xacro (`xacro/`), Gazebo SDF worlds (`sdf.rs`), rover's TOML
-//! worlds (`world_toml.rs`), mesh files (`mesh_file.rs`), `package://` and `model://` lookup
+//! worlds (`world_toml.rs`), mesh files and their textures (`mesh_file.rs`), OGRE material
+//! scripts (`ogre.rs`), `package://` and `model://` lookup
 //! (`resource.rs`), with the XML helpers they share (`xml.rs`). The entries are
 //! [`RobotModel::load`](crate::RobotModel::load) and [`World::load`](crate::World::load);
 //! nothing here is needed to run a model built in code.
@@ -8,6 +9,7 @@
 pub(crate) mod controllers;
 pub(crate) mod gazebo;
 pub(crate) mod mesh_file;
+pub(crate) mod ogre;
 pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod sdf;
@@ -18,7 +20,7 @@ pub(crate) mod xacro;
 pub(crate) mod xml;
 
 pub use controllers::{load_controllers, parse_controllers};
-pub use mesh_file::{TriMesh, load_mesh};
+pub use mesh_file::{TriMesh, TriMeshPart, load_mesh, load_texture};
 pub use resource::{NotFound, ResourcePaths};
 pub use robot::LoadOptions;
 pub use toml::{load_toml, parse_toml};

@@ -145,6 +145,30 @@ impl ResourcePaths {
         })
     }
 
+    /// Resolves a URI naming a folder or a file (as SDF material scripts' `<uri>` do) to the
+    /// folder: `model://MODEL/rel`, `file://` or a plain path relative to `base_dir`; `None`
+    /// when there is no such folder.
+    pub fn resolve_dir(&self, uri: &str, base_dir: &Path) -> Option<PathBuf> {
+        let path = if let Some(rest) = uri.strip_prefix("model://") {
+            let (model, rel) = rest.split_once('/').unwrap_or((rest, ""));
+            self.find_model(model).ok()?.join(rel)
+        } else {
+            let p = Path::new(uri.strip_prefix("file://").unwrap_or(uri));
+            if p.is_absolute() {
+                p.to_path_buf()
+            } else {
+                base_dir.join(p)
+            }
+        };
+        if path.is_dir() {
+            Some(path)
+        } else if path.is_file() {
+            path.parent().map(Path::to_path_buf)
+        } else {
+            None
+        }
+    }
+
     /// Resolves a file URI as URDF and SDF use them: `package://PKG/rel`, `model://MODEL/rel`,
     /// `file:///abs`, `file://rel` or a plain path (relative to `base_dir`).
     pub fn resolve(&self, uri: &str, base_dir: &Path) -> Result<PathBuf, NotFound> {

@@ -467,6 +467,7 @@ fn convert_link(
             shape: geometry(&v.geometry)?,
             color: color.unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)),
             color_given: color.is_some(),
+            texture: None,
         });
     }
     let mut collisions = Vec::with_capacity(link.collision.len());

@@ -150,13 +150,22 @@ fn read_world_entities(
     for node in world_el.children().filter(Node::is_element) {
         match node.tag_name().name() {
             "model" => loader.model(ctx, node, Pose::IDENTITY, None, models, 0)?,
-            "include" => match person_model(node) {
-                Some(model) => {
+            "include" => match (person_model(node), included_name(node)) {
+                (Some(model), _) => {
                     let person = included_person(ctx, node, &model, world.people.len())?;
                     world.people.push(person);
                 }
-                None => loader.include(ctx, node, Pose::IDENTITY, models, 0)?,
+                // Gazebo's own sun and ground plane, built in: the sun's light direction, and
+                // the 100 m x 100 m grey plane rover's ground already is.
+                (None, Some("sun")) => world.sun_direction = GAZEBO_SUN_DIRECTION,
+                (None, Some("ground_plane")) => {}
+                (None, _) => loader.include(ctx, node, Pose::IDENTITY, models, 0)?,
             },
+            "light" => {
+                if let Some(direction) = directional_light(ctx, node)? {
+                    world.sun_direction = direction;
+                }
+            }
             "actor" => world.people.push(actor(ctx, node)?),
             "physics" | "gravity" | "state" => {}
             other => {
@@ -408,11 +417,13 @@ impl Loader<'_> {
                         continue;
                     };
                     let color = material_color(ctx, item)?;
+                    let texture = self.script_texture(item, base);
                     link.visuals.push(Visual {
                         link_from_shape: ctx.local_pose(item)?,
                         shape,
                         color: color.unwrap_or(Rgba::rgb(0.7, 0.7, 0.7)),
                         color_given: color.is_some(),
+                        texture,
                     });
                 }
                 "collision" => {
@@ -523,6 +534,30 @@ impl Loader<'_> {
         }))
     }
 
+    /// The texture of a visual's OGRE material script (`<material><script>` with `<uri>`
+    /// folders or files and a `<name>`), as Gazebo classic finds it: the first `texture` of
+    /// that material in the `.material` files there, the image in one of those folders or in
+    /// a `textures` folder beside them. `Gazebo/*` names are colours (gazebo.material has no
+    /// textures rover needs); a named material rover cannot find is reported once.
+    fn script_texture(&mut self, visual: Node<'_, '_>, base: &Path) -> Option<PathBuf> {
+        let script = child(visual, "material").and_then(|m| child(m, "script"))?;
+        let name = child(script, "name")?.text()?.trim();
+        if name.is_empty() || name.starts_with("Gazebo/") {
+            return None;
+        }
+        let dirs: Vec<PathBuf> = children(script, "uri")
+            .filter_map(|u| u.text())
+            .filter_map(|u| self.resources.resolve_dir(u.trim(), base))
+            .collect();
+        let found = super::ogre::find_texture(name, &dirs);
+        if found.is_none() {
+            self.skipped.insert(format!(
+                "material script {name} (no texture found: flat colour)"
+            ));
+        }
+        found
+    }
+
     fn include(
         &mut self,
         ctx: &Ctx<'_, '_>,
@@ -589,6 +624,34 @@ impl Loader<'_> {
         };
         self.model(&inner, model, placed, Some(overrides), out, depth)
     }
+}
+
+/// The direction of the light in Gazebo's `model://sun` (a directional light).
+const GAZEBO_SUN_DIRECTION: [f64; 3] = [-0.5, 0.1, -0.9];
+
+/// The `model://NAME` an `<include>` names, if it names one.
+fn included_name<'a>(include: Node<'a, '_>) -> Option<&'a str> {
+    let uri = child(include, "uri")?.text()?.trim();
+    Some(uri.strip_prefix("model://")?.trim_end_matches('/'))
+}
+
+/// A world's `<light type="directional">`: the `<direction>` its light travels (Gazebo's
+/// default (0, 0, -1)); `None` for other lights (rover lights the scene with one sun).
+fn directional_light(ctx: &Ctx<'_, '_>, light: Node<'_, '_>) -> Result<Option<[f64; 3]>> {
+    if light.attribute("type") != Some("directional") {
+        return Ok(None);
+    }
+    let direction = match child(light, "direction") {
+        Some(d) => ctx.numbers::<3>(d)?,
+        None => [0.0, 0.0, -1.0],
+    };
+    if direction.iter().all(|v| *v == 0.0) {
+        return Err(ctx.err(
+            light,
+            "<light type=\"directional\"><direction>0 0 0</direction>: expected a non-zero direction",
+        ));
+    }
+    Ok(Some(direction))
 }
 
 /// `person_standing` or `person_walking` when an `<include>` brings in one of Gazebo's people

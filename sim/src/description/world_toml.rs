@@ -474,6 +474,7 @@ impl RawWorld {
             objects,
             people,
             models: Vec::new(),
+            sun_direction: crate::model::world::DEFAULT_SUN_DIRECTION,
         })
     }
 }

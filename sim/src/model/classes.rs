@@ -120,3 +120,87 @@ pub fn class_of_model(name: &str) -> Option<&'static str> {
 pub fn is_known_class(class: &str) -> bool {
     COCO_CLASSES.contains(&class)
 }
+
+/// A labelled thing of a world: what a ground-truth box is of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Labelled {
+    /// A person (index in the world's people).
+    Person(usize),
+    /// A TOML world object with a `class` (index in the world's objects).
+    Object(usize),
+    /// A Gazebo model of a known class (index in the world's models).
+    Model(usize),
+}
+
+/// The labelled things of a world numbered 1, 2, ... in one fixed order (people, then labelled
+/// objects, then labelled models, each in world order): the numbers the renderer's id pass
+/// writes (0 is "nothing labelled"), shared by the renderer and the ground truth.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct EntityIds {
+    /// Entity `id` is `entities[id - 1]`, with its class.
+    entities: Vec<(Labelled, String)>,
+    people: Vec<u32>,
+    objects: Vec<u32>,
+    models: Vec<u32>,
+}
+
+impl EntityIds {
+    /// Numbers `world`'s labelled things.
+    pub fn new(world: &crate::model::world::World) -> Self {
+        let mut ids = Self::default();
+        let next = |ids: &mut Self, label: Labelled, class: &str| {
+            ids.entities.push((label, class.to_owned()));
+            ids.entities.len() as u32
+        };
+        for i in 0..world.people.len() {
+            let id = next(&mut ids, Labelled::Person(i), "person");
+            ids.people.push(id);
+        }
+        for (i, object) in world.objects.iter().enumerate() {
+            let id = match &object.class {
+                Some(class) => next(&mut ids, Labelled::Object(i), class),
+                None => 0,
+            };
+            ids.objects.push(id);
+        }
+        for (i, model) in world.models.iter().enumerate() {
+            let id = match &model.class {
+                Some(class) => next(&mut ids, Labelled::Model(i), class),
+                None => 0,
+            };
+            ids.models.push(id);
+        }
+        ids
+    }
+
+    /// How many labelled things there are (the largest id).
+    pub fn len(&self) -> usize {
+        self.entities.len()
+    }
+
+    /// Whether the world has nothing labelled.
+    pub fn is_empty(&self) -> bool {
+        self.entities.is_empty()
+    }
+
+    /// The id of person `index` (never 0: people are always labelled).
+    pub fn person(&self, index: usize) -> u32 {
+        self.people.get(index).copied().unwrap_or(0)
+    }
+
+    /// The id of world object `index`, 0 when it has no class.
+    pub fn object(&self, index: usize) -> u32 {
+        self.objects.get(index).copied().unwrap_or(0)
+    }
+
+    /// The id of Gazebo model `index`, 0 when it has no known class.
+    pub fn model(&self, index: usize) -> u32 {
+        self.models.get(index).copied().unwrap_or(0)
+    }
+
+    /// What entity `id` is and its class (`None` for 0 or an id past the last).
+    pub fn entity(&self, id: u32) -> Option<(Labelled, &str)> {
+        let i = (id as usize).checked_sub(1)?;
+        self.entities.get(i).map(|(l, c)| (*l, c.as_str()))
+    }
+}

@@ -1,6 +1,9 @@
 //! Triangle meshes as plain data: what the renderer uploads and what viewers draw, in the
 //! thing's own frame.
 
+use std::path::PathBuf;
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use crate::geometry::{Pose, Rgba};
@@ -24,6 +27,34 @@ pub struct MeshData {
     pub indices: Vec<u32>,
     /// The colour a mesh file's material gives it, if any.
     pub color: Option<Rgba>,
+    /// Texture coordinates per vertex (u right, v down, in 0..1 repeating), or empty.
+    pub uvs: Vec<[f32; 2]>,
+    /// Runs of `indices` drawn with a texture (the rest is drawn in the mesh's colour).
+    pub textured: Vec<TexturedRun>,
+}
+
+/// A run of a mesh's indices drawn with a diffuse texture instead of its colour.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexturedRun {
+    /// First index (into [`MeshData::indices`]).
+    pub first_index: u32,
+    /// Number of indices.
+    pub count: u32,
+    /// The decoded texture (shared by every mesh that uses the file).
+    pub texture: Arc<TextureImage>,
+}
+
+/// A decoded texture image, RGBA8 rows top to bottom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureImage {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// RGBA8 pixels.
+    pub rgba: Vec<u8>,
 }
 
 impl MeshData {

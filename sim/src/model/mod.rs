@@ -15,13 +15,15 @@ pub(crate) mod world;
 
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
 pub use camera_info::{CameraInfo, link_from_optical};
-pub use classes::{COCO_CLASSES, MODEL_CLASSES, class_of_model, is_known_class};
+pub use classes::{
+    COCO_CLASSES, EntityIds, Labelled, MODEL_CLASSES, class_of_model, is_known_class,
+};
 pub use controllers::{
     CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose,
     TrajectoryConstraints, TrajectorySpec,
 };
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
-pub use mesh::{MeshData, MeshVertex};
+pub use mesh::{MeshData, MeshVertex, TextureImage, TexturedRun};
 pub use person::{Person, Walk};
 pub use robot::{
     Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
@@ -30,6 +32,6 @@ pub use sensors::{
     CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
 };
 pub use world::{
-    DEFAULT_STEP_HZ, Ground, JointSolver, Model, ModelLink, Object, Physics, RobotSpawn,
-    STEP_HZ_RANGE, World, check_step_hz,
+    DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, Ground, JointSolver, Model, ModelLink, Object, Physics,
+    RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
 };

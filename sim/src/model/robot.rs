@@ -36,6 +36,9 @@ pub struct Visual {
     /// Whether the description gave the colour; when not, a mesh file's own material colour
     /// is shown (see [`Visual::display_color`]).
     pub color_given: bool,
+    /// A diffuse texture the description's material gives a mesh (an SDF `<material><script>`
+    /// naming an OGRE material with a `texture`), drawn over the mesh's own materials.
+    pub texture: Option<PathBuf>,
 }
 
 impl Visual {

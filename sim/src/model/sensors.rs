@@ -45,6 +45,16 @@ impl Distortion {
             .iter()
             .all(|c| *c == 0.0)
     }
+
+    /// Brown-Conrady lens distortion as gazebo_ros_camera applies it, on normalised image
+    /// coordinates (x = (u - cx) / fx, y = (v - cy) / fy): the distorted point of an ideal one.
+    pub fn distort(&self, x: f64, y: f64) -> (f64, f64) {
+        let r2 = x * x + y * y;
+        let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2 + self.k3 * r2 * r2 * r2;
+        let dx = 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x);
+        let dy = self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y;
+        (x * radial + dx, y * radial + dy)
+    }
 }
 
 /// A `<sensor type="camera">` attached to a link.

@@ -32,7 +32,13 @@ pub struct World {
     pub people: Vec<Person>,
     /// Models of a Gazebo SDF world (empty for TOML worlds).
     pub models: Vec<Model>,
+    /// The direction sunlight travels (world frame, unit): from a Gazebo world's directional
+    /// light (`model://sun`'s is (-0.5, 0.1, -0.9)), else [`DEFAULT_SUN_DIRECTION`].
+    pub sun_direction: [f64; 3],
 }
+
+/// rover's own sun: late morning, from behind-left of a car facing +x.
+pub const DEFAULT_SUN_DIRECTION: [f64; 3] = [0.45, -0.35, -0.82];
 
 /// Robot spawn settings (`[robot]`).
 #[derive(Debug, Clone, PartialEq)]

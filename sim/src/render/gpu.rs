@@ -138,30 +138,7 @@ impl Readback {
         mut row: impl FnMut(usize, &[u8]),
     ) -> Result<(), RenderError> {
         let slice = self.buffer.slice(..);
-        self.mapped.store(MAP_PENDING, Ordering::Release);
-        let mapped = Arc::clone(&self.mapped);
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            mapped.store(
-                if r.is_ok() { MAP_OK } else { MAP_FAILED },
-                Ordering::Release,
-            );
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
-        match self.mapped.load(Ordering::Acquire) {
-            MAP_OK => {}
-            MAP_FAILED => {
-                return Err(RenderError::Readback(
-                    "the readback buffer could not be mapped".into(),
-                ));
-            }
-            _ => {
-                return Err(RenderError::Readback(
-                    "the GPU finished without mapping the readback buffer".into(),
-                ));
-            }
-        }
+        map_and_wait(device, &slice, &self.mapped)?;
         {
             let data = slice
                 .get_mapped_range()
@@ -170,6 +147,80 @@ impl Readback {
             for y in 0..self.height as usize {
                 row(y, &data[y * self.padded_row as usize..][..w * 4]);
             }
+        }
+        self.buffer.unmap();
+        Ok(())
+    }
+}
+
+/// Maps `slice` for reading and waits for it; `mapped` is the buffer's reusable flag.
+fn map_and_wait(
+    device: &wgpu::Device,
+    slice: &wgpu::BufferSlice<'_>,
+    mapped: &Arc<AtomicU8>,
+) -> Result<(), RenderError> {
+    mapped.store(MAP_PENDING, Ordering::Release);
+    let flag = Arc::clone(mapped);
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        flag.store(
+            if r.is_ok() { MAP_OK } else { MAP_FAILED },
+            Ordering::Release,
+        );
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    match mapped.load(Ordering::Acquire) {
+        MAP_OK => Ok(()),
+        MAP_FAILED => Err(RenderError::Readback(
+            "the readback buffer could not be mapped".into(),
+        )),
+        _ => Err(RenderError::Readback(
+            "the GPU finished without mapping the readback buffer".into(),
+        )),
+    }
+}
+
+/// A mappable copy of a GPU buffer, allocated once.
+pub(crate) struct BufferReadback {
+    buffer: wgpu::Buffer,
+    size: u64,
+    mapped: Arc<AtomicU8>,
+}
+
+impl BufferReadback {
+    /// A buffer of `size` bytes.
+    pub(crate) fn new(device: &wgpu::Device, label: &str, size: u64) -> Self {
+        Self {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            size,
+            mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
+        }
+    }
+
+    /// Records the copy of `source` (at least as large) into the buffer.
+    pub(crate) fn copy_from(&self, encoder: &mut wgpu::CommandEncoder, source: &wgpu::Buffer) {
+        encoder.copy_buffer_to_buffer(source, 0, &self.buffer, 0, self.size);
+    }
+
+    /// Waits for the submitted copy and hands its bytes to `read`.
+    pub(crate) fn read(
+        &self,
+        device: &wgpu::Device,
+        read: impl FnOnce(&[u8]),
+    ) -> Result<(), RenderError> {
+        let slice = self.buffer.slice(..);
+        map_and_wait(device, &slice, &self.mapped)?;
+        {
+            let data = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Readback(e.to_string()))?;
+            read(&data);
         }
         self.buffer.unmap();
         Ok(())

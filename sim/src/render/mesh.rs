@@ -1,13 +1,18 @@
 //! Triangle meshes for the renderer: primitives with their sizes baked in (so instance
-//! transforms stay rigid and normals stay right), URDF mesh files, and the human figure.
+//! transforms stay rigid and normals stay right), URDF and SDF mesh files with their textures
+//! (decoded once per file and mesh; one that will not decode is a warning and a flat colour),
+//! and the human figure.
+
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
-use crate::description::mesh_file::load_mesh;
+use crate::description::mesh_file::{TriMesh, load_mesh, load_texture};
 use crate::error::Result;
 use crate::geometry::{Pose, Rgba, Shape};
-use crate::model::mesh::MeshData;
+use crate::model::mesh::{MeshData, TextureImage, TexturedRun};
 use crate::model::person::Person;
+use crate::model::robot::Visual;
 
 /// A box with full side lengths, centred.
 pub(crate) fn cuboid(size: Vec3) -> MeshData {
@@ -123,25 +128,75 @@ fn mesh_of(shape: &Shape, cylinder_segments: u32) -> Result<MeshData> {
         Shape::Cylinder { radius_m, length_m } => cylinder(*radius_m, *length_m, cylinder_segments),
         Shape::Sphere { radius_m } => sphere(*radius_m),
         Shape::Capsule { radius_m, length_m } => capsule(*radius_m, *length_m),
-        Shape::Mesh { path, scale } => {
-            let tri = load_mesh(path, *scale)?;
-            let mut m = MeshData {
-                color: tri.color,
-                ..MeshData::default()
-            };
-            // Flat shading: one normal per face.
-            for t in &tri.triangles {
-                let [a, b, c] =
-                    t.map(|i| tri.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
-                let n = (b - a).cross(c - a);
-                for p in [a, b, c] {
-                    let i = m.push(p, n);
-                    m.indices.push(i);
-                }
-            }
-            m
-        }
+        Shape::Mesh { path, scale } => file_mesh(&load_mesh(path, *scale)?),
     })
+}
+
+/// A mesh file's triangles flat shaded (one normal per face), with its textured parts.
+fn file_mesh(tri: &TriMesh) -> MeshData {
+    let mut m = MeshData {
+        color: tri.color,
+        ..MeshData::default()
+    };
+    for t in &tri.triangles {
+        let [a, b, c] = t.map(|i| tri.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+        let n = (b - a).cross(c - a);
+        for (corner, p) in t.iter().zip([a, b, c]) {
+            let i = m.push(p, n);
+            m.indices.push(i);
+            if !tri.uvs.is_empty() {
+                m.uvs
+                    .push(tri.uvs.get(*corner as usize).copied().unwrap_or_default());
+            }
+        }
+    }
+    let mut textures: Vec<Arc<TextureImage>> = Vec::new();
+    for part in &tri.parts {
+        let Some(path) = &part.texture else {
+            continue;
+        };
+        let texture = match textures.iter().find(|t| &t.path == path) {
+            Some(t) => Arc::clone(t),
+            None => match load_texture(path) {
+                Ok(t) => {
+                    textures.push(Arc::new(t));
+                    Arc::clone(&textures[textures.len() - 1])
+                }
+                Err(e) => {
+                    tracing::warn!("{e}; drawing that part in its flat colour");
+                    continue;
+                }
+            },
+        };
+        m.textured.push(TexturedRun {
+            first_index: (part.first_triangle * 3) as u32,
+            count: (part.triangles * 3) as u32,
+            texture,
+        });
+    }
+    m
+}
+
+/// A visual's mesh as the camera draws it: [`shape_mesh`], with the texture of the visual's
+/// material script (Gazebo's OGRE `texture`) over the whole mesh when it has one and the mesh
+/// has texture coordinates.
+pub fn visual_mesh(visual: &Visual) -> Result<MeshData> {
+    let mut mesh = shape_mesh(&visual.shape)?;
+    if let Some(path) = &visual.texture
+        && !mesh.uvs.is_empty()
+    {
+        match load_texture(path) {
+            Ok(texture) => {
+                mesh.textured = vec![TexturedRun {
+                    first_index: 0,
+                    count: mesh.indices.len() as u32,
+                    texture: Arc::new(texture),
+                }];
+            }
+            Err(e) => tracing::warn!("{e}; drawing the visual in its flat colour"),
+        }
+    }
+    Ok(mesh)
 }
 
 /// A coloured part of a figure, in the figure's frame.

@@ -1,9 +1,10 @@
 //! Offscreen camera rendering with wgpu: the GPU context (`gpu.rs`), the scene uploaded once
-//! (`scene.rs`, from the triangles of `mesh.rs`), one file per render pass (`passes/`), CPU
+//! (`scene.rs`, from the triangles of `mesh.rs`, textures in `material.rs`), one file per render pass (`passes/`), CPU
 //! post-processing (`post.rs`: distortion, noise) and the renderer that runs them
 //! (`renderer.rs`). No window, no surface: it runs headless.
 
 pub(crate) mod gpu;
+pub(crate) mod material;
 pub(crate) mod mesh;
 pub(crate) mod passes;
 pub(crate) mod post;
@@ -11,5 +12,5 @@ pub(crate) mod renderer;
 pub(crate) mod scene;
 
 pub use gpu::RenderError;
-pub use mesh::{PersonPart, object_mesh, person_parts, shape_mesh};
-pub use renderer::CameraRenderer;
+pub use mesh::{PersonPart, object_mesh, person_parts, shape_mesh, visual_mesh};
+pub use renderer::{CameraRenderer, EntityImage};

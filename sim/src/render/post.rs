@@ -48,6 +48,26 @@ impl PostProcess {
         }
     }
 
+    /// The id image through the same distortion as the colour image, sampled at the nearest
+    /// pixel (ids do not blend): `ideal` (pinhole) into `out`; 0 where the lens sees past the
+    /// ideal image.
+    pub(crate) fn remap_ids(&self, ideal: &[u32], out: &mut [u32]) {
+        let (w, h) = (self.width, self.height);
+        match &self.distortion_map {
+            None => out.copy_from_slice(ideal),
+            Some(map) => {
+                for (o, src) in out.iter_mut().zip(map) {
+                    let (sx, sy) = (src[0].round(), src[1].round());
+                    *o = if sx < 0.0 || sy < 0.0 || sx > (w - 1) as f32 || sy > (h - 1) as f32 {
+                        0
+                    } else {
+                        ideal[sy as usize * w + sx as usize]
+                    };
+                }
+            }
+        }
+    }
+
     /// Distortion (remap through the precomputed table) and noise, from `ideal` into `rgb`.
     pub(crate) fn run(&mut self) {
         let (w, h) = (self.width, self.height);
@@ -90,21 +110,8 @@ impl PostProcess {
     }
 }
 
-/// Brown-Conrady lens distortion as gazebo_ros_camera applies it, on normalised image
-/// coordinates (x = (u - cx) / fx, y = (v - cy) / fy): the distorted point of an ideal one.
-/// The renderer needs only its inverse ([`distortion_map`]); the tests check one against the
-/// other.
-#[cfg(test)]
-pub(crate) fn distort(d: &Distortion, x: f64, y: f64) -> (f64, f64) {
-    let r2 = x * x + y * y;
-    let radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
-    let dx = 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
-    let dy = d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
-    (x * radial + dx, y * radial + dy)
-}
-
-/// For each output (distorted) pixel, where to sample the ideal pinhole render: [`distort`]
-/// inverted by fixed-point iteration, computed once per camera.
+/// For each output (distorted) pixel, where to sample the ideal pinhole render:
+/// [`Distortion::distort`] inverted by fixed-point iteration, computed once per camera.
 pub(crate) fn distortion_map(info: &CameraInfo, d: &Distortion) -> Vec<[f32; 2]> {
     let (fx, cx, cy) = (info.k[0], info.k[2], info.k[5]);
     let (w, h) = (info.width as usize, info.height as usize);
@@ -171,7 +178,7 @@ mod distortion_tests {
         ] {
             let [sx, sy] = map[v * w + u];
             // Distorting the ideal point we sample must land back on the output pixel.
-            let (xd, yd) = distort(&d, (f64::from(sx) - cx) / fx, (f64::from(sy) - cy) / fx);
+            let (xd, yd) = d.distort((f64::from(sx) - cx) / fx, (f64::from(sy) - cy) / fx);
             let (ud, vd) = (xd * fx + cx, yd * fx + cy);
             assert!(
                 (ud - u as f64).abs() < 0.01 && (vd - v as f64).abs() < 0.01,

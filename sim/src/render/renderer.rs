@@ -1,17 +1,20 @@
 //! [`CameraRenderer`]: the robot camera's image, rendered offscreen (a GPU, or Mesa's software
 //! Vulkan where there is none) from the URDF camera's pose with gazebo_ros_camera's intrinsics,
-//! read back as RGB8 at the sensor's size, then post-processed (distortion, noise).
+//! read back as RGB8 at the sensor's size, then post-processed (distortion, noise). On request
+//! it also reads back the instance-id image and each labelled thing's silhouette (ground truth).
 
 use glam::{Mat4, Vec4};
 
 use crate::geometry::Pose;
 use crate::model::camera_info::{CameraInfo, link_from_optical};
+use crate::model::classes::EntityIds;
 use crate::model::robot::RobotModel;
 use crate::model::sensors::CameraConfig;
 use crate::model::world::World;
 use crate::render::gpu::RenderError;
 use crate::render::gpu::{Gpu, Readback};
 use crate::render::passes::colour::{ColourPass, View};
+use crate::render::passes::silhouette::SilhouettePass;
 use crate::render::post::PostProcess;
 use crate::render::scene::Scene;
 
@@ -25,6 +28,34 @@ pub struct CameraRenderer {
     info: CameraInfo,
     near_m: f32,
     far_m: f32,
+    /// How many labelled things the scene has (ids 1..=entities).
+    entities: u32,
+    ids: Option<IdOutputs>,
+}
+
+/// The id image and silhouettes read back each frame once ground truth is asked for.
+struct IdOutputs {
+    readback: Readback,
+    silhouette: SilhouettePass,
+    image: EntityImage,
+}
+
+/// Each pixel's labelled thing and each thing's unoccluded size, for one frame: what ground
+/// truth is measured from. Ids are [`EntityIds`] numbers (0: nothing labelled).
+#[derive(Debug, Clone, Default)]
+pub struct EntityImage {
+    /// Image width (px).
+    pub width: u32,
+    /// Image height (px).
+    pub height: u32,
+    /// The id of every pixel of the output image (distorted like the colour image, nearest
+    /// pixel), rows top to bottom.
+    pub ids: Vec<u32>,
+    /// The id of every pixel of the ideal pinhole image (before distortion).
+    pub ideal_ids: Vec<u32>,
+    /// Per entity (index `id - 1`): the pixels of the ideal image it covers with nothing in
+    /// front of it.
+    pub silhouette_px: Vec<u32>,
 }
 
 impl std::fmt::Debug for CameraRenderer {
@@ -48,15 +79,10 @@ impl CameraRenderer {
         let gpu = Gpu::new()?;
         let info = CameraInfo::from_config(camera);
         let (w, h) = (info.width, info.height);
-        let colour = ColourPass::new(
-            &gpu.device,
-            w,
-            h,
-            world.ground.checker_color,
-            world.ground.checker_size_m as f32,
-        );
+        let entity_ids = EntityIds::new(world);
+        let scene = Scene::new(&gpu.device, &gpu.queue, world, robot, &entity_ids)?;
+        let colour = ColourPass::new(&gpu.device, &scene, w, h, world);
         let readback = Readback::new(&gpu.device, "camera readback", w, h);
-        let scene = Scene::new(&gpu.device, world, robot)?;
         let post = PostProcess::new(&info, camera.noise, &camera.distortion, seed);
         Ok(Self {
             gpu,
@@ -67,7 +93,41 @@ impl CameraRenderer {
             info,
             near_m: camera.clip_near_m as f32,
             far_m: camera.clip_far_m as f32,
+            entities: entity_ids.len() as u32,
+            ids: None,
         })
+    }
+
+    /// From the next render on, also reads back the instance-id image and every labelled
+    /// thing's silhouette ([`Self::entity_image`]). Allocates their buffers once.
+    pub fn enable_entity_image(&mut self) -> Result<(), RenderError> {
+        if self.ids.is_some() {
+            return Ok(());
+        }
+        let (w, h) = (self.info.width, self.info.height);
+        let pixels = (w * h) as usize;
+        self.ids = Some(IdOutputs {
+            readback: Readback::new(&self.gpu.device, "entity id readback", w, h),
+            silhouette: SilhouettePass::new(&self.gpu.device, w, h, self.entities)?,
+            image: EntityImage {
+                width: w,
+                height: h,
+                ids: vec![0; pixels],
+                ideal_ids: vec![0; pixels],
+                silhouette_px: vec![0; self.entities as usize],
+            },
+        });
+        Ok(())
+    }
+
+    /// The last rendered image (RGB8 rows, top to bottom, after distortion and noise).
+    pub fn rgb(&self) -> &[u8] {
+        &self.post.rgb
+    }
+
+    /// The last render's entity image, once [`Self::enable_entity_image`] was called.
+    pub fn entity_image(&self) -> Option<&EntityImage> {
+        self.ids.as_ref().map(|ids| &ids.image)
     }
 
     /// The intrinsics (CameraInfo) images are rendered with.
@@ -140,6 +200,13 @@ impl CameraRenderer {
         self.colour
             .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
         self.readback.copy_from(&mut encoder, &self.colour.target);
+        if let Some(ids) = &self.ids {
+            ids.readback.copy_from(&mut encoder, &self.colour.ids);
+            if self.entities > 0 {
+                ids.silhouette
+                    .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
+            }
+        }
         self.gpu.queue.submit([encoder.finish()]);
         let w = self.info.width as usize;
         let ideal = &mut self.post.ideal;
@@ -150,6 +217,21 @@ impl CameraRenderer {
             }
         })?;
         self.post.run();
+        if let Some(ids) = &mut self.ids {
+            let image = &mut ids.image;
+            let ideal = &mut image.ideal_ids;
+            ids.readback.read_rows(&self.gpu.device, |y, row| {
+                let out = &mut ideal[y * w..][..w];
+                for (o, px) in out.iter_mut().zip(row.chunks_exact(4)) {
+                    *o = u32::from_ne_bytes([px[0], px[1], px[2], px[3]]);
+                }
+            })?;
+            self.post.remap_ids(&image.ideal_ids, &mut image.ids);
+            if self.entities > 0 {
+                ids.silhouette
+                    .read_counts(&self.gpu.device, &mut image.silhouette_px)?;
+            }
+        }
         Ok(&self.post.rgb)
     }
 }

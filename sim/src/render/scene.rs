@@ -1,46 +1,73 @@
 //! What the camera sees, on the GPU: every mesh of the world, its people and models and the
-//! robot's visuals uploaded once, one instance (transform and colour) per drawn mesh. Per frame
-//! only the transforms of things that move change. Passes draw the same scene.
+//! robot's visuals uploaded once, one instance (transform, colour and labelled-entity id) per
+//! drawn mesh. Per frame only the transforms of things that move change. Passes draw the same
+//! scene.
 
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 use crate::geometry::{Pose, Rgba};
+use crate::model::classes::EntityIds;
 use crate::model::mesh::MeshData;
 use crate::model::robot::RobotModel;
 use crate::model::world::World;
 use crate::render::gpu::RenderError;
-use crate::render::mesh::{cuboid, object_mesh, person_parts, shape_mesh};
+use crate::render::material::Materials;
+use crate::render::mesh::{cuboid, object_mesh, person_parts, visual_mesh};
 
-/// Per-instance vertex data: the model matrix and the colour (alpha < 0 marks the checkered
-/// ground).
+/// Per-instance vertex data: the model matrix, the colour (alpha < 0 marks the checkered
+/// ground) and the labelled entity the mesh belongs to ([`EntityIds`]; 0: none).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct Instance {
     model: [[f32; 4]; 4],
     color: [f32; 4],
+    entity: u32,
 }
 
 impl Instance {
-    fn new(pose: Pose, color: Rgba) -> Self {
+    fn new(pose: Pose, color: Rgba, entity: u32) -> Self {
         Self {
             model: matrix(pose),
             color: color.0,
+            entity,
         }
     }
+}
+
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 8 => Float32x2];
+const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Uint32];
+
+/// The vertex buffers every pass's vertex shader reads: slot 0 the mesh's vertices (location 0:
+/// position, 1: normal, 8: texture coordinates), slot 1 the instances (2-5: model matrix columns, 6: colour, 7: entity).
+pub(crate) fn vertex_buffer_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
+    [
+        Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<GpuVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &VERTEX_ATTRIBUTES,
+        }),
+        Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Instance>() as u64,
+            step_mode: wgpu::VertexStepMode::Instance,
+            attributes: &INSTANCE_ATTRIBUTES,
+        }),
+    ]
 }
 
 fn matrix(pose: Pose) -> [[f32; 4]; 4] {
     Mat4::from_rotation_translation(pose.rotation, pose.translation).to_cols_array_2d()
 }
 
-/// One vertex as the passes read it (location 0: position, 1: normal). The model's
-/// [`MeshData`] stays plain data; this layout is the renderer's own.
+/// One vertex as the passes read it (location 0: position, 1: normal, 8: texture
+/// coordinates). The model's [`MeshData`] stays plain data; this layout is the renderer's own.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct GpuVertex {
     position: [f32; 3],
     normal: [f32; 3],
+    uv: [f32; 2],
 }
 
 /// One uploaded mesh.
@@ -48,6 +75,16 @@ pub(crate) struct GpuMesh {
     pub(crate) vertices: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
     pub(crate) count: u32,
+    /// Runs of indices and the material (bind group in [`Materials`]) each is drawn with.
+    pub(crate) draws: Vec<Draw>,
+}
+
+/// A run of a mesh's indices drawn with one material.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Draw {
+    pub(crate) first_index: u32,
+    pub(crate) count: u32,
+    pub(crate) material: u32,
 }
 
 /// A drawn shape whose instance follows a moving frame (a robot link, a person, a model link).
@@ -62,6 +99,10 @@ struct Attached {
 /// The uploaded scene: mesh `i` is drawn with instance `i`.
 pub(crate) struct Scene {
     pub(crate) meshes: Vec<GpuMesh>,
+    /// The textures and flags the meshes' draws bind.
+    pub(crate) materials: Materials,
+    /// The meshes of labelled things (indices into `meshes`).
+    pub(crate) labelled: Vec<u32>,
     instances: Vec<Instance>,
     pub(crate) instance_buffer: wgpu::Buffer,
     robot: Vec<Attached>,
@@ -73,22 +114,29 @@ pub(crate) struct Scene {
 /// Collects meshes and instances before the instance buffer exists.
 struct Builder<'d> {
     device: &'d wgpu::Device,
+    queue: &'d wgpu::Queue,
+    materials: Materials,
     meshes: Vec<GpuMesh>,
     instances: Vec<Instance>,
+    labelled: Vec<u32>,
 }
 
 impl Builder<'_> {
-    fn add(&mut self, mesh: &MeshData, pose: Pose, color: Rgba) -> usize {
+    fn add(&mut self, mesh: &MeshData, pose: Pose, color: Rgba, entity: u32) -> usize {
         let device = self.device;
         let vertices: Vec<GpuVertex> = mesh
             .vertices
             .iter()
-            .map(|v| GpuVertex {
+            .enumerate()
+            .map(|(i, v)| GpuVertex {
                 position: v.position,
                 normal: v.normal,
+                uv: mesh.uvs.get(i).copied().unwrap_or_default(),
             })
             .collect();
+        let draws = self.draws(mesh);
         self.meshes.push(GpuMesh {
+            draws,
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: None,
                 contents: bytemuck::cast_slice(&vertices),
@@ -101,23 +149,75 @@ impl Builder<'_> {
             }),
             count: mesh.indices.len() as u32,
         });
-        self.instances.push(Instance::new(pose, color));
+        self.instances.push(Instance::new(pose, color, entity));
+        if entity != 0 {
+            self.labelled.push(self.meshes.len() as u32 - 1);
+        }
         self.instances.len() - 1
+    }
+}
+
+impl Builder<'_> {
+    /// The mesh's textured runs with its own colour between them, in index order.
+    fn draws(&mut self, mesh: &MeshData) -> Vec<Draw> {
+        let mut runs: Vec<_> = mesh.textured.iter().collect();
+        runs.sort_by_key(|r| r.first_index);
+        let total = mesh.indices.len() as u32;
+        let mut draws = Vec::with_capacity(runs.len() * 2 + 1);
+        let mut at = 0;
+        for run in runs {
+            let (start, end) = (
+                run.first_index.min(total),
+                (run.first_index + run.count).min(total),
+            );
+            if start < at || start >= end {
+                continue;
+            }
+            if start > at {
+                draws.push(Draw {
+                    first_index: at,
+                    count: start - at,
+                    material: 0,
+                });
+            }
+            let material = self
+                .materials
+                .textured(self.device, self.queue, &run.texture);
+            draws.push(Draw {
+                first_index: start,
+                count: end - start,
+                material,
+            });
+            at = end;
+        }
+        if at < total {
+            draws.push(Draw {
+                first_index: at,
+                count: total - at,
+                material: 0,
+            });
+        }
+        draws
     }
 }
 
 impl Scene {
     /// Uploads the ground, objects, SDF models, people and the robot's visuals (at the origin
-    /// until the first [`Scene::set_robot_link_poses`]).
+    /// until the first [`Scene::set_robot_link_poses`]); labelled things carry their `ids`.
     pub(crate) fn new(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         world: &World,
         robot: &RobotModel,
+        ids: &EntityIds,
     ) -> Result<Self, RenderError> {
         let mut b = Builder {
             device,
+            queue,
+            materials: Materials::new(device, queue),
             meshes: Vec::new(),
             instances: Vec::new(),
+            labelled: Vec::new(),
         };
         let [gx, gy] = world.ground.size_m;
         let ground = cuboid(Vec3::new(gx as f32, gy as f32, 0.02));
@@ -127,20 +227,26 @@ impl Scene {
             &ground,
             Pose::from_translation(Vec3::new(0.0, 0.0, -0.01)),
             ground_color,
+            0,
         );
-        for object in &world.objects {
+        for (i, object) in world.objects.iter().enumerate() {
             let mesh = object_mesh(&object.shape)?;
-            b.add(&mesh, object.world_from_object(), object.color);
+            b.add(
+                &mesh,
+                object.world_from_object(),
+                object.color,
+                ids.object(i),
+            );
         }
-        let models = add_models(&mut b, world)?;
-        let people = add_people(&mut b, world);
+        let models = add_models(&mut b, world, ids)?;
+        let people = add_people(&mut b, world, ids);
         let mut attached = Vec::new();
         for (link_index, link) in robot.links.iter().enumerate() {
             for visual in &link.visuals {
-                let mesh = shape_mesh(&visual.shape)?;
+                let mesh = visual_mesh(visual)?;
                 let color = visual.display_color(&mesh);
                 attached.push(Attached {
-                    instance: b.add(&mesh, visual.link_from_shape, color),
+                    instance: b.add(&mesh, visual.link_from_shape, color, 0),
                     frame: link_index,
                     frame_from_shape: visual.link_from_shape,
                 });
@@ -153,6 +259,8 @@ impl Scene {
         });
         Ok(Self {
             meshes: b.meshes,
+            materials: b.materials,
+            labelled: b.labelled,
             instances: b.instances,
             instance_buffer,
             robot: attached,
@@ -201,17 +309,23 @@ fn move_attached(instances: &mut [Instance], attached: &[Attached], world_from_f
     }
 }
 
-fn add_models(b: &mut Builder<'_>, world: &World) -> Result<Vec<Attached>, RenderError> {
+fn add_models(
+    b: &mut Builder<'_>,
+    world: &World,
+    ids: &EntityIds,
+) -> Result<Vec<Attached>, RenderError> {
     let mut moving = Vec::new();
     let model_links = world
         .models
         .iter()
-        .flat_map(|m| m.links.iter().map(move |l| (m, l)));
-    for (link_index, (model, link)) in model_links.enumerate() {
+        .enumerate()
+        .flat_map(|(i, m)| m.links.iter().map(move |l| (i, m, l)));
+    for (link_index, (model_index, model, link)) in model_links.enumerate() {
         for visual in &link.visuals {
-            let mesh = shape_mesh(&visual.shape)?;
+            let mesh = visual_mesh(visual)?;
             let pose = link.world_from_link * visual.link_from_shape;
-            let index = b.add(&mesh, pose, visual.display_color(&mesh));
+            let color = visual.display_color(&mesh);
+            let index = b.add(&mesh, pose, color, ids.model(model_index));
             if link.is_dynamic(model) {
                 moving.push(Attached {
                     instance: index,
@@ -224,13 +338,14 @@ fn add_models(b: &mut Builder<'_>, world: &World) -> Result<Vec<Attached>, Rende
     Ok(moving)
 }
 
-fn add_people(b: &mut Builder<'_>, world: &World) -> Vec<Attached> {
+fn add_people(b: &mut Builder<'_>, world: &World, ids: &EntityIds) -> Vec<Attached> {
     let mut parts = Vec::new();
     for (person_index, person) in world.people.iter().enumerate() {
         let world_from_person = person.world_from_person(0.0);
+        let id = ids.person(person_index);
         for part in person_parts(person) {
             parts.push(Attached {
-                instance: b.add(&part.mesh, world_from_person * part.pose, part.color),
+                instance: b.add(&part.mesh, world_from_person * part.pose, part.color, id),
                 frame: person_index,
                 frame_from_shape: part.pose,
             });

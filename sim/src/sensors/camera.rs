@@ -1,4 +1,5 @@
-//! The camera as a sensor: renders the robot's camera at its `update_rate` on sim time.
+//! The camera as a sensor: renders the robot's camera at its `update_rate` on sim time, with
+//! the frame's ground truth when asked for.
 
 use crate::error::SimError;
 use crate::geometry::Pose;
@@ -6,7 +7,8 @@ use crate::model::camera_info::CameraInfo;
 use crate::model::robot::LinkId;
 use crate::physics::simulation::Simulation;
 use crate::render::gpu::RenderError;
-use crate::render::renderer::CameraRenderer;
+use crate::render::renderer::{CameraRenderer, EntityImage};
+use crate::sensors::ground_truth::{GroundTruth, GroundTruthBox};
 
 /// One camera image.
 #[derive(Debug, Clone, Copy)]
@@ -21,6 +23,10 @@ pub struct CameraFrame<'a> {
     pub height: u32,
     /// RGB8 pixels, rows top to bottom.
     pub rgb: &'a [u8],
+    /// Every labelled thing in view (empty unless [`CameraSensor::enable_ground_truth`]).
+    pub ground_truth: &'a [GroundTruthBox],
+    /// The instance-id image of the same frame (`None` unless ground truth is enabled).
+    pub entities: Option<&'a EntityImage>,
 }
 
 /// A robot camera rendering at its update rate.
@@ -33,6 +39,7 @@ pub struct CameraSensor {
     seq: u64,
     link_poses: Vec<Pose>,
     model_poses: Vec<Pose>,
+    truth: Option<(GroundTruth, Vec<GroundTruthBox>)>,
 }
 
 impl CameraSensor {
@@ -64,7 +71,19 @@ impl CameraSensor {
             seq: 0,
             link_poses: Vec::with_capacity(robot.links.len()),
             model_poses: Vec::new(),
+            truth: None,
         })
+    }
+
+    /// From the next image on, every frame carries its ground truth: the renderer also writes
+    /// the instance-id image and the silhouettes, and each labelled thing's boxes, pixel counts
+    /// and visibility are measured from them.
+    pub fn enable_ground_truth(&mut self, sim: &Simulation) -> Result<(), RenderError> {
+        if self.truth.is_none() {
+            self.renderer.enable_entity_image()?;
+            self.truth = Some((GroundTruth::new(sim.world())?, Vec::new()));
+        }
+        Ok(())
     }
 
     /// The intrinsics.
@@ -131,13 +150,23 @@ impl CameraSensor {
             sim.model_link_poses_into(&mut self.model_poses);
             self.renderer.set_model_link_poses(&self.model_poses);
         }
-        let rgb = self.renderer.render(&self.link_poses, camera)?;
+        self.renderer.render(&self.link_poses, camera)?;
+        let entities = self.renderer.entity_image();
+        let ground_truth = match (&mut self.truth, entities) {
+            (Some((truth, boxes)), Some(image)) => {
+                truth.measure(sim, self.renderer.info(), camera, image, boxes);
+                boxes.as_slice()
+            }
+            _ => &[],
+        };
         Ok(CameraFrame {
             sim_time_s: sim.sim_time_s(),
             seq,
             width,
             height,
-            rgb,
+            rgb: self.renderer.rgb(),
+            ground_truth,
+            entities,
         })
     }
 }

@@ -1,51 +1,109 @@
 //! Ground truth for the camera: where every labelled thing of the world (people, objects with a
-//! `class`, Gazebo models of a known class) is in the image. This file gives the full
-//! ("amodal") box: the projection of the thing's whole mesh through the camera's K, occluders
-//! ignored, clipped to the image, `truncated` when the clip cut it or part of it is behind the
-//! camera. The meshes are the ones the camera renders, built once.
+//! `class`, Gazebo models of a known class) is in the image, from the renderer itself.
+//!
+//! * The **full box** (amodal): the projection of the thing's whole mesh through the camera's
+//!   K (and its lens distortion), occluders ignored, clipped to the image; `truncated` when the
+//!   clip cut it or part of it is behind the camera. The meshes are the ones the camera renders,
+//!   built once.
+//! * The **visible box** (tight) and visible pixel count: from the instance-id image the colour
+//!   pass writes in the same draw, distorted like the colour image with nearest sampling.
+//! * The **visibility fraction**: the thing's pixels in the ideal id image over the pixels it
+//!   covers with nothing in front of it (the silhouette pass), both inside the image.
+//! * **Ignore** regions: too small ([`MIN_VISIBLE_PX`]) or too occluded ([`MIN_VISIBILITY`]) to
+//!   ask a detector for; an evaluation counts a detection there neither as right nor wrong, as
+//!   COCO's `iscrowd`.
 
 use glam::Vec3;
 
 use crate::geometry::Pose;
 use crate::model::camera_info::{CameraInfo, link_from_optical};
+use crate::model::classes::EntityIds;
+use crate::model::classes::Labelled;
+use crate::model::sensors::Distortion;
 use crate::model::world::World;
 use crate::physics::Simulation;
-use crate::render::{RenderError, object_mesh, person_parts, shape_mesh};
+use crate::render::{EntityImage, RenderError, object_mesh, person_parts, shape_mesh};
 
 /// Points closer to the camera than this along its axis (m) count as behind it.
 const NEAR_M: f32 = 1e-3;
 
-/// What a ground-truth box is of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Labelled {
-    /// A person (index in the world's people).
-    Person(usize),
-    /// A TOML world object with a `class` (index in the world's objects).
-    Object(usize),
-    /// A Gazebo model of a known class (index in the world's models).
-    Model(usize),
+/// A thing with fewer visible pixels than this (a 10 x 10 patch) is an ignore region.
+pub const MIN_VISIBLE_PX: u32 = 100;
+
+/// A thing with less than this fraction of itself visible (the rest hidden behind other
+/// things) is an ignore region.
+pub const MIN_VISIBILITY: f64 = 0.2;
+
+/// A box in the image, by its edges (px): `xmin..xmax` covers the columns the thing spans
+/// (pixel `i` covers `i..i + 1`), like darknet_ros's boxes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelBox {
+    /// Left edge (px, 0 at the image's left).
+    pub xmin: f64,
+    /// Top edge (px, 0 at the top).
+    pub ymin: f64,
+    /// Right edge (px).
+    pub xmax: f64,
+    /// Bottom edge (px).
+    pub ymax: f64,
 }
 
-/// One labelled thing's box in the image (pixels, edges: `xmin..xmax` covers the columns the
-/// thing spans, like darknet_ros's boxes).
+impl PixelBox {
+    /// Width (px).
+    pub fn width(&self) -> f64 {
+        (self.xmax - self.xmin).max(0.0)
+    }
+
+    /// Height (px).
+    pub fn height(&self) -> f64 {
+        (self.ymax - self.ymin).max(0.0)
+    }
+
+    /// Area (px^2).
+    pub fn area(&self) -> f64 {
+        self.width() * self.height()
+    }
+
+    /// Intersection over union with `other` (0 when either is empty).
+    pub fn iou(&self, other: &PixelBox) -> f64 {
+        let inter = PixelBox {
+            xmin: self.xmin.max(other.xmin),
+            ymin: self.ymin.max(other.ymin),
+            xmax: self.xmax.min(other.xmax),
+            ymax: self.ymax.min(other.ymax),
+        }
+        .area();
+        let union = self.area() + other.area() - inter;
+        if union > 0.0 { inter / union } else { 0.0 }
+    }
+}
+
+/// One labelled thing in one image.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroundTruthBox {
+    /// Its number in the id image ([`EntityIds`], from 1).
+    pub id: u32,
     /// What it is of.
     pub entity: Labelled,
     /// Its COCO class.
     pub class: String,
     /// Its name in the world.
     pub name: String,
-    /// Left edge (px, 0 at the image's left).
-    pub xmin: f64,
-    /// Top edge (px).
-    pub ymin: f64,
-    /// Right edge (px).
-    pub xmax: f64,
-    /// Bottom edge (px).
-    pub ymax: f64,
-    /// The full box was cut by the image border or by the camera's plane.
+    /// The full (amodal) box, clipped to the image.
+    pub full: PixelBox,
+    /// The tight box around its visible pixels (`None`: nothing of it is visible).
+    pub visible: Option<PixelBox>,
+    /// How many pixels of the output image show it.
+    pub visible_px: u32,
+    /// How many pixels of the ideal image it would cover with nothing in front of it.
+    pub unoccluded_px: u32,
+    /// Visible fraction of what would be seen with nothing in front (0..1).
+    pub visibility: f64,
+    /// The image border or the camera's plane cut its full box.
     pub truncated: bool,
+    /// Too small or too occluded to ask a detector for (see [`MIN_VISIBLE_PX`],
+    /// [`MIN_VISIBILITY`]): neither a miss nor a false positive.
+    pub ignore: bool,
 }
 
 /// Where a part of a labelled thing is each frame.
@@ -67,6 +125,7 @@ struct Part {
 
 #[derive(Debug, Clone)]
 struct Entity {
+    id: u32,
     label: Labelled,
     class: String,
     name: String,
@@ -79,6 +138,26 @@ pub struct GroundTruth {
     entities: Vec<Entity>,
     /// Reused for the model links' poses.
     model_poses: Vec<Pose>,
+    /// Reused per frame: per entity (index `id - 1`), visible pixels of the output image and
+    /// of the ideal image, and the visible box's pixel bounds.
+    visible: Vec<Visible>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Visible {
+    px: u32,
+    ideal_px: u32,
+    bounds: [u32; 4],
+}
+
+impl Default for Visible {
+    fn default() -> Self {
+        Self {
+            px: 0,
+            ideal_px: 0,
+            bounds: [u32::MAX, u32::MAX, 0, 0],
+        }
+    }
 }
 
 fn vertices(mesh: &crate::model::MeshData) -> Vec<Vec3> {
@@ -91,9 +170,11 @@ fn vertices(mesh: &crate::model::MeshData) -> Vec<Vec3> {
 impl GroundTruth {
     /// Collects the world's labelled things (their meshes as the camera renders them).
     pub fn new(world: &World) -> Result<Self, RenderError> {
+        let ids = EntityIds::new(world);
         let mut entities = Vec::new();
         for (i, person) in world.people.iter().enumerate() {
             entities.push(Entity {
+                id: ids.person(i),
                 label: Labelled::Person(i),
                 class: "person".to_owned(),
                 name: person.name.clone(),
@@ -111,6 +192,7 @@ impl GroundTruth {
                 continue;
             };
             entities.push(Entity {
+                id: ids.object(i),
                 label: Labelled::Object(i),
                 class: class.clone(),
                 name: object.name.clone(),
@@ -137,6 +219,7 @@ impl GroundTruth {
                 }
             }
             entities.push(Entity {
+                id: ids.model(i),
                 label: Labelled::Model(i),
                 class: class.clone(),
                 name: model.name.clone(),
@@ -144,14 +227,82 @@ impl GroundTruth {
             });
         }
         Ok(Self {
+            visible: vec![Visible::default(); entities.len()],
             entities,
             model_poses: Vec::new(),
         })
     }
 
-    /// The full box of every labelled thing the camera at `world_from_camera` (its link's
-    /// pose) sees at least a corner of, into `out` (cleared first).
-    pub fn full_boxes(
+    /// Every labelled thing the camera at `world_from_camera` (its link's pose) sees at least
+    /// a corner of, or a pixel of, in `image` (the renderer's entity image of the same frame),
+    /// into `out` (cleared first), in id order.
+    pub fn measure(
+        &mut self,
+        sim: &Simulation,
+        info: &CameraInfo,
+        world_from_camera: Pose,
+        image: &EntityImage,
+        out: &mut Vec<GroundTruthBox>,
+    ) {
+        self.count_visible(image);
+        self.full_boxes(sim, info, world_from_camera, out);
+        out.retain_mut(|b| {
+            let i = (b.id - 1) as usize;
+            let Some(seen) = self.visible.get(i) else {
+                return false;
+            };
+            b.visible_px = seen.px;
+            b.unoccluded_px = image.silhouette_px.get(i).copied().unwrap_or(0);
+            b.visibility = if b.unoccluded_px > 0 {
+                (f64::from(seen.ideal_px) / f64::from(b.unoccluded_px)).min(1.0)
+            } else {
+                0.0
+            };
+            b.visible = (seen.px > 0).then(|| {
+                let [x0, y0, x1, y1] = seen.bounds;
+                PixelBox {
+                    xmin: f64::from(x0),
+                    ymin: f64::from(y0),
+                    xmax: f64::from(x1) + 1.0,
+                    ymax: f64::from(y1) + 1.0,
+                }
+            });
+            b.ignore = b.visible_px < MIN_VISIBLE_PX || b.visibility < MIN_VISIBILITY;
+            b.full.xmax > b.full.xmin || b.visible_px > 0
+        });
+    }
+
+    /// Per entity: visible pixels (output and ideal image) and the visible pixels' bounds.
+    fn count_visible(&mut self, image: &EntityImage) {
+        self.visible.fill(Visible::default());
+        let w = image.width as usize;
+        for (i, &id) in image.ids.iter().enumerate() {
+            if id == 0 {
+                continue;
+            }
+            if let Some(v) = self.visible.get_mut(id as usize - 1) {
+                let (x, y) = ((i % w) as u32, (i / w) as u32);
+                v.px += 1;
+                v.bounds = [
+                    v.bounds[0].min(x),
+                    v.bounds[1].min(y),
+                    v.bounds[2].max(x),
+                    v.bounds[3].max(y),
+                ];
+            }
+        }
+        for &id in &image.ideal_ids {
+            if id != 0
+                && let Some(v) = self.visible.get_mut(id as usize - 1)
+            {
+                v.ideal_px += 1;
+            }
+        }
+    }
+
+    /// The full box of every labelled thing, in id order, into `out` (cleared first); an
+    /// entity wholly outside the image gets an empty box.
+    fn full_boxes(
         &mut self,
         sim: &Simulation,
         info: &CameraInfo,
@@ -163,6 +314,9 @@ impl GroundTruth {
         let optical_from_world =
             (world_from_camera * Pose::from_rotation(link_from_optical())).inverse();
         let (fx, cx, fy, cy) = (info.k[0], info.k[2], info.k[4], info.k[5]);
+        let [k1, k2, p1, p2, k3] = info.d;
+        let lens = Distortion { k1, k2, k3, p1, p2 };
+        let distorted = !lens.is_zero();
         let (w, h) = (f64::from(info.width), f64::from(info.height));
         for e in &self.entities {
             let mut bounds = [
@@ -187,8 +341,14 @@ impl GroundTruth {
                         behind = true;
                         continue;
                     }
-                    let u = fx * f64::from(p.x / p.z) + cx;
-                    let v = fy * f64::from(p.y / p.z) + cy;
+                    let (mut x, mut y) = (f64::from(p.x / p.z), f64::from(p.y / p.z));
+                    if distorted {
+                        (x, y) = lens.distort(x, y);
+                    }
+                    // K puts pixel centres at integer coordinates: pixel i spans i-0.5..i+0.5,
+                    // so its edges are 0.5 further on.
+                    let u = fx * x + cx + 0.5;
+                    let v = fy * y + cy + 0.5;
                     bounds = [
                         bounds[0].min(u),
                         bounds[1].min(v),
@@ -197,20 +357,39 @@ impl GroundTruth {
                     ];
                 }
             }
-            let [x0, y0, x1, y1] = bounds;
-            let clipped = [x0.max(0.0), y0.max(0.0), x1.min(w), y1.min(h)];
-            if !(clipped[0] < clipped[2] && clipped[1] < clipped[3]) {
-                continue;
-            }
+            let clipped = [
+                bounds[0].clamp(0.0, w),
+                bounds[1].clamp(0.0, h),
+                bounds[2].clamp(0.0, w),
+                bounds[3].clamp(0.0, h),
+            ];
+            let full = if clipped[0] < clipped[2] && clipped[1] < clipped[3] {
+                PixelBox {
+                    xmin: clipped[0],
+                    ymin: clipped[1],
+                    xmax: clipped[2],
+                    ymax: clipped[3],
+                }
+            } else {
+                PixelBox {
+                    xmin: 0.0,
+                    ymin: 0.0,
+                    xmax: 0.0,
+                    ymax: 0.0,
+                }
+            };
             out.push(GroundTruthBox {
+                id: e.id,
                 entity: e.label,
                 class: e.class.clone(),
                 name: e.name.clone(),
-                xmin: clipped[0],
-                ymin: clipped[1],
-                xmax: clipped[2],
-                ymax: clipped[3],
+                full,
+                visible: None,
+                visible_px: 0,
+                unoccluded_px: 0,
+                visibility: 0.0,
                 truncated: behind || clipped != bounds,
+                ignore: true,
             });
         }
     }

@@ -1,13 +1,17 @@
 //! The colour pass: the scene shaded by a sun and an ambient term, the ground checkered, the
 //! sky as clear colour, into an RGBA8 target the size of the image (with its depth buffer).
+//! The same draw writes each pixel's labelled-entity id into a second, R32Uint target: the
+//! instance-id image the ground truth reads (same frame, same depth test, no extra draw).
 
 use glam::{Mat4, Vec3};
 
 use crate::geometry::{Pose, Rgba};
-use crate::render::scene::{GpuVertex, Instance, Scene};
+use crate::model::world::World;
+use crate::render::scene::{Scene, vertex_buffer_layouts};
 
 const SKY: [f32; 3] = [0.62, 0.75, 0.9];
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 #[repr(C)]
@@ -37,21 +41,30 @@ pub(crate) struct ColourPass {
     /// The rendered image (RGBA8), copied out by the renderer's readback.
     pub(crate) target: wgpu::Texture,
     target_view: wgpu::TextureView,
+    /// Each pixel's labelled-entity id (R32Uint, 0: nothing labelled).
+    pub(crate) ids: wgpu::Texture,
+    ids_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
     checker: Rgba,
     checker_size_m: f32,
+    /// The direction sunlight travels (world frame, unit).
+    sun: Vec3,
 }
 
 impl ColourPass {
-    /// Builds the pipeline and `width` x `height` targets; `checker` and `checker_size_m` are
-    /// the ground's second colour and square size.
+    /// Builds the pipeline and `width` x `height` targets for `scene`, lit by `world`'s sun,
+    /// its ground checkered as the world says.
     pub(crate) fn new(
         device: &wgpu::Device,
+        scene: &Scene,
         width: u32,
         height: u32,
-        checker: Rgba,
-        checker_size_m: f32,
+        world: &World,
     ) -> Self {
+        let checker = world.ground.checker_color;
+        let checker_size_m = world.ground.checker_size_m as f32;
+        let [sx, sy, sz] = world.sun_direction.map(|v| v as f32);
+        let sun = Vec3::new(sx, sy, sz).try_normalize().unwrap_or(Vec3::NEG_Z);
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("globals"),
             size: std::mem::size_of::<Globals>() as u64,
@@ -79,9 +92,10 @@ impl ColourPass {
                 resource: globals.as_entire_binding(),
             }],
         });
-        let pipeline = pipeline(device, &layout);
+        let pipeline = pipeline(device, &layout, &scene.materials.layout);
         let target = texture(device, "camera color", width, height, COLOR_FORMAT, true);
         let depth = texture(device, "camera depth", width, height, DEPTH_FORMAT, false);
+        let ids = texture(device, "camera entity ids", width, height, ID_FORMAT, true);
         Self {
             pipeline,
             globals,
@@ -89,8 +103,11 @@ impl ColourPass {
             target_view: target.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
             target,
+            ids_view: ids.create_view(&Default::default()),
+            ids,
             checker,
             checker_size_m,
+            sun,
         }
     }
 
@@ -108,8 +125,7 @@ impl ColourPass {
             world_from_optical.translation,
         )
         .inverse();
-        // Late-morning sun from behind-left of a car facing +x.
-        let sun = Vec3::new(0.45, -0.35, -0.82).normalize();
+        let sun = self.sun;
         let globals = Globals {
             view_proj: (view.projection * view_matrix).to_cols_array_2d(),
             camera_pos: world_from_optical.translation.extend(1.0).to_array(),
@@ -121,20 +137,31 @@ impl ColourPass {
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("camera"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.target_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: f64::from(SKY[0]),
-                        g: f64::from(SKY[1]),
-                        b: f64::from(SKY[2]),
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &self.target_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: f64::from(SKY[0]),
+                            g: f64::from(SKY[1]),
+                            b: f64::from(SKY[2]),
+                            a: 1.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &self.ids_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+            ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
                 depth_ops: Some(wgpu::Operations {
@@ -153,31 +180,29 @@ impl ColourPass {
         for (i, mesh) in scene.meshes.iter().enumerate() {
             pass.set_vertex_buffer(0, mesh.vertices.slice(..));
             pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..mesh.count, 0, i as u32..i as u32 + 1);
+            for draw in &mesh.draws {
+                pass.set_bind_group(1, &scene.materials.groups[draw.material as usize], &[]);
+                let indices = draw.first_index..draw.first_index + draw.count;
+                pass.draw_indexed(indices, 0, i as u32..i as u32 + 1);
+            }
         }
     }
 }
 
-fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::RenderPipeline {
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    materials: &wgpu::BindGroupLayout,
+) -> wgpu::RenderPipeline {
     let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("camera shader"),
         source: wgpu::ShaderSource::Wgsl(include_str!("colour.wgsl").into()),
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("camera pipeline layout"),
-        bind_group_layouts: &[Some(layout)],
+        bind_group_layouts: &[Some(layout), Some(materials)],
         immediate_size: 0,
     });
-    let vertex_layout = wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<GpuVertex>() as u64,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-    };
-    let instance_layout = wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<Instance>() as u64,
-        step_mode: wgpu::VertexStepMode::Instance,
-        attributes: &wgpu::vertex_attr_array![2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4],
-    };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("camera pipeline"),
         layout: Some(&pipeline_layout),
@@ -185,7 +210,7 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
             module: &shader,
             entry_point: Some("vs_main"),
             compilation_options: Default::default(),
-            buffers: &[Some(vertex_layout), Some(instance_layout)],
+            buffers: &vertex_buffer_layouts(),
         },
         primitive: wgpu::PrimitiveState {
             // Meshes wind counter-clockwise seen from outside. Culling back faces also hides
@@ -207,7 +232,7 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
             module: &shader,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into())],
+            targets: &[Some(COLOR_FORMAT.into()), Some(ID_FORMAT.into())],
         }),
         multiview_mask: None,
         cache: None,
@@ -215,7 +240,7 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
 }
 
 /// A 2D render target; `readable` ones can be copied out.
-fn texture(
+pub(crate) fn texture(
     device: &wgpu::Device,
     label: &str,
     width: u32,
