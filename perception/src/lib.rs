@@ -11,6 +11,9 @@
 //! * The default model is YOLOv12n from the crates.io package easy-yolo 0.1.3
 //!   ([`ensure_default_model`]); its weights are AGPL-3.0 and are fetched at set-up, never
 //!   shipped.
+//! * [`CocoEvaluator`] scores detections against ground truth exactly as pycocotools' COCOeval
+//!   (`bbox`): AP50, AP75, AP50:95, per-class precision, recall and counts; [`match_frame`]
+//!   matches one frame live with the same rule.
 //! * [`onnxruntime_reference`] runs onnxruntime (Python) on the same graph and input, for tests
 //!   and benchmarks.
 //!
@@ -27,6 +30,7 @@ mod head;
 mod labels;
 mod lockstep;
 mod messages;
+mod metrics;
 mod onnxruntime;
 mod preprocess;
 mod reference;
@@ -44,6 +48,10 @@ pub use head::Head;
 pub use labels::{COCO80, parse_metadata_names, read_labels_file};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
+pub use metrics::{
+    COCO_IOU_THRESHOLDS, COCO_MAX_DETECTIONS, ClassMetrics, CocoEvaluator, Detection,
+    DetectionMetrics, EvalBox, FrameMatch, GroundTruthObject, MatchedPair, match_frame,
+};
 pub use onnxruntime::{Runtime, find_onnxruntime_library};
 pub use preprocess::{Letterbox, RgbView, load_rgb};
 pub use reference::{OrtRun, onnxruntime_reference, onnxruntime_reference_profiled};

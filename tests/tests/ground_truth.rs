@@ -273,3 +273,107 @@ fn with_lens_distortion_ids_land_where_the_colour_image_shows_the_cube() -> Resu
     );
     Ok(())
 }
+
+/// Gazebo's textured street models from osrf gazebo_models: the hatchback (OBJ, its MTL's
+/// `map_Kd` textures) and the stop sign (COLLADA with an OGRE material script texture), with
+/// Gazebo's sun and ground plane, seen by the tutorial car. (fire_hydrant and cafe_table are
+/// left out until rover reads COLLADA node hierarchies itself: mesh-loader 0.1.13 does not
+/// apply `<unit>` under nested nodes nor follow `<instance_node>`, so they come out 100 and 39
+/// times too large or misplaced — docs/GROUND_TRUTH.md.)
+const STREET: &str = r#"<sdf version="1.6"><world name="street">
+  <include><uri>model://sun</uri></include>
+  <include><uri>model://ground_plane</uri></include>
+  <include><uri>model://hatchback</uri><name>parked_car</name><pose>8 2.5 0 0 0 1.1</pose></include>
+  <include><uri>model://stop_sign</uri><pose>6 -1.2 0 0 0 -1.5708</pose></include>
+</world></sdf>"#;
+
+/// With textures, YOLO on the street scene finds the textured car with IoU >= 0.5 against its
+/// ground-truth visible box, and the ground truth lists both models (real models, textures,
+/// renderer and detector).
+#[test]
+fn yolo_finds_the_textured_street_car() -> Result<()> {
+    let Some(models) = rover_tests::shared("corpus/gazebo_models") else {
+        eprintln!("SKIPPED: ../shared/corpus/gazebo_models not found (the textured street models)");
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("street.world");
+    std::fs::write(&path, STREET)?;
+    let world = World::load_with(
+        &path,
+        &rover_sim::ResourcePaths::default().with_model_path(models),
+    )?;
+    assert_eq!(
+        world.sun_direction,
+        [-0.5, 0.1, -0.9],
+        "model://sun lights the scene"
+    );
+    let robot = RobotModel::load(&rover_tests::repo("assets/robots/my_robot.urdf"))?;
+    let mut sim = Simulation::new(world, robot, &SimOptions::default())?;
+    sim.step();
+    let mut camera = CameraSensor::new(&sim)?;
+    camera.enable_ground_truth(&sim)?;
+    let frame = camera.capture(&sim)?;
+    let (w, h) = (frame.width, frame.height);
+    let rgb = frame.rgb.to_vec();
+    let truth = frame.ground_truth.to_vec();
+    let out = std::env::var_os("ROVER_TEST_OUT").map(std::path::PathBuf::from);
+    if let Some(out) = &out {
+        image::save_buffer(
+            out.join("street.png"),
+            &rgb,
+            w,
+            h,
+            image::ExtendedColorType::Rgb8,
+        )?;
+    }
+    let mut detector =
+        rover_perception::Detector::load(rover_perception::DetectorConfig::default())?;
+    let boxes = detector.detect(
+        rover_perception::RgbView::new(w as usize, h as usize, &rgb)?,
+        rover_perception::FrameStamp::default(),
+    )?;
+    let mut found = Vec::new();
+    for t in &truth {
+        let visible = t.visible.context("a street model is not visible")?;
+        let best = boxes
+            .bounding_boxes
+            .iter()
+            .filter(|d| d.class == t.class)
+            .map(|d| {
+                let det = rover_sim::PixelBox {
+                    xmin: d.xmin as f64,
+                    ymin: d.ymin as f64,
+                    xmax: d.xmax as f64,
+                    ymax: d.ymax as f64,
+                };
+                (det.iou(&visible), d.probability)
+            })
+            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+        println!(
+            "{:<13} {:<12} visible {:?} ({} px, visibility {:.2}): best IoU {:.2} at p {:.2}",
+            t.name,
+            t.class,
+            edges(&visible),
+            t.visible_px,
+            t.visibility,
+            best.0,
+            best.1
+        );
+        if best.0 >= 0.5 {
+            found.push(t.class.clone());
+        }
+    }
+    for d in &boxes.bounding_boxes {
+        println!(
+            "detected {} {:.2} [{}, {}, {}, {}]",
+            d.class, d.probability, d.xmin, d.ymin, d.xmax, d.ymax
+        );
+    }
+    assert_eq!(truth.len(), 2, "{truth:?}");
+    assert!(
+        found.iter().any(|c| c == "car"),
+        "YOLO found only {found:?}"
+    );
+    Ok(())
+}

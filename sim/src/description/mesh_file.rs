@@ -47,15 +47,60 @@ pub struct TriMeshPart {
     pub texture: Option<PathBuf>,
 }
 
+/// A material of an OBJ file's MTL library, as far as rover draws it.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct ObjMaterial {
+    name: String,
+    diffuse: Option<[f32; 4]>,
+    texture: Option<PathBuf>,
+}
+
+/// The materials of the MTL libraries an OBJ file names (`mtllib`), read leniently: `newmtl`,
+/// `Kd` and `map_Kd` (its last word is the file; options before it are skipped), statements
+/// indented or not. A library that cannot be read gives no materials (the mesh is drawn in
+/// its colour).
+fn obj_materials(obj: &Path, bytes: &[u8]) -> Vec<ObjMaterial> {
+    let dir = obj.parent().unwrap_or(Path::new("."));
+    let text = String::from_utf8_lossy(bytes);
+    let mut materials: Vec<ObjMaterial> = Vec::new();
+    for line in text.lines() {
+        let Some(file) = line.trim().strip_prefix("mtllib ") else {
+            continue;
+        };
+        let Ok(lib) = crate::io::read_bounded(&dir.join(file.trim()), MAX_MESH_BYTES) else {
+            continue;
+        };
+        for statement in String::from_utf8_lossy(&lib).lines().map(str::trim) {
+            let mut words = statement.split_whitespace();
+            match (words.next(), materials.last_mut()) {
+                (Some("newmtl"), _) => materials.push(ObjMaterial {
+                    name: words.collect::<Vec<_>>().join(" "),
+                    ..ObjMaterial::default()
+                }),
+                (Some("Kd"), Some(m)) => {
+                    let rgb: Vec<f32> = words.filter_map(|w| w.parse().ok()).collect();
+                    if let [r, g, b] = rgb[..] {
+                        m.diffuse = Some([r, g, b, 1.0]);
+                    }
+                }
+                (Some("map_Kd"), Some(m)) => m.texture = words.last().map(PathBuf::from),
+                _ => {}
+            }
+        }
+    }
+    materials
+}
+
 /// Where a texture a mesh file names is: the path as written (relative to the mesh), else
 /// its file name next to the mesh, in `../materials/textures` or `../materials` (Gazebo's
 /// model layout; OBJ files often name `model://` paths or bare names that live there).
 pub(crate) fn find_texture(mesh: &Path, named: &Path) -> Option<PathBuf> {
-    if named.is_file() {
-        return Some(named.to_path_buf());
+    let dir = mesh.parent()?;
+    let as_written = dir.join(named);
+    if as_written.is_file() {
+        return Some(as_written);
     }
     let file = named.file_name()?;
-    let dir = mesh.parent()?;
     [
         dir.to_path_buf(),
         dir.join("../materials/textures"),
@@ -141,19 +186,30 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
             .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
         ..TriMesh::default()
     };
+    // mesh-loader 0.1.13 skips indented MTL lines (3ds Max exports indent every statement):
+    // rover reads each OBJ's material library itself for what it draws.
+    let mtl = if ext.as_deref() == Some("obj") {
+        obj_materials(path, &bytes)
+    } else {
+        Vec::new()
+    };
     for (index, part) in scene.meshes.iter().enumerate() {
         let material = scene.materials.get(index);
+        let own = material.and_then(|m| mtl.iter().find(|o| o.name == m.name));
         let has_uvs = part.texcoords[0].len() == part.vertices.len() && !part.vertices.is_empty();
+        let named_texture = material
+            .and_then(|m| m.texture.diffuse.clone())
+            .or_else(|| own.and_then(|o| o.texture.clone()));
         mesh.parts.push(TriMeshPart {
             first_triangle: mesh.triangles.len(),
             triangles: part.faces.len(),
             color: material
                 .and_then(|m| m.color.diffuse)
+                .or_else(|| own.and_then(|o| o.diffuse))
                 .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
-            texture: material
-                .and_then(|m| m.texture.diffuse.as_deref())
+            texture: named_texture
                 .filter(|_| has_uvs)
-                .and_then(|named| find_texture(path, named)),
+                .and_then(|named| find_texture(path, &named)),
         });
         let offset = u32::try_from(mesh.positions.len())
             .map_err(|_| SimError::invalid(path, None, "mesh has more than 2^32 vertices"))?;

@@ -167,10 +167,7 @@ impl Materials {
 /// (an odd last row or column is dropped): (width, height, RGBA8).
 fn mip_chain(image: &TextureImage) -> Vec<(u32, u32, Vec<u8>)> {
     let mut levels = vec![(image.width, image.height, image.rgba.clone())];
-    loop {
-        let Some((w, h, rgba)) = levels.last() else {
-            break;
-        };
+    while let Some((w, h, rgba)) = levels.last() {
         let (w, h) = (*w as usize, *h as usize);
         if w <= 1 && h <= 1 {
             break;
