@@ -48,6 +48,11 @@ impl PostProcess {
         }
     }
 
+    /// Whether the lens distorts the image.
+    pub(crate) fn distorts(&self) -> bool {
+        self.distortion_map.is_some()
+    }
+
     /// The id image through the same distortion as the colour image, sampled at the nearest
     /// pixel (ids do not blend): `ideal` (pinhole) into `out`; 0 where the lens sees past the
     /// ideal image.

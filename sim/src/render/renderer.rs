@@ -53,6 +53,8 @@ pub struct EntityImage {
     pub ids: Vec<u32>,
     /// The id of every pixel of the ideal pinhole image (before distortion).
     pub ideal_ids: Vec<u32>,
+    /// Whether the lens distorts (otherwise `ids` equals `ideal_ids`).
+    pub distorted: bool,
     /// Per entity (index `id - 1`): the pixels of the ideal image it covers with nothing in
     /// front of it.
     pub silhouette_px: Vec<u32>,
@@ -114,6 +116,7 @@ impl CameraRenderer {
                 height: h,
                 ids: vec![0; pixels],
                 ideal_ids: vec![0; pixels],
+                distorted: self.post.distorts(),
                 silhouette_px: vec![0; self.entities as usize],
             },
         });
@@ -196,16 +199,26 @@ impl CameraRenderer {
             projection: self.projection(),
             world_from_optical: world_from_camera * Pose::from_rotation(link_from_optical()),
         };
+        // Both passes first, then every copy: a transfer between passes would stall a
+        // software rasterizer.
+        let silhouette = self.ids.as_ref().filter(|_| self.entities > 0);
+        if let Some(ids) = silhouette {
+            ids.silhouette.prepare(&self.gpu.queue, &view);
+        }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        let scene = &self.scene;
         self.colour
-            .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
+            .encode(&self.gpu.queue, &mut encoder, scene, &view, |pass| {
+                if let Some(ids) = silhouette {
+                    ids.silhouette.draw(pass, scene);
+                }
+            });
         self.readback.copy_from(&mut encoder, &self.colour.target);
         if let Some(ids) = &self.ids {
             ids.readback.copy_from(&mut encoder, &self.colour.ids);
-            if self.entities > 0 {
-                ids.silhouette
-                    .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
-            }
+        }
+        if let Some(ids) = silhouette {
+            ids.silhouette.copy_out(&mut encoder);
         }
         self.gpu.queue.submit([encoder.finish()]);
         let w = self.info.width as usize;
@@ -221,10 +234,8 @@ impl CameraRenderer {
             let image = &mut ids.image;
             let ideal = &mut image.ideal_ids;
             ids.readback.read_rows(&self.gpu.device, |y, row| {
-                let out = &mut ideal[y * w..][..w];
-                for (o, px) in out.iter_mut().zip(row.chunks_exact(4)) {
-                    *o = u32::from_ne_bytes([px[0], px[1], px[2], px[3]]);
-                }
+                let out: &mut [u8] = bytemuck::cast_slice_mut(&mut ideal[y * w..][..w]);
+                out.copy_from_slice(row);
             })?;
             self.post.remap_ids(&image.ideal_ids, &mut image.ids);
             if self.entities > 0 {

@@ -276,20 +276,28 @@ impl GroundTruth {
     fn count_visible(&mut self, image: &EntityImage) {
         self.visible.fill(Visible::default());
         let w = image.width as usize;
-        for (i, &id) in image.ids.iter().enumerate() {
-            if id == 0 {
-                continue;
+        for (y, row) in image.ids.chunks_exact(w).enumerate() {
+            for (x, &id) in row.iter().enumerate() {
+                if id == 0 {
+                    continue;
+                }
+                if let Some(v) = self.visible.get_mut(id as usize - 1) {
+                    let (x, y) = (x as u32, y as u32);
+                    v.px += 1;
+                    v.bounds = [
+                        v.bounds[0].min(x),
+                        v.bounds[1].min(y),
+                        v.bounds[2].max(x),
+                        v.bounds[3].max(y),
+                    ];
+                }
             }
-            if let Some(v) = self.visible.get_mut(id as usize - 1) {
-                let (x, y) = ((i % w) as u32, (i / w) as u32);
-                v.px += 1;
-                v.bounds = [
-                    v.bounds[0].min(x),
-                    v.bounds[1].min(y),
-                    v.bounds[2].max(x),
-                    v.bounds[3].max(y),
-                ];
+        }
+        if !image.distorted {
+            for v in &mut self.visible {
+                v.ideal_px = v.px;
             }
+            return;
         }
         for &id in &image.ideal_ids {
             if id != 0

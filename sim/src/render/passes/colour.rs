@@ -10,9 +10,12 @@ use crate::model::world::World;
 use crate::render::scene::{Scene, vertex_buffer_layouts};
 
 const SKY: [f32; 3] = [0.62, 0.75, 0.9];
-const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The colour target's format.
+pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// The id target's format.
+pub(crate) const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The depth buffer's format.
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -111,13 +114,16 @@ impl ColourPass {
         }
     }
 
-    /// Uploads this frame's uniforms and records the pass.
+    /// Uploads this frame's uniforms and records the pass; `after` records more draws into
+    /// the same pass (same targets and depth buffer; one pass is far cheaper than two on a
+    /// software rasterizer).
     pub(crate) fn encode(
         &self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         scene: &Scene,
         view: &View,
+        after: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) {
         let world_from_optical = view.world_from_optical;
         let view_matrix = Mat4::from_rotation_translation(
@@ -186,6 +192,7 @@ impl ColourPass {
                 pass.draw_indexed(indices, 0, i as u32..i as u32 + 1);
             }
         }
+        after(&mut pass);
     }
 }
 

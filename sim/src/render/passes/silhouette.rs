@@ -1,15 +1,15 @@
-//! The silhouette pass: the pixels each labelled thing would cover with nothing in front of it
+//! The silhouette draws: the pixels each labelled thing would cover with nothing in front of it
 //! (no depth test, only labelled meshes), as one bit per pixel in a mask per entity, counted on
 //! the CPU after read back. Against the id image's visible pixels this gives each thing's
-//! visibility fraction. Allocated only when ground truth is asked for.
+//! visibility fraction. They are recorded at the end of the colour pass (its targets masked
+//! off): a pass of their own cost 2.4 ms more on llvmpipe. Allocated only when ground truth is
+//! asked for.
 
 use glam::Mat4;
 
 use crate::render::gpu::{BufferReadback, RenderError};
-use crate::render::passes::colour::{View, texture};
+use crate::render::passes::colour::{COLOR_FORMAT, DEPTH_FORMAT, ID_FORMAT, View};
 use crate::render::scene::{Scene, vertex_buffer_layouts};
-
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -24,11 +24,12 @@ pub(crate) struct SilhouettePass {
     globals: wgpu::Buffer,
     masks: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
-    depth_view: wgpu::TextureView,
     readback: BufferReadback,
     width: u32,
     words_per_entity: u32,
     entities: u32,
+    /// Zeroes the masks each frame (allocated once).
+    zeros: Vec<u8>,
 }
 
 impl SilhouettePass {
@@ -100,35 +101,22 @@ impl SilhouettePass {
                 },
             ],
         });
-        let depth = texture(
-            device,
-            "silhouette depth",
-            width,
-            height,
-            DEPTH_FORMAT,
-            false,
-        );
         Ok(Self {
             pipeline: pipeline(device, &layout),
             globals,
             readback: BufferReadback::new(device, "silhouette readback", mask_bytes),
             masks,
             bind_group,
-            depth_view: depth.create_view(&Default::default()),
             width,
             words_per_entity,
             entities,
+            zeros: vec![0; mask_bytes as usize],
         })
     }
 
-    /// Clears the masks and records the pass and the copy of the masks for read back.
-    pub(crate) fn encode(
-        &self,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &Scene,
-        view: &View,
-    ) {
+    /// Uploads this frame's uniforms and zeroes the masks (queue writes, before the frame's
+    /// commands: no transfer between the passes, which would stall a software rasterizer).
+    pub(crate) fn prepare(&self, queue: &wgpu::Queue, view: &View) {
         let world_from_optical = view.world_from_optical;
         let view_matrix = Mat4::from_rotation_translation(
             world_from_optical.rotation,
@@ -140,33 +128,24 @@ impl SilhouettePass {
             size: [self.width, self.words_per_entity, 0, 0],
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
-        encoder.clear_buffer(&self.masks, 0, None);
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("silhouettes"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[]);
-            pass.set_vertex_buffer(1, scene.instance_buffer.slice(..));
-            for &i in &scene.labelled {
-                let mesh = &scene.meshes[i as usize];
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.count, 0, i..i + 1);
-            }
+        queue.write_buffer(&self.masks, 0, &self.zeros);
+    }
+
+    /// Records the draws into the colour pass (after [`Self::prepare`]).
+    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>, scene: &Scene) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_vertex_buffer(1, scene.instance_buffer.slice(..));
+        for &i in &scene.labelled {
+            let mesh = &scene.meshes[i as usize];
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.count, 0, i..i + 1);
         }
+    }
+
+    /// Records the copy of the masks for read back (after [`Self::encode`]).
+    pub(crate) fn copy_out(&self, encoder: &mut wgpu::CommandEncoder) {
         self.readback.copy_from(encoder, &self.masks);
     }
 
@@ -182,10 +161,17 @@ impl SilhouettePass {
         let words = self.words_per_entity as usize;
         self.readback.read(device, |bytes| {
             for (count, mask) in counts.iter_mut().zip(bytes.chunks_exact(words * 4)) {
-                *count = mask
-                    .chunks_exact(4)
-                    .map(|w| u32::from_ne_bytes([w[0], w[1], w[2], w[3]]).count_ones())
-                    .sum();
+                let mut pairs = mask.chunks_exact(8);
+                let mut sum = 0;
+                for pair in &mut pairs {
+                    let mut word = [0u8; 8];
+                    word.copy_from_slice(pair);
+                    sum += u64::from_ne_bytes(word).count_ones();
+                }
+                for byte in pairs.remainder() {
+                    sum += byte.count_ones();
+                }
+                *count = sum;
             }
         })
     }
@@ -229,7 +215,19 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
             module: &shader,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[],
+            // The colour pass's targets, left untouched.
+            targets: &[
+                Some(wgpu::ColorTargetState {
+                    format: COLOR_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::empty(),
+                }),
+                Some(wgpu::ColorTargetState {
+                    format: ID_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::empty(),
+                }),
+            ],
         }),
         multiview_mask: None,
         cache: None,

@@ -1,4 +1,4 @@
-// rover's silhouette pass: every labelled thing drawn with nothing in front of it. Each
+// rover's silhouette draws: every labelled thing drawn with nothing in front of it. Each
 // fragment sets its pixel's bit in its entity's mask (one bit per pixel, one mask per
 // entity), so overlapping parts of one thing count once and other things never hide it.
 
@@ -36,9 +36,19 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
+// Drawn inside the colour pass with its targets masked off: the outputs are never written.
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    @location(1) entity: u32,
+};
+
 @fragment
-fn fs_main(f: VertexOut) {
+fn fs_main(f: VertexOut) -> FragmentOut {
     let pixel = u32(f.clip.y) * g.size.x + u32(f.clip.x);
     let word = (f.entity - 1u) * g.size.y + (pixel >> 5u);
     atomicOr(&masks[word], 1u << (pixel & 31u));
+    var out: FragmentOut;
+    out.color = vec4<f32>(0.0);
+    out.entity = 0u;
+    return out;
 }
