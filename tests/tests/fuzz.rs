@@ -76,7 +76,9 @@ fn every_parser_survives_mutated_real_files() -> anyhow::Result<()> {
 fn regressions() -> Vec<(&'static str, Input, &'static str)> {
     vec![
         // mesh-loader 0.1.13 indexed past a COLLADA array when a "0" landed inside a <p>
-        // index list of jersey_barrier.dae: a panic that took rover down.
+        // index list of jersey_barrier.dae: a panic that took rover down. rover reads COLLADA
+        // itself now and the shifted list is still valid, so the file loads: what must hold
+        // is that nothing panics (check_one fails on a panic or a hang).
         (
             "mesh_dae",
             Input::Mutated {
@@ -88,7 +90,7 @@ fn regressions() -> Vec<(&'static str, Input, &'static str)> {
                     token: 6,
                 }],
             },
-            "the mesh parser failed",
+            "",
         ),
         // Finite but absurd magnitudes: with the accepted ranges switched off, the long run
         // found both within 11k inputs (a 1e30 m box panicked inside parry's contact code,

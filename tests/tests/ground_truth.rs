@@ -274,24 +274,29 @@ fn with_lens_distortion_ids_land_where_the_colour_image_shows_the_cube() -> Resu
     Ok(())
 }
 
-/// Gazebo's textured street models from osrf gazebo_models: the hatchback (OBJ, its MTL's
-/// `map_Kd` textures) and the stop sign (COLLADA with an OGRE material script texture), with
-/// Gazebo's sun and ground plane, seen by the tutorial car. (fire_hydrant and cafe_table are
-/// left out until rover reads COLLADA node hierarchies itself: mesh-loader 0.1.13 does not
-/// apply `<unit>` under nested nodes nor follow `<instance_node>`, so they come out 100 and 39
-/// times too large or misplaced — docs/GROUND_TRUTH.md.)
+/// Gazebo's textured street models from osrf gazebo_models — hatchback (OBJ, its MTL's
+/// `map_Kd` textures), stop_sign (COLLADA + an OGRE material script), fire_hydrant (COLLADA in
+/// centimetres under a translated node, its effect's image) and cafe_table (COLLADA in inches,
+/// instanced nodes, two wood textures) — with Gazebo's sun and ground plane, seen by the
+/// tutorial car with its camera raised on a 1 m mast (eye height, so the table is seen from
+/// above as in COCO's photos rather than from underneath).
 const STREET: &str = r#"<sdf version="1.6"><world name="street">
   <include><uri>model://sun</uri></include>
   <include><uri>model://ground_plane</uri></include>
-  <include><uri>model://hatchback</uri><name>parked_car</name><pose>8 2.5 0 0 0 1.1</pose></include>
-  <include><uri>model://stop_sign</uri><pose>6 -1.2 0 0 0 -1.5708</pose></include>
+  <include><uri>model://hatchback</uri><name>parked_car</name><pose>9 3.4 0 0 0 1.1</pose></include>
+  <include><uri>model://stop_sign</uri><pose>7 -1.5 0 0 0 -1.5708</pose></include>
+  <include><uri>model://fire_hydrant</uri><pose>3 -1.5 0 0 0 0</pose></include>
+  <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
 </world></sdf>"#;
 
-/// With textures, YOLO on the street scene finds the textured car with IoU >= 0.5 against its
-/// ground-truth visible box, and the ground truth lists both models (real models, textures,
-/// renderer and detector).
+/// With textures, YOLO on the street scene finds the car and the fire hydrant with IoU >= 0.5
+/// against their ground-truth visible boxes, and the stop sign inside its box (COCO-trained
+/// YOLO boxes the plate; the model's ground truth includes the pole). Real models, textures,
+/// renderer and detector. (The issue asks for three of the four at IoU >= 0.5: the stop sign's
+/// box convention and the lone cafe table, which YOLO does not call a dining table from any
+/// pose tried, keep it at two — docs/GROUND_TRUTH.md.)
 #[test]
-fn yolo_finds_the_textured_street_car() -> Result<()> {
+fn yolo_finds_the_textured_street_models() -> Result<()> {
     let Some(models) = rover_tests::shared("corpus/gazebo_models") else {
         eprintln!("SKIPPED: ../shared/corpus/gazebo_models not found (the textured street models)");
         return Ok(());
@@ -308,7 +313,13 @@ fn yolo_finds_the_textured_street_car() -> Result<()> {
         [-0.5, 0.1, -0.9],
         "model://sun lights the scene"
     );
-    let robot = RobotModel::load(&rover_tests::repo("assets/robots/my_robot.urdf"))?;
+    let mut robot = RobotModel::load(&rover_tests::repo("assets/robots/my_robot.urdf"))?;
+    let mast = robot
+        .joints
+        .iter_mut()
+        .find(|j| j.name == "camera_joint")
+        .context("the tutorial car has no camera_joint")?;
+    mast.parent_from_child.translation.z += 1.0;
     let mut sim = Simulation::new(world, robot, &SimOptions::default())?;
     sim.step();
     let mut camera = CameraSensor::new(&sim)?;
@@ -370,10 +381,23 @@ fn yolo_finds_the_textured_street_car() -> Result<()> {
             d.class, d.probability, d.xmin, d.ymin, d.xmax, d.ymax
         );
     }
-    assert_eq!(truth.len(), 2, "{truth:?}");
+    assert_eq!(truth.len(), 4, "{truth:?}");
     assert!(
-        found.iter().any(|c| c == "car"),
+        found.iter().any(|c| c == "car") && found.iter().any(|c| c == "fire hydrant"),
         "YOLO found only {found:?}"
+    );
+    let sign = truth
+        .iter()
+        .find(|t| t.class == "stop sign")
+        .and_then(|t| t.visible)
+        .context("no stop sign in view")?;
+    assert!(
+        boxes.bounding_boxes.iter().any(|d| d.class == "stop sign"
+            && d.xmin as f64 >= sign.xmin - 2.0
+            && d.xmax as f64 <= sign.xmax + 2.0
+            && d.ymin as f64 >= sign.ymin - 2.0
+            && d.ymax as f64 <= sign.ymax + 2.0),
+        "no stop sign detected inside {sign:?}"
     );
     Ok(())
 }

@@ -1,9 +1,10 @@
 //! Triangle meshes from STL (binary or ASCII), Wavefront OBJ and COLLADA (`.dae`) files, as
 //! URDF `<mesh>` and SDF `<mesh><uri>` use them.
 //!
-//! Parsing is OpenRR's `mesh-loader` (what urdf-viz uses): it applies COLLADA's `<unit>` and node
-//! transforms and tells binary STL files that begin with "solid" from ASCII ones. rover adds the
-//! URDF `scale`, merges the file's meshes and checks the result.
+//! STL and OBJ parsing is OpenRR's `mesh-loader` (what urdf-viz uses): it tells binary STL files
+//! that begin with "solid" from ASCII ones. COLLADA is rover's own reader (`collada.rs`: node
+//! hierarchies, units and up axes as Gazebo draws them). rover adds the URDF `scale`, merges the
+//! file's meshes and checks the result.
 
 use std::path::{Path, PathBuf};
 
@@ -149,11 +150,20 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
         .map(str::to_ascii_lowercase);
     let loader = mesh_loader::Loader::default();
     let bytes = crate::io::read_bounded(path, MAX_MESH_BYTES)?;
+    if ext.as_deref() == Some("dae") {
+        let text = std::str::from_utf8(&bytes).map_err(|e| {
+            SimError::invalid(
+                path,
+                None,
+                format!("cannot read mesh: not UTF-8 text ({e})"),
+            )
+        })?;
+        return super::collada::load_collada(path, text, scale);
+    }
     let load: fn(&mesh_loader::Loader, &[u8], &Path) -> std::io::Result<mesh_loader::Scene> =
         match ext.as_deref() {
             Some("stl") => |l, b, p| l.load_stl_from_slice(b, p),
             Some("obj") => |l, b, p| l.load_obj_from_slice(b, p),
-            Some("dae") => |l, b, p| l.load_collada_from_slice(b, p),
             _ => {
                 return Err(SimError::invalid(
                     path,
@@ -162,8 +172,8 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
                 ));
             }
         };
-    // mesh-loader 0.1.13 indexes some malformed COLLADA files out of bounds (found by
-    // tests/tests/fuzz.rs); its panic becomes this file's error instead of taking rover down.
+    // A panic in the parser becomes this file's error instead of taking rover down (mesh-loader
+    // 0.1.13 indexed some malformed COLLADA files out of bounds; tests/tests/fuzz.rs).
     let scene =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load(&loader, &bytes, path)))
             .map_err(|payload| {

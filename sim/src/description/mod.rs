@@ -1,11 +1,13 @@
 //! File formats -> model: ros_control controllers YAML (`controllers.rs`), URDF (`robot.rs` with `urdf.rs` for the elements and `gazebo.rs` for
 //! the `<gazebo>` extensions), xacro (`xacro/`), Gazebo SDF worlds (`sdf.rs`), rover's TOML
-//! worlds (`world_toml.rs`), mesh files and their textures (`mesh_file.rs`), OGRE material
+//! worlds (`world_toml.rs`), mesh files and their textures (`mesh_file.rs`, COLLADA in
+//! `collada.rs`), OGRE material
 //! scripts (`ogre.rs`), `package://` and `model://` lookup
 //! (`resource.rs`), with the XML helpers they share (`xml.rs`). The entries are
 //! [`RobotModel::load`](crate::RobotModel::load) and [`World::load`](crate::World::load);
 //! nothing here is needed to run a model built in code.
 
+pub(crate) mod collada;
 pub(crate) mod controllers;
 pub(crate) mod gazebo;
 pub(crate) mod mesh_file;
