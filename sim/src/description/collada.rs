@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Vec3};
 use roxmltree::Node;
 
-use crate::description::mesh_file::{TriMesh, TriMeshPart, find_texture};
+use crate::description::trimesh::{TriMesh, TriMeshPart, find_texture};
 use crate::error::{Result, SimError};
 use crate::geometry::Rgba;
 
@@ -293,37 +293,7 @@ fn add_geometry<'a>(
             None => None,
         };
         let (vertex_offset, uv_offset) = (offset(vertex_input), uv_input.map(offset));
-        // Index lists: one <p> per polygon for <polygons>, else one with <vcount> or threes.
-        let mut indices = Vec::new();
-        let mut counts = Vec::new();
-        for p in children(prim, "p") {
-            let list: Vec<usize> = p
-                .text()
-                .unwrap_or("")
-                .split_whitespace()
-                .map(|t| {
-                    t.parse::<usize>()
-                        .map_err(|_| (p, format!("\"{t}\" is not an index")))
-                })
-                .collect::<std::result::Result<_, _>>()?;
-            if kind == "polygons" {
-                counts.push(list.len() / stride);
-            }
-            indices.extend(list);
-        }
-        if kind == "polylist" {
-            counts = match child(prim, "vcount") {
-                Some(v) => v
-                    .text()
-                    .unwrap_or("")
-                    .split_whitespace()
-                    .filter_map(|t| t.parse::<usize>().ok())
-                    .collect(),
-                None => Vec::new(),
-            };
-        } else if kind == "triangles" {
-            counts = vec![3; indices.len() / (3 * stride)];
-        }
+        let (indices, counts) = index_lists(prim, kind, stride)?;
         let material = prim
             .attribute("material")
             .and_then(|symbol| {
@@ -377,6 +347,46 @@ fn add_geometry<'a>(
         });
     }
     Ok(())
+}
+
+/// A primitive's index lists and its polygons' corner counts: one `<p>` per polygon for
+/// `<polygons>`, else one `<p>` with `<vcount>` (polylist) or threes (triangles).
+fn index_lists<'a>(
+    prim: Node<'a, 'a>,
+    kind: &str,
+    stride: usize,
+) -> std::result::Result<(Vec<usize>, Vec<usize>), NodeError<'a>> {
+    let mut indices = Vec::new();
+    let mut counts = Vec::new();
+    for p in children(prim, "p") {
+        let list: Vec<usize> = p
+            .text()
+            .unwrap_or("")
+            .split_whitespace()
+            .map(|t| {
+                t.parse::<usize>()
+                    .map_err(|_| (p, format!("\"{t}\" is not an index")))
+            })
+            .collect::<std::result::Result<_, _>>()?;
+        if kind == "polygons" {
+            counts.push(list.len() / stride);
+        }
+        indices.extend(list);
+    }
+    if kind == "polylist" {
+        counts = child(prim, "vcount")
+            .map(|v| {
+                v.text()
+                    .unwrap_or("")
+                    .split_whitespace()
+                    .filter_map(|t| t.parse::<usize>().ok())
+                    .collect()
+            })
+            .unwrap_or_default();
+    } else if kind == "triangles" {
+        counts = vec![3; indices.len() / (3 * stride)];
+    }
+    Ok((indices, counts))
 }
 
 /// A material's diffuse colour and image file: material -> `<instance_effect>` -> effect ->

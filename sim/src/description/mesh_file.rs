@@ -10,43 +10,13 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use crate::description::trimesh::{TriMesh, TriMeshPart, find_texture};
 use crate::error::{Result, SimError};
 use crate::geometry::Rgba;
 use crate::model::mesh::TextureImage;
 
 /// Largest mesh file accepted (a 231k-triangle COLLADA file is ~20 MB).
 const MAX_MESH_BYTES: u64 = 512 << 20;
-
-/// An indexed triangle mesh in metres (the file's unit and the URDF scale applied).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TriMesh {
-    /// Vertex positions.
-    pub positions: Vec<Vec3>,
-    /// Texture coordinates per position (u right, v down the image), when the file has them
-    /// (empty otherwise).
-    pub uvs: Vec<[f32; 2]>,
-    /// Triangles as indices into `positions`.
-    pub triangles: Vec<[u32; 3]>,
-    /// The diffuse colour of the file's first material, when it names one.
-    pub color: Option<Rgba>,
-    /// The file's meshes in order, each a run of `triangles` with its own material.
-    pub parts: Vec<TriMeshPart>,
-}
-
-/// A run of a [`TriMesh`]'s triangles that share one material.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TriMeshPart {
-    /// First triangle (index into `triangles`).
-    pub first_triangle: usize,
-    /// Number of triangles.
-    pub triangles: usize,
-    /// The material's diffuse colour, if it has one.
-    pub color: Option<Rgba>,
-    /// The material's diffuse texture (COLLADA `<image><init_from>`, OBJ `map_Kd`) found on
-    /// disk: next to the mesh, else in the model's `materials/textures` folder (where Gazebo
-    /// looks); `None` when the part has no texture coordinates or no texture.
-    pub texture: Option<PathBuf>,
-}
 
 /// A material of an OBJ file's MTL library, as far as rover draws it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -90,26 +60,6 @@ fn obj_materials(obj: &Path, bytes: &[u8]) -> Vec<ObjMaterial> {
         }
     }
     materials
-}
-
-/// Where a texture a mesh file names is: the path as written (relative to the mesh), else
-/// its file name next to the mesh, in `../materials/textures` or `../materials` (Gazebo's
-/// model layout; OBJ files often name `model://` paths or bare names that live there).
-pub(crate) fn find_texture(mesh: &Path, named: &Path) -> Option<PathBuf> {
-    let dir = mesh.parent()?;
-    let as_written = dir.join(named);
-    if as_written.is_file() {
-        return Some(as_written);
-    }
-    let file = named.file_name()?;
-    [
-        dir.to_path_buf(),
-        dir.join("../materials/textures"),
-        dir.join("../materials"),
-    ]
-    .into_iter()
-    .map(|d| d.join(file))
-    .find(|p| p.is_file())
 }
 
 /// Largest texture file accepted.
@@ -187,7 +137,22 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
                 )
             })?
             .map_err(|e| SimError::invalid(path, None, format!("cannot read mesh: {e}")))?;
+    let mtl = if ext.as_deref() == Some("obj") {
+        obj_materials(path, &bytes)
+    } else {
+        Vec::new()
+    };
+    from_scene(path, &scene, &mtl, scale)
+}
 
+/// mesh-loader's scene as a [`TriMesh`]: its meshes merged, a part per mesh with its material
+/// (`mtl`: rover's own reading of an OBJ's MTL libraries), checked and scaled.
+fn from_scene(
+    path: &Path,
+    scene: &mesh_loader::Scene,
+    mtl: &[ObjMaterial],
+    scale: Vec3,
+) -> Result<TriMesh> {
     let mut mesh = TriMesh {
         color: scene
             .materials
@@ -197,12 +162,7 @@ pub fn load_mesh(path: &Path, scale: Vec3) -> Result<TriMesh> {
         ..TriMesh::default()
     };
     // mesh-loader 0.1.13 skips indented MTL lines (3ds Max exports indent every statement):
-    // rover reads each OBJ's material library itself for what it draws.
-    let mtl = if ext.as_deref() == Some("obj") {
-        obj_materials(path, &bytes)
-    } else {
-        Vec::new()
-    };
+    // `mtl` is rover's own reading of each OBJ's material library, for what it draws.
     for (index, part) in scene.meshes.iter().enumerate() {
         let material = scene.materials.get(index);
         let own = material.and_then(|m| mtl.iter().find(|o| o.name == m.name));

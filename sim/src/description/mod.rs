@@ -16,15 +16,17 @@ pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod sdf;
 pub(crate) mod toml;
+pub(crate) mod trimesh;
 pub(crate) mod urdf;
 pub(crate) mod world_toml;
 pub(crate) mod xacro;
 pub(crate) mod xml;
 
 pub use controllers::{load_controllers, parse_controllers};
-pub use mesh_file::{TriMesh, TriMeshPart, load_mesh, load_texture};
+pub use mesh_file::{load_mesh, load_texture};
 pub use resource::{NotFound, ResourcePaths};
 pub use robot::LoadOptions;
 pub use toml::{load_toml, parse_toml};
+pub use trimesh::{TriMesh, TriMeshPart};
 pub use world_toml::WorldFile;
 pub use xacro::{Expanded, expand_file as expand_xacro, uses_xacro};

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
-use crate::description::mesh_file::{TriMesh, load_mesh, load_texture};
+use crate::description::mesh_file::{load_mesh, load_texture};
+use crate::description::trimesh::TriMesh;
 use crate::error::Result;
 use crate::geometry::{Pose, Rgba, Shape};
 use crate::model::mesh::{MeshData, TextureImage, TexturedRun};
