@@ -70,6 +70,9 @@ pub struct RunConfig {
     pub serial_detection: bool,
     /// Follower settings.
     pub follower: FollowerConfig,
+    /// Measure ground truth for every camera image and judge each detection against it
+    /// (observers get [`crate::Observer::detections_truth`]).
+    pub ground_truth: bool,
     /// Pace the run to this many sim seconds per wall second (None = as fast as the CPU
     /// allows). Pacing never changes the trace: it only waits.
     pub real_time_factor: Option<f64>,
@@ -315,6 +318,7 @@ fn run_inner(
         detector_config: config.detector.clone(),
         inject_fault: config.inject_fault,
         follower: config.follower.clone(),
+        ground_truth: config.ground_truth,
     };
     let mut fan = Fanout::default();
     fan.push(&mut files);

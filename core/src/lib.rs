@@ -41,7 +41,7 @@ pub use pilot::{Mode, Pilot};
 pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use scenario::{
     Scenario, ScenarioCheck, ScenarioCriteria, ScenarioMetrics, ScenarioOptions, ScenarioResult,
-    Sensor, collect_scenario_files, robot_name, run_scenario,
+    Sensor, collect_scenario_files, judge_scenario, robot_name, run_scenario,
 };
 pub use script::{Script, ScriptPlayer, Step};
 pub use session::{DetectorMode, Session, SessionOptions};

@@ -4,7 +4,9 @@
 //! the loop figures they are shown.
 
 use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
+use rover_sim::{
+    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
+};
 
 use crate::error::CoreError;
 use crate::follower::FollowState;
@@ -59,6 +61,9 @@ pub trait Observer {
     fn camera_frame(&mut self, _frame: &CameraFrame<'_>, _world_from_camera: Pose) {}
     /// Detections of an earlier camera image (see their `image_stamp`).
     fn detections(&mut self, _boxes: &BoundingBoxes, _labels: &[String]) {}
+    /// With ground truth on ([`crate::SessionOptions::ground_truth`]): right after
+    /// [`Observer::detections`], the ground truth of the image those detections came from.
+    fn detections_truth(&mut self, _boxes: &BoundingBoxes, _truth: &[GroundTruthBox]) {}
     /// A laser scan, taken from `world_from_laser` (the sensor's frame) at `scan.stamp_s`.
     fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
     /// A mode change, a warning.
@@ -88,6 +93,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
         self.0.detections(boxes, labels);
         self.1.detections(boxes, labels);
+    }
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        self.0.detections_truth(boxes, truth);
+        self.1.detections_truth(boxes, truth);
     }
     fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
         self.0.laser_scan(scan, world_from_laser);
@@ -155,6 +164,11 @@ impl Observer for Fanout<'_> {
     fn detections(&mut self, boxes: &BoundingBoxes, labels: &[String]) {
         for o in &mut self.observers {
             o.detections(boxes, labels);
+        }
+    }
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        for o in &mut self.observers {
+            o.detections_truth(boxes, truth);
         }
     }
     fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {

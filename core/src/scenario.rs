@@ -24,8 +24,13 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rover_perception::{DetectorConfig, InjectedFault};
-use rover_sim::{ControlSample, RobotModel, SimError, Simulation, World, WorldFile};
+use rover_perception::{
+    BoundingBoxes, CocoEvaluator, DetectionMetrics, DetectorConfig, EvalBox, GroundTruthObject,
+    InjectedFault,
+};
+use rover_sim::{
+    ControlSample, GroundTruthBox, PixelBox, RobotModel, SimError, Simulation, World, WorldFile,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
@@ -65,6 +70,11 @@ pub struct ScenarioCriteria {
     pub max_lost_s: Option<f64>,
     /// At the end the robot faces the target within this angle (deg).
     pub final_facing_deg: Option<f64>,
+    /// The detector's recall at IoU 0.5 against the renderer's ground truth, per class with
+    /// something to find: the lowest must reach this (0..1).
+    pub min_recall: Option<f64>,
+    /// The detector's precision at IoU 0.5, per class it reported: the lowest must reach this.
+    pub min_precision: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -381,6 +391,11 @@ pub struct ScenarioMetrics {
     /// seeing it again (or to the end).
     #[serde(default)]
     pub longest_lost_s: f64,
+    /// The detector judged against the renderer's ground truth of the images it took, with
+    /// COCO's rules (AP50, AP50:95, per-class precision, recall, mean IoU); `None` when it
+    /// took no image.
+    #[serde(default)]
+    pub detector: Option<DetectionMetrics>,
 }
 
 /// One criterion's verdict.
@@ -470,6 +485,11 @@ struct Probe {
     /// When the target was last lost after the first TRACKING (s).
     lost_since_s: Option<f64>,
     metrics: ScenarioMetrics,
+    /// Every detection result against the ground truth of its image.
+    evaluator: CocoEvaluator,
+    /// Reused per result.
+    truth: Vec<GroundTruthObject>,
+    found: Vec<rover_perception::Detection>,
 }
 
 /// Clearances are measured up to this distance (m).
@@ -491,16 +511,51 @@ impl Probe {
                 min_clearance_m: f64::from(CLEARANCE_CAP_M),
                 ..ScenarioMetrics::default()
             },
+            evaluator: CocoEvaluator::default(),
+            truth: Vec::new(),
+            found: Vec::new(),
         }
     }
 
-    /// What was measured so far.
-    pub fn metrics(&self) -> &ScenarioMetrics {
-        &self.metrics
+    /// What was measured so far, the detector's metrics included.
+    pub fn metrics(&self) -> ScenarioMetrics {
+        let mut m = self.metrics.clone();
+        if self.evaluator.images() > 0 {
+            m.detector = Some(self.evaluator.summary());
+        }
+        m
     }
 }
 
 impl Observer for Probe {
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        self.truth.clear();
+        self.truth.extend(truth.iter().map(|t| GroundTruthObject {
+            class: t.class.clone(),
+            // Ground truth is what is visible; a thing with nothing visible is an ignore
+            // region (its full box, so a detection there is neither right nor wrong).
+            bbox: eval_box(t.visible.unwrap_or(t.full)),
+            ignore: t.ignore,
+        }));
+        self.found.clear();
+        self.found.extend(
+            boxes
+                .bounding_boxes
+                .iter()
+                .map(|b| rover_perception::Detection {
+                    class: b.class.clone(),
+                    bbox: EvalBox {
+                        xmin: b.xmin as f64,
+                        ymin: b.ymin as f64,
+                        xmax: b.xmax as f64,
+                        ymax: b.ymax as f64,
+                    },
+                    score: b.probability,
+                }),
+        );
+        self.evaluator.add_image(&self.truth, &self.found);
+    }
+
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         let t = sample.sim_time_s;
         // The first update counts for one control period of the tutorial car (100 Hz).
@@ -572,6 +627,12 @@ impl Observer for Probe {
         self.last_state = state;
         self.last_state_following = following;
     }
+}
+
+/// Judges a run's metrics against `scenario`'s criteria (what [`run_scenario`] does at the
+/// end; also for re-judging saved metrics against other bounds).
+pub fn judge_scenario(scenario: &Scenario, metrics: &ScenarioMetrics) -> Vec<ScenarioCheck> {
+    judge(&scenario.criteria, metrics, scenario.follow_at_s)
 }
 
 /// Judges measured metrics against criteria.
@@ -668,6 +729,7 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
             m.longest_lost_s <= limit,
         );
     }
+    detector_checks(criteria, m, &mut check);
     if let Some(limit) = criteria.final_facing_deg {
         check(
             "final_facing_deg",
@@ -677,6 +739,55 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
         );
     }
     checks
+}
+
+/// A ground-truth box as the evaluator takes it.
+fn eval_box(b: PixelBox) -> EvalBox {
+    EvalBox {
+        xmin: b.xmin,
+        ymin: b.ymin,
+        xmax: b.xmax,
+        ymax: b.ymax,
+    }
+}
+
+/// `min_recall` and `min_precision`: the worst class must reach the bound.
+fn detector_checks(
+    criteria: &ScenarioCriteria,
+    m: &ScenarioMetrics,
+    check: &mut impl FnMut(&str, String, String, bool),
+) {
+    let classes = m
+        .detector
+        .as_ref()
+        .map(|d| d.classes.as_slice())
+        .unwrap_or(&[]);
+    let worst = |value: fn(&rover_perception::ClassMetrics) -> Option<f64>| {
+        classes
+            .iter()
+            .filter_map(|c| value(c).map(|v| (v, c.class.as_str())))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    for (name, limit, found) in [
+        ("min_recall", criteria.min_recall, worst(|c| c.recall)),
+        (
+            "min_precision",
+            criteria.min_precision,
+            worst(|c| c.precision),
+        ),
+    ] {
+        let Some(limit) = limit else {
+            continue;
+        };
+        check(
+            name,
+            format!(">= {limit:.2}"),
+            found.map_or("nothing judged".to_owned(), |(v, class)| {
+                format!("{v:.3} ({class})")
+            }),
+            found.is_some_and(|(v, _)| v >= limit),
+        );
+    }
 }
 
 /// How [`run_scenario`] runs a scenario besides what the file says.
@@ -706,6 +817,7 @@ pub fn run_scenario(
             seed: scenario.seed,
             ..rover_sim::SimOptions::default()
         },
+        ground_truth: true,
         ..RunConfig::default()
     };
     let script = Script {
@@ -732,7 +844,7 @@ pub fn run_scenario(
         )?;
     }
     let wall_s = started.elapsed().as_secs_f64();
-    let metrics = probe.metrics().clone();
+    let metrics = probe.metrics();
     let checks = judge(&scenario.criteria, &metrics, scenario.follow_at_s);
     Ok(ScenarioResult {
         name: scenario.name.clone(),

@@ -13,8 +13,8 @@ use rover_perception::{
     FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
 };
 use rover_sim::{
-    CameraFrame, CameraInfo, CameraSensor, ControlSample, LaserSensor, LinkId, RobotModel,
-    SimOptions, Simulation, World,
+    CameraFrame, CameraInfo, CameraSensor, ControlSample, GroundTruthBox, LaserSensor, LinkId,
+    RobotModel, SimOptions, Simulation, World,
 };
 
 use crate::error::{CoreError, Result};
@@ -66,7 +66,15 @@ pub struct SessionOptions {
     pub inject_fault: Option<InjectedFault>,
     /// Follower settings.
     pub follower: FollowerConfig,
+    /// Measure the ground truth of every camera image (rover_sim's id image and silhouettes)
+    /// and hand each detection result's observers the ground truth of its image
+    /// ([`Observer::detections_truth`]).
+    pub ground_truth: bool,
 }
+
+/// How many recent images' ground truth is kept for detections still to come (a pipelined
+/// result arrives one image later; the worker may lag a few).
+const TRUTH_FRAMES: usize = 8;
 
 impl Default for SessionOptions {
     fn default() -> Self {
@@ -78,6 +86,7 @@ impl Default for SessionOptions {
             detector_config: DetectorConfig::default(),
             inject_fault: None,
             follower: FollowerConfig::default(),
+            ground_truth: false,
         }
     }
 }
@@ -125,6 +134,9 @@ pub struct Session {
     last_boxes: Option<BoundingBoxes>,
     detections_done: u64,
     detector_started: Option<Instant>,
+    /// With ground truth on: the last [`TRUTH_FRAMES`] images' ground truth, slot `seq %
+    /// TRUTH_FRAMES` holding (seq, boxes).
+    truth_frames: Vec<(u64, Vec<GroundTruthBox>)>,
 }
 
 impl std::fmt::Debug for Session {
@@ -149,7 +161,14 @@ impl Session {
     ) -> Result<Self> {
         let sim = Simulation::new(world, robot, &options.sim)?;
         let wants_camera = options.camera || options.detector != DetectorMode::Off;
-        let camera = start_camera(&sim, wants_camera, observer)?;
+        let mut camera = start_camera(&sim, wants_camera, observer)?;
+        if options.ground_truth
+            && let Some(camera) = camera.as_mut()
+        {
+            camera
+                .enable_ground_truth(&sim)
+                .map_err(CoreError::Camera)?;
+        }
         let camera_link = sim
             .robot()
             .cameras
@@ -191,6 +210,11 @@ impl Session {
             last_boxes: None,
             detections_done: 0,
             detector_started: None,
+            truth_frames: if options.ground_truth {
+                vec![(u64::MAX, Vec::new()); TRUTH_FRAMES]
+            } else {
+                Vec::new()
+            },
         })
     }
 
@@ -429,6 +453,11 @@ impl Session {
         };
         self.stats.frames += 1;
         observer.camera_frame(&frame, world_from_camera);
+        if let Some(slot) = self.truth_frames.get_mut(frame.seq as usize % TRUTH_FRAMES) {
+            slot.0 = frame.seq;
+            slot.1.clear();
+            slot.1.extend_from_slice(frame.ground_truth);
+        }
         let stamp = FrameStamp {
             sim_time_s: frame.sim_time_s,
             frame: frame.seq,
@@ -522,6 +551,14 @@ impl Session {
         }
         self.follower.observe(&boxes);
         observer.detections(&boxes, &self.labels);
+        let seq = boxes.image_stamp.frame;
+        if let Some((_, truth)) = self
+            .truth_frames
+            .get(seq as usize % TRUTH_FRAMES)
+            .filter(|(s, _)| *s == seq)
+        {
+            observer.detections_truth(&boxes, truth);
+        }
         self.last_boxes = Some(boxes);
     }
 }

@@ -30,7 +30,7 @@
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// COCO's IoU thresholds, `np.linspace(0.5, 0.95, 10)` (0.9 is `0.8999999999999999` there).
 pub const COCO_IOU_THRESHOLDS: [f64; 10] = [
@@ -571,7 +571,7 @@ fn average_precision(tally: &ClassTally, order: &[usize], t: usize) -> f64 {
 
 /// One class's results in [`DetectionMetrics`]. The AP fields and `recall` are `None` for a
 /// class without non-ignored ground truth (COCO's `-1`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClassMetrics {
     /// Class name.
     pub class: String,
@@ -606,7 +606,7 @@ pub struct ClassMetrics {
 
 /// What [`CocoEvaluator::summary`] returns. The means are over the classes with non-ignored
 /// ground truth, as COCO's `stats` are (`None` when there is none).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DetectionMetrics {
     /// Mean AP at IoU 0.5 (COCO's `stats[1]`).
     pub ap50: Option<f64>,

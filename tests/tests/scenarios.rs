@@ -155,3 +155,60 @@ fn turtlebot3_autorace_reaches_a_person_8m_ahead_its_lds_taking_over() -> Result
     assert!(result.passed, "{:#?}", result.checks);
     Ok(())
 }
+
+/// `rover eval` judges the detector too: every result against the renderer's ground truth of
+/// its image, with COCO's rules (real renderer, real default detector). With the person behind
+/// the car it turns, finds them and drives up: the person is seen whole and recall and
+/// precision are high; `min_recall` / `min_precision` criteria pass or fail on them.
+#[test]
+fn eval_judges_the_detector_against_ground_truth() -> Result<()> {
+    let mut scenario = Scenario::load(&repo("scenarios/static_behind.toml"))?;
+    scenario.criteria.min_recall = Some(0.9);
+    scenario.criteria.min_precision = Some(0.9);
+    let result = run_scenario(&scenario, &ScenarioOptions::default(), &mut NoObserver)?;
+    let detector = result
+        .metrics
+        .detector
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("no detector metrics"))?;
+    let person = detector
+        .class("person")
+        .ok_or_else(|| anyhow::anyhow!("no person class: {detector:?}"))?;
+    println!("person: {person:?}");
+    for c in &result.checks {
+        println!("{}: {} (want {}) {}", c.name, c.value, c.limit, c.passed);
+    }
+    // The detector takes an image every 0.2 s of the 30 s run; ground truth lists the person
+    // in each image where any of them is in view.
+    assert!(person.ground_truth > 50, "{person:?}");
+    assert!(person.recall.is_some_and(|r| r >= 0.9), "{person:?}");
+    assert!(person.mean_iou.is_some_and(|iou| iou > 0.9), "{person:?}");
+    assert!(person.ap50.is_some_and(|ap| ap > 0.85), "{person:?}");
+    let check = |name: &str| {
+        result
+            .checks
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.passed)
+    };
+    assert_eq!(
+        (check("min_recall"), check("min_precision")),
+        (Some(true), Some(true))
+    );
+    // A bound the detector does not reach fails, naming the class.
+    scenario.criteria.min_recall = Some(0.999);
+    let strict = rover_core::ScenarioMetrics {
+        detector: Some(detector.clone()),
+        ..result.metrics.clone()
+    };
+    let checks = rover_core::judge_scenario(&scenario, &strict);
+    let failed = checks
+        .iter()
+        .find(|c| c.name == "min_recall")
+        .ok_or_else(|| anyhow::anyhow!("no min_recall check"))?;
+    assert!(
+        !failed.passed && failed.value.contains("person"),
+        "{failed:?}"
+    );
+    Ok(())
+}

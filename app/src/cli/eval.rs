@@ -511,7 +511,7 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         .unwrap_or(5);
     writeln!(
         out,
-        "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6}  failed",
+        "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>5} {:>5} {:>5} {:>6}  failed",
         "scenario",
         "robot",
         "result",
@@ -521,6 +521,9 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         "clear m",
         "avoid s",
         "lost s",
+        "AP50",
+        "P",
+        "R",
         "wall s"
     )?;
     for r in &report.results {
@@ -536,10 +539,13 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
         if r.skipped.is_some() {
             writeln!(
                 out,
-                "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>6}  {}",
+                "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7} {:>7} {:>6} {:>5} {:>5} {:>5} {:>6}  {}",
                 r.name,
                 r.robot,
                 "skip",
+                "",
+                "",
+                "",
                 "",
                 "",
                 "",
@@ -551,9 +557,10 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
             )?;
             continue;
         }
+        let (ap50, precision, recall) = detector_summary(m);
         writeln!(
             out,
-            "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7.3} {:>7.1} {:>6.1} {:>6.1}  {}",
+            "{:<24} {:<robot_width$} {:<6} {:>6} {:>7} {:>7} {:>7.3} {:>7.1} {:>6.1} {:>5} {:>5} {:>5} {:>6.1}  {}",
             r.name,
             r.robot,
             verdict(r),
@@ -563,15 +570,72 @@ pub fn write_table(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<
             m.min_clearance_m,
             m.avoiding_s,
             m.longest_lost_s,
+            opt(ap50, 2),
+            opt(precision, 2),
+            opt(recall, 2),
             r.wall_s,
             failed.join("; ")
         )?;
     }
+    write_detector_classes(out, report, robot_width)?;
     let mut robots: Vec<&str> = report.results.iter().map(|r| r.robot.as_str()).collect();
     robots.sort_unstable();
     robots.dedup();
     if robots.len() > 1 {
         write_matrix(out, report, &robots)?;
+    }
+    Ok(())
+}
+
+/// The detector against ground truth in one run: AP50 over its classes, and the lowest
+/// class precision and recall at IoU 0.5.
+fn detector_summary(m: &rover_core::ScenarioMetrics) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let Some(d) = &m.detector else {
+        return (None, None, None);
+    };
+    let lowest = |v: fn(&rover_perception::ClassMetrics) -> Option<f64>| {
+        d.classes.iter().filter_map(v).min_by(f64::total_cmp)
+    };
+    (d.ap50, lowest(|c| c.precision), lowest(|c| c.recall))
+}
+
+/// The detector per run and class (COCO's rules against the renderer's ground truth).
+fn write_detector_classes(
+    out: &mut dyn Write,
+    report: &EvalReport,
+    robot_width: usize,
+) -> std::io::Result<()> {
+    let rows: Vec<_> = report
+        .results
+        .iter()
+        .filter_map(|r| r.metrics.detector.as_ref().map(|d| (r, d)))
+        .flat_map(|(r, d)| d.classes.iter().map(move |c| (r, c)))
+        .collect();
+    if rows.is_empty() {
+        return Ok(());
+    }
+    writeln!(out)?;
+    writeln!(
+        out,
+        "the detector against the renderer's ground truth (IoU 0.5; AP with COCO's rules):\n  {:<24} {:<robot_width$} {:<14} {:>5} {:>8} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}",
+        "scenario", "robot", "class", "AP50", "AP50:95", "P", "R", "IoU", "gt", "TP", "FP"
+    )?;
+    for (r, c) in rows {
+        writeln!(
+            out,
+            "  {:<24} {:<robot_width$} {:<14} {:>5} {:>8} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}",
+            r.name,
+            r.robot,
+            c.class,
+            opt(c.ap50, 2),
+            opt(c.ap50_95, 3),
+            opt(c.precision, 2),
+            opt(c.recall, 2),
+            opt(c.mean_iou, 2),
+            c.ground_truth,
+            c.true_positives,
+            c.false_positives
+        )?;
     }
     Ok(())
 }
@@ -613,7 +677,7 @@ fn write_matrix(out: &mut dyn Write, report: &EvalReport, robots: &[&str]) -> st
 fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
     writeln!(
         out,
-        "scenario,robot,result,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,longest_lost_s,wall_s,failed"
+        "scenario,robot,result,acquired_at_s,final_range_m,max_range_after_acquire_m,min_clearance_m,min_person_range_m,drove_while_searching_s,travel_m,final_facing_deg,transitions,final_state,avoiding_s,longest_lost_s,ap50,ap50_95,min_precision,min_recall,wall_s,failed"
     )?;
     for r in &report.results {
         let m = &r.metrics;
@@ -626,7 +690,7 @@ fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
             .collect();
         writeln!(
             out,
-            "{},{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{:.2},{}",
+            "{},{},{},{},{},{},{:.4},{},{:.2},{:.3},{},{},{},{:.2},{:.2},{},{},{},{},{:.2},{}",
             r.name,
             r.robot,
             verdict(r),
@@ -642,6 +706,10 @@ fn write_csv(out: &mut dyn Write, report: &EvalReport) -> std::io::Result<()> {
             m.final_state,
             m.avoiding_s,
             m.longest_lost_s,
+            opt(detector_summary(m).0, 4),
+            opt(m.detector.as_ref().and_then(|d| d.ap50_95), 4),
+            opt(detector_summary(m).1, 4),
+            opt(detector_summary(m).2, 4),
             r.wall_s,
             failed.join(" ")
         )?;

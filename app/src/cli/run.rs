@@ -202,6 +202,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         detector_config: args.detector.config(super::args::spare_detect_threads())?,
         inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
+        ground_truth: false,
     };
     let mut ros = args
         .ros
