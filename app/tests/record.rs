@@ -173,3 +173,34 @@ fn a_recorded_arm_moves_its_links_and_plots_its_joints() -> Result<()> {
     assert_eq!(timed("/world/robot/hand_link")?, 200);
     Ok(())
 }
+
+/// `--ground-truth`: every detection result is shown beside the ground truth of its own image
+/// (the labelled person's visible box, "MISSED" when nothing found it), the false positives
+/// apart, and the running per-class precision, recall and IoU plotted.
+#[test]
+fn a_recorded_run_with_ground_truth_shows_truth_beside_detections() -> Result<()> {
+    let (entities, _dir) = record(
+        &["--duration", "2", "--ground-truth"],
+        "{ at = 0.0, toggle = \"follow\" }",
+    )?;
+    let names: Vec<_> = entities.keys().cloned().collect();
+    let get = |path: &str| {
+        entities
+            .get(path)
+            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
+    };
+    let detections = get("/world/robot/camera/image/detections")?.timed_rows;
+    assert!(detections >= 9, "{detections} detection results");
+    let truth = get("/world/robot/camera/image/ground_truth")?;
+    assert_eq!(truth.timed_rows, detections, "one ground truth per result");
+    assert!(truth.components.iter().any(|c| c.starts_with("Boxes2D:")));
+    assert_eq!(
+        get("/world/robot/camera/image/false_positives")?.timed_rows,
+        detections
+    );
+    for what in ["precision", "recall", "iou"] {
+        let plot = get(&format!("/plots/detector/person/{what}"))?;
+        assert_eq!(plot.timed_rows, detections, "{what}");
+    }
+    Ok(())
+}

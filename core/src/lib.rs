@@ -15,6 +15,7 @@ mod error;
 mod follower;
 mod headless;
 mod input;
+mod judge;
 mod observer;
 mod paths;
 mod pilot;
@@ -35,6 +36,7 @@ pub use headless::{
     run_headless_observed,
 };
 pub use input::{Action, InputSource, JointAction, NoInput};
+pub use judge::{ClassTally, LiveJudge, MATCH_IOU, eval_objects};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
 pub use pilot::{Mode, Pilot};

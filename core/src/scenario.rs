@@ -25,11 +25,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rover_perception::{
-    BoundingBoxes, CocoEvaluator, DetectionMetrics, DetectorConfig, EvalBox, GroundTruthObject,
+    BoundingBoxes, CocoEvaluator, DetectionMetrics, DetectorConfig, GroundTruthObject,
     InjectedFault,
 };
 use rover_sim::{
-    ControlSample, GroundTruthBox, PixelBox, RobotModel, SimError, Simulation, World, WorldFile,
+    ControlSample, GroundTruthBox, RobotModel, SimError, Simulation, World, WorldFile,
 };
 use serde::{Deserialize, Serialize};
 
@@ -529,30 +529,7 @@ impl Probe {
 
 impl Observer for Probe {
     fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
-        self.truth.clear();
-        self.truth.extend(truth.iter().map(|t| GroundTruthObject {
-            class: t.class.clone(),
-            // Ground truth is what is visible; a thing with nothing visible is an ignore
-            // region (its full box, so a detection there is neither right nor wrong).
-            bbox: eval_box(t.visible.unwrap_or(t.full)),
-            ignore: t.ignore,
-        }));
-        self.found.clear();
-        self.found.extend(
-            boxes
-                .bounding_boxes
-                .iter()
-                .map(|b| rover_perception::Detection {
-                    class: b.class.clone(),
-                    bbox: EvalBox {
-                        xmin: b.xmin as f64,
-                        ymin: b.ymin as f64,
-                        xmax: b.xmax as f64,
-                        ymax: b.ymax as f64,
-                    },
-                    score: b.probability,
-                }),
-        );
+        crate::judge::eval_objects(boxes, truth, &mut self.truth, &mut self.found);
         self.evaluator.add_image(&self.truth, &self.found);
     }
 
@@ -739,16 +716,6 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
         );
     }
     checks
-}
-
-/// A ground-truth box as the evaluator takes it.
-fn eval_box(b: PixelBox) -> EvalBox {
-    EvalBox {
-        xmin: b.xmin,
-        ymin: b.ymin,
-        xmax: b.xmax,
-        ymax: b.ymax,
-    }
 }
 
 /// `min_recall` and `min_precision`: the worst class must reach the bound.

@@ -334,6 +334,14 @@ pub(crate) struct FollowArgs {
     #[arg(long)]
     pub(crate) serial_detect: bool,
 
+    /// Ground truth: measure every camera image's labelled things from the renderer (people,
+    /// `class = "..."` objects, known Gazebo models) and judge each detection against its own
+    /// image at IoU 0.5: Rerun shows the ground-truth boxes beside the detections, misses and
+    /// false positives marked, and per-class precision, recall and IoU over time
+    /// (docs/GROUND_TRUTH.md)
+    #[arg(long)]
+    pub(crate) ground_truth: bool,
+
     /// Follower: class to follow (a darknet_ros `Class`, e.g. person, dog)
     #[arg(long, default_value = "person", value_name = "CLASS")]
     pub(crate) target_class: String,

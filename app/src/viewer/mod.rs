@@ -17,6 +17,11 @@
 //! world/robot/camera                     Transform3D base_from_camera_optical, static
 //! world/robot/camera/image               Pinhole (Gazebo's K), Image, AnnotationContext
 //! world/robot/camera/image/detections    Boxes2D "person 0.87" with class ids
+//! world/robot/camera/image/ground_truth  Boxes2D (with --ground-truth): each labelled thing's
+//!                                        visible box, "person (truth)" or "MISSED person";
+//!                                        ignore regions under .../ground_truth/ignore
+//! world/robot/camera/image/false_positives  Boxes2D: detections that found nothing
+//! plots/detector/<class>/{precision,recall,iou}  Scalars: running, IoU 0.5 (--ground-truth)
 //! world/odometry                         Points3D (odometry position) + trail LineStrips3D
 //! world/odometry/follower/{target,goal}  Points3D: the follower's target estimate, the point it
 //!                                        drives to (the pursued point once the target is lost)
@@ -36,9 +41,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use rerun::{RecordingStream, RecordingStreamBuilder};
-use rover_core::{EventLevel, LoopStats, Mode, Observer};
+use rover_core::{EventLevel, LiveJudge, LoopStats, Mode, Observer};
 use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, Simulation};
+use rover_sim::{
+    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
+};
 
 pub use blueprint::blueprint;
 pub use images::ImageOptions;
@@ -71,6 +78,10 @@ pub struct Recorder {
     /// Where the web viewer is, when serving it.
     pub web_url: Option<String>,
     _web: Option<Box<dyn std::any::Any>>,
+    /// The detector's class names (ground truth boxes take their class ids from them).
+    labels: Vec<String>,
+    /// Detections against ground truth, running (with `--ground-truth`).
+    judge: LiveJudge,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -121,6 +132,8 @@ impl Recorder {
             watch: sinks.watch,
             viewer_gone: false,
             started: Instant::now(),
+            labels: Vec::new(),
+            judge: LiveJudge::default(),
             web_url: sinks.web_url,
             _web: sinks.web_server,
         }))
@@ -184,6 +197,7 @@ impl Recorder {
 
 impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation, camera: Option<&CameraInfo>, labels: &[String]) {
+        self.labels = labels.to_vec();
         self.paths = scene::log_scene(&self.rec, sim, camera, labels, self.images.options());
         self.laser = sim.robot().lasers.first().and_then(|l| {
             let link = sim.robot().link_id(&l.link)?;
@@ -326,6 +340,93 @@ impl Observer for Recorder {
         self.set_time(stamp.sim_time_s);
     }
 
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        let stamp = boxes.image_stamp;
+        self.rec.set_duration_secs("sim_time", stamp.sim_time_s);
+        self.rec.set_time_sequence("frame", stamp.frame as i64);
+        let k = self.images.options().scale();
+        let matched = self.judge.judge(boxes, truth).clone();
+        let class_id = |class: &str| {
+            self.labels
+                .iter()
+                .position(|l| l == class)
+                .and_then(|i| u16::try_from(i).ok())
+                .unwrap_or(u16::MAX)
+        };
+        let scaled = |b: rover_sim::PixelBox| {
+            (
+                [b.xmin as f32 / k, b.ymin as f32 / k],
+                [b.width() as f32 / k, b.height() as f32 / k],
+            )
+        };
+        let (shown, ignored): (Vec<(usize, &GroundTruthBox)>, Vec<_>) = truth
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.visible.is_some())
+            .partition(|(_, t)| !t.ignore);
+        let gt = rerun::Boxes2D::from_mins_and_sizes(
+            shown
+                .iter()
+                .filter_map(|(_, t)| t.visible.map(|b| scaled(b).0)),
+            shown
+                .iter()
+                .filter_map(|(_, t)| t.visible.map(|b| scaled(b).1)),
+        )
+        .with_labels(shown.iter().map(|(i, t)| {
+            if matched.misses.contains(i) {
+                format!("MISSED {}", t.class)
+            } else {
+                format!("{} (truth)", t.class)
+            }
+        }))
+        .with_class_ids(shown.iter().map(|(_, t)| class_id(&t.class)))
+        .with_radii([0.5f32]);
+        self.log("world/robot/camera/image/ground_truth", &gt);
+        let ignore = rerun::Boxes2D::from_mins_and_sizes(
+            ignored
+                .iter()
+                .filter_map(|(_, t)| t.visible.map(|b| scaled(b).0)),
+            ignored
+                .iter()
+                .filter_map(|(_, t)| t.visible.map(|b| scaled(b).1)),
+        )
+        .with_labels(ignored.iter().map(|(_, t)| format!("ignore: {}", t.class)))
+        .with_colors([rerun::Color::from_rgb(128, 128, 128)]);
+        self.log("world/robot/camera/image/ground_truth/ignore", &ignore);
+        let b = &boxes.bounding_boxes;
+        let fp: Vec<_> = matched
+            .false_positives
+            .iter()
+            .filter_map(|&i| b.get(i))
+            .collect();
+        let false_positives = rerun::Boxes2D::from_mins_and_sizes(
+            fp.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
+            fp.iter()
+                .map(|b| [b.width() as f32 / k, b.height() as f32 / k]),
+        )
+        .with_labels(
+            fp.iter()
+                .map(|b| format!("FALSE {} {:.2}", b.class, b.probability)),
+        )
+        .with_colors([rerun::Color::from_rgb(255, 0, 255)]);
+        self.log("world/robot/camera/image/false_positives", &false_positives);
+        for (class, tally) in self.judge.tallies() {
+            for (what, value) in [
+                ("precision", tally.precision()),
+                ("recall", tally.recall()),
+                ("iou", tally.mean_iou()),
+            ] {
+                if let Some(v) = value {
+                    self.log(
+                        &format!("plots/detector/{class}/{what}"),
+                        &rerun::Scalars::single(v),
+                    );
+                }
+            }
+        }
+        self.set_time(stamp.sim_time_s);
+    }
+
     fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
         let Some(link_from_sensor) = self.laser.as_ref().map(|l| l.1) else {
             return;
@@ -345,7 +446,8 @@ impl Observer for Recorder {
     }
 
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
-        self.rec.set_duration_secs("sim_time", sim_time_s);
+        // Both timelines, also for an event before the first control update.
+        self.set_time(sim_time_s);
         let level = match level {
             EventLevel::Info => rerun::TextLogLevel::INFO,
             EventLevel::Warn => rerun::TextLogLevel::WARN,
