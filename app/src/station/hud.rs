@@ -33,6 +33,9 @@ pub(super) struct HudState<'a> {
     pub real_time_factor: f64,
     /// The arm keys' line (robots with actuated joints).
     pub arm: Option<String>,
+    /// With `--ground-truth`: how the newest detection result matched its image's ground
+    /// truth ([`truth_text`]).
+    pub truth: Option<&'a str>,
 }
 
 /// Composes camera image, boxes and HUD into `canvas`.
@@ -100,7 +103,12 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
         cmd.linear_mps, cmd.angular_radps, teleop.speed_mps, teleop.turn_radps
     );
     canvas.text(8, y0 + 22, &line2, [230, 230, 230]);
-    let line3 = if stats.detector_ok {
+    let line3 = if let (true, Some(truth)) = (stats.detector_ok, hud.truth) {
+        format!(
+            "yolo {:.1} Hz {:.0} ms  {truth}  {:.2}x",
+            stats.detector_hz, stats.detector_latency_ms, hud.real_time_factor
+        )
+    } else if stats.detector_ok {
         format!(
             "yolo {:.1} Hz {:.0} ms  dropped {}  sim {:.2}x real time",
             stats.detector_hz,
@@ -149,6 +157,29 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
     }
 }
 
+/// One detection result against its image's ground truth, for the HUD's detector line:
+/// "truth 2: found 1 (IoU 0.97) missed 1 false 0" (written into `out`, cleared first).
+pub(super) fn truth_text(
+    out: &mut String,
+    matched: &rover_perception::FrameMatch,
+    truth: &[rover_sim::GroundTruthBox],
+) {
+    use std::fmt::Write as _;
+    out.clear();
+    let to_find = truth.iter().filter(|t| !t.ignore).count();
+    let _ = write!(out, "truth {to_find}: found {}", matched.matches.len());
+    if !matched.matches.is_empty() {
+        let iou = matched.matches.iter().map(|m| m.iou).sum::<f64>() / matched.matches.len() as f64;
+        let _ = write!(out, " (IoU {iou:.2})");
+    }
+    let _ = write!(
+        out,
+        " missed {} false {}",
+        matched.misses.len(),
+        matched.false_positives.len()
+    );
+}
+
 /// Splits `text` after at most `chars` characters, at a space when there is one.
 fn split_line(text: &str, chars: usize) -> (&str, &str) {
     let Some((cut, _)) = text.char_indices().nth(chars) else {
@@ -185,6 +216,48 @@ impl std::fmt::Display for GoalText {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_truth_line_counts_what_was_found_missed_and_false() {
+        let thing = |ignore: bool| rover_sim::GroundTruthBox {
+            id: 1,
+            entity: rover_sim::Labelled::Person(0),
+            class: "person".into(),
+            name: "alice".into(),
+            full: rover_sim::PixelBox {
+                xmin: 0.0,
+                ymin: 0.0,
+                xmax: 10.0,
+                ymax: 10.0,
+            },
+            visible: None,
+            visible_px: 0,
+            unoccluded_px: 0,
+            visibility: 0.0,
+            truncated: false,
+            ignore,
+        };
+        let matched = rover_perception::FrameMatch {
+            matches: vec![rover_perception::MatchedPair {
+                detection: 0,
+                ground_truth: 0,
+                iou: 0.974,
+            }],
+            misses: vec![1],
+            false_positives: vec![1, 2],
+            ignored: vec![],
+        };
+        let mut line = String::from("stale");
+        truth_text(
+            &mut line,
+            &matched,
+            &[thing(false), thing(false), thing(true)],
+        );
+        assert_eq!(line, "truth 2: found 1 (IoU 0.97) missed 1 false 2");
+        let none = rover_perception::FrameMatch::default();
+        truth_text(&mut line, &none, &[]);
+        assert_eq!(line, "truth 0: found 0 missed 0 false 0");
+    }
 
     #[test]
     fn warnings_wrap_at_a_space() {

@@ -91,6 +91,9 @@ struct Feed {
     image_size: (usize, usize),
     warning: Option<String>,
     mode: Mode,
+    /// With `--ground-truth`: the newest result against its image's ground truth.
+    judge: rover_core::LiveJudge,
+    truth: Option<String>,
 }
 
 impl Observer for Feed {
@@ -107,6 +110,14 @@ impl Observer for Feed {
         if level == EventLevel::Warn {
             self.warning = Some(text.to_owned());
         }
+    }
+    fn detections_truth(
+        &mut self,
+        boxes: &rover_perception::BoundingBoxes,
+        truth: &[rover_sim::GroundTruthBox],
+    ) {
+        let matched = self.judge.judge(boxes, truth);
+        hud::truth_text(self.truth.get_or_insert_with(String::new), matched, truth);
     }
 }
 
@@ -282,6 +293,7 @@ impl App<'_, '_> {
                 paused: self.paused,
                 real_time_factor: self.rtf,
                 arm: self.arm.status(self.session.sim()),
+                truth: self.feed.truth.as_deref(),
             },
         );
     }
