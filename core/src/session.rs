@@ -455,8 +455,7 @@ impl Session {
         observer.camera_frame(&frame, world_from_camera);
         if let Some(slot) = self.truth_frames.get_mut(frame.seq as usize % TRUTH_FRAMES) {
             slot.0 = frame.seq;
-            slot.1.clear();
-            slot.1.extend_from_slice(frame.ground_truth);
+            rover_sim::copy_boxes(&mut slot.1, frame.ground_truth);
         }
         let stamp = FrameStamp {
             sim_time_s: frame.sim_time_s,

@@ -55,5 +55,5 @@ pub use render::{
 };
 pub use sensors::{
     CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, LaserScan, LaserSensor, MIN_VISIBILITY,
-    MIN_VISIBLE_PX, PixelBox,
+    MIN_VISIBLE_PX, PixelBox, copy_boxes,
 };

@@ -78,8 +78,9 @@ impl PixelBox {
     }
 }
 
-/// One labelled thing in one image.
-#[derive(Debug, Clone, PartialEq)]
+/// One labelled thing in one image. Cloning into an existing box reuses its strings
+/// (`clone_from`), so per-frame copies ([`copy_boxes`]) do not allocate.
+#[derive(Debug, PartialEq)]
 pub struct GroundTruthBox {
     /// Its number in the id image ([`EntityIds`], from 1).
     pub id: u32,
@@ -104,6 +105,50 @@ pub struct GroundTruthBox {
     /// Too small or too occluded to ask a detector for (see [`MIN_VISIBLE_PX`],
     /// [`MIN_VISIBILITY`]): neither a miss nor a false positive.
     pub ignore: bool,
+}
+
+impl Clone for GroundTruthBox {
+    fn clone(&self) -> Self {
+        Self {
+            class: self.class.clone(),
+            name: self.name.clone(),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        let (mut class, mut name) = (
+            std::mem::take(&mut self.class),
+            std::mem::take(&mut self.name),
+        );
+        class.clone_from(&source.class);
+        name.clone_from(&source.name);
+        *self = Self {
+            class,
+            name,
+            ..*source
+        };
+    }
+}
+
+/// Copies `from` into `out`, reusing the boxes (and their strings) already there.
+pub fn copy_boxes(out: &mut Vec<GroundTruthBox>, from: &[GroundTruthBox]) {
+    copy_boxes_from(out, from.iter());
+}
+
+fn copy_boxes_from<'a>(
+    out: &mut Vec<GroundTruthBox>,
+    from: impl Iterator<Item = &'a GroundTruthBox>,
+) {
+    let mut n = 0;
+    for b in from {
+        match out.get_mut(n) {
+            Some(slot) => slot.clone_from(b),
+            None => out.push(b.clone()),
+        }
+        n += 1;
+    }
+    out.truncate(n);
 }
 
 /// Where a part of a labelled thing is each frame.
@@ -141,6 +186,8 @@ pub struct GroundTruth {
     /// Reused per frame: per entity (index `id - 1`), visible pixels of the output image and
     /// of the ideal image, and the visible box's pixel bounds.
     visible: Vec<Visible>,
+    /// Every entity's box this frame, in id order (strings made once).
+    all: Vec<GroundTruthBox>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -226,10 +273,33 @@ impl GroundTruth {
                 parts,
             });
         }
+        let empty = PixelBox {
+            xmin: 0.0,
+            ymin: 0.0,
+            xmax: 0.0,
+            ymax: 0.0,
+        };
+        let all = entities
+            .iter()
+            .map(|e| GroundTruthBox {
+                id: e.id,
+                entity: e.label,
+                class: e.class.clone(),
+                name: e.name.clone(),
+                full: empty,
+                visible: None,
+                visible_px: 0,
+                unoccluded_px: 0,
+                visibility: 0.0,
+                truncated: false,
+                ignore: true,
+            })
+            .collect();
         Ok(Self {
             visible: vec![Visible::default(); entities.len()],
             entities,
             model_poses: Vec::new(),
+            all,
         })
     }
 
@@ -245,12 +315,9 @@ impl GroundTruth {
         out: &mut Vec<GroundTruthBox>,
     ) {
         self.count_visible(image);
-        self.full_boxes(sim, info, world_from_camera, out);
-        out.retain_mut(|b| {
+        self.full_boxes(sim, info, world_from_camera);
+        for (b, seen) in self.all.iter_mut().zip(&self.visible) {
             let i = (b.id - 1) as usize;
-            let Some(seen) = self.visible.get(i) else {
-                return false;
-            };
             b.visible_px = seen.px;
             b.unoccluded_px = image.silhouette_px.get(i).copied().unwrap_or(0);
             b.visibility = if b.unoccluded_px > 0 {
@@ -268,8 +335,13 @@ impl GroundTruth {
                 }
             });
             b.ignore = b.visible_px < MIN_VISIBLE_PX || b.visibility < MIN_VISIBILITY;
-            b.full.xmax > b.full.xmin || b.visible_px > 0
-        });
+        }
+        copy_boxes_from(
+            out,
+            self.all
+                .iter()
+                .filter(|b| b.full.xmax > b.full.xmin || b.visible_px > 0),
+        );
     }
 
     /// Per entity: visible pixels (output and ideal image) and the visible pixels' bounds.
@@ -308,16 +380,9 @@ impl GroundTruth {
         }
     }
 
-    /// The full box of every labelled thing, in id order, into `out` (cleared first); an
-    /// entity wholly outside the image gets an empty box.
-    fn full_boxes(
-        &mut self,
-        sim: &Simulation,
-        info: &CameraInfo,
-        world_from_camera: Pose,
-        out: &mut Vec<GroundTruthBox>,
-    ) {
-        out.clear();
+    /// The full box and truncation of every labelled thing (`self.all`); an entity wholly
+    /// outside the image gets an empty box.
+    fn full_boxes(&mut self, sim: &Simulation, info: &CameraInfo, world_from_camera: Pose) {
         sim.model_link_poses_into(&mut self.model_poses);
         let optical_from_world =
             (world_from_camera * Pose::from_rotation(link_from_optical())).inverse();
@@ -326,7 +391,7 @@ impl GroundTruth {
         let lens = Distortion { k1, k2, k3, p1, p2 };
         let distorted = !lens.is_zero();
         let (w, h) = (f64::from(info.width), f64::from(info.height));
-        for e in &self.entities {
+        for (e, out) in self.entities.iter().zip(self.all.iter_mut()) {
             let mut bounds = [
                 f64::INFINITY,
                 f64::INFINITY,
@@ -386,19 +451,49 @@ impl GroundTruth {
                     ymax: 0.0,
                 }
             };
-            out.push(GroundTruthBox {
-                id: e.id,
-                entity: e.label,
-                class: e.class.clone(),
-                name: e.name.clone(),
-                full,
-                visible: None,
-                visible_px: 0,
-                unoccluded_px: 0,
-                visibility: 0.0,
-                truncated: behind || clipped != bounds,
-                ignore: true,
-            });
+            out.full = full;
+            out.truncated = behind || clipped != bounds;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn thing(class: &str, px: u32) -> GroundTruthBox {
+        let b = PixelBox {
+            xmin: 1.0,
+            ymin: 2.0,
+            xmax: 3.0,
+            ymax: 4.0,
+        };
+        GroundTruthBox {
+            id: 1,
+            entity: Labelled::Person(0),
+            class: class.into(),
+            name: "alice".into(),
+            full: b,
+            visible: Some(b),
+            visible_px: px,
+            unoccluded_px: px,
+            visibility: 1.0,
+            truncated: false,
+            ignore: false,
+        }
+    }
+
+    #[test]
+    fn copying_boxes_reuses_the_boxes_and_strings_already_there() {
+        let mut out = Vec::new();
+        copy_boxes(&mut out, &[thing("person", 10), thing("dog", 20)]);
+        let person_text = out[0].class.as_ptr();
+        copy_boxes(&mut out, &[thing("person", 30)]);
+        assert_eq!(out, vec![thing("person", 30)]);
+        assert_eq!(
+            out[0].class.as_ptr(),
+            person_text,
+            "the string was reallocated"
+        );
     }
 }

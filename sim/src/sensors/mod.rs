@@ -7,5 +7,7 @@ pub(crate) mod ground_truth;
 pub(crate) mod laser;
 
 pub use camera::{CameraFrame, CameraSensor};
-pub use ground_truth::{GroundTruth, GroundTruthBox, MIN_VISIBILITY, MIN_VISIBLE_PX, PixelBox};
+pub use ground_truth::{
+    GroundTruth, GroundTruthBox, MIN_VISIBILITY, MIN_VISIBLE_PX, PixelBox, copy_boxes,
+};
 pub use laser::{LaserScan, LaserSensor};
