@@ -9,39 +9,56 @@ use std::collections::BTreeMap;
 use rover_perception::{BoundingBoxes, Detection, EvalBox, FrameMatch, GroundTruthObject};
 use rover_sim::GroundTruthBox;
 
-/// Fills `truth` and `found` (cleared first) with one frame's ground truth and detections as
-/// the evaluator takes them.
+/// Fills `truth` and `found` with one frame's ground truth and detections as the evaluator
+/// takes them, reusing the objects (and their class strings) already there.
 pub fn eval_objects(
     boxes: &BoundingBoxes,
     ground_truth: &[GroundTruthBox],
     truth: &mut Vec<GroundTruthObject>,
     found: &mut Vec<Detection>,
 ) {
-    truth.clear();
-    truth.extend(ground_truth.iter().map(|t| {
+    truth.truncate(ground_truth.len());
+    for (i, t) in ground_truth.iter().enumerate() {
         let b = t.visible.unwrap_or(t.full);
-        GroundTruthObject {
-            class: t.class.clone(),
-            bbox: EvalBox {
-                xmin: b.xmin,
-                ymin: b.ymin,
-                xmax: b.xmax,
-                ymax: b.ymax,
-            },
-            ignore: t.ignore || t.visible.is_none(),
+        let bbox = EvalBox {
+            xmin: b.xmin,
+            ymin: b.ymin,
+            xmax: b.xmax,
+            ymax: b.ymax,
+        };
+        let ignore = t.ignore || t.visible.is_none();
+        match truth.get_mut(i) {
+            Some(o) => {
+                o.class.clone_from(&t.class);
+                (o.bbox, o.ignore) = (bbox, ignore);
+            }
+            None => truth.push(GroundTruthObject {
+                class: t.class.clone(),
+                bbox,
+                ignore,
+            }),
         }
-    }));
-    found.clear();
-    found.extend(boxes.bounding_boxes.iter().map(|b| Detection {
-        class: b.class.clone(),
-        bbox: EvalBox {
+    }
+    found.truncate(boxes.bounding_boxes.len());
+    for (i, b) in boxes.bounding_boxes.iter().enumerate() {
+        let bbox = EvalBox {
             xmin: b.xmin as f64,
             ymin: b.ymin as f64,
             xmax: b.xmax as f64,
             ymax: b.ymax as f64,
-        },
-        score: b.probability,
-    }));
+        };
+        match found.get_mut(i) {
+            Some(d) => {
+                d.class.clone_from(&b.class);
+                (d.bbox, d.score) = (bbox, b.probability);
+            }
+            None => found.push(Detection {
+                class: b.class.clone(),
+                bbox,
+                score: b.probability,
+            }),
+        }
+    }
 }
 
 /// One class's running tally.
@@ -85,11 +102,21 @@ pub struct LiveJudge {
     tallies: BTreeMap<String, ClassTally>,
 }
 
-fn tally<'a>(
-    tallies: &'a mut BTreeMap<String, ClassTally>,
+/// Updates `class`'s tally (a new class's name is the only allocation).
+fn tally(
+    tallies: &mut BTreeMap<String, ClassTally>,
     class: Option<&str>,
-) -> &'a mut ClassTally {
-    tallies.entry(class.unwrap_or("?").to_owned()).or_default()
+    update: impl FnOnce(&mut ClassTally),
+) {
+    let class = class.unwrap_or("?");
+    match tallies.get_mut(class) {
+        Some(t) => update(t),
+        None => {
+            let mut t = ClassTally::default();
+            update(&mut t);
+            tallies.insert(class.to_owned(), t);
+        }
+    }
 }
 
 /// The IoU at which a detection counts as finding a thing.
@@ -102,19 +129,19 @@ impl LiveJudge {
         eval_objects(boxes, ground_truth, &mut self.truth, &mut self.found);
         self.last = rover_perception::match_frame(&self.truth, &self.found, MATCH_IOU);
         let tallies = &mut self.tallies;
+        let class_of_detection = |d: usize| self.found.get(d).map(|d| d.class.as_str());
         for m in &self.last.matches {
-            let t = tally(
-                tallies,
-                self.found.get(m.detection).map(|d| d.class.as_str()),
-            );
-            t.true_positives += 1;
-            t.iou_sum += m.iou;
+            tally(tallies, class_of_detection(m.detection), |t| {
+                t.true_positives += 1;
+                t.iou_sum += m.iou;
+            });
         }
         for &d in &self.last.false_positives {
-            tally(tallies, self.found.get(d).map(|d| d.class.as_str())).false_positives += 1;
+            tally(tallies, class_of_detection(d), |t| t.false_positives += 1);
         }
         for &g in &self.last.misses {
-            tally(tallies, self.truth.get(g).map(|t| t.class.as_str())).misses += 1;
+            let class = self.truth.get(g).map(|t| t.class.as_str());
+            tally(tallies, class, |t| t.misses += 1);
         }
         &self.last
     }

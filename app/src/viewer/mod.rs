@@ -58,6 +58,19 @@ use images::ImageLogger;
 use scene::{ScenePaths, transform};
 use sinks::ViewerWatch;
 
+/// Detections as Rerun boxes on an image shown at 1/`scale` of its size.
+fn detection_boxes<'a>(
+    boxes: impl Iterator<Item = &'a rover_perception::BoundingBox> + Clone,
+    scale: f32,
+) -> rerun::Boxes2D {
+    rerun::Boxes2D::from_mins_and_sizes(
+        boxes
+            .clone()
+            .map(|b| [b.xmin as f32 / scale, b.ymin as f32 / scale]),
+        boxes.map(|b| [b.width() as f32 / scale, b.height() as f32 / scale]),
+    )
+}
+
 /// The Rerun recorder.
 pub struct Recorder {
     rec: RecordingStream,
@@ -326,16 +339,12 @@ impl Observer for Recorder {
         self.rec.set_time_sequence("frame", stamp.frame as i64);
         let k = self.images.options().scale();
         let b = &boxes.bounding_boxes;
-        let data = rerun::Boxes2D::from_mins_and_sizes(
-            b.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
-            b.iter()
-                .map(|b| [b.width() as f32 / k, b.height() as f32 / k]),
-        )
-        .with_labels(
-            b.iter()
-                .map(|b| format!("{} {:.2}", b.class, b.probability)),
-        )
-        .with_class_ids(b.iter().map(|b| u16::try_from(b.id).unwrap_or(u16::MAX)));
+        let data = detection_boxes(b.iter(), k)
+            .with_labels(
+                b.iter()
+                    .map(|b| format!("{} {:.2}", b.class, b.probability)),
+            )
+            .with_class_ids(b.iter().map(|b| u16::try_from(b.id).unwrap_or(u16::MAX)));
         self.log("world/robot/camera/image/detections", &data);
         self.set_time(stamp.sim_time_s);
     }
@@ -399,16 +408,12 @@ impl Observer for Recorder {
             .iter()
             .filter_map(|&i| b.get(i))
             .collect();
-        let false_positives = rerun::Boxes2D::from_mins_and_sizes(
-            fp.iter().map(|b| [b.xmin as f32 / k, b.ymin as f32 / k]),
-            fp.iter()
-                .map(|b| [b.width() as f32 / k, b.height() as f32 / k]),
-        )
-        .with_labels(
-            fp.iter()
-                .map(|b| format!("FALSE {} {:.2}", b.class, b.probability)),
-        )
-        .with_colors([rerun::Color::from_rgb(255, 0, 255)]);
+        let false_positives = detection_boxes(fp.iter().copied(), k)
+            .with_labels(
+                fp.iter()
+                    .map(|b| format!("FALSE {} {:.2}", b.class, b.probability)),
+            )
+            .with_colors([rerun::Color::from_rgb(255, 0, 255)]);
         self.log("world/robot/camera/image/false_positives", &false_positives);
         for (class, tally) in self.judge.tallies() {
             for (what, value) in [

@@ -83,18 +83,8 @@ pub(crate) fn load_collada(path: &Path, text: &str, scale: Vec3) -> Result<TriMe
     for p in &placed {
         add_geometry(&mut mesh, p, &ids, path, dir).map_err(|(n, m)| err(n, m))?;
     }
-    if !mesh.uvs.is_empty() {
-        mesh.uvs.resize(mesh.positions.len(), [0.0, 0.0]);
-    }
     mesh.color = mesh.parts.iter().find_map(|p| p.color);
-    if mesh.triangles.is_empty() {
-        return Err(SimError::invalid(
-            path,
-            None,
-            "mesh has no triangles: expected at least one",
-        ));
-    }
-    Ok(mesh)
+    mesh.finish(path)
 }
 
 type NodeError<'a> = (Node<'a, 'a>, String);

@@ -219,17 +219,7 @@ fn from_scene(
                 .extend(part.texcoords[0].iter().map(|t| [t[0], 1.0 - t[1]]));
         }
     }
-    if !mesh.uvs.is_empty() {
-        mesh.uvs.resize(mesh.positions.len(), [0.0, 0.0]);
-    }
-    if mesh.triangles.is_empty() {
-        return Err(SimError::invalid(
-            path,
-            None,
-            "mesh has no triangles: expected at least one",
-        ));
-    }
-    Ok(mesh)
+    mesh.finish(path)
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use crate::error::{Result, SimError};
 use crate::geometry::Rgba;
 
 /// An indexed triangle mesh in metres (the file's unit and the URDF scale applied).
@@ -22,6 +23,24 @@ pub struct TriMesh {
     pub color: Option<Rgba>,
     /// The file's meshes in order, each a run of `triangles` with its own material.
     pub parts: Vec<TriMeshPart>,
+}
+
+impl TriMesh {
+    /// The last step of every reader: texture coordinates padded to one per position (when
+    /// some part had them), and a mesh without triangles refused.
+    pub(crate) fn finish(mut self, path: &Path) -> Result<Self> {
+        if !self.uvs.is_empty() {
+            self.uvs.resize(self.positions.len(), [0.0, 0.0]);
+        }
+        if self.triangles.is_empty() {
+            return Err(SimError::invalid(
+                path,
+                None,
+                "mesh has no triangles: expected at least one",
+            ));
+        }
+        Ok(self)
+    }
 }
 
 /// A run of a [`TriMesh`]'s triangles that share one material.

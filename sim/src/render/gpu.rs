@@ -137,28 +137,24 @@ impl Readback {
         device: &wgpu::Device,
         mut row: impl FnMut(usize, &[u8]),
     ) -> Result<(), RenderError> {
-        let slice = self.buffer.slice(..);
-        map_and_wait(device, &slice, &self.mapped)?;
-        {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(e.to_string()))?;
-            let w = self.width as usize;
+        let (w, padded) = (self.width as usize, self.padded_row as usize);
+        read_mapped(device, &self.buffer, &self.mapped, |data| {
             for y in 0..self.height as usize {
-                row(y, &data[y * self.padded_row as usize..][..w * 4]);
+                row(y, &data[y * padded..][..w * 4]);
             }
-        }
-        self.buffer.unmap();
-        Ok(())
+        })
     }
 }
 
-/// Maps `slice` for reading and waits for it; `mapped` is the buffer's reusable flag.
-fn map_and_wait(
+/// Maps `buffer` for reading, waits for the submitted work, hands its bytes to `read` and
+/// unmaps it; `mapped` is the buffer's reusable flag.
+fn read_mapped(
     device: &wgpu::Device,
-    slice: &wgpu::BufferSlice<'_>,
+    buffer: &wgpu::Buffer,
     mapped: &Arc<AtomicU8>,
+    read: impl FnOnce(&[u8]),
 ) -> Result<(), RenderError> {
+    let slice = buffer.slice(..);
     mapped.store(MAP_PENDING, Ordering::Release);
     let flag = Arc::clone(mapped);
     slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -171,14 +167,26 @@ fn map_and_wait(
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| RenderError::Readback(e.to_string()))?;
     match mapped.load(Ordering::Acquire) {
-        MAP_OK => Ok(()),
-        MAP_FAILED => Err(RenderError::Readback(
-            "the readback buffer could not be mapped".into(),
-        )),
-        _ => Err(RenderError::Readback(
-            "the GPU finished without mapping the readback buffer".into(),
-        )),
+        MAP_OK => {}
+        MAP_FAILED => {
+            return Err(RenderError::Readback(
+                "the readback buffer could not be mapped".into(),
+            ));
+        }
+        _ => {
+            return Err(RenderError::Readback(
+                "the GPU finished without mapping the readback buffer".into(),
+            ));
+        }
     }
+    {
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        read(&data);
+    }
+    buffer.unmap();
+    Ok(())
 }
 
 /// A mappable copy of a GPU buffer, allocated once.
@@ -214,15 +222,6 @@ impl BufferReadback {
         device: &wgpu::Device,
         read: impl FnOnce(&[u8]),
     ) -> Result<(), RenderError> {
-        let slice = self.buffer.slice(..);
-        map_and_wait(device, &slice, &self.mapped)?;
-        {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(e.to_string()))?;
-            read(&data);
-        }
-        self.buffer.unmap();
-        Ok(())
+        read_mapped(device, &self.buffer, &self.mapped, read)
     }
 }
