@@ -676,3 +676,50 @@ fn joint_commands_that_make_no_sense() -> anyhow::Result<()> {
     assert!(wheel.contains("has no actuator"), "{wheel}");
     Ok(())
 }
+
+/// A texture that will not decode is a warning and a flat colour, never a failed load: an OBJ
+/// whose MTL names a "PNG" that is not one still gives its triangles, with no textured run.
+#[test]
+fn a_texture_that_will_not_decode_leaves_the_mesh_in_its_colour() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    std::fs::write(
+        dir.path().join("quad.obj"),
+        "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl skin\nf 1/1 2/2 3/3 4/4\n",
+    )?;
+    std::fs::write(
+        dir.path().join("quad.mtl"),
+        "newmtl skin\n\tKd 0.2 0.4 0.6\n\tmap_Kd broken.png\n",
+    )?;
+    std::fs::write(dir.path().join("broken.png"), b"not a png at all")?;
+    let path = dir.path().join("quad.obj");
+    let tri = rover_sim::load_mesh(&path, glam::Vec3::ONE)?;
+    assert_eq!(tri.parts.len(), 1);
+    assert!(
+        tri.parts[0]
+            .texture
+            .as_ref()
+            .is_some_and(|t| t.ends_with("broken.png")),
+        "the indented map_Kd is read: {:?}",
+        tri.parts[0]
+    );
+    assert_eq!(
+        tri.parts[0].color,
+        Some(rover_sim::Rgba::rgb(0.2, 0.4, 0.6))
+    );
+    let err = rover_sim::load_texture(&dir.path().join("broken.png"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("broken.png") && err.contains("cannot decode texture"),
+        "{err}"
+    );
+    let mesh = rover_sim::shape_mesh(&rover_sim::Shape::Mesh {
+        path,
+        scale: glam::Vec3::ONE,
+    })?;
+    assert_eq!(mesh.indices.len(), 6);
+    assert!(mesh.textured.is_empty(), "drawn in its flat colour");
+    assert_eq!(mesh.color, Some(rover_sim::Rgba::rgb(0.2, 0.4, 0.6)));
+    Ok(())
+}

@@ -83,7 +83,6 @@ pub(crate) fn load_collada(path: &Path, text: &str, scale: Vec3) -> Result<TriMe
     for p in &placed {
         add_geometry(&mut mesh, p, &ids, path, dir).map_err(|(n, m)| err(n, m))?;
     }
-    mesh.color = mesh.parts.iter().find_map(|p| p.color);
     mesh.finish(path)
 }
 

@@ -153,14 +153,7 @@ fn from_scene(
     mtl: &[ObjMaterial],
     scale: Vec3,
 ) -> Result<TriMesh> {
-    let mut mesh = TriMesh {
-        color: scene
-            .materials
-            .iter()
-            .find_map(|m| m.color.diffuse)
-            .map(|c| Rgba(c.map(|v| v.clamp(0.0, 1.0)))),
-        ..TriMesh::default()
-    };
+    let mut mesh = TriMesh::default();
     // mesh-loader 0.1.13 skips indented MTL lines (3ds Max exports indent every statement):
     // `mtl` is rover's own reading of each OBJ's material library, for what it draws.
     for (index, part) in scene.meshes.iter().enumerate() {

@@ -19,16 +19,18 @@ pub struct TriMesh {
     pub uvs: Vec<[f32; 2]>,
     /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
-    /// The diffuse colour of the file's first material, when it names one.
+    /// The diffuse colour of the first part that has one.
     pub color: Option<Rgba>,
     /// The file's meshes in order, each a run of `triangles` with its own material.
     pub parts: Vec<TriMeshPart>,
 }
 
 impl TriMesh {
-    /// The last step of every reader: texture coordinates padded to one per position (when
-    /// some part had them), and a mesh without triangles refused.
+    /// The last step of every reader: the mesh's colour from its first part that has one,
+    /// texture coordinates padded to one per position (when some part had them), and a mesh
+    /// without triangles refused.
     pub(crate) fn finish(mut self, path: &Path) -> Result<Self> {
+        self.color = self.parts.iter().find_map(|p| p.color);
         if !self.uvs.is_empty() {
             self.uvs.resize(self.positions.len(), [0.0, 0.0]);
         }
