@@ -11,6 +11,7 @@
 //! Nothing here depends on winit, wgpu surfaces, rerun or gilrs: everything runs headless in
 //! tests. The modules are private; this page lists the API.
 
+mod dataset;
 mod error;
 mod follower;
 mod headless;
@@ -26,6 +27,11 @@ mod session;
 mod teleop;
 mod trace;
 
+pub use dataset::{
+    COCO_CATEGORY_IDS, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox, ImageFormat,
+    ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, Randomization, Shot, Split,
+    coco_category, coco_json, coco_results, data_yaml, write_dataset, yolo_class,
+};
 pub use error::{CoreError, Result};
 pub use follower::{
     AvoidConfig, Avoided, CameraGeometry, FollowState, FollowTarget, Follower, FollowerConfig,

@@ -618,6 +618,20 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value_t = 200)]
         scans: usize,
     },
+    /// Dataset: labelled 640x480 images per second (layout, render + ground truth, encode and
+    /// write), written into a temporary folder
+    Dataset {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Images to make (after one warm-up)
+        #[arg(long, default_value_t = 100)]
+        images: u64,
+
+        /// Image files: png or jpg
+        #[arg(long, default_value = "png", value_name = "png|jpg")]
+        image_format: DatasetImageFormat,
+    },
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]
@@ -635,6 +649,124 @@ pub(crate) enum BenchKind {
         #[arg(long)]
         profile: bool,
     },
+}
+
+/// `rover dataset`'s options.
+#[derive(Debug, Args)]
+pub(crate) struct DatasetArgs {
+    #[command(flatten)]
+    pub(crate) world: WorldArgs,
+
+    /// The dataset's folder (new, empty, or one this command made before: it resumes)
+    #[arg(long, value_name = "DIR")]
+    pub(crate) out: PathBuf,
+
+    /// How many images
+    #[arg(long, default_value_t = 100, value_name = "N")]
+    pub(crate) images: u64,
+
+    /// Fraction of images in the validation split
+    #[arg(long, default_value_t = 0.1, value_name = "FRACTION")]
+    pub(crate) val: f64,
+
+    /// Output formats: yolo (Ultralytics layout, data.yaml), coco (COCO JSON), or both
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "yolo,coco",
+        value_name = "FORMAT,..."
+    )]
+    pub(crate) format: Vec<DatasetFormat>,
+
+    /// Image files: png (lossless) or jpg (quality 95)
+    #[arg(long, default_value = "png", value_name = "png|jpg")]
+    pub(crate) image_format: DatasetImageFormat,
+
+    /// What to randomize: robot, things (people's and labelled things' poses), clothes,
+    /// light, noise; `none` for none
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "robot,things,clothes,light,noise",
+        value_name = "WHAT,..."
+    )]
+    pub(crate) randomize: Vec<Randomize>,
+
+    /// Distances from the robot to the thing it faces (m)
+    #[arg(long, default_value = "1.5,8", value_name = "MIN,MAX", value_parser = parse_range)]
+    pub(crate) distance: [f64; 2],
+
+    /// Fraction of background images (the robot anywhere, facing anywhere)
+    #[arg(long, default_value_t = 0.05, value_name = "FRACTION")]
+    pub(crate) background: f64,
+
+    /// How far people and labelled things move from where the world puts them (m, in x and y)
+    #[arg(long, default_value_t = 0.5, value_name = "M")]
+    pub(crate) move_m: f64,
+
+    /// How far labelled objects and models turn (deg, either way); people face any way
+    #[arg(long, default_value_t = 180.0, value_name = "DEG")]
+    pub(crate) turn_deg: f64,
+
+    /// Largest camera noise standard deviation (0..1 of full scale)
+    #[arg(long, default_value_t = 0.02, value_name = "STDDEV")]
+    pub(crate) noise_max: f64,
+
+    /// Also run the detector on every image: its boxes in the records, COCO results in
+    /// OUT/detections/, and its COCO metrics (AP50, AP50:95, per class) in OUT/metrics.json
+    #[arg(long)]
+    pub(crate) detect: bool,
+
+    #[command(flatten)]
+    pub(crate) detector: DetectorArgs,
+}
+
+/// A dataset output format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DatasetFormat {
+    /// Ultralytics YOLO: images/, labels/, data.yaml
+    Yolo,
+    /// COCO JSON: annotations/instances_{train,val}.json
+    Coco,
+}
+
+/// A dataset image format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DatasetImageFormat {
+    /// Lossless PNG
+    Png,
+    /// JPEG, quality 95
+    Jpg,
+}
+
+/// Something `rover dataset` can randomize.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum Randomize {
+    /// Where the robot (its camera) stands and looks
+    Robot,
+    /// Where people and labelled things stand and face
+    Things,
+    /// People's shirt and trousers colours
+    Clothes,
+    /// The sun's direction and strength, the sky's light
+    Light,
+    /// The camera's noise
+    Noise,
+    /// Nothing
+    None,
+}
+
+fn parse_range(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let [lo, hi] = parts.as_slice() else {
+        return Err(format!("expected MIN,MAX, found '{text}'"));
+    };
+    let number = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("expected a number, found '{t}'"))
+    };
+    Ok([number(lo)?, number(hi)?])
 }
 
 /// `rover eval`'s options.
@@ -735,6 +867,20 @@ pub(crate) enum Command {
     /// OUT/eval.csv, and exits 1 when a scenario fails. --robot (repeatable) runs the suite on
     /// other robots; --shard and --merge split a suite over machines.
     Eval(EvalArgs),
+
+    /// Write a labelled dataset from a world: images with YOLO labels and/or COCO JSON
+    ///
+    /// Every image is a scene laid out anew from --seed and the image's number: the robot
+    /// faces a labelled thing (a person, an object with class = "...", a Gazebo model of a
+    /// known class) from 1.5-8 m, people and labelled things move and turn, people change
+    /// clothes, the sun moves, the camera's noise varies (--randomize chooses). The labels are
+    /// the renderer's own ground truth: visible (tight) boxes, ignore regions for things too
+    /// small or hidden (COCO iscrowd; left out of YOLO labels). Layout: OUT/data.yaml,
+    /// OUT/images/{train,val}, OUT/labels/{train,val} (Ultralytics), OUT/annotations/
+    /// instances_{train,val}.json (COCO), OUT/ground_truth/ (rover's record per image: full and
+    /// visible boxes, visibility, layout). The same command on the same folder resumes a
+    /// stopped run; a folder made with other settings is refused. docs/GROUND_TRUTH.md.
+    Dataset(DatasetArgs),
 
     /// Benchmarks: physics-only real-time factor (default), or `bench detect`
     Bench {

@@ -1,9 +1,11 @@
 //! The `rover` command line: clap arguments ([`args`]), runs in the window or headless
-//! ([`run`]), `rover bench` ([`bench`]) and `rover detect` ([`detect`]). `anyhow` errors, `tracing`
+//! ([`run`]), `rover bench` ([`bench`]), `rover detect` ([`detect`]), `rover eval` ([`eval`]) and
+//! `rover dataset` (`dataset`). `anyhow` errors, `tracing`
 //! logs; the binary's `main` only calls [`main`].
 
 mod args;
 pub mod bench;
+mod dataset;
 pub mod detect;
 pub mod eval;
 mod run;
@@ -96,6 +98,16 @@ pub fn main() -> ExitCode {
                 })
             }),
         Some(Command::Eval(args)) => eval::run(args),
+        Some(Command::Dataset(args)) => dataset::run(args),
+        Some(Command::Bench {
+            kind:
+                Some(BenchKind::Dataset {
+                    world,
+                    images,
+                    image_format,
+                }),
+            ..
+        }) => dataset::bench(world, images, image_format),
         None => run::run(cli.run),
     };
     match result {

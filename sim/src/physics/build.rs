@@ -30,7 +30,6 @@ pub(crate) fn person_body_pose(person: &Person, t_s: f64) -> Pose {
     pose_from_position_yaw([x, y, person.height_m / 2.0], heading)
 }
 
-/// Adds the ground, objects, walls and people; returns the people's bodies.
 /// Adds the SDF models' links, one rigid body each; returns the bodies in model/link order.
 pub(crate) fn add_models(
     physics: &mut PhysicsWorld,
@@ -73,10 +72,17 @@ pub(crate) fn add_models(
     Ok(bodies)
 }
 
-pub(crate) fn add_world(
-    physics: &mut PhysicsWorld,
-    world: &World,
-) -> Result<(RigidBodyHandle, Vec<RigidBodyHandle>)> {
+/// The bodies [`add_world`] made.
+pub(crate) struct WorldBodies {
+    pub(crate) ground: RigidBodyHandle,
+    /// One per world object, in world order.
+    pub(crate) objects: Vec<RigidBodyHandle>,
+    /// One per person, in world order.
+    pub(crate) people: Vec<RigidBodyHandle>,
+}
+
+/// Adds the ground, objects, walls and people.
+pub(crate) fn add_world(physics: &mut PhysicsWorld, world: &World) -> Result<WorldBodies> {
     let ground =
         physics.insert_body(RigidBodyBuilder::fixed().translation(Vec3::new(0.0, 0.0, -0.5)));
     let [sx, sy] = world.ground.size_m;
@@ -87,6 +93,7 @@ pub(crate) fn add_world(
             .collision_groups(world_groups()),
         Some(ground),
     );
+    let mut objects = Vec::with_capacity(world.objects.len());
     for object in &world.objects {
         let pose = object.world_from_object();
         let builder = match object.mass_kg {
@@ -108,6 +115,7 @@ pub(crate) fn add_world(
                 .collision_groups(world_groups()),
             Some(body),
         );
+        objects.push(body);
     }
     let mut people = Vec::with_capacity(world.people.len());
     for person in &world.people {
@@ -123,7 +131,11 @@ pub(crate) fn add_world(
         );
         people.push(body);
     }
-    Ok((ground, people))
+    Ok(WorldBodies {
+        ground,
+        objects,
+        people,
+    })
 }
 
 pub(crate) struct RobotBodies {

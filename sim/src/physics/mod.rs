@@ -8,6 +8,7 @@ pub(crate) mod build;
 pub(crate) mod controllers;
 pub(crate) mod diff_drive;
 pub(crate) mod joints;
+pub(crate) mod placement;
 pub(crate) mod simulation;
 
 pub use actuators::{

@@ -12,8 +12,8 @@ use crate::model::robot::{JointId, LinkId, RobotModel};
 use crate::model::world::{JointSolver, World, check_step_hz};
 use crate::physics::actuators::{Actuators, JointCommand, JointState};
 use crate::physics::build::{
-    STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, add_models, add_robot, add_world,
-    joint_mass_ratio, person_body_pose,
+    STIFF_MASS_RATIO, STIFF_SOLVER_ITERATIONS, WORLD_GROUP, WorldBodies, add_models, add_robot,
+    add_world, joint_mass_ratio, person_body_pose,
 };
 use crate::physics::controllers::{
     ControllerCommandState, Controllers, JointTrajectory, TrajectoryState,
@@ -22,6 +22,7 @@ use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
+use crate::physics::placement::PlacementCache;
 
 /// Options that are not part of the world or robot files.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -62,24 +63,30 @@ struct WheelJoint {
 
 /// A running simulation.
 pub struct Simulation {
-    physics: PhysicsWorld,
-    robot: RobotModel,
-    world: World,
-    link_body: Vec<RigidBodyHandle>,
-    body_from_link: Vec<Pose>,
+    pub(crate) physics: PhysicsWorld,
+    pub(crate) robot: RobotModel,
+    pub(crate) world: World,
+    pub(crate) link_body: Vec<RigidBodyHandle>,
+    pub(crate) body_from_link: Vec<Pose>,
     base: RigidBodyHandle,
     /// Driven wheel joints: the left and right ones first (their speeds are the measured
     /// wheel speeds), then a skid steer's rear wheels. Empty when the robot cannot be driven.
     wheels: Vec<WheelJoint>,
-    drive: DiffDriveController,
-    encoder: EncoderOdometry,
+    pub(crate) drive: DiffDriveController,
+    pub(crate) encoder: EncoderOdometry,
     step_index: u64,
     dt_s: f64,
     seed: u64,
     /// Kinematic bodies of the people, in world order.
-    people: Vec<RigidBodyHandle>,
+    pub(crate) people: Vec<RigidBodyHandle>,
+    /// Bodies of the world objects, in world order.
+    pub(crate) objects: Vec<RigidBodyHandle>,
+    /// Counts placements ([`Simulation::layout_version`]).
+    pub(crate) layout: u64,
+    /// Relative poses of placed things, kept until the next step.
+    pub(crate) placement: PlacementCache,
     /// Bodies of the SDF models' links, in model then link order.
-    model_links: Vec<RigidBodyHandle>,
+    pub(crate) model_links: Vec<RigidBodyHandle>,
     /// The ground's body (not an obstacle for clearance figures).
     ground: RigidBodyHandle,
     /// Every moving joint as built (joint order; `None` for fixed ones).
@@ -146,7 +153,11 @@ impl Simulation {
         physics.integration_parameters.dt = dt_s as f32;
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
 
-        let (ground, people) = add_world(&mut physics, &world)?;
+        let WorldBodies {
+            ground,
+            objects,
+            people,
+        } = add_world(&mut physics, &world)?;
         let model_links = add_models(&mut physics, &world)?;
         let solver = options.joints.unwrap_or(world.physics.joints);
         let robot_bodies = add_robot(&mut physics, &world, &robot, solver)?;
@@ -227,6 +238,9 @@ impl Simulation {
             dt_s,
             seed: options.seed,
             people,
+            objects,
+            layout: 0,
+            placement: PlacementCache::default(),
             model_links,
             ground,
             joints: robot_bodies.joints,
@@ -279,6 +293,7 @@ impl Simulation {
         }
         self.actuators.apply_efforts(&mut self.physics, self.dt_s);
         self.physics.step();
+        self.placement.clear();
         self.step_index += 1;
         let measured = self.wheel_speeds_radps();
         self.encoder.integrate(measured, self.dt_s);
@@ -595,7 +610,7 @@ impl Simulation {
 /// saturates at `wheelTorque`, like Gazebo's joint velocity constraint with `fmax`.
 const WHEEL_MOTOR_GAIN: f32 = 50.0;
 
-fn planar(pose: Pose) -> Odometry {
+pub(crate) fn planar(pose: Pose) -> Odometry {
     Odometry {
         x_m: f64::from(pose.translation.x),
         y_m: f64::from(pose.translation.y),

@@ -209,6 +209,36 @@ pub struct PersonPart {
     pub pose: Pose,
     /// Its colour.
     pub color: Rgba,
+    /// Where the colour comes from (re-dressing a person repaints the clothes).
+    pub paint: Paint,
+}
+
+/// Where a figure part's colour comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Paint {
+    /// The person's shirt colour.
+    Shirt,
+    /// The person's trousers colour.
+    Trousers,
+    /// The person's skin colour.
+    Skin,
+    /// The person's hair colour.
+    Hair,
+    /// A colour of its own (shoes, lips).
+    Fixed(Rgba),
+}
+
+impl Paint {
+    /// The colour this paint has on `person`.
+    pub fn of(self, person: &Person) -> Rgba {
+        match self {
+            Self::Shirt => person.shirt_color,
+            Self::Trousers => person.trousers_color,
+            Self::Skin => person.skin_color,
+            Self::Hair => person.hair_color,
+            Self::Fixed(color) => color,
+        }
+    }
 }
 
 /// One cross-section of a [`loft`]: at height `z`, a rounded rectangle with half sizes
@@ -338,21 +368,24 @@ fn limb(from: Vec3, to: Vec3, r_from: f32, r_to: f32) -> (MeshData, Pose) {
 pub fn person_parts(person: &Person) -> Vec<PersonPart> {
     let mut f = Figure {
         s: (person.height_m / 1.75) as f32,
+        person,
         parts: Vec::new(),
     };
-    limbs(&mut f, person);
-    trunk(&mut f, person);
-    face(&mut f, person);
+    limbs(&mut f);
+    trunk(&mut f);
+    face(&mut f);
     f.parts
 }
 
-/// A figure being built: its scale against a 1.75 m person, and its parts so far.
-struct Figure {
+/// A figure being built: its scale against a 1.75 m person, whose colours it wears, and its
+/// parts so far.
+struct Figure<'p> {
     s: f32,
+    person: &'p Person,
     parts: Vec<PersonPart>,
 }
 
-impl Figure {
+impl Figure<'_> {
     fn v(&self, x: f32, y: f32, z: f32) -> Vec3 {
         Vec3::new(x, y, z) * self.s
     }
@@ -375,20 +408,26 @@ impl Figure {
             .collect()
     }
 
-    fn add(&mut self, mesh: MeshData, pose: Pose, color: Rgba) {
-        self.parts.push(PersonPart { mesh, pose, color });
+    fn add(&mut self, mesh: MeshData, pose: Pose, paint: Paint) {
+        let color = paint.of(self.person);
+        self.parts.push(PersonPart {
+            mesh,
+            pose,
+            color,
+            paint,
+        });
     }
 }
 
 /// Shoes, legs and arms.
-fn limbs(f: &mut Figure, person: &Person) {
+fn limbs(f: &mut Figure) {
     let shoe = Rgba::rgb(0.1, 0.08, 0.07);
     for side in [-1.0f32, 1.0] {
         let y = 0.09 * side;
         f.add(
             ellipsoid(0.1 * f.s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
             f.at(0.035, y, 0.045),
-            shoe,
+            Paint::Fixed(shoe),
         );
         // Leg: ankle, calf, knee, thigh, hip.
         let leg = f.scaled(&[
@@ -400,25 +439,25 @@ fn limbs(f: &mut Figure, person: &Person) {
             Section::new(0.86, 0.08, 0.08).at(0.0, y * 0.9),
             Section::new(0.9, 0.07, 0.07).at(0.0, y * 0.85),
         ]);
-        f.add(loft(&leg, 2.0, 16), Pose::IDENTITY, person.trousers_color);
+        f.add(loft(&leg, 2.0, 16), Pose::IDENTITY, Paint::Trousers);
         // Arm: shoulder, elbow, wrist hanging just off the body.
         let shoulder = f.v(0.0, 0.185 * side, 1.42);
         let elbow = f.v(-0.03, 0.225 * side, 1.14);
         let wrist = f.v(0.07, 0.24 * side, 0.9);
         let (mesh, pose) = limb(shoulder, elbow, 0.052 * f.s, 0.042 * f.s);
-        f.add(mesh, pose, person.shirt_color);
+        f.add(mesh, pose, Paint::Shirt);
         let (mesh, pose) = limb(elbow, wrist, 0.036 * f.s, 0.027 * f.s);
-        f.add(mesh, pose, person.skin_color);
+        f.add(mesh, pose, Paint::Skin);
         f.add(
             ellipsoid(0.045 * f.s, Vec3::new(0.65, 0.5, 1.3), 8, 12),
             Pose::from_parts(f.v(0.09, 0.243 * side, 0.84), Quat::from_rotation_y(-0.35)),
-            person.skin_color,
+            Paint::Skin,
         );
     }
 }
 
 /// Pelvis, torso and neck.
-fn trunk(f: &mut Figure, person: &Person) {
+fn trunk(f: &mut Figure) {
     // Pelvis in trousers, torso in the shirt: shoulders broad, waist narrower.
     let pelvis = f.scaled(&[
         Section::new(0.8, 0.06, 0.1),
@@ -426,11 +465,7 @@ fn trunk(f: &mut Figure, person: &Person) {
         Section::new(0.95, 0.11, 0.175),
         Section::new(1.03, 0.105, 0.165),
     ]);
-    f.add(
-        loft(&pelvis, 2.6, 24),
-        Pose::IDENTITY,
-        person.trousers_color,
-    );
+    f.add(loft(&pelvis, 2.6, 24), Pose::IDENTITY, Paint::Trousers);
     let torso = f.scaled(&[
         Section::new(0.98, 0.1, 0.16),
         Section::new(1.1, 0.1, 0.155),
@@ -440,22 +475,18 @@ fn trunk(f: &mut Figure, person: &Person) {
         Section::new(1.46, 0.07, 0.14),
         Section::new(1.48, 0.04, 0.06),
     ]);
-    f.add(loft(&torso, 2.6, 24), Pose::IDENTITY, person.shirt_color);
+    f.add(loft(&torso, 2.6, 24), Pose::IDENTITY, Paint::Shirt);
     let neck = f.scaled(&[
         Section::new(1.42, 0.048, 0.048),
         Section::new(1.58, 0.045, 0.045),
     ]);
-    f.add(
-        loft(&neck, 2.0, 12),
-        f.at(-0.01, 0.0, 0.0),
-        person.skin_color,
-    );
+    f.add(loft(&neck, 2.0, 12), f.at(-0.01, 0.0, 0.0), Paint::Skin);
 }
 
 /// Eyes, brows, ears, mouth, nose, head and hair.
-fn face(f: &mut Figure, person: &Person) {
+fn face(f: &mut Figure) {
     // Eyes, brows and mouth on the face (the face's front is at x ~ 0.1).
-    let dark = Rgba::rgb(0.08, 0.06, 0.05);
+    let dark = Paint::Fixed(Rgba::rgb(0.08, 0.06, 0.05));
     for side in [-1.0f32, 1.0] {
         f.add(
             ellipsoid(0.012 * f.s, Vec3::new(0.6, 1.2, 0.8), 6, 8),
@@ -465,41 +496,41 @@ fn face(f: &mut Figure, person: &Person) {
         f.add(
             ellipsoid(0.016 * f.s, Vec3::new(0.4, 1.6, 0.35), 6, 8),
             f.at(0.092, 0.034 * side, 1.682),
-            person.hair_color,
+            Paint::Hair,
         );
         // Ears.
         f.add(
             ellipsoid(0.03 * f.s, Vec3::new(0.6, 0.35, 1.0), 6, 8),
             f.at(0.0, 0.08 * side, 1.64),
-            person.skin_color,
+            Paint::Skin,
         );
     }
     f.add(
         ellipsoid(0.018 * f.s, Vec3::new(0.4, 1.5, 0.35), 6, 8),
         f.at(0.09, 0.0, 1.585),
-        Rgba::rgb(0.55, 0.25, 0.22),
+        Paint::Fixed(Rgba::rgb(0.55, 0.25, 0.22)),
     );
     // Nose.
     f.add(
         ellipsoid(0.016 * f.s, Vec3::new(0.9, 0.8, 1.3), 6, 8),
         f.at(0.1, 0.0, 1.625),
-        person.skin_color,
+        Paint::Skin,
     );
     // Head: the face in skin, hair over the top and back.
     f.add(
         ellipsoid(0.1 * f.s, Vec3::new(0.95, 0.8, 1.15), 12, 18),
         f.at(0.005, 0.0, 1.635),
-        person.skin_color,
+        Paint::Skin,
     );
     f.add(
         ellipsoid(0.104 * f.s, Vec3::new(0.98, 0.86, 0.7), 10, 16),
         f.at(-0.006, 0.0, 1.7),
-        person.hair_color,
+        Paint::Hair,
     );
     f.add(
         ellipsoid(0.09 * f.s, Vec3::new(0.7, 0.88, 1.0), 8, 12),
         f.at(-0.045, 0.0, 1.62),
-        person.hair_color,
+        Paint::Hair,
     );
 }
 

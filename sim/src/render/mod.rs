@@ -12,5 +12,6 @@ pub(crate) mod renderer;
 pub(crate) mod scene;
 
 pub use gpu::RenderError;
-pub use mesh::{PersonPart, object_mesh, person_parts, shape_mesh, visual_mesh};
+pub use mesh::{Paint, PersonPart, object_mesh, person_parts, shape_mesh, visual_mesh};
+pub use passes::colour::Light;
 pub use renderer::{CameraRenderer, EntityImage};

@@ -40,6 +40,12 @@ impl PostProcess {
         }
     }
 
+    /// From the next image on, adds `noise` (none: a clean image). The noise stays seeded
+    /// from the frame number.
+    pub(crate) fn set_noise(&mut self, noise: Option<GaussianNoise>) {
+        self.noise = noise.map(|n| (n, Rng(self.noise_seed)));
+    }
+
     /// Seeds the next image's noise from the frame number.
     pub(crate) fn seed_frame(&mut self, frame: u64) {
         if let Some((_, rng)) = &mut self.noise {

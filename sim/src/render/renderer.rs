@@ -8,12 +8,14 @@ use glam::{Mat4, Vec4};
 use crate::geometry::Pose;
 use crate::model::camera_info::{CameraInfo, link_from_optical};
 use crate::model::classes::EntityIds;
+use crate::model::person::Person;
 use crate::model::robot::RobotModel;
 use crate::model::sensors::CameraConfig;
+use crate::model::sensors::GaussianNoise;
 use crate::model::world::World;
 use crate::render::gpu::RenderError;
 use crate::render::gpu::{Gpu, Readback};
-use crate::render::passes::colour::{ColourPass, View};
+use crate::render::passes::colour::{ColourPass, Light, View};
 use crate::render::passes::silhouette::SilhouettePass;
 use crate::render::post::PostProcess;
 use crate::render::scene::Scene;
@@ -178,6 +180,28 @@ impl CameraRenderer {
     /// Moves person `index` (world order) to `world_from_person` for the following renders.
     pub fn set_person_pose(&mut self, index: usize, world_from_person: Pose) {
         self.scene.set_person_pose(index, world_from_person);
+    }
+
+    /// Paints person `index` (world order) in `person`'s clothes for the following renders.
+    pub fn dress_person(&mut self, index: usize, person: &Person) {
+        self.scene.dress_person(index, person);
+    }
+
+    /// Moves the world objects (every object in world order) for the following renders.
+    pub fn set_object_poses(&mut self, world_from_objects: &[Pose]) {
+        self.scene.set_object_poses(world_from_objects);
+    }
+
+    /// Lights the following renders: the sun travelling along `sun_direction` (world frame)
+    /// with `light`'s strengths.
+    pub fn set_light(&mut self, sun_direction: [f64; 3], light: Light) {
+        let [x, y, z] = sun_direction.map(|v| v as f32);
+        self.colour.set_light(glam::Vec3::new(x, y, z), light);
+    }
+
+    /// Gaussian noise on the following images (none: clean images).
+    pub fn set_noise(&mut self, noise: Option<GaussianNoise>) {
+        self.post.set_noise(noise);
     }
 
     /// Seeds the next image's noise from the frame number, so that an image's noise does not

@@ -9,11 +9,12 @@ use wgpu::util::DeviceExt;
 use crate::geometry::{Pose, Rgba};
 use crate::model::classes::EntityIds;
 use crate::model::mesh::MeshData;
+use crate::model::person::Person;
 use crate::model::robot::RobotModel;
 use crate::model::world::World;
 use crate::render::gpu::RenderError;
 use crate::render::material::Materials;
-use crate::render::mesh::{cuboid, object_mesh, person_parts, visual_mesh};
+use crate::render::mesh::{Paint, cuboid, object_mesh, person_parts, visual_mesh};
 
 /// Per-instance vertex data: the model matrix, the colour (alpha < 0 marks the checkered
 /// ground) and the labelled entity the mesh belongs to ([`EntityIds`]; 0: none).
@@ -106,9 +107,14 @@ pub(crate) struct Scene {
     instances: Vec<Instance>,
     pub(crate) instance_buffer: wgpu::Buffer,
     robot: Vec<Attached>,
-    people: Vec<Attached>,
-    /// Visuals of moving SDF model links.
+    /// Every figure part, with where its colour comes from.
+    people: Vec<(Attached, Paint)>,
+    /// Visuals of every SDF model link.
     models: Vec<Attached>,
+    /// Whether some model link can move on its own (physics).
+    moving_models: bool,
+    /// One instance per world object, in world order.
+    objects: Vec<usize>,
 }
 
 /// Collects meshes and instances before the instance buffer exists.
@@ -229,16 +235,21 @@ impl Scene {
             ground_color,
             0,
         );
+        let mut objects = Vec::with_capacity(world.objects.len());
         for (i, object) in world.objects.iter().enumerate() {
             let mesh = object_mesh(&object.shape)?;
-            b.add(
+            objects.push(b.add(
                 &mesh,
                 object.world_from_object(),
                 object.color,
                 ids.object(i),
-            );
+            ));
         }
         let models = add_models(&mut b, world, ids)?;
+        let moving_models = world
+            .models
+            .iter()
+            .any(|m| m.links.iter().any(|l| l.is_dynamic(m)));
         let people = add_people(&mut b, world, ids);
         let mut attached = Vec::new();
         for (link_index, link) in robot.links.iter().enumerate() {
@@ -266,23 +277,39 @@ impl Scene {
             robot: attached,
             people,
             models,
+            moving_models,
+            objects,
         })
     }
 
     /// Whether some SDF model link can move.
     pub(crate) fn has_moving_models(&self) -> bool {
-        !self.models.is_empty()
+        self.moving_models
     }
 
-    /// Moves the visuals of moving SDF model links (every model link in world order).
+    /// Moves the visuals of SDF model links (every model link in world order).
     pub(crate) fn set_model_link_poses(&mut self, world_from_model_links: &[Pose]) {
         move_attached(&mut self.instances, &self.models, world_from_model_links);
     }
 
     /// Moves person `index` (world order) to `world_from_person`.
     pub(crate) fn set_person_pose(&mut self, index: usize, world_from_person: Pose) {
-        for a in self.people.iter().filter(|a| a.frame == index) {
+        for (a, _) in self.people.iter().filter(|(a, _)| a.frame == index) {
             self.instances[a.instance].model = matrix(world_from_person * a.frame_from_shape);
+        }
+    }
+
+    /// Paints person `index` (world order) in `person`'s colours.
+    pub(crate) fn dress_person(&mut self, index: usize, person: &Person) {
+        for (a, paint) in self.people.iter().filter(|(a, _)| a.frame == index) {
+            self.instances[a.instance].color = paint.of(person).0;
+        }
+    }
+
+    /// Moves the world objects (world order).
+    pub(crate) fn set_object_poses(&mut self, world_from_objects: &[Pose]) {
+        for (&instance, pose) in self.objects.iter().zip(world_from_objects) {
+            self.instances[instance].model = matrix(*pose);
         }
     }
 
@@ -314,41 +341,40 @@ fn add_models(
     world: &World,
     ids: &EntityIds,
 ) -> Result<Vec<Attached>, RenderError> {
-    let mut moving = Vec::new();
     let model_links = world
         .models
         .iter()
         .enumerate()
-        .flat_map(|(i, m)| m.links.iter().map(move |l| (i, m, l)));
-    for (link_index, (model_index, model, link)) in model_links.enumerate() {
+        .flat_map(|(i, m)| m.links.iter().map(move |l| (i, l)));
+    let mut moving = Vec::new();
+    for (link_index, (model_index, link)) in model_links.enumerate() {
         for visual in &link.visuals {
             let mesh = visual_mesh(visual)?;
             let pose = link.world_from_link * visual.link_from_shape;
             let color = visual.display_color(&mesh);
             let index = b.add(&mesh, pose, color, ids.model(model_index));
-            if link.is_dynamic(model) {
-                moving.push(Attached {
-                    instance: index,
-                    frame: link_index,
-                    frame_from_shape: visual.link_from_shape,
-                });
-            }
+            moving.push(Attached {
+                instance: index,
+                frame: link_index,
+                frame_from_shape: visual.link_from_shape,
+            });
         }
     }
     Ok(moving)
 }
 
-fn add_people(b: &mut Builder<'_>, world: &World, ids: &EntityIds) -> Vec<Attached> {
+fn add_people(b: &mut Builder<'_>, world: &World, ids: &EntityIds) -> Vec<(Attached, Paint)> {
     let mut parts = Vec::new();
     for (person_index, person) in world.people.iter().enumerate() {
         let world_from_person = person.world_from_person(0.0);
         let id = ids.person(person_index);
         for part in person_parts(person) {
-            parts.push(Attached {
+            let attached = Attached {
                 instance: b.add(&part.mesh, world_from_person * part.pose, part.color, id),
                 frame: person_index,
                 frame_from_shape: part.pose,
-            });
+            };
+            parts.push((attached, part.paint));
         }
     }
     parts

@@ -5,8 +5,10 @@ use crate::error::SimError;
 use crate::geometry::Pose;
 use crate::model::camera_info::CameraInfo;
 use crate::model::robot::LinkId;
+use crate::model::sensors::GaussianNoise;
 use crate::physics::simulation::Simulation;
 use crate::render::gpu::RenderError;
+use crate::render::passes::colour::Light;
 use crate::render::renderer::{CameraRenderer, EntityImage};
 use crate::sensors::ground_truth::{GroundTruth, GroundTruthBox};
 
@@ -39,6 +41,9 @@ pub struct CameraSensor {
     seq: u64,
     link_poses: Vec<Pose>,
     model_poses: Vec<Pose>,
+    object_poses: Vec<Pose>,
+    /// The sim's layout the renderer's copies were last moved to.
+    layout_seen: u64,
     truth: Option<(GroundTruth, Vec<GroundTruthBox>)>,
 }
 
@@ -71,6 +76,8 @@ impl CameraSensor {
             seq: 0,
             link_poses: Vec::with_capacity(robot.links.len()),
             model_poses: Vec::new(),
+            object_poses: Vec::new(),
+            layout_seen: sim.layout_version(),
             truth: None,
         })
     }
@@ -89,6 +96,18 @@ impl CameraSensor {
     /// The intrinsics.
     pub fn info(&self) -> &CameraInfo {
         self.renderer.info()
+    }
+
+    /// Lights the following images: the sun travelling along `sun_direction` (world frame)
+    /// with `light`'s strengths (the world's sun and rover's default strengths until then).
+    pub fn set_light(&mut self, sun_direction: [f64; 3], light: Light) {
+        self.renderer.set_light(sun_direction, light);
+    }
+
+    /// Gaussian noise on the following images instead of the camera's own `<noise>` (none:
+    /// clean images).
+    pub fn set_noise(&mut self, noise: Option<GaussianNoise>) {
+        self.renderer.set_noise(noise);
     }
 
     /// The renderer (adapter name, ...).
@@ -132,6 +151,12 @@ impl CameraSensor {
         Some(seq)
     }
 
+    /// Numbers the next image `seq` (its noise is seeded from its number): images made out
+    /// of order, such as a dataset's, get the same noise however they are made.
+    pub fn set_frame_number(&mut self, seq: u64) {
+        self.seq = seq;
+    }
+
     /// Renders an image now.
     pub fn capture(&mut self, sim: &Simulation) -> Result<CameraFrame<'_>, RenderError> {
         sim.link_poses_into(&mut self.link_poses);
@@ -140,13 +165,23 @@ impl CameraSensor {
         self.seq += 1;
         self.renderer.seed_frame(seq);
         let (width, height) = (self.renderer.info().width, self.renderer.info().height);
+        let relaid = self.layout_seen != sim.layout_version();
+        self.layout_seen = sim.layout_version();
         for (index, person) in sim.world().people.iter().enumerate() {
-            if person.walk.is_some() {
+            if person.walk.is_some() || relaid {
                 self.renderer
                     .set_person_pose(index, sim.world_from_person(index));
             }
+            if relaid {
+                self.renderer.dress_person(index, person);
+            }
         }
-        if self.renderer.has_moving_models() {
+        if relaid || sim.world().objects.iter().any(|o| o.mass_kg.is_some()) {
+            // Placed objects, and objects physics moves (a pushed crate) drawn where they are.
+            sim.object_poses_into(&mut self.object_poses);
+            self.renderer.set_object_poses(&self.object_poses);
+        }
+        if self.renderer.has_moving_models() || relaid {
             sim.model_link_poses_into(&mut self.model_poses);
             self.renderer.set_model_link_poses(&self.model_poses);
         }

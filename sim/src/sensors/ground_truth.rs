@@ -154,8 +154,8 @@ fn copy_boxes_from<'a>(
 /// Where a part of a labelled thing is each frame.
 #[derive(Debug, Clone, Copy)]
 enum Frame {
-    /// Fixed in the world.
-    World(Pose),
+    /// On a world object (index), at this pose in the object's frame.
+    Object(usize, Pose),
     /// On a person (index), at this pose in the person's frame.
     Person(usize, Pose),
     /// On a model link (index among all model links), at this pose in the link's frame.
@@ -183,6 +183,8 @@ pub struct GroundTruth {
     entities: Vec<Entity>,
     /// Reused for the model links' poses.
     model_poses: Vec<Pose>,
+    /// Reused for the world objects' poses.
+    object_poses: Vec<Pose>,
     /// Reused per frame: per entity (index `id - 1`), visible pixels of the output image and
     /// of the ideal image, and the visible box's pixel bounds.
     visible: Vec<Visible>,
@@ -244,7 +246,7 @@ impl GroundTruth {
                 class: class.clone(),
                 name: object.name.clone(),
                 parts: vec![Part {
-                    frame: Frame::World(object.world_from_object()),
+                    frame: Frame::Object(i, Pose::IDENTITY),
                     vertices: vertices(&object_mesh(&object.shape)?),
                 }],
             });
@@ -299,6 +301,7 @@ impl GroundTruth {
             visible: vec![Visible::default(); entities.len()],
             entities,
             model_poses: Vec::new(),
+            object_poses: Vec::new(),
             all,
         })
     }
@@ -384,6 +387,7 @@ impl GroundTruth {
     /// outside the image gets an empty box.
     fn full_boxes(&mut self, sim: &Simulation, info: &CameraInfo, world_from_camera: Pose) {
         sim.model_link_poses_into(&mut self.model_poses);
+        sim.object_poses_into(&mut self.object_poses);
         let optical_from_world =
             (world_from_camera * Pose::from_rotation(link_from_optical())).inverse();
         let (fx, cx, fy, cy) = (info.k[0], info.k[2], info.k[4], info.k[5]);
@@ -401,7 +405,9 @@ impl GroundTruth {
             let mut behind = false;
             for part in &e.parts {
                 let world_from_part = match part.frame {
-                    Frame::World(pose) => pose,
+                    Frame::Object(i, pose) => {
+                        self.object_poses.get(i).copied().unwrap_or_default() * pose
+                    }
                     Frame::Person(i, pose) => sim.world_from_person(i) * pose,
                     Frame::ModelLink(i, pose) => {
                         self.model_poses.get(i).copied().unwrap_or_default() * pose

@@ -52,6 +52,26 @@ pub(crate) struct ColourPass {
     checker_size_m: f32,
     /// The direction sunlight travels (world frame, unit).
     sun: Vec3,
+    /// The sun's and the sky's strength.
+    light: Light,
+}
+
+/// How the scene is lit, besides the sun's direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    /// The sun's strength on a surface facing it (rover's default 0.75).
+    pub sun: f32,
+    /// The sky's (ambient) light, as a multiple of rover's default (1.0).
+    pub ambient: f32,
+}
+
+impl Default for Light {
+    fn default() -> Self {
+        Self {
+            sun: 0.75,
+            ambient: 1.0,
+        }
+    }
 }
 
 impl ColourPass {
@@ -111,7 +131,17 @@ impl ColourPass {
             checker,
             checker_size_m,
             sun,
+            light: Light::default(),
         }
+    }
+
+    /// Lights the following frames with a sun travelling along `direction` (world frame; a
+    /// zero vector keeps the current one) and `light`'s strengths.
+    pub(crate) fn set_light(&mut self, direction: Vec3, light: Light) {
+        if let Some(sun) = direction.try_normalize() {
+            self.sun = sun;
+        }
+        self.light = light;
     }
 
     /// Uploads this frame's uniforms and records the pass; `after` records more draws into
@@ -135,8 +165,13 @@ impl ColourPass {
         let globals = Globals {
             view_proj: (view.projection * view_matrix).to_cols_array_2d(),
             camera_pos: world_from_optical.translation.extend(1.0).to_array(),
-            sun: sun.extend(0.75).to_array(),
-            ambient: [0.45, 0.47, 0.5, self.checker_size_m],
+            sun: sun.extend(self.light.sun).to_array(),
+            ambient: [
+                0.45 * self.light.ambient,
+                0.47 * self.light.ambient,
+                0.5 * self.light.ambient,
+                self.checker_size_m,
+            ],
             checker: self.checker.0,
             sky: [SKY[0], SKY[1], SKY[2], 80.0],
         };

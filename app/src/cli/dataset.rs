@@ -1,0 +1,208 @@
+//! `rover dataset`: the command line around [`rover_core::write_dataset`] — options, a
+//! progress bar, Ctrl-C (complete images kept, the same command resumes), a summary.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+use rover_core::{DatasetProgress, DatasetSpec, DatasetSummary, ImageFormat, Randomization};
+
+use crate::cli::args::{
+    DatasetArgs, DatasetFormat, DatasetImageFormat, Randomize, spare_detect_threads,
+};
+use crate::cli::{Interrupted, stop_on_signals};
+
+impl DatasetImageFormat {
+    pub(crate) fn format(self) -> ImageFormat {
+        match self {
+            Self::Png => ImageFormat::Png,
+            Self::Jpg => ImageFormat::Jpg,
+        }
+    }
+}
+
+/// The randomization the options ask for.
+fn randomization(args: &DatasetArgs) -> Randomization {
+    let on = |what| args.randomize.contains(&what) && !args.randomize.contains(&Randomize::None);
+    Randomization {
+        robot: on(Randomize::Robot),
+        distance_m: args.distance,
+        background: args.background,
+        move_m: if on(Randomize::Things) {
+            args.move_m
+        } else {
+            0.0
+        },
+        turn_deg: if on(Randomize::Things) {
+            args.turn_deg
+        } else {
+            0.0
+        },
+        clothes: on(Randomize::Clothes),
+        light: on(Randomize::Light),
+        noise_max: if on(Randomize::Noise) {
+            args.noise_max
+        } else {
+            0.0
+        },
+    }
+}
+
+/// Runs `rover dataset`.
+pub(crate) fn run(args: DatasetArgs) -> Result<()> {
+    let mut config = args.world.run_config(None);
+    config.detector = args.detector.tool_config(spare_detect_threads())?;
+    config.stop = Some(stop_on_signals()?);
+    let spec = DatasetSpec {
+        out: args.out.clone(),
+        images: args.images,
+        seed: args.world.seed,
+        val_fraction: args.val,
+        image_format: args.image_format.format(),
+        yolo: args.format.contains(&DatasetFormat::Yolo),
+        coco: args.format.contains(&DatasetFormat::Coco),
+        randomization: randomization(&args),
+        detect: args.detect,
+    };
+    let bar = ProgressBar::new(spec.images);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} images  {per_sec}  eta {eta}  {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut first = true;
+    let summary = rover_core::write_dataset(&config, &spec, &mut |p: DatasetProgress| {
+        if first {
+            first = false;
+            if p.kept > 0 {
+                bar.suspend(|| {
+                    println!(
+                        "resuming {}: {} of {} images already complete",
+                        spec.out.display(),
+                        p.kept,
+                        p.total
+                    );
+                });
+            }
+            bar.set_position(p.done);
+            bar.reset_eta();
+        }
+        bar.set_position(p.done);
+    });
+    bar.finish_and_clear();
+    let summary = summary?;
+    print_summary(&summary, &spec);
+    if summary.interrupted {
+        println!(
+            "interrupted: {} of {} images complete; run the same command again to go on",
+            summary.kept + summary.made,
+            summary.total
+        );
+        return Err(Interrupted.into());
+    }
+    Ok(())
+}
+
+fn print_summary(s: &DatasetSummary, spec: &DatasetSpec) {
+    let rate = if s.wall_s > 0.0 {
+        s.made as f64 / s.wall_s
+    } else {
+        0.0
+    };
+    println!(
+        "dataset {}: {} images ({} made now at {rate:.1}/s, {} kept from before)",
+        s.out.display(),
+        s.total,
+        s.made,
+        s.kept
+    );
+    if s.interrupted {
+        return;
+    }
+    println!(
+        "  train {} / val {} images; {} labelled boxes, {} ignore regions, {} images with no box",
+        s.split_images[0], s.split_images[1], s.boxes, s.ignored, s.backgrounds
+    );
+    let mut wrote = Vec::new();
+    if spec.yolo {
+        wrote.push("data.yaml, labels/{train,val}/ (YOLO)");
+    }
+    if spec.coco {
+        wrote.push("annotations/instances_{train,val}.json (COCO)");
+    }
+    println!(
+        "  wrote images/{{train,val}}/, {}, ground_truth/",
+        wrote.join(", ")
+    );
+    if let Some([train, val, all]) = &s.metrics {
+        let f = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
+        println!("  detector (COCO rules; metrics.json, detections/):");
+        for (name, m) in [("train", train), ("val", val), ("all", all)] {
+            println!(
+                "    {name:<5} {} images  AP50 {}  AP50:95 {}",
+                m.images,
+                f(m.ap50),
+                f(m.ap50_95)
+            );
+        }
+        for c in &all.classes {
+            println!(
+                "    {:<14} AP50 {}  precision {}  recall {}  mean IoU {}  ({} truth, {} detections)",
+                c.class,
+                f(c.ap50),
+                f(c.precision),
+                f(c.recall),
+                f(c.mean_iou),
+                c.ground_truth,
+                c.detections
+            );
+        }
+    }
+}
+
+/// `rover bench dataset`: images per second into a temporary folder, after one warm-up image.
+pub(crate) fn bench(
+    world: crate::cli::args::WorldArgs,
+    images: u64,
+    format: DatasetImageFormat,
+) -> Result<()> {
+    let config = world.run_config(None);
+    let scratch = tempfile::tempdir()?;
+    let spec = DatasetSpec {
+        out: scratch.path().join("dataset"),
+        images: 1,
+        seed: world.seed,
+        val_fraction: 0.1,
+        image_format: format.format(),
+        yolo: true,
+        coco: true,
+        randomization: Randomization::default(),
+        detect: false,
+    };
+    rover_core::write_dataset(&config, &spec, &mut |_| {})?;
+    let spec = DatasetSpec {
+        images: images.max(1) + 1,
+        ..spec
+    };
+    let start = Instant::now();
+    let summary = rover_core::write_dataset(&config, &spec, &mut |_| {})?;
+    let total_s = start.elapsed().as_secs_f64();
+    println!(
+        "dataset benchmark: {} labelled {} images: {:.1} images/s while making them ({:.1} ms each), {:.1}/s including set-up and the COCO/YOLO files ({:.2} s in all)",
+        summary.made,
+        match format {
+            DatasetImageFormat::Png => "PNG",
+            DatasetImageFormat::Jpg => "JPEG",
+        },
+        summary.made as f64 / summary.wall_s,
+        1e3 * summary.wall_s / summary.made.max(1) as f64,
+        summary.made as f64 / total_s,
+        total_s
+    );
+    println!(
+        "  {} labelled boxes, {} ignore regions in {} images",
+        summary.boxes, summary.ignored, summary.total
+    );
+    Ok(())
+}

@@ -1,0 +1,515 @@
+//! `rover dataset`: labelled images from any world. Every image is a scene laid out anew from
+//! the seed and the image's number ([`Randomization`]), rendered by the robot's camera with
+//! its ground truth, and written as an image, a YOLO label and rover's record; at the end the
+//! records become COCO JSON and Ultralytics' `data.yaml`. Deterministic (same seed, same
+//! files), resumable (a stopped run goes on where it stopped), and stopped cleanly by a full
+//! disk ([`store`] says how the folder is kept consistent).
+
+mod export;
+mod randomize;
+mod store;
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::sync::mpsc;
+use std::time::Instant;
+
+use rover_perception::{CocoEvaluator, DetectionMetrics, Detector, FrameStamp, RgbView};
+use rover_sim::{CameraSensor, SimOptions, Simulation};
+use sha2::{Digest, Sha256};
+
+pub use export::{
+    COCO_CATEGORY_IDS, DetectedBox, ImageRecord, LabelledBox, coco_category, coco_json,
+    coco_results, data_yaml, yolo_class,
+};
+pub use randomize::{Randomization, Shot};
+pub use store::{ImageFormat, MANIFEST, MANIFEST_FORMAT, Manifest, Split, Store, write_whole};
+
+use crate::error::{CoreError, Result};
+use crate::headless::RunConfig;
+use randomize::{BaseLayout, Rng, lay_out};
+
+/// What dataset to make.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DatasetSpec {
+    /// The dataset's folder.
+    pub out: PathBuf,
+    /// How many images (numbered 0..images).
+    pub images: u64,
+    /// The seed of every image's layout and noise.
+    pub seed: u64,
+    /// Fraction of images in the validation split (each image's own draw).
+    pub val_fraction: f64,
+    /// How images are stored.
+    pub image_format: ImageFormat,
+    /// Write Ultralytics YOLO labels and data.yaml.
+    pub yolo: bool,
+    /// Write COCO JSON.
+    pub coco: bool,
+    /// What is randomized.
+    pub randomization: Randomization,
+    /// Run the detector on every image: its boxes in the records, COCO results files and
+    /// rover's COCO metrics of it (`metrics.json`).
+    pub detect: bool,
+}
+
+/// How far a dataset run is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DatasetProgress {
+    /// Images complete (kept from before and made now).
+    pub done: u64,
+    /// Images asked for.
+    pub total: u64,
+    /// Images that were already complete when the run started.
+    pub kept: u64,
+}
+
+/// What a dataset run did.
+#[derive(Debug, Clone)]
+pub struct DatasetSummary {
+    /// The folder.
+    pub out: PathBuf,
+    /// Images asked for.
+    pub total: u64,
+    /// Images made by this run.
+    pub made: u64,
+    /// Images that were already complete.
+    pub kept: u64,
+    /// Images per split (train, val), over the whole dataset.
+    pub split_images: [u64; 2],
+    /// Labelled boxes over the whole dataset (YOLO lines), and ignore regions.
+    pub boxes: u64,
+    /// Ignore regions (COCO `iscrowd`) over the whole dataset.
+    pub ignored: u64,
+    /// Images with no labelled box.
+    pub backgrounds: u64,
+    /// Wall time of the images made by this run (s).
+    pub wall_s: f64,
+    /// Ended early through [`RunConfig::stop`]: complete images kept, the rest to resume.
+    pub interrupted: bool,
+    /// With `detect`: rover's COCO metrics of the detector per split (train, val) and over all.
+    pub metrics: Option<[DetectionMetrics; 3]>,
+}
+
+/// One image on its way to the disk.
+struct Job {
+    split: Split,
+    index: u64,
+    rgb: Vec<u8>,
+    width: u32,
+    height: u32,
+    label: Option<String>,
+    record: String,
+}
+
+/// Makes (or resumes) the dataset `spec` asks for from the world and robot `config` names.
+/// `progress` hears of every image completed. Errors: bad options, a folder that holds
+/// something else, a disk that fills up (what was written stays complete and resumable).
+pub fn write_dataset(
+    config: &RunConfig,
+    spec: &DatasetSpec,
+    progress: &mut dyn FnMut(DatasetProgress),
+) -> Result<DatasetSummary> {
+    check_spec(spec)?;
+    let (mut world, robot) = config.load_world_and_robot()?;
+    for person in &mut world.people {
+        // Still scenes: people stand where the layout puts them.
+        person.walk = None;
+    }
+    let options = SimOptions {
+        seed: spec.seed,
+        ..config.options.clone()
+    };
+    let mut sim = Simulation::new(world, robot, &options)?;
+    let mut camera = CameraSensor::new(&sim).map_err(CoreError::Camera)?;
+    camera
+        .enable_ground_truth(&sim)
+        .map_err(CoreError::Camera)?;
+    let mut detector = match spec.detect {
+        true => Some(Detector::load(config.detector.clone())?),
+        false => None,
+    };
+    let manifest = manifest(spec, &sim, &camera, detector.as_ref())?;
+    let (store, done) = Store::open(&spec.out, &manifest)?;
+    let base = BaseLayout::new(&sim);
+    if base.targets() == 0 {
+        tracing::warn!(
+            "{}: nothing in the world is labelled (people, objects with class = \"...\", Gazebo models of a known class): every image will be a background image",
+            sim.world().source.display()
+        );
+    }
+    let kept = done.len() as u64;
+    progress(DatasetProgress {
+        done: kept,
+        total: spec.images,
+        kept,
+    });
+    let start = Instant::now();
+    let (made, interrupted) = std::thread::scope(|scope| -> Result<(u64, bool)> {
+        let (jobs, inbox) = mpsc::sync_channel::<Job>(2);
+        let (returns, recycled) = mpsc::channel::<Vec<u8>>();
+        let writer_store = store.clone();
+        let writer =
+            scope.spawn(move || write_jobs(&writer_store, inbox, spec.image_format, returns));
+        let mut made = 0;
+        let mut interrupted = false;
+        for index in (0..spec.images).filter(|i| !done.contains(i)) {
+            if config
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(Ordering::Relaxed))
+            {
+                interrupted = true;
+                break;
+            }
+            let rgb = recycled.try_recv().unwrap_or_default();
+            let job = make_image(
+                &mut sim,
+                &mut camera,
+                detector.as_mut(),
+                (&base, spec, &store),
+                index,
+                rgb,
+            )?;
+            if jobs.send(job).is_err() {
+                break; // the writer stopped on an error, joined below
+            }
+            made += 1;
+            progress(DatasetProgress {
+                done: kept + made,
+                total: spec.images,
+                kept,
+            });
+        }
+        drop(jobs);
+        match writer.join() {
+            Ok(Ok(())) => Ok((made, interrupted)),
+            Ok(Err((path, e))) => Err(disk_error(&path, e, &store, spec.images)),
+            Err(_) => Err(CoreError::Option(
+                "the dataset writer thread panicked".into(),
+            )),
+        }
+    })?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let mut summary = DatasetSummary {
+        out: spec.out.clone(),
+        total: spec.images,
+        made,
+        kept,
+        split_images: [0; 2],
+        boxes: 0,
+        ignored: 0,
+        backgrounds: 0,
+        wall_s,
+        interrupted,
+        metrics: None,
+    };
+    if !interrupted {
+        finish(&store, spec, &mut summary)?;
+    }
+    Ok(summary)
+}
+
+fn check_spec(spec: &DatasetSpec) -> Result<()> {
+    if spec.images == 0 {
+        return Err(CoreError::Option("ask for at least one image".into()));
+    }
+    if !(spec.val_fraction.is_finite() && (0.0..=1.0).contains(&spec.val_fraction)) {
+        return Err(CoreError::Option(format!(
+            "the validation fraction must be between 0 and 1, found {}",
+            spec.val_fraction
+        )));
+    }
+    if !spec.yolo && !spec.coco {
+        return Err(CoreError::Option(
+            "choose at least one output format (yolo, coco)".into(),
+        ));
+    }
+    spec.randomization.check().map_err(CoreError::Option)
+}
+
+fn sha256_of(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| CoreError::Option(format!("cannot read {}: {e}", path.display())))?;
+    Ok(format!("{:x}", Sha256::digest(&bytes)))
+}
+
+fn manifest(
+    spec: &DatasetSpec,
+    sim: &Simulation,
+    camera: &CameraSensor,
+    detector: Option<&Detector>,
+) -> Result<Manifest> {
+    let detector = match detector {
+        Some(d) => Some(format!(
+            "{} sha256 {} threshold {}",
+            d.model_path()
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy(),
+            sha256_of(d.model_path())?,
+            d.config().threshold
+        )),
+        None => None,
+    };
+    Ok(Manifest {
+        format: MANIFEST_FORMAT.into(),
+        rover_version: env!("CARGO_PKG_VERSION").into(),
+        seed: spec.seed,
+        images: spec.images,
+        val_fraction: spec.val_fraction,
+        image_format: spec.image_format,
+        yolo: spec.yolo,
+        coco: spec.coco,
+        world: sim.world().source.display().to_string(),
+        world_sha256: sha256_of(&sim.world().source)?,
+        robot: sim.robot().source.display().to_string(),
+        robot_sha256: sha256_of(&sim.robot().source)?,
+        camera: sim
+            .robot()
+            .cameras
+            .first()
+            .map(|c| c.name.clone())
+            .unwrap_or_default(),
+        width: camera.info().width,
+        height: camera.info().height,
+        randomization: spec.randomization.clone(),
+        detector,
+    })
+}
+
+/// Lays out, renders and labels image `index`.
+fn make_image(
+    sim: &mut Simulation,
+    camera: &mut CameraSensor,
+    detector: Option<&mut Detector>,
+    (base, spec, store): (&BaseLayout, &DatasetSpec, &Store),
+    index: u64,
+    mut rgb: Vec<u8>,
+) -> Result<Job> {
+    let mut rng = Rng::for_image(spec.seed, index);
+    let split = if rng.uniform() < spec.val_fraction {
+        Split::Val
+    } else {
+        Split::Train
+    };
+    let shot = lay_out(sim, camera, base, &spec.randomization, &mut rng)?;
+    camera.set_frame_number(index);
+    let frame = camera.capture(sim).map_err(CoreError::Camera)?;
+    rgb.clear();
+    rgb.extend_from_slice(frame.rgb);
+    let (width, height) = (frame.width, frame.height);
+    let objects = frame
+        .ground_truth
+        .iter()
+        .map(LabelledBox::from_truth)
+        .collect();
+    let detections = match detector {
+        Some(d) => {
+            let view = RgbView::new(width as usize, height as usize, &rgb)?;
+            let stamp = FrameStamp {
+                sim_time_s: 0.0,
+                frame: index,
+            };
+            Some(DetectedBox::from_result(&d.detect(view, stamp)?))
+        }
+        None => None,
+    };
+    let record = ImageRecord {
+        index,
+        split,
+        file_name: store.file_name(index),
+        width,
+        height,
+        objects,
+        detections,
+        shot,
+    };
+    Ok(Job {
+        split,
+        index,
+        rgb,
+        width,
+        height,
+        label: spec.yolo.then(|| record.yolo_label()),
+        record: serde_json::to_string(&record)
+            .map_err(|e| CoreError::Option(format!("image record: {e}")))?,
+    })
+}
+
+/// The writer thread: encodes and writes every job's files (the record last), hands the
+/// image buffers back. Stops at the first error, with the file it concerned.
+fn write_jobs(
+    store: &Store,
+    inbox: mpsc::Receiver<Job>,
+    format: ImageFormat,
+    returns: mpsc::Sender<Vec<u8>>,
+) -> std::result::Result<(), (PathBuf, std::io::Error)> {
+    for job in inbox {
+        let image = store.image_path(job.split, job.index);
+        store::write_whole_with(&image, |w| encode(w, &job, format)).map_err(|e| (image, e))?;
+        if let Some(label) = &job.label {
+            let path = store.label_path(job.split, job.index);
+            write_whole(&path, label.as_bytes()).map_err(|e| (path, e))?;
+        }
+        let path = store.record_path(job.split, job.index);
+        write_whole(&path, job.record.as_bytes()).map_err(|e| (path, e))?;
+        let _ = returns.send(job.rgb);
+    }
+    Ok(())
+}
+
+fn encode(w: &mut impl std::io::Write, job: &Job, format: ImageFormat) -> std::io::Result<()> {
+    use image::ImageEncoder;
+    // The encoders wrap write errors in their own; keep the first one as it was (a full disk
+    // must read as one).
+    let mut w = KeepError {
+        inner: w,
+        first: None,
+    };
+    let (rgb, width, height) = (&job.rgb, job.width, job.height);
+    let color = image::ExtendedColorType::Rgb8;
+    let result = match format {
+        ImageFormat::Png => image::codecs::png::PngEncoder::new_with_quality(
+            &mut w,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        )
+        .write_image(rgb, width, height, color),
+        ImageFormat::Jpg => image::codecs::jpeg::JpegEncoder::new_with_quality(&mut w, 95)
+            .write_image(rgb, width, height, color),
+    };
+    match (result, w.first) {
+        (Ok(()), _) => Ok(()),
+        (Err(_), Some(io)) => Err(io),
+        (Err(image::ImageError::IoError(io)), None) => Err(io),
+        (Err(other), None) => Err(std::io::Error::other(other)),
+    }
+}
+
+/// A writer that remembers the first error of the writer it wraps.
+struct KeepError<W> {
+    inner: W,
+    first: Option<std::io::Error>,
+}
+
+impl<W: std::io::Write> KeepError<W> {
+    fn keep<T>(&mut self, r: std::io::Result<T>) -> std::io::Result<T> {
+        r.map_err(|e| {
+            let copy = std::io::Error::new(e.kind(), e.to_string());
+            self.first.get_or_insert(e);
+            copy
+        })
+    }
+}
+
+impl<W: std::io::Write> std::io::Write for KeepError<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let r = self.inner.write(buf);
+        self.keep(r)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let r = self.inner.flush();
+        self.keep(r)
+    }
+}
+
+/// A write that failed: a full disk says what is kept and how to go on.
+fn disk_error(path: &Path, e: std::io::Error, store: &Store, total: u64) -> CoreError {
+    let complete = complete_count(store, total);
+    if e.kind() == std::io::ErrorKind::StorageFull || e.raw_os_error() == Some(28) {
+        CoreError::Option(format!(
+            "{}: no space left on the device; stopped with {complete} of {total} images complete in {} (the image being written was removed). Free some space and run the same command again: it goes on from there",
+            path.display(),
+            store.root().display()
+        ))
+    } else {
+        CoreError::Option(format!(
+            "cannot write {}: {e}; {complete} of {total} images are complete in {} and the same command resumes",
+            path.display(),
+            store.root().display()
+        ))
+    }
+}
+
+/// Reads every record back and writes what is made from all of them: data.yaml, COCO JSON,
+/// detections and metrics.
+fn finish(store: &Store, spec: &DatasetSpec, summary: &mut DatasetSummary) -> Result<()> {
+    let mut records = Vec::with_capacity(spec.images as usize);
+    for index in 0..spec.images {
+        let record = Split::ALL
+            .iter()
+            .map(|s| store.record_path(*s, index))
+            .find(|p| p.is_file())
+            .ok_or_else(|| CoreError::Option(format!("image {index}'s record is missing")))?;
+        let text = std::fs::read_to_string(&record).map_err(|e| CoreError::write(&record, e))?;
+        let r: ImageRecord = serde_json::from_str(&text).map_err(|e| {
+            CoreError::Option(format!(
+                "{}: not an image record ({e}); delete it and run again to remake that image",
+                record.display()
+            ))
+        })?;
+        records.push(r);
+    }
+    for r in &records {
+        summary.split_images[usize::from(r.split == Split::Val)] += 1;
+        let boxes = r.objects.iter().filter(|o| !o.ignore).count() as u64;
+        summary.boxes += boxes;
+        summary.ignored += r.objects.len() as u64 - boxes;
+        summary.backgrounds += u64::from(boxes == 0);
+    }
+    let root = store.root();
+    let write = |path: PathBuf, text: &str| -> Result<()> {
+        write_whole(&path, text.as_bytes()).map_err(|e| disk_error(&path, e, store, spec.images))
+    };
+    let json_error = |e: serde_json::Error| CoreError::Option(format!("JSON: {e}"));
+    if spec.yolo {
+        write(root.join("data.yaml"), &data_yaml())?;
+    }
+    if spec.coco {
+        let dir = root.join("annotations");
+        std::fs::create_dir_all(&dir).map_err(|e| CoreError::write(&dir, e))?;
+        for split in Split::ALL {
+            let text = coco_json(&records, split).map_err(json_error)?;
+            write(dir.join(format!("instances_{}.json", split.name())), &text)?;
+        }
+    }
+    if spec.detect {
+        let dir = root.join("detections");
+        std::fs::create_dir_all(&dir).map_err(|e| CoreError::write(&dir, e))?;
+        let mut evaluators = [
+            CocoEvaluator::new(),
+            CocoEvaluator::new(),
+            CocoEvaluator::new(),
+        ];
+        for r in &records {
+            let (truth, found) = (r.eval_truth(), r.eval_detections());
+            evaluators[usize::from(r.split == Split::Val)].add_image(&truth, &found);
+            evaluators[2].add_image(&truth, &found);
+        }
+        for split in Split::ALL {
+            let text = coco_results(&records, split).map_err(json_error)?;
+            write(dir.join(format!("{}.json", split.name())), &text)?;
+        }
+        let metrics = evaluators.map(|e| e.summary());
+        let text = serde_json::to_string_pretty(&serde_json::json!({
+            "train": metrics[0], "val": metrics[1], "all": metrics[2],
+        }))
+        .map_err(json_error)?;
+        write(root.join("metrics.json"), &text)?;
+        summary.metrics = Some(metrics);
+    }
+    Ok(())
+}
+
+/// How many of the first `total` images have their record (are complete).
+fn complete_count(store: &Store, total: u64) -> u64 {
+    (0..total)
+        .filter(|&i| {
+            Split::ALL
+                .iter()
+                .any(|s| store.record_path(*s, i).is_file())
+        })
+        .count() as u64
+}

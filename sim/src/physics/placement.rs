@@ -1,0 +1,224 @@
+//! Placing things by hand: the robot, people, objects and models moved to new poses between
+//! steps (no physics in between), people re-dressed. Used to lay out randomized scenes
+//! (`rover dataset`); the camera follows every placement at its next image
+//! ([`Simulation::layout_version`]).
+
+use rapier3d::prelude::*;
+
+use crate::error::{Result, SimError};
+use crate::geometry::{Pose, Rgba};
+use crate::physics::build::person_body_pose;
+use crate::physics::diff_drive::EncoderOdometry;
+use crate::physics::simulation::{Simulation, planar};
+
+impl Simulation {
+    /// Changes whenever something is placed or re-dressed, so a camera knows to move its
+    /// drawn copies (starts at 0).
+    pub fn layout_version(&self) -> u64 {
+        self.layout
+    }
+
+    /// Moves the whole robot rigidly so that its base link is at `world_from_base`, joints
+    /// as they are, every body at rest; the wheel-encoder odometry restarts there.
+    pub fn place_robot(&mut self, world_from_base: Pose) -> Result<()> {
+        check_pose(&world_from_base, "robot pose")?;
+        if self.placement.robot.is_none() {
+            // Links welded by fixed joints share a body: each body once, relative to the base
+            // as it was at the first placement since the last step, so placing many times
+            // gives the same poses as placing once (no drift).
+            let base_from_world = self.world_from_base().inverse();
+            let mut bodies = self.link_body.clone();
+            bodies.sort_unstable_by_key(|h| h.into_raw_parts());
+            bodies.dedup();
+            let relative = bodies
+                .into_iter()
+                .filter_map(|h| {
+                    self.physics
+                        .bodies
+                        .get(h)
+                        .map(|b| (h, base_from_world * *b.position()))
+                })
+                .collect();
+            self.placement.robot = Some(relative);
+        }
+        for &(handle, base_from_body) in self.placement.robot.iter().flatten() {
+            if let Some(body) = self.physics.bodies.get_mut(handle) {
+                body.set_position(world_from_base * base_from_body, true);
+                body.set_linvel(Vec3::ZERO, true);
+                body.set_angvel(Vec3::ZERO, true);
+            }
+        }
+        self.encoder = EncoderOdometry::new(planar(world_from_base), self.drive.config());
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// Stands person `index` (world order) at `position_m` (x, y) facing `heading_rad`; a
+    /// walk, if they have one, now starts from there.
+    pub fn place_person(
+        &mut self,
+        index: usize,
+        position_m: [f64; 2],
+        heading_rad: f64,
+    ) -> Result<()> {
+        if !(position_m.iter().all(|v| v.is_finite()) && heading_rad.is_finite()) {
+            return Err(SimError::Setup(format!(
+                "person position must be finite, found {position_m:?}, heading {heading_rad}"
+            )));
+        }
+        let t = self.sim_time_s();
+        let person = self
+            .world
+            .people
+            .get_mut(index)
+            .ok_or_else(|| no_such("person", index))?;
+        person.position_m = position_m;
+        person.heading_rad = heading_rad;
+        let pose = person_body_pose(person, t);
+        if let Some(body) = self
+            .people
+            .get(index)
+            .and_then(|h| self.physics.bodies.get_mut(*h))
+        {
+            body.set_position(pose, true);
+        }
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// Dresses person `index` (world order) in a shirt and trousers of these colours.
+    pub fn dress_person(&mut self, index: usize, shirt: Rgba, trousers: Rgba) -> Result<()> {
+        let person = self
+            .world
+            .people
+            .get_mut(index)
+            .ok_or_else(|| no_such("person", index))?;
+        person.shirt_color = shirt;
+        person.trousers_color = trousers;
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// Moves world object `index` (world order) to centre `position_m` with heading `yaw_rad`,
+    /// at rest.
+    pub fn place_object(&mut self, index: usize, position_m: [f64; 3], yaw_rad: f64) -> Result<()> {
+        let object = self
+            .world
+            .objects
+            .get_mut(index)
+            .ok_or_else(|| no_such("object", index))?;
+        object.position_m = position_m;
+        object.yaw_rad = yaw_rad;
+        let pose = object.world_from_object();
+        check_pose(&pose, "object pose")?;
+        if let Some(body) = self
+            .objects
+            .get(index)
+            .and_then(|h| self.physics.bodies.get_mut(*h))
+        {
+            body.set_position(pose, true);
+            body.set_linvel(Vec3::ZERO, true);
+            body.set_angvel(Vec3::ZERO, true);
+        }
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// Moves SDF model `index` (world order) rigidly so that its frame is at
+    /// `world_from_model`, its links at rest.
+    pub fn place_model(&mut self, index: usize, world_from_model: Pose) -> Result<()> {
+        check_pose(&world_from_model, "model pose")?;
+        let first: usize = self
+            .world
+            .models
+            .iter()
+            .take(index)
+            .map(|m| m.links.len())
+            .sum();
+        let model = self
+            .world
+            .models
+            .get_mut(index)
+            .ok_or_else(|| no_such("model", index))?;
+        let cached = self.placement.models.iter().find(|(i, _)| *i == index);
+        let model_from_links = match cached {
+            Some((_, links)) => links.clone(),
+            None => {
+                // Relative to the model as it was at its first placement since the last step.
+                let model_from_world = model.world_from_model.inverse();
+                let links: Vec<Pose> = (0..model.links.len())
+                    .map(|k| {
+                        let now = self
+                            .model_links
+                            .get(first + k)
+                            .and_then(|h| self.physics.bodies.get(*h))
+                            .map_or(model.links[k].world_from_link, |b| *b.position());
+                        model_from_world * now
+                    })
+                    .collect();
+                self.placement.models.push((index, links.clone()));
+                links
+            }
+        };
+        model.world_from_model = world_from_model;
+        for (k, (link, model_from_link)) in model.links.iter_mut().zip(model_from_links).enumerate()
+        {
+            link.world_from_link = world_from_model * model_from_link;
+            if let Some(body) = self
+                .model_links
+                .get(first + k)
+                .and_then(|h| self.physics.bodies.get_mut(*h))
+            {
+                body.set_position(link.world_from_link, true);
+                body.set_linvel(Vec3::ZERO, true);
+                body.set_angvel(Vec3::ZERO, true);
+            }
+        }
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// World pose of every world object (world order) into `out` (cleared first; no
+    /// allocation once `out` has the capacity).
+    pub fn object_poses_into(&self, out: &mut Vec<Pose>) {
+        out.clear();
+        out.extend(self.world.objects.iter().zip(&self.objects).map(|(o, h)| {
+            self.physics
+                .bodies
+                .get(*h)
+                .map_or_else(|| o.world_from_object(), |b| *b.position())
+        }));
+    }
+}
+
+/// Where things were, relative to their own frame, when first placed since the last step.
+#[derive(Debug, Default)]
+pub(crate) struct PlacementCache {
+    /// Every robot body (once) relative to the base link.
+    robot: Option<Vec<(RigidBodyHandle, Pose)>>,
+    /// Per placed model (its index): every link relative to the model's frame.
+    models: Vec<(usize, Vec<Pose>)>,
+}
+
+impl PlacementCache {
+    /// Forgets the cached poses (physics moved things).
+    pub(crate) fn clear(&mut self) {
+        if self.robot.is_some() || !self.models.is_empty() {
+            *self = Self::default();
+        }
+    }
+}
+
+fn check_pose(pose: &Pose, what: &str) -> Result<()> {
+    if pose.translation.is_finite() && pose.rotation.is_finite() {
+        Ok(())
+    } else {
+        Err(SimError::Setup(format!(
+            "{what} must be finite, found {pose:?}"
+        )))
+    }
+}
+
+fn no_such(what: &str, index: usize) -> SimError {
+    SimError::Setup(format!("no {what} number {index} in the world"))
+}
