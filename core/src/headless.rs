@@ -306,6 +306,7 @@ fn run_inner(
         config.trace.as_deref(),
         config.save_frames.as_deref(),
         config.frame_every,
+        config.ground_truth,
     )?;
     let world_name = world.name.clone();
     let robot_name = robot.name.clone();

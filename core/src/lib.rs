@@ -54,4 +54,7 @@ pub use scenario::{
 pub use script::{Script, ScriptPlayer, Step};
 pub use session::{DetectorMode, Session, SessionOptions};
 pub use teleop::{KeyAction, TELEOP_KEYS, Teleop, key_action};
-pub use trace::{TRACE_HEADER, TraceParseError, TraceRow, TraceWriter, parse_trace, trace_joints};
+pub use trace::{
+    TRACE_HEADER, TRACE_TRUTH_COLUMNS, TraceParseError, TraceRow, TraceWriter, TruthColumns,
+    parse_trace, trace_joints,
+};

@@ -6,11 +6,13 @@ use std::fs::File;
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, Pose, Simulation};
+use rover_perception::BoundingBoxes;
+use rover_sim::{CameraFrame, CameraInfo, ControlSample, GroundTruthBox, Pose, Simulation};
 
 use crate::error::{CoreError, Result};
+use crate::judge::LiveJudge;
 use crate::observer::{LoopStats, Observer};
-use crate::trace::TraceWriter;
+use crate::trace::{TraceWriter, TruthColumns};
 
 /// A buffered file that only ever holds whole lines: it writes its buffer up to the last
 /// newline, and when a write fails (disk full) it cuts the file back to the end of the last
@@ -87,11 +89,21 @@ pub struct TraceObserver {
     joints: Vec<rover_sim::JointId>,
     failed: Option<CoreError>,
     rows: u64,
+    /// With ground truth on: judges each detection result for the ground-truth columns.
+    judge: Option<LiveJudge>,
+    /// The newest judged result's columns.
+    truth: Option<TruthColumns>,
 }
 
 impl TraceObserver {
     /// Creates (truncates) the trace file; the header is written when the run starts.
     pub fn create(path: &Path) -> Result<Self> {
+        Self::create_with(path, false)
+    }
+
+    /// As [`TraceObserver::create`]; with `ground_truth` (the run measures it) the trace has
+    /// the ground-truth columns ([`crate::TRACE_TRUTH_COLUMNS`]).
+    pub fn create_with(path: &Path, ground_truth: bool) -> Result<Self> {
         let file = File::create(path).map_err(|e| CoreError::write(path, e))?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -100,6 +112,8 @@ impl TraceObserver {
             joints: Vec::new(),
             failed: None,
             rows: 0,
+            judge: ground_truth.then(LiveJudge::default),
+            truth: None,
         })
     }
 
@@ -147,7 +161,7 @@ impl Observer for TraceObserver {
             .iter()
             .map(|j| robot.joint(*j).name.as_str())
             .collect();
-        match TraceWriter::with_joints(file, &names) {
+        match TraceWriter::with_columns(file, self.judge.is_some(), &names) {
             Ok(w) => self.writer = Some(w),
             Err(e) => self.failed = Some(CoreError::write(&self.path, e)),
         }
@@ -159,7 +173,8 @@ impl Observer for TraceObserver {
                 .joints
                 .iter()
                 .map(|j| sim.joint_state(*j).unwrap_or_default());
-            match w.row_with_joints(sample, (stats.mode, stats.follow_state), joints) {
+            let state = (stats.mode, stats.follow_state);
+            match w.full_row(sample, state, self.truth.as_ref(), joints) {
                 Ok(()) => self.rows += 1,
                 Err(e) => {
                     if let Some(w) = self.writer.take() {
@@ -167,6 +182,12 @@ impl Observer for TraceObserver {
                     }
                 }
             }
+        }
+    }
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        if let Some(judge) = self.judge.as_mut() {
+            let frame = judge.judge(boxes, truth);
+            self.truth = Some(TruthColumns::of(boxes.image_stamp.frame, frame));
         }
     }
     fn failure(&mut self) -> Option<CoreError> {
@@ -253,14 +274,18 @@ pub struct RunFilesWritten {
 }
 
 impl RunFiles {
-    /// Creates the trace file (with its header) and the frames folder, as asked.
+    /// Creates the trace file (with the ground-truth columns when the run measures
+    /// `ground_truth`) and the frames folder, as asked.
     pub fn open(
         trace: Option<&Path>,
         save_frames: Option<&Path>,
         frame_every: u64,
+        ground_truth: bool,
     ) -> Result<Self> {
         Ok(Self {
-            trace: trace.map(TraceObserver::create).transpose()?,
+            trace: trace
+                .map(|p| TraceObserver::create_with(p, ground_truth))
+                .transpose()?,
             frames: save_frames
                 .map(|dir| FrameSaver::new(dir, frame_every))
                 .transpose()?,
@@ -300,6 +325,11 @@ impl Observer for RunFiles {
     fn camera_frame(&mut self, frame: &CameraFrame<'_>, world_from_camera: Pose) {
         if let Some(f) = self.frames.as_mut() {
             f.camera_frame(frame, world_from_camera);
+        }
+    }
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        if let Some(t) = self.trace.as_mut() {
+            t.detections_truth(boxes, truth);
         }
     }
     fn failure(&mut self) -> Option<CoreError> {

@@ -165,7 +165,13 @@ fn eval_judges_the_detector_against_ground_truth() -> Result<()> {
     let mut scenario = Scenario::load(&repo("scenarios/static_behind.toml"))?;
     scenario.criteria.min_recall = Some(0.9);
     scenario.criteria.min_precision = Some(0.9);
-    let result = run_scenario(&scenario, &ScenarioOptions::default(), &mut NoObserver)?;
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("trace.csv");
+    let options = ScenarioOptions {
+        trace: Some(trace.clone()),
+        ..ScenarioOptions::default()
+    };
+    let result = run_scenario(&scenario, &options, &mut NoObserver)?;
     let detector = result
         .metrics
         .detector
@@ -184,6 +190,45 @@ fn eval_judges_the_detector_against_ground_truth() -> Result<()> {
     assert!(person.recall.is_some_and(|r| r >= 0.9), "{person:?}");
     assert!(person.mean_iou.is_some_and(|iou| iou > 0.9), "{person:?}");
     assert!(person.ap50.is_some_and(|ap| ap > 0.85), "{person:?}");
+    // The trace's ground-truth columns hold each result's match, row by row, and add up to
+    // the metrics: every judged image appears, in order.
+    let text = std::fs::read_to_string(&trace)?;
+    assert!(
+        text.starts_with(&format!(
+            "{},{}",
+            rover_core::TRACE_HEADER,
+            rover_core::TRACE_TRUTH_COLUMNS
+        )),
+        "{}",
+        text.lines().next().unwrap_or("")
+    );
+    let rows = parse_trace(&text)?;
+    let mut judged: Vec<rover_core::TruthColumns> = Vec::new();
+    for t in rows.iter().filter_map(|r| r.truth) {
+        if judged.last().is_none_or(|last| last.image != t.image) {
+            assert!(judged.last().is_none_or(|last| last.image < t.image));
+            judged.push(t);
+        }
+    }
+    let sum = |f: fn(&rover_core::TruthColumns) -> u32| judged.iter().map(f).sum::<u32>();
+    println!(
+        "trace: {} results judged, {} things, {} found, {} missed, {} false",
+        judged.len(),
+        sum(|t| t.things),
+        sum(|t| t.found),
+        sum(|t| t.missed),
+        sum(|t| t.false_positives)
+    );
+    assert!(judged.len() > 50, "{} results in the trace", judged.len());
+    assert!(judged.iter().all(|t| t.found + t.missed == t.things));
+    assert!(judged.iter().all(|t| t.mean_iou.is_some() == (t.found > 0)
+        && t.mean_iou.is_none_or(|iou| (0.5..=1.0).contains(&iou))));
+    let found = f64::from(sum(|t| t.found));
+    let recall = found / f64::from(sum(|t| t.things));
+    assert!(
+        person.recall.is_some_and(|r| (r - recall).abs() < 0.05),
+        "trace recall {recall} vs {person:?}"
+    );
     let check = |name: &str| {
         result
             .checks

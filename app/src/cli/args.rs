@@ -337,8 +337,8 @@ pub(crate) struct FollowArgs {
     /// Ground truth: measure every camera image's labelled things from the renderer (people,
     /// `class = "..."` objects, known Gazebo models) and judge each detection against its own
     /// image at IoU 0.5: Rerun shows the ground-truth boxes beside the detections, misses and
-    /// false positives marked, and per-class precision, recall and IoU over time
-    /// (docs/GROUND_TRUTH.md)
+    /// false positives marked, and per-class precision, recall and IoU over time; the HUD
+    /// says it in one line; --trace gets truth_* columns (docs/GROUND_TRUTH.md)
     #[arg(long)]
     pub(crate) ground_truth: bool,
 

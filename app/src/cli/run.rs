@@ -187,6 +187,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         args.trace.as_deref(),
         args.save_frames.as_deref(),
         args.frame_every,
+        args.follow.ground_truth,
     )?;
     let options = SessionOptions {
         sim: config.options.clone(),
