@@ -191,24 +191,6 @@ impl Simulation {
     }
 }
 
-/// Where things were, relative to their own frame, when first placed since the last step.
-#[derive(Debug, Default)]
-pub(crate) struct PlacementCache {
-    /// Every robot body (once) relative to the base link.
-    robot: Option<Vec<(RigidBodyHandle, Pose)>>,
-    /// Per placed model (its index): every link relative to the model's frame.
-    models: Vec<(usize, Vec<Pose>)>,
-}
-
-impl PlacementCache {
-    /// Forgets the cached poses (physics moved things).
-    pub(crate) fn clear(&mut self) {
-        if self.robot.is_some() || !self.models.is_empty() {
-            *self = Self::default();
-        }
-    }
-}
-
 fn check_pose(pose: &Pose, what: &str) -> Result<()> {
     if pose.translation.is_finite() && pose.rotation.is_finite() {
         Ok(())

@@ -7,7 +7,7 @@ use rapier3d::prelude::*;
 use crate::error::{Result, SimError, quoted_list};
 use crate::geometry::{Pose, yaw_of};
 use crate::model::actuation::Pid;
-use crate::model::drive::OdometrySource;
+use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::robot::{JointId, LinkId, RobotModel};
 use crate::model::world::{JointSolver, World, check_step_hz};
 use crate::physics::actuators::{Actuators, JointCommand, JointState};
@@ -22,7 +22,6 @@ use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
-use crate::physics::placement::PlacementCache;
 
 /// Options that are not part of the world or robot files.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -176,35 +175,7 @@ impl Simulation {
             physics.integration_parameters.num_solver_iterations = STIFF_SOLVER_ITERATIONS;
         }
 
-        let wheel = |name: &str, side: usize| -> Result<WheelJoint> {
-            let id = robot.joint_id(name).ok_or_else(|| {
-                SimError::Setup(format!(
-                    "diff drive joint \"{name}\" missing from the robot"
-                ))
-            })?;
-            let joint = robot_bodies.joints[id.index()].ok_or_else(|| {
-                SimError::Setup(format!("diff drive joint \"{name}\" is not a wheel joint"))
-            })?;
-            Ok(WheelJoint { joint, side })
-        };
-        let mut wheels = Vec::new();
-        if drivable {
-            wheels.push(wheel(&drive_config.left_joint, LEFT)?);
-            wheels.push(wheel(&drive_config.right_joint, RIGHT)?);
-            for name in &drive_config.extra_left_joints {
-                wheels.push(wheel(name, LEFT)?);
-            }
-            for name in &drive_config.extra_right_joints {
-                wheels.push(wheel(name, RIGHT)?);
-            }
-        }
-        for w in &wheels {
-            if let Some(data) = joint_data_mut(&mut physics, w.joint.handle) {
-                data.set_motor_model(JointAxis::AngX, MotorModel::ForceBased)
-                    .set_motor_velocity(JointAxis::AngX, 0.0, WHEEL_MOTOR_GAIN)
-                    .set_motor_max_force(JointAxis::AngX, drive_config.wheel_torque_nm as f32);
-            }
-        }
+        let wheels = wheel_joints(&robot, &robot_bodies.joints, &drive_config, &mut physics)?;
 
         let (actuators, controllers) = actuate(
             &robot,
@@ -610,6 +581,46 @@ impl Simulation {
 /// saturates at `wheelTorque`, like Gazebo's joint velocity constraint with `fmax`.
 const WHEEL_MOTOR_GAIN: f32 = 50.0;
 
+/// The driven wheel joints (left and right, then a skid steer's extra ones), their motors set
+/// up as the diff-drive plugin drives them; none when the robot cannot be driven.
+fn wheel_joints(
+    robot: &RobotModel,
+    joints: &[Option<BuiltJoint>],
+    drive_config: &DiffDriveConfig,
+    physics: &mut PhysicsWorld,
+) -> Result<Vec<WheelJoint>> {
+    let wheel = |name: &str, side: usize| -> Result<WheelJoint> {
+        let id = robot.joint_id(name).ok_or_else(|| {
+            SimError::Setup(format!(
+                "diff drive joint \"{name}\" missing from the robot"
+            ))
+        })?;
+        let joint = joints[id.index()].ok_or_else(|| {
+            SimError::Setup(format!("diff drive joint \"{name}\" is not a wheel joint"))
+        })?;
+        Ok(WheelJoint { joint, side })
+    };
+    let mut wheels = Vec::new();
+    if robot.diff_drive.is_some() {
+        wheels.push(wheel(&drive_config.left_joint, LEFT)?);
+        wheels.push(wheel(&drive_config.right_joint, RIGHT)?);
+        for name in &drive_config.extra_left_joints {
+            wheels.push(wheel(name, LEFT)?);
+        }
+        for name in &drive_config.extra_right_joints {
+            wheels.push(wheel(name, RIGHT)?);
+        }
+    }
+    for w in &wheels {
+        if let Some(data) = joint_data_mut(physics, w.joint.handle) {
+            data.set_motor_model(JointAxis::AngX, MotorModel::ForceBased)
+                .set_motor_velocity(JointAxis::AngX, 0.0, WHEEL_MOTOR_GAIN)
+                .set_motor_max_force(JointAxis::AngX, drive_config.wheel_torque_nm as f32);
+        }
+    }
+    Ok(wheels)
+}
+
 pub(crate) fn planar(pose: Pose) -> Odometry {
     Odometry {
         x_m: f64::from(pose.translation.x),
@@ -617,5 +628,24 @@ pub(crate) fn planar(pose: Pose) -> Odometry {
         yaw_rad: wrap_angle(yaw_of(pose.rotation)),
         linear_mps: 0.0,
         angular_radps: 0.0,
+    }
+}
+
+/// Where placed things were, relative to their own frame, when first placed since the last
+/// step (`physics/placement.rs` places; a step forgets).
+#[derive(Debug, Default)]
+pub(crate) struct PlacementCache {
+    /// Every robot body (once) relative to the base link.
+    pub(crate) robot: Option<Vec<(RigidBodyHandle, Pose)>>,
+    /// Per placed model (its index): every link relative to the model's frame.
+    pub(crate) models: Vec<(usize, Vec<Pose>)>,
+}
+
+impl PlacementCache {
+    /// Forgets the cached poses (physics moved things).
+    pub(crate) fn clear(&mut self) {
+        if self.robot.is_some() || !self.models.is_empty() {
+            *self = Self::default();
+        }
     }
 }
