@@ -38,10 +38,11 @@ pub use model::{
     ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DiffDriveConfig,
     Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface, Inertial, Joint,
     JointId, JointKind, JointSolver, Labelled, LaserConfig, Link, LinkId, MAX_LASER_SAMPLES,
-    MODEL_CLASSES, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose, Object,
-    OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn, RosControlPlugin,
-    STEP_HZ_RANGE, TextureImage, TexturedRun, TrajectoryConstraints, TrajectorySpec, Transmission,
-    Visual, Walk, World, check_step_hz, class_of_model, is_known_class, link_from_optical,
+    MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose,
+    Object, OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn,
+    RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun, TrajectoryConstraints,
+    TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz, class_of_model,
+    is_known_class, label_part_of_model, link_from_optical,
 };
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,

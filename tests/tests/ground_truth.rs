@@ -289,12 +289,12 @@ const STREET: &str = r#"<sdf version="1.6"><world name="street">
   <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
 </world></sdf>"#;
 
-/// With textures, YOLO on the street scene finds the car and the fire hydrant with IoU >= 0.5
-/// against their ground-truth visible boxes, and the stop sign inside its box (COCO-trained
-/// YOLO boxes the plate; the model's ground truth includes the pole). Real models, textures,
-/// renderer and detector. (The issue asks for three of the four at IoU >= 0.5: the stop sign's
-/// box convention and the lone cafe table, which YOLO does not call a dining table from any
-/// pose tried, keep it at two — docs/GROUND_TRUTH.md.)
+/// With textures, YOLO on the street scene finds three of the four models — the car, the fire
+/// hydrant and the stop sign — with IoU >= 0.5 against their ground-truth visible boxes. The
+/// stop sign's ground truth is its face alone, as COCO boxes stop signs (`MODEL_LABEL_PARTS`:
+/// the model is one mesh with its pole; with the pole in its box YOLO's plate box had IoU 0.30).
+/// Real models, textures, renderer and detector. The lone cafe table is not called a dining
+/// table by YOLO from any pose tried (docs/GROUND_TRUTH.md).
 #[test]
 fn yolo_finds_the_textured_street_models() -> Result<()> {
     let Some(models) = rover_tests::shared("corpus/gazebo_models") else {
@@ -382,22 +382,19 @@ fn yolo_finds_the_textured_street_models() -> Result<()> {
         );
     }
     assert_eq!(truth.len(), 4, "{truth:?}");
-    assert!(
-        found.iter().any(|c| c == "car") && found.iter().any(|c| c == "fire hydrant"),
-        "YOLO found only {found:?}"
-    );
+    for class in ["car", "fire hydrant", "stop sign"] {
+        assert!(
+            found.iter().any(|c| c == class),
+            "YOLO found only {found:?}"
+        );
+    }
+    // The sign's box is its face: about as wide as tall (with the pole it was 3x taller).
     let sign = truth
         .iter()
         .find(|t| t.class == "stop sign")
         .and_then(|t| t.visible)
         .context("no stop sign in view")?;
-    assert!(
-        boxes.bounding_boxes.iter().any(|d| d.class == "stop sign"
-            && d.xmin as f64 >= sign.xmin - 2.0
-            && d.xmax as f64 <= sign.xmax + 2.0
-            && d.ymin as f64 >= sign.ymin - 2.0
-            && d.ymax as f64 <= sign.ymax + 2.0),
-        "no stop sign detected inside {sign:?}"
-    );
+    let aspect = sign.height() / sign.width();
+    assert!((0.8..1.25).contains(&aspect), "stop sign box {sign:?}");
     Ok(())
 }

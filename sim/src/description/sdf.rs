@@ -18,7 +18,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::{
     MAX_COORDINATE_M, MAX_MAGNITUDE, Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of,
 };
-use crate::model::classes::class_of_model;
+use crate::model::classes::{class_of_model, label_part_of_model};
 use crate::model::person::{Person, Walk};
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
@@ -326,12 +326,14 @@ impl Loader<'_> {
         depth: usize,
     ) -> Result<()> {
         let own_name = node.attribute("name").unwrap_or("model").to_owned();
-        let class = overrides
+        // The name that gives the class: the model:// name, else the model's own.
+        let known = overrides
             .as_ref()
             .and_then(|o| o.uri_name.as_deref())
-            .and_then(class_of_model)
-            .or_else(|| class_of_model(&own_name))
-            .map(str::to_owned);
+            .filter(|n| class_of_model(n).is_some())
+            .or_else(|| Some(own_name.as_str()).filter(|n| class_of_model(n).is_some()));
+        let class = known.and_then(class_of_model).map(str::to_owned);
+        let label_above_m = known.and_then(label_part_of_model);
         let (name, static_override) = match overrides {
             Some(o) => (o.name.unwrap_or(own_name), o.is_static),
             None => (own_name, None),
@@ -345,6 +347,7 @@ impl Loader<'_> {
             world_from_model,
             links: Vec::new(),
             class,
+            label_above_m,
         };
         let base = ctx.path.parent().unwrap_or(Path::new("."));
         for item in node.children().filter(Node::is_element) {

@@ -108,6 +108,20 @@ pub const MODEL_CLASSES: &[(&str, &str)] = &[
     ("person_walking", "person"),
 ];
 
+/// Gazebo models of which COCO boxes only a part: the part at least this high (m) in the
+/// model's frame is labelled. osrf's `stop_sign` is one mesh, a 1.57 m pole and a 0.6 m face
+/// from 1.22 m to 1.82 m; COCO's stop signs are the face alone.
+pub const MODEL_LABEL_PARTS: &[(&str, f32)] = &[("stop_sign", 1.22)];
+
+/// The height above which a Gazebo model (by `model://` name or its own name) is labelled
+/// ([`MODEL_LABEL_PARTS`]); `None`: all of it.
+pub fn label_part_of_model(name: &str) -> Option<f32> {
+    MODEL_LABEL_PARTS
+        .iter()
+        .find(|(model, _)| *model == name)
+        .map(|(_, above_m)| *above_m)
+}
+
 /// The COCO class of a Gazebo model, from its `model://` name or its own name.
 pub fn class_of_model(name: &str) -> Option<&'static str> {
     MODEL_CLASSES

@@ -156,6 +156,10 @@ pub struct Model {
     /// The COCO class it is: from [`MODEL_CLASSES`](crate::model::classes::MODEL_CLASSES) by
     /// its `model://` name (or its own name); `None`: unlabelled.
     pub class: Option<String>,
+    /// Only the part of the model at least this high in its own frame is labelled (m), as
+    /// COCO boxes a stop sign's face and not its pole ([`MODEL_LABEL_PARTS`](crate::model::classes::MODEL_LABEL_PARTS));
+    /// `None`: all of it.
+    pub label_above_m: Option<f32>,
 }
 
 /// One link of a [`Model`].

@@ -345,19 +345,35 @@ fn add_models(
         .models
         .iter()
         .enumerate()
-        .flat_map(|(i, m)| m.links.iter().map(move |l| (i, l)));
+        .flat_map(|(i, m)| m.links.iter().map(move |l| (i, m, l)));
     let mut moving = Vec::new();
-    for (link_index, (model_index, link)) in model_links.enumerate() {
+    for (link_index, (model_index, model, link)) in model_links.enumerate() {
         for visual in &link.visuals {
             let mesh = visual_mesh(visual)?;
             let pose = link.world_from_link * visual.link_from_shape;
             let color = visual.display_color(&mesh);
-            let index = b.add(&mesh, pose, color, ids.model(model_index));
-            moving.push(Attached {
-                instance: index,
-                frame: link_index,
-                frame_from_shape: visual.link_from_shape,
-            });
+            let id = ids.model(model_index);
+            let mut attach = |instance| {
+                moving.push(Attached {
+                    instance,
+                    frame: link_index,
+                    frame_from_shape: visual.link_from_shape,
+                });
+            };
+            match model.label_above_m.filter(|_| id != 0) {
+                // Only the upper part is labelled (a stop sign's face): drawn as two meshes,
+                // the rest unlabelled.
+                Some(above_m) => {
+                    let model_from_shape = model.world_from_model.inverse() * pose;
+                    let (labelled, rest) = mesh.split_at_height(model_from_shape, above_m);
+                    for (part, part_id) in [(rest, 0), (labelled, id)] {
+                        if !part.indices.is_empty() {
+                            attach(b.add(&part, pose, color, part_id));
+                        }
+                    }
+                }
+                None => attach(b.add(&mesh, pose, color, id)),
+            }
         }
     }
     Ok(moving)

@@ -261,9 +261,17 @@ impl GroundTruth {
             let mut parts = Vec::new();
             for (k, link) in model.links.iter().enumerate() {
                 for visual in &link.visuals {
+                    let mut mesh = shape_mesh(&visual.shape)?;
+                    if let Some(above_m) = model.label_above_m {
+                        // Only the labelled part, as the renderer labels it.
+                        let model_from_shape = model.world_from_model.inverse()
+                            * link.world_from_link
+                            * visual.link_from_shape;
+                        mesh = mesh.split_at_height(model_from_shape, above_m).0;
+                    }
                     parts.push(Part {
                         frame: Frame::ModelLink(first_link + k, visual.link_from_shape),
-                        vertices: vertices(&shape_mesh(&visual.shape)?),
+                        vertices: vertices(&mesh),
                     });
                 }
             }
