@@ -574,6 +574,61 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     Ok(())
 }
 
+/// `--ground-truth --ros`: the ground truth of each detected image goes out shaped like
+/// darknet_ros's boxes on /rover/ground_truth/bounding_boxes (rostopic reads it with
+/// darknet_ros_msgs): the person in view, `probability` 1, COCO's number as `id`, the visible
+/// box inside the image.
+#[test]
+fn the_ground_truth_topic_carries_the_person_in_view() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    if !shared_ros().join("darknet_ros_msgs/msg").exists() {
+        return skip("../shared/ros/darknet_ros_msgs not found");
+    }
+    let mut graph = RosGraph::start()?;
+    let py = graph.darknet_msgs()?;
+    graph.spawn_rover(30.0, &["--ground-truth"])?;
+    let mut c = graph.command("/usr/bin/rostopic");
+    c.args(["echo", "-n", "3", "/rover/ground_truth/bounding_boxes"])
+        .env("PYTHONPATH", &py);
+    let truth = graph.run(c, Duration::from_secs(30))?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    let rover_log = graph.log("rover");
+    assert!(
+        truth.contains("Class: \"person\""),
+        "no person in\n{truth}\nrover:\n{rover_log}"
+    );
+    let field = |name: &str| -> Result<f64> {
+        truth
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(&format!("{name}: ")))
+            .with_context(|| format!("no {name} in\n{truth}"))?
+            .trim()
+            .parse()
+            .with_context(|| format!("{name} is not a number"))
+    };
+    assert_eq!(field("probability")?, 1.0);
+    assert_eq!(field("id")?, 0.0, "person is COCO's class 0");
+    let (xmin, ymin, xmax, ymax) = (
+        field("xmin")?,
+        field("ymin")?,
+        field("xmax")?,
+        field("ymax")?,
+    );
+    assert!(
+        0.0 <= xmin && xmin < xmax && xmax <= 640.0 && 0.0 <= ymin && ymin < ymax && ymax <= 480.0,
+        "box ({xmin}, {ymin})-({xmax}, {ymax}) in a 640x480 image"
+    );
+    assert!(
+        xmax - xmin >= 10.0 && ymax - ymin >= 30.0,
+        "a person-sized box"
+    );
+    assert!(truth.contains("frame_id: \"ground_truth\""), "{truth}");
+    Ok(())
+}
+
 #[test]
 fn rover_survives_a_roscore_restart_and_publishes_again() -> Result<()> {
     let _one = lock();

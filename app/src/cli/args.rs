@@ -197,11 +197,13 @@ pub(crate) struct RosArgs {
 }
 
 impl RosArgs {
-    /// The bridge's settings, when --ros is on.
-    pub(crate) fn options(&self) -> Option<crate::ros::RosOptions> {
+    /// The bridge's settings, when --ros is on; `ground_truth`: the run measures it
+    /// (`--ground-truth`), the bridge publishes it.
+    pub(crate) fn options(&self, ground_truth: bool) -> Option<crate::ros::RosOptions> {
         self.ros.then(|| crate::ros::RosOptions {
             name: self.ros_name.clone(),
             sim_time: self.ros_sim_time,
+            ground_truth,
         })
     }
 }

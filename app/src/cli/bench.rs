@@ -591,6 +591,7 @@ pub fn ros(config: &RunConfig, repeats: u32) -> Result<RosBench> {
     let options = crate::ros::RosOptions {
         name: "rover".into(),
         sim_time: false,
+        ground_truth: false,
     };
     let mut plain = f64::INFINITY;
     let mut bridged = f64::INFINITY;

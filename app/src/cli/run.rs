@@ -56,7 +56,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
         println!("Rerun web viewer: {url}");
     }
-    let summary = match args.ros.options() {
+    let summary = match args.ros.options(config.ground_truth) {
         Some(ros) => {
             let (world, robot) = config.load_world_and_robot()?;
             let (mut bridge, mut cmd_vel) = RosBridge::start(&ros, &robot)?;
@@ -208,7 +208,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     };
     let mut ros = args
         .ros
-        .options()
+        .options(args.follow.ground_truth)
         .map(|o| RosBridge::start(&o, &robot))
         .transpose()?;
     let summary = {

@@ -80,6 +80,8 @@ pub(super) enum Event {
     Image(ImageFrame),
     /// [`Detections`].
     Detections(Detections),
+    /// Ground-truth boxes of a detected image, shaped as [`Detections`].
+    Truth(Detections),
     /// A laser scan (its ranges in a recycled buffer).
     Scan(LaserScan),
 }
@@ -97,6 +99,9 @@ pub(super) trait TopicFamily: Send {
     fn image(&mut self, _image: &mut ImageFrame) {}
     /// Detections.
     fn detections(&mut self, _detections: &mut Detections) {}
+    /// The ground truth of the image the last detections came from (`--ground-truth`), as
+    /// boxes.
+    fn ground_truth(&mut self, _truth: &mut Detections) {}
     /// A laser scan.
     fn scan(&mut self, _scan: &mut LaserScan) {}
 }
@@ -179,7 +184,7 @@ impl BufferReturn {
             Event::Start(_) => {}
             Event::Control(c) => send(&self.joints, c.joints),
             Event::Image(i) => send(&self.pixels, i.pixels),
-            Event::Detections(d) => send(&self.boxes, d.boxes),
+            Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
         }
     }

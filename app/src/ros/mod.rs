@@ -22,6 +22,7 @@ mod controllers;
 mod convert;
 mod detections;
 mod events;
+mod ground_truth;
 mod joint_states;
 mod laser;
 mod odom;
@@ -36,7 +37,9 @@ use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, LoopStats, Observer};
 use rover_perception::BoundingBoxes;
 use rover_ros1::{Node, NodeOptions, Value};
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, LaserScan, Pose, RobotModel, Simulation};
+use rover_sim::{
+    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, RobotModel, Simulation,
+};
 
 pub use cmd_vel::RosCmdVel;
 use controllers::ControllerCommands;
@@ -52,12 +55,19 @@ pub struct RosOptions {
     pub name: String,
     /// Also set `/use_sim_time` so ROS nodes follow `/clock`.
     pub sim_time: bool,
+    /// The run measures ground truth (`--ground-truth`): publish it on
+    /// `/rover/ground_truth/bounding_boxes`.
+    pub ground_truth: bool,
 }
 
 /// The topic families the bridge publishes, advertised in this order and shown every event in
 /// it.
-fn families(node: &Node, plan: &RosPlan) -> Result<Vec<Box<dyn TopicFamily>>> {
-    Ok(vec![
+fn families(
+    node: &Node,
+    plan: &RosPlan,
+    options: &RosOptions,
+) -> Result<Vec<Box<dyn TopicFamily>>> {
+    let mut families: Vec<Box<dyn TopicFamily>> = vec![
         Box::new(clock::Clock::advertise(node, plan)?),
         Box::new(odom::Odom::advertise(node, plan)?),
         Box::new(tf::Tf::advertise(node, plan)?),
@@ -66,7 +76,11 @@ fn families(node: &Node, plan: &RosPlan) -> Result<Vec<Box<dyn TopicFamily>>> {
         Box::new(detections::DarknetTopics::advertise(node, plan)?),
         Box::new(laser::Laser::advertise(node, plan)?),
         Box::new(controller_states::ControllerStates::advertise(node, plan)?),
-    ])
+    ];
+    if options.ground_truth {
+        families.push(Box::new(ground_truth::GroundTruthTopic::advertise(node)?));
+    }
+    Ok(families)
 }
 
 /// The input half of the bridge: `/cmd_vel` and the controllers' `command` topics.
@@ -116,7 +130,7 @@ impl RosBridge {
         if options.sim_time {
             node.set_param("use_sim_time", Value::Bool(true))?;
         }
-        let families = families(&node, &plan)?;
+        let families = families(&node, &plan, options)?;
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
         let controllers = ControllerCommands::subscribe(&node, &plan)?;
         for c in &plan.controllers {
@@ -244,6 +258,13 @@ impl Observer for RosBridge {
         let started = std::time::Instant::now();
         let detections = detections::capture(boxes, self.now_s, self.buffers.take_boxes());
         self.send(Event::Detections(detections));
+        self.busy += started.elapsed();
+    }
+
+    fn detections_truth(&mut self, boxes: &BoundingBoxes, truth: &[GroundTruthBox]) {
+        let started = std::time::Instant::now();
+        let truth = ground_truth::capture(boxes, truth, self.now_s, self.buffers.take_boxes());
+        self.send(Event::Truth(truth));
         self.busy += started.elapsed();
     }
 

@@ -36,6 +36,7 @@ fn run(
                 Event::Control(update) => family.control(update),
                 Event::Image(image) => family.image(image),
                 Event::Detections(detections) => family.detections(detections),
+                Event::Truth(truth) => family.ground_truth(truth),
                 Event::Scan(scan) => family.scan(scan),
             }
         }
