@@ -123,26 +123,32 @@ impl TopicFamily for DarknetTopics {
         self.found.publish(&self.found_msg);
 
         let out = &mut self.boxes_msg;
-        out.header.seq = seq_of(&self.boxes);
-        out.header.stamp_s = detections.stamp_s;
-        out.image_header.seq = detections.image_seq as u32;
-        out.image_header.stamp_s = detections.image_stamp_s;
-        // Class strings keep their capacity: no allocation once warm.
-        out.bounding_boxes
-            .resize_with(detections.boxes.len(), msgs::BoundingBox::default);
-        for (m, b) in out.bounding_boxes.iter_mut().zip(&detections.boxes) {
-            m.probability = b.probability;
-            m.xmin = b.xmin;
-            m.ymin = b.ymin;
-            m.xmax = b.xmax;
-            m.ymax = b.ymax;
-            m.id = b.id;
-            m.class.clone_from(&b.class);
-        }
+        fill(out, seq_of(&self.boxes), detections);
         if !out.bounding_boxes.is_empty() {
             self.boxes.publish(out);
         }
         self.publish_detection_image(detections.image_seq, &detections.boxes);
+    }
+}
+
+/// Fills a darknet_ros_msgs/BoundingBoxes with `boxes` (numbered `seq`, stamped when
+/// published, `image_header` their image's). Class strings keep their capacity: no allocation
+/// once warm.
+pub(super) fn fill(out: &mut msgs::BoundingBoxes, seq: u32, boxes: &Detections) {
+    out.header.seq = seq;
+    out.header.stamp_s = boxes.stamp_s;
+    out.image_header.seq = boxes.image_seq as u32;
+    out.image_header.stamp_s = boxes.image_stamp_s;
+    out.bounding_boxes
+        .resize_with(boxes.boxes.len(), msgs::BoundingBox::default);
+    for (m, b) in out.bounding_boxes.iter_mut().zip(&boxes.boxes) {
+        m.probability = b.probability;
+        m.xmin = b.xmin;
+        m.ymin = b.ymin;
+        m.xmax = b.xmax;
+        m.ymax = b.ymax;
+        m.id = b.id;
+        m.class.clone_from(&b.class);
     }
 }
 

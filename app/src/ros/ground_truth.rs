@@ -12,6 +12,7 @@ use rover_ros1::{Node, Publisher};
 use rover_sim::{COCO_CLASSES, GroundTruthBox};
 
 use super::convert::{header, seq_of};
+use super::detections::fill;
 use super::events::{Detections, Start, TopicFamily};
 
 /// The ground-truth topic.
@@ -44,24 +45,9 @@ impl TopicFamily for GroundTruthTopic {
     }
 
     fn ground_truth(&mut self, truth: &mut Detections) {
-        let out = &mut self.msg;
-        out.header.seq = seq_of(&self.boxes);
-        out.header.stamp_s = truth.stamp_s;
-        out.image_header.seq = truth.image_seq as u32;
-        out.image_header.stamp_s = truth.image_stamp_s;
-        out.bounding_boxes
-            .resize_with(truth.boxes.len(), msgs::BoundingBox::default);
-        for (m, b) in out.bounding_boxes.iter_mut().zip(&truth.boxes) {
-            m.probability = b.probability;
-            m.xmin = b.xmin;
-            m.ymin = b.ymin;
-            m.xmax = b.xmax;
-            m.ymax = b.ymax;
-            m.id = b.id;
-            m.class.clone_from(&b.class);
-        }
+        fill(&mut self.msg, seq_of(&self.boxes), truth);
         // Every judged image, empty or not: an empty message says nothing labelled is in view.
-        self.boxes.publish(out);
+        self.boxes.publish(&self.msg);
     }
 }
 
