@@ -405,7 +405,7 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
     )];
     if let Some(models) = rover_tests::shared("corpus/gazebo_models") {
         let world = tmp.path().join("street.world");
-        std::fs::write(&world, STREET)?;
+        std::fs::write(&world, rover_tests::STREET_WORLD)?;
         runs.push((
             "street",
             world,
@@ -473,13 +473,3 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
     }
     Ok(())
 }
-
-/// osrf's textured street models with Gazebo's sun (the ground-truth street test's world).
-const STREET: &str = r#"<sdf version="1.6"><world name="street">
-  <include><uri>model://sun</uri></include>
-  <include><uri>model://ground_plane</uri></include>
-  <include><uri>model://hatchback</uri><name>parked_car</name><pose>9 3.4 0 0 0 1.1</pose></include>
-  <include><uri>model://stop_sign</uri><pose>7 -1.5 0 0 0 -1.5708</pose></include>
-  <include><uri>model://fire_hydrant</uri><pose>3 -1.5 0 0 0 0</pose></include>
-  <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
-</world></sdf>"#;

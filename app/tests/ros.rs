@@ -422,6 +422,34 @@ fn teleop_twist_keyboard_in_tmux_drives_and_stops_the_car() -> Result<()> {
     Ok(())
 }
 
+/// The first `name: value` number in `rostopic echo`'s output.
+fn echoed(text: &str, name: &str) -> Result<f64> {
+    text.lines()
+        .find_map(|l| l.trim().strip_prefix(&format!("{name}: ")))
+        .with_context(|| format!("no {name} in\n{text}"))?
+        .trim()
+        .parse()
+        .with_context(|| format!("{name} is not a number"))
+}
+
+/// The first box `rostopic echo` printed is person-sized and inside the 640x480 image.
+fn check_person_box(text: &str) -> Result<()> {
+    let [xmin, ymin, xmax, ymax] = ["xmin", "ymin", "xmax", "ymax"].map(|f| echoed(text, f));
+    let (xmin, ymin, xmax, ymax) = (xmin?, ymin?, xmax?, ymax?);
+    for v in [xmin, ymin, xmax, ymax] {
+        ensure!(v.fract() == 0.0, "pixel bounds are integers: {v}");
+    }
+    ensure!(
+        0.0 <= xmin && xmin < xmax && xmax <= 640.0 && 0.0 <= ymin && ymin < ymax && ymax <= 480.0,
+        "box ({xmin}, {ymin})-({xmax}, {ymax}) in a 640x480 image"
+    );
+    ensure!(
+        xmax - xmin >= 10.0 && ymax - ymin >= 30.0,
+        "a person-sized box: ({xmin}, {ymin})-({xmax}, {ymax})"
+    );
+    Ok(())
+}
+
 /// `rostopic hz` prints `average rate: X`; the last one.
 fn average_rate(text: &str) -> Option<f64> {
     text.lines()
@@ -490,26 +518,7 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
         boxes.contains("Class: \"person\""),
         "no person in\n{boxes}\nrover:\n{rover_log}"
     );
-    let field = |name: &str| -> Result<i64> {
-        boxes
-            .lines()
-            .find_map(|l| l.trim().strip_prefix(&format!("{name}: ")))
-            .with_context(|| format!("no {name} in\n{boxes}"))?
-            .trim()
-            .parse()
-            .with_context(|| format!("{name} is not an integer"))
-    };
-    let (xmin, ymin, xmax, ymax) = (
-        field("xmin")?,
-        field("ymin")?,
-        field("xmax")?,
-        field("ymax")?,
-    );
-    assert!(
-        0 <= xmin && xmin < xmax && xmax <= 640 && 0 <= ymin && ymin < ymax && ymax <= 480,
-        "box ({xmin}, {ymin})-({xmax}, {ymax}) in a 640x480 image"
-    );
-    assert!(xmax - xmin >= 10 && ymax - ymin >= 30, "a person-sized box");
+    check_person_box(&boxes)?;
 
     // rostopic hz: the camera's 30 Hz within 20%, the plugin's 100 Hz within 10%.
     let image_rate =
@@ -600,31 +609,9 @@ fn the_ground_truth_topic_carries_the_person_in_view() -> Result<()> {
         truth.contains("Class: \"person\""),
         "no person in\n{truth}\nrover:\n{rover_log}"
     );
-    let field = |name: &str| -> Result<f64> {
-        truth
-            .lines()
-            .find_map(|l| l.trim().strip_prefix(&format!("{name}: ")))
-            .with_context(|| format!("no {name} in\n{truth}"))?
-            .trim()
-            .parse()
-            .with_context(|| format!("{name} is not a number"))
-    };
-    assert_eq!(field("probability")?, 1.0);
-    assert_eq!(field("id")?, 0.0, "person is COCO's class 0");
-    let (xmin, ymin, xmax, ymax) = (
-        field("xmin")?,
-        field("ymin")?,
-        field("xmax")?,
-        field("ymax")?,
-    );
-    assert!(
-        0.0 <= xmin && xmin < xmax && xmax <= 640.0 && 0.0 <= ymin && ymin < ymax && ymax <= 480.0,
-        "box ({xmin}, {ymin})-({xmax}, {ymax}) in a 640x480 image"
-    );
-    assert!(
-        xmax - xmin >= 10.0 && ymax - ymin >= 30.0,
-        "a person-sized box"
-    );
+    assert_eq!(echoed(&truth, "probability")?, 1.0);
+    assert_eq!(echoed(&truth, "id")?, 0.0, "person is COCO's class 0");
+    check_person_box(&truth)?;
     assert!(truth.contains("frame_id: \"ground_truth\""), "{truth}");
     Ok(())
 }

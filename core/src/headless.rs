@@ -135,6 +135,13 @@ impl RunSummary {
 }
 
 impl RunConfig {
+    /// Whether [`RunConfig::stop`] asks the run to end.
+    pub fn stop_requested(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
     /// Loads the world and robot this config names, with its spawn, drive and camera choices
     /// applied.
     pub fn load_world_and_robot(&self) -> Result<(World, RobotModel)> {
@@ -432,11 +439,7 @@ fn step_to_end(
     let mut last_report = started;
     let mut interrupted = false;
     while session.sim().step_index() < total_steps {
-        if config
-            .stop
-            .as_ref()
-            .is_some_and(|s| s.load(Ordering::Relaxed))
-        {
+        if config.stop_requested() {
             interrupted = true;
             break;
         }

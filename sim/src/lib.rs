@@ -44,6 +44,7 @@ pub use model::{
     TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz, class_of_model,
     is_known_class, label_part_of_model, link_from_optical,
 };
+pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
     HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory,

@@ -1,11 +1,15 @@
-//! Seedable random numbers for sensor noise: the same seed gives the same noise on every run.
+//! Seedable random numbers: the same seed gives the same noise, and the same dataset, on every
+//! run.
 
-/// Small, seedable random numbers (SplitMix64) for sensor noise.
+/// SplitMix64: small, seedable random numbers, rover's own so that its sequence is fixed
+/// forever (sensor noise, and the layouts of `rover dataset`'s images, must not change with a
+/// random-number crate's next version). The tuple's value is the state; seed it directly.
 #[derive(Debug, Clone)]
-pub(crate) struct Rng(pub(crate) u64);
+pub struct SplitMix64(pub u64);
 
-impl Rng {
-    pub(crate) fn next_u64(&mut self) -> u64 {
+impl SplitMix64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -13,6 +17,12 @@ impl Rng {
         z ^ (z >> 31)
     }
 
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in (0, 1): never 0, for logarithms.
     pub(crate) fn uniform(&mut self) -> f64 {
         ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
     }

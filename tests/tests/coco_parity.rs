@@ -19,21 +19,17 @@ const HEIGHT: f64 = 480.0;
 /// moves AP by only ~4e-5 on this fixture.
 const TOLERANCE: f64 = 1e-9;
 
-/// SplitMix64: a small seeded generator, the same sequence everywhere.
-struct Rng(u64);
+/// rover's SplitMix64: the same sequence everywhere.
+struct Rng(rover_sim::SplitMix64);
 
 impl Rng {
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in [0, 1).
     fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        self.0.unit()
     }
 
     fn below(&mut self, n: u64) -> u64 {
@@ -79,7 +75,7 @@ fn det(class: &str, bbox: EvalBox, score: f64) -> Detection {
 }
 
 fn fixture(seed: u64, images: usize) -> Vec<Image> {
-    let mut rng = Rng(seed);
+    let mut rng = Rng(rover_sim::SplitMix64(seed));
     let mut out = Vec::with_capacity(images);
     for i in 0..images {
         let mut ground_truth = Vec::new();

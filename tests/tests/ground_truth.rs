@@ -274,22 +274,9 @@ fn with_lens_distortion_ids_land_where_the_colour_image_shows_the_cube() -> Resu
     Ok(())
 }
 
-/// Gazebo's textured street models from osrf gazebo_models — hatchback (OBJ, its MTL's
-/// `map_Kd` textures), stop_sign (COLLADA + an OGRE material script), fire_hydrant (COLLADA in
-/// centimetres under a translated node, its effect's image) and cafe_table (COLLADA in inches,
-/// instanced nodes, two wood textures) — with Gazebo's sun and ground plane, seen by the
-/// tutorial car with its camera raised on a 1 m mast (eye height, so the table is seen from
-/// above as in COCO's photos rather than from underneath).
-const STREET: &str = r#"<sdf version="1.6"><world name="street">
-  <include><uri>model://sun</uri></include>
-  <include><uri>model://ground_plane</uri></include>
-  <include><uri>model://hatchback</uri><name>parked_car</name><pose>9 3.4 0 0 0 1.1</pose></include>
-  <include><uri>model://stop_sign</uri><pose>7 -1.5 0 0 0 -1.5708</pose></include>
-  <include><uri>model://fire_hydrant</uri><pose>3 -1.5 0 0 0 0</pose></include>
-  <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
-</world></sdf>"#;
-
-/// With textures, YOLO on the street scene finds three of the four models — the car, the fire
+/// With textures, YOLO on the street scene (`rover_tests::STREET_WORLD`, seen by the tutorial
+/// car with its camera raised on a 1 m mast: eye height, so the table is seen from above as in
+/// COCO's photos) finds three of the four models — the car, the fire
 /// hydrant and the stop sign — with IoU >= 0.5 against their ground-truth visible boxes. The
 /// stop sign's ground truth is its face alone, as COCO boxes stop signs (`MODEL_LABEL_PARTS`:
 /// the model is one mesh with its pole; with the pole in its box YOLO's plate box had IoU 0.30).
@@ -303,7 +290,7 @@ fn yolo_finds_the_textured_street_models() -> Result<()> {
     };
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("street.world");
-    std::fs::write(&path, STREET)?;
+    std::fs::write(&path, rover_tests::STREET_WORLD)?;
     let world = World::load_with(
         &path,
         &rover_sim::ResourcePaths::default().with_model_path(models),

@@ -9,7 +9,7 @@ use anyhow::Result;
 use rover_perception::{BoundingBox, BoundingBoxes};
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
-use rover_sim::{COCO_CLASSES, GroundTruthBox};
+use rover_sim::GroundTruthBox;
 
 use super::convert::{header, seq_of};
 use super::detections::fill;
@@ -81,10 +81,7 @@ pub(super) fn capture(
         b.ymin = v.ymin.round() as i64;
         b.xmax = v.xmax.round() as i64;
         b.ymax = v.ymax.round() as i64;
-        b.id = COCO_CLASSES
-            .iter()
-            .position(|c| *c == t.class)
-            .map_or(-1, |i| i as i16);
+        b.id = rover_core::yolo_class(&t.class).map_or(-1, |i| i as i16);
     }
     Detections {
         stamp_s: now_s.max(boxes.image_stamp.sim_time_s),

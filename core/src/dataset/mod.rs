@@ -10,7 +10,6 @@ mod randomize;
 mod store;
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -154,11 +153,7 @@ pub fn write_dataset(
         let mut made = 0;
         let mut interrupted = false;
         for index in (0..spec.images).filter(|i| !done.contains(i)) {
-            if config
-                .stop
-                .as_ref()
-                .is_some_and(|s| s.load(Ordering::Relaxed))
-            {
+            if config.stop_requested() {
                 interrupted = true;
                 break;
             }

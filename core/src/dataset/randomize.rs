@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use glam::{Quat, Vec3};
 use rover_sim::{
-    GaussianNoise, Light, Pose, Rgba, Shape, Simulation, World, pose_from_position_yaw,
+    GaussianNoise, Light, Pose, Rgba, Shape, Simulation, SplitMix64, World, pose_from_position_yaw,
 };
 use serde::{Deserialize, Serialize};
 
@@ -74,31 +74,23 @@ impl Randomization {
     }
 }
 
-/// SplitMix64: small, seedable, and fixed forever (a dataset's images and labels must not
-/// change with a random-number crate's next version, or resumed datasets would mix two
-/// streams).
+/// Image `index`'s random stream: rover's own SplitMix64 ([`SplitMix64`], fixed forever: a
+/// dataset's images and labels must not change with a random-number crate's next version, or
+/// resumed datasets would mix two streams).
 #[derive(Debug, Clone)]
-pub(crate) struct Rng(u64);
+pub(crate) struct Rng(SplitMix64);
 
 impl Rng {
     /// The stream of image `index` of a dataset seeded with `seed`.
     pub(crate) fn for_image(seed: u64, index: u64) -> Self {
-        let mut mix = Self(seed ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03));
+        let mut mix = SplitMix64(seed ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03));
         let first = mix.next_u64();
-        Self(first ^ index)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        Self(SplitMix64(first ^ index))
     }
 
     /// Uniform in [0, 1).
     pub(crate) fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        self.0.unit()
     }
 
     /// Uniform in [lo, hi).

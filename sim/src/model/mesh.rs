@@ -173,22 +173,22 @@ impl Clipped {
         height: [f32; 3],
         texture: Option<&Arc<TextureImage>>,
     ) {
-        let mut kept: [Option<Corner>; 4] = [None; 4];
+        // At most four: each edge gives its start if kept and the point where it crosses.
+        let mut kept = [corners[0]; 4];
         let mut n = 0;
         for k in 0..3 {
             let (a, b) = (k, (k + 1) % 3);
-            if height[a] >= 0.0 && n < 4 {
-                kept[n] = Some(corners[a]);
+            if height[a] >= 0.0 {
+                kept[n] = corners[a];
                 n += 1;
             }
-            if (height[a] < 0.0) != (height[b] < 0.0) && n < 4 {
+            if (height[a] < 0.0) != (height[b] < 0.0) {
                 let t = height[a] / (height[a] - height[b]);
-                kept[n] = Some(corners[a].lerp(&corners[b], t));
+                kept[n] = corners[a].lerp(&corners[b], t);
                 n += 1;
             }
         }
-        let kept: Vec<Corner> = kept.iter().flatten().copied().collect();
-        for k in 1..kept.len().saturating_sub(1) {
+        for k in 1..n.saturating_sub(1) {
             self.triangle([kept[0], kept[k], kept[k + 1]], texture);
         }
     }

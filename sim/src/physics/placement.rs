@@ -43,9 +43,7 @@ impl Simulation {
         }
         for &(handle, base_from_body) in self.placement.robot.iter().flatten() {
             if let Some(body) = self.physics.bodies.get_mut(handle) {
-                body.set_position(world_from_base * base_from_body, true);
-                body.set_linvel(Vec3::ZERO, true);
-                body.set_angvel(Vec3::ZERO, true);
+                put_at_rest(body, world_from_base * base_from_body);
             }
         }
         self.encoder = EncoderOdometry::new(planar(world_from_base), self.drive.config());
@@ -116,9 +114,7 @@ impl Simulation {
             .get(index)
             .and_then(|h| self.physics.bodies.get_mut(*h))
         {
-            body.set_position(pose, true);
-            body.set_linvel(Vec3::ZERO, true);
-            body.set_angvel(Vec3::ZERO, true);
+            put_at_rest(body, pose);
         }
         self.layout += 1;
         Ok(())
@@ -169,9 +165,7 @@ impl Simulation {
                 .get(first + k)
                 .and_then(|h| self.physics.bodies.get_mut(*h))
             {
-                body.set_position(link.world_from_link, true);
-                body.set_linvel(Vec3::ZERO, true);
-                body.set_angvel(Vec3::ZERO, true);
+                put_at_rest(body, link.world_from_link);
             }
         }
         self.layout += 1;
@@ -189,6 +183,13 @@ impl Simulation {
                 .map_or_else(|| o.world_from_object(), |b| *b.position())
         }));
     }
+}
+
+/// Moves `body` to `pose`, still.
+fn put_at_rest(body: &mut RigidBody, pose: Pose) {
+    body.set_position(pose, true);
+    body.set_linvel(Vec3::ZERO, true);
+    body.set_angvel(Vec3::ZERO, true);
 }
 
 fn check_pose(pose: &Pose, what: &str) -> Result<()> {

@@ -3,7 +3,7 @@
 
 use crate::model::camera_info::CameraInfo;
 use crate::model::sensors::{Distortion, GaussianNoise};
-use crate::noise::Rng;
+use crate::noise::SplitMix64 as Rng;
 
 /// The ideal image, the output image and what turns one into the other; buffers allocated once.
 pub(crate) struct PostProcess {

@@ -14,7 +14,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::Pose;
 use crate::model::robot::LinkId;
 use crate::model::sensors::LaserConfig;
-use crate::noise::Rng;
+use crate::noise::SplitMix64 as Rng;
 use crate::physics::simulation::Simulation;
 
 /// One scan, shaped like `sensor_msgs/LaserScan` (f32 fields as in the message).
