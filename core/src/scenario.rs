@@ -608,12 +608,13 @@ impl Observer for Probe {
 
 /// Judges a run's metrics against `scenario`'s criteria (what [`run_scenario`] does at the
 /// end; also for re-judging saved metrics against other bounds).
-pub fn judge_scenario(scenario: &Scenario, metrics: &ScenarioMetrics) -> Vec<ScenarioCheck> {
-    judge(&scenario.criteria, metrics, scenario.follow_at_s)
-}
-
-/// Judges measured metrics against criteria.
-fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> Vec<ScenarioCheck> {
+///
+/// `min_clearance_m` is judged only for a robot with a range sensor: without one the follower
+/// cannot see obstacles (the scenarios about obstacles `need` a laser); the clearance is still
+/// measured and shown.
+pub fn judge_scenario(scenario: &Scenario, m: &ScenarioMetrics) -> Vec<ScenarioCheck> {
+    let (criteria, follow_at_s) = (&scenario.criteria, scenario.follow_at_s);
+    let sees_obstacles = Sensor::Laser.on(&scenario.robot);
     let mut checks = Vec::new();
     let mut check = |name: &str, limit: String, value: String, passed: bool| {
         checks.push(ScenarioCheck {
@@ -652,11 +653,22 @@ fn judge(criteria: &ScenarioCriteria, m: &ScenarioMetrics, follow_at_s: f64) -> 
         );
     }
     if let Some(limit) = criteria.min_clearance_m {
+        let (limit, passed) = if sees_obstacles {
+            (format!("> {limit:.2} m"), m.min_clearance_m > limit)
+        } else {
+            (
+                format!(
+                    "> {limit:.2} m, not judged: {} has no range sensor to see obstacles",
+                    scenario.robot_name
+                ),
+                true,
+            )
+        };
         check(
             "min_clearance_m",
-            format!("> {limit:.2} m"),
+            limit,
             format!("{:.3} m", m.min_clearance_m),
-            m.min_clearance_m > limit,
+            passed,
         );
     }
     if let Some(limit) = criteria.min_person_range_m {
@@ -812,7 +824,7 @@ pub fn run_scenario(
     }
     let wall_s = started.elapsed().as_secs_f64();
     let metrics = probe.metrics();
-    let checks = judge(&scenario.criteria, &metrics, scenario.follow_at_s);
+    let checks = judge_scenario(scenario, &metrics);
     Ok(ScenarioResult {
         name: scenario.name.clone(),
         robot: scenario.robot_name.clone(),

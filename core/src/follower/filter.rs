@@ -14,6 +14,8 @@ const ACCEL_SIGMA_MPS2: f64 = 1.2;
 const VELOCITY_DECAY_S: f64 = 4.0;
 /// Initial velocity uncertainty (m/s).
 const INITIAL_SPEED_SIGMA_MPS: f64 = 1.0;
+/// Velocity uncertainty of a target taken to have stopped (m/s): people walk on again.
+const HALTED_SPEED_SIGMA_MPS: f64 = 0.3;
 
 /// Position/velocity estimate of one target in the odometry frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,6 +92,35 @@ impl TargetFilter {
             self.state[0] + self.state[2] * travel_s,
             self.state[1] + self.state[3] * travel_s,
         ]
+    }
+
+    /// The velocity the prediction has at `time_s` (m/s, odometry frame): the estimate's,
+    /// decayed with the time since, and zero once the prediction stops at `horizon_s`.
+    pub fn predicted_velocity_mps(&self, time_s: f64, horizon_s: f64) -> [f64; 2] {
+        let dt = (time_s - self.time_s).max(0.0);
+        if dt >= horizon_s.max(0.0) && dt > 0.0 {
+            return [0.0, 0.0];
+        }
+        let decay = (-dt / VELOCITY_DECAY_S).exp();
+        [self.state[2] * decay, self.state[3] * decay]
+    }
+
+    /// The target stopped where it was last estimated: moves the estimate to `time_s` (its
+    /// uncertainty grows with the time), keeps the position of the last estimate and sets the
+    /// velocity to zero with an uncertainty of [`HALTED_SPEED_SIGMA_MPS`]. For a lost target
+    /// whose prediction walked it out to where the camera would have seen it.
+    pub(crate) fn halt(&mut self, time_s: f64) {
+        let position = [self.state[0], self.state[1]];
+        self.predict(time_s);
+        self.state = Vector4::new(position[0], position[1], 0.0, 0.0);
+        let position_cov = self.position_covariance();
+        let mut covariance = Matrix4::zeros();
+        covariance
+            .fixed_view_mut::<2, 2>(0, 0)
+            .copy_from(&position_cov);
+        covariance[(2, 2)] = HALTED_SPEED_SIGMA_MPS.powi(2);
+        covariance[(3, 3)] = HALTED_SPEED_SIGMA_MPS.powi(2);
+        self.covariance = covariance;
     }
 
     /// Moves the estimate forward to `time_s` (no-op for an earlier time).
@@ -196,5 +227,33 @@ mod tests {
         let later = mahalanobis2(&f, jump, &cov);
         assert!(later < soon, "{later} vs {soon}");
         assert!(f.position_sigma_m() > 0.5);
+    }
+
+    #[test]
+    fn the_predicted_velocity_decays_and_a_halted_target_stands() {
+        let cov = Matrix2::identity() * 0.05f64.powi(2);
+        let mut f = TargetFilter::new(0.0, [0.0, 0.0], cov);
+        for i in 1..=20 {
+            let t = f64::from(i) * 0.2;
+            f.update(t, [0.5 * t, 0.0], &cov);
+        }
+        let [vx, _] = f.velocity_mps();
+        let [soon, _] = f.predicted_velocity_mps(4.5, 2.0);
+        let [later, _] = f.predicted_velocity_mps(5.5, 2.0);
+        assert!(
+            vx > soon && soon > later && later > 0.0,
+            "{vx} {soon} {later}"
+        );
+        assert_eq!(f.predicted_velocity_mps(6.5, 2.0), [0.0, 0.0]);
+        let before = f.position_m();
+        let sigma = f.position_sigma_m();
+        f.halt(5.0);
+        assert_eq!(f.position_m(), before);
+        assert_eq!(f.velocity_mps(), [0.0, 0.0]);
+        assert_eq!(f.predicted_position_m(9.0, 2.0), before);
+        assert!(
+            f.position_sigma_m() > sigma,
+            "the position grows less certain"
+        );
     }
 }

@@ -326,6 +326,14 @@ const MOVING_MPS: f64 = 0.25;
 const ARRIVED_BEARING_RAD: f64 = 0.15;
 /// How far ahead a lost target's motion is extrapolated (s).
 const PREDICTION_HORIZON_S: f64 = 2.0;
+/// The detector finds a person reliably while their box is at least this tall (px).
+const RELIABLE_BOX_PX: f64 = 100.0;
+/// A prediction is in plain view this much beyond where the camera sees a person whole (m) ...
+const WHOLE_VIEW_MARGIN_M: f64 = 0.3;
+/// ... and this far inside the image's side edges (rad).
+const FOV_MARGIN_RAD: f64 = 0.15;
+/// Detector messages in a row without a lost target in plain view that halt its track.
+const CONTRADICTED_MESSAGES: u32 = 2;
 /// Pose history length: enough for a few seconds of control updates at 100 Hz.
 const HISTORY: usize = 512;
 /// Laser returns within this distance of the target's prediction are taken to be the target
@@ -411,12 +419,24 @@ pub struct Follower {
     goal: Option<[f64; 2]>,
     /// From how far the camera sees a person of the target height whole (m, from the camera).
     whole_view_m: f64,
+    /// Up to how far the detector finds a person reliably (m, from the camera): their box is
+    /// [`RELIABLE_BOX_PX`] tall there.
+    reliable_range_m: f64,
+    /// Half the camera's horizontal field of view, on its narrower side (rad).
+    half_fov_rad: f64,
+    /// Detector messages in a row that did not show a lost target where its prediction put it
+    /// in plain view.
+    contradictions: u32,
 }
 
 impl Follower {
     /// A follower for a camera with this geometry (no laser).
     pub fn new(config: FollowerConfig, camera: CameraGeometry) -> Self {
         let whole_view_m = camera.whole_view_range_m(config.target_height_m);
+        let reliable_range_m = camera.fy * config.target_height_m / RELIABLE_BOX_PX;
+        let half_fov_rad = (camera.cx.min(camera.width_px - camera.cx) / camera.fx)
+            .atan()
+            .max(0.0);
         Self {
             config,
             camera,
@@ -442,6 +462,9 @@ impl Follower {
             arrived_s: None,
             goal: None,
             whole_view_m,
+            reliable_range_m,
+            half_fov_rad,
+            contradictions: 0,
         }
     }
 
@@ -489,6 +512,7 @@ impl Follower {
         self.detour_side = 0.0;
         self.arrived_s = None;
         self.goal = None;
+        self.contradictions = 0;
     }
 
     /// Records the robot's odometry at a control update. Call it at every control update in
@@ -663,9 +687,44 @@ impl Follower {
                 .map(|c| (c.seen.range_m, c));
         }
         let Some((_, c)) = best else {
+            self.note_missed(t_image, [camera_x, camera_y], camera_yaw);
             return;
         };
+        self.contradictions = 0;
         self.fold_in(t_image, pose.yaw_rad, keeping, &c);
+    }
+
+    /// A detector message without the target. A walking target last estimated nearer than
+    /// the camera sees a person whole (a low camera's blind zone), whose prediction has walked
+    /// them out to where the camera would see them whole and in view, did not go there: they
+    /// stopped or turned in the blind zone. After [`CONTRADICTED_MESSAGES`] such messages in a
+    /// row the track halts at its last estimate (the nearer choice), so a pursuit does not
+    /// drive past a person who stopped.
+    fn note_missed(&mut self, t_image: f64, camera_xy: [f64; 2], camera_yaw_rad: f64) {
+        let Some(t) = self.target.as_mut() else {
+            return;
+        };
+        let [vx, vy] = t
+            .filter
+            .predicted_velocity_mps(t_image, PREDICTION_HORIZON_S);
+        let from_camera = |p: [f64; 2]| {
+            let (dx, dy) = (p[0] - camera_xy[0], p[1] - camera_xy[1]);
+            (dx.hypot(dy), wrap_angle(dy.atan2(dx) - camera_yaw_rad))
+        };
+        let (last_m, _) = from_camera(t.filter.position_m());
+        let (range_m, bearing_rad) = from_camera(t.position_at(t_image));
+        let in_plain_view = range_m >= self.whole_view_m + WHOLE_VIEW_MARGIN_M
+            && range_m <= self.reliable_range_m
+            && bearing_rad.abs() <= self.half_fov_rad - FOV_MARGIN_RAD;
+        if vx.hypot(vy) > MOVING_MPS && last_m < self.whole_view_m && in_plain_view {
+            self.contradictions += 1;
+        } else {
+            self.contradictions = 0;
+        }
+        if self.contradictions >= CONTRADICTED_MESSAGES {
+            t.filter.halt(t_image);
+            self.contradictions = 0;
+        }
     }
 
     /// Folds a chosen detection into the target (`keeping`), or makes it a new target.
@@ -869,9 +928,8 @@ impl Follower {
             FollowState::Searching => FollowState::Searching,
             FollowState::Pursuing => {
                 // Standing, or lost long enough that the prediction has stopped moving.
-                let [vx, vy] = t.filter.velocity_mps();
-                let standing =
-                    vx.hypot(vy) <= MOVING_MPS || now_s - t.filter.time_s() > PREDICTION_HORIZON_S;
+                let [vx, vy] = t.filter.predicted_velocity_mps(now_s, PREDICTION_HORIZON_S);
+                let standing = vx.hypot(vy) <= MOVING_MPS;
                 let look_s = if t.close_and_centred && standing {
                     c.close_hold_s
                 } else {
@@ -926,7 +984,7 @@ impl Follower {
         };
         let c = &self.config;
         let here = t.position_at(now_s);
-        let [vx, vy] = t.filter.velocity_mps();
+        let [vx, vy] = t.filter.predicted_velocity_mps(now_s, PREDICTION_HORIZON_S);
         let moving = vx.hypot(vy) > MOVING_MPS;
         let tracking = state == FollowState::Tracking;
         let lead = if tracking && moving { c.lead_s } else { 0.0 };
@@ -934,9 +992,8 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = range_bearing_from(odom, here);
         let (_, bearing) = range_bearing_from(odom, aim);
-        // Inside the band between the standoff and where the camera sees a walking person
-        // whole (no laser), the range is right: the car turns with them and stays put.
-        let (near_m, far_m) = (c.standoff_m, self.standoff_m(moving));
+        // Inside the band the range is right: the car turns with them and stays put.
+        let (near_m, far_m) = self.standoff_band_m(moving);
         let range_error = if range > far_m {
             range - far_m
         } else if range < near_m {
@@ -954,12 +1011,12 @@ impl Follower {
         // Hysteresis: once centred and at the standoff, stay still until the error is clear.
         if bearing.abs() < 0.03 {
             self.heading_settled = true;
-        } else if bearing.abs() > c.bearing_deadband_rad || (moving && tracking) {
+        } else if bearing.abs() > c.bearing_deadband_rad || moving {
             self.heading_settled = false;
         }
         if range_error.abs() < 0.05 {
             self.range_settled = true;
-        } else if range_error.abs() > c.standoff_band_m || (moving && tracking) {
+        } else if range_error.abs() > c.standoff_band_m || moving {
             self.range_settled = false;
         }
         let angular = if self.heading_settled {
@@ -1000,17 +1057,19 @@ impl Follower {
         self.avoid(preferred, here, speed_cap, now_s, odom)
     }
 
-    /// The furthest range to keep from the target (m, from the base). A walking person is
-    /// followed from anywhere between the standoff and where the camera sees them whole,
-    /// unless a laser keeps them at the standoff: a low camera that closes in on a walking
-    /// person loses them at every step. Once they stand, the car closes in to the standoff.
-    fn standoff_m(&self, moving: bool) -> f64 {
+    /// The ranges to keep from the target (m, from the base: nearest, furthest). A walking
+    /// person is kept where the camera sees them whole, unless a laser keeps them at the
+    /// standoff: a low camera that closes in on a walking person loses them at every step,
+    /// and one who walks toward the car walks into its blind zone unless it gives way. Once
+    /// they stand, the car closes in to the standoff.
+    fn standoff_band_m(&self, moving: bool) -> (f64, f64) {
         let c = &self.config;
         if !moving || self.laser.is_some() {
-            return c.standoff_m;
+            return (c.standoff_m, c.standoff_m);
         }
-        (self.whole_view_m + self.camera.forward_m)
-            .clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M)
+        let whole_m = (self.whole_view_m + self.camera.forward_m)
+            .clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M);
+        (whole_m, whole_m)
     }
 
     /// Replaces `preferred` by a free arc when the laser shows an obstacle in its way.
@@ -1547,5 +1606,123 @@ mod tests {
         assert_eq!(f.state(), FollowState::Tracking);
         let here = f.target().expect("target").position_at(2.0);
         assert!((here[1] - 0.5).abs() < 0.15, "{here:?}");
+    }
+
+    /// The box the test camera sees of a person standing at `person` (odometry frame) from a
+    /// robot at `odom`, cut off at the image's top edge as a low camera sees a near person.
+    fn seen_box(odom: Odometry, person: [f64; 2]) -> BoundingBox {
+        let (s, c) = odom.yaw_rad.sin_cos();
+        let camera_xy = [
+            odom.x_m + c * camera().forward_m,
+            odom.y_m + s * camera().forward_m,
+        ];
+        let (dx, dy) = (person[0] - camera_xy[0], person[1] - camera_xy[1]);
+        let mut b = person_box(dx.hypot(dy), wrap_angle(dy.atan2(dx) - odom.yaw_rad));
+        b.ymin = b.ymin.max(0);
+        b
+    }
+
+    #[test]
+    fn a_walker_lost_in_the_blind_zone_who_does_not_walk_out_of_it_has_stopped() {
+        // The camera sees the person whole from 2.49 m. They walk away at 0.5 m/s from 1.6 m to
+        // 2.2 m in front of the camera, seen at 5 Hz, then stop there and are never detected
+        // again (a detector's blind spot): their prediction would carry them on into plain view
+        // (0.8 m further), where the camera sees nobody. The track stops where it was last.
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        f.command(0.0, odom, true);
+        let forward = camera().forward_m;
+        for i in 0..=6 {
+            let t = f64::from(i) * 0.2;
+            f.observe(&message(
+                t,
+                vec![seen_box(odom, [forward + 1.6 + 0.5 * t, 0.0])],
+            ));
+            f.command(t + 0.01, odom, true);
+        }
+        let [vx, _] = f.target().expect("target").filter.velocity_mps();
+        assert!(vx > 0.3, "walking away: {vx} m/s");
+        for i in 7..=40 {
+            let t = f64::from(i) * 0.2;
+            f.observe(&message(t, vec![]));
+            f.command(t + 0.01, odom, true);
+        }
+        let t = f.target().expect("target");
+        let here = t.position_at(8.0);
+        assert!(
+            (here[0] - (forward + 2.2)).abs() < 0.25 && here[1].abs() < 0.1,
+            "the track should stop near where the person was last seen: {here:?}"
+        );
+        let [vx, vy] = t.filter.predicted_velocity_mps(8.0, PREDICTION_HORIZON_S);
+        assert!(vx.hypot(vy) < 1e-9);
+
+        // A walker lost in plain view (hidden, or gone out of the side) is not taken to have
+        // stopped: the prediction walks on for its horizon.
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        f.command(0.0, odom, true);
+        for i in 0..=6 {
+            let t = f64::from(i) * 0.2;
+            f.observe(&message(
+                t,
+                vec![seen_box(odom, [forward + 3.0 + 0.5 * t, 0.0])],
+            ));
+            f.command(t + 0.01, odom, true);
+        }
+        for i in 7..=40 {
+            let t = f64::from(i) * 0.2;
+            f.observe(&message(t, vec![]));
+            f.command(t + 0.01, odom, true);
+        }
+        let here = f.target().expect("target").position_at(8.0);
+        assert!(here[0] > forward + 3.6 + 0.5, "{here:?}");
+    }
+
+    #[test]
+    fn a_camera_only_car_gives_way_to_a_walker_coming_closer() {
+        // A person walks straight at the car at 0.4 m/s from 4 m. Without a laser, the car keeps
+        // them where its camera sees them whole (2.49 m from the camera): it backs away instead
+        // of letting them walk into its blind zone.
+        let config = FollowerConfig::default();
+        let mut f = Follower::new(config.clone(), camera());
+        let whole_m = camera().whole_view_range_m(config.target_height_m) + camera().forward_m;
+        let mut odom = Odometry::default();
+        f.command(0.0, odom, true);
+        let mut nearest_m = f64::INFINITY;
+        let mut backed_m = 0.0f64;
+        for i in 1..=1200 {
+            let t = f64::from(i) * 0.01;
+            let person = [4.0 - 0.4 * t, 0.0];
+            if i % 20 == 0 {
+                f.observe(&message(t, vec![seen_box(odom, person)]));
+            }
+            let cmd = f.command(t, odom, true);
+            drive(&mut odom, cmd, 0.01);
+            backed_m = backed_m.min(odom.x_m);
+            if t > 4.0 {
+                nearest_m = nearest_m.min(person[0] - odom.x_m);
+            }
+        }
+        assert!(backed_m < -2.0, "backed away {backed_m} m");
+        assert!(
+            nearest_m > whole_m - 0.5,
+            "let the person within {nearest_m} m (sees them whole from {whole_m} m)"
+        );
+        // With a laser the standoff is kept instead: the laser sees them at any range.
+        let mut f = Follower::new(config.clone(), camera()).with_laser(LaserMount::default());
+        let mut odom = Odometry::default();
+        f.command(0.0, odom, true);
+        for i in 1..=300 {
+            let t = f64::from(i) * 0.01;
+            if i % 20 == 0 {
+                f.observe(&message(t, vec![seen_box(odom, [4.0 - 0.4 * t, 0.0])]));
+            }
+            let cmd = f.command(t, odom, true);
+            drive(&mut odom, cmd, 0.01);
+        }
+        assert!(
+            odom.x_m > 0.0,
+            "the laser car drove toward them: {}",
+            odom.x_m
+        );
     }
 }
