@@ -34,15 +34,16 @@ pub use description::{
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
-    COCO_CLASSES, CameraConfig, CameraInfo, Collision, CommandKind, ControllerConfig,
+    COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
     ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DiffDriveConfig,
-    Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface, Inertial, Joint,
-    JointId, JointKind, JointSolver, Labelled, LaserConfig, Link, LinkId, MAX_LASER_SAMPLES,
+    Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface, IkOptions,
+    IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId, JointKind, JointSolver,
+    KinematicChain, KinematicsError, Labelled, LaserConfig, Link, LinkId, MAX_LASER_SAMPLES,
     MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose,
     Object, OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn,
     RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun, TrajectoryConstraints,
     TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz, class_of_model,
-    is_known_class, label_part_of_model, link_from_optical,
+    is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
 };
 pub use noise::SplitMix64;
 pub use physics::{

@@ -634,6 +634,30 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value = "png", value_name = "png|jpg")]
         image_format: DatasetImageFormat,
     },
+    /// Inverse kinematics: ms per solve (damped least squares) to targets made by forward
+    /// kinematics from seeded random in-limit poses of the chain, solved from its rest pose;
+    /// e.g. `rover bench ik --robot tiago_no_hand.urdf --base torso_lift_link --ee-link
+    /// arm_tool_link`
+    Ik {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// The chain's base link [default: the robot's root link]
+        #[arg(long, value_name = "LINK")]
+        base: Option<String>,
+
+        /// The end effector: the chain's tip link
+        #[arg(long, value_name = "LINK")]
+        ee_link: String,
+
+        /// Targets to solve
+        #[arg(long, default_value_t = 200)]
+        targets: usize,
+
+        /// Also match the tip's orientation (full pose targets), not only its position
+        #[arg(long)]
+        pose: bool,
+    },
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]

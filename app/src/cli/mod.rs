@@ -5,6 +5,7 @@
 
 mod args;
 pub mod bench;
+pub mod bench_ik;
 mod dataset;
 pub mod detect;
 pub mod eval;
@@ -108,6 +109,17 @@ pub fn main() -> ExitCode {
                 }),
             ..
         }) => dataset::bench(world, images, image_format),
+        Some(Command::Bench {
+            kind:
+                Some(BenchKind::Ik {
+                    world,
+                    base,
+                    ee_link,
+                    targets,
+                    pose,
+                }),
+            ..
+        }) => bench_ik::bench(world, base.as_deref(), &ee_link, targets, pose),
         None => run::run(cli.run),
     };
     match result {

@@ -1,12 +1,14 @@
 //! Plain data: robots, worlds, people, drives, sensors and meshes as rover simulates them.
-//! Imports only `geometry` and `error`; `description` fills it from files, `physics`, `render`
-//! and `sensors` run it.
+//! Imports only `geometry`, `error` and `noise` (the IK's seeded restarts); `description` fills
+//! it from files, `physics`, `render` and `sensors` run it. `kinematics` is the maths of its
+//! joint chains (forward and inverse kinematics).
 
 pub(crate) mod actuation;
 pub(crate) mod camera_info;
 pub(crate) mod classes;
 pub(crate) mod controllers;
 pub(crate) mod drive;
+pub(crate) mod kinematics;
 pub(crate) mod mesh;
 pub(crate) mod person;
 pub(crate) mod robot;
@@ -24,6 +26,10 @@ pub use controllers::{
     TrajectoryConstraints, TrajectorySpec,
 };
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
+pub use kinematics::{
+    ChainJoint, IkOptions, IkSolution, IkSolver, IkTarget, KinematicChain, KinematicsError,
+    isometry_from_pose,
+};
 pub use mesh::{MeshData, MeshVertex, TextureImage, TexturedRun};
 pub use person::{Person, Walk};
 pub use robot::{
