@@ -836,3 +836,72 @@ fn rostopic_drives_tiagos_torso_and_arm_through_its_controllers() -> Result<()> 
     }
     Ok(())
 }
+
+/// TIAGo's xtion is a depth camera (`<sensor type="depth">`, gazebo_ros_openni_kinect): a rospy
+/// node receives `/xtion/depth_registered/image_raw` as 32FC1 (4-byte rows, little-endian,
+/// metres within the sensor's 0.3-8 m clip range or NaN) with a camera_info of the same size
+/// on `/xtion/depth_registered/camera_info`, in the colour image's optical frame.
+#[test]
+fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
+        return skip("PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+    };
+    let urdf = data.join(
+        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
+    );
+    let mut graph = RosGraph::start()?;
+    let robot_args = [
+        "--robot",
+        &urdf.to_string_lossy(),
+        "--drive",
+        "wheel_left_joint,wheel_right_joint",
+    ]
+    .map(str::to_owned);
+    let args: Vec<&str> = robot_args.iter().map(String::as_str).collect();
+    graph.spawn_rover(20.0, &args)?;
+    let listener = graph.dir.path().join("depth.py");
+    std::fs::write(
+        &listener,
+        "import math, struct, rospy\nfrom sensor_msgs.msg import Image, CameraInfo\nrospy.init_node('depth_check')\nimg = rospy.wait_for_message('/xtion/depth_registered/image_raw', Image, timeout=40)\ninfo = rospy.wait_for_message('/xtion/depth_registered/camera_info', CameraInfo, timeout=20)\nvals = struct.unpack('<%df' % (len(img.data) // 4), img.data)\nfinite = [v for v in vals if not math.isnan(v)]\nprint('image %s %d %d %d %d %d %s' % (img.encoding, img.width, img.height, img.step, len(img.data), img.is_bigendian, img.header.frame_id))\nprint('info %d %d %.3f %s' % (info.width, info.height, info.K[0], info.header.frame_id))\nprint('values %d %.4f %.4f' % (len(finite), min(finite) if finite else -1, max(finite) if finite else -1))\n",
+    )?;
+    let mut c = graph.command(PYTHON);
+    c.arg(&listener);
+    let out = graph.run(c, Duration::from_secs(60))?;
+    println!("{out}");
+    let line = |key: &str| -> Vec<String> {
+        out.lines()
+            .find(|l| l.starts_with(key))
+            .map(|l| l.split(' ').map(str::to_owned).collect())
+            .unwrap_or_default()
+    };
+    let image = line("image ");
+    ensure!(image.len() == 8, "no depth image:\n{out}");
+    ensure!(image[1] == "32FC1", "encoding {}", image[1]);
+    let (w, h): (usize, usize) = (image[2].parse()?, image[3].parse()?);
+    ensure!((w, h) == (640, 480), "{w}x{h}");
+    ensure!(image[4] == (4 * w).to_string(), "step {}", image[4]);
+    ensure!(image[5] == (4 * w * h).to_string(), "{} bytes", image[5]);
+    ensure!(image[6] == "0", "big-endian");
+    let info = line("info ");
+    ensure!(info.len() == 5, "no depth camera_info:\n{out}");
+    ensure!(
+        info[1] == image[2] && info[2] == image[3],
+        "camera_info {info:?} vs image {image:?}"
+    );
+    ensure!(info[4] == image[7], "frames: {} vs {}", info[4], image[7]);
+    let values = line("values ");
+    ensure!(values.len() == 4, "{out}");
+    let (finite, lo, hi): (usize, f64, f64) =
+        (values[1].parse()?, values[2].parse()?, values[3].parse()?);
+    ensure!(finite > 1000, "{finite} pixels in range:\n{out}");
+    ensure!(
+        lo >= 0.3 - 1e-3 && hi <= 8.0 + 1e-3,
+        "depth {lo}..{hi} m outside the clip range"
+    );
+    graph.wait_rover(Duration::from_secs(120))?;
+    Ok(())
+}

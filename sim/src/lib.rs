@@ -35,9 +35,9 @@ pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
 pub use model::{
     COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
-    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DiffDriveConfig,
-    Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface, IkOptions,
-    IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId, JointKind, JointSolver,
+    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DepthOutput,
+    DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, Ground, HardwareInterface,
+    IkOptions, IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId, JointKind, JointSolver,
     KinematicChain, KinematicsError, Labelled, LaserConfig, Link, LinkId, MAX_LASER_SAMPLES,
     MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model, ModelLink, NamedPose,
     Object, OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel, RobotSpawn,

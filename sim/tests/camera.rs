@@ -133,3 +133,50 @@ fn same_seed_same_bytes_and_noise_has_the_configured_stddev() -> Result<()> {
     );
     Ok(())
 }
+
+/// A depth image from the depth buffer: a 1 m cube whose near face is 2.5 m (then 4.5 m) in
+/// front of the camera, square to the optical axis, reads that distance at every pixel of the
+/// face within 1% (the optical frame's z, constant across the face); the sky beyond the clip
+/// range is NaN; the ground's depth grows toward the horizon.
+#[test]
+fn the_depth_image_holds_each_pixels_distance_along_the_optical_axis() -> Result<()> {
+    let robot = robot()?;
+    let config = robot.cameras[0].clone();
+    let info = CameraInfo::from_config(&config);
+    let camera = Pose::from_translation(Vec3::new(0.0, 0.0, 0.5));
+    for face_m in [2.5f64, 4.5] {
+        let world = cube_world([face_m + 0.5, 0.0, 0.5], 1.0)?;
+        let mut renderer = CameraRenderer::new(&world, &robot, &config, 0)?;
+        renderer.enable_depth();
+        let rgb = renderer.render(&parked(&robot), camera)?.to_vec();
+        let depth = renderer.depth_m().ok_or("no depth image")?;
+        let w = info.width as usize;
+        assert_eq!(depth.len(), w * info.height as usize);
+        // Every red pixel is the cube's near face.
+        let mut face = 0;
+        for (i, p) in rgb.chunks_exact(3).enumerate() {
+            if p[0] > 60 && p[1] < 40 && p[2] < 40 {
+                let d = f64::from(depth[i]);
+                assert!(
+                    (d - face_m).abs() <= 0.01 * face_m,
+                    "pixel ({}, {}) of the face {face_m} m away reads {d} m",
+                    i % w,
+                    i / w
+                );
+                face += 1;
+            }
+        }
+        assert!(face > 1000, "{face} face pixels");
+        // The top row looks at the sky: nothing within the clip range.
+        assert!(depth[..w].iter().all(|d| d.is_nan()));
+        // The bottom row sees the ground: z = height / tan(dip), nearer toward the bottom.
+        let bottom = f64::from(depth[(info.height as usize - 1) * w + w / 2]);
+        let dip = ((f64::from(info.height) - 1.0 - info.k[5]) / info.k[4]).atan();
+        let expected = 0.5 / dip.tan();
+        assert!(
+            (bottom - expected).abs() <= 0.01 * expected,
+            "ground at the bottom row: {bottom} m, expected {expected} m"
+        );
+    }
+    Ok(())
+}

@@ -1,6 +1,8 @@
 //! The camera's image (sensor_msgs/Image, `rgb8`) and its calibration (sensor_msgs/CameraInfo)
 //! on `/<cameraName>/<imageTopicName>` and `/<cameraName>/<cameraInfoTopicName>`, with every
-//! image.
+//! image; a depth camera's depth image (`32FC1`, metres along the optical axis, NaN where
+//! nothing is in range, as gazebo_ros_openni_kinect publishes it) and its camera_info on
+//! `/<cameraName>/<depthImageTopicName>` and `/<cameraName>/<depthImageCameraInfoTopicName>`.
 
 use anyhow::Result;
 use rover_ros1::msgs;
@@ -15,10 +17,13 @@ use super::plan::RosPlan;
 pub(super) struct Camera {
     image: Option<Publisher<msgs::Image>>,
     info: Option<Publisher<msgs::CameraInfo>>,
+    depth_image: Option<Publisher<msgs::Image>>,
+    depth_info: Option<Publisher<msgs::CameraInfo>>,
     /// Whether the run has a camera (its calibration is in `info_msg`).
     calibrated: bool,
     image_msg: msgs::Image,
     info_msg: msgs::CameraInfo,
+    depth_msg: msgs::Image,
 }
 
 impl Camera {
@@ -35,12 +40,26 @@ impl Camera {
                 .as_deref()
                 .map(|t| node.advertise(t, 10, false))
                 .transpose()?,
+            depth_image: plan
+                .depth_image_topic
+                .as_deref()
+                .map(|t| node.advertise(t, 2, false))
+                .transpose()?,
+            depth_info: plan
+                .depth_info_topic
+                .as_deref()
+                .map(|t| node.advertise(t, 10, false))
+                .transpose()?,
             calibrated: false,
             image_msg: msgs::Image {
                 encoding: "rgb8".into(),
                 ..msgs::Image::default()
             },
             info_msg: msgs::CameraInfo::default(),
+            depth_msg: msgs::Image {
+                encoding: "32FC1".into(),
+                ..msgs::Image::default()
+            },
         })
     }
 }
@@ -59,6 +78,7 @@ impl TopicFamily for Camera {
                 p: c.p,
             };
             self.image_msg.header.frame_id = c.frame_id.clone();
+            self.depth_msg.header.frame_id = c.frame_id.clone();
         }
         self.calibrated = start.camera.is_some();
     }
@@ -73,6 +93,7 @@ impl TopicFamily for Camera {
             self.info_msg.header.stamp_s = image.stamp_s;
             p.publish(&self.info_msg);
         }
+        self.publish_depth(image);
         let Some(p) = self.image.as_mut() else {
             return;
         };
@@ -89,15 +110,57 @@ impl TopicFamily for Camera {
     }
 }
 
-/// The image to hand over (on the loop thread): `frame` copied into the recycled `pixels`.
-pub(super) fn capture(frame: &CameraFrame<'_>, mut pixels: Vec<u8>) -> ImageFrame {
+impl Camera {
+    /// The depth image and its camera_info (the colour camera's: the depth image is rendered
+    /// with the same intrinsics), when the frame has one.
+    fn publish_depth(&mut self, image: &mut ImageFrame) {
+        if image.depth.is_empty() {
+            return;
+        }
+        if self.calibrated
+            && let Some(p) = self.depth_info.as_mut()
+        {
+            self.info_msg.header.seq = image.seq as u32;
+            self.info_msg.header.stamp_s = image.stamp_s;
+            p.publish(&self.info_msg);
+        }
+        let Some(p) = self.depth_image.as_mut() else {
+            return;
+        };
+        let msg = &mut self.depth_msg;
+        msg.header.seq = image.seq as u32;
+        msg.header.stamp_s = image.stamp_s;
+        msg.width = image.width;
+        msg.height = image.height;
+        msg.step = image.width * 4;
+        std::mem::swap(&mut msg.data, &mut image.depth);
+        p.publish(msg);
+        std::mem::swap(&mut msg.data, &mut image.depth);
+    }
+}
+
+/// The image to hand over (on the loop thread): `frame` copied into the recycled `pixels`,
+/// its depth image (if any) into `depth` as 32FC1 bytes.
+pub(super) fn capture(
+    frame: &CameraFrame<'_>,
+    mut pixels: Vec<u8>,
+    mut depth: Vec<u8>,
+) -> ImageFrame {
     pixels.clear();
     pixels.extend_from_slice(frame.rgb);
+    depth.clear();
+    if let Some(metres) = frame.depth_m {
+        depth.reserve(metres.len() * 4);
+        for m in metres {
+            depth.extend_from_slice(&m.to_le_bytes());
+        }
+    }
     ImageFrame {
         stamp_s: frame.sim_time_s,
         seq: frame.seq,
         width: frame.width,
         height: frame.height,
         pixels,
+        depth,
     }
 }

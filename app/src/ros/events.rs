@@ -56,6 +56,9 @@ pub(super) struct ImageFrame {
     pub height: u32,
     /// RGB8, rows top to bottom. A family may keep it and leave another buffer in its place.
     pub pixels: Vec<u8>,
+    /// A depth camera's depth image as 32FC1 bytes (little-endian f32 metres along the optical
+    /// axis, NaN for nothing in range, rows top to bottom); empty without one.
+    pub depth: Vec<u8>,
 }
 
 /// The detector's boxes for one image.
@@ -183,7 +186,10 @@ impl BufferReturn {
         match event {
             Event::Start(_) => {}
             Event::Control(c) => send(&self.joints, c.joints),
-            Event::Image(i) => send(&self.pixels, i.pixels),
+            Event::Image(i) => {
+                send(&self.pixels, i.pixels);
+                send(&self.pixels, i.depth);
+            }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
         }

@@ -249,7 +249,12 @@ impl Observer for RosBridge {
 
     fn camera_frame(&mut self, frame: &CameraFrame<'_>, _world_from_camera: Pose) {
         let started = std::time::Instant::now();
-        let image = camera::capture(frame, self.buffers.take_pixels());
+        let depth = if frame.depth_m.is_some() {
+            self.buffers.take_pixels()
+        } else {
+            Vec::new()
+        };
+        let image = camera::capture(frame, self.buffers.take_pixels(), depth);
         self.send(Event::Image(image));
         self.busy += started.elapsed();
     }

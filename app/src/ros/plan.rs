@@ -24,6 +24,11 @@ pub struct RosPlan {
     pub image_topic: Option<String>,
     /// Camera info topic (`/<cameraName>/<cameraInfoTopicName>`).
     pub info_topic: Option<String>,
+    /// A depth camera's depth image topic (`/<cameraName>/<depthImageTopicName>`, 32FC1).
+    pub depth_image_topic: Option<String>,
+    /// A depth camera's depth camera_info topic
+    /// (`/<cameraName>/<depthImageCameraInfoTopicName>`).
+    pub depth_info_topic: Option<String>,
     /// The first laser's topic (`topicName`).
     pub scan_topic: Option<String>,
     /// Every moving joint the session reports, in `/joint_states` order.
@@ -136,6 +141,12 @@ impl RosPlan {
             wheel_tf: drive.publish_wheel_tf,
             image_topic: camera_topic(camera.map_or("image_raw", |c| c.image_topic.as_str())),
             info_topic: camera_topic(camera.map_or("camera_info", |c| c.info_topic.as_str())),
+            depth_image_topic: camera
+                .and_then(|c| c.depth.as_ref())
+                .and_then(|d| camera_topic(&d.image_topic)),
+            depth_info_topic: camera
+                .and_then(|c| c.depth.as_ref())
+                .and_then(|d| camera_topic(&d.info_topic)),
             scan_topic: robot.lasers.first().map(|l| topic(&l.topic)),
             joints: moving_joints(robot, &drive),
             joint_states_hz: robot.controllers.as_ref().and_then(|c| {

@@ -14,7 +14,8 @@ use crate::geometry::{Pose, pose_from_xyz_rpy};
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
-    CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
+    CameraConfig, DepthOutput, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
+    PixelFormat,
 };
 
 /// Everything read from `<gazebo>` elements.
@@ -322,6 +323,7 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
         frame_name: link.to_owned(),
         image_topic: "image_raw".to_owned(),
         info_topic: "camera_info".to_owned(),
+        depth: (sensor.attribute("type") == Some("depth")).then(DepthOutput::default),
         line: Some(line_of(ctx.doc, sensor)),
     };
     let mut plugin_distortion = Distortion::default();
@@ -458,6 +460,16 @@ fn read_camera_plugin(
             "frameName" => c.frame_name = text(),
             "imageTopicName" => c.image_topic = text(),
             "cameraInfoTopicName" => c.info_topic = text(),
+            "depthImageTopicName" => {
+                if let Some(d) = &mut c.depth {
+                    d.image_topic = text();
+                }
+            }
+            "depthImageCameraInfoTopicName" => {
+                if let Some(d) = &mut c.depth {
+                    d.info_topic = text();
+                }
+            }
             "distortionK1" => plugin_distortion.k1 = ctx.number(p, what, "coefficient")?,
             "distortionK2" => plugin_distortion.k2 = ctx.number(p, what, "coefficient")?,
             "distortionK3" => plugin_distortion.k3 = ctx.number(p, what, "coefficient")?,

@@ -96,6 +96,7 @@ pub(crate) mod tests {
             frame_name: "camera_link".into(),
             image_topic: "image_raw".into(),
             info_topic: "camera_info".into(),
+            depth: None,
             line: None,
         }
     }

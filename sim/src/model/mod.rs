@@ -36,7 +36,8 @@ pub use robot::{
     Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
 };
 pub use sensors::{
-    CameraConfig, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES, PixelFormat,
+    CameraConfig, DepthOutput, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
+    PixelFormat,
 };
 pub use world::{
     DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, Ground, JointSolver, Model, ModelLink, Object, Physics,

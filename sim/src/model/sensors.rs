@@ -90,8 +90,29 @@ pub struct CameraConfig {
     pub image_topic: String,
     /// The camera plugin's `<cameraInfoTopicName>` (default `camera_info`).
     pub info_topic: String,
+    /// A depth camera's depth outputs (`<sensor type="depth">`); `None` for a colour camera.
+    pub depth: Option<DepthOutput>,
     /// Line of the `<sensor>` element, for messages.
     pub line: Option<u32>,
+}
+
+/// What a depth camera (`<sensor type="depth">`, gazebo_ros_openni_kinect) publishes besides
+/// its colour image: a 32FC1 depth image (metres along the optical axis) and its camera_info.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepthOutput {
+    /// `<depthImageTopicName>` (default `depth/image_raw`).
+    pub image_topic: String,
+    /// `<depthImageCameraInfoTopicName>` (default `depth/camera_info`).
+    pub info_topic: String,
+}
+
+impl Default for DepthOutput {
+    fn default() -> Self {
+        Self {
+            image_topic: "depth/image_raw".to_owned(),
+            info_topic: "depth/camera_info".to_owned(),
+        }
+    }
 }
 
 /// A 2D laser scanner: `<sensor type="ray">` (or `gpu_ray`) with `libgazebo_ros_laser.so`'s

@@ -33,6 +33,8 @@ pub struct CameraRenderer {
     /// How many labelled things the scene has (ids 1..=entities).
     entities: u32,
     ids: Option<IdOutputs>,
+    /// The depth image's readback and metres, once a depth image is asked for.
+    depth: Option<(Readback, Vec<f32>)>,
 }
 
 /// The id image and silhouettes read back each frame once ground truth is asked for.
@@ -99,6 +101,7 @@ impl CameraRenderer {
             far_m: camera.clip_far_m as f32,
             entities: entity_ids.len() as u32,
             ids: None,
+            depth: None,
         })
     }
 
@@ -123,6 +126,26 @@ impl CameraRenderer {
             },
         });
         Ok(())
+    }
+
+    /// From the next render on, also reads back the depth buffer as a depth image
+    /// ([`Self::depth_m`]). Allocates its buffers once.
+    pub fn enable_depth(&mut self) {
+        if self.depth.is_none() {
+            let (w, h) = (self.info.width, self.info.height);
+            self.depth = Some((
+                Readback::new(&self.gpu.device, "depth readback", w, h),
+                vec![f32::NAN; (w * h) as usize],
+            ));
+        }
+    }
+
+    /// The last render's depth image, once [`Self::enable_depth`] was called: per pixel of
+    /// the ideal pinhole image (no distortion, no noise), rows top to bottom, the distance
+    /// along the optical axis (the optical frame's z, as ROS depth images hold it) to what
+    /// the pixel shows (m); NaN where nothing is within the clip range.
+    pub fn depth_m(&self) -> Option<&[f32]> {
+        self.depth.as_ref().map(|(_, metres)| metres.as_slice())
     }
 
     /// The last rendered image (RGB8 rows, top to bottom, after distortion and noise).
@@ -164,6 +187,26 @@ impl CameraRenderer {
             ),
             Vec4::new(0.0, 0.0, -f * n / (f - n), 0.0),
         )
+    }
+
+    /// Turns the read-back depth buffer into metres along the optical axis: the projection
+    /// maps z in [near, far] to d = f (z - n) / (z (f - n)), so z = f n / (f - d (f - n)).
+    fn read_depth(&mut self) -> Result<(), RenderError> {
+        let Some((readback, metres)) = &mut self.depth else {
+            return Ok(());
+        };
+        let (n, f) = (self.near_m, self.far_m);
+        let w = self.info.width as usize;
+        readback.read_rows(&self.gpu.device, |y, row| {
+            for (out, d) in metres[y * w..][..w].iter_mut().zip(row.chunks_exact(4)) {
+                let d = f32::from_le_bytes([d[0], d[1], d[2], d[3]]);
+                *out = if d < 1.0 {
+                    f * n / (f - d * (f - n))
+                } else {
+                    f32::NAN
+                };
+            }
+        })
     }
 
     /// Whether some SDF model link can move (so [`Self::set_model_link_poses`] matters).
@@ -241,6 +284,9 @@ impl CameraRenderer {
         if let Some(ids) = &self.ids {
             ids.readback.copy_from(&mut encoder, &self.colour.ids);
         }
+        if let Some((readback, _)) = &self.depth {
+            readback.copy_from(&mut encoder, &self.colour.depth);
+        }
         if let Some(ids) = silhouette {
             ids.silhouette.copy_out(&mut encoder);
         }
@@ -254,6 +300,7 @@ impl CameraRenderer {
             }
         })?;
         self.post.run();
+        self.read_depth()?;
         if let Some(ids) = &mut self.ids {
             let image = &mut ids.image;
             let ideal = &mut image.ideal_ids;

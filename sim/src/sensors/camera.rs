@@ -29,6 +29,11 @@ pub struct CameraFrame<'a> {
     pub ground_truth: &'a [GroundTruthBox],
     /// The instance-id image of the same frame (`None` unless ground truth is enabled).
     pub entities: Option<&'a EntityImage>,
+    /// The depth image of the same frame (`None` unless [`CameraSensor::enable_depth`]: a
+    /// `<sensor type="depth">` has it on): per pixel, rows top to bottom, the distance along
+    /// the optical axis (m; the optical frame's z, as a ROS 32FC1 depth image holds it), NaN
+    /// where nothing is within the clip range. The ideal pinhole image: no distortion or noise.
+    pub depth_m: Option<&'a [f32]>,
 }
 
 /// A robot camera rendering at its update rate.
@@ -63,7 +68,10 @@ impl CameraSensor {
                 config.link
             )))
         })?;
-        let renderer = CameraRenderer::new(sim.world(), robot, config, sim.seed())?;
+        let mut renderer = CameraRenderer::new(sim.world(), robot, config, sim.seed())?;
+        if config.depth.is_some() {
+            renderer.enable_depth();
+        }
         Ok(Self {
             renderer,
             link,
@@ -91,6 +99,12 @@ impl CameraSensor {
             self.truth = Some((GroundTruth::new(sim.world())?, Vec::new()));
         }
         Ok(())
+    }
+
+    /// From the next image on, every frame carries its depth image
+    /// ([`CameraFrame::depth_m`]).
+    pub fn enable_depth(&mut self) {
+        self.renderer.enable_depth();
     }
 
     /// The intrinsics.
@@ -202,6 +216,7 @@ impl CameraSensor {
             rgb: self.renderer.rgb(),
             ground_truth,
             entities,
+            depth_m: self.renderer.depth_m(),
         })
     }
 }

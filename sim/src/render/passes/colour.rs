@@ -47,6 +47,9 @@ pub(crate) struct ColourPass {
     /// Each pixel's labelled-entity id (R32Uint, 0: nothing labelled).
     pub(crate) ids: wgpu::Texture,
     ids_view: wgpu::TextureView,
+    /// The depth buffer (Depth32Float, 0 at the near clip, 1 at the far clip and where
+    /// nothing was drawn), copied out for a depth camera.
+    pub(crate) depth: wgpu::Texture,
     depth_view: wgpu::TextureView,
     checker: Rgba,
     checker_size_m: f32,
@@ -117,7 +120,7 @@ impl ColourPass {
         });
         let pipeline = pipeline(device, &layout, &scene.materials.layout);
         let target = texture(device, "camera color", width, height, COLOR_FORMAT, true);
-        let depth = texture(device, "camera depth", width, height, DEPTH_FORMAT, false);
+        let depth = texture(device, "camera depth", width, height, DEPTH_FORMAT, true);
         let ids = texture(device, "camera entity ids", width, height, ID_FORMAT, true);
         Self {
             pipeline,
@@ -125,6 +128,7 @@ impl ColourPass {
             bind_group,
             target_view: target.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
+            depth,
             target,
             ids_view: ids.create_view(&Default::default()),
             ids,
@@ -207,7 +211,8 @@ impl ColourPass {
                 view: &self.depth_view,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
+                    // Kept: a depth camera reads it back.
+                    store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
             }),
