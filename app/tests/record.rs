@@ -204,3 +204,52 @@ fn a_recorded_run_with_ground_truth_shows_truth_beside_detections() -> Result<()
     }
     Ok(())
 }
+
+/// A depth camera (TIAGo's xtion, `<sensor type="depth">`): each logged image has its depth
+/// image beside it under the camera's pinhole, as a Rerun `DepthImage` in metres.
+#[test]
+fn a_recorded_depth_camera_logs_its_depth_image_with_each_image() -> Result<()> {
+    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
+        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+        return Ok(());
+    };
+    let urdf = data.join(
+        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
+    );
+    let urdf = urdf.to_string_lossy();
+    let (entities, _dir) = record(
+        &[
+            "--robot",
+            urdf.as_ref(),
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+            "--duration",
+            "1",
+        ],
+        "",
+    )?;
+    let names: Vec<_> = entities.keys().cloned().collect();
+    let get = |path: &str| {
+        entities
+            .get(path)
+            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
+    };
+    let image = get("/world/robot/camera/image")?;
+    let depth = get("/world/robot/camera/image/depth")?;
+    println!(
+        "images {}, depth images {}: {:?}",
+        image.timed_rows, depth.timed_rows, depth.components
+    );
+    assert!(depth.timed_rows > 10, "{} depth images", depth.timed_rows);
+    assert!(
+        depth.components.iter().any(|c| c.contains("DepthImage")),
+        "{:?}",
+        depth.components
+    );
+    assert!(
+        depth.components.iter().any(|c| c.contains("meter")),
+        "{:?}",
+        depth.components
+    );
+    Ok(())
+}

@@ -5,6 +5,8 @@ use rover_sim::CameraFrame;
 
 /// Entity path of the camera image.
 pub(super) const IMAGE_PATH: &str = "world/robot/camera/image";
+/// Entity path of a depth camera's depth image (metres, under the camera's pinhole).
+pub(super) const DEPTH_PATH: &str = "world/robot/camera/image/depth";
 
 /// How camera images are logged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,6 +116,19 @@ impl ImageLogger {
         };
         if let Err(e) = result {
             tracing::warn!("rerun: {IMAGE_PATH}: {e}");
+        }
+        // A depth camera's depth image, full size only (the pinhole is the logged size's).
+        if let Some(depth) = frame.depth_m.filter(|_| factor == 1) {
+            let bytes: Vec<u8> = depth.iter().flat_map(|m| m.to_le_bytes()).collect();
+            let image = rerun::DepthImage::from_data_type_and_bytes(
+                bytes,
+                [frame.width, frame.height],
+                rerun::datatypes::ChannelDatatype::F32,
+            )
+            .with_meter(1.0);
+            if let Err(e) = rec.log(DEPTH_PATH, &image) {
+                tracing::warn!("rerun: {DEPTH_PATH}: {e}");
+            }
         }
     }
 }

@@ -17,6 +17,7 @@
 //! world/robot/camera                     Transform3D base_from_camera_optical, static
 //! world/robot/camera/image               Pinhole (Gazebo's K), Image, AnnotationContext
 //! world/robot/camera/image/detections    Boxes2D "person 0.87" with class ids
+//! world/robot/camera/image/depth         DepthImage (metres) of a <sensor type="depth">
 //! world/robot/camera/image/ground_truth  Boxes2D (with --ground-truth): each labelled thing's
 //!                                        visible box, "person (truth)" or "MISSED person";
 //!                                        ignore regions under .../ground_truth/ignore
