@@ -274,8 +274,11 @@ pub struct CameraBench {
 pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
     let (world, robot) = config.load_world_and_robot()?;
     let mut sim = Simulation::new(world, robot, &config.options)?;
+    // The colour image alone, then with ground truth, then with a depth image.
     let mut sensor = rover_sim::CameraSensor::new(&sim)?;
+    sensor.disable_depth();
     let mut truth = rover_sim::CameraSensor::new(&sim)?;
+    truth.disable_depth();
     truth.enable_ground_truth(&sim)?;
     let mut depth = rover_sim::CameraSensor::new(&sim)?;
     depth.enable_depth();

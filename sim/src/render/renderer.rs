@@ -140,6 +140,11 @@ impl CameraRenderer {
         }
     }
 
+    /// Stops reading the depth buffer back (and frees its buffers).
+    pub fn disable_depth(&mut self) {
+        self.depth = None;
+    }
+
     /// The last render's depth image, once [`Self::enable_depth`] was called: per pixel of
     /// the ideal pinhole image (no distortion, no noise), rows top to bottom, the distance
     /// along the optical axis (the optical frame's z, as ROS depth images hold it) to what

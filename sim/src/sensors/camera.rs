@@ -107,6 +107,11 @@ impl CameraSensor {
         self.renderer.enable_depth();
     }
 
+    /// From the next image on, no depth image (a depth camera's colour image only).
+    pub fn disable_depth(&mut self) {
+        self.renderer.disable_depth();
+    }
+
     /// The intrinsics.
     pub fn info(&self) -> &CameraInfo {
         self.renderer.info()
