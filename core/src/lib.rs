@@ -17,6 +17,7 @@ mod follower;
 mod headless;
 mod input;
 mod judge;
+mod look;
 mod observer;
 mod paths;
 mod pilot;
@@ -43,6 +44,7 @@ pub use headless::{
 };
 pub use input::{Action, InputSource, JointAction, NoInput};
 pub use judge::{ClassTally, LiveJudge, MATCH_IOU, eval_objects};
+pub use look::{Look, LookConfig};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
 pub use pilot::{Mode, Pilot};

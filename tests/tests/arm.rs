@@ -460,3 +460,83 @@ fn tiago_ik_solves_20_reachable_targets_and_the_simulated_tool_gets_there() -> R
     println!("full-range targets: iterations {iterations:?}");
     Ok(())
 }
+
+/// Look, with the real renderer and the real default detector: TIAGo's head turns so the box
+/// of a person standing 3.2 m away, 20 degrees to the left (170 px off the image centre at
+/// first) converges on the image centre, within 32 px in 3 s of sim time; from the boxes, the
+/// xtion's intrinsics and the head's joint positions only.
+#[test]
+fn tiago_looks_at_the_person_the_detector_sees() -> Result<()> {
+    use rover_core::{Look, LookConfig};
+    use rover_perception::{Detector, DetectorConfig, FrameStamp, RgbView};
+    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
+        return Ok(());
+    };
+    let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+    robot.set_drive(&DriveSpec {
+        left_joint: "wheel_left_joint".into(),
+        right_joint: "wheel_right_joint".into(),
+        wheel_separation_m: None,
+        wheel_diameter_m: None,
+        wheel_torque_nm: None,
+    })?;
+    let world = World::from_str(
+        "[[person]]\nname = \"alice\"\nposition_m = [3.0, 1.1]\nheading_deg = 200.0\n",
+        std::path::Path::new("look.toml"),
+    )?;
+    let options = SimOptions {
+        cmd_timeout_s: Some(0.0),
+        ..SimOptions::default()
+    };
+    let mut sim = Simulation::new(world, robot, &options)?;
+    for (name, q) in HOME {
+        sim.command_joint(name, JointCommand::Position(q))?;
+    }
+    run_for(&mut sim, 1.0);
+    let camera_config = sim.robot().cameras[0].clone();
+    let mut look = Look::new(
+        sim.robot(),
+        &camera_config,
+        "torso_lift_link",
+        LookConfig::default(),
+    )?;
+    let names: Vec<String> = look.joints().iter().map(|j| j.name.clone()).collect();
+    assert_eq!(names, ["head_1_joint", "head_2_joint"]);
+    let mut camera = rover_sim::CameraSensor::new(&sim)?;
+    camera.disable_depth();
+    let (cx, cy) = (camera.info().k[2], camera.info().k[5]);
+    let mut detector = Detector::load(DetectorConfig::default())?;
+    let start_s = sim.sim_time_s();
+    let mut offsets = Vec::new();
+    while sim.sim_time_s() < start_s + 3.0 + 1e-6 {
+        let frame = camera.capture(&sim)?;
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let stamp = FrameStamp {
+            sim_time_s: frame.sim_time_s,
+            frame: frame.seq,
+        };
+        let rgb = frame.rgb.to_vec();
+        let boxes = detector.detect(RgbView::new(w, h, &rgb)?, stamp)?;
+        let q: Vec<f64> = names
+            .iter()
+            .map(|n| state(&sim, n).map(|s| s.position))
+            .collect::<Result<_>>()?;
+        if let Some(targets) = look.observe(&boxes, &q)? {
+            let px = look.looked_at_px().unwrap_or([cx, cy]);
+            offsets.push((sim.sim_time_s() - start_s, (px[0] - cx).hypot(px[1] - cy)));
+            for (name, target) in names.iter().zip(targets) {
+                sim.command_joint(name, JointCommand::Position(target))?;
+            }
+        }
+        run_for(&mut sim, 0.2);
+    }
+    println!("(s, px off centre): {offsets:.1?}");
+    let first = offsets.first().map_or(0.0, |o| o.1);
+    assert!(first > 100.0, "the person starts off centre: {offsets:?}");
+    let (t, last) = offsets.last().copied().unwrap_or((0.0, f64::INFINITY));
+    assert!(
+        last <= 32.0 && t <= 3.0 + 1e-6,
+        "the box centre is {last} px off the image centre at {t} s: {offsets:?}"
+    );
+    Ok(())
+}

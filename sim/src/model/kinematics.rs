@@ -308,6 +308,49 @@ impl KinematicChain {
         pose
     }
 
+    /// Joint changes (clamped so the result stays within the limits) that turn `axis_tip` (a
+    /// unit vector in the tip's frame, e.g. a camera's optical axis) toward `toward_tip`
+    /// (a unit vector in the tip's frame, e.g. the ray through a pixel), by damped least
+    /// squares on the chain's angular Jacobian: a pan-tilt head or a wrist looks at a point.
+    pub fn pointing_step(
+        &self,
+        q: &[f64],
+        axis_tip: Vector3<f64>,
+        toward_tip: Vector3<f64>,
+        damping: f64,
+    ) -> Result<Vec<f64>, KinematicsError> {
+        self.check(q)?;
+        let mut axes = vec![Vector3::zeros(); self.joints.len()];
+        let tip = self.walk(q, |i, _, axis| axes[i] = axis);
+        let (from, to) = (tip.rotation * axis_tip, tip.rotation * toward_tip);
+        let cross = from.cross(&to);
+        let angle = cross.norm().atan2(from.dot(&to));
+        let rotation = match cross.try_normalize(1e-12) {
+            Some(unit) => unit * angle,
+            None => return Ok(vec![0.0; q.len()]),
+        };
+        // J_w is 3 x n: columns are the revolute joints' axes (a slide turns nothing).
+        let mut a = nalgebra::Matrix3::identity() * damping * damping;
+        for (axis, joint) in axes.iter().zip(&self.joints) {
+            if !joint.prismatic {
+                a += axis * axis.transpose();
+            }
+        }
+        let Some(cholesky) = a.cholesky() else {
+            return Ok(vec![0.0; q.len()]);
+        };
+        let y = cholesky.solve(&rotation);
+        Ok(axes
+            .iter()
+            .zip(&self.joints)
+            .zip(q)
+            .map(|((axis, joint), q)| {
+                let step = if joint.prismatic { 0.0 } else { axis.dot(&y) };
+                joint.clamp(q + step) - q
+            })
+            .collect())
+    }
+
     /// An in-limit pose drawn from `rng` (continuous joints within ±π).
     pub fn random_pose(&self, rng: &mut SplitMix64) -> Vec<f64> {
         self.joints
@@ -685,6 +728,25 @@ mod tests {
                 got: 1
             })
         ));
+    }
+
+    #[test]
+    fn a_pointing_step_turns_the_tip_toward_a_direction() {
+        // The planar arm's tool x axis, turned toward a direction 0.3 rad to its left: the
+        // revolute joints turn by 0.3 rad between them (least squares splits it).
+        let chain = KinematicChain::new(&arm(), "base", "tool").expect("chain");
+        let q = [0.1, 0.2, -0.4];
+        let toward = Vector3::new(0.3f64.cos(), 0.3f64.sin(), 0.0);
+        let step = chain
+            .pointing_step(&q, Vector3::x(), toward, 1e-3)
+            .expect("step");
+        assert!(step[0].abs() < 1e-12, "the lift does not turn: {step:?}");
+        assert!((step[1] + step[2] - 0.3).abs() < 1e-3, "{step:?}");
+        // Already pointing there: no change.
+        let none = chain
+            .pointing_step(&q, Vector3::x(), Vector3::x(), 1e-3)
+            .expect("step");
+        assert!(none.iter().all(|s| s.abs() < 1e-12), "{none:?}");
     }
 
     #[test]
