@@ -608,13 +608,8 @@ impl Observer for Probe {
 
 /// Judges a run's metrics against `scenario`'s criteria (what [`run_scenario`] does at the
 /// end; also for re-judging saved metrics against other bounds).
-///
-/// `min_clearance_m` is judged only for a robot with a range sensor: without one the follower
-/// cannot see obstacles (the scenarios about obstacles `need` a laser); the clearance is still
-/// measured and shown.
 pub fn judge_scenario(scenario: &Scenario, m: &ScenarioMetrics) -> Vec<ScenarioCheck> {
     let (criteria, follow_at_s) = (&scenario.criteria, scenario.follow_at_s);
-    let sees_obstacles = Sensor::Laser.on(&scenario.robot);
     let mut checks = Vec::new();
     let mut check = |name: &str, limit: String, value: String, passed: bool| {
         checks.push(ScenarioCheck {
@@ -653,22 +648,11 @@ pub fn judge_scenario(scenario: &Scenario, m: &ScenarioMetrics) -> Vec<ScenarioC
         );
     }
     if let Some(limit) = criteria.min_clearance_m {
-        let (limit, passed) = if sees_obstacles {
-            (format!("> {limit:.2} m"), m.min_clearance_m > limit)
-        } else {
-            (
-                format!(
-                    "> {limit:.2} m, not judged: {} has no range sensor to see obstacles",
-                    scenario.robot_name
-                ),
-                true,
-            )
-        };
         check(
             "min_clearance_m",
-            limit,
+            format!("> {limit:.2} m"),
             format!("{:.3} m", m.min_clearance_m),
-            passed,
+            m.min_clearance_m > limit,
         );
     }
     if let Some(limit) = criteria.min_person_range_m {

@@ -182,38 +182,6 @@ fn the_tutorials_camera_only_car_follows_a_walker_who_stops_and_keeps_its_person
     Ok(())
 }
 
-/// Obstacle clearance is judged only for robots with a range sensor: the camera-only car
-/// cannot see the walking world's boxes (it may back into one giving way to a person); the
-/// clearance is still measured and shown, and the laser car is held to it.
-#[test]
-fn clearance_is_judged_only_for_robots_that_can_see_obstacles() -> Result<()> {
-    let touching = rover_core::ScenarioMetrics {
-        min_clearance_m: 0.0,
-        ..rover_core::ScenarioMetrics::default()
-    };
-    let clearance = |robot: Option<&str>| -> Result<rover_core::ScenarioCheck> {
-        let robot = robot.map(repo);
-        let scenario =
-            Scenario::load_with_robot(&repo("scenarios/walking_square.toml"), robot.as_deref())?;
-        rover_core::judge_scenario(&scenario, &touching)
-            .into_iter()
-            .find(|c| c.name == "min_clearance_m")
-            .ok_or_else(|| anyhow::anyhow!("walking_square has a clearance criterion"))
-    };
-    let laser = clearance(None)?;
-    assert!(!laser.passed, "{laser:?}");
-    let camera_only = clearance(Some("assets/robots/my_robot.urdf"))?;
-    assert!(camera_only.passed, "{camera_only:?}");
-    assert!(
-        camera_only
-            .limit
-            .contains("not judged: my_robot has no range sensor"),
-        "{camera_only:?}"
-    );
-    assert_eq!(camera_only.value, "0.000 m");
-    Ok(())
-}
-
 /// `rover eval` judges the detector too: every result against the renderer's ground truth of
 /// its image, with COCO's rules (real renderer, real default detector). With the person behind
 /// the car it turns, finds them and drives up: the person is seen whole and recall and

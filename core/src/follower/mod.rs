@@ -336,6 +336,14 @@ const FOV_MARGIN_RAD: f64 = 0.15;
 const CONTRADICTED_MESSAGES: u32 = 2;
 /// Pose history length: enough for a few seconds of control updates at 100 Hz.
 const HISTORY: usize = 512;
+/// The robot's trail keeps a point every this far (m) ...
+const TRAIL_SPACING_M: f64 = 0.05;
+/// ... this many of them (20 m of driving).
+const TRAIL_POINTS: usize = 400;
+/// Backing up without a range sensor needs the ground this far behind the base (m) ...
+const REVERSE_LOOK_M: f64 = 0.35;
+/// ... to be within this of the trail (m): ground the robot has driven over.
+const TRAIL_WIDTH_M: f64 = 0.12;
 /// Laser returns within this distance of the target's prediction are taken to be the target
 /// (m), and returns this close to it are not obstacles.
 const LASER_GATE_M: f64 = 0.4;
@@ -398,6 +406,9 @@ pub struct Follower {
     search_sign: f64,
     /// Whether the search is still turning to face the prediction (before it sweeps).
     search_facing: bool,
+    /// Where the robot has been (odometry frame, m): every [`TRAIL_SPACING_M`], the last
+    /// [`TRAIL_POINTS`].
+    trail: VecDeque<[f64; 2]>,
     /// The newest scan's returns in the odometry frame, and its time.
     returns_odom: Vec<[f64; 2]>,
     scan_s: Option<f64>,
@@ -448,6 +459,7 @@ impl Follower {
             last_cmd_s: None,
             state: FollowState::Waiting,
             poses: VecDeque::with_capacity(HISTORY),
+            trail: VecDeque::with_capacity(TRAIL_POINTS),
             search_sign: 1.0,
             search_facing: false,
             returns_odom: Vec::new(),
@@ -525,6 +537,28 @@ impl Follower {
             self.poses.pop_front();
         }
         self.poses.push_back((now_s, odom));
+        let here = [odom.x_m, odom.y_m];
+        if self
+            .trail
+            .back()
+            .is_none_or(|p| (p[0] - here[0]).hypot(p[1] - here[1]) >= TRAIL_SPACING_M)
+        {
+            if self.trail.len() == TRAIL_POINTS {
+                self.trail.pop_front();
+            }
+            self.trail.push_back(here);
+        }
+    }
+
+    /// Whether the ground [`REVERSE_LOOK_M`] behind the base is ground the robot has driven
+    /// over (within [`TRAIL_WIDTH_M`] of its trail): the only ground a robot without a range
+    /// sensor knows to be free behind it.
+    fn driven_behind(&self, odom: Odometry) -> bool {
+        let (s, c) = odom.yaw_rad.sin_cos();
+        let behind = [odom.x_m - REVERSE_LOOK_M * c, odom.y_m - REVERSE_LOOK_M * s];
+        self.trail
+            .iter()
+            .any(|p| (p[0] - behind[0]).hypot(p[1] - behind[1]) <= TRAIL_WIDTH_M)
     }
 
     /// Range (m, horizontal, from the camera) and bearing (rad, positive left, from the
@@ -1052,6 +1086,12 @@ impl Follower {
             }
         } else {
             0.0
+        };
+        // Without a range sensor, backing up is blind: only over ground already driven.
+        let linear = if linear < 0.0 && self.laser.is_none() && !self.driven_behind(odom) {
+            0.0
+        } else {
+            linear
         };
         let preferred = Twist::new(linear, angular);
         self.avoid(preferred, here, speed_cap, now_s, odom)
@@ -1681,31 +1721,53 @@ mod tests {
     fn a_camera_only_car_gives_way_to_a_walker_coming_closer() {
         // A person walks straight at the car at 0.4 m/s from 4 m. Without a laser, the car keeps
         // them where its camera sees them whole (2.49 m from the camera): it backs away instead
-        // of letting them walk into its blind zone.
+        // of letting them walk into its blind zone, over the 3 m it drove to get here; where it
+        // has not driven it does not back up blind.
         let config = FollowerConfig::default();
-        let mut f = Follower::new(config.clone(), camera());
         let whole_m = camera().whole_view_range_m(config.target_height_m) + camera().forward_m;
-        let mut odom = Odometry::default();
-        f.command(0.0, odom, true);
-        let mut nearest_m = f64::INFINITY;
-        let mut backed_m = 0.0f64;
-        for i in 1..=1200 {
-            let t = f64::from(i) * 0.01;
-            let person = [4.0 - 0.4 * t, 0.0];
-            if i % 20 == 0 {
-                f.observe(&message(t, vec![seen_box(odom, person)]));
+        let run = |came_from_m: f64| {
+            let mut f = Follower::new(config.clone(), camera());
+            for i in 0..=100 {
+                let x = -came_from_m * (1.0 - f64::from(i) / 100.0);
+                let pose = Odometry {
+                    x_m: x,
+                    ..Odometry::default()
+                };
+                f.record_pose(-1.0 + f64::from(i) * 0.01, pose);
             }
-            let cmd = f.command(t, odom, true);
-            drive(&mut odom, cmd, 0.01);
-            backed_m = backed_m.min(odom.x_m);
-            if t > 4.0 {
-                nearest_m = nearest_m.min(person[0] - odom.x_m);
+            let mut odom = Odometry::default();
+            f.command(0.0, odom, true);
+            let (mut nearest_m, mut backed_m) = (f64::INFINITY, 0.0f64);
+            for i in 1..=1200 {
+                let t = f64::from(i) * 0.01;
+                let person = [4.0 - 0.4 * t, 0.0];
+                if i % 20 == 0 && person[0] - odom.x_m > 1.0 {
+                    f.observe(&message(t, vec![seen_box(odom, person)]));
+                }
+                let cmd = f.command(t, odom, true);
+                drive(&mut odom, cmd, 0.01);
+                backed_m = backed_m.min(odom.x_m);
+                // While its trail lasts (it ends 3 m back, reached after ~10 s).
+                if t > 4.0 && t <= 9.0 {
+                    nearest_m = nearest_m.min(person[0] - odom.x_m);
+                }
             }
-        }
+            (backed_m, nearest_m)
+        };
+        let (backed_m, nearest_m) = run(3.0);
         assert!(backed_m < -2.0, "backed away {backed_m} m");
+        assert!(
+            backed_m > -3.0 - REVERSE_LOOK_M,
+            "backed off its trail: {backed_m} m"
+        );
         assert!(
             nearest_m > whole_m - 0.5,
             "let the person within {nearest_m} m (sees them whole from {whole_m} m)"
+        );
+        let (blind_m, _) = run(0.0);
+        assert!(
+            blind_m > -0.05,
+            "backed {blind_m} m over ground it never drove"
         );
         // With a laser the standoff is kept instead: the laser sees them at any range.
         let mut f = Follower::new(config.clone(), camera()).with_laser(LaserMount::default());
