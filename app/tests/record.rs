@@ -47,6 +47,14 @@ fn read_rrd(path: &std::path::Path) -> Result<BTreeMap<String, Entity>> {
     Ok(out)
 }
 
+/// The recorded entity at `path`, or an error listing the entities there are.
+fn entity<'a>(entities: &'a BTreeMap<String, Entity>, path: &str) -> Result<&'a Entity> {
+    entities.get(path).ok_or_else(|| {
+        let names: Vec<_> = entities.keys().collect();
+        anyhow::anyhow!("{path} missing; entities: {names:?}")
+    })
+}
+
 /// Runs `rover --headless --record` with `args` and a script of `steps`; returns the
 /// recording's entities and the folder (which holds `run.rrd` and `trace.csv`).
 fn record(args: &[&str], steps: &str) -> Result<(BTreeMap<String, Entity>, tempfile::TempDir)> {
@@ -80,13 +88,8 @@ fn a_recorded_headless_run_reads_back_with_every_entity() -> Result<()> {
         "{ at = 0.0, cmd_vel = [0.3, 0.2] }, { at = 1.0, toggle = \"follow\" }",
     )?;
     let trace = dir.path().join("trace.csv");
-    let names: Vec<_> = entities.keys().cloned().collect();
-    println!("{names:#?}");
-    let get = |path: &str| {
-        entities
-            .get(path)
-            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
-    };
+    println!("{:#?}", entities.keys().collect::<Vec<_>>());
+    let get = |path: &str| entity(&entities, path);
     // Static scene.
     assert!(
         get("/world")?
@@ -152,13 +155,7 @@ fn a_recorded_arm_moves_its_links_and_plots_its_joints() -> Result<()> {
         ],
         "{ at = 0.2, pose = \"reach\" }",
     )?;
-    let names: Vec<_> = entities.keys().cloned().collect();
-    let timed = |path: &str| {
-        entities
-            .get(path)
-            .map(|e| e.timed_rows)
-            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
-    };
+    let timed = |path: &str| entity(&entities, path).map(|e| e.timed_rows);
     // 2 s of 100 Hz control updates.
     for joint in [
         "shoulder_pan_joint",
@@ -183,12 +180,7 @@ fn a_recorded_run_with_ground_truth_shows_truth_beside_detections() -> Result<()
         &["--duration", "2", "--ground-truth"],
         "{ at = 0.0, toggle = \"follow\" }",
     )?;
-    let names: Vec<_> = entities.keys().cloned().collect();
-    let get = |path: &str| {
-        entities
-            .get(path)
-            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
-    };
+    let get = |path: &str| entity(&entities, path);
     let detections = get("/world/robot/camera/image/detections")?.timed_rows;
     assert!(detections >= 9, "{detections} detection results");
     let truth = get("/world/robot/camera/image/ground_truth")?;
@@ -209,13 +201,9 @@ fn a_recorded_run_with_ground_truth_shows_truth_beside_detections() -> Result<()
 /// image beside it under the camera's pinhole, as a Rerun `DepthImage` in metres.
 #[test]
 fn a_recorded_depth_camera_logs_its_depth_image_with_each_image() -> Result<()> {
-    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
-        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
         return Ok(());
     };
-    let urdf = data.join(
-        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
-    );
     let urdf = urdf.to_string_lossy();
     let (entities, _dir) = record(
         &[
@@ -228,12 +216,7 @@ fn a_recorded_depth_camera_logs_its_depth_image_with_each_image() -> Result<()> 
         ],
         "",
     )?;
-    let names: Vec<_> = entities.keys().cloned().collect();
-    let get = |path: &str| {
-        entities
-            .get(path)
-            .ok_or_else(|| anyhow::anyhow!("{path} missing; entities: {names:?}"))
-    };
+    let get = |path: &str| entity(&entities, path);
     let image = get("/world/robot/camera/image")?;
     let depth = get("/world/robot/camera/image/depth")?;
     println!(

@@ -211,6 +211,28 @@ impl RosGraph {
         Ok(())
     }
 
+    /// Writes `script` to `<dir>/<name>` and runs it with the graph's python, as [`Self::run`].
+    fn run_python(&self, name: &str, script: &str, timeout: Duration) -> Result<String> {
+        let path = self.dir.path().join(name);
+        std::fs::write(&path, script)?;
+        let mut c = self.command(PYTHON);
+        c.arg(&path);
+        self.run(c, timeout)
+    }
+
+    /// Starts rover with TIAGo (`urdf`), its wheels driven, and `extra` arguments.
+    fn spawn_tiago(&mut self, duration_s: f64, urdf: &Path, extra: &[&str]) -> Result<()> {
+        let urdf = urdf.to_string_lossy();
+        let mut args = vec![
+            "--robot",
+            urdf.as_ref(),
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+        ];
+        args.extend_from_slice(extra);
+        self.spawn_rover(duration_s, &args)
+    }
+
     /// Runs a ROS tool to completion (killed after `timeout`); returns its stdout + stderr.
     fn run(&self, mut command: Command, timeout: Duration) -> Result<String> {
         let mut child = command
@@ -472,14 +494,11 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     graph.spawn_rover(45.0, &[])?;
 
     // /odom as a rospy node sees it, for comparison with the trace.
-    let recorder = graph.dir.path().join("odom.py");
-    std::fs::write(
-        &recorder,
+    let odom = graph.run_python(
+        "odom.py",
         "import math, threading, rospy\nfrom nav_msgs.msg import Odometry\nrospy.init_node('odom_check')\ngot = []\ndone = threading.Event()\ndef keep(m):\n    if len(got) < 200:\n        got.append(m)\n    else:\n        done.set()\nrospy.Subscriber('/odom', Odometry, keep, queue_size=500)\ndone.wait(60)\nfor m in got[:200]:\n    q = m.pose.pose.orientation\n    print('%d.%09d %.12f %.12f %.12f %s %s' % (m.header.stamp.secs, m.header.stamp.nsecs, m.pose.pose.position.x, m.pose.pose.position.y, 2 * math.atan2(q.z, q.w), m.header.frame_id, m.child_frame_id))\n",
+        Duration::from_secs(60),
     )?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&recorder);
-    let odom = graph.run(c, Duration::from_secs(60))?;
 
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["echo", "-n", "1", "/darknet_ros/bounding_boxes"])
@@ -683,36 +702,24 @@ fn rostopic_drives_tiagos_torso_and_arm_through_its_controllers() -> Result<()> 
     if !ok {
         return skip("python3-trajectory-msgs is not installed (./test installs it)");
     }
-    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
-        return skip("PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
     };
-    let urdf = data.join(
-        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
-    );
     let controllers = repo().join("assets/controllers/tiago_no_hand.yaml");
     let mut graph = RosGraph::start()?;
-    let robot_args = [
-        "--robot",
-        &urdf.to_string_lossy(),
-        "--drive",
-        "wheel_left_joint,wheel_right_joint",
-        "--controllers",
-        &controllers.to_string_lossy(),
-        "--no-detector",
-    ]
-    .map(str::to_owned);
-    let args: Vec<&str> = robot_args.iter().map(String::as_str).collect();
-    graph.spawn_rover(26.0, &args)?;
+    let controllers = controllers.to_string_lossy();
+    graph.spawn_tiago(
+        26.0,
+        &urdf,
+        &["--controllers", controllers.as_ref(), "--no-detector"],
+    )?;
 
     // /joint_states as a rospy node sees it: names and stamps of 20 messages.
-    let listener = graph.dir.path().join("joint_states.py");
-    std::fs::write(
-        &listener,
+    let states = graph.run_python(
+        "joint_states.py",
         "import threading, rospy\nfrom sensor_msgs.msg import JointState\nrospy.init_node('joint_states_check')\ngot = []\ndone = threading.Event()\ndef keep(m):\n    got.append(m)\n    if len(got) >= 20:\n        done.set()\nrospy.Subscriber('/joint_states', JointState, keep, queue_size=100)\ndone.wait(30)\nfor m in got[:20]:\n    print('%.6f %d %d %d %s' % (m.header.stamp.to_sec(), len(m.name), len(m.position), len(m.effort), ','.join(m.name)))\n",
+        Duration::from_secs(40),
     )?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&listener);
-    let states = graph.run(c, Duration::from_secs(40))?;
     let lines: Vec<Vec<&str>> = states
         .lines()
         .map(|l| l.split(' ').collect::<Vec<_>>())
@@ -847,30 +854,16 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
     if let Some(why) = missing_ros() {
         return skip(&why);
     }
-    let Some(data) = rover_tests::pypi("example-robot-data", "6.0.0") else {
-        return skip("PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
     };
-    let urdf = data.join(
-        "cmeel.prefix/share/example-robot-data/robots/tiago_description/robots/tiago_no_hand.urdf",
-    );
     let mut graph = RosGraph::start()?;
-    let robot_args = [
-        "--robot",
-        &urdf.to_string_lossy(),
-        "--drive",
-        "wheel_left_joint,wheel_right_joint",
-    ]
-    .map(str::to_owned);
-    let args: Vec<&str> = robot_args.iter().map(String::as_str).collect();
-    graph.spawn_rover(20.0, &args)?;
-    let listener = graph.dir.path().join("depth.py");
-    std::fs::write(
-        &listener,
+    graph.spawn_tiago(20.0, &urdf, &[])?;
+    let out = graph.run_python(
+        "depth.py",
         "import math, struct, rospy\nfrom sensor_msgs.msg import Image, CameraInfo\nrospy.init_node('depth_check')\nimg = rospy.wait_for_message('/xtion/depth_registered/image_raw', Image, timeout=40)\ninfo = rospy.wait_for_message('/xtion/depth_registered/camera_info', CameraInfo, timeout=20)\nvals = struct.unpack('<%df' % (len(img.data) // 4), img.data)\nfinite = [v for v in vals if not math.isnan(v)]\nprint('image %s %d %d %d %d %d %s' % (img.encoding, img.width, img.height, img.step, len(img.data), img.is_bigendian, img.header.frame_id))\nprint('info %d %d %.3f %s' % (info.width, info.height, info.K[0], info.header.frame_id))\nprint('values %d %.4f %.4f' % (len(finite), min(finite) if finite else -1, max(finite) if finite else -1))\n",
+        Duration::from_secs(60),
     )?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&listener);
-    let out = graph.run(c, Duration::from_secs(60))?;
     println!("{out}");
     let line = |key: &str| -> Vec<String> {
         out.lines()

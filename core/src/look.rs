@@ -55,8 +55,6 @@ pub struct Look {
     chain: KinematicChain,
     /// fx, fy, cx, cy (px).
     intrinsics: [f64; 4],
-    /// The optical axis (z) of the optical frame, in the camera link's frame.
-    axis_link: Vector3<f64>,
     link_from_optical: nalgebra::UnitQuaternion<f64>,
     /// Where the box looked at last is expected after the step (px), and its image's time (s).
     last: Option<([f64; 2], f64)>,
@@ -80,7 +78,6 @@ impl Look {
             config,
             chain,
             intrinsics: [info.k[0], info.k[4], info.k[2], info.k[5]],
-            axis_link: rotation * Vector3::z(),
             link_from_optical: rotation,
             last: None,
             looked_at: None,
@@ -148,9 +145,12 @@ impl Look {
         ));
         let ray_optical = Vector3::new((px[0] - cx) / fx, (px[1] - cy) / fy, 1.0).normalize();
         let ray_link = self.link_from_optical * ray_optical;
-        let step = self
-            .chain
-            .pointing_step(q, self.axis_link, ray_link, c.damping)?;
+        let step = self.chain.pointing_step(
+            q,
+            self.link_from_optical * Vector3::z(),
+            ray_link,
+            c.damping,
+        )?;
         Ok(Some(
             q.iter()
                 .zip(&step)

@@ -113,6 +113,23 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
     }
 }
 
+/// A robot from PyPI `example-robot-data` 6.0.0 (`file` under its `robots/` folder, e.g.
+/// [`TIAGO_NO_HAND`]); `None`, with the reason printed, when the wheel cannot be had.
+pub fn example_robot_data(file: &str) -> Option<PathBuf> {
+    let Some(wheel) = pypi("example-robot-data", "6.0.0") else {
+        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
+        return None;
+    };
+    Some(
+        wheel
+            .join("cmeel.prefix/share/example-robot-data/robots")
+            .join(file),
+    )
+}
+
+/// PAL's TIAGo without its hand, in `example-robot-data`.
+pub const TIAGO_NO_HAND: &str = "tiago_description/robots/tiago_no_hand.urdf";
+
 /// A PyPI wheel unpacked into `~/.cache/rover/pypi/NAME-VERSION` (downloaded with pip the first
 /// time; nothing is committed). `None`, with the reason printed, when it cannot be had (offline,
 /// no pip), so tests can skip.

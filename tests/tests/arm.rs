@@ -2,29 +2,21 @@
 //! (`tiago_no_hand.urdf`) and Universal Robots' UR5, both from PyPI `example-robot-data`
 //! 6.0.0, fetched into the cache at test time (skipped, with the reason, when unavailable).
 
-use std::path::PathBuf;
-
 use anyhow::Result;
 use rover_sim::{
     DriveSpec, JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel,
     SimOptions, Simulation, Twist, World,
 };
+use rover_tests::{TIAGO_NO_HAND, example_robot_data};
 
-fn example_robot_data(file: &str) -> Option<PathBuf> {
-    let Some(wheel) = rover_tests::pypi("example-robot-data", "6.0.0") else {
-        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
-        return None;
-    };
-    Some(
-        wheel
-            .join("cmeel.prefix/share/example-robot-data/robots")
-            .join(file),
-    )
+/// TIAGo without its hand, its wheels driven like gazebo_ros_diff_drive, on flat ground.
+fn tiago(solver: JointSolver) -> Result<Option<Simulation>> {
+    tiago_in(World::flat()?, solver)
 }
 
-/// TIAGo without its hand, its wheels driven like gazebo_ros_diff_drive.
-fn tiago(solver: JointSolver) -> Result<Option<Simulation>> {
-    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
+/// TIAGo as [`tiago`], in `world`.
+fn tiago_in(world: World, solver: JointSolver) -> Result<Option<Simulation>> {
+    let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
         return Ok(None);
     };
     let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
@@ -40,7 +32,7 @@ fn tiago(solver: JointSolver) -> Result<Option<Simulation>> {
         cmd_timeout_s: Some(0.0),
         ..SimOptions::default()
     };
-    Ok(Some(Simulation::new(World::flat()?, robot, &options)?))
+    Ok(Some(Simulation::new(world, robot, &options)?))
 }
 
 /// TIAGo's arm "home" pose (arm_1..arm_7).
@@ -264,7 +256,7 @@ fn tiago_head_follows_a_command_with_its_own_pid_gains() -> Result<()> {
 /// harder than the effort limit.
 #[test]
 fn tiago_arm_2_step_as_the_trace_records_it() -> Result<()> {
-    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
+    let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
         return Ok(());
     };
     let dir = tempfile::tempdir()?;
@@ -469,26 +461,13 @@ fn tiago_ik_solves_20_reachable_targets_and_the_simulated_tool_gets_there() -> R
 fn tiago_looks_at_the_person_the_detector_sees() -> Result<()> {
     use rover_core::{Look, LookConfig};
     use rover_perception::{Detector, DetectorConfig, FrameStamp, RgbView};
-    let Some(urdf) = example_robot_data("tiago_description/robots/tiago_no_hand.urdf") else {
-        return Ok(());
-    };
-    let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
-    robot.set_drive(&DriveSpec {
-        left_joint: "wheel_left_joint".into(),
-        right_joint: "wheel_right_joint".into(),
-        wheel_separation_m: None,
-        wheel_diameter_m: None,
-        wheel_torque_nm: None,
-    })?;
     let world = World::from_str(
         "[[person]]\nname = \"alice\"\nposition_m = [3.0, 1.1]\nheading_deg = 200.0\n",
         std::path::Path::new("look.toml"),
     )?;
-    let options = SimOptions {
-        cmd_timeout_s: Some(0.0),
-        ..SimOptions::default()
+    let Some(mut sim) = tiago_in(world, JointSolver::default())? else {
+        return Ok(());
     };
-    let mut sim = Simulation::new(world, robot, &options)?;
     for (name, q) in HOME {
         sim.command_joint(name, JointCommand::Position(q))?;
     }

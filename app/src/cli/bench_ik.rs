@@ -20,7 +20,7 @@ pub struct IkBench {
     pub targets: usize,
     /// Solves within the solver's tolerances.
     pub converged: usize,
-    /// Median and slowest time per solve (ms).
+    /// Median time per solve (ms).
     pub median_ms: f64,
     /// Slowest solve (ms).
     pub max_ms: f64,
@@ -45,17 +45,7 @@ pub fn ik(
     let chain = KinematicChain::new(&robot, base, ee_link)?;
     let options = IkOptions::default();
     let mut solver = IkSolver::new(chain.clone(), options)?;
-    let start: Vec<f64> = chain
-        .joints()
-        .iter()
-        .map(|j| {
-            j.clamp(if j.lower.is_finite() && j.upper.is_finite() {
-                (j.lower + j.upper) / 2.0
-            } else {
-                0.0
-            })
-        })
-        .collect();
+    let start: Vec<f64> = chain.joints().iter().map(|j| j.middle()).collect();
     let mut rng = SplitMix64(config.options.seed ^ 0x1c);
     let goals: Vec<IkTarget> = (0..targets.max(1))
         .map(|_| {

@@ -85,58 +85,67 @@ impl TopicFamily for Camera {
 
     fn image(&mut self, image: &mut ImageFrame) {
         // The camera's frame number, which the boxes' image_header names too.
-        let seq = image.seq as u32;
-        if self.calibrated
-            && let Some(p) = self.info.as_mut()
-        {
-            self.info_msg.header.seq = seq;
-            self.info_msg.header.stamp_s = image.stamp_s;
-            p.publish(&self.info_msg);
+        if self.calibrated {
+            publish_info(self.info.as_mut(), &mut self.info_msg, image);
         }
-        self.publish_depth(image);
-        let Some(p) = self.image.as_mut() else {
-            return;
-        };
-        let msg = &mut self.image_msg;
-        msg.header.seq = seq;
-        msg.header.stamp_s = image.stamp_s;
-        msg.width = image.width;
-        msg.height = image.height;
-        msg.step = image.width * 3;
-        // Published from the event's buffer, which stays with the event.
-        std::mem::swap(&mut msg.data, &mut image.pixels);
-        p.publish(msg);
-        std::mem::swap(&mut msg.data, &mut image.pixels);
+        let meta = (image.seq as u32, image.stamp_s, image.width, image.height);
+        publish_image(
+            self.image.as_mut(),
+            &mut self.image_msg,
+            meta,
+            3,
+            &mut image.pixels,
+        );
+        // A depth camera's depth image and its camera_info (the colour camera's: the depth
+        // image is rendered with the same intrinsics).
+        if !image.depth.is_empty() {
+            if self.calibrated {
+                publish_info(self.depth_info.as_mut(), &mut self.info_msg, image);
+            }
+            publish_image(
+                self.depth_image.as_mut(),
+                &mut self.depth_msg,
+                meta,
+                4,
+                &mut image.depth,
+            );
+        }
     }
 }
 
-impl Camera {
-    /// The depth image and its camera_info (the colour camera's: the depth image is rendered
-    /// with the same intrinsics), when the frame has one.
-    fn publish_depth(&mut self, image: &mut ImageFrame) {
-        if image.depth.is_empty() {
-            return;
-        }
-        if self.calibrated
-            && let Some(p) = self.depth_info.as_mut()
-        {
-            self.info_msg.header.seq = image.seq as u32;
-            self.info_msg.header.stamp_s = image.stamp_s;
-            p.publish(&self.info_msg);
-        }
-        let Some(p) = self.depth_image.as_mut() else {
-            return;
-        };
-        let msg = &mut self.depth_msg;
+/// Publishes the camera_info stamped like `image`.
+fn publish_info(
+    publisher: Option<&mut Publisher<msgs::CameraInfo>>,
+    msg: &mut msgs::CameraInfo,
+    image: &ImageFrame,
+) {
+    if let Some(p) = publisher {
         msg.header.seq = image.seq as u32;
         msg.header.stamp_s = image.stamp_s;
-        msg.width = image.width;
-        msg.height = image.height;
-        msg.step = image.width * 4;
-        std::mem::swap(&mut msg.data, &mut image.depth);
         p.publish(msg);
-        std::mem::swap(&mut msg.data, &mut image.depth);
     }
+}
+
+/// Publishes `data` (rows of `bytes_per_px` x width) as `msg`, stamped with `(seq, stamp,
+/// width, height)`: from the event's buffer, which stays with the event.
+fn publish_image(
+    publisher: Option<&mut Publisher<msgs::Image>>,
+    msg: &mut msgs::Image,
+    (seq, stamp_s, width, height): (u32, f64, u32, u32),
+    bytes_per_px: u32,
+    data: &mut Vec<u8>,
+) {
+    let Some(p) = publisher else {
+        return;
+    };
+    msg.header.seq = seq;
+    msg.header.stamp_s = stamp_s;
+    msg.width = width;
+    msg.height = height;
+    msg.step = width * bytes_per_px;
+    std::mem::swap(&mut msg.data, data);
+    p.publish(msg);
+    std::mem::swap(&mut msg.data, data);
 }
 
 /// The image to hand over (on the loop thread): `frame` copied into the recycled `pixels`,

@@ -40,18 +40,24 @@ pub(crate) fn polar_covariance(
     rotation * local * rotation.transpose()
 }
 
+/// The covariance of a target at rest: `position_cov`, and an unknown velocity of
+/// `speed_sigma_mps` per axis, uncorrelated with the position.
+fn standing_covariance(position_cov: &Matrix2<f64>, speed_sigma_mps: f64) -> Matrix4<f64> {
+    let mut covariance = Matrix4::zeros();
+    covariance
+        .fixed_view_mut::<2, 2>(0, 0)
+        .copy_from(position_cov);
+    covariance[(2, 2)] = speed_sigma_mps.powi(2);
+    covariance[(3, 3)] = speed_sigma_mps.powi(2);
+    covariance
+}
+
 impl TargetFilter {
     /// Starts at a measured position (standing still, velocity unknown).
     pub(crate) fn new(time_s: f64, position_m: [f64; 2], position_cov: Matrix2<f64>) -> Self {
-        let mut covariance = Matrix4::zeros();
-        covariance
-            .fixed_view_mut::<2, 2>(0, 0)
-            .copy_from(&position_cov);
-        covariance[(2, 2)] = INITIAL_SPEED_SIGMA_MPS.powi(2);
-        covariance[(3, 3)] = INITIAL_SPEED_SIGMA_MPS.powi(2);
         Self {
             state: Vector4::new(position_m[0], position_m[1], 0.0, 0.0),
-            covariance,
+            covariance: standing_covariance(&position_cov, INITIAL_SPEED_SIGMA_MPS),
             time_s,
         }
     }
@@ -113,14 +119,7 @@ impl TargetFilter {
         let position = [self.state[0], self.state[1]];
         self.predict(time_s);
         self.state = Vector4::new(position[0], position[1], 0.0, 0.0);
-        let position_cov = self.position_covariance();
-        let mut covariance = Matrix4::zeros();
-        covariance
-            .fixed_view_mut::<2, 2>(0, 0)
-            .copy_from(&position_cov);
-        covariance[(2, 2)] = HALTED_SPEED_SIGMA_MPS.powi(2);
-        covariance[(3, 3)] = HALTED_SPEED_SIGMA_MPS.powi(2);
-        self.covariance = covariance;
+        self.covariance = standing_covariance(&self.position_covariance(), HALTED_SPEED_SIGMA_MPS);
     }
 
     /// Moves the estimate forward to `time_s` (no-op for an earlier time).

@@ -1026,15 +1026,7 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = range_bearing_from(odom, here);
         let (_, bearing) = range_bearing_from(odom, aim);
-        // Inside the band the range is right: the car turns with them and stays put.
-        let (near_m, far_m) = self.standoff_band_m(moving);
-        let range_error = if range > far_m {
-            range - far_m
-        } else if range < near_m {
-            range - near_m
-        } else {
-            0.0
-        };
+        let range_error = range - self.keep_range_m(moving);
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -1097,19 +1089,18 @@ impl Follower {
         self.avoid(preferred, here, speed_cap, now_s, odom)
     }
 
-    /// The ranges to keep from the target (m, from the base: nearest, furthest). A walking
-    /// person is kept where the camera sees them whole, unless a laser keeps them at the
-    /// standoff: a low camera that closes in on a walking person loses them at every step,
-    /// and one who walks toward the car walks into its blind zone unless it gives way. Once
-    /// they stand, the car closes in to the standoff.
-    fn standoff_band_m(&self, moving: bool) -> (f64, f64) {
+    /// The range to keep from the target (m, from the base). A walking person is kept where
+    /// the camera sees them whole, unless a laser keeps them at the standoff: a low camera
+    /// that closes in on a walking person loses them at every step, and one who walks toward
+    /// the car walks into its blind zone unless it gives way. Once they stand, the car closes
+    /// in to the standoff.
+    fn keep_range_m(&self, moving: bool) -> f64 {
         let c = &self.config;
         if !moving || self.laser.is_some() {
-            return (c.standoff_m, c.standoff_m);
+            return c.standoff_m;
         }
-        let whole_m = (self.whole_view_m + self.camera.forward_m)
-            .clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M);
-        (whole_m, whole_m)
+        (self.whole_view_m + self.camera.forward_m)
+            .clamp(c.standoff_m, c.standoff_m + MAX_EXTRA_STANDOFF_M)
     }
 
     /// Replaces `preferred` by a free arc when the laser shows an obstacle in its way.

@@ -93,6 +93,15 @@ impl ChainJoint {
     pub fn clamp(&self, q: f64) -> f64 {
         q.clamp(self.lower, self.upper)
     }
+
+    /// The middle of the range (0 for a continuous joint): the solver's default rest pose.
+    pub fn middle(&self) -> f64 {
+        if self.lower.is_finite() && self.upper.is_finite() {
+            (self.lower + self.upper) / 2.0
+        } else {
+            0.0
+        }
+    }
 }
 
 /// One step down the chain: a joint's origin (fixed joints folded in) and, for a moving joint,
@@ -353,16 +362,18 @@ impl KinematicChain {
 
     /// An in-limit pose drawn from `rng` (continuous joints within ±π).
     pub fn random_pose(&self, rng: &mut SplitMix64) -> Vec<f64> {
-        self.joints
-            .iter()
-            .map(|j| {
-                let (lo, hi) = (
-                    j.lower.max(-std::f64::consts::PI),
-                    j.upper.min(std::f64::consts::PI),
-                );
-                lo + (hi - lo) * rng.unit()
-            })
-            .collect()
+        let mut q = vec![0.0; self.joints.len()];
+        self.fill_random_pose(rng, &mut q);
+        q
+    }
+
+    /// [`Self::random_pose`] into `q` (the chain's length).
+    fn fill_random_pose(&self, rng: &mut SplitMix64, q: &mut [f64]) {
+        use std::f64::consts::PI;
+        for (q, j) in q.iter_mut().zip(&self.joints) {
+            let (lo, hi) = (j.lower.max(-PI), j.upper.min(PI));
+            *q = lo + (hi - lo) * rng.unit();
+        }
     }
 }
 
@@ -460,6 +471,7 @@ pub struct IkSolver {
     jacobian: OMatrix<f64, U6, Dyn>,
     q: Vec<f64>,
     frames: Vec<(Vector3<f64>, Vector3<f64>)>,
+    best_q: Vec<f64>,
     step: DVector<f64>,
     pull: DVector<f64>,
     scratch: DVector<f64>,
@@ -474,17 +486,7 @@ impl IkSolver {
                 chain.check(rest)?;
                 rest.clone()
             }
-            None => chain
-                .joints
-                .iter()
-                .map(|j| {
-                    if j.lower.is_finite() && j.upper.is_finite() {
-                        (j.lower + j.upper) / 2.0
-                    } else {
-                        0.0
-                    }
-                })
-                .collect(),
+            None => chain.joints.iter().map(ChainJoint::middle).collect(),
         };
         Ok(Self {
             chain,
@@ -493,6 +495,7 @@ impl IkSolver {
             jacobian: OMatrix::<f64, U6, Dyn>::zeros(n),
             q: vec![0.0; n],
             frames: vec![(Vector3::zeros(), Vector3::zeros()); n],
+            best_q: vec![0.0; n],
             step: DVector::zeros(n),
             pull: DVector::zeros(n),
             scratch: DVector::zeros(n),
@@ -513,48 +516,38 @@ impl IkSolver {
         start: &[f64],
     ) -> Result<IkSolution, KinematicsError> {
         self.chain.check(start)?;
+        for (q, (s, j)) in self.q.iter_mut().zip(start.iter().zip(&self.chain.joints)) {
+            *q = j.clamp(*s);
+        }
         let mut rng = SplitMix64(self.options.seed);
-        let mut best: Option<IkSolution> = None;
+        let weight = self.options.orientation_weight_m;
+        let mut best: Option<(f64, f64)> = None;
         let mut iterations = 0;
         for attempt in 0..=self.options.restarts {
-            if attempt == 0 {
-                for (q, (s, j)) in self.q.iter_mut().zip(start.iter().zip(&self.chain.joints)) {
-                    *q = j.clamp(*s);
-                }
-            } else {
-                let pose = self.chain.random_pose(&mut rng);
-                self.q.copy_from_slice(&pose);
+            if attempt > 0 {
+                self.chain.fill_random_pose(&mut rng, &mut self.q);
             }
-            let (position_error_m, orientation_error_rad, used) = self.descend(target);
+            let (position_m, rotation_rad, used) = self.descend(target);
             iterations += used;
-            let converged = position_error_m <= self.options.tolerance_m
-                && orientation_error_rad <= self.options.tolerance_rad;
-            let score =
-                position_error_m + self.options.orientation_weight_m * orientation_error_rad;
-            let better = best.as_ref().is_none_or(|b| {
-                score
-                    < b.position_error_m
-                        + self.options.orientation_weight_m * b.orientation_error_rad
-            });
-            if better {
-                best = Some(IkSolution {
-                    q: self.q.clone(),
-                    position_error_m,
-                    orientation_error_rad,
-                    iterations,
-                    converged,
-                });
+            if best.is_none_or(|(p, r)| position_m + weight * rotation_rad < p + weight * r) {
+                best = Some((position_m, rotation_rad));
+                self.best_q.copy_from_slice(&self.q);
             }
-            if converged {
+            if position_m <= self.options.tolerance_m && rotation_rad <= self.options.tolerance_rad
+            {
                 break;
             }
         }
-        let mut best = best.ok_or(KinematicsError::Length {
-            expected: self.chain.joints.len(),
-            got: 0,
-        })?;
-        best.iterations = iterations;
-        Ok(best)
+        let (position_error_m, orientation_error_rad) =
+            best.unwrap_or((f64::INFINITY, f64::INFINITY));
+        Ok(IkSolution {
+            q: self.best_q.clone(),
+            position_error_m,
+            orientation_error_rad,
+            iterations,
+            converged: position_error_m <= self.options.tolerance_m
+                && orientation_error_rad <= self.options.tolerance_rad,
+        })
     }
 
     /// Errors of the tip at `self.q` (the weighted 6-vector, position m, orientation rad),
