@@ -70,6 +70,8 @@ pub struct RunConfig {
     pub serial_detection: bool,
     /// Follower settings.
     pub follower: FollowerConfig,
+    /// The arm's look and reach (links, classes).
+    pub arm: crate::arm_task::ArmConfig,
     /// Measure ground truth for every camera image and judge each detection against it
     /// (observers get [`crate::Observer::detections_truth`]).
     pub ground_truth: bool,
@@ -85,7 +87,7 @@ pub struct RunConfig {
 /// Whether a headless run renders the camera and runs the detector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Perception {
-    /// When the script toggles follow mode, or something watches the camera.
+    /// When the script toggles follow mode, look or reach, or something watches the camera.
     #[default]
     Auto,
     /// Always.
@@ -307,7 +309,7 @@ fn run_inner(
     let perceive = match config.perception {
         Perception::On => true,
         Perception::Off => false,
-        Perception::Auto => player.toggles_follow() || observer_wants_camera,
+        Perception::Auto => player.toggles_perception() || observer_wants_camera,
     };
     let mut files = RunFiles::open(
         config.trace.as_deref(),
@@ -326,6 +328,7 @@ fn run_inner(
         detector_config: config.detector.clone(),
         inject_fault: config.inject_fault,
         follower: config.follower.clone(),
+        arm: config.arm.clone(),
         ground_truth: config.ground_truth,
     };
     let mut fan = Fanout::default();

@@ -15,6 +15,11 @@ pub enum Action {
     Key(KeyAction),
     /// Flip between manual and follow mode.
     ToggleFollow,
+    /// Switch the arm's look on or off (the camera's chain turns to the class's box).
+    ToggleLook,
+    /// Switch the arm's reach on or off (the tool goes to a pre-grasp point short of the
+    /// class's object; the camera looks at it when its chain is not the arm's).
+    ToggleReach,
     /// Move the robot's joints (the arm); the base's mode does not change.
     Joint(JointAction),
 }

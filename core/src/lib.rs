@@ -11,6 +11,7 @@
 //! Nothing here depends on winit, wgpu surfaces, rerun or gilrs: everything runs headless in
 //! tests. The modules are private; this page lists the API.
 
+mod arm_task;
 mod dataset;
 mod error;
 mod follower;
@@ -21,6 +22,7 @@ mod look;
 mod observer;
 mod paths;
 mod pilot;
+mod reach;
 mod run_files;
 mod scenario;
 mod script;
@@ -28,6 +30,7 @@ mod session;
 mod teleop;
 mod trace;
 
+pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
 pub use dataset::{
     COCO_CATEGORY_IDS, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox, ImageFormat,
     ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, Randomization, Shot, Split,
@@ -48,6 +51,7 @@ pub use look::{Look, LookConfig};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
 pub use pilot::{Mode, Pilot};
+pub use reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep, object_point, pregrasp};
 pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use scenario::{
     Scenario, ScenarioCheck, ScenarioCriteria, ScenarioMetrics, ScenarioOptions, ScenarioResult,

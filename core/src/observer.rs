@@ -8,6 +8,7 @@ use rover_sim::{
     CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
 };
 
+use crate::arm_task::ArmStatus;
 use crate::error::CoreError;
 use crate::follower::FollowState;
 use crate::pilot::Mode;
@@ -48,6 +49,8 @@ pub struct LoopStats {
     /// The point the follower is driving to (odometry frame, m): the target while it is seen,
     /// where it was last going once it is lost (PURSUING).
     pub follow_goal_m: Option<[f64; 2]>,
+    /// The arm's task (look, reach) and its points.
+    pub arm: ArmStatus,
 }
 
 /// Watches a session without influencing it (the Rerun recorder, the window).

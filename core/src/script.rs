@@ -5,6 +5,7 @@
 //!   { at = 0.0, cmd_vel = [0.5, 0.0] },   # linear.x m/s, angular.z rad/s
 //!   { at = 2.0, key = "j" },              # a teleop_twist_keyboard key
 //!   { at = 3.0, toggle = "follow" },      # flip between manual and follow mode
+//!   { at = 3.0, toggle = "reach" },       # the arm's reach on or off (or "look")
 //!   { at = 4.0, joint = "arm_2_joint", position = -0.8 },  # or velocity = / effort =
 //!   { at = 6.0, pose = "home" },          # a named pose of the controllers file
 //!   { at = 8.0, controller = "gripper_controller", command = 0.02 },  # its `command` topic
@@ -170,9 +171,11 @@ impl Script {
                     },
                     (None, None, Some(mode)) => match mode.as_str() {
                         "follow" => Action::ToggleFollow,
+                        "look" => Action::ToggleLook,
+                        "reach" => Action::ToggleReach,
                         other => {
                             return bail(format!(
-                                "toggle \"{other}\" is unknown; expected \"follow\""
+                                "toggle \"{other}\" is unknown; expected \"follow\", \"look\" or \"reach\""
                             ));
                         }
                     },
@@ -214,12 +217,15 @@ impl ScriptPlayer {
         &self.script
     }
 
-    /// True when the script switches the follower on or off somewhere.
-    pub fn toggles_follow(&self) -> bool {
-        self.script
-            .steps
-            .iter()
-            .any(|s| matches!(s.action, Action::ToggleFollow))
+    /// True when the script switches something that acts on detections (the follower, the
+    /// arm's look or reach) on or off somewhere.
+    pub fn toggles_perception(&self) -> bool {
+        self.script.steps.iter().any(|s| {
+            matches!(
+                s.action,
+                Action::ToggleFollow | Action::ToggleLook | Action::ToggleReach
+            )
+        })
     }
 
     /// Applies the steps due at the session's sim time (half a physics step of tolerance).
@@ -280,7 +286,8 @@ mod tests {
         assert!(err("steps = [ { at = -1.0, key = \"k\" } ]").contains(">= 0"));
         assert!(err("steps = [ { at = 1.0, cmd_vel = [nan, 0.0] } ]").contains("finite"));
         assert!(
-            err("steps = [ { at = 1.0, toggle = \"dance\" } ]").contains("expected \"follow\"")
+            err("steps = [ { at = 1.0, toggle = \"dance\" } ]")
+                .contains("expected \"follow\", \"look\" or \"reach\"")
         );
         let both = err("steps = [ { at = 1.0, joint = \"a\", position = 1.0, velocity = 2.0 } ]");
         assert!(both.contains("exactly one of `position`"), "{both}");

@@ -17,6 +17,7 @@ use rover_sim::{
     RobotModel, SimOptions, Simulation, World,
 };
 
+use crate::arm_task::{ArmConfig, ArmMode, ArmTask};
 use crate::error::{CoreError, Result};
 use crate::follower::{CameraGeometry, Follower, FollowerConfig, LaserMount};
 use crate::input::{Action, JointAction};
@@ -66,6 +67,8 @@ pub struct SessionOptions {
     pub inject_fault: Option<InjectedFault>,
     /// Follower settings.
     pub follower: FollowerConfig,
+    /// The arm's look and reach: links and settings.
+    pub arm: ArmConfig,
     /// Measure the ground truth of every camera image (rover_sim's id image and silhouettes)
     /// and hand each detection result's observers the ground truth of its image
     /// ([`Observer::detections_truth`]).
@@ -86,6 +89,7 @@ impl Default for SessionOptions {
             detector_config: DetectorConfig::default(),
             inject_fault: None,
             follower: FollowerConfig::default(),
+            arm: ArmConfig::default(),
             ground_truth: false,
         }
     }
@@ -130,6 +134,7 @@ pub struct Session {
     every_frame: bool,
     pilot: Pilot,
     follower: Follower,
+    arm: ArmTask,
     stats: LoopStats,
     last_boxes: Option<BoundingBoxes>,
     detections_done: u64,
@@ -175,6 +180,8 @@ impl Session {
             .first()
             .and_then(|c| sim.robot().link_id(&c.link))
             .unwrap_or(sim.robot().root);
+        let camera_config = camera.as_ref().and(sim.robot().cameras.first());
+        let arm = ArmTask::new(&sim, camera_config, &options.arm);
         let laser = start_laser(&sim)?;
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
@@ -198,6 +205,7 @@ impl Session {
         observer.start(&sim, camera.as_ref().map(|c| c.info()), &labels);
         Ok(Self {
             follower,
+            arm,
             sim,
             camera,
             camera_link,
@@ -221,6 +229,17 @@ impl Session {
     /// The simulation.
     pub fn sim(&self) -> &Simulation {
         &self.sim
+    }
+
+    /// The arm's reach controller, when the robot has one (an end effector, a depth camera).
+    pub fn reach(&self) -> Option<&crate::reach::Reach> {
+        self.arm.reach()
+    }
+
+    /// Moves world object `index` (world order) to `position_m` (its centre) with heading
+    /// `yaw_rad`, at rest: a scene change from outside the loop (a test, a scripted event).
+    pub fn place_object(&mut self, index: usize, position_m: [f64; 3], yaw_rad: f64) -> Result<()> {
+        Ok(self.sim.place_object(index, position_m, yaw_rad)?)
     }
 
     /// The pilot (mode, teleop limits).
@@ -261,8 +280,22 @@ impl Session {
     /// Applies a user input (script step, key, gamepad). Manual input while following takes
     /// control back at once.
     pub fn input(&mut self, action: Action, observer: &mut dyn Observer) {
-        if let Action::Joint(joint) = action {
-            self.joint_input(joint, observer);
+        let arm_mode = match action {
+            Action::Joint(joint) => {
+                self.joint_input(joint, observer);
+                return;
+            }
+            Action::ToggleLook => Some(ArmMode::Look),
+            Action::ToggleReach => Some(ArmMode::Reach),
+            _ => None,
+        };
+        if let Some(mode) = arm_mode {
+            let (level, text) = match self.arm.toggle(mode, &mut self.sim) {
+                Ok(text) => (EventLevel::Info, text),
+                Err(why) => (EventLevel::Warn, why),
+            };
+            emit(observer, self.sim.sim_time_s(), level, &text);
+            self.stats.arm = self.arm.status();
             return;
         }
         let before = self.pilot.mode();
@@ -377,6 +410,8 @@ impl Session {
                 .filter(|_| following)
                 .map(|t| t.position_at(sample.sim_time_s));
             self.stats.follow_goal_m = self.follower.goal_m().filter(|_| following);
+            self.arm.update(&self.sim).map_err(arm_error)?;
+            self.stats.arm = self.arm.status();
             observer.control(&self.sim, sample, &self.stats);
         }
         Ok(sample)
@@ -453,6 +488,7 @@ impl Session {
         };
         self.stats.frames += 1;
         observer.camera_frame(&frame, world_from_camera);
+        self.arm.capture(&frame, &self.sim);
         if let Some(slot) = self.truth_frames.get_mut(frame.seq as usize % TRUTH_FRAMES) {
             slot.0 = frame.seq;
             rover_sim::copy_boxes(&mut slot.1, frame.ground_truth);
@@ -549,6 +585,14 @@ impl Session {
             }
         }
         self.follower.observe(&boxes);
+        if let Err(e) = self.arm.observe(&boxes, &mut self.sim) {
+            emit(
+                observer,
+                self.sim.sim_time_s(),
+                EventLevel::Warn,
+                &format!("arm: {e}"),
+            );
+        }
         observer.detections(&boxes, &self.labels);
         let seq = boxes.image_stamp.frame;
         if let Some((_, truth)) = self
@@ -718,4 +762,9 @@ fn camera_geometry(
             pitch_down_rad,
         },
     }
+}
+
+/// A chain error from the arm's tasks (a chain built from this robot does not produce one).
+fn arm_error(e: rover_sim::KinematicsError) -> CoreError {
+    CoreError::Option(format!("arm: {e}"))
 }

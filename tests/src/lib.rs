@@ -130,6 +130,28 @@ pub fn example_robot_data(file: &str) -> Option<PathBuf> {
 /// PAL's TIAGo without its hand, in `example-robot-data`.
 pub const TIAGO_NO_HAND: &str = "tiago_description/robots/tiago_no_hand.urdf";
 
+/// TIAGo without its hand ([`TIAGO_NO_HAND`]), its wheels driven like gazebo_ros_diff_drive;
+/// `None`, with the reason printed, when example-robot-data cannot be had.
+pub fn tiago() -> anyhow::Result<Option<RobotModel>> {
+    let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
+        return Ok(None);
+    };
+    let mut robot = RobotModel::load_with(&urdf, &rover_sim::LoadOptions::default())?;
+    robot.set_drive(&tiago_drive())?;
+    Ok(Some(robot))
+}
+
+/// TIAGo's wheels, driven like gazebo_ros_diff_drive (sizes from the URDF).
+pub fn tiago_drive() -> rover_sim::DriveSpec {
+    rover_sim::DriveSpec {
+        left_joint: "wheel_left_joint".into(),
+        right_joint: "wheel_right_joint".into(),
+        wheel_separation_m: None,
+        wheel_diameter_m: None,
+        wheel_torque_nm: None,
+    }
+}
+
 /// A PyPI wheel unpacked into `~/.cache/rover/pypi/NAME-VERSION` (downloaded with pip the first
 /// time; nothing is committed). `None`, with the reason printed, when it cannot be had (offline,
 /// no pip), so tests can skip.

@@ -4,8 +4,8 @@
 
 use anyhow::Result;
 use rover_sim::{
-    DriveSpec, JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel,
-    SimOptions, Simulation, Twist, World,
+    JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel, SimOptions,
+    Simulation, Twist, World,
 };
 use rover_tests::{TIAGO_NO_HAND, example_robot_data};
 
@@ -16,17 +16,9 @@ fn tiago(solver: JointSolver) -> Result<Option<Simulation>> {
 
 /// TIAGo as [`tiago`], in `world`.
 fn tiago_in(world: World, solver: JointSolver) -> Result<Option<Simulation>> {
-    let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
+    let Some(robot) = rover_tests::tiago()? else {
         return Ok(None);
     };
-    let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
-    robot.set_drive(&DriveSpec {
-        left_joint: "wheel_left_joint".into(),
-        right_joint: "wheel_right_joint".into(),
-        wheel_separation_m: None,
-        wheel_diameter_m: None,
-        wheel_torque_nm: None,
-    })?;
     let options = SimOptions {
         joints: Some(solver),
         cmd_timeout_s: Some(0.0),
@@ -270,13 +262,7 @@ fn tiago_arm_2_step_as_the_trace_records_it() -> Result<()> {
     let trace = dir.path().join("trace.csv");
     let config = rover_core::RunConfig {
         robot: Some(urdf),
-        drive: Some(DriveSpec {
-            left_joint: "wheel_left_joint".into(),
-            right_joint: "wheel_right_joint".into(),
-            wheel_separation_m: None,
-            wheel_diameter_m: None,
-            wheel_torque_nm: None,
-        }),
+        drive: Some(rover_tests::tiago_drive()),
         script: Some(script),
         duration_s: Some(7.0),
         trace: Some(trace.clone()),

@@ -164,6 +164,9 @@ pub(crate) struct RunArgs {
     pub(crate) follow: FollowArgs,
 
     #[command(flatten)]
+    pub(crate) arm: ArmArgs,
+
+    #[command(flatten)]
     pub(crate) detector: DetectorArgs,
 
     #[command(flatten)]
@@ -384,6 +387,53 @@ impl FollowArgs {
             (true, _) => Perception::On,
             _ => Perception::Auto,
         }
+    }
+}
+
+/// The arm's look and reach (docs/ARM.md): switched on by `toggle = "look"` / `"reach"` in a
+/// script, the station's keys, or ROS.
+#[derive(Debug, Args)]
+pub(crate) struct ArmArgs {
+    /// Arm: the end effector that reaches (e.g. TIAGo's arm_tool_link) [default: the world's
+    /// [robot] ee_link]
+    #[arg(long, value_name = "LINK")]
+    pub(crate) ee_link: Option<String>,
+
+    /// Arm: the link look and reach work from; IK moves the joints between it and --ee-link
+    /// (e.g. TIAGo's torso_lift_link, so the head looks while the arm reaches) [default: the
+    /// world's [robot] arm_base, else the robot's root link]
+    #[arg(long, value_name = "LINK")]
+    pub(crate) arm_base: Option<String>,
+
+    /// Arm: the class look turns to and reach goes for (a darknet_ros `Class`)
+    #[arg(long, default_value = "sports ball", value_name = "CLASS")]
+    pub(crate) arm_class: String,
+
+    /// Arm: how far short of the object's seen surface the tool stops (m)
+    #[arg(long, default_value_t = 0.10, value_name = "M")]
+    pub(crate) reach_standoff: f64,
+}
+
+impl ArmArgs {
+    pub(crate) fn arm(&self) -> anyhow::Result<rover_core::ArmConfig> {
+        anyhow::ensure!(
+            self.reach_standoff.is_finite() && self.reach_standoff >= 0.0,
+            "--reach-standoff must be a distance of 0 m or more, found {}",
+            self.reach_standoff
+        );
+        Ok(rover_core::ArmConfig {
+            base_link: self.arm_base.clone(),
+            ee_link: self.ee_link.clone(),
+            look: rover_core::LookConfig {
+                class: self.arm_class.clone(),
+                ..rover_core::LookConfig::default()
+            },
+            reach: rover_core::ReachConfig {
+                class: self.arm_class.clone(),
+                standoff_m: self.reach_standoff,
+                ..rover_core::ReachConfig::default()
+            },
+        })
     }
 }
 

@@ -36,6 +36,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         detector: args.detector.config(super::args::spare_detect_threads())?,
         inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
+        arm: args.arm.arm()?,
         ground_truth: args.follow.ground_truth,
         // ROS peers expect real time: --ros paces headless runs unless --rtf says otherwise.
         real_time_factor: args.window.rtf.or(args.ros.ros.then_some(1.0)),
@@ -204,6 +205,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         detector_config: args.detector.config(super::args::spare_detect_threads())?,
         inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
+        arm: args.arm.arm()?,
         ground_truth: args.follow.ground_truth,
     };
     let mut ros = args

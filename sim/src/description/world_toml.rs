@@ -106,6 +106,8 @@ struct RawRobot {
     #[serde(default)]
     drive: Option<DriveSpec>,
     controllers: Option<PathBuf>,
+    arm_base: Option<String>,
+    ee_link: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -420,6 +422,8 @@ impl RawWorld {
             xacro_args: raw_robot.xacro_args,
             drive: raw_robot.drive,
             controllers: raw_robot.controllers.map(|c| base_dir.join(c)),
+            arm_base: raw_robot.arm_base,
+            ee_link: raw_robot.ee_link,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

@@ -56,6 +56,10 @@ pub struct RobotSpawn {
     /// `controllers`: a ros_control controllers YAML for the robot, resolved against the world
     /// file's folder.
     pub controllers: Option<PathBuf>,
+    /// `arm_base`: the link the arm's look and reach work from (default: the robot's root).
+    pub arm_base: Option<String>,
+    /// `ee_link`: the arm's end effector, which reaches.
+    pub ee_link: Option<String>,
 }
 
 /// Physics settings (`[physics]`).

@@ -1,0 +1,352 @@
+//! The arm's tasks in a session, switched on and off like the follower: **look** (the camera's
+//! chain turns so the chosen detection's box centre comes to the image centre) and **reach**
+//! (the tool goes to a pre-grasp point short of it, the camera's own chain looking at it when
+//! that chain is not the arm's). Both act on detector messages only, with the depth image and
+//! the robot's joint states of the image the message came from (kept for the last few images).
+
+use nalgebra::Vector3;
+use rover_perception::BoundingBoxes;
+use rover_sim::{
+    CameraConfig, CameraFrame, JointCommand, KinematicsError, LinkId, Pose, Simulation,
+    isometry_from_pose, link_from_optical,
+};
+
+use crate::look::{Look, LookConfig};
+use crate::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
+
+/// How many recent images are kept for detections still to come.
+const FRAMES: usize = 8;
+
+/// Which links the arm's tasks use and how they behave.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ArmConfig {
+    /// The arm's base link (IK and points are in its frame); `None`: the world's `[robot]
+    /// arm_base`, else the robot's root link.
+    pub base_link: Option<String>,
+    /// The end effector (the tool that reaches); `None`: the world's `[robot] ee_link`, else
+    /// no reach.
+    pub ee_link: Option<String>,
+    /// Look settings (its class is the one looked at).
+    pub look: LookConfig,
+    /// Reach settings (its class is the one reached for).
+    pub reach: ReachConfig,
+}
+
+/// What the arm is doing on its own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ArmMode {
+    /// Nothing: it takes commands (keys, scripts, ROS).
+    #[default]
+    Off,
+    /// Looking at the class.
+    Look,
+    /// Reaching for the class.
+    Reach,
+}
+
+impl ArmMode {
+    /// `off`, `look` or `reach`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ArmMode::Off => "off",
+            ArmMode::Look => "look",
+            ArmMode::Reach => "reach",
+        }
+    }
+}
+
+/// The arm's task as observers see it (HUD, Rerun, ROS).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ArmStatus {
+    /// Which task runs.
+    pub mode: ArmMode,
+    /// What the reach is doing (meaningful in [`ArmMode::Reach`]).
+    pub reach: ReachState,
+    /// The object point reached for, world frame (m).
+    pub object_world_m: Option<[f64; 3]>,
+    /// The pre-grasp goal, world frame (m).
+    pub goal_world_m: Option<[f64; 3]>,
+    /// The tool, world frame (m).
+    pub tool_world_m: Option<[f64; 3]>,
+}
+
+/// One image as the tasks need it later.
+#[derive(Debug, Clone)]
+struct FrameRecord {
+    seq: u64,
+    depth_m: Vec<f32>,
+    width: u32,
+    height: u32,
+    /// The optical frame in the arm's base frame.
+    base_from_optical: nalgebra::Isometry3<f64>,
+    /// Every joint's position (robot joint order; 0 for joints that do not move).
+    q: Vec<f64>,
+}
+
+/// The session's arm tasks.
+#[derive(Debug)]
+pub(crate) struct ArmTask {
+    mode: ArmMode,
+    base_link: LinkId,
+    camera_link: LinkId,
+    look: Result<Look, String>,
+    reach: Result<Reach, String>,
+    /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
+    look_while_reaching: bool,
+    frames: Vec<FrameRecord>,
+    q: Vec<f64>,
+    status: ArmStatus,
+}
+
+impl ArmTask {
+    /// The tasks for `sim`'s robot seeing through `camera` (the session's camera, if any).
+    /// What cannot be built is kept as the reason, said when the task is switched on.
+    pub(crate) fn new(sim: &Simulation, camera: Option<&CameraConfig>, config: &ArmConfig) -> Self {
+        let robot = sim.robot();
+        let spawn = &sim.world().robot;
+        let root = &robot.links[robot.root.index()].name;
+        let base_name = (config.base_link.as_ref())
+            .or(spawn.arm_base.as_ref())
+            .unwrap_or(root);
+        let ee_link = config.ee_link.as_ref().or(spawn.ee_link.as_ref());
+        let base_link = robot.link_id(base_name).unwrap_or(robot.root);
+        let camera_link = camera
+            .and_then(|c| robot.link_id(&c.link))
+            .unwrap_or(robot.root);
+        let no_camera = || "the robot has no camera running".to_owned();
+        let look = camera.ok_or_else(no_camera).and_then(|c| {
+            Look::new(robot, c, base_name, config.look.clone()).map_err(|e| e.to_string())
+        });
+        let reach = match (camera, ee_link) {
+            (None, _) => Err(no_camera()),
+            (Some(c), _) if c.depth.is_none() => Err(format!(
+                "camera \"{}\" renders no depth (reach needs a <sensor type=\"depth\">)",
+                c.name
+            )),
+            (Some(_), None) => Err(
+                "no end effector given (--ee-link LINK, or ee_link in the world's [robot])"
+                    .to_owned(),
+            ),
+            (Some(c), Some(ee)) => {
+                Reach::new(robot, c, base_name, ee, config.reach.clone()).map_err(|e| e.to_string())
+            }
+        };
+        let look_while_reaching = match (&look, &reach) {
+            (Ok(look), Ok(reach)) => look
+                .joints()
+                .iter()
+                .all(|j| reach.joints().iter().all(|r| r.id != j.id)),
+            _ => false,
+        };
+        Self {
+            mode: ArmMode::Off,
+            base_link,
+            camera_link,
+            look,
+            reach,
+            look_while_reaching,
+            frames: Vec::new(),
+            q: Vec::with_capacity(robot.joints.len()),
+            status: ArmStatus::default(),
+        }
+    }
+
+    /// The status for observers.
+    pub(crate) fn status(&self) -> ArmStatus {
+        self.status
+    }
+
+    /// The reach controller, when the robot has one.
+    pub(crate) fn reach(&self) -> Option<&Reach> {
+        self.reach.as_ref().ok()
+    }
+
+    /// Switches `mode` on (or off when it is on); the text for the event log, or why it
+    /// cannot run (a warning; nothing changes).
+    pub(crate) fn toggle(&mut self, mode: ArmMode, sim: &mut Simulation) -> Result<String, String> {
+        let next = if self.mode == mode {
+            ArmMode::Off
+        } else {
+            mode
+        };
+        match next {
+            ArmMode::Look => {
+                self.look.as_ref().map_err(|e| format!("no look: {e}"))?;
+            }
+            ArmMode::Reach => {
+                self.reach.as_ref().map_err(|e| format!("no reach: {e}"))?;
+            }
+            ArmMode::Off => {}
+        }
+        // Whatever was going on stops where it is.
+        self.hold(sim);
+        if let Ok(reach) = self.reach.as_mut() {
+            reach.reset();
+        }
+        self.mode = next;
+        self.status = ArmStatus {
+            mode: next,
+            ..ArmStatus::default()
+        };
+        if self.frames.is_empty() && next != ArmMode::Off {
+            self.frames = vec![
+                FrameRecord {
+                    seq: u64::MAX,
+                    depth_m: Vec::new(),
+                    width: 0,
+                    height: 0,
+                    base_from_optical: nalgebra::Isometry3::identity(),
+                    q: Vec::new(),
+                };
+                FRAMES
+            ];
+        }
+        Ok(format!("arm: {}", next.as_str()))
+    }
+
+    /// Keeps what a camera image's detections will need: its depth, where the camera was and
+    /// the joints' positions (only while a task runs).
+    pub(crate) fn capture(&mut self, frame: &CameraFrame<'_>, sim: &Simulation) {
+        if self.mode == ArmMode::Off {
+            return;
+        }
+        let Some(slot) = self.frames.get_mut(frame.seq as usize % FRAMES) else {
+            return;
+        };
+        slot.seq = frame.seq;
+        slot.width = frame.width;
+        slot.height = frame.height;
+        slot.depth_m.clear();
+        slot.depth_m
+            .extend_from_slice(frame.depth_m.unwrap_or_default());
+        let base_from_camera =
+            sim.world_from_link(self.base_link).inverse() * sim.world_from_link(self.camera_link);
+        slot.base_from_optical =
+            isometry_from_pose(&(base_from_camera * Pose::from_rotation(link_from_optical())));
+        joint_positions(sim, &mut slot.q);
+    }
+
+    /// A detector message: the tasks' joint targets go to the simulation. Errors are the
+    /// chain's (they cannot happen for a chain built from this robot).
+    pub(crate) fn observe(
+        &mut self,
+        boxes: &BoundingBoxes,
+        sim: &mut Simulation,
+    ) -> Result<(), KinematicsError> {
+        if self.mode == ArmMode::Off {
+            return Ok(());
+        }
+        let seq = boxes.image_stamp.frame;
+        let Some(record) = self
+            .frames
+            .get(seq as usize % FRAMES)
+            .filter(|r| r.seq == seq)
+        else {
+            return Ok(());
+        };
+        let looking = self.mode == ArmMode::Look || self.look_while_reaching;
+        if looking && let Ok(look) = self.look.as_mut() {
+            let q: Vec<f64> = look
+                .joints()
+                .iter()
+                .map(|j| record.q[j.id.index()])
+                .collect();
+            if let Some(targets) = look.observe(boxes, &q)? {
+                command(sim, look.joints().iter().map(|j| j.name.as_str()), &targets);
+            }
+        }
+        if self.mode == ArmMode::Reach
+            && let Ok(reach) = self.reach.as_mut()
+        {
+            joint_positions(sim, &mut self.q);
+            let q: Vec<f64> = reach
+                .joints()
+                .iter()
+                .map(|j| self.q[j.id.index()])
+                .collect();
+            let view = DepthView {
+                depth_m: &record.depth_m,
+                width: record.width,
+                height: record.height,
+                base_from_optical: record.base_from_optical,
+            };
+            match reach.observe(boxes, &view, &q)? {
+                ReachStep::Keep => {}
+                ReachStep::Move(targets) => {
+                    command(
+                        sim,
+                        reach.joints().iter().map(|j| j.name.as_str()),
+                        &targets,
+                    );
+                }
+                ReachStep::Hold => {
+                    command(sim, reach.joints().iter().map(|j| j.name.as_str()), &q);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// After a control update: the reach's arrival and the status's world points.
+    pub(crate) fn update(&mut self, sim: &Simulation) -> Result<(), KinematicsError> {
+        if self.mode != ArmMode::Reach {
+            return Ok(());
+        }
+        let Ok(reach) = self.reach.as_mut() else {
+            return Ok(());
+        };
+        joint_positions(sim, &mut self.q);
+        let q: Vec<f64> = reach
+            .joints()
+            .iter()
+            .map(|j| self.q[j.id.index()])
+            .collect();
+        reach.update_tool(&q)?;
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base_link));
+        let world = |p: Vector3<f64>| {
+            let w = world_from_base * nalgebra::Point3::from(p);
+            [w.x, w.y, w.z]
+        };
+        let tool = reach.chain().base_from_tip(&q)?.translation.vector;
+        self.status = ArmStatus {
+            mode: self.mode,
+            reach: reach.state(),
+            object_world_m: reach.object_m().map(world),
+            goal_world_m: reach.goal_m().map(world),
+            tool_world_m: Some(world(tool)),
+        };
+        Ok(())
+    }
+
+    /// Tells the tasks' joints to stay where they are.
+    fn hold(&mut self, sim: &mut Simulation) {
+        joint_positions(sim, &mut self.q);
+        let joints = match self.mode {
+            ArmMode::Off => return,
+            ArmMode::Look => self.look.as_ref().map(|l| l.joints()).unwrap_or_default(),
+            ArmMode::Reach => self.reach.as_ref().map(|r| r.joints()).unwrap_or_default(),
+        };
+        let q: Vec<f64> = joints.iter().map(|j| self.q[j.id.index()]).collect();
+        command(sim, joints.iter().map(|j| j.name.as_str()), &q);
+    }
+}
+
+/// Every joint's position now (robot joint order; 0 for a joint that does not move).
+fn joint_positions(sim: &Simulation, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(
+        sim.robot()
+            .joint_ids()
+            .map(|(id, _)| sim.joint_state(id).map_or(0.0, |s| s.position)),
+    );
+}
+
+/// Position commands to `names`; a joint without an actuator is skipped (logged once per
+/// command at debug level: the chain's passive joints follow the others).
+fn command<'a>(sim: &mut Simulation, names: impl Iterator<Item = &'a str>, targets: &[f64]) {
+    for (name, q) in names.zip(targets) {
+        if let Err(e) = sim.command_joint(name, JointCommand::Position(*q)) {
+            tracing::debug!("arm: {e}");
+        }
+    }
+}

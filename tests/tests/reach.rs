@@ -1,0 +1,273 @@
+//! Reach, with the real renderer, physics and detector: TIAGo (`tiago_no_hand.urdf`) sees a
+//! ball on a stand through its xtion (a depth camera), and its arm's tool goes to a point 10 cm
+//! short of it, from the boxes, the depth image and its own joint states only.
+
+use anyhow::Result;
+use rover_core::{
+    Action, ArmConfig, DetectorMode, JointAction, NoObserver, ReachState, Session, SessionOptions,
+};
+use rover_sim::{JointCommand, Pose, SimOptions, World};
+
+/// The ball's radius (m) and where it rests at first (centre, world frame).
+const BALL_RADIUS_M: f64 = 0.06;
+const BALL_AT: [f64; 3] = [0.75, -0.25, 0.76];
+
+/// A stand 0.7 m high and a red ball on it (a red sphere is what YOLO calls "sports ball").
+fn world() -> Result<World> {
+    let text = format!(
+        "[[cylinder]]\nname = \"stand\"\nradius_m = 0.04\nlength_m = 0.7\nposition_m = [{x}, {y}, 0.35]\ncolor = \"#8a8a8a\"\n\
+         [[sphere]]\nname = \"ball\"\nradius_m = {BALL_RADIUS_M}\nposition_m = [{x}, {y}, {z}]\ncolor = \"#d02020\"\nmass_kg = 0.1\nclass = \"sports ball\"\n",
+        x = BALL_AT[0],
+        y = BALL_AT[1],
+        z = BALL_AT[2],
+    );
+    Ok(World::from_str(&text, std::path::Path::new("reach.toml"))?)
+}
+
+/// TIAGo's arm "home" pose and its head tilted down at the table.
+const START: [(&str, f64); 9] = [
+    ("arm_1_joint", 0.2),
+    ("arm_2_joint", -1.34),
+    ("arm_3_joint", -0.2),
+    ("arm_4_joint", 1.94),
+    ("arm_5_joint", -1.57),
+    ("arm_6_joint", 1.37),
+    ("arm_7_joint", 0.0),
+    ("head_1_joint", 0.0),
+    ("head_2_joint", -0.6),
+];
+
+/// A session with TIAGo in [`world`], detecting at 5 Hz of sim time in lockstep.
+fn session(seed: u64) -> Result<Option<Session>> {
+    let Some(robot) = rover_tests::tiago()? else {
+        return Ok(None);
+    };
+    let options = SessionOptions {
+        sim: SimOptions {
+            seed,
+            cmd_timeout_s: Some(0.0),
+            ..SimOptions::default()
+        },
+        camera: true,
+        every_frame: false,
+        detector: DetectorMode::Lockstep { rate_hz: 5.0 },
+        arm: ArmConfig {
+            base_link: Some("torso_lift_link".into()),
+            ee_link: Some("arm_tool_link".into()),
+            ..ArmConfig::default()
+        },
+        ..SessionOptions::default()
+    };
+    let mut session = Session::new(world()?, robot, &options, &mut NoObserver)?;
+    for (joint, q) in START {
+        session.input(
+            Action::Joint(JointAction::Command {
+                joint: joint.into(),
+                command: JointCommand::Position(q),
+            }),
+            &mut NoObserver,
+        );
+    }
+    Ok(Some(session))
+}
+
+fn ball(session: &Session) -> Pose {
+    let mut poses = Vec::new();
+    session.sim().object_poses_into(&mut poses);
+    poses.get(1).copied().unwrap_or(Pose::IDENTITY)
+}
+
+/// The arm's joint positions now.
+fn arm_q(session: &Session) -> Vec<f64> {
+    let sim = session.sim();
+    (1..=7)
+        .map(|k| {
+            sim.robot()
+                .joint_id(&format!("arm_{k}_joint"))
+                .and_then(|id| sim.joint_state(id))
+                .map_or(f64::NAN, |s| s.position)
+        })
+        .collect()
+}
+
+/// What a run records every control update: time, tool (world), state, arm joints.
+#[derive(Debug, Default)]
+struct Run {
+    tool: Vec<(f64, [f64; 3], ReachState)>,
+    joints: Vec<Vec<f64>>,
+}
+
+fn run_for(session: &mut Session, seconds: f64, run: &mut Run) -> Result<()> {
+    let end = session.sim().sim_time_s() + seconds;
+    while session.sim().sim_time_s() < end - 1e-9 {
+        if session.step(&mut NoObserver)?.is_some() {
+            let status = session.stats().arm;
+            if let Some(tool) = status.tool_world_m {
+                run.tool
+                    .push((session.sim().sim_time_s(), tool, status.reach));
+            }
+            run.joints.push(arm_q(session));
+        }
+    }
+    Ok(())
+}
+
+/// Where the tool should end: 10 cm short of the ball's surface point the camera sees at the
+/// box centre (on the line from the camera to the ball's centre), horizontally along the line
+/// from the arm's base (torso_lift_link) — computed here from the ball's true pose.
+fn pregrasp_truth(session: &Session) -> Result<[f64; 3]> {
+    let sim = session.sim();
+    let link = |name: &str| {
+        sim.robot()
+            .link_id(name)
+            .map(|id| sim.world_from_link(id))
+            .ok_or_else(|| anyhow::anyhow!("no link {name}"))
+    };
+    let camera_link = sim
+        .robot()
+        .cameras
+        .first()
+        .map(|c| c.link.clone())
+        .unwrap_or_default();
+    let camera = link(&camera_link)?;
+    let base = link("torso_lift_link")?;
+    let centre = ball(session).translation;
+    let toward_camera = (camera.translation - centre).normalize();
+    let surface = centre + toward_camera * BALL_RADIUS_M as f32;
+    let mut horizontal = base.inverse().transform_point(surface);
+    horizontal.z = 0.0;
+    let approach = base.rotation * horizontal.normalize();
+    let p = surface - approach * 0.1;
+    Ok([f64::from(p.x), f64::from(p.y), f64::from(p.z)])
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Reach: the tool ends within 5 cm of the pre-grasp point within 10 s of switching reach on,
+/// never touching the ball (it does not move; the tool stays outside it); with the ball gone
+/// no arm joint moves more than 0.01 rad over 3 s; the same seed gives the same joint trace.
+#[test]
+fn tiago_reaches_short_of_the_ball_the_detector_sees() -> Result<()> {
+    let Some(mut session) = session(3)? else {
+        return Ok(());
+    };
+    let mut run = Run::default();
+    run_for(&mut session, 1.5, &mut run)?;
+    let ball_at_start = ball(&session).translation;
+    let before_reach = run.joints.len();
+    session.input(Action::ToggleReach, &mut NoObserver);
+    let start_s = session.sim().sim_time_s();
+    run_for(&mut session, 10.0, &mut run)?;
+    let goal = pregrasp_truth(&session)?;
+    let status = session.stats().arm;
+    println!("status at 10 s: {status:?}; pre-grasp from the truth {goal:.3?}");
+    let centre = ball(&session).translation;
+    let centre = [
+        f64::from(centre.x),
+        f64::from(centre.y),
+        f64::from(centre.z),
+    ];
+    let closest = run
+        .tool
+        .iter()
+        .map(|(_, p, _)| distance(*p, centre))
+        .fold(f64::INFINITY, f64::min);
+    let arrived = run
+        .tool
+        .iter()
+        .find(|(_, p, _)| distance(*p, goal) <= 0.05)
+        .map(|(t, _, _)| t - start_s);
+    let end = status.tool_world_m.unwrap_or([f64::NAN; 3]);
+    let timeline: Vec<String> = run
+        .tool
+        .iter()
+        .step_by(25)
+        .map(|(t, p, s)| {
+            format!(
+                "{:.2} s {} {:.3} m",
+                t - start_s,
+                s.as_str(),
+                distance(*p, goal)
+            )
+        })
+        .collect();
+    println!("(time, state, tool to the pre-grasp point): {timeline:?}");
+    println!(
+        "tool within 5 cm of the pre-grasp point after {arrived:?} s; at 10 s {:.3} m from it; closest to the ball's centre {closest:.3} m; the ball moved {:.4} m",
+        distance(end, goal),
+        (ball(&session).translation - ball_at_start).length()
+    );
+    assert!(distance(end, goal) <= 0.05, "tool {end:?}, goal {goal:?}");
+    assert!(arrived.is_some_and(|t| t <= 10.0));
+    assert!(closest > BALL_RADIUS_M, "the tool went into the ball");
+    assert!(
+        (ball(&session).translation - ball_at_start).length() < 1e-3,
+        "the ball was touched"
+    );
+
+    // The ball taken away: the arm holds still.
+    session.place_object(1, [0.0, -6.0, BALL_RADIUS_M], 0.0)?;
+    let before = arm_q(&session);
+    let mut hidden = Run::default();
+    run_for(&mut session, 3.0, &mut hidden)?;
+    let moved = hidden
+        .joints
+        .iter()
+        .flat_map(|q| q.iter().zip(&before).map(|(a, b)| (a - b).abs()))
+        .fold(0.0, f64::max);
+    println!(
+        "ball hidden: state {:?}, largest joint change {moved:.5} rad",
+        session.stats().arm.reach
+    );
+    assert!(
+        moved <= 0.01,
+        "a joint moved {moved} rad with the ball gone"
+    );
+    assert_eq!(session.stats().arm.reach, ReachState::Lost);
+
+    // The ball back on its stand 15 cm to the left: the arm plans again and gets there.
+    let moved_to = [BALL_AT[0] - 0.05, BALL_AT[1] + 0.15];
+    session.place_object(0, [moved_to[0], moved_to[1], 0.35], 0.0)?;
+    session.place_object(1, [moved_to[0], moved_to[1], BALL_AT[2]], 0.0)?;
+    let mut again = Run::default();
+    let again_s = session.sim().sim_time_s();
+    run_for(&mut session, 10.0, &mut again)?;
+    let goal = pregrasp_truth(&session)?;
+    let arrived = again
+        .tool
+        .iter()
+        .find(|(_, p, _)| distance(*p, goal) <= 0.05)
+        .map(|(t, _, _)| t - again_s);
+    let end = session.stats().arm.tool_world_m.unwrap_or([f64::NAN; 3]);
+    println!(
+        "ball moved: tool within 5 cm after {arrived:?} s, {:.3} m from the new pre-grasp point at 10 s ({:?})",
+        distance(end, goal),
+        session.stats().arm.reach
+    );
+    assert!(distance(end, goal) <= 0.05, "tool {end:?}, goal {goal:?}");
+
+    // The same seed, the same joint trace.
+    let Some(mut again) = session_at_reach(3)? else {
+        return Ok(());
+    };
+    let mut second = Run::default();
+    run_for(&mut again, 10.0, &mut second)?;
+    let first: Vec<&Vec<f64>> = run.joints.iter().skip(before_reach).collect();
+    let repeat: Vec<&Vec<f64>> = second.joints.iter().collect();
+    assert_eq!(first.len(), repeat.len());
+    assert!(first == repeat, "the joint trace differs between two runs");
+    Ok(())
+}
+
+/// A fresh [`session`] run 1.5 s and switched to reach, as the test's first run.
+fn session_at_reach(seed: u64) -> Result<Option<Session>> {
+    let Some(mut session) = session(seed)? else {
+        return Ok(None);
+    };
+    let mut run = Run::default();
+    run_for(&mut session, 1.5, &mut run)?;
+    session.input(Action::ToggleReach, &mut NoObserver);
+    Ok(Some(session))
+}
