@@ -898,3 +898,74 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
     graph.wait_rover(Duration::from_secs(120))?;
     Ok(())
 }
+
+/// The arm's reach over ROS: a rospy node asks `/rover/arm/task` for `reach`; TIAGo, seeing a
+/// red ball on a stand 0.75 m ahead through its xtion, reports `reach arrived` on the latched
+/// `/rover/arm/state`, and `/rover/arm/goal` is a PointStamped in base_footprint 10 cm short
+/// of the ball, at its height.
+#[test]
+fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
+    };
+    let mut graph = RosGraph::start()?;
+    let world = graph.dir.path().join("ball.toml");
+    std::fs::write(
+        &world,
+        "[[cylinder]]\nname = \"stand\"\nradius_m = 0.04\nlength_m = 0.7\nposition_m = [0.75, -0.25, 0.35]\ncolor = \"#8a8a8a\"\n\
+         [[sphere]]\nname = \"ball\"\nradius_m = 0.06\nposition_m = [0.75, -0.25, 0.76]\ncolor = \"#d02020\"\nmass_kg = 0.1\n",
+    )?;
+    let script = graph.dir.path().join("start.toml");
+    std::fs::write(
+        &script,
+        "steps = [\n  { at = 0.0, joint = \"arm_1_joint\", position = 0.2 },\n  { at = 0.0, joint = \"arm_2_joint\", position = -1.34 },\n  { at = 0.0, joint = \"arm_3_joint\", position = -0.2 },\n  { at = 0.0, joint = \"arm_4_joint\", position = 1.94 },\n  { at = 0.0, joint = \"arm_5_joint\", position = -1.57 },\n  { at = 0.0, joint = \"arm_6_joint\", position = 1.37 },\n  { at = 0.0, joint = \"head_2_joint\", position = -0.6 },\n]\n",
+    )?;
+    let (world, script) = (world.to_string_lossy(), script.to_string_lossy());
+    graph.spawn_tiago(
+        45.0,
+        &urdf,
+        &[
+            "--world",
+            world.as_ref(),
+            "--script",
+            script.as_ref(),
+            "--ee-link",
+            "arm_tool_link",
+            "--arm-base",
+            "torso_lift_link",
+        ],
+    )?;
+    let out = graph.run_python(
+        "reach.py",
+        "import rospy\nfrom std_msgs.msg import String\nfrom geometry_msgs.msg import PointStamped\nrospy.init_node('reach_check')\nstates = []\nrospy.Subscriber('/rover/arm/state', String, lambda m: states.append(m.data))\ntask = rospy.Publisher('/rover/arm/task', String, queue_size=1, latch=True)\nrospy.sleep(3.0)\ntask.publish(String('reach'))\nend = rospy.Time.now() + rospy.Duration(30)\nwhile 'reach arrived' not in states and rospy.Time.now() < end:\n    rospy.sleep(0.1)\nprint('states ' + ','.join(s.replace(' ', '_') for s in states))\ng = rospy.wait_for_message('/rover/arm/goal', PointStamped, timeout=10)\nprint('goal %s %.4f %.4f %.4f' % (g.header.frame_id, g.point.x, g.point.y, g.point.z))\n",
+        Duration::from_secs(60),
+    )?;
+    println!("{out}");
+    let states = out
+        .lines()
+        .find_map(|l| l.strip_prefix("states "))
+        .unwrap_or_default();
+    ensure!(
+        states.split(',').any(|s| s == "reach_arrived"),
+        "no `reach arrived` on /rover/arm/state:\n{out}"
+    );
+    let goal: Vec<&str> = out
+        .lines()
+        .find_map(|l| l.strip_prefix("goal "))
+        .map(|l| l.split(' ').collect())
+        .unwrap_or_default();
+    ensure!(goal.len() == 4, "no /rover/arm/goal:\n{out}");
+    ensure!(goal[0] == "base_footprint", "goal frame {}", goal[0]);
+    let (x, y, z): (f64, f64, f64) = (goal[1].parse()?, goal[2].parse()?, goal[3].parse()?);
+    // The ball's near surface is about 0.69 m ahead; 10 cm short of it, at its height.
+    ensure!(
+        (0.5..0.68).contains(&x) && (-0.3..-0.1).contains(&y) && (0.7..0.85).contains(&z),
+        "goal ({x}, {y}, {z}) is not 10 cm short of the ball"
+    );
+    graph.wait_rover(Duration::from_secs(120))?;
+    Ok(())
+}

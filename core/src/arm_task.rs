@@ -70,6 +70,14 @@ pub struct ArmStatus {
     pub tool_world_m: Option<[f64; 3]>,
 }
 
+impl ArmStatus {
+    /// How far the tool is from the pre-grasp goal (m), once there is one.
+    pub fn tool_to_goal_m(&self) -> Option<f64> {
+        let (t, g) = (self.tool_world_m?, self.goal_world_m?);
+        Some(((t[0] - g[0]).powi(2) + (t[1] - g[1]).powi(2) + (t[2] - g[2]).powi(2)).sqrt())
+    }
+}
+
 /// One image as the tasks need it later.
 #[derive(Debug, Clone)]
 struct FrameRecord {
@@ -161,14 +169,18 @@ impl ArmTask {
         self.reach.as_ref().ok()
     }
 
-    /// Switches `mode` on (or off when it is on); the text for the event log, or why it
-    /// cannot run (a warning; nothing changes).
-    pub(crate) fn toggle(&mut self, mode: ArmMode, sim: &mut Simulation) -> Result<String, String> {
-        let next = if self.mode == mode {
+    /// The mode a toggle of `mode` leads to: `mode`, or off when it runs.
+    pub(crate) fn toggled(&self, mode: ArmMode) -> ArmMode {
+        if self.mode == mode {
             ArmMode::Off
         } else {
             mode
-        };
+        }
+    }
+
+    /// Switches to `next` (the arm stops where it is); the text for the event log, or why it
+    /// cannot run (a warning; nothing changes). Setting the mode that runs starts it afresh.
+    pub(crate) fn set(&mut self, next: ArmMode, sim: &mut Simulation) -> Result<String, String> {
         match next {
             ArmMode::Look => {
                 self.look.as_ref().map_err(|e| format!("no look: {e}"))?;

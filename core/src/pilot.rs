@@ -69,7 +69,7 @@ impl Pilot {
                 Some(Twist::ZERO)
             }
             // The arm moves in either mode; the base is not touched.
-            Action::Joint(_) | Action::ToggleLook | Action::ToggleReach => None,
+            Action::Joint(_) | Action::ToggleLook | Action::ToggleReach | Action::Arm(_) => None,
         }
     }
 }

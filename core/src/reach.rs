@@ -86,6 +86,11 @@ pub enum ReachState {
 }
 
 impl ReachState {
+    /// 0 seeking, 1 moving, 2 arrived, 3 lost, 4 unreachable (for plots).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
     /// `seeking`, `moving`, `arrived`, `lost` or `unreachable`.
     pub fn as_str(self) -> &'static str {
         match self {

@@ -285,12 +285,13 @@ impl Session {
                 self.joint_input(joint, observer);
                 return;
             }
-            Action::ToggleLook => Some(ArmMode::Look),
-            Action::ToggleReach => Some(ArmMode::Reach),
+            Action::ToggleLook => Some(self.arm.toggled(ArmMode::Look)),
+            Action::ToggleReach => Some(self.arm.toggled(ArmMode::Reach)),
+            Action::Arm(mode) => Some(mode),
             _ => None,
         };
         if let Some(mode) = arm_mode {
-            let (level, text) = match self.arm.toggle(mode, &mut self.sim) {
+            let (level, text) = match self.arm.set(mode, &mut self.sim) {
                 Ok(text) => (EventLevel::Info, text),
                 Err(why) => (EventLevel::Warn, why),
             };

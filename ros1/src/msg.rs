@@ -76,6 +76,11 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities",
     ),
     ("rosgraph_msgs/Clock", "time clock"),
+    ("std_msgs/String", "string data"),
+    (
+        "geometry_msgs/PointStamped",
+        "Header header\ngeometry_msgs/Point point",
+    ),
     ("std_msgs/Float64", "float64 data"),
     (
         "trajectory_msgs/JointTrajectoryPoint",

@@ -332,6 +332,45 @@ impl Decode for Float64 {
     }
 }
 
+/// `std_msgs/String`: a line of text (rover's arm task in and state out).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Text {
+    /// The text.
+    pub data: String,
+}
+
+impl Message for Text {
+    const TYPE: &'static str = "std_msgs/String";
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::string(out, &self.data);
+    }
+}
+
+impl Decode for Text {
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        Ok(Self {
+            data: Reader::new(bytes).string()?,
+        })
+    }
+}
+
+/// `geometry_msgs/PointStamped`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PointStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The point (m).
+    pub point: Vector3,
+}
+
+impl Message for PointStamped {
+    const TYPE: &'static str = "geometry_msgs/PointStamped";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        self.point.encode(out);
+    }
+}
+
 /// `trajectory_msgs/JointTrajectoryPoint`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct JointTrajectoryPoint {
@@ -633,6 +672,11 @@ mod tests {
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
             ("std_msgs/Header", "2176decaecbce78abc3b96ef049fabed"),
             ("std_msgs/Float64", "fdb28210bfa9d7c91146260178d9a584"),
+            ("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1"),
+            (
+                "geometry_msgs/PointStamped",
+                "c63aecb41bfdfd6b7e1fac37c7cbe7bf",
+            ),
             (
                 "trajectory_msgs/JointTrajectoryPoint",
                 "f3cd1e1c4d320c79d6985c904ae5dcd3",

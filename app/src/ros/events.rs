@@ -26,6 +26,21 @@ pub(super) struct ControlUpdate {
     pub sample: ControlSample,
     /// One per joint of the plan's `joints`, in that order.
     pub joints: Vec<JointSample>,
+    /// The arm's task.
+    pub arm: ArmSample,
+}
+
+/// The arm's task at a control update, its points in the robot's base frame.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct ArmSample {
+    /// Which task runs.
+    pub mode: rover_core::ArmMode,
+    /// What reach is doing.
+    pub reach: rover_core::ReachState,
+    /// The object point reach goes for (m, base frame).
+    pub object_base_m: Option<[f64; 3]>,
+    /// The pre-grasp goal (m, base frame).
+    pub goal_base_m: Option<[f64; 3]>,
 }
 
 /// One moving joint's state at a control update.

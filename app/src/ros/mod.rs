@@ -9,11 +9,14 @@
 //!
 //! One file per topic family, as OpenRR's arci-ros has one adapter per family: `clock.rs`,
 //! `odom.rs`, `tf.rs` (`/tf`, `/tf_static`), `joint_states.rs`, `camera.rs` (image,
-//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, `controller_states.rs` (the controllers' `state`), and `cmd_vel.rs` and `controllers.rs` (the controllers' `command` topics) in. Each publishing
+//! camera_info), `detections.rs` (darknet_ros), `laser.rs`, `controller_states.rs` (the
+//! controllers' `state`), `arm.rs` (the arm's look and reach: task in, state and points out),
+//! and `cmd_vel.rs` and `controllers.rs` (the controllers' `command` topics) in. Each publishing
 //! family implements `TopicFamily` (`events.rs`, with what travels between the threads) and is
 //! listed once in `families` below; `plan.rs` names the topics, frames and moving joints,
 //! `publisher.rs` is the thread. A new topic is a new file beside them and a line in `families`.
 
+mod arm;
 mod camera;
 mod clock;
 mod cmd_vel;
@@ -76,6 +79,7 @@ fn families(
         Box::new(detections::DarknetTopics::advertise(node, plan)?),
         Box::new(laser::Laser::advertise(node, plan)?),
         Box::new(controller_states::ControllerStates::advertise(node, plan)?),
+        Box::new(arm::ArmTopics::advertise(node, plan)?),
     ];
     if options.ground_truth {
         families.push(Box::new(ground_truth::GroundTruthTopic::advertise(node)?));
@@ -83,16 +87,21 @@ fn families(
     Ok(families)
 }
 
-/// The input half of the bridge: `/cmd_vel` and the controllers' `command` topics.
+/// The input half of the bridge: `/cmd_vel`, the controllers' `command` topics and the arm's
+/// task.
 #[derive(Debug)]
 pub struct RosInput {
     cmd_vel: RosCmdVel,
     controllers: ControllerCommands,
+    arm: arm::ArmTaskInput,
 }
 
 impl InputSource for RosInput {
     fn poll(&mut self) -> Option<Action> {
-        self.cmd_vel.poll().or_else(|| self.controllers.poll())
+        self.cmd_vel
+            .poll()
+            .or_else(|| self.controllers.poll())
+            .or_else(|| self.arm.poll())
     }
 }
 
@@ -133,6 +142,7 @@ impl RosBridge {
         let families = families(&node, &plan, options)?;
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
         let controllers = ControllerCommands::subscribe(&node, &plan)?;
+        let arm_task = arm::ArmTaskInput::subscribe(&node)?;
         for c in &plan.controllers {
             tracing::info!(
                 "ROS: controller {} takes {} on {}",
@@ -175,6 +185,7 @@ impl RosBridge {
             RosInput {
                 cmd_vel: cmd,
                 controllers,
+                arm: arm_task,
             },
         ))
     }
@@ -235,7 +246,7 @@ impl Observer for RosBridge {
         }));
     }
 
-    fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         let started = std::time::Instant::now();
         self.now_s = sample.sim_time_s;
         let mut joints = self.buffers.take_joints();
@@ -243,6 +254,7 @@ impl Observer for RosBridge {
         self.send(Event::Control(ControlUpdate {
             sample: *sample,
             joints,
+            arm: arm_sample(sim, &stats.arm),
         }));
         self.busy += started.elapsed();
     }
@@ -278,5 +290,22 @@ impl Observer for RosBridge {
         let scan = laser::capture(scan, self.buffers.take_ranges());
         self.send(Event::Scan(scan));
         self.busy += started.elapsed();
+    }
+}
+
+/// The arm's status with its points moved from the world into the robot's base frame.
+fn arm_sample(sim: &Simulation, arm: &rover_core::ArmStatus) -> events::ArmSample {
+    let base_from_world = sim.world_from_base().inverse();
+    let to_base = |p: Option<[f64; 3]>| {
+        p.map(|[x, y, z]| {
+            let b = base_from_world.transform_point(glam::Vec3::new(x as f32, y as f32, z as f32));
+            [f64::from(b.x), f64::from(b.y), f64::from(b.z)]
+        })
+    };
+    events::ArmSample {
+        mode: arm.mode,
+        reach: arm.reach,
+        object_base_m: to_base(arm.object_world_m),
+        goal_base_m: to_base(arm.goal_world_m),
     }
 }

@@ -64,7 +64,8 @@ impl ArmKeys {
         }))
     }
 
-    /// The HUD's arm line: the picked joint, where it is, and the keys.
+    /// The HUD's arm line: the picked joint, where it is, and the keys (see [`task_line`] for
+    /// the line while look or reach runs).
     pub fn status(&self, sim: &Simulation) -> Option<String> {
         let id = *self.joints.get(self.selected)?;
         let joint = sim.robot().joint(id);
@@ -80,5 +81,25 @@ impl ArmKeys {
             joint.name.trim_end_matches("_joint"),
             self.joints.len().min(9)
         ))
+    }
+}
+
+/// The HUD's arm line while look or reach runs: the task, the reach's state and how far the
+/// tool is from its goal, and the key that stops it; `None` when neither runs.
+pub fn task_line(status: &rover_core::ArmStatus) -> Option<String> {
+    use rover_core::ArmMode;
+    match status.mode {
+        ArmMode::Off => None,
+        ArmMode::Look => Some("arm LOOK at the class   v stops   g reach".to_owned()),
+        ArmMode::Reach => {
+            let to_goal = status
+                .tool_to_goal_m()
+                .map(|d| format!(", tool {d:.2} m from the goal"))
+                .unwrap_or_default();
+            Some(format!(
+                "arm REACH {}{to_goal}   g stops",
+                status.reach.as_str()
+            ))
+        }
     }
 }

@@ -60,7 +60,9 @@ fn teleop_name(name: &str, wasd: bool) -> Option<&'static str> {
         (_, "f") => "f",
         (_, "p") => "p",
         (_, "n") => "n",
-        // The arm's: pick a joint, jog it, home.
+        // The arm's: pick a joint, jog it, home; reach (grab) and look (view) on / off.
+        (_, "g") => "g",
+        (_, "v") => "v",
         (_, "[") => "[",
         (_, "]") => "]",
         (_, "h") => "h",
@@ -111,6 +113,8 @@ impl KeyTeleop {
         }
         match name {
             "f" => Some(KeyCommand::Input(Action::ToggleFollow)),
+            "g" => Some(KeyCommand::Input(Action::ToggleReach)),
+            "v" => Some(KeyCommand::Input(Action::ToggleLook)),
             "p" => Some(KeyCommand::TogglePause),
             "n" => Some(KeyCommand::StepOnce),
             "[" => Some(KeyCommand::Jog(-1)),
@@ -239,6 +243,14 @@ mod tests {
         assert_eq!(
             k.key("f", true, MANUAL),
             Some(KeyCommand::Input(Action::ToggleFollow))
+        );
+        assert_eq!(
+            k.key("g", true, MANUAL),
+            Some(KeyCommand::Input(Action::ToggleReach))
+        );
+        assert_eq!(
+            k.key("v", true, MANUAL),
+            Some(KeyCommand::Input(Action::ToggleLook))
         );
         assert_eq!(k.key("p", true, MANUAL), Some(KeyCommand::TogglePause));
         assert_eq!(k.key("n", true, MANUAL), Some(KeyCommand::StepOnce));

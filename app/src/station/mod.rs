@@ -292,7 +292,8 @@ impl App<'_, '_> {
                 session: &self.session,
                 paused: self.paused,
                 real_time_factor: self.rtf,
-                arm: self.arm.status(self.session.sim()),
+                arm: arm::task_line(&self.session.stats().arm)
+                    .or_else(|| self.arm.status(self.session.sim())),
                 truth: self.feed.truth.as_deref(),
             },
         );

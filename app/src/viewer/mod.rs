@@ -303,6 +303,7 @@ impl Observer for Recorder {
                     .with_labels([stats.follow_state.as_str()]),
             );
         }
+        self.log_arm(&stats.arm);
         if stats.detector_ok {
             self.log(
                 "plots/detector/latency_ms",
@@ -459,5 +460,43 @@ impl Observer for Recorder {
             EventLevel::Warn => rerun::TextLogLevel::WARN,
         };
         self.log("log", &rerun::TextLog::new(text).with_level(level));
+    }
+}
+
+impl Recorder {
+    /// The arm's look or reach while one runs: the object point, the pre-grasp goal (labelled
+    /// with the reach's state) and the tool in the world frame; the reach's state and the
+    /// tool's distance to its goal as plots.
+    fn log_arm(&self, arm: &rover_core::ArmStatus) {
+        if arm.mode != rover_core::ArmMode::Reach {
+            return;
+        }
+        let point = |p: Option<[f64; 3]>| p.map(|[x, y, z]| [x as f32, y as f32, z as f32]);
+        self.log(
+            "world/arm/object",
+            &rerun::Points3D::new(point(arm.object_world_m))
+                .with_radii([0.02f32])
+                .with_colors([rerun::Color::from_rgb(255, 70, 70)]),
+        );
+        self.log(
+            "world/arm/goal",
+            &rerun::Points3D::new(point(arm.goal_world_m))
+                .with_radii([0.015f32])
+                .with_colors([rerun::Color::from_rgb(90, 200, 255)])
+                .with_labels([arm.reach.as_str()]),
+        );
+        self.log(
+            "world/arm/tool",
+            &rerun::Points3D::new(point(arm.tool_world_m))
+                .with_radii([0.01f32])
+                .with_colors([rerun::Color::from_rgb(255, 230, 80)]),
+        );
+        self.log(
+            "plots/arm/reach_state",
+            &rerun::Scalars::single(arm.reach.index() as f64),
+        );
+        if let Some(d) = arm.tool_to_goal_m() {
+            self.log("plots/arm/tool_to_goal_m", &rerun::Scalars::single(d));
+        }
     }
 }
