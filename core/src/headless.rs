@@ -32,7 +32,8 @@ pub struct RunConfig {
     pub spawn: Option<[f64; 3]>,
     /// Wheels to drive (overrides the world's `[robot.drive]`).
     pub drive: Option<rover_sim::DriveSpec>,
-    /// Which camera to render when the robot has several (default: the first in the file).
+    /// Which camera to render when the robot has several (default: the world's `[robot]
+    /// camera`, else the first in the file).
     pub camera: Option<String>,
     /// A ros_control controllers YAML for the robot (overrides the world's `controllers`).
     pub controllers: Option<PathBuf>,
@@ -169,7 +170,7 @@ impl RunConfig {
         {
             robot.load_controllers(path)?;
         }
-        if let Some(name) = &self.camera {
+        if let Some(name) = self.camera.as_ref().or(world.robot.camera.as_ref()) {
             robot.select_camera(name)?;
         } else if robot.cameras.len() > 1 {
             tracing::info!(

@@ -72,9 +72,14 @@ fn session(seed: u64) -> Result<Option<Session>> {
 }
 
 fn ball(session: &Session) -> Pose {
+    object(session, 1)
+}
+
+/// World object `index`'s pose now.
+fn object(session: &Session, index: usize) -> Pose {
     let mut poses = Vec::new();
     session.sim().object_poses_into(&mut poses);
-    poses.get(1).copied().unwrap_or(Pose::IDENTITY)
+    poses.get(index).copied().unwrap_or(Pose::IDENTITY)
 }
 
 /// The arm's joint positions now.
@@ -116,6 +121,17 @@ fn run_for(session: &mut Session, seconds: f64, run: &mut Run) -> Result<()> {
 /// box centre (on the line from the camera to the ball's centre), horizontally along the line
 /// from the arm's base (torso_lift_link) — computed here from the ball's true pose.
 fn pregrasp_truth(session: &Session) -> Result<[f64; 3]> {
+    pregrasp_truth_of(session, "torso_lift_link", 1, BALL_RADIUS_M)
+}
+
+/// [`pregrasp_truth`] for world object `ball` of radius `radius_m`, the arm working from
+/// link `base_link`.
+fn pregrasp_truth_of(
+    session: &Session,
+    base_link: &str,
+    ball: usize,
+    radius_m: f64,
+) -> Result<[f64; 3]> {
     let sim = session.sim();
     let link = |name: &str| {
         sim.robot()
@@ -130,10 +146,10 @@ fn pregrasp_truth(session: &Session) -> Result<[f64; 3]> {
         .map(|c| c.link.clone())
         .unwrap_or_default();
     let camera = link(&camera_link)?;
-    let base = link("torso_lift_link")?;
-    let centre = ball(session).translation;
+    let base = link(base_link)?;
+    let centre = object(session, ball).translation;
     let toward_camera = (camera.translation - centre).normalize();
-    let surface = centre + toward_camera * BALL_RADIUS_M as f32;
+    let surface = centre + toward_camera * radius_m as f32;
     let mut horizontal = base.inverse().transform_point(surface);
     horizontal.z = 0.0;
     let approach = base.rotation * horizontal.normalize();
@@ -270,4 +286,46 @@ fn session_at_reach(seed: u64) -> Result<Option<Session>> {
     run_for(&mut session, 1.5, &mut run)?;
     session.input(Action::ToggleReach, &mut NoObserver);
     Ok(Some(session))
+}
+
+/// The worked example, worlds/arm_car_reach.toml as shipped: the tutorial car's five-joint arm
+/// reaches from the ball's box in its mast's depth camera to within 5 cm of the point 10 cm
+/// short of it in 10 s, without touching the ball.
+#[test]
+fn the_arm_car_reaches_for_the_ball_in_its_example_world() -> Result<()> {
+    let config = rover_core::RunConfig {
+        world: Some(rover_tests::repo("worlds/arm_car_reach.toml")),
+        ..rover_core::RunConfig::default()
+    };
+    let (world, robot) = config.load_world_and_robot()?;
+    let options = SessionOptions {
+        camera: true,
+        every_frame: false,
+        detector: DetectorMode::Lockstep { rate_hz: 5.0 },
+        ..SessionOptions::default()
+    };
+    let mut session = Session::new(world, robot, &options, &mut NoObserver)?;
+    let mut run = Run::default();
+    run_for(&mut session, 0.5, &mut run)?;
+    let ball_at_start = object(&session, 1).translation;
+    session.input(Action::ToggleReach, &mut NoObserver);
+    let start_s = session.sim().sim_time_s();
+    run_for(&mut session, 10.0, &mut run)?;
+    let radius_m = 0.06;
+    let goal = pregrasp_truth_of(&session, "base_link", 1, radius_m)?;
+    let status = session.stats().arm;
+    let end = status.tool_world_m.unwrap_or([f64::NAN; 3]);
+    let arrived = run
+        .tool
+        .iter()
+        .find(|(_, p, _)| distance(*p, goal) <= 0.05)
+        .map(|(t, _, _)| t - start_s);
+    let moved = (object(&session, 1).translation - ball_at_start).length();
+    println!(
+        "arm car: {status:?}; pre-grasp from the truth {goal:.3?}; within 5 cm after {arrived:?} s; {:.3} m at 10 s; the ball moved {moved:.4} m",
+        distance(end, goal)
+    );
+    assert!(distance(end, goal) <= 0.05, "tool {end:?}, goal {goal:?}");
+    assert!(moved < 1e-3, "the ball was touched");
+    Ok(())
 }

@@ -106,6 +106,7 @@ struct RawRobot {
     #[serde(default)]
     drive: Option<DriveSpec>,
     controllers: Option<PathBuf>,
+    camera: Option<String>,
     arm_base: Option<String>,
     ee_link: Option<String>,
 }
@@ -422,6 +423,7 @@ impl RawWorld {
             xacro_args: raw_robot.xacro_args,
             drive: raw_robot.drive,
             controllers: raw_robot.controllers.map(|c| base_dir.join(c)),
+            camera: raw_robot.camera,
             arm_base: raw_robot.arm_base,
             ee_link: raw_robot.ee_link,
         };

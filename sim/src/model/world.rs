@@ -56,6 +56,9 @@ pub struct RobotSpawn {
     /// `controllers`: a ros_control controllers YAML for the robot, resolved against the world
     /// file's folder.
     pub controllers: Option<PathBuf>,
+    /// `camera`: which of the robot's cameras to render, by `<sensor name>` or cameraName
+    /// (default: the first).
+    pub camera: Option<String>,
     /// `arm_base`: the link the arm's look and reach work from (default: the robot's root).
     pub arm_base: Option<String>,
     /// `ee_link`: the arm's end effector, which reaches.
