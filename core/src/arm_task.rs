@@ -7,8 +7,8 @@
 use nalgebra::Vector3;
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraFrame, JointCommand, KinematicsError, LinkId, Pose, Simulation,
-    isometry_from_pose, link_from_optical,
+    CameraConfig, CameraFrame, IkOptions, IkSolver, IkTarget, JointCommand, KinematicChain,
+    KinematicsError, LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
 };
 
 use crate::look::{Look, LookConfig};
@@ -99,6 +99,8 @@ pub(crate) struct ArmTask {
     camera_link: LinkId,
     look: Result<Look, String>,
     reach: Result<Reach, String>,
+    /// The end effector moved to points (scripts, Cartesian jogging).
+    tool: Result<IkSolver, String>,
     /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
     look_while_reaching: bool,
     frames: Vec<FrameRecord>,
@@ -139,6 +141,16 @@ impl ArmTask {
                 Reach::new(robot, c, base_name, ee, config.reach.clone()).map_err(|e| e.to_string())
             }
         };
+        let tool = ee_link
+            .ok_or_else(|| {
+                "no end effector given (--ee-link LINK, or ee_link in the world's [robot])"
+                    .to_owned()
+            })
+            .and_then(|ee| {
+                KinematicChain::new(robot, base_name, ee)
+                    .and_then(|chain| IkSolver::new(chain, IkOptions::default()))
+                    .map_err(|e| e.to_string())
+            });
         let look_while_reaching = match (&look, &reach) {
             (Ok(look), Ok(reach)) => look
                 .joints()
@@ -152,6 +164,7 @@ impl ArmTask {
             camera_link,
             look,
             reach,
+            tool,
             look_while_reaching,
             frames: Vec::new(),
             q: Vec::with_capacity(robot.joints.len()),
@@ -162,6 +175,62 @@ impl ArmTask {
     /// The status for observers.
     pub(crate) fn status(&self) -> ArmStatus {
         self.status
+    }
+
+    /// Whether the end effector can be moved to points.
+    pub(crate) fn has_tool(&self) -> bool {
+        self.tool.is_ok()
+    }
+
+    /// Moves the end effector to `position_m` (arm base frame), or by it from where the joints'
+    /// targets put it (`relative`), by IK from those targets. Why not, when it cannot: no end
+    /// effector, a point out of reach (by more than 1 cm), a value that is not finite.
+    pub(crate) fn move_tool(
+        &mut self,
+        position_m: [f64; 3],
+        relative: bool,
+        sim: &mut Simulation,
+    ) -> Result<(), String> {
+        let solver = self.tool.as_mut().map_err(|e| format!("no tool: {e}"))?;
+        if !position_m.iter().all(|v| v.is_finite()) {
+            return Err(format!("tool: {position_m:?} is not a finite point"));
+        }
+        let q: Vec<f64> = solver
+            .chain()
+            .joints()
+            .iter()
+            .map(|j| {
+                sim.joint_target(j.id)
+                    .or_else(|| sim.joint_state(j.id).map(|s| s.position))
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        let [x, y, z] = position_m;
+        let mut goal = Vector3::new(x, y, z);
+        if relative {
+            goal += solver
+                .chain()
+                .base_from_tip(&q)
+                .map_err(|e| e.to_string())?
+                .translation
+                .vector;
+        }
+        let solution = solver
+            .solve(&IkTarget::point(goal), &q)
+            .map_err(|e| e.to_string())?;
+        if solution.position_error_m > 0.01 {
+            return Err(format!(
+                "tool: ({:.3}, {:.3}, {:.3}) m in {} is out of reach by {:.3} m",
+                goal.x,
+                goal.y,
+                goal.z,
+                solver.chain().base_name(),
+                solution.position_error_m
+            ));
+        }
+        let names = solver.chain().joints().iter().map(|j| j.name.as_str());
+        command(sim, names, &solution.q);
+        Ok(())
     }
 
     /// The reach controller, when the robot has one.

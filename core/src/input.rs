@@ -53,6 +53,15 @@ pub enum JointAction {
     },
     /// Go to a named pose of the controllers file.
     Pose(String),
+    /// The arm's end effector (`--ee-link`) to a point in the arm base's frame (m, REP-103),
+    /// by IK; with `relative`, moved by that much from where the joints' targets put it
+    /// (Cartesian jogging: quick steps add up).
+    Tool {
+        /// The point, or the step (m).
+        position_m: [f64; 3],
+        /// A step from the current target rather than a point.
+        relative: bool,
+    },
 }
 
 /// Input from outside the loop that drives it like manual input: the ROS bridge's `/cmd_vel`.

@@ -8,6 +8,8 @@
 //!   { at = 3.0, toggle = "reach" },       # the arm's reach on or off (or "look")
 //!   { at = 4.0, joint = "arm_2_joint", position = -0.8 },  # or velocity = / effort =
 //!   { at = 6.0, pose = "home" },          # a named pose of the controllers file
+//!   { at = 7.0, tool = [0.5, -0.2, 0.1] },  # the end effector (--ee-link) to a point, m,
+//!                                         # in the arm base's frame (--arm-base), by IK
 //!   { at = 8.0, controller = "gripper_controller", command = 0.02 },  # its `command` topic
 //! ]
 //! ```
@@ -63,6 +65,7 @@ struct RawStep {
     pose: Option<String>,
     controller: Option<String>,
     command: Option<f64>,
+    tool: Option<[f64; 3]>,
 }
 
 impl RawStep {
@@ -98,6 +101,15 @@ impl RawStep {
         }
         if let Some(pose) = &self.pose {
             return Some(Ok(JointAction::Pose(pose.clone())));
+        }
+        if let Some(position_m) = self.tool {
+            if !position_m.iter().all(|v| v.is_finite()) {
+                return Some(Err("`tool` must be three finite numbers (m)".into()));
+            }
+            return Some(Ok(JointAction::Tool {
+                position_m,
+                relative: false,
+            }));
         }
         match (&self.controller, self.command) {
             (Some(name), Some(value)) if value.is_finite() => Some(Ok(JointAction::Controller {
@@ -146,7 +158,7 @@ impl Script {
             let action = match (joint, s.cmd_vel, s.key, s.toggle) {
                 (Some(_), _, _, _) if base_given => {
                     return bail(
-                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose` or `controller` besides `at`".into(),
+                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose`, `controller` or `tool` besides `at`".into(),
                     );
                 }
                 (Some(Ok(action)), ..) => Action::Joint(action),
@@ -181,7 +193,7 @@ impl Script {
                     },
                     _ => {
                         return bail(
-                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose` or `controller` besides `at`".into(),
+                        "expected exactly one of `cmd_vel`, `key`, `toggle`, `joint`, `pose`, `controller` or `tool` besides `at`".into(),
                     );
                     }
                 },
@@ -322,6 +334,19 @@ mod tests {
                 value: 0.02
             })
         );
+        let tool = parse("steps = [ { at = 1.0, tool = [0.5, -0.2, 0.1] } ]")?;
+        assert_eq!(
+            tool.steps[0].action,
+            Action::Joint(JointAction::Tool {
+                position_m: [0.5, -0.2, 0.1],
+                relative: false
+            })
+        );
+        let bad = parse("steps = [ { at = 1.0, tool = [0.5, nan, 0.1] } ]")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(bad.contains("three finite numbers"), "{bad}");
         Ok(())
     }
 }

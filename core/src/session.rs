@@ -231,6 +231,12 @@ impl Session {
         &self.sim
     }
 
+    /// Whether the arm's end effector can be moved to points ([`JointAction::Tool`]): an
+    /// end effector is given and its chain is sound.
+    pub fn has_tool(&self) -> bool {
+        self.arm.has_tool()
+    }
+
     /// The arm's reach controller, when the robot has one (an end effector, a depth camera).
     pub fn reach(&self) -> Option<&crate::reach::Reach> {
         self.arm.reach()
@@ -337,6 +343,20 @@ impl Session {
                 trajectory,
             } => self.sim.follow_trajectory(controller, trajectory),
             JointAction::Pose(name) => self.sim.go_to_named_pose(name),
+            JointAction::Tool {
+                position_m,
+                relative,
+            } => {
+                if let Err(why) = self.arm.move_tool(*position_m, *relative, &mut self.sim) {
+                    emit(
+                        observer,
+                        self.sim.sim_time_s(),
+                        EventLevel::Warn,
+                        &format!("{why}; command dropped"),
+                    );
+                }
+                Ok(())
+            }
         };
         if let Err(e) = result {
             emit(

@@ -329,3 +329,95 @@ fn the_arm_car_reaches_for_the_ball_in_its_example_world() -> Result<()> {
     assert!(moved < 1e-3, "the ball was touched");
     Ok(())
 }
+
+/// Warnings a session says.
+#[derive(Default)]
+struct Warnings(Vec<String>);
+
+impl rover_core::Observer for Warnings {
+    fn event(&mut self, _t: f64, level: rover_core::EventLevel, text: &str) {
+        if level == rover_core::EventLevel::Warn {
+            self.0.push(text.to_owned());
+        }
+    }
+}
+
+/// The end effector to a point and jogged (scripts' `tool = [...]`, the station's `0` and
+/// `[` `]`): TIAGo's tool goes to a point in torso_lift_link within 2 cm in 3 s of real
+/// physics; three 1 cm steps up add up to 3 cm; a point out of reach is refused with a warning
+/// and no joint target changes.
+#[test]
+fn tiagos_tool_goes_to_a_point_and_jogs_by_ik() -> Result<()> {
+    let Some(mut session) = session(0)? else {
+        return Ok(());
+    };
+    let mut run = Run::default();
+    run_for(&mut session, 1.0, &mut run)?;
+    let tool = |session: &Session| -> Result<[f64; 3]> {
+        let sim = session.sim();
+        let base = sim
+            .robot()
+            .link_id("torso_lift_link")
+            .map(|id| sim.world_from_link(id))
+            .ok_or_else(|| anyhow::anyhow!("no torso_lift_link"))?;
+        let tip = sim
+            .robot()
+            .link_id("arm_tool_link")
+            .map(|id| sim.world_from_link(id))
+            .ok_or_else(|| anyhow::anyhow!("no arm_tool_link"))?;
+        let p = base.inverse().transform_point(tip.translation);
+        Ok([f64::from(p.x), f64::from(p.y), f64::from(p.z)])
+    };
+    let mut warnings = Warnings::default();
+    let goal = [0.55, -0.25, -0.05];
+    session.input(
+        Action::Joint(JointAction::Tool {
+            position_m: goal,
+            relative: false,
+        }),
+        &mut warnings,
+    );
+    run_for(&mut session, 3.0, &mut run)?;
+    let at = tool(&session)?;
+    println!("tool at {at:.3?} for {goal:?}");
+    assert!(distance(at, goal) < 0.02, "tool {at:?} for {goal:?}");
+    for _ in 0..3 {
+        session.input(
+            Action::Joint(JointAction::Tool {
+                position_m: [0.0, 0.0, 0.01],
+                relative: true,
+            }),
+            &mut warnings,
+        );
+    }
+    run_for(&mut session, 2.0, &mut run)?;
+    let up = tool(&session)?;
+    println!("after three 1 cm steps up: {up:.3?}");
+    assert!((up[2] - at[2] - 0.03).abs() < 0.01, "{at:?} -> {up:?}");
+    assert!(warnings.0.is_empty(), "{:?}", warnings.0);
+    let before = arm_q(&session);
+    session.input(
+        Action::Joint(JointAction::Tool {
+            position_m: [3.0, 0.0, 0.0],
+            relative: false,
+        }),
+        &mut warnings,
+    );
+    run_for(&mut session, 1.0, &mut run)?;
+    let moved = arm_q(&session)
+        .iter()
+        .zip(&before)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "out of reach: {:?}; largest joint change {moved:.5} rad",
+        warnings.0
+    );
+    assert!(
+        warnings.0.iter().any(|w| w.contains("out of reach")),
+        "{:?}",
+        warnings.0
+    );
+    assert!(moved < 0.01, "a joint moved {moved} rad");
+    Ok(())
+}

@@ -1,6 +1,8 @@
 //! The driver's station's arm keys: pick one of the robot's actuated joints (1-9; the gamepad's
-//! D-pad left and right), jog it a step at a time (`[` and `]`, held keys repeat; D-pad down
-//! and up), go home (`h`; the pad's North button). Jogging moves the joint's target one step
+//! D-pad left and right), or with an end effector (`--ee-link`) one of its axes, x, y or z of
+//! the arm's base (`0`, again for the next), jog it a step at a time (`[` and `]`, held keys
+//! repeat; D-pad down and up: 0.1 rad, 1 cm, or 1 cm of the tool by IK), go home (`h`; the
+//! pad's North button). Jogging moves the joint's target one step
 //! from its current target, so quick repeated presses add up exactly however fast the joint
 //! follows; the joint's limits and the actuator's velocity and effort limits still apply.
 
@@ -12,11 +14,16 @@ pub(super) const JOG_RAD: f64 = 0.1;
 /// One jog step of a prismatic joint (m).
 pub(super) const JOG_M: f64 = 0.01;
 
-/// Which joint the keys move.
+/// One Cartesian jog step of the end effector (m).
+pub(super) const JOG_TOOL_M: f64 = 0.01;
+
+/// Which joint (or tool axis) the keys move.
 #[derive(Debug, Clone, Default)]
 pub(super) struct ArmKeys {
     joints: Vec<JointId>,
     selected: usize,
+    /// The end effector's axis picked (0 x, 1 y, 2 z), instead of a joint.
+    tool_axis: Option<usize>,
 }
 
 impl ArmKeys {
@@ -25,7 +32,13 @@ impl ArmKeys {
         Self {
             joints: sim.robot().actuated_joints(),
             selected: 0,
+            tool_axis: None,
         }
+    }
+
+    /// Picks the end effector's next axis (x, then y, then z, then x again).
+    pub fn select_tool_axis(&mut self) {
+        self.tool_axis = Some(self.tool_axis.map_or(0, |a| (a + 1) % 3));
     }
 
     /// Whether the robot has joints to jog.
@@ -37,6 +50,7 @@ impl ArmKeys {
     pub fn select(&mut self, index: usize) {
         if index < self.joints.len() {
             self.selected = index;
+            self.tool_axis = None;
         }
     }
 
@@ -46,11 +60,20 @@ impl ArmKeys {
         if n > 0 {
             let step = if step >= 0 { 1 } else { n - 1 };
             self.selected = (self.selected + step) % n;
+            self.tool_axis = None;
         }
     }
 
     /// The command that jogs the picked joint one step in `direction` (-1 or +1).
     pub fn jog(&self, sim: &Simulation, direction: i8) -> Option<Action> {
+        if let Some(axis) = self.tool_axis {
+            let mut step = [0.0; 3];
+            step[axis] = f64::from(direction) * JOG_TOOL_M;
+            return Some(Action::Joint(JointAction::Tool {
+                position_m: step,
+                relative: true,
+            }));
+        }
         let id = *self.joints.get(self.selected)?;
         let joint = sim.robot().joint(id);
         let step = match joint.kind {
@@ -67,6 +90,14 @@ impl ArmKeys {
     /// The HUD's arm line: the picked joint, where it is, and the keys (see [`task_line`] for
     /// the line while look or reach runs).
     pub fn status(&self, sim: &Simulation) -> Option<String> {
+        if let Some(axis) = self.tool_axis {
+            return Some(format!(
+                "arm tool {}  [ ] jog {:.0} cm  0 next axis  1-{} pick a joint",
+                ["x", "y", "z"][axis],
+                JOG_TOOL_M * 100.0,
+                self.joints.len().min(9)
+            ));
+        }
         let id = *self.joints.get(self.selected)?;
         let joint = sim.robot().joint(id);
         let unit = match joint.kind {

@@ -26,6 +26,9 @@ pub enum KeyCommand {
     StepOnce,
     /// Pick the arm's Nth actuated joint (0-based; keys 1-9).
     SelectJoint(usize),
+    /// Pick the end effector's next axis, x, y or z of the arm's base, for Cartesian jogging
+    /// (`0`).
+    SelectToolAxis,
     /// Jog the picked joint one step down (-1, `[`) or up (+1, `]`).
     Jog(i8),
     /// Go to the controllers file's "home" pose (`h`).
@@ -66,8 +69,8 @@ fn teleop_name(name: &str, wasd: bool) -> Option<&'static str> {
         (_, "[") => "[",
         (_, "]") => "]",
         (_, "h") => "h",
-        (_, digit @ ("1" | "2" | "3" | "4" | "5" | "6" | "7" | "8" | "9")) => {
-            ["1", "2", "3", "4", "5", "6", "7", "8", "9"]
+        (_, digit @ ("0" | "1" | "2" | "3" | "4" | "5" | "6" | "7" | "8" | "9")) => {
+            ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9"]
                 .into_iter()
                 .find(|d| *d == digit)?
         }
@@ -120,6 +123,7 @@ impl KeyTeleop {
             "[" => Some(KeyCommand::Jog(-1)),
             "]" => Some(KeyCommand::Jog(1)),
             "h" => Some(KeyCommand::Home),
+            "0" => Some(KeyCommand::SelectToolAxis),
             digit if digit.len() == 1 && digit.as_bytes()[0].is_ascii_digit() => Some(
                 KeyCommand::SelectJoint(usize::from(digit.as_bytes()[0] - b'1')),
             ),
@@ -252,6 +256,8 @@ mod tests {
             k.key("v", true, MANUAL),
             Some(KeyCommand::Input(Action::ToggleLook))
         );
+        assert_eq!(k.key("0", true, MANUAL), Some(KeyCommand::SelectToolAxis));
+        assert_eq!(k.key("3", true, MANUAL), Some(KeyCommand::SelectJoint(2)));
         assert_eq!(k.key("p", true, MANUAL), Some(KeyCommand::TogglePause));
         assert_eq!(k.key("n", true, MANUAL), Some(KeyCommand::StepOnce));
         assert_eq!(k.key("y", true, MANUAL), None);

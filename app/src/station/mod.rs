@@ -203,9 +203,12 @@ impl App<'_, '_> {
             }
             Some(KeyCommand::StepOnce) if self.paused => self.step_once = true,
             Some(KeyCommand::SelectJoint(i)) => self.arm.select(i),
+            Some(KeyCommand::SelectToolAxis) if self.session.has_tool() => {
+                self.arm.select_tool_axis();
+            }
             Some(KeyCommand::Jog(direction)) => self.jog(direction),
             Some(KeyCommand::Home) => self.home(),
-            Some(KeyCommand::StepOnce) | None => {}
+            Some(KeyCommand::StepOnce | KeyCommand::SelectToolAxis) | None => {}
         }
     }
 
