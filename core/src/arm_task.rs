@@ -7,8 +7,8 @@
 use nalgebra::Vector3;
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraFrame, IkOptions, IkSolver, IkTarget, JointCommand, KinematicChain,
-    KinematicsError, LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
+    CameraConfig, CameraFrame, IkSolver, IkTarget, JointCommand, KinematicChain, KinematicsError,
+    LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
 };
 
 use crate::look::{Look, LookConfig};
@@ -148,7 +148,7 @@ impl ArmTask {
             })
             .and_then(|ee| {
                 KinematicChain::new(robot, base_name, ee)
-                    .and_then(|chain| IkSolver::new(chain, IkOptions::default()))
+                    .and_then(|chain| IkSolver::new(chain, crate::reach::arm_ik_options()))
                     .map_err(|e| e.to_string())
             });
         let look_while_reaching = match (&look, &reach) {

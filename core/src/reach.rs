@@ -168,7 +168,7 @@ impl Reach {
         let info = CameraInfo::from_config(camera);
         Ok(Self {
             config,
-            solver: IkSolver::new(chain, IkOptions::default())?,
+            solver: IkSolver::new(chain, arm_ik_options())?,
             intrinsics: [info.k[0], info.k[4], info.k[2], info.k[5]],
             object: None,
             goal: None,
@@ -320,6 +320,16 @@ impl Reach {
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(p, _)| p)
+    }
+}
+
+/// IK settings for an arm moved by perception or by hand: 1 mm is close enough, so a solve from
+/// the arm's own pose that gets there is kept rather than restarted from random poses (which
+/// could swing the arm into a far-off configuration for a slightly smaller error).
+pub(crate) fn arm_ik_options() -> IkOptions {
+    IkOptions {
+        tolerance_m: 1e-3,
+        ..IkOptions::default()
     }
 }
 

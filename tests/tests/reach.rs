@@ -199,7 +199,7 @@ fn tiago_reaches_short_of_the_ball_the_detector_sees() -> Result<()> {
     let timeline: Vec<String> = run
         .tool
         .iter()
-        .step_by(25)
+        .step_by(100)
         .map(|(t, p, s)| {
             format!(
                 "{:.2} s {} {:.3} m",

@@ -157,7 +157,7 @@ mod tests {
         assert_eq!(k.key("]", true, MANUAL), Some(KeyCommand::Jog(1)));
         assert_eq!(k.key("[", true, MANUAL), Some(KeyCommand::Jog(-1)));
         assert_eq!(k.key("h", true, MANUAL), Some(KeyCommand::Home));
-        assert_eq!(k.key("0", true, MANUAL), None);
+        assert_eq!(k.key("0", true, MANUAL), Some(KeyCommand::SelectToolAxis));
         // Releases do nothing.
         assert_eq!(k.key("]", false, MANUAL), None);
     }
