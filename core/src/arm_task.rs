@@ -26,6 +26,12 @@ pub struct ArmConfig {
     /// The end effector (the tool that reaches); `None`: the world's `[robot] ee_link`, else
     /// no reach.
     pub ee_link: Option<String>,
+    /// A MoveIt SRDF whose planning group gives the base and end effector when they are not
+    /// given ([`rover_sim::load_arm_group`]); `None`: the world's `[robot] srdf`.
+    pub srdf: Option<std::path::PathBuf>,
+    /// Which SRDF group is the arm (`None`: the world's `[robot] arm_group`, else `arm`, else
+    /// the only group).
+    pub group: Option<String>,
     /// Look settings (its class is the one looked at).
     pub look: LookConfig,
     /// Reach settings (its class is the one reached for).
@@ -68,6 +74,39 @@ pub struct ArmStatus {
     pub goal_world_m: Option<[f64; 3]>,
     /// The tool, world frame (m).
     pub tool_world_m: Option<[f64; 3]>,
+}
+
+impl ArmConfig {
+    /// The config with the SRDF's planning group (here or in the world's `[robot]`) read into
+    /// the base and end effector not given; an error for an SRDF that cannot be read or has no
+    /// such group (file and line, the groups it has).
+    pub fn resolved(
+        &self,
+        robot: &rover_sim::RobotModel,
+        spawn: &rover_sim::RobotSpawn,
+    ) -> Result<Self, rover_sim::SimError> {
+        let mut out = self.clone();
+        let Some(srdf) = self.srdf.as_ref().or(spawn.srdf.as_ref()) else {
+            return Ok(out);
+        };
+        let group_name = self.group.as_deref().or(spawn.arm_group.as_deref());
+        let group = rover_sim::load_arm_group(srdf, robot, group_name)?;
+        tracing::info!(
+            "arm: SRDF group \"{}\": {} -> {}",
+            group.name,
+            group.base_link,
+            group.tip_link
+        );
+        let explicit_base = self.base_link.is_some() || spawn.arm_base.is_some();
+        let explicit_tip = self.ee_link.is_some() || spawn.ee_link.is_some();
+        if !explicit_base {
+            out.base_link = Some(group.base_link);
+        }
+        if !explicit_tip {
+            out.ee_link = Some(group.tip_link);
+        }
+        Ok(out)
+    }
 }
 
 impl ArmStatus {

@@ -181,7 +181,8 @@ impl Session {
             .and_then(|c| sim.robot().link_id(&c.link))
             .unwrap_or(sim.robot().root);
         let camera_config = camera.as_ref().and(sim.robot().cameras.first());
-        let arm = ArmTask::new(&sim, camera_config, &options.arm);
+        let arm_config = options.arm.resolved(sim.robot(), &sim.world().robot)?;
+        let arm = ArmTask::new(&sim, camera_config, &arm_config);
         let laser = start_laser(&sim)?;
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);

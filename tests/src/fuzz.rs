@@ -646,6 +646,31 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         hang_limit: text_limit,
     });
 
+    // MoveIt SRDF planning groups: Franka's panda (example-robot-data), resolved on its URDF.
+    if let (Some(urdf), Some(srdf)) = (
+        crate::example_robot_data("panda_description/urdf/panda.urdf"),
+        crate::example_robot_data("panda_description/srdf/panda.srdf"),
+    ) {
+        let dir = work.join("srdf");
+        std::fs::create_dir_all(&dir)?;
+        let panda = rover_sim::RobotModel::load(&urdf)?;
+        out.push(Target {
+            name: "srdf",
+            seeds: read_all(&[srdf])?,
+            input_path: dir.join("robot.srdf"),
+            load: Box::new(move |p| {
+                let group = rover_sim::load_arm_group(p, &panda, None).map_err(|e| e.to_string())?;
+                // A group that resolves must be a chain the IK takes, or say why not.
+                outcome(rover_sim::KinematicChain::new(
+                    &panda,
+                    &group.base_link,
+                    &group.tip_link,
+                ))
+            }),
+            hang_limit: text_limit,
+        });
+    }
+
     // SDF: playground.world with its models.
     if let Some(c) = corpus.as_ref() {
         let dir = work.join("sdf");

@@ -505,3 +505,69 @@ fn tiago_looks_at_the_person_the_detector_sees() -> Result<()> {
     );
     Ok(())
 }
+
+/// MoveIt SRDF planning groups: Franka's panda (example-robot-data's `panda.srdf`, an `arm`
+/// group of joints and an end effector) resolves to panda_link0 -> panda_hand_tcp, a chain the
+/// IK takes; a chain group, subgroups, and bad files (no such group, a joint the robot lacks,
+/// UR5's SRDF without groups) are located errors that name what exists.
+#[test]
+fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
+    use rover_sim::{KinematicChain, load_arm_group, parse_arm_group};
+    let (Some(panda), Some(srdf), Some(ur5_srdf), Some(tiago_urdf)) = (
+        example_robot_data("panda_description/urdf/panda.urdf"),
+        example_robot_data("panda_description/srdf/panda.srdf"),
+        example_robot_data("ur_description/srdf/ur5.srdf"),
+        example_robot_data(TIAGO_NO_HAND),
+    ) else {
+        return Ok(());
+    };
+    let robot = RobotModel::load(&panda)?;
+    let group = load_arm_group(&srdf, &robot, None)?;
+    println!("panda: {group:?}");
+    assert_eq!(
+        (group.name.as_str(), group.base_link.as_str(), group.tip_link.as_str()),
+        ("arm", "panda_link0", "panda_hand_tcp")
+    );
+    let chain = KinematicChain::new(&robot, &group.base_link, &group.tip_link)?;
+    assert_eq!(chain.joints().len(), 7);
+    let err = load_arm_group(&srdf, &robot, Some("legs"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("no group \"legs\"") && err.contains("arm, hand, arm_and_hand"),
+        "{err}"
+    );
+    let none = load_arm_group(&ur5_srdf, &RobotModel::load(&tiago_urdf)?, None)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(none.contains("the groups are: none"), "{none}");
+
+    let tiago = RobotModel::load(&tiago_urdf)?;
+    let path = std::path::Path::new("tiago.srdf");
+    let text = "<robot name=\"tiago\">\n  <group name=\"torso_arm\">\n    <chain base_link=\"base_footprint\" tip_link=\"arm_tool_link\"/>\n  </group>\n  <group name=\"head\">\n    <joint name=\"head_1_joint\"/>\n    <joint name=\"head_2_joint\"/>\n  </group>\n  <group name=\"both\">\n    <group name=\"head\"/>\n  </group>\n  <group name=\"bad\">\n    <joint name=\"elbow_joint\"/>\n  </group>\n</robot>\n";
+    let chain_group = parse_arm_group(text, path, &tiago, Some("torso_arm"))?;
+    assert_eq!(chain_group.tip_link, "arm_tool_link");
+    let head = parse_arm_group(text, path, &tiago, Some("head"))?;
+    assert_eq!(
+        (head.base_link.as_str(), head.tip_link.as_str()),
+        ("torso_lift_link", "head_2_link")
+    );
+    let nested = parse_arm_group(text, path, &tiago, Some("both"))?;
+    assert_eq!(nested.tip_link, "head_2_link");
+    let bad = parse_arm_group(text, path, &tiago, Some("bad"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        bad.contains("tiago.srdf:13") && bad.contains("no joint \"elbow_joint\""),
+        "{bad}"
+    );
+    let several = parse_arm_group(text, path, &tiago, None)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(several.contains("torso_arm, head, both, bad"), "{several}");
+    Ok(())
+}

@@ -405,6 +405,16 @@ pub(crate) struct ArmArgs {
     #[arg(long, value_name = "LINK")]
     pub(crate) arm_base: Option<String>,
 
+    /// Arm: a MoveIt SRDF whose planning group (--arm-group) gives --arm-base and --ee-link
+    /// when they are not given [default: the world's [robot] srdf]
+    #[arg(long, value_name = "FILE")]
+    pub(crate) srdf: Option<PathBuf>,
+
+    /// Arm: the SRDF's planning group that is the arm [default: the world's [robot] arm_group,
+    /// else `arm`, else the only group]
+    #[arg(long, value_name = "NAME")]
+    pub(crate) arm_group: Option<String>,
+
     /// Arm: the class look turns to and reach goes for (a darknet_ros `Class`)
     #[arg(long, default_value = "sports ball", value_name = "CLASS")]
     pub(crate) arm_class: String,
@@ -424,6 +434,8 @@ impl ArmArgs {
         Ok(rover_core::ArmConfig {
             base_link: self.arm_base.clone(),
             ee_link: self.ee_link.clone(),
+            srdf: self.srdf.clone(),
+            group: self.arm_group.clone(),
             look: rover_core::LookConfig {
                 class: self.arm_class.clone(),
                 ..rover_core::LookConfig::default()

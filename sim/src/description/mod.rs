@@ -2,7 +2,7 @@
 //! the `<gazebo>` extensions), xacro (`xacro/`), Gazebo SDF worlds (`sdf.rs`), rover's TOML
 //! worlds (`world_toml.rs`), mesh files and their textures (`mesh_file.rs`, COLLADA in
 //! `collada.rs`), OGRE material
-//! scripts (`ogre.rs`), `package://` and `model://` lookup
+//! scripts (`ogre.rs`), MoveIt SRDF planning groups (`srdf.rs`), `package://` and `model://` lookup
 //! (`resource.rs`), with the XML helpers they share (`xml.rs`). The entries are
 //! [`RobotModel::load`](crate::RobotModel::load) and [`World::load`](crate::World::load);
 //! nothing here is needed to run a model built in code.
@@ -15,6 +15,7 @@ pub(crate) mod ogre;
 pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod sdf;
+pub(crate) mod srdf;
 pub(crate) mod toml;
 pub(crate) mod trimesh;
 pub(crate) mod urdf;
@@ -26,6 +27,7 @@ pub use controllers::{load_controllers, parse_controllers};
 pub use mesh_file::{load_mesh, load_texture};
 pub use resource::{NotFound, ResourcePaths};
 pub use robot::LoadOptions;
+pub use srdf::{ArmGroup, load_arm_group, parse_arm_group};
 pub use toml::{load_toml, parse_toml};
 pub use trimesh::{TriMesh, TriMeshPart};
 pub use world_toml::WorldFile;

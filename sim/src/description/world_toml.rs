@@ -107,6 +107,8 @@ struct RawRobot {
     drive: Option<DriveSpec>,
     controllers: Option<PathBuf>,
     camera: Option<String>,
+    srdf: Option<PathBuf>,
+    arm_group: Option<String>,
     arm_base: Option<String>,
     ee_link: Option<String>,
 }
@@ -424,6 +426,8 @@ impl RawWorld {
             drive: raw_robot.drive,
             controllers: raw_robot.controllers.map(|c| base_dir.join(c)),
             camera: raw_robot.camera,
+            srdf: raw_robot.srdf.map(|s| base_dir.join(s)),
+            arm_group: raw_robot.arm_group,
             arm_base: raw_robot.arm_base,
             ee_link: raw_robot.ee_link,
         };

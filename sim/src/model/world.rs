@@ -59,6 +59,11 @@ pub struct RobotSpawn {
     /// `camera`: which of the robot's cameras to render, by `<sensor name>` or cameraName
     /// (default: the first).
     pub camera: Option<String>,
+    /// `srdf`: a MoveIt SRDF for the robot (resolved against the world file's folder): its
+    /// planning group gives the arm's base and end effector.
+    pub srdf: Option<PathBuf>,
+    /// `arm_group`: which SRDF group is the arm (default: `arm`, else the only group).
+    pub arm_group: Option<String>,
     /// `arm_base`: the link the arm's look and reach work from (default: the robot's root).
     pub arm_base: Option<String>,
     /// `ee_link`: the arm's end effector, which reaches.
