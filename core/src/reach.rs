@@ -46,7 +46,8 @@ pub struct ReachConfig {
     pub lost_after: u32,
     /// A goal IK reaches no closer than this (m) is refused.
     pub max_ik_error_m: f64,
-    /// The tool within this distance (m) of the goal counts as arrived.
+    /// The tool within this distance (m) of the goal counts as arrived (and as moving again
+    /// beyond twice it).
     pub arrived_m: f64,
     /// Depth beyond this (m) is not trusted (no object is that far within an arm's reach).
     pub max_range_m: f64,
@@ -222,11 +223,13 @@ impl Reach {
     pub fn update_tool(&mut self, q: &[f64]) -> Result<(), KinematicsError> {
         let tool = self.solver.chain().base_from_tip(q)?.translation.vector;
         if let Some(goal) = &self.goal {
-            let near = (tool - goal.pregrasp_m).norm() <= self.config.arrived_m;
-            self.state = match (self.state, near) {
-                (ReachState::Moving, true) => ReachState::Arrived,
-                (ReachState::Arrived, false) => ReachState::Moving,
-                (state, _) => state,
+            // Arrived within `arrived_m`, moving again only beyond twice that: a tool that
+            // settles right at the edge does not flicker between the two.
+            let d = (tool - goal.pregrasp_m).norm();
+            self.state = match self.state {
+                ReachState::Moving if d <= self.config.arrived_m => ReachState::Arrived,
+                ReachState::Arrived if d > 2.0 * self.config.arrived_m => ReachState::Moving,
+                state => state,
             };
         }
         Ok(())

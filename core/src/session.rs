@@ -433,7 +433,23 @@ impl Session {
                 .map(|t| t.position_at(sample.sim_time_s));
             self.stats.follow_goal_m = self.follower.goal_m().filter(|_| following);
             self.arm.update(&self.sim).map_err(arm_error)?;
+            let before = self.stats.arm;
             self.stats.arm = self.arm.status();
+            if before.mode == ArmMode::Reach
+                && self.stats.arm.mode == ArmMode::Reach
+                && before.reach != self.stats.arm.reach
+            {
+                emit(
+                    observer,
+                    sample.sim_time_s,
+                    EventLevel::Info,
+                    &format!(
+                        "reach: {} -> {}",
+                        before.reach.as_str(),
+                        self.stats.arm.reach.as_str()
+                    ),
+                );
+            }
             observer.control(&self.sim, sample, &self.stats);
         }
         Ok(sample)

@@ -659,7 +659,8 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             seeds: read_all(&[srdf])?,
             input_path: dir.join("robot.srdf"),
             load: Box::new(move |p| {
-                let group = rover_sim::load_arm_group(p, &panda, None).map_err(|e| e.to_string())?;
+                let group =
+                    rover_sim::load_arm_group(p, &panda, None).map_err(|e| e.to_string())?;
                 // A group that resolves must be a chain the IK takes, or say why not.
                 outcome(rover_sim::KinematicChain::new(
                     &panda,

@@ -525,7 +525,11 @@ fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
     let group = load_arm_group(&srdf, &robot, None)?;
     println!("panda: {group:?}");
     assert_eq!(
-        (group.name.as_str(), group.base_link.as_str(), group.tip_link.as_str()),
+        (
+            group.name.as_str(),
+            group.base_link.as_str(),
+            group.tip_link.as_str()
+        ),
         ("arm", "panda_link0", "panda_hand_tcp")
     );
     let chain = KinematicChain::new(&robot, &group.base_link, &group.tip_link)?;

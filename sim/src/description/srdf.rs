@@ -46,7 +46,10 @@ pub fn parse_arm_group(
     if !root.has_tag_name("robot") {
         return Err(fail(
             root,
-            format!("expected an SRDF <robot>, found <{}>", root.tag_name().name()),
+            format!(
+                "expected an SRDF <robot>, found <{}>",
+                root.tag_name().name()
+            ),
         ));
     }
     let groups: Vec<Node<'_, '_>> = children(root, "group").collect();
@@ -66,9 +69,10 @@ pub fn parse_arm_group(
             .or(groups.first().filter(|_| groups.len() == 1)),
     };
     let Some(group) = group.copied() else {
-        let wanted = name.map_or("no --arm-group given and no group \"arm\"".to_owned(), |n| {
-            format!("no group \"{n}\"")
-        });
+        let wanted = name.map_or(
+            "no --arm-group given and no group \"arm\"".to_owned(),
+            |n| format!("no group \"{n}\""),
+        );
         return Err(fail(root, format!("{wanted}; the groups are: {}", known())));
     };
     let group_name = group.attribute("name").unwrap_or_default().to_owned();
@@ -108,17 +112,26 @@ fn chain_of(
 ) -> Result<(String, String)> {
     let name = group.attribute("name").unwrap_or_default();
     if depth > 8 {
-        return Err(fail(group, format!("group \"{name}\": subgroups nest too deep (a loop?)")));
+        return Err(fail(
+            group,
+            format!("group \"{name}\": subgroups nest too deep (a loop?)"),
+        ));
     }
     if let Some(chain) = children(group, "chain").next() {
         let link = |attr: &str| -> Result<String> {
             let l = chain.attribute(attr).ok_or_else(|| {
-                fail(chain, format!("group \"{name}\": <chain> needs {attr}=\"...\""))
+                fail(
+                    chain,
+                    format!("group \"{name}\": <chain> needs {attr}=\"...\""),
+                )
             })?;
             if robot.link_id(l).is_none() {
                 return Err(fail(
                     chain,
-                    format!("group \"{name}\": no link \"{l}\" in robot \"{}\"", robot.name),
+                    format!(
+                        "group \"{name}\": no link \"{l}\" in robot \"{}\"",
+                        robot.name
+                    ),
                 ));
             }
             Ok(l.to_owned())
@@ -135,7 +148,10 @@ fn chain_of(
                 let id = robot.joint_id(j).ok_or_else(|| {
                     fail(
                         node,
-                        format!("group \"{name}\": no joint \"{j}\" in robot \"{}\"", robot.name),
+                        format!(
+                            "group \"{name}\": no joint \"{j}\" in robot \"{}\"",
+                            robot.name
+                        ),
                     )
                 })?;
                 joints.push(id);
@@ -144,7 +160,10 @@ fn chain_of(
                 let sub = node.attribute("name").unwrap_or_default();
                 let Some(sub_group) = groups.iter().find(|g| g.attribute("name") == Some(sub))
                 else {
-                    return Err(fail(node, format!("group \"{name}\": no subgroup \"{sub}\"")));
+                    return Err(fail(
+                        node,
+                        format!("group \"{name}\": no subgroup \"{sub}\""),
+                    ));
                 };
                 let (base, tip) = chain_of(*sub_group, groups, robot, fail, depth + 1)?;
                 for link in [base, tip] {
