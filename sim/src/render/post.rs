@@ -1,5 +1,6 @@
 //! Post-processing on the CPU after read back, as gazebo_ros_camera's output has it: lens
-//! distortion (a remap table computed once per camera) and seeded gaussian noise.
+//! distortion (a remap table computed once per camera) and seeded gaussian noise; a depth
+//! camera's depth image gets its `<noise>` in metres, as gz-sim's depth camera applies it.
 
 use crate::model::camera_info::CameraInfo;
 use crate::model::sensors::{Distortion, GaussianNoise};
@@ -14,6 +15,8 @@ pub(crate) struct PostProcess {
     /// The image handed out, RGB8.
     pub(crate) rgb: Vec<u8>,
     noise: Option<(GaussianNoise, Rng)>,
+    /// The depth image's noise stream (the same noise settings, in metres).
+    depth_rng: Rng,
     /// The noise seed; each frame's noise comes from it and the frame number.
     noise_seed: u64,
     distortion_map: Option<Vec<[f32; 2]>>,
@@ -35,6 +38,7 @@ impl PostProcess {
             ideal: vec![0; pixels * 3],
             rgb: vec![0; pixels * 3],
             noise: noise.map(|n| (n, Rng(noise_seed))),
+            depth_rng: Rng(!noise_seed),
             noise_seed,
             distortion_map: (!distortion.is_zero()).then(|| distortion_map(info, distortion)),
         }
@@ -48,9 +52,28 @@ impl PostProcess {
 
     /// Seeds the next image's noise from the frame number.
     pub(crate) fn seed_frame(&mut self, frame: u64) {
+        let mut mix = Rng(self.noise_seed ^ frame.wrapping_mul(0xA076_1D64_78BD_642F));
+        let colour = mix.next_u64();
         if let Some((_, rng)) = &mut self.noise {
-            let mut mix = Rng(self.noise_seed ^ frame.wrapping_mul(0xA076_1D64_78BD_642F));
-            *rng = Rng(mix.next_u64());
+            *rng = Rng(colour);
+        }
+        self.depth_rng = Rng(mix.next_u64());
+    }
+
+    /// The camera's gaussian noise on a depth image (metres; NaN stays NaN, nothing goes
+    /// below zero); nothing without noise.
+    pub(crate) fn add_depth_noise(&mut self, metres: &mut [f32]) {
+        let Some((noise, _)) = &self.noise else {
+            return;
+        };
+        let rng = &mut self.depth_rng;
+        for pair in metres.chunks_mut(2) {
+            let (a, b) = rng.normal_pair();
+            for (d, z) in pair.iter_mut().zip([a, b]) {
+                if d.is_finite() {
+                    *d = (f64::from(*d) + noise.mean + noise.stddev * z).max(0.0) as f32;
+                }
+            }
         }
     }
 

@@ -146,7 +146,8 @@ impl CameraRenderer {
     }
 
     /// The last render's depth image, once [`Self::enable_depth`] was called: per pixel of
-    /// the ideal pinhole image (no distortion, no noise), rows top to bottom, the distance
+    /// the ideal pinhole image (no distortion; the camera's gaussian `<noise>` in metres, when
+    /// it has one), rows top to bottom, the distance
     /// along the optical axis (the optical frame's z, as ROS depth images hold it) to what
     /// the pixel shows (m); NaN where nothing is within the clip range.
     pub fn depth_m(&self) -> Option<&[f32]> {
@@ -211,7 +212,9 @@ impl CameraRenderer {
                     f32::NAN
                 };
             }
-        })
+        })?;
+        self.post.add_depth_noise(metres);
+        Ok(())
     }
 
     /// Whether some SDF model link can move (so [`Self::set_model_link_poses`] matters).

@@ -32,7 +32,8 @@ pub struct CameraFrame<'a> {
     /// The depth image of the same frame (`None` unless [`CameraSensor::enable_depth`]: a
     /// `<sensor type="depth">` has it on): per pixel, rows top to bottom, the distance along
     /// the optical axis (m; the optical frame's z, as a ROS 32FC1 depth image holds it), NaN
-    /// where nothing is within the clip range. The ideal pinhole image: no distortion or noise.
+    /// where nothing is within the clip range. The ideal pinhole image (no distortion), with the
+    /// camera's gaussian `<noise>` in metres when it has one.
     pub depth_m: Option<&'a [f32]>,
 }
 
