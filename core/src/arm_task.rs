@@ -17,8 +17,9 @@ use crate::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
 /// How many recent images are kept for detections still to come.
 const FRAMES: usize = 8;
 
-/// Which links the arm's tasks use and how they behave.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// Which links the arm's tasks use and how they behave. The default looks at and reaches for
+/// the same class, `sports ball`.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ArmConfig {
     /// The arm's base link (IK and points are in its frame); `None`: the world's `[robot]
     /// arm_base`, else the robot's root link.
@@ -74,6 +75,23 @@ pub struct ArmStatus {
     pub goal_world_m: Option<[f64; 3]>,
     /// The tool, world frame (m).
     pub tool_world_m: Option<[f64; 3]>,
+}
+
+impl Default for ArmConfig {
+    fn default() -> Self {
+        let reach = ReachConfig::default();
+        Self {
+            base_link: None,
+            ee_link: None,
+            srdf: None,
+            group: None,
+            look: LookConfig {
+                class: reach.class.clone(),
+                ..LookConfig::default()
+            },
+            reach,
+        }
+    }
 }
 
 impl ArmConfig {

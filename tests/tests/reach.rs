@@ -421,3 +421,70 @@ fn tiagos_tool_goes_to_a_point_and_jogs_by_ik() -> Result<()> {
     assert!(moved < 0.01, "a joint moved {moved} rad");
     Ok(())
 }
+
+/// Look through the session's toggle (the station's `v`, a script's `toggle = "look"`): TIAGo's
+/// head, looking straight ahead with the ball to its right, turns so the ball's box centre comes within 32 px of the
+/// image centre within 3 s; the arm does not move.
+#[test]
+fn tiagos_head_looks_at_the_ball_when_look_is_switched_on() -> Result<()> {
+    let Some(mut session) = session(1)? else {
+        return Ok(());
+    };
+    session.input(
+        Action::Joint(JointAction::Command {
+            joint: "head_1_joint".into(),
+            command: JointCommand::Position(0.0),
+        }),
+        &mut NoObserver,
+    );
+    let mut run = Run::default();
+    run_for(&mut session, 2.0, &mut run)?;
+    let arm_before = arm_q(&session);
+    let info = session
+        .camera_info()
+        .cloned()
+        .ok_or_else(|| anyhow::anyhow!("no camera"))?;
+    let (cx, cy) = (info.k[2], info.k[5]);
+    let off_centre = |session: &Session| {
+        session.last_boxes().and_then(|b| {
+            b.bounding_boxes
+                .iter()
+                .find(|b| b.class == "sports ball")
+                .map(|b| {
+                    let u = (b.xmin + b.xmax) as f64 / 2.0;
+                    let v = (b.ymin + b.ymax) as f64 / 2.0;
+                    (u - cx).hypot(v - cy)
+                })
+        })
+    };
+    let first = off_centre(&session);
+    println!(
+        "boxes before look: {:?}",
+        session.last_boxes().map(|b| b
+            .bounding_boxes
+            .iter()
+            .map(|b| (b.class.clone(), b.probability, b.xmin, b.xmax))
+            .collect::<Vec<_>>())
+    );
+    session.input(Action::ToggleLook, &mut NoObserver);
+    let mut offsets = Vec::new();
+    let start_s = session.sim().sim_time_s();
+    while session.sim().sim_time_s() < start_s + 3.0 - 1e-9 {
+        run_for(&mut session, 0.2, &mut run)?;
+        offsets.push((session.sim().sim_time_s() - start_s, off_centre(&session)));
+    }
+    println!("ball off centre at first: {first:?} px; then (s, px): {offsets:.1?}");
+    assert!(
+        first.is_some_and(|px| px > 100.0),
+        "the ball starts off centre"
+    );
+    let last = offsets.last().and_then(|o| o.1).unwrap_or(f64::INFINITY);
+    assert!(last <= 32.0, "{last} px off centre after 3 s");
+    let arm_moved = arm_q(&session)
+        .iter()
+        .zip(&arm_before)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(arm_moved < 0.01, "the arm moved {arm_moved} rad");
+    Ok(())
+}
