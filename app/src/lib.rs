@@ -6,6 +6,7 @@
 //! * [`station`] — the driver's station: the window, its HUD, keyboard and gamepad teleop.
 //! * [`ros`] — the ROS 1 bridge (`--ros`): `/cmd_vel` in; odometry, TF, camera and darknet_ros
 //!   topics out, on [`rover_ros1`].
+//! * [`ros2`] — the ROS 2 bridge (`--ros2`): the same names over DDS, on RustDDS.
 //!
 //! The binary `rover` is a thin `main` over [`cli::main`], so tests drive exactly what users
 //! run.
@@ -13,5 +14,6 @@
 pub mod cli;
 pub mod palette;
 pub mod ros;
+pub mod ros2;
 pub mod station;
 pub mod viewer;

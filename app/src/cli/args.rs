@@ -190,6 +190,13 @@ pub(crate) struct RosArgs {
     #[arg(long)]
     pub(crate) ros: bool,
 
+    /// Join ROS 2 over DDS (RTPS, as rmw_cyclonedds and rmw_fastrtps speak it; ROS_DOMAIN_ID
+    /// is honoured; no ROS install needed): rt/cmd_vel drives the car, and rover publishes
+    /// /clock, /odom and /tf with ROS 2's types. Can run beside --ros. Headless runs then
+    /// default to --rtf 1. See docs/ROS2.md
+    #[arg(long)]
+    pub(crate) ros2: bool,
+
     /// With --ros: the node name
     #[arg(long, value_name = "NAME", default_value = "rover", requires = "ros")]
     pub(crate) ros_name: String,
@@ -200,6 +207,11 @@ pub(crate) struct RosArgs {
 }
 
 impl RosArgs {
+    /// Whether a ROS bridge (1 or 2) runs.
+    pub(crate) fn any(&self) -> bool {
+        self.ros || self.ros2
+    }
+
     /// The bridge's settings, when --ros is on; `ground_truth`: the run measures it
     /// (`--ground-truth`), the bridge publishes it.
     pub(crate) fn options(&self, ground_truth: bool) -> Option<crate::ros::RosOptions> {

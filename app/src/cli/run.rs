@@ -6,12 +6,13 @@ use std::time::Duration;
 
 use anyhow::Result;
 use rover_core::{
-    DetectorMode, Fanout, InputSource, NoInput, RunConfig, RunFiles, Session, SessionOptions,
-    run_headless, run_headless_driven, run_headless_observed,
+    Action, DetectorMode, Fanout, InputSource, NoInput, RunConfig, RunFiles, Session,
+    SessionOptions, run_headless, run_headless_driven, run_headless_observed,
 };
 
 use super::args::RunArgs;
-use crate::ros::RosBridge;
+use crate::ros::{RosBridge, RosInput};
+use crate::ros2::{Ros2Bridge, Ros2Input, Ros2Options};
 use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
@@ -38,10 +39,11 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         follower: args.follow.follower()?,
         arm: args.arm.arm()?,
         ground_truth: args.follow.ground_truth,
-        // ROS peers expect real time: --ros paces headless runs unless --rtf says otherwise.
-        real_time_factor: args.window.rtf.or(args.ros.ros.then_some(1.0)),
+        // ROS peers expect real time: --ros and --ros2 pace headless runs unless --rtf says
+        // otherwise.
+        real_time_factor: args.window.rtf.or(args.ros.any().then_some(1.0)),
         // ... and the detector keeps up on its own thread (newest frame), as in the window.
-        detector_thread: args.ros.ros,
+        detector_thread: args.ros.any(),
         ..args.world.run_config(args.cmd_timeout)
     };
     let recorder_options = args.viewer.options(false)?;
@@ -57,16 +59,30 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
         println!("Rerun web viewer: {url}");
     }
-    let summary = match args.ros.options(config.ground_truth) {
-        Some(ros) => {
-            let (world, robot) = config.load_world_and_robot()?;
-            let (mut bridge, mut cmd_vel) = RosBridge::start(&ros, &robot)?;
-            let result = {
-                let mut fan = Fanout::default();
-                fan.push(&mut bridge);
-                fan.push_some(recorder.as_mut());
-                run_headless_driven(&config, world, robot, &mut fan, true, &mut cmd_vel)
-            };
+    let summary = if args.ros.any() {
+        let (world, robot) = config.load_world_and_robot()?;
+        let (mut ros1, mut ros1_input) = match args.ros.options(config.ground_truth) {
+            Some(options) => {
+                let (bridge, input) = RosBridge::start(&options, &robot)?;
+                (Some(bridge), Some(input))
+            }
+            None => (None, None),
+        };
+        let (mut ros2, mut ros2_input) = if args.ros.ros2 {
+            let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
+            (Some(bridge), Some(input))
+        } else {
+            (None, None)
+        };
+        let result = {
+            let mut fan = Fanout::default();
+            fan.push_some(ros1.as_mut());
+            fan.push_some(ros2.as_mut());
+            fan.push_some(recorder.as_mut());
+            let mut inputs = Inputs(ros1_input.as_mut(), ros2_input.as_mut());
+            run_headless_driven(&config, world, robot, &mut fan, true, &mut inputs)
+        };
+        if let Some(bridge) = ros1.as_mut() {
             bridge.finish();
             if bridge.dropped() > 0 {
                 tracing::info!(
@@ -74,12 +90,22 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
                     bridge.dropped()
                 );
             }
-            result
         }
-        None => match recorder.as_mut() {
+        if let Some(bridge) = ros2.as_mut() {
+            bridge.finish();
+            if bridge.dropped() > 0 {
+                tracing::info!(
+                    "ROS 2 bridge: {} events dropped while it was behind",
+                    bridge.dropped()
+                );
+            }
+        }
+        result
+    } else {
+        match recorder.as_mut() {
             Some(rec) => run_headless_observed(&config, rec, true),
             None => run_headless(&config),
-        },
+        }
     };
     let mut record_failed = None;
     if let Some(rec) = recorder.as_mut() {
@@ -265,4 +291,14 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         summary.interrupted,
         summary.sim_time_s,
     )
+}
+
+/// The ROS 1 and ROS 2 bridges' inputs, polled in turn (either may be off).
+struct Inputs<'a>(Option<&'a mut RosInput>, Option<&'a mut Ros2Input>);
+
+impl InputSource for Inputs<'_> {
+    fn poll(&mut self) -> Option<Action> {
+        let ros1 = self.0.as_mut().and_then(|i| i.poll());
+        ros1.or_else(|| self.1.as_mut().and_then(|i| i.poll()))
+    }
 }

@@ -1,0 +1,286 @@
+//! ROS 2 messages as rover publishes and reads them: plain structs whose serde layout is the
+//! message's CDR layout (fields in the `.msg` order; fixed arrays without a length, sequences
+//! and strings with one), and their DDS type names (`geometry_msgs::msg::dds_::Twist_`), as
+//! rmw_cyclonedds and rmw_fastrtps name them. Written from the ROS 2 message definitions
+//! (Humble and Jazzy agree on every one here); no ROS install is needed.
+
+use serde::{Deserialize, Serialize};
+
+/// A message with its DDS type name.
+pub trait RosMessage: Serialize + Send + 'static {
+    /// `pkg::msg::dds_::Type_`.
+    const DDS_TYPE: &'static str;
+}
+
+/// `builtin_interfaces/msg/Time`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Time {
+    /// Whole seconds.
+    pub sec: i32,
+    /// Nanoseconds, 0..1e9.
+    pub nanosec: u32,
+}
+
+impl Time {
+    /// Sim time in seconds as a ROS 2 stamp (rounded to the nanosecond).
+    pub fn from_secs(t_s: f64) -> Self {
+        let total_ns = (t_s.max(0.0) * 1e9).round() as u64;
+        Self {
+            sec: i32::try_from(total_ns / 1_000_000_000).unwrap_or(i32::MAX),
+            nanosec: (total_ns % 1_000_000_000) as u32,
+        }
+    }
+
+    /// Seconds.
+    #[cfg(test)]
+    pub fn as_secs(self) -> f64 {
+        f64::from(self.sec) + f64::from(self.nanosec) * 1e-9
+    }
+}
+
+/// `std_msgs/msg/Header` (no `seq` in ROS 2).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Stamp.
+    pub stamp: Time,
+    /// Frame id.
+    pub frame_id: String,
+}
+
+/// `geometry_msgs/msg/Vector3` and `Point`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Quaternion`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w.
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    fn default() -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }
+    }
+}
+
+impl Quaternion {
+    /// A rotation by `yaw_rad` about +z.
+    pub fn from_yaw(yaw_rad: f64) -> Self {
+        let (s, c) = (yaw_rad / 2.0).sin_cos();
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: s,
+            w: c,
+        }
+    }
+}
+
+/// `geometry_msgs/msg/Twist`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Twist {
+    /// Linear velocity (m/s).
+    pub linear: Vector3,
+    /// Angular velocity (rad/s).
+    pub angular: Vector3,
+}
+
+impl RosMessage for Twist {
+    const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Twist_";
+}
+
+/// A 6x6 row-major covariance: `float64[36]`, written without a length as CDR fixed arrays are
+/// (serde's arrays stop at 32, hence the tuple).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Covariance(pub [f64; 36]);
+
+impl Default for Covariance {
+    fn default() -> Self {
+        Self([0.0; 36])
+    }
+}
+
+impl Serialize for Covariance {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeTuple;
+        let mut t = s.serialize_tuple(36)?;
+        for v in &self.0 {
+            t.serialize_element(v)?;
+        }
+        t.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for Covariance {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Covariance;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("36 float64")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Covariance, A::Error> {
+                let mut out = [0.0; 36];
+                for (i, v) in out.iter_mut().enumerate() {
+                    *v = a
+                        .next_element()?
+                        .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
+                }
+                Ok(Covariance(out))
+            }
+        }
+        d.deserialize_tuple(36, Visit)
+    }
+}
+
+/// `geometry_msgs/msg/Pose`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// Position (m).
+    pub position: Vector3,
+    /// Orientation.
+    pub orientation: Quaternion,
+}
+
+/// `geometry_msgs/msg/PoseWithCovariance`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct PoseWithCovariance {
+    /// Pose.
+    pub pose: Pose,
+    /// Covariance (x, y, z, roll, pitch, yaw).
+    pub covariance: Covariance,
+}
+
+/// `geometry_msgs/msg/TwistWithCovariance`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwistWithCovariance {
+    /// Twist.
+    pub twist: Twist,
+    /// Covariance.
+    pub covariance: Covariance,
+}
+
+/// `nav_msgs/msg/Odometry`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Odometry {
+    /// Stamp and odometry frame.
+    pub header: Header,
+    /// The base frame.
+    pub child_frame_id: String,
+    /// Pose in the odometry frame.
+    pub pose: PoseWithCovariance,
+    /// Velocity in the base frame.
+    pub twist: TwistWithCovariance,
+}
+
+impl RosMessage for Odometry {
+    const DDS_TYPE: &'static str = "nav_msgs::msg::dds_::Odometry_";
+}
+
+/// `rosgraph_msgs/msg/Clock`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Clock {
+    /// Sim time.
+    pub clock: Time,
+}
+
+impl RosMessage for Clock {
+    const DDS_TYPE: &'static str = "rosgraph_msgs::msg::dds_::Clock_";
+}
+
+/// `geometry_msgs/msg/Transform`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    /// Translation (m).
+    pub translation: Vector3,
+    /// Rotation.
+    pub rotation: Quaternion,
+}
+
+/// `geometry_msgs/msg/TransformStamped`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransformStamped {
+    /// Stamp and parent frame.
+    pub header: Header,
+    /// Child frame.
+    pub child_frame_id: String,
+    /// The child's frame in the parent's.
+    pub transform: Transform,
+}
+
+/// `tf2_msgs/msg/TFMessage`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TfMessage {
+    /// Transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
+impl RosMessage for TfMessage {
+    const DDS_TYPE: &'static str = "tf2_msgs::msg::dds_::TFMessage_";
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use byteorder::LittleEndian;
+    use rustdds::serialization::{from_bytes, to_vec};
+
+    fn cdr<M: Serialize>(m: &M) -> Vec<u8> {
+        to_vec::<M, LittleEndian>(m).unwrap_or_default()
+    }
+
+    #[test]
+    fn stamps_round_to_the_nanosecond() {
+        let t = Time::from_secs(12.345_678_901_2);
+        assert_eq!((t.sec, t.nanosec), (12, 345_678_901));
+        assert!((t.as_secs() - 12.345_678_901).abs() < 1e-12);
+        assert_eq!(Time::from_secs(-1.0), Time::default());
+    }
+
+    /// CDR layouts as a ROS 2 peer reads them: a Twist is six float64 (48 bytes, no padding);
+    /// an Odometry carries its 36-entry covariances without a length and reads back equal.
+    #[test]
+    fn cdr_layouts_match_the_message_definitions() {
+        let twist = Twist {
+            linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 },
+            angular: Vector3 { x: 0.0, y: 0.0, z: -0.3 },
+        };
+        let bytes = cdr(&twist);
+        assert_eq!(bytes.len(), 48);
+        assert_eq!(&bytes[..8], &0.5f64.to_le_bytes());
+        let mut odom = Odometry {
+            header: Header {
+                stamp: Time::from_secs(1.5),
+                frame_id: "odom".into(),
+            },
+            child_frame_id: "base_footprint".into(),
+            ..Odometry::default()
+        };
+        odom.pose.covariance.0[35] = 1e-3;
+        let bytes = cdr(&odom);
+        // stamp 8, "odom" 4 + 5 (+3 padding), "base_footprint" 4 + 15 (+1), pose 56 + 288,
+        // twist 48 + 288.
+        assert_eq!(bytes.len(), 8 + 12 + 20 + 344 + 336);
+        let back = from_bytes::<Odometry, LittleEndian>(&bytes).ok().map(|(m, _)| m);
+        assert_eq!(back.as_ref(), Some(&odom));
+    }
+}
