@@ -30,8 +30,8 @@ use rover_sim::{ControlSample, ODOM_POSE_COVARIANCE_DIAGONAL, RobotModel, Simula
 use rustdds::no_key::{DataReader, DataWriter};
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{
-    CDRDeserializerAdapter, CDRSerializerAdapter, DomainParticipant, QosPolicies,
-    QosPolicyBuilder, TopicKind,
+    CDRDeserializerAdapter, CDRSerializerAdapter, DomainParticipant, QosPolicies, QosPolicyBuilder,
+    TopicKind,
 };
 
 use crate::ros::RosPlan;
@@ -87,7 +87,12 @@ fn writer<M: RosMessage>(
     qos: &QosPolicies,
 ) -> Result<Writer<M>> {
     let topic = participant
-        .create_topic(dds_topic(ros_name), M::DDS_TYPE.to_owned(), qos, TopicKind::NoKey)
+        .create_topic(
+            dds_topic(ros_name),
+            M::DDS_TYPE.to_owned(),
+            qos,
+            TopicKind::NoKey,
+        )
         .with_context(|| format!("creating the DDS topic for {ros_name}"))?;
     publisher
         .create_datawriter_no_key::<M, CDRSerializerAdapter<M>>(&topic, Some(qos.clone()))

@@ -138,7 +138,10 @@ impl<'de> Deserialize<'de> for Covariance {
             fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
                 f.write_str("36 float64")
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Covariance, A::Error> {
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> Result<Covariance, A::Error> {
                 let mut out = [0.0; 36];
                 for (i, v) in out.iter_mut().enumerate() {
                     *v = a
@@ -261,8 +264,16 @@ mod tests {
     #[test]
     fn cdr_layouts_match_the_message_definitions() {
         let twist = Twist {
-            linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 },
-            angular: Vector3 { x: 0.0, y: 0.0, z: -0.3 },
+            linear: Vector3 {
+                x: 0.5,
+                y: 0.0,
+                z: 0.0,
+            },
+            angular: Vector3 {
+                x: 0.0,
+                y: 0.0,
+                z: -0.3,
+            },
         };
         let bytes = cdr(&twist);
         assert_eq!(bytes.len(), 48);
@@ -280,7 +291,9 @@ mod tests {
         // stamp 8, "odom" 4 + 5 (+3 padding), "base_footprint" 4 + 15 (+1), pose 56 + 288,
         // twist 48 + 288.
         assert_eq!(bytes.len(), 8 + 12 + 20 + 344 + 336);
-        let back = from_bytes::<Odometry, LittleEndian>(&bytes).ok().map(|(m, _)| m);
+        let back = from_bytes::<Odometry, LittleEndian>(&bytes)
+            .ok()
+            .map(|(m, _)| m);
         assert_eq!(back.as_ref(), Some(&odom));
     }
 }

@@ -1,0 +1,295 @@
+//! The ROS 2 bridge (`rover --ros2`) against a real DDS peer: Eclipse Cyclone DDS (what
+//! rmw_cyclonedds_cpp uses), from PyPI `cyclonedds` 11.0.1, with the ROS 2 messages declared
+//! under their DDS type names as rmw does. Skipped, with the reason, where the wheel cannot be
+//! had. Each test runs in its own DDS domain, so tests and other peers do not meet.
+
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, ensure};
+use rover_core::parse_trace;
+
+/// The ROS 2 messages the peer uses, as cyclonedds IdlStructs named like rmw names them.
+const MESSAGES: &str = r#"
+from dataclasses import dataclass
+from cyclonedds.idl import IdlStruct
+import cyclonedds.idl.types as types
+
+@dataclass
+class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+@dataclass
+class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Time
+    frame_id: str
+
+@dataclass
+class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+@dataclass
+class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+@dataclass
+class Quaternion(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+    w: types.float64
+
+@dataclass
+class Pose(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
+    position: Point
+    orientation: Quaternion
+
+@dataclass
+class PoseWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
+    pose: Pose
+    covariance: types.array[types.float64, 36]
+
+@dataclass
+class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    linear: Vector3
+    angular: Vector3
+
+@dataclass
+class TwistWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
+    twist: Twist
+    covariance: types.array[types.float64, 36]
+
+@dataclass
+class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
+    header: Header
+    child_frame_id: str
+    pose: PoseWithCovariance
+    twist: TwistWithCovariance
+"#;
+
+/// A rover and a Python peer in DDS domain `domain`, logs in `dir`.
+struct Graph {
+    dir: tempfile::TempDir,
+    domain: u16,
+    cyclonedds: PathBuf,
+    rover: Option<Child>,
+}
+
+impl Graph {
+    fn new(cyclonedds: PathBuf, domain: u16) -> Result<Self> {
+        Ok(Self {
+            dir: tempfile::tempdir()?,
+            domain,
+            cyclonedds,
+            rover: None,
+        })
+    }
+
+    fn trace_path(&self) -> PathBuf {
+        self.dir.path().join("trace.csv")
+    }
+
+    /// `rover --headless --ros2` for `duration_s` of sim time at real time.
+    fn spawn_rover(&mut self, duration_s: f64, extra: &[&str]) -> Result<()> {
+        let log = std::fs::File::create(self.dir.path().join("rover.log"))?;
+        let child = Command::new(env!("CARGO_BIN_EXE_rover"))
+            .args(["--headless", "--ros2", "--rtf", "1", "--duration"])
+            .arg(duration_s.to_string())
+            .arg("--trace")
+            .arg(self.trace_path())
+            .args(extra)
+            .env("ROS_DOMAIN_ID", self.domain.to_string())
+            .env("RUST_LOG", "info")
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .context("starting rover")?;
+        self.rover = Some(child);
+        Ok(())
+    }
+
+    /// Runs `script` (after the message definitions) with cyclonedds importable; its output.
+    fn python(&self, name: &str, script: &str, timeout: Duration) -> Result<String> {
+        let path = self.dir.path().join(name);
+        std::fs::write(&path, format!("{MESSAGES}\n{script}"))?;
+        // Output into a file: a pipe would fill up and stall the peer.
+        let log_path = self.dir.path().join(format!("{name}.log"));
+        let log = std::fs::File::create(&log_path)?;
+        let mut child = Command::new("python3")
+            .arg(&path)
+            .env("PYTHONPATH", &self.cyclonedds)
+            .env("PYTHONUNBUFFERED", "1")
+            .env("ROS_DOMAIN_ID", self.domain.to_string())
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()?;
+        let start = Instant::now();
+        while child.try_wait()?.is_none() {
+            if start.elapsed() > timeout {
+                let _ = child.kill();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = child.wait();
+        Ok(std::fs::read_to_string(&log_path)?)
+    }
+
+    /// Waits for rover to finish; its exit must be clean.
+    fn wait_rover(&mut self, timeout: Duration) -> Result<()> {
+        let Some(mut child) = self.rover.take() else {
+            return Ok(());
+        };
+        let start = Instant::now();
+        loop {
+            if let Some(status) = child.try_wait()? {
+                let log = std::fs::read_to_string(self.dir.path().join("rover.log"))?;
+                ensure!(status.success(), "rover failed ({status}):\n{log}");
+                return Ok(());
+            }
+            if start.elapsed() > timeout {
+                let _ = child.kill();
+                anyhow::bail!("rover did not finish in {timeout:?}");
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Graph {
+    fn drop(&mut self) {
+        if let Some(mut child) = self.rover.take() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Cyclone DDS's Python package, unpacked from PyPI; `None` (with the reason) without it.
+fn cyclonedds() -> Option<PathBuf> {
+    let dir = rover_tests::pypi("cyclonedds", "11.0.1")?;
+    let ok = Command::new("python3")
+        .args(["-c", "import cyclonedds.domain"])
+        .env("PYTHONPATH", &dir)
+        .status()
+        .is_ok_and(|s| s.success());
+    if ok {
+        Some(dir)
+    } else {
+        eprintln!("SKIP: cyclonedds from {} does not import", dir.display());
+        None
+    }
+}
+
+/// A DDS domain of this test's own (ROS 2 allows 0..=232).
+fn domain(salt: u16) -> u16 {
+    10 + ((std::process::id() as u16).wrapping_add(salt)) % 200
+}
+
+/// A Cyclone DDS participant publishing geometry_msgs/msg/Twist on `rt/cmd_vel` drives the car
+/// (>= 0.3 m); one subscribing to `rt/odom` receives nav_msgs/msg/Odometry equal to the trace's
+/// odometry (1e-6, the trace's precision) at the same stamps, in frame odom, child
+/// base_link (the tutorial car's robotBaseFrame).
+#[test]
+fn a_cyclone_dds_peer_drives_the_car_and_reads_its_odometry() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(1))?;
+    graph.spawn_rover(12.0, &[])?;
+    let out = graph.python(
+        "drive.py",
+        r#"
+import time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(__import__('os').environ['ROS_DOMAIN_ID']))
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
+cmd = DataWriter(dp, Topic(dp, 'rt/cmd_vel', Twist), qos=reliable)
+odom = DataReader(dp, Topic(dp, 'rt/odom', Odometry), qos=reliable)
+got = []
+end = time.time() + 9
+while time.time() < end:
+    cmd.write(Twist(linear=Vector3(0.5, 0.0, 0.0), angular=Vector3(0.0, 0.0, 0.0)))
+    for m in odom.take(N=1000):
+        got.append(m)
+    time.sleep(0.1)
+print('odom', len(got))
+for m in got:
+    p = m.pose.pose
+    print('o %d %d %s %s %.9f %.9f %.9f %.9f %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec,
+          m.header.frame_id, m.child_frame_id, p.position.x, p.position.y, p.orientation.z,
+          p.orientation.w, m.twist.twist.linear.x))
+"#,
+        Duration::from_secs(40),
+    )?;
+    graph.wait_rover(Duration::from_secs(60))?;
+    let trace = std::fs::read_to_string(graph.trace_path())?;
+    let rows = parse_trace(&trace)?;
+    let last = rows.last().context("an empty trace")?;
+    let driven = last.x_m.hypot(last.y_m);
+    println!(
+        "{}\nrover drove {driven:.3} m",
+        out.lines().take(3).collect::<Vec<_>>().join("\n")
+    );
+    ensure!(driven >= 0.3, "the car drove {driven} m:\n{out}");
+    let odom: Vec<Vec<&str>> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("o "))
+        .map(|l| l.split(' ').collect())
+        .collect();
+    ensure!(
+        odom.len() >= 100,
+        "{} odometry messages:\n{out}",
+        odom.len()
+    );
+    let sent: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("odom "))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or(0);
+    let mut compared = 0;
+    for f in &odom {
+        ensure!(f.len() == 9, "{f:?}");
+        ensure!(f[2] == "odom" && f[3] == "base_link", "frames {f:?}");
+        let stamp_s = f[0].parse::<f64>()? + f[1].parse::<f64>()? * 1e-9;
+        let Some(row) = rows.iter().find(|r| (r.sim_time_s - stamp_s).abs() < 5e-5) else {
+            continue;
+        };
+        let (x, y): (f64, f64) = (f[4].parse()?, f[5].parse()?);
+        let yaw = 2.0 * f[6].parse::<f64>()?.atan2(f[7].parse::<f64>()?);
+        ensure!(
+            (x - row.odom_x_m).abs() <= 1e-6
+                && (y - row.odom_y_m).abs() <= 1e-6
+                && (yaw - row.odom_yaw_rad).abs() <= 1e-6,
+            "at {stamp_s} s: odom ({x}, {y}, {yaw}) vs trace ({}, {}, {})",
+            row.odom_x_m,
+            row.odom_y_m,
+            row.odom_yaw_rad
+        );
+        compared += 1;
+    }
+    println!(
+        "{compared} of {} odometry messages equal the trace",
+        odom.len()
+    );
+    ensure!(
+        compared + 5 >= odom.len() && odom.len() + 50 >= sent,
+        "{compared} of {} matched a trace row ({sent} sent)",
+        odom.len()
+    );
+    Ok(())
+}
