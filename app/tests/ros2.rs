@@ -293,3 +293,139 @@ for m in got:
     );
     Ok(())
 }
+
+/// tf2's and sensor_msgs' messages for the peer.
+const MORE_MESSAGES: &str = r#"
+@dataclass
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3
+    rotation: Quaternion
+
+@dataclass
+class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header
+    child_frame_id: str
+    transform: Transform
+
+@dataclass
+class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    transforms: types.sequence[TransformStamped]
+
+@dataclass
+class Image(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
+    header: Header
+    height: types.uint32
+    width: types.uint32
+    encoding: str
+    is_bigendian: types.uint8
+    step: types.uint32
+    data: types.sequence[types.uint8]
+
+@dataclass
+class JointState(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
+    header: Header
+    name: types.sequence[str]
+    position: types.sequence[types.float64]
+    velocity: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+"#;
+
+/// `/tf_static` reaches a peer that joins 4 s after rover started (transient local), with the
+/// camera's optical frame; the camera's images arrive as rgb8 640x480 in that frame at the
+/// camera's 30 Hz of sim time, and `/joint_states` names the wheels: the rates delivered to
+/// the peer are printed.
+#[test]
+fn a_late_cyclone_peer_gets_tf_static_and_the_camera_images() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(2))?;
+    graph.spawn_rover(16.0, &[])?;
+    std::thread::sleep(Duration::from_secs(4));
+    let script = format!(
+        "{MORE_MESSAGES}\n{}",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+static = DataReader(dp, Topic(dp, 'rt/tf_static', TFMessage), qos=latched)
+images = DataReader(dp, Topic(dp, 'rt/camera/image_raw', Image), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(100)))
+joints = DataReader(dp, Topic(dp, 'rt/joint_states', JointState), qos=Qos(Policy.History.KeepLast(1000)))
+got_static, got_images, got_joints = [], [], []
+start = time.time()
+while time.time() < start + 6:
+    got_static += static.take(N=10)
+    got_images += images.take(N=100)
+    got_joints += joints.take(N=1000)
+    time.sleep(0.02)
+wall = time.time() - start
+for m in got_static:
+    print('static ' + ','.join(t.header.frame_id + '>' + t.child_frame_id for t in m.transforms))
+stamps = [i.header.stamp.sec + i.header.stamp.nanosec * 1e-9 for i in got_images]
+if got_images:
+    i = got_images[-1]
+    print('image %d %d %s %d %d %s' % (i.width, i.height, i.encoding, i.step, len(i.data), i.header.frame_id))
+    print('images %d over %.2f s sim, %.2f s wall' % (len(stamps), max(stamps) - min(stamps), wall))
+if got_joints:
+    j = got_joints[-1]
+    js = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in got_joints]
+    print('joints %s %d over %.2f s sim' % (','.join(j.name), len(js), max(js) - min(js)))
+"#
+    );
+    let out = graph.python("late.py", &script, Duration::from_secs(30))?;
+    graph.wait_rover(Duration::from_secs(60))?;
+    println!("{out}");
+    let static_line = out
+        .lines()
+        .find_map(|l| l.strip_prefix("static "))
+        .with_context(|| format!("no /tf_static for the late joiner:\n{out}"))?;
+    ensure!(
+        static_line.contains("camera_link>camera_link_optical"),
+        "no optical frame in /tf_static: {static_line}"
+    );
+    let image: Vec<&str> = out
+        .lines()
+        .find_map(|l| l.strip_prefix("image "))
+        .map(|l| l.split(' ').collect())
+        .with_context(|| format!("no image:\n{out}"))?;
+    ensure!(
+        image
+            == [
+                "640",
+                "480",
+                "rgb8",
+                "1920",
+                "921600",
+                "camera_link_optical"
+            ],
+        "image {image:?}"
+    );
+    let rate: Vec<f64> = out
+        .lines()
+        .find_map(|l| l.strip_prefix("images "))
+        .map(|l| {
+            l.split(' ')
+                .filter_map(|w| w.parse().ok())
+                .collect::<Vec<f64>>()
+        })
+        .unwrap_or_default();
+    ensure!(rate.len() == 3, "{out}");
+    let hz = (rate[0] - 1.0) / rate[1];
+    println!(
+        "images delivered at {hz:.1} Hz of sim time ({:.1} per wall second)",
+        rate[0] / rate[2]
+    );
+    ensure!(hz > 25.0, "images at {hz} Hz");
+    ensure!(
+        out.lines()
+            .any(|l| l.starts_with("joints ") && l.contains("left_wheel_joint")),
+        "{out}"
+    );
+    Ok(())
+}

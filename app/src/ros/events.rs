@@ -45,7 +45,7 @@ pub(super) struct ArmSample {
 
 /// One moving joint's state at a control update.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct JointSample {
+pub(crate) struct JointSample {
     /// The child link's frame in the parent link's, now.
     pub parent_from_child: Pose,
     /// Measured speed (rad/s).

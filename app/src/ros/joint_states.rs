@@ -72,7 +72,7 @@ impl TopicFamily for JointStates {
 }
 
 /// Samples every joint of `joints` at a control update (on the loop thread), into `out`.
-pub(super) fn sample(
+pub(crate) fn sample(
     sim: &Simulation,
     sample: &ControlSample,
     joints: &[MovingJoint],

@@ -32,7 +32,7 @@ pub struct RosPlan {
     /// The first laser's topic (`topicName`).
     pub scan_topic: Option<String>,
     /// Every moving joint the session reports, in `/joint_states` order.
-    pub(super) joints: Vec<MovingJoint>,
+    pub(crate) joints: Vec<MovingJoint>,
     /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
     /// every control update.
     pub joint_states_hz: Option<f64>,
@@ -63,7 +63,7 @@ pub(super) struct ControllerTopic {
 /// A moving joint the bridge reports (`/joint_states`; `/tf` for wheels with
 /// `publishWheelTF`).
 #[derive(Debug, Clone)]
-pub(super) struct MovingJoint {
+pub(crate) struct MovingJoint {
     /// Joint name.
     pub name: String,
     /// Parent link.
@@ -84,7 +84,7 @@ pub(super) struct MovingJoint {
 
 /// What moves a joint, and where the session reports its speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum JointSource {
+pub(crate) enum JointSource {
     /// A drive wheel: `side` indexes the control sample's wheel speeds (0 left, 1 right).
     Wheel {
         /// 0 for the left wheel, 1 for the right.

@@ -97,7 +97,7 @@ impl TopicFamily for Tf {
 
 /// What `/tf_static` says for `robot` (on the loop thread, once): every fixed joint, the
 /// camera's optical frame under `camera_link`, and each laser's frame when it is not its link.
-pub(super) fn static_transforms(
+pub(crate) fn static_transforms(
     robot: &RobotModel,
     camera: Option<&CameraInfo>,
     camera_link: Option<&str>,

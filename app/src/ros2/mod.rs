@@ -11,8 +11,13 @@
 //! QoS as ROS 2 nodes expect: reliable, volatile, keep last 10 for `/odom`, `/tf`, `/clock` and
 //! the command topic (rclcpp's default).
 //!
-//! This first step carries `/cmd_vel` in and `/clock`, `/odom` and `/tf` (odom -> base) out;
-//! the other topics of the ROS 1 bridge follow (docs/ROS2.md says which).
+//! Sensor data (the camera's image and camera_info, the laser's scan) best effort, keep last 5
+//! (rclcpp's SensorDataQoS); `/tf_static` transient local, keep last 1 (a late joiner gets it).
+//!
+//! Carried so far: `/cmd_vel` in; `/clock`, odometry, `/tf` (odom -> base and the moving joints'
+//! links), `/tf_static`, `/joint_states`, the camera's image and camera_info, the laser's scan
+//! out (`topics.rs`). Not yet: the detector's boxes, depth images, the controllers' and the
+//! arm's topics, MCAP recording (docs/ROS2.md).
 //!
 //! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): the bridge needs
 //! topics, writers and readers with chosen QoS — what RustDDS offers directly — and nothing of
@@ -20,13 +25,14 @@
 //! less to build (RustDDS's cold build: 2 min on 2 cores).
 
 mod msgs;
+mod topics;
 
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, LoopStats, Observer};
-use rover_sim::{ControlSample, ODOM_POSE_COVARIANCE_DIAGONAL, RobotModel, Simulation, Twist};
+use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation, Twist};
 use rustdds::no_key::{DataReader, DataWriter};
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{
@@ -35,7 +41,9 @@ use rustdds::{
 };
 
 use crate::ros::RosPlan;
-use msgs::{Covariance, Header, RosMessage, Time};
+use crate::ros::shared::{JointSample, sample_joints, static_transforms};
+use msgs::RosMessage;
+use topics::Topics;
 
 /// `--ros2` settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,8 +109,22 @@ fn writer<M: RosMessage>(
 
 /// What the loop thread hands the publishing thread.
 enum Event {
-    /// A control update: its sample.
-    Control(ControlSample),
+    /// The run starts: the static transforms and the camera's calibration.
+    Start {
+        static_tf: Vec<rover_ros1::msgs::TransformStamped>,
+        camera: Option<rover_sim::CameraInfo>,
+    },
+    /// A control update: its sample and the moving joints (the plan's order).
+    Control(ControlSample, Vec<JointSample>),
+    /// A camera image: stamp, size, RGB8 pixels.
+    Image {
+        stamp_s: f64,
+        width: u32,
+        height: u32,
+        pixels: Vec<u8>,
+    },
+    /// A laser scan.
+    Scan(LaserScan),
 }
 
 /// The observer half of the bridge.
@@ -110,6 +132,8 @@ pub struct Ros2Bridge {
     tx: Option<SyncSender<Event>>,
     thread: Option<JoinHandle<()>>,
     dropped: u64,
+    plan: RosPlan,
+    camera_link: Option<String>,
 }
 
 impl std::fmt::Debug for Ros2Bridge {
@@ -195,6 +219,8 @@ impl Ros2Bridge {
                 tx: Some(tx),
                 thread: Some(thread),
                 dropped: 0,
+                plan,
+                camera_link: robot.cameras.first().map(|c| c.link.clone()),
             },
             Ros2Input {
                 cmd_vel,
@@ -234,88 +260,31 @@ impl Drop for Ros2Bridge {
 }
 
 impl Observer for Ros2Bridge {
-    fn control(&mut self, _sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
-        self.send(Event::Control(*sample));
-    }
-}
-
-/// The writers and the messages they reuse.
-struct Topics {
-    clock: Writer<msgs::Clock>,
-    odom: Writer<msgs::Odometry>,
-    tf: Writer<msgs::TfMessage>,
-    odom_msg: msgs::Odometry,
-    tf_msg: Option<msgs::TfMessage>,
-}
-
-/// A 6x6 covariance with `diagonal` on its diagonal.
-fn covariance(diagonal: [f64; 6]) -> Covariance {
-    let mut c = [0.0; 36];
-    for (i, d) in diagonal.iter().enumerate() {
-        c[i * 7] = *d;
-    }
-    Covariance(c)
-}
-
-impl Topics {
-    fn create(participant: &DomainParticipant, plan: &RosPlan) -> Result<Self> {
-        let qos = default_qos();
-        let publisher = participant
-            .create_publisher(&qos)
-            .context("creating the DDS publisher")?;
-        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
-        let mut odom_msg = msgs::Odometry {
-            header: Header {
-                stamp: Time::default(),
-                frame_id: plan.odom_frame.clone(),
-            },
-            child_frame_id: plan.base_frame.clone(),
-            ..msgs::Odometry::default()
-        };
-        odom_msg.pose.covariance = cov;
-        odom_msg.twist.covariance = cov;
-        let tf_msg = plan.odom_tf.then(|| msgs::TfMessage {
-            transforms: vec![msgs::TransformStamped {
-                header: Header {
-                    stamp: Time::default(),
-                    frame_id: plan.odom_frame.clone(),
-                },
-                child_frame_id: plan.base_frame.clone(),
-                transform: msgs::Transform::default(),
-            }],
+    fn start(&mut self, sim: &Simulation, camera: Option<&rover_sim::CameraInfo>, _: &[String]) {
+        let static_tf = static_transforms(sim.robot(), camera, self.camera_link.as_deref());
+        self.send(Event::Start {
+            static_tf,
+            camera: camera.cloned(),
         });
-        Ok(Self {
-            clock: writer(participant, &publisher, "/clock", &qos)?,
-            odom: writer(participant, &publisher, &plan.odom_topic, &qos)?,
-            tf: writer(participant, &publisher, "/tf", &qos)?,
-            odom_msg,
-            tf_msg,
-        })
     }
 
-    fn control(&mut self, sample: &ControlSample) {
-        let stamp = Time::from_secs(sample.sim_time_s);
-        let o = sample.odometry;
-        let _ = self.clock.write(msgs::Clock { clock: stamp }, None);
-        let msg = &mut self.odom_msg;
-        msg.header.stamp = stamp;
-        msg.pose.pose.position = msgs::Vector3 {
-            x: o.x_m,
-            y: o.y_m,
-            z: 0.0,
-        };
-        msg.pose.pose.orientation = msgs::Quaternion::from_yaw(o.yaw_rad);
-        msg.twist.twist.linear.x = o.linear_mps;
-        msg.twist.twist.angular.z = o.angular_radps;
-        let _ = self.odom.write(msg.clone(), None);
-        if let Some(tf) = &mut self.tf_msg {
-            if let Some(t) = tf.transforms.first_mut() {
-                t.header.stamp = stamp;
-                t.transform.translation = msg.pose.pose.position;
-                t.transform.rotation = msg.pose.pose.orientation;
-            }
-            let _ = self.tf.write(tf.clone(), None);
-        }
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
+        let mut joints = Vec::with_capacity(self.plan.joints.len());
+        sample_joints(sim, sample, &self.plan.joints, &mut joints);
+        self.send(Event::Control(*sample, joints));
+    }
+
+    fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {
+        self.send(Event::Image {
+            stamp_s: frame.sim_time_s,
+            width: frame.width,
+            height: frame.height,
+            pixels: frame.rgb.to_vec(),
+        });
+    }
+
+    fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
+        self.send(Event::Scan(scan.clone()));
     }
 }
 
@@ -323,7 +292,15 @@ impl Topics {
 fn run(participant: DomainParticipant, mut topics: Topics, events: &Receiver<Event>) {
     for event in events {
         match event {
-            Event::Control(sample) => topics.control(&sample),
+            Event::Start { static_tf, camera } => topics.start(&static_tf, camera.as_ref()),
+            Event::Control(sample, joints) => topics.control(&sample, &joints),
+            Event::Image {
+                stamp_s,
+                width,
+                height,
+                pixels,
+            } => topics.image(stamp_s, width, height, pixels),
+            Event::Scan(scan) => topics.scan(&scan),
         }
     }
     drop(topics);

@@ -241,6 +241,124 @@ impl RosMessage for TfMessage {
     const DDS_TYPE: &'static str = "tf2_msgs::msg::dds_::TFMessage_";
 }
 
+/// `sensor_msgs/msg/JointState`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointState {
+    /// Stamp.
+    pub header: Header,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Positions (rad or m).
+    pub position: Vec<f64>,
+    /// Velocities.
+    pub velocity: Vec<f64>,
+    /// Efforts.
+    pub effort: Vec<f64>,
+}
+
+impl RosMessage for JointState {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::JointState_";
+}
+
+/// `sensor_msgs/msg/Image`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Image {
+    /// Stamp and optical frame.
+    pub header: Header,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `rgb8`, `32FC1`, ...
+    pub encoding: String,
+    /// 0: little-endian.
+    pub is_bigendian: u8,
+    /// Bytes per row.
+    pub step: u32,
+    /// Pixels, rows top to bottom.
+    #[serde(with = "serde_bytes")]
+    pub data: Vec<u8>,
+}
+
+impl RosMessage for Image {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Image_";
+}
+
+/// `sensor_msgs/msg/RegionOfInterest`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct RegionOfInterest {
+    /// Left (px).
+    pub x_offset: u32,
+    /// Top (px).
+    pub y_offset: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Width (px).
+    pub width: u32,
+    /// Whether to rectify.
+    pub do_rectify: bool,
+}
+
+/// `sensor_msgs/msg/CameraInfo` (ROS 2 names its matrices in lower case).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CameraInfo {
+    /// Stamp and optical frame.
+    pub header: Header,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `plumb_bob`.
+    pub distortion_model: String,
+    /// Distortion coefficients.
+    pub d: Vec<f64>,
+    /// Intrinsics, row-major 3x3.
+    pub k: [f64; 9],
+    /// Rectification, row-major 3x3.
+    pub r: [f64; 9],
+    /// Projection, row-major 3x4.
+    pub p: [f64; 12],
+    /// Binning.
+    pub binning_x: u32,
+    /// Binning.
+    pub binning_y: u32,
+    /// Region of interest.
+    pub roi: RegionOfInterest,
+}
+
+impl RosMessage for CameraInfo {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::CameraInfo_";
+}
+
+/// `sensor_msgs/msg/LaserScan`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LaserScan {
+    /// Stamp and the scanner's frame.
+    pub header: Header,
+    /// First ray's angle (rad).
+    pub angle_min: f32,
+    /// Last ray's angle (rad).
+    pub angle_max: f32,
+    /// Between rays (rad).
+    pub angle_increment: f32,
+    /// Between rays (s).
+    pub time_increment: f32,
+    /// Between scans (s).
+    pub scan_time: f32,
+    /// Shortest range (m).
+    pub range_min: f32,
+    /// Longest range (m).
+    pub range_max: f32,
+    /// Ranges (m).
+    pub ranges: Vec<f32>,
+    /// Intensities.
+    pub intensities: Vec<f32>,
+}
+
+impl RosMessage for LaserScan {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::LaserScan_";
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,300 @@
+//! The ROS 2 bridge's writers, one per topic, and the messages they fill: on the publishing
+//! thread. Names, frames and joints come from the ROS 1 bridge's plan ([`RosPlan`]); stamps
+//! are sim time.
+
+use anyhow::{Context, Result};
+use rover_sim::{ControlSample, LaserScan, ODOM_POSE_COVARIANCE_DIAGONAL, Pose};
+use rustdds::policy::{Durability, History, Reliability};
+use rustdds::{DomainParticipant, QosPolicies, QosPolicyBuilder};
+
+use super::msgs::{self, Covariance, Header, Time};
+use super::{Writer, default_qos, writer};
+use crate::ros::RosPlan;
+use crate::ros::shared::{JointSample, JointSource};
+
+/// `/tf_static`'s QoS: reliable, transient local, keep last 1 (tf2's static broadcaster): a
+/// late joiner gets it.
+fn latched_qos() -> QosPolicies {
+    QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::from_millis(100),
+        })
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1 })
+        .build()
+}
+
+/// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).
+fn sensor_qos() -> QosPolicies {
+    QosPolicyBuilder::new()
+        .reliability(Reliability::BestEffort)
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 5 })
+        .build()
+}
+
+/// A 6x6 covariance with `diagonal` on its diagonal.
+fn covariance(diagonal: [f64; 6]) -> Covariance {
+    let mut c = [0.0; 36];
+    for (i, d) in diagonal.iter().enumerate() {
+        c[i * 7] = *d;
+    }
+    Covariance(c)
+}
+
+fn header(frame_id: &str) -> Header {
+    Header {
+        stamp: Time::default(),
+        frame_id: frame_id.to_owned(),
+    }
+}
+
+fn transform(parent: &str, child: &str, stamp: Time, pose: Pose) -> msgs::TransformStamped {
+    let (t, r) = (pose.translation, pose.rotation);
+    msgs::TransformStamped {
+        header: Header {
+            stamp,
+            frame_id: parent.to_owned(),
+        },
+        child_frame_id: child.to_owned(),
+        transform: msgs::Transform {
+            translation: msgs::Vector3 {
+                x: f64::from(t.x),
+                y: f64::from(t.y),
+                z: f64::from(t.z),
+            },
+            rotation: msgs::Quaternion {
+                x: f64::from(r.x),
+                y: f64::from(r.y),
+                z: f64::from(r.z),
+                w: f64::from(r.w),
+            },
+        },
+    }
+}
+
+/// The writers and the messages they reuse.
+pub(super) struct Topics {
+    clock: Writer<msgs::Clock>,
+    odom: Writer<msgs::Odometry>,
+    tf: Writer<msgs::TfMessage>,
+    tf_static: Writer<msgs::TfMessage>,
+    joint_states: Writer<msgs::JointState>,
+    image: Option<(Writer<msgs::Image>, Writer<msgs::CameraInfo>)>,
+    scan: Option<Writer<msgs::LaserScan>>,
+    odom_msg: msgs::Odometry,
+    /// odom -> base (with `publishOdomTF`), then the moving joints' links.
+    tf_msg: msgs::TfMessage,
+    odom_tf: bool,
+    /// Indices (plan joints) of the joints whose links go on `/tf`, in `tf_msg` order.
+    joints_on_tf: Vec<usize>,
+    joints_msg: msgs::JointState,
+    info_msg: Option<msgs::CameraInfo>,
+}
+
+impl Topics {
+    /// The robot's topics on `participant`.
+    pub(super) fn create(participant: &DomainParticipant, plan: &RosPlan) -> Result<Self> {
+        let qos = default_qos();
+        let publisher = participant
+            .create_publisher(&qos)
+            .context("creating the DDS publisher")?;
+        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
+        let mut odom_msg = msgs::Odometry {
+            header: header(&plan.odom_frame),
+            child_frame_id: plan.base_frame.clone(),
+            ..msgs::Odometry::default()
+        };
+        odom_msg.pose.covariance = cov;
+        odom_msg.twist.covariance = cov;
+        let mut transforms = Vec::new();
+        if plan.odom_tf {
+            let odom = &plan.odom_frame;
+            transforms.push(transform(
+                odom,
+                &plan.base_frame,
+                Time::default(),
+                Pose::IDENTITY,
+            ));
+        }
+        let mut joints_on_tf = Vec::new();
+        for (i, j) in plan.joints.iter().enumerate() {
+            let wheel = matches!(j.source, JointSource::Wheel { .. });
+            if !wheel || plan.wheel_tf {
+                joints_on_tf.push(i);
+                transforms.push(transform(
+                    &j.parent_link,
+                    &j.child_link,
+                    Time::default(),
+                    j.parent_from_child_at_rest,
+                ));
+            }
+        }
+        let sensor = sensor_qos();
+        let image = match (&plan.image_topic, &plan.info_topic) {
+            (Some(image), Some(info)) => Some((
+                writer(participant, &publisher, image, &sensor)?,
+                writer(participant, &publisher, info, &sensor)?,
+            )),
+            _ => None,
+        };
+        let scan = match &plan.scan_topic {
+            Some(topic) => Some(writer(participant, &publisher, topic, &sensor)?),
+            None => None,
+        };
+        Ok(Self {
+            clock: writer(participant, &publisher, "/clock", &qos)?,
+            odom: writer(participant, &publisher, &plan.odom_topic, &qos)?,
+            tf: writer(participant, &publisher, "/tf", &qos)?,
+            tf_static: writer(participant, &publisher, "/tf_static", &latched_qos())?,
+            joint_states: writer(participant, &publisher, "/joint_states", &qos)?,
+            image,
+            scan,
+            odom_msg,
+            tf_msg: msgs::TfMessage { transforms },
+            odom_tf: plan.odom_tf,
+            joints_on_tf,
+            joints_msg: msgs::JointState {
+                header: Header::default(),
+                name: plan.joints.iter().map(|j| j.name.clone()).collect(),
+                ..msgs::JointState::default()
+            },
+            info_msg: None,
+        })
+    }
+
+    /// The run starts: `/tf_static` once (kept for late joiners), the camera's calibration.
+    pub(super) fn start(
+        &mut self,
+        static_tf: &[rover_ros1::msgs::TransformStamped],
+        camera: Option<&rover_sim::CameraInfo>,
+    ) {
+        let transforms = static_tf
+            .iter()
+            .map(|t| msgs::TransformStamped {
+                header: header(&t.header.frame_id),
+                child_frame_id: t.child_frame_id.clone(),
+                transform: msgs::Transform {
+                    translation: msgs::Vector3 {
+                        x: t.translation.x,
+                        y: t.translation.y,
+                        z: t.translation.z,
+                    },
+                    rotation: msgs::Quaternion {
+                        x: t.rotation.x,
+                        y: t.rotation.y,
+                        z: t.rotation.z,
+                        w: t.rotation.w,
+                    },
+                },
+            })
+            .collect();
+        let _ = self.tf_static.write(msgs::TfMessage { transforms }, None);
+        self.info_msg = camera.map(|c| msgs::CameraInfo {
+            header: header(&c.frame_id),
+            height: c.height,
+            width: c.width,
+            distortion_model: c.distortion_model.to_owned(),
+            d: c.d.to_vec(),
+            k: c.k,
+            r: c.r,
+            p: c.p,
+            ..msgs::CameraInfo::default()
+        });
+    }
+
+    /// A control update: `/clock`, odometry, `/tf`, `/joint_states`.
+    pub(super) fn control(&mut self, sample: &ControlSample, joints: &[JointSample]) {
+        let stamp = Time::from_secs(sample.sim_time_s);
+        let o = sample.odometry;
+        let _ = self.clock.write(msgs::Clock { clock: stamp }, None);
+        let msg = &mut self.odom_msg;
+        msg.header.stamp = stamp;
+        msg.pose.pose.position = msgs::Vector3 {
+            x: o.x_m,
+            y: o.y_m,
+            z: 0.0,
+        };
+        msg.pose.pose.orientation = msgs::Quaternion::from_yaw(o.yaw_rad);
+        msg.twist.twist.linear.x = o.linear_mps;
+        msg.twist.twist.angular.z = o.angular_radps;
+        let _ = self.odom.write(msg.clone(), None);
+        let first_joint = usize::from(self.odom_tf);
+        if let Some(t) = self.tf_msg.transforms.first_mut().filter(|_| self.odom_tf) {
+            t.transform.translation = msg.pose.pose.position;
+            t.transform.rotation = msg.pose.pose.orientation;
+        }
+        for (t, &i) in self.tf_msg.transforms[first_joint..]
+            .iter_mut()
+            .zip(&self.joints_on_tf)
+        {
+            if let Some(j) = joints.get(i) {
+                let p = transform("", "", stamp, j.parent_from_child);
+                t.transform = p.transform;
+            }
+        }
+        for t in &mut self.tf_msg.transforms {
+            t.header.stamp = stamp;
+        }
+        if !self.tf_msg.transforms.is_empty() {
+            let _ = self.tf.write(self.tf_msg.clone(), None);
+        }
+        let js = &mut self.joints_msg;
+        js.header.stamp = stamp;
+        js.position.clear();
+        js.position.extend(joints.iter().map(|j| j.position));
+        js.velocity.clear();
+        js.velocity.extend(joints.iter().map(|j| j.velocity_radps));
+        js.effort.clear();
+        js.effort.extend(joints.iter().map(|j| j.effort));
+        if !js.name.is_empty() {
+            let _ = self.joint_states.write(js.clone(), None);
+        }
+    }
+
+    /// A camera image (RGB8) and its camera_info, with the image's stamp.
+    pub(super) fn image(&mut self, stamp_s: f64, width: u32, height: u32, pixels: Vec<u8>) {
+        let (Some((image, info)), Some(info_msg)) = (&self.image, &mut self.info_msg) else {
+            return;
+        };
+        let stamp = Time::from_secs(stamp_s);
+        info_msg.header.stamp = stamp;
+        let msg = msgs::Image {
+            header: Header {
+                stamp,
+                frame_id: info_msg.header.frame_id.clone(),
+            },
+            height,
+            width,
+            encoding: "rgb8".to_owned(),
+            is_bigendian: 0,
+            step: width * 3,
+            data: pixels,
+        };
+        let _ = image.write(msg, None);
+        let _ = info.write(info_msg.clone(), None);
+    }
+
+    /// A laser scan.
+    pub(super) fn scan(&mut self, scan: &LaserScan) {
+        let Some(writer) = &self.scan else {
+            return;
+        };
+        let msg = msgs::LaserScan {
+            header: Header {
+                stamp: Time::from_secs(scan.stamp_s),
+                frame_id: scan.frame_id.clone(),
+            },
+            angle_min: scan.angle_min_rad,
+            angle_max: scan.angle_max_rad,
+            angle_increment: scan.angle_increment_rad,
+            time_increment: scan.time_increment_s,
+            scan_time: scan.scan_time_s,
+            range_min: scan.range_min_m,
+            range_max: scan.range_max_m,
+            ranges: scan.ranges_m.clone(),
+            intensities: Vec::new(),
+        };
+        let _ = writer.write(msg, None);
+    }
+}
