@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use anyhow::Result;
 use rover_core::{
-    Action, DetectorMode, Fanout, InputSource, NoInput, RunConfig, RunFiles, Session,
-    SessionOptions, run_headless, run_headless_driven, run_headless_observed,
+    Action, DetectorMode, Fanout, InputSource, RunConfig, RunFiles, Session, SessionOptions,
+    run_headless, run_headless_driven, run_headless_observed,
 };
 
 use super::args::RunArgs;
@@ -234,23 +234,27 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         arm: args.arm.arm()?,
         ground_truth: args.follow.ground_truth,
     };
-    let mut ros = args
-        .ros
-        .options(args.follow.ground_truth)
-        .map(|o| RosBridge::start(&o, &robot))
-        .transpose()?;
+    let (mut ros, mut ros_input) = match args.ros.options(args.follow.ground_truth) {
+        Some(o) => {
+            let (bridge, input) = RosBridge::start(&o, &robot)?;
+            (Some(bridge), Some(input))
+        }
+        None => (None, None),
+    };
+    let (mut ros2, mut ros2_input) = if args.ros.ros2 {
+        let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
+        (Some(bridge), Some(input))
+    } else {
+        (None, None)
+    };
     let summary = {
         let mut fan = Fanout::default();
         fan.push(&mut files);
         fan.push_some(recorder.as_mut());
-        let mut no_input = NoInput;
-        let inputs: &mut dyn InputSource = match ros.as_mut() {
-            Some((bridge, cmd_vel)) => {
-                fan.push(bridge);
-                cmd_vel
-            }
-            None => &mut no_input,
-        };
+        fan.push_some(ros.as_mut());
+        fan.push_some(ros2.as_mut());
+        let mut both = Inputs(ros_input.as_mut(), ros2_input.as_mut());
+        let inputs: &mut dyn InputSource = &mut both;
         let session = Session::new(world, robot, &options, &mut fan)?;
         station::run(
             session,
@@ -269,7 +273,10 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         )?
     };
     let record_failed = recorder.as_mut().and_then(|r| r.finish().err());
-    if let Some((bridge, _)) = ros.as_mut() {
+    if let Some(bridge) = ros.as_mut() {
+        bridge.finish();
+    }
+    if let Some(bridge) = ros2.as_mut() {
         bridge.finish();
     }
     println!(
