@@ -429,3 +429,53 @@ if got_joints:
     );
     Ok(())
 }
+
+/// A peer publishing garbage on `rt/cmd_vel` (a string under Twist's type name): rover warns
+/// once and goes on; a real Twist afterwards still drives the car.
+#[test]
+fn garbage_on_cmd_vel_is_ignored_with_one_warning() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(3))?;
+    graph.spawn_rover(10.0, &[])?;
+    let out = graph.python(
+        "garbage.py",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+
+@dataclass
+class Bad(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    data: str
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+bad = DataWriter(dp, Topic(dp, 'rt/cmd_vel', Bad))
+for i in range(20):
+    bad.write(Bad(data='not a twist %d' % i))
+    time.sleep(0.1)
+del bad
+good = DataWriter(dp, Topic(dp, 'rt/cmd_vel', Twist))
+for i in range(40):
+    good.write(Twist(linear=Vector3(0.5, 0.0, 0.0), angular=Vector3(0.0, 0.0, 0.0)))
+    time.sleep(0.1)
+print('done')
+"#,
+        Duration::from_secs(30),
+    )?;
+    graph.wait_rover(Duration::from_secs(60))?;
+    let log = std::fs::read_to_string(graph.dir.path().join("rover.log"))?;
+    let rows = parse_trace(&std::fs::read_to_string(graph.trace_path())?)?;
+    let driven = rows.last().map_or(0.0, |r| r.x_m.hypot(r.y_m));
+    let warnings = log.matches("could not be read").count();
+    println!("{out}rover drove {driven:.3} m; {warnings} warning(s)");
+    ensure!(out.contains("done"), "{out}");
+    ensure!(
+        driven >= 0.3,
+        "the car drove {driven} m after the garbage:\n{log}"
+    );
+    ensure!(warnings <= 1, "{warnings} warnings:\n{log}");
+    Ok(())
+}
