@@ -60,52 +60,13 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         println!("Rerun web viewer: {url}");
     }
     let summary = if args.ros.any() {
-        let (world, robot) = config.load_world_and_robot()?;
-        let (mut ros1, mut ros1_input) = match args.ros.options(config.ground_truth) {
-            Some(options) => {
-                let (bridge, input) = RosBridge::start(&options, &robot)?;
-                (Some(bridge), Some(input))
-            }
-            None => (None, None),
-        };
-        let (mut ros2, mut ros2_input) = if args.ros.ros2 {
-            let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
-            (Some(bridge), Some(input))
-        } else {
-            (None, None)
-        };
-        let result = {
-            let mut fan = Fanout::default();
-            fan.push_some(ros1.as_mut());
-            fan.push_some(ros2.as_mut());
-            fan.push_some(recorder.as_mut());
-            let mut inputs = Inputs(ros1_input.as_mut(), ros2_input.as_mut());
-            run_headless_driven(&config, world, robot, &mut fan, true, &mut inputs)
-        };
-        if let Some(bridge) = ros1.as_mut() {
-            bridge.finish();
-            if bridge.dropped() > 0 {
-                tracing::info!(
-                    "ROS bridge: {} events dropped while it was behind",
-                    bridge.dropped()
-                );
-            }
-        }
-        if let Some(bridge) = ros2.as_mut() {
-            bridge.finish();
-            if bridge.dropped() > 0 {
-                tracing::info!(
-                    "ROS 2 bridge: {} events dropped while it was behind",
-                    bridge.dropped()
-                );
-            }
-        }
-        result
+        run_with_ros(&config, &args.ros, recorder.as_mut())
     } else {
         match recorder.as_mut() {
             Some(rec) => run_headless_observed(&config, rec, true),
             None => run_headless(&config),
         }
+        .map_err(anyhow::Error::from)
     };
     let mut record_failed = None;
     if let Some(rec) = recorder.as_mut() {
@@ -153,6 +114,55 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         summary.interrupted,
         summary.sim_time_s,
     )
+}
+
+/// A headless run with the ROS 1 and/or ROS 2 bridge (and the recorder, when there is one).
+fn run_with_ros(
+    config: &RunConfig,
+    ros: &super::args::RosArgs,
+    recorder: Option<&mut Recorder>,
+) -> Result<rover_core::RunSummary> {
+    let (world, robot) = config.load_world_and_robot()?;
+    let (mut ros1, mut ros1_input) = match ros.options(config.ground_truth) {
+        Some(options) => {
+            let (bridge, input) = RosBridge::start(&options, &robot)?;
+            (Some(bridge), Some(input))
+        }
+        None => (None, None),
+    };
+    let (mut ros2, mut ros2_input) = if ros.ros2 {
+        let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
+        (Some(bridge), Some(input))
+    } else {
+        (None, None)
+    };
+    let result = {
+        let mut fan = Fanout::default();
+        fan.push_some(ros1.as_mut());
+        fan.push_some(ros2.as_mut());
+        fan.push_some(recorder);
+        let mut inputs = Inputs(ros1_input.as_mut(), ros2_input.as_mut());
+        run_headless_driven(config, world, robot, &mut fan, true, &mut inputs)
+    };
+    if let Some(bridge) = ros1.as_mut() {
+        bridge.finish();
+        if bridge.dropped() > 0 {
+            tracing::info!(
+                "ROS bridge: {} events dropped while it was behind",
+                bridge.dropped()
+            );
+        }
+    }
+    if let Some(bridge) = ros2.as_mut() {
+        bridge.finish();
+        if bridge.dropped() > 0 {
+            tracing::info!(
+                "ROS 2 bridge: {} events dropped while it was behind",
+                bridge.dropped()
+            );
+        }
+    }
+    Ok(result?)
 }
 
 /// Sim seconds from which a recording with a footer gets the memory hint.

@@ -24,6 +24,7 @@
 //! ros2-client's node machinery (parameters, rosout, actions, async executors) yet; one crate
 //! less to build (RustDDS's cold build: 2 min on 2 cores).
 
+mod dds;
 mod msgs;
 mod topics;
 
@@ -33,17 +34,16 @@ use std::thread::JoinHandle;
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, LoopStats, Observer};
 use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation, Twist};
-use rustdds::no_key::{DataReader, DataWriter};
-use rustdds::policy::{Durability, History, Reliability};
-use rustdds::{
-    CDRDeserializerAdapter, CDRSerializerAdapter, DomainParticipant, QosPolicies, QosPolicyBuilder,
-    TopicKind,
-};
+use rustdds::no_key::DataReader;
+use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
 
 use crate::ros::RosPlan;
 use crate::ros::shared::{JointSample, sample_joints, static_transforms};
 use msgs::RosMessage;
 use topics::Topics;
+
+pub use dds::dds_topic;
+use dds::default_qos;
 
 /// `--ros2` settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,44 +67,6 @@ impl Ros2Options {
         };
         Ok(Self { domain_id })
     }
-}
-
-/// A ROS name as its DDS topic: `/odom` -> `rt/odom`, `/a/b` -> `rt/a/b`.
-pub fn dds_topic(ros_name: &str) -> String {
-    format!("rt/{}", ros_name.trim_start_matches('/'))
-}
-
-/// rclcpp's default QoS: reliable, volatile, keep last 10.
-fn default_qos() -> QosPolicies {
-    QosPolicyBuilder::new()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: rustdds::Duration::from_millis(100),
-        })
-        .durability(Durability::Volatile)
-        .history(History::KeepLast { depth: 10 })
-        .build()
-}
-
-type Writer<M> = DataWriter<M, CDRSerializerAdapter<M>>;
-
-/// A writer of `M` on the ROS topic `ros_name`.
-fn writer<M: RosMessage>(
-    participant: &DomainParticipant,
-    publisher: &rustdds::Publisher,
-    ros_name: &str,
-    qos: &QosPolicies,
-) -> Result<Writer<M>> {
-    let topic = participant
-        .create_topic(
-            dds_topic(ros_name),
-            M::DDS_TYPE.to_owned(),
-            qos,
-            TopicKind::NoKey,
-        )
-        .with_context(|| format!("creating the DDS topic for {ros_name}"))?;
-    publisher
-        .create_datawriter_no_key::<M, CDRSerializerAdapter<M>>(&topic, Some(qos.clone()))
-        .with_context(|| format!("creating the writer for {ros_name}"))
 }
 
 /// What the loop thread hands the publishing thread.

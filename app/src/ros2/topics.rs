@@ -7,8 +7,8 @@ use rover_sim::{ControlSample, LaserScan, ODOM_POSE_COVARIANCE_DIAGONAL, Pose};
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{DomainParticipant, QosPolicies, QosPolicyBuilder};
 
+use super::dds::{Writer, default_qos, writer};
 use super::msgs::{self, Covariance, Header, Time};
-use super::{Writer, default_qos, writer};
 use crate::ros::RosPlan;
 use crate::ros::shared::{JointSample, JointSource};
 

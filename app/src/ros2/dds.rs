@@ -1,0 +1,47 @@
+//! DDS helpers shared by the bridge's halves: ROS names as DDS topics, rclcpp's default QoS,
+//! and typed writers.
+
+use anyhow::{Context, Result};
+use rustdds::no_key::DataWriter;
+use rustdds::policy::{Durability, History, Reliability};
+use rustdds::{CDRSerializerAdapter, DomainParticipant, QosPolicies, QosPolicyBuilder, TopicKind};
+
+use super::msgs::RosMessage;
+
+/// A ROS name as its DDS topic: `/odom` -> `rt/odom`, `/a/b` -> `rt/a/b`.
+pub fn dds_topic(ros_name: &str) -> String {
+    format!("rt/{}", ros_name.trim_start_matches('/'))
+}
+
+/// rclcpp's default QoS: reliable, volatile, keep last 10.
+pub(super) fn default_qos() -> QosPolicies {
+    QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::from_millis(100),
+        })
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 10 })
+        .build()
+}
+
+pub(super) type Writer<M> = DataWriter<M, CDRSerializerAdapter<M>>;
+
+/// A writer of `M` on the ROS topic `ros_name`.
+pub(super) fn writer<M: RosMessage>(
+    participant: &DomainParticipant,
+    publisher: &rustdds::Publisher,
+    ros_name: &str,
+    qos: &QosPolicies,
+) -> Result<Writer<M>> {
+    let topic = participant
+        .create_topic(
+            dds_topic(ros_name),
+            M::DDS_TYPE.to_owned(),
+            qos,
+            TopicKind::NoKey,
+        )
+        .with_context(|| format!("creating the DDS topic for {ros_name}"))?;
+    publisher
+        .create_datawriter_no_key::<M, CDRSerializerAdapter<M>>(&topic, Some(qos.clone()))
+        .with_context(|| format!("creating the writer for {ros_name}"))
+}
