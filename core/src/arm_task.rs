@@ -7,8 +7,8 @@
 use nalgebra::Vector3;
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraFrame, IkSolver, IkTarget, JointCommand, KinematicChain, KinematicsError,
-    LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
+    CameraConfig, CameraFrame, ChainJoint, IkSolver, IkTarget, JointCommand, KinematicChain,
+    KinematicsError, LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
 };
 
 use crate::look::{Look, LookConfig};
@@ -161,7 +161,9 @@ pub(crate) struct ArmTask {
     /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
     look_while_reaching: bool,
     frames: Vec<FrameRecord>,
+    /// Every joint's position (robot order), and one chain's (chain order): scratch buffers.
     q: Vec<f64>,
+    chain_q: Vec<f64>,
     status: ArmStatus,
 }
 
@@ -225,6 +227,7 @@ impl ArmTask {
             look_while_reaching,
             frames: Vec::new(),
             q: Vec::with_capacity(robot.joints.len()),
+            chain_q: Vec::with_capacity(robot.joints.len()),
             status: ArmStatus::default(),
         }
     }
@@ -285,8 +288,7 @@ impl ArmTask {
                 solution.position_error_m
             ));
         }
-        let names = solver.chain().joints().iter().map(|j| j.name.as_str());
-        command(sim, names, &solution.q);
+        command(sim, solver.chain().joints(), &solution.q);
         Ok(())
     }
 
@@ -384,42 +386,26 @@ impl ArmTask {
         };
         let looking = self.mode == ArmMode::Look || self.look_while_reaching;
         if looking && let Ok(look) = self.look.as_mut() {
-            let q: Vec<f64> = look
-                .joints()
-                .iter()
-                .map(|j| record.q[j.id.index()])
-                .collect();
-            if let Some(targets) = look.observe(boxes, &q)? {
-                command(sim, look.joints().iter().map(|j| j.name.as_str()), &targets);
+            chain_positions(look.joints(), &record.q, &mut self.chain_q);
+            if let Some(targets) = look.observe(boxes, &self.chain_q)? {
+                command(sim, look.joints(), &targets);
             }
         }
         if self.mode == ArmMode::Reach
             && let Ok(reach) = self.reach.as_mut()
         {
             joint_positions(sim, &mut self.q);
-            let q: Vec<f64> = reach
-                .joints()
-                .iter()
-                .map(|j| self.q[j.id.index()])
-                .collect();
+            chain_positions(reach.joints(), &self.q, &mut self.chain_q);
             let view = DepthView {
                 depth_m: &record.depth_m,
                 width: record.width,
                 height: record.height,
                 base_from_optical: record.base_from_optical,
             };
-            match reach.observe(boxes, &view, &q)? {
+            match reach.observe(boxes, &view, &self.chain_q)? {
                 ReachStep::Keep => {}
-                ReachStep::Move(targets) => {
-                    command(
-                        sim,
-                        reach.joints().iter().map(|j| j.name.as_str()),
-                        &targets,
-                    );
-                }
-                ReachStep::Hold => {
-                    command(sim, reach.joints().iter().map(|j| j.name.as_str()), &q);
-                }
+                ReachStep::Move(targets) => command(sim, reach.joints(), &targets),
+                ReachStep::Hold => command(sim, reach.joints(), &self.chain_q),
             }
         }
         Ok(())
@@ -434,18 +420,13 @@ impl ArmTask {
             return Ok(());
         };
         joint_positions(sim, &mut self.q);
-        let q: Vec<f64> = reach
-            .joints()
-            .iter()
-            .map(|j| self.q[j.id.index()])
-            .collect();
-        reach.update_tool(&q)?;
+        chain_positions(reach.joints(), &self.q, &mut self.chain_q);
+        let tool = reach.update_tool(&self.chain_q)?;
         let world_from_base = isometry_from_pose(&sim.world_from_link(self.base_link));
         let world = |p: Vector3<f64>| {
             let w = world_from_base * nalgebra::Point3::from(p);
             [w.x, w.y, w.z]
         };
-        let tool = reach.chain().base_from_tip(&q)?.translation.vector;
         self.status = ArmStatus {
             mode: self.mode,
             reach: reach.state(),
@@ -464,8 +445,8 @@ impl ArmTask {
             ArmMode::Look => self.look.as_ref().map(|l| l.joints()).unwrap_or_default(),
             ArmMode::Reach => self.reach.as_ref().map(|r| r.joints()).unwrap_or_default(),
         };
-        let q: Vec<f64> = joints.iter().map(|j| self.q[j.id.index()]).collect();
-        command(sim, joints.iter().map(|j| j.name.as_str()), &q);
+        chain_positions(joints, &self.q, &mut self.chain_q);
+        command(sim, joints, &self.chain_q);
     }
 }
 
@@ -479,11 +460,21 @@ fn joint_positions(sim: &Simulation, out: &mut Vec<f64>) {
     );
 }
 
-/// Position commands to `names`; a joint without an actuator is skipped (logged once per
-/// command at debug level: the chain's passive joints follow the others).
-fn command<'a>(sim: &mut Simulation, names: impl Iterator<Item = &'a str>, targets: &[f64]) {
-    for (name, q) in names.zip(targets) {
-        if let Err(e) = sim.command_joint(name, JointCommand::Position(*q)) {
+/// A chain's joints' positions (chain order) out of every joint's (robot order), into `out`.
+fn chain_positions(joints: &[ChainJoint], all: &[f64], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(
+        joints
+            .iter()
+            .map(|j| all.get(j.id.index()).copied().unwrap_or(0.0)),
+    );
+}
+
+/// Position commands to a chain's `joints`; a joint without an actuator is skipped (logged at
+/// debug level: the chain's passive joints follow the others).
+fn command(sim: &mut Simulation, joints: &[ChainJoint], targets: &[f64]) {
+    for (joint, q) in joints.iter().zip(targets) {
+        if let Err(e) = sim.command_joint(&joint.name, JointCommand::Position(*q)) {
             tracing::debug!("arm: {e}");
         }
     }

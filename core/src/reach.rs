@@ -219,8 +219,9 @@ impl Reach {
     }
 
     /// Notes where the tool is now (the arm's joint positions, [`Reach::joints`] order): a
-    /// moving reach within [`ReachConfig::arrived_m`] of its goal has arrived.
-    pub fn update_tool(&mut self, q: &[f64]) -> Result<(), KinematicsError> {
+    /// moving reach within [`ReachConfig::arrived_m`] of its goal has arrived. Returns the
+    /// tool's position (base frame, m).
+    pub fn update_tool(&mut self, q: &[f64]) -> Result<Vector3<f64>, KinematicsError> {
         let tool = self.solver.chain().base_from_tip(q)?.translation.vector;
         if let Some(goal) = &self.goal {
             // Arrived within `arrived_m`, moving again only beyond twice that: a tool that
@@ -232,7 +233,7 @@ impl Reach {
                 state => state,
             };
         }
-        Ok(())
+        Ok(tool)
     }
 
     /// Takes one detector message, the depth image it came from and the arm's joint positions

@@ -130,7 +130,7 @@ const RECYCLED_IMAGES: usize = 8;
 
 /// The loop thread's end of the buffers coming back: each `take_*` gives a recycled buffer, or
 /// a new empty one.
-pub(super) struct BufferPool {
+pub(crate) struct BufferPool {
     pixels: Receiver<Vec<u8>>,
     ranges: Receiver<Vec<f32>>,
     boxes: Receiver<Vec<BoundingBox>>,
@@ -138,7 +138,7 @@ pub(super) struct BufferPool {
 }
 
 /// The publishing thread's end: what an event still holds after every family saw it.
-pub(super) struct BufferReturn {
+pub(crate) struct BufferReturn {
     pixels: SyncSender<Vec<u8>>,
     ranges: SyncSender<Vec<f32>>,
     boxes: SyncSender<Vec<BoundingBox>>,
@@ -146,7 +146,7 @@ pub(super) struct BufferReturn {
 }
 
 /// A pool and its return path.
-pub(super) fn buffer_pool() -> (BufferPool, BufferReturn) {
+pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
     let (pixels_back, pixels) = sync_channel(RECYCLED_IMAGES);
     let (ranges_back, ranges) = sync_channel(4);
     let (boxes_back, boxes) = sync_channel(4);
@@ -192,21 +192,39 @@ impl BufferPool {
 impl BufferReturn {
     /// Sends the event's buffer back (unless it has no capacity to offer); dropped when the
     /// pool is full or gone.
-    pub fn give_back(&self, event: Event) {
-        fn send<T>(to: &SyncSender<Vec<T>>, buffer: Vec<T>) {
-            if buffer.capacity() > 0 {
-                let _ = to.try_send(buffer);
-            }
-        }
+    pub(super) fn give_back(&self, event: Event) {
         match event {
             Event::Start(_) => {}
-            Event::Control(c) => send(&self.joints, c.joints),
+            Event::Control(c) => self.joints(c.joints),
             Event::Image(i) => {
-                send(&self.pixels, i.pixels);
-                send(&self.pixels, i.depth);
+                self.pixels(i.pixels);
+                self.pixels(i.depth);
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
-            Event::Scan(s) => send(&self.ranges, s.ranges_m),
+            Event::Scan(s) => self.ranges(s.ranges_m),
         }
+    }
+
+    /// An image buffer back (the ROS 2 bridge's too).
+    pub fn pixels(&self, buffer: Vec<u8>) {
+        send(&self.pixels, buffer);
+    }
+
+    /// A ranges buffer back.
+    pub fn ranges(&self, buffer: Vec<f32>) {
+        send(&self.ranges, buffer);
+    }
+
+    /// A joints buffer back.
+    pub fn joints(&self, buffer: Vec<JointSample>) {
+        send(&self.joints, buffer);
+    }
+}
+
+/// Sends `buffer` back (unless it has no capacity to offer); dropped when the pool is full or
+/// gone.
+fn send<T>(to: &SyncSender<Vec<T>>, buffer: Vec<T>) {
+    if buffer.capacity() > 0 {
+        let _ = to.try_send(buffer);
     }
 }

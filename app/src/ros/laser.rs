@@ -56,7 +56,7 @@ impl TopicFamily for Laser {
 
 /// The scan to hand over (on the loop thread): `scan` copied, its ranges into the recycled
 /// `ranges_m`.
-pub(super) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> LaserScan {
+pub(crate) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> LaserScan {
     ranges_m.clone_from(&scan.ranges_m);
     LaserScan {
         frame_id: scan.frame_id.clone(),

@@ -49,10 +49,10 @@ pub use cmd_vel::RosCmdVel;
 /// What the ROS 2 bridge shares with this one: the static transforms, the moving joints'
 /// sampling, and their types.
 pub(crate) mod shared {
-    pub(crate) use super::events::JointSample;
+    pub(crate) use super::events::{BufferPool, BufferReturn, JointSample, buffer_pool};
     pub(crate) use super::joint_states::sample as sample_joints;
-    pub(crate) use super::plan::JointSource;
-    pub(crate) use super::tf::static_transforms;
+    pub(crate) use super::laser::capture as capture_scan;
+    pub(crate) use super::tf::{joints_on_tf, static_transforms};
 }
 use controllers::ControllerCommands;
 pub use plan::RosPlan;

@@ -35,21 +35,16 @@ impl Tf {
                 Pose::IDENTITY,
             ));
         }
-        let mut joints_on_tf = Vec::new();
-        for (i, j) in plan.joints.iter().enumerate() {
-            // Wheels as publishWheelTF says; every other moving joint's link always, as
-            // robot_state_publisher would from /joint_states.
-            let wheel = matches!(j.source, JointSource::Wheel { .. });
-            if !wheel || plan.wheel_tf {
-                joints_on_tf.push(i);
-                transforms.push(transform(
-                    &j.parent_link,
-                    &j.child_link,
-                    0.0,
-                    j.parent_from_child_at_rest,
-                ));
-            }
-        }
+        let joints_on_tf = joints_on_tf(plan);
+        transforms.extend(joints_on_tf.iter().map(|&i| {
+            let j = &plan.joints[i];
+            transform(
+                &j.parent_link,
+                &j.child_link,
+                0.0,
+                j.parent_from_child_at_rest,
+            )
+        }));
         Ok(Self {
             tf: node.advertise("/tf", 100, false)?,
             tf_static: node.advertise("/tf_static", 10, true)?,
@@ -93,6 +88,18 @@ impl TopicFamily for Tf {
             self.tf.publish(&self.msg);
         }
     }
+}
+
+/// Indices (in the plan's joints) of the joints whose links go on `/tf`: wheels as
+/// `publishWheelTF` says; every other moving joint's link always, as robot_state_publisher
+/// would from `/joint_states`.
+pub(crate) fn joints_on_tf(plan: &RosPlan) -> Vec<usize> {
+    plan.joints
+        .iter()
+        .enumerate()
+        .filter(|(_, j)| plan.wheel_tf || !matches!(j.source, JointSource::Wheel { .. }))
+        .map(|(i, _)| i)
+        .collect()
 }
 
 /// What `/tf_static` says for `robot` (on the loop thread, once): every fixed joint, the

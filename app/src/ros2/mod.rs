@@ -38,7 +38,10 @@ use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
 
 use crate::ros::RosPlan;
-use crate::ros::shared::{JointSample, sample_joints, static_transforms};
+use crate::ros::shared::{
+    BufferPool, BufferReturn, JointSample, buffer_pool, capture_scan, sample_joints,
+    static_transforms,
+};
 use msgs::RosMessage;
 use topics::Topics;
 
@@ -94,6 +97,8 @@ pub struct Ros2Bridge {
     tx: Option<SyncSender<Event>>,
     thread: Option<JoinHandle<()>>,
     dropped: u64,
+    /// Recycled buffers for the events (joints, pixels, ranges).
+    buffers: BufferPool,
     plan: RosPlan,
     camera_link: Option<String>,
 }
@@ -166,9 +171,10 @@ impl Ros2Bridge {
             .context("creating the cmd_vel reader")?;
         let topics = Topics::create(&participant, &plan)?;
         let (tx, rx) = sync_channel::<Event>(64);
+        let (buffers, returns) = buffer_pool();
         let thread = std::thread::Builder::new()
             .name("ros2-bridge".into())
-            .spawn(move || run(participant, topics, &rx))
+            .spawn(move || run(participant, topics, &rx, &returns))
             .context("starting the ROS 2 bridge thread")?;
         tracing::info!(
             "ROS 2: DDS domain {}; cmd_vel on {}, odometry on {}",
@@ -181,6 +187,7 @@ impl Ros2Bridge {
                 tx: Some(tx),
                 thread: Some(thread),
                 dropped: 0,
+                buffers,
                 plan,
                 camera_link: robot.cameras.first().map(|c| c.link.clone()),
             },
@@ -231,38 +238,59 @@ impl Observer for Ros2Bridge {
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
-        let mut joints = Vec::with_capacity(self.plan.joints.len());
+        let mut joints = self.buffers.take_joints();
         sample_joints(sim, sample, &self.plan.joints, &mut joints);
         self.send(Event::Control(*sample, joints));
     }
 
     fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {
+        let mut pixels = self.buffers.take_pixels();
+        pixels.clear();
+        pixels.extend_from_slice(frame.rgb);
         self.send(Event::Image {
             stamp_s: frame.sim_time_s,
             width: frame.width,
             height: frame.height,
-            pixels: frame.rgb.to_vec(),
+            pixels,
         });
     }
 
     fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
-        self.send(Event::Scan(scan.clone()));
+        let scan = capture_scan(scan, self.buffers.take_ranges());
+        self.send(Event::Scan(scan));
     }
 }
 
 /// The publishing thread: every event to the topics, until the bridge hangs up.
-fn run(participant: DomainParticipant, mut topics: Topics, events: &Receiver<Event>) {
+/// The buffers events carry go back to the loop thread once published.
+fn run(
+    participant: DomainParticipant,
+    mut topics: Topics,
+    events: &Receiver<Event>,
+    returns: &BufferReturn,
+) {
     for event in events {
         match event {
             Event::Start { static_tf, camera } => topics.start(&static_tf, camera.as_ref()),
-            Event::Control(sample, joints) => topics.control(&sample, &joints),
+            Event::Control(sample, joints) => {
+                topics.control(&sample, &joints);
+                returns.joints(joints);
+            }
             Event::Image {
                 stamp_s,
                 width,
                 height,
                 pixels,
-            } => topics.image(stamp_s, width, height, pixels),
-            Event::Scan(scan) => topics.scan(&scan),
+            } => {
+                if let Some(pixels) = topics.image(stamp_s, width, height, pixels) {
+                    returns.pixels(pixels);
+                }
+            }
+            Event::Scan(scan) => {
+                if let Some(ranges) = topics.scan(scan) {
+                    returns.ranges(ranges);
+                }
+            }
         }
     }
     drop(topics);

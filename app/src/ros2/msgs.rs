@@ -260,8 +260,40 @@ impl RosMessage for JointState {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::JointState_";
 }
 
+/// A buffer lent to a message: the writer serializes the message and drops it, and the bridge
+/// takes the buffer back ([`Lent::take_back`]) for the next one, so steady publishing
+/// allocates nothing.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Lent<T>(std::sync::Arc<Vec<T>>);
+
+impl<T> Lent<T> {
+    /// Lends `buffer`.
+    pub fn new(buffer: Vec<T>) -> Self {
+        Self(std::sync::Arc::new(buffer))
+    }
+
+    /// The buffer, once no message holds it any more.
+    pub fn take_back(self) -> Option<Vec<T>> {
+        std::sync::Arc::try_unwrap(self.0).ok()
+    }
+}
+
+/// `uint8[]`: a length and the bytes.
+impl Serialize for Lent<u8> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_bytes(&self.0)
+    }
+}
+
+/// `float32[]`: a length and the values.
+impl Serialize for Lent<f32> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.as_slice().serialize(s)
+    }
+}
+
 /// `sensor_msgs/msg/Image`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Image {
     /// Stamp and optical frame.
     pub header: Header,
@@ -276,8 +308,7 @@ pub struct Image {
     /// Bytes per row.
     pub step: u32,
     /// Pixels, rows top to bottom.
-    #[serde(with = "serde_bytes")]
-    pub data: Vec<u8>,
+    pub data: Lent<u8>,
 }
 
 impl RosMessage for Image {
@@ -331,7 +362,7 @@ impl RosMessage for CameraInfo {
 }
 
 /// `sensor_msgs/msg/LaserScan`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct LaserScan {
     /// Stamp and the scanner's frame.
     pub header: Header,
@@ -350,7 +381,7 @@ pub struct LaserScan {
     /// Longest range (m).
     pub range_max: f32,
     /// Ranges (m).
-    pub ranges: Vec<f32>,
+    pub ranges: Lent<f32>,
     /// Intensities.
     pub intensities: Vec<f32>,
 }

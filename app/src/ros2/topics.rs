@@ -8,9 +8,9 @@ use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{DomainParticipant, QosPolicies, QosPolicyBuilder};
 
 use super::dds::{Writer, default_qos, writer};
-use super::msgs::{self, Covariance, Header, Time};
+use super::msgs::{self, Covariance, Header, Lent, Time};
 use crate::ros::RosPlan;
-use crate::ros::shared::{JointSample, JointSource};
+use crate::ros::shared::{JointSample, joints_on_tf};
 
 /// `/tf_static`'s QoS: reliable, transient local, keep last 1 (tf2's static broadcaster): a
 /// late joiner gets it.
@@ -49,27 +49,29 @@ fn header(frame_id: &str) -> Header {
     }
 }
 
-fn transform(parent: &str, child: &str, stamp: Time, pose: Pose) -> msgs::TransformStamped {
+/// A pose as a geometry_msgs Transform.
+fn transform_of(pose: Pose) -> msgs::Transform {
     let (t, r) = (pose.translation, pose.rotation);
+    msgs::Transform {
+        translation: msgs::Vector3 {
+            x: f64::from(t.x),
+            y: f64::from(t.y),
+            z: f64::from(t.z),
+        },
+        rotation: msgs::Quaternion {
+            x: f64::from(r.x),
+            y: f64::from(r.y),
+            z: f64::from(r.z),
+            w: f64::from(r.w),
+        },
+    }
+}
+
+fn transform(parent: &str, child: &str, pose: Pose) -> msgs::TransformStamped {
     msgs::TransformStamped {
-        header: Header {
-            stamp,
-            frame_id: parent.to_owned(),
-        },
+        header: header(parent),
         child_frame_id: child.to_owned(),
-        transform: msgs::Transform {
-            translation: msgs::Vector3 {
-                x: f64::from(t.x),
-                y: f64::from(t.y),
-                z: f64::from(t.z),
-            },
-            rotation: msgs::Quaternion {
-                x: f64::from(r.x),
-                y: f64::from(r.y),
-                z: f64::from(r.z),
-                w: f64::from(r.w),
-            },
-        },
+        transform: transform_of(pose),
     }
 }
 
@@ -110,26 +112,13 @@ impl Topics {
         let mut transforms = Vec::new();
         if plan.odom_tf {
             let odom = &plan.odom_frame;
-            transforms.push(transform(
-                odom,
-                &plan.base_frame,
-                Time::default(),
-                Pose::IDENTITY,
-            ));
+            transforms.push(transform(odom, &plan.base_frame, Pose::IDENTITY));
         }
-        let mut joints_on_tf = Vec::new();
-        for (i, j) in plan.joints.iter().enumerate() {
-            let wheel = matches!(j.source, JointSource::Wheel { .. });
-            if !wheel || plan.wheel_tf {
-                joints_on_tf.push(i);
-                transforms.push(transform(
-                    &j.parent_link,
-                    &j.child_link,
-                    Time::default(),
-                    j.parent_from_child_at_rest,
-                ));
-            }
-        }
+        let joints_on_tf = joints_on_tf(plan);
+        transforms.extend(joints_on_tf.iter().map(|&i| {
+            let j = &plan.joints[i];
+            transform(&j.parent_link, &j.child_link, j.parent_from_child_at_rest)
+        }));
         let sensor = sensor_qos();
         let image = match (&plan.image_topic, &plan.info_topic) {
             (Some(image), Some(info)) => Some((
@@ -229,8 +218,7 @@ impl Topics {
             .zip(&self.joints_on_tf)
         {
             if let Some(j) = joints.get(i) {
-                let p = transform("", "", stamp, j.parent_from_child);
-                t.transform = p.transform;
+                t.transform = transform_of(j.parent_from_child);
             }
         }
         for t in &mut self.tf_msg.transforms {
@@ -252,11 +240,19 @@ impl Topics {
         }
     }
 
-    /// A camera image (RGB8) and its camera_info, with the image's stamp.
-    pub(super) fn image(&mut self, stamp_s: f64, width: u32, height: u32, pixels: Vec<u8>) {
+    /// A camera image (RGB8) and its camera_info, with the image's stamp; the pixels' buffer
+    /// back, for the next image.
+    pub(super) fn image(
+        &mut self,
+        stamp_s: f64,
+        width: u32,
+        height: u32,
+        pixels: Vec<u8>,
+    ) -> Option<Vec<u8>> {
         let (Some((image, info)), Some(info_msg)) = (&self.image, &mut self.info_msg) else {
-            return;
+            return Some(pixels);
         };
+        let pixels = Lent::new(pixels);
         let stamp = Time::from_secs(stamp_s);
         info_msg.header.stamp = stamp;
         let msg = msgs::Image {
@@ -269,21 +265,23 @@ impl Topics {
             encoding: "rgb8".to_owned(),
             is_bigendian: 0,
             step: width * 3,
-            data: pixels,
+            data: pixels.clone(),
         };
         let _ = image.write(msg, None);
         let _ = info.write(info_msg.clone(), None);
+        pixels.take_back()
     }
 
-    /// A laser scan.
-    pub(super) fn scan(&mut self, scan: &LaserScan) {
+    /// A laser scan; its ranges' buffer back, for the next scan.
+    pub(super) fn scan(&mut self, scan: LaserScan) -> Option<Vec<f32>> {
         let Some(writer) = &self.scan else {
-            return;
+            return Some(scan.ranges_m);
         };
+        let ranges = Lent::new(scan.ranges_m);
         let msg = msgs::LaserScan {
             header: Header {
                 stamp: Time::from_secs(scan.stamp_s),
-                frame_id: scan.frame_id.clone(),
+                frame_id: scan.frame_id,
             },
             angle_min: scan.angle_min_rad,
             angle_max: scan.angle_max_rad,
@@ -292,9 +290,10 @@ impl Topics {
             scan_time: scan.scan_time_s,
             range_min: scan.range_min_m,
             range_max: scan.range_max_m,
-            ranges: scan.ranges_m.clone(),
+            ranges: ranges.clone(),
             intensities: Vec::new(),
         };
         let _ = writer.write(msg, None);
+        ranges.take_back()
     }
 }
