@@ -61,12 +61,12 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # --- Python tools for the tests: onnxruntime, numpy, scikit-image, PyYAML (the reference xacro),
-# pycocotools (the reference COCO metrics), the Rerun viewer -----------------------------------
+# pycocotools (the reference COCO metrics), rosbags (reads ROS 2 MCAP files), the Rerun viewer -----------------------------------
 # The system python3 when it already has them, else a virtual environment in rover's cache
 # (no sudo, nothing installed into the system's Python). Its bin/ goes first on PATH.
 if [ "$purpose" = test ]; then
   rerun_ok() { "$1" --version 2>/dev/null | grep -q " 0\.36\.3"; }
-  if python3 -c "import onnxruntime, numpy, skimage, yaml, pycocotools" 2>/dev/null && rerun_ok rerun; then
+  if python3 -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags" 2>/dev/null && rerun_ok rerun; then
     :
   else
     venv="$cache/venv"
@@ -74,10 +74,10 @@ if [ "$purpose" = test ]; then
       say "creating a Python environment for the test references in $venv"
       python3 -m venv "$venv"
     fi
-    if ! "$venv/bin/python3" -c "import onnxruntime, numpy, skimage, yaml, pycocotools" 2>/dev/null || ! rerun_ok "$venv/bin/rerun"; then
-      say "installing onnxruntime, numpy, scikit-image, pyyaml, pycocotools, rerun-sdk==0.36.3 from PyPI into $venv"
+    if ! "$venv/bin/python3" -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags" 2>/dev/null || ! rerun_ok "$venv/bin/rerun"; then
+      say "installing onnxruntime, numpy, scikit-image, pyyaml, pycocotools, rosbags, rerun-sdk==0.36.3 from PyPI into $venv"
       "$venv/bin/python3" -m pip install --quiet --disable-pip-version-check \
-        onnxruntime numpy scikit-image pyyaml pycocotools rerun-sdk==0.36.3
+        onnxruntime numpy scikit-image pyyaml pycocotools rosbags==0.11.9 rerun-sdk==0.36.3
     fi
     export PATH="$venv/bin:$PATH"
   fi

@@ -192,10 +192,19 @@ pub(crate) struct RosArgs {
 
     /// Join ROS 2 over DDS (RTPS, as rmw_cyclonedds and rmw_fastrtps speak it; ROS_DOMAIN_ID
     /// is honoured; no ROS install needed): rt/cmd_vel drives the car, and rover publishes
-    /// /clock, /odom and /tf with ROS 2's types. Can run beside --ros. Headless runs then
-    /// default to --rtf 1. See docs/ROS2.md
+    /// what the ROS 1 bridge does with ROS 2's types (/clock, /odom, /tf, /tf_static,
+    /// /joint_states, the camera's image and camera_info, /darknet_ros/bounding_boxes and
+    /// found_object, the laser's scan). Can run beside --ros. Headless runs then default to
+    /// --rtf 1. See docs/ROS2.md
     #[arg(long)]
     pub(crate) ros2: bool,
+
+    /// Record the ROS 2 topics (those --ros2 publishes, with or without --ros2) into an MCAP
+    /// file: CDR messages and their ROS 2 definitions, as `ros2 bag record -s mcap` writes
+    /// them, for `ros2 bag play FILE`, Foxglove, rosbags or Rerun. Stamps are sim time;
+    /// nothing is dropped (the run waits for the disk if it must). Does not change the pace
+    #[arg(long, value_name = "FILE.mcap")]
+    pub(crate) record_mcap: Option<PathBuf>,
 
     /// With --ros: the node name
     #[arg(long, value_name = "NAME", default_value = "rover", requires = "ros")]
@@ -207,9 +216,20 @@ pub(crate) struct RosArgs {
 }
 
 impl RosArgs {
-    /// Whether a ROS bridge (1 or 2) runs.
+    /// Whether a ROS peer may be listening (--ros or --ros2): headless runs then keep real
+    /// time.
     pub(crate) fn any(&self) -> bool {
         self.ros || self.ros2
+    }
+
+    /// Whether a bridge runs: a ROS peer, or the MCAP recording.
+    pub(crate) fn bridges(&self) -> bool {
+        self.any() || self.record_mcap.is_some()
+    }
+
+    /// The ROS 2 bridge's settings (--ros2 and/or --record-mcap), `None` when it is off.
+    pub(crate) fn ros2_options(&self) -> anyhow::Result<Option<crate::ros2::Ros2Options>> {
+        crate::ros2::Ros2Options::new(self.ros2, self.record_mcap.as_deref())
     }
 
     /// The bridge's settings, when --ros is on; `ground_truth`: the run measures it

@@ -12,7 +12,7 @@ use rover_core::{
 
 use super::args::RunArgs;
 use crate::ros::{RosBridge, RosInput};
-use crate::ros2::{Ros2Bridge, Ros2Input, Ros2Options};
+use crate::ros2::{Ros2Bridge, Ros2Input};
 use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
@@ -59,7 +59,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
         println!("Rerun web viewer: {url}");
     }
-    let summary = if args.ros.any() {
+    let summary = if args.ros.bridges() {
         run_with_ros(&config, &args.ros, recorder.as_mut())
     } else {
         match recorder.as_mut() {
@@ -130,12 +130,7 @@ fn run_with_ros(
         }
         None => (None, None),
     };
-    let (mut ros2, mut ros2_input) = if ros.ros2 {
-        let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
-        (Some(bridge), Some(input))
-    } else {
-        (None, None)
-    };
+    let (mut ros2, mut ros2_input) = start_ros2(ros, &robot)?;
     let result = {
         let mut fan = Fanout::default();
         fan.push_some(ros1.as_mut());
@@ -153,16 +148,12 @@ fn run_with_ros(
             );
         }
     }
-    if let Some(bridge) = ros2.as_mut() {
-        bridge.finish();
-        if bridge.dropped() > 0 {
-            tracing::info!(
-                "ROS 2 bridge: {} events dropped while it was behind",
-                bridge.dropped()
-            );
-        }
-    }
-    Ok(result?)
+    let recorded = ros2
+        .as_mut()
+        .map(|bridge| finish_ros2(bridge, ros.record_mcap.as_deref()));
+    let summary = result?;
+    recorded.transpose()?;
+    Ok(summary)
 }
 
 /// Sim seconds from which a recording with a footer gets the memory hint.
@@ -251,12 +242,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         }
         None => (None, None),
     };
-    let (mut ros2, mut ros2_input) = if args.ros.ros2 {
-        let (bridge, input) = Ros2Bridge::start(&Ros2Options::from_env()?, &robot)?;
-        (Some(bridge), Some(input))
-    } else {
-        (None, None)
-    };
+    let (mut ros2, mut ros2_input) = start_ros2(&args.ros, &robot)?;
     let summary = {
         let mut fan = Fanout::default();
         fan.push(&mut files);
@@ -286,9 +272,10 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     if let Some(bridge) = ros.as_mut() {
         bridge.finish();
     }
-    if let Some(bridge) = ros2.as_mut() {
-        bridge.finish();
-    }
+    let recorded = ros2
+        .as_mut()
+        .map(|bridge| finish_ros2(bridge, args.ros.record_mcap.as_deref()));
+    recorded.transpose()?;
     println!(
         "rover: {:.1} s sim time in {:.1} s wall; mode {}",
         summary.sim_time_s,
@@ -308,6 +295,42 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         summary.interrupted,
         summary.sim_time_s,
     )
+}
+
+/// The ROS 2 bridge (--ros2 and/or --record-mcap) and its input (with --ros2), when asked for.
+fn start_ros2(
+    ros: &super::args::RosArgs,
+    robot: &rover_sim::RobotModel,
+) -> Result<(Option<Ros2Bridge>, Option<Ros2Input>)> {
+    Ok(match ros.ros2_options()? {
+        Some(options) => {
+            let (bridge, input) = Ros2Bridge::start(&options, robot)?;
+            (Some(bridge), input)
+        }
+        None => (None, None),
+    })
+}
+
+/// Stops the ROS 2 bridge and says what it did: events dropped while behind, what the MCAP
+/// file holds (an error when it could not be written in full).
+fn finish_ros2(bridge: &mut Ros2Bridge, mcap: Option<&std::path::Path>) -> Result<()> {
+    let recorded = bridge.finish();
+    if bridge.dropped() > 0 {
+        tracing::info!(
+            "ROS 2 bridge: {} events dropped while it was behind",
+            bridge.dropped()
+        );
+    }
+    if let (Some(recorded), Some(path)) = (recorded, mcap) {
+        let summary = recorded?;
+        println!(
+            "MCAP: {} ({} messages on {} topics)",
+            path.display(),
+            summary.messages,
+            summary.channels
+        );
+    }
+    Ok(())
 }
 
 /// The ROS 1 and ROS 2 bridges' inputs, polled in turn (either may be off).

@@ -13,9 +13,9 @@ use super::events::{Detections, ImageFrame, Start, TopicFamily};
 use super::plan::RosPlan;
 
 /// darknet_ros's boxes.
-const BOUNDING_BOXES_TOPIC: &str = "/darknet_ros/bounding_boxes";
+pub(crate) const BOUNDING_BOXES_TOPIC: &str = "/darknet_ros/bounding_boxes";
 /// darknet_ros's per-image object count.
-const FOUND_OBJECT_TOPIC: &str = "/darknet_ros/found_object";
+pub(crate) const FOUND_OBJECT_TOPIC: &str = "/darknet_ros/found_object";
 /// darknet_ros's image with boxes drawn (latched).
 const DETECTION_IMAGE_TOPIC: &str = "/darknet_ros/detection_image";
 
@@ -154,7 +154,7 @@ pub(super) fn fill(out: &mut msgs::BoundingBoxes, seq: u32, boxes: &Detections) 
 
 /// The detections to hand over (on the loop thread), published at `now_s` (never before their
 /// image): `boxes` copied into the recycled `out`, whose class strings keep their capacity.
-pub(super) fn capture(boxes: &BoundingBoxes, now_s: f64, mut out: Vec<BoundingBox>) -> Detections {
+pub(crate) fn capture(boxes: &BoundingBoxes, now_s: f64, mut out: Vec<BoundingBox>) -> Detections {
     out.clone_from(&boxes.bounding_boxes);
     Detections {
         stamp_s: now_s.max(boxes.image_stamp.sim_time_s),

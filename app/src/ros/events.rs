@@ -77,7 +77,7 @@ pub(super) struct ImageFrame {
 }
 
 /// The detector's boxes for one image.
-pub(super) struct Detections {
+pub(crate) struct Detections {
     /// When they are published (sim s; never before their image).
     pub stamp_s: f64,
     /// Their image's stamp (sim s).
@@ -213,6 +213,11 @@ impl BufferReturn {
     /// A ranges buffer back.
     pub fn ranges(&self, buffer: Vec<f32>) {
         send(&self.ranges, buffer);
+    }
+
+    /// A boxes buffer back.
+    pub fn boxes(&self, buffer: Vec<BoundingBox>) {
+        send(&self.boxes, buffer);
     }
 
     /// A joints buffer back.

@@ -49,7 +49,12 @@ pub use cmd_vel::RosCmdVel;
 /// What the ROS 2 bridge shares with this one: the static transforms, the moving joints'
 /// sampling, and their types.
 pub(crate) mod shared {
-    pub(crate) use super::events::{BufferPool, BufferReturn, JointSample, buffer_pool};
+    pub(crate) use super::detections::{
+        BOUNDING_BOXES_TOPIC, FOUND_OBJECT_TOPIC, capture as capture_detections,
+    };
+    pub(crate) use super::events::{
+        BufferPool, BufferReturn, Detections, JointSample, buffer_pool,
+    };
     pub(crate) use super::joint_states::sample as sample_joints;
     pub(crate) use super::laser::capture as capture_scan;
     pub(crate) use super::tf::{joints_on_tf, static_transforms};

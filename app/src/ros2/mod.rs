@@ -25,39 +25,60 @@
 //! less to build (RustDDS's cold build: 2 min on 2 cores).
 
 mod dds;
+mod definitions;
+mod mcap;
 mod msgs;
 mod topics;
 
+use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, LoopStats, Observer};
+use rover_perception::BoundingBoxes;
 use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation, Twist};
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
 
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    BufferPool, BufferReturn, JointSample, buffer_pool, capture_scan, sample_joints,
-    static_transforms,
+    BufferPool, BufferReturn, Detections, JointSample, buffer_pool, capture_detections,
+    capture_scan, sample_joints, static_transforms,
 };
 use msgs::RosMessage;
-use topics::Topics;
+use topics::{Sinks, Topics};
 
 pub use dds::dds_topic;
 use dds::default_qos;
+pub use mcap::McapSummary;
 
-/// `--ros2` settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// `--ros2` and `--record-mcap` settings.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Ros2Options {
-    /// The DDS domain (`ROS_DOMAIN_ID`, 0 by default).
-    pub domain_id: u16,
+    /// Join this DDS domain (`--ros2`; `ROS_DOMAIN_ID`, 0 by default).
+    pub domain_id: Option<u16>,
+    /// Record the topics into this MCAP file (`--record-mcap`).
+    pub mcap: Option<PathBuf>,
 }
 
 impl Ros2Options {
-    /// From the environment: `ROS_DOMAIN_ID` (0..=232, as ROS 2 allows; 0 when unset).
-    pub fn from_env() -> Result<Self> {
+    /// `--ros2` (`dds`: its domain from the environment) and/or `--record-mcap`; `None` when
+    /// neither is asked for.
+    pub fn new(dds: bool, mcap: Option<&Path>) -> Result<Option<Self>> {
+        if !dds && mcap.is_none() {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            domain_id: if dds { Some(domain_from_env()?) } else { None },
+            mcap: mcap.map(Path::to_owned),
+        }))
+    }
+}
+
+/// The DDS domain from `ROS_DOMAIN_ID` (0..=232, as ROS 2 allows; 0 when unset).
+fn domain_from_env() -> Result<u16> {
+    {
         let domain_id = match std::env::var("ROS_DOMAIN_ID") {
             Ok(text) if !text.trim().is_empty() => {
                 let id: u16 = text.trim().parse().with_context(|| {
@@ -68,7 +89,7 @@ impl Ros2Options {
             }
             _ => 0,
         };
-        Ok(Self { domain_id })
+        Ok(domain_id)
     }
 }
 
@@ -90,13 +111,22 @@ enum Event {
     },
     /// A laser scan.
     Scan(LaserScan),
+    /// A detector result.
+    Detections(Detections),
 }
 
 /// The observer half of the bridge.
 pub struct Ros2Bridge {
     tx: Option<SyncSender<Event>>,
-    thread: Option<JoinHandle<()>>,
+    thread: Option<JoinHandle<Option<Result<McapSummary>>>>,
     dropped: u64,
+    /// Recording: every event is sent, waiting for the thread when it is behind (nothing
+    /// lost); DDS alone drops what the thread cannot keep up with.
+    lossless: bool,
+    /// The MCAP file's summary, once finished.
+    recorded: Option<Result<McapSummary>>,
+    /// The newest control update's sim time: detector results are published then.
+    now_s: f64,
     /// Recycled buffers for the events (joints, pixels, ranges).
     buffers: BufferPool,
     plan: RosPlan,
@@ -146,55 +176,72 @@ impl InputSource for Ros2Input {
 }
 
 impl Ros2Bridge {
-    /// Joins DDS domain `options.domain_id`, creates the robot's topics and starts the
-    /// publishing thread.
-    pub fn start(options: &Ros2Options, robot: &RobotModel) -> Result<(Self, Ros2Input)> {
+    /// Joins DDS domain `options.domain_id` (when set) and creates the robot's topics there,
+    /// opens the MCAP file (when set), and starts the publishing thread. The input half
+    /// (`rt/cmd_vel`) comes with DDS.
+    pub fn start(options: &Ros2Options, robot: &RobotModel) -> Result<(Self, Option<Ros2Input>)> {
         let plan = RosPlan::for_robot(robot);
-        let participant = DomainParticipant::new(options.domain_id)
-            .with_context(|| format!("joining DDS domain {}", options.domain_id))?;
-        let qos = default_qos();
-        let subscriber = participant
-            .create_subscriber(&qos)
-            .context("creating the DDS subscriber")?;
-        let cmd_topic = participant
-            .create_topic(
-                dds_topic(&plan.cmd_topic),
-                msgs::Twist::DDS_TYPE.to_owned(),
-                &qos,
-                TopicKind::NoKey,
-            )
-            .context("creating the cmd_vel topic")?;
-        let cmd_vel = subscriber
-            .create_datareader_no_key::<msgs::Twist, CDRDeserializerAdapter<msgs::Twist>>(
-                &cmd_topic, None,
-            )
-            .context("creating the cmd_vel reader")?;
-        let topics = Topics::create(&participant, &plan)?;
+        let participant = match options.domain_id {
+            Some(domain) => Some(
+                DomainParticipant::new(domain)
+                    .with_context(|| format!("joining DDS domain {domain}"))?,
+            ),
+            None => None,
+        };
+        let input = match &participant {
+            Some(p) => Some(cmd_vel_input(p, &plan)?),
+            None => None,
+        };
+        let publisher = match &participant {
+            Some(p) => Some(
+                p.create_publisher(&default_qos())
+                    .context("creating the DDS publisher")?,
+            ),
+            None => None,
+        };
+        let mcap = match &options.mcap {
+            Some(path) => Some(mcap::McapRecorder::create(path)?),
+            None => None,
+        };
+        let sinks = Sinks {
+            dds: participant.as_ref().zip(publisher.as_ref()),
+            mcap,
+        };
+        let topics = Topics::create(sinks, &plan)?;
         let (tx, rx) = sync_channel::<Event>(64);
         let (buffers, returns) = buffer_pool();
         let thread = std::thread::Builder::new()
             .name("ros2-bridge".into())
-            .spawn(move || run(participant, topics, &rx, &returns))
+            .spawn(move || {
+                let recorded = run(topics, &rx, &returns);
+                drop(publisher);
+                drop(participant);
+                recorded
+            })
             .context("starting the ROS 2 bridge thread")?;
-        tracing::info!(
-            "ROS 2: DDS domain {}; cmd_vel on {}, odometry on {}",
-            options.domain_id,
-            dds_topic(&plan.cmd_topic),
-            dds_topic(&plan.odom_topic)
-        );
+        if let Some(domain) = options.domain_id {
+            tracing::info!(
+                "ROS 2: DDS domain {domain}; cmd_vel on {}, odometry on {}",
+                dds_topic(&plan.cmd_topic),
+                dds_topic(&plan.odom_topic)
+            );
+        }
+        if let Some(path) = &options.mcap {
+            tracing::info!("recording the ROS 2 topics to {}", path.display());
+        }
         Ok((
             Self {
                 tx: Some(tx),
                 thread: Some(thread),
                 dropped: 0,
+                lossless: options.mcap.is_some(),
+                recorded: None,
+                now_s: 0.0,
                 buffers,
                 plan,
                 camera_link: robot.cameras.first().map(|c| c.link.clone()),
             },
-            Ros2Input {
-                cmd_vel,
-                warned: false,
-            },
+            input,
         ))
     }
 
@@ -203,21 +250,35 @@ impl Ros2Bridge {
         self.dropped
     }
 
-    /// Sends what is queued and stops the thread.
-    pub fn finish(&mut self) {
+    /// Sends what is queued, stops the thread and closes the MCAP file: what it holds, when
+    /// one is recorded (an error when it could not be written in full).
+    pub fn finish(&mut self) -> Option<Result<McapSummary>> {
         self.tx = None;
         if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+            self.recorded = match thread.join() {
+                Ok(recorded) => recorded,
+                Err(_) => Some(Err(anyhow::anyhow!("the ROS 2 bridge thread panicked"))),
+            };
         }
+        self.recorded.take()
     }
 
     fn send(&mut self, event: Event) {
-        if let Some(tx) = &self.tx {
+        let Some(tx) = &self.tx else { return };
+        let sent = if self.lossless {
+            tx.send(event).map_err(|_| ())
+        } else {
             match tx.try_send(event) {
-                Ok(()) => {}
-                Err(TrySendError::Full(_)) => self.dropped += 1,
-                Err(TrySendError::Disconnected(_)) => self.tx = None,
+                Ok(()) => Ok(()),
+                Err(TrySendError::Full(_)) => {
+                    self.dropped += 1;
+                    Ok(())
+                }
+                Err(TrySendError::Disconnected(_)) => Err(()),
             }
+        };
+        if sent.is_err() {
+            self.tx = None;
         }
     }
 }
@@ -238,6 +299,7 @@ impl Observer for Ros2Bridge {
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
+        self.now_s = sample.sim_time_s;
         let mut joints = self.buffers.take_joints();
         sample_joints(sim, sample, &self.plan.joints, &mut joints);
         self.send(Event::Control(*sample, joints));
@@ -259,16 +321,45 @@ impl Observer for Ros2Bridge {
         let scan = capture_scan(scan, self.buffers.take_ranges());
         self.send(Event::Scan(scan));
     }
+
+    fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
+        let detections = capture_detections(boxes, self.now_s, self.buffers.take_boxes());
+        self.send(Event::Detections(detections));
+    }
 }
 
-/// The publishing thread: every event to the topics, until the bridge hangs up.
-/// The buffers events carry go back to the loop thread once published.
+/// `rt/cmd_vel`'s reader.
+fn cmd_vel_input(participant: &DomainParticipant, plan: &RosPlan) -> Result<Ros2Input> {
+    let qos = default_qos();
+    let subscriber = participant
+        .create_subscriber(&qos)
+        .context("creating the DDS subscriber")?;
+    let cmd_topic = participant
+        .create_topic(
+            dds_topic(&plan.cmd_topic),
+            msgs::Twist::DDS_TYPE.to_owned(),
+            &qos,
+            TopicKind::NoKey,
+        )
+        .context("creating the cmd_vel topic")?;
+    let cmd_vel = subscriber
+        .create_datareader_no_key::<msgs::Twist, CDRDeserializerAdapter<msgs::Twist>>(
+            &cmd_topic, None,
+        )
+        .context("creating the cmd_vel reader")?;
+    Ok(Ros2Input {
+        cmd_vel,
+        warned: false,
+    })
+}
+
+/// The publishing thread: every event to the topics, until the bridge hangs up; then the MCAP
+/// file is closed. The buffers events carry go back to the loop thread once published.
 fn run(
-    participant: DomainParticipant,
     mut topics: Topics,
     events: &Receiver<Event>,
     returns: &BufferReturn,
-) {
+) -> Option<Result<McapSummary>> {
     for event in events {
         match event {
             Event::Start { static_tf, camera } => topics.start(&static_tf, camera.as_ref()),
@@ -291,8 +382,11 @@ fn run(
                     returns.ranges(ranges);
                 }
             }
+            Event::Detections(d) => {
+                topics.detections(&d);
+                returns.boxes(d.boxes);
+            }
         }
     }
-    drop(topics);
-    drop(participant);
+    topics.finish()
 }

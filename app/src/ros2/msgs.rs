@@ -10,6 +10,8 @@ use serde::{Deserialize, Serialize};
 pub trait RosMessage: Serialize + Send + 'static {
     /// `pkg::msg::dds_::Type_`.
     const DDS_TYPE: &'static str;
+    /// The `.msg` definition with its dependencies, as MCAP's `ros2msg` schemas carry it.
+    const DEFINITION: &'static str;
 }
 
 /// `builtin_interfaces/msg/Time`.
@@ -106,6 +108,7 @@ pub struct Twist {
 
 impl RosMessage for Twist {
     const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Twist_";
+    const DEFINITION: &'static str = super::definitions::TWIST;
 }
 
 /// A 6x6 row-major covariance: `float64[36]`, written without a length as CDR fixed arrays are
@@ -197,6 +200,7 @@ pub struct Odometry {
 
 impl RosMessage for Odometry {
     const DDS_TYPE: &'static str = "nav_msgs::msg::dds_::Odometry_";
+    const DEFINITION: &'static str = super::definitions::ODOMETRY;
 }
 
 /// `rosgraph_msgs/msg/Clock`.
@@ -208,6 +212,7 @@ pub struct Clock {
 
 impl RosMessage for Clock {
     const DDS_TYPE: &'static str = "rosgraph_msgs::msg::dds_::Clock_";
+    const DEFINITION: &'static str = super::definitions::CLOCK;
 }
 
 /// `geometry_msgs/msg/Transform`.
@@ -239,6 +244,7 @@ pub struct TfMessage {
 
 impl RosMessage for TfMessage {
     const DDS_TYPE: &'static str = "tf2_msgs::msg::dds_::TFMessage_";
+    const DEFINITION: &'static str = super::definitions::TF_MESSAGE;
 }
 
 /// `sensor_msgs/msg/JointState`.
@@ -258,6 +264,7 @@ pub struct JointState {
 
 impl RosMessage for JointState {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::JointState_";
+    const DEFINITION: &'static str = super::definitions::JOINT_STATE;
 }
 
 /// A buffer lent to a message: the writer serializes the message and drops it, and the bridge
@@ -313,6 +320,7 @@ pub struct Image {
 
 impl RosMessage for Image {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Image_";
+    const DEFINITION: &'static str = super::definitions::IMAGE;
 }
 
 /// `sensor_msgs/msg/RegionOfInterest`.
@@ -359,6 +367,7 @@ pub struct CameraInfo {
 
 impl RosMessage for CameraInfo {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::CameraInfo_";
+    const DEFINITION: &'static str = super::definitions::CAMERA_INFO;
 }
 
 /// `sensor_msgs/msg/LaserScan`.
@@ -388,6 +397,57 @@ pub struct LaserScan {
 
 impl RosMessage for LaserScan {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::LaserScan_";
+    const DEFINITION: &'static str = super::definitions::LASER_SCAN;
+}
+
+/// `darknet_ros_msgs/msg/BoundingBox` as darknet_ros's ROS 2 branch (`foxy`) declares it: ROS 1's
+/// `Class` became `class_id` (ROS 2 field names are lower case) and moved last.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBox {
+    /// Confidence, 0..1.
+    pub probability: f64,
+    /// Left edge (px).
+    pub xmin: i64,
+    /// Top edge (px).
+    pub ymin: i64,
+    /// Right edge (px).
+    pub xmax: i64,
+    /// Bottom edge (px).
+    pub ymax: i64,
+    /// Class index.
+    pub id: i16,
+    /// Class name.
+    pub class_id: String,
+}
+
+/// `darknet_ros_msgs/msg/BoundingBoxes`: the boxes of one image.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBoxes {
+    /// When the boxes were published.
+    pub header: Header,
+    /// The detected image's header.
+    pub image_header: Header,
+    /// The boxes, highest probability first.
+    pub bounding_boxes: Vec<BoundingBox>,
+}
+
+impl RosMessage for BoundingBoxes {
+    const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::BoundingBoxes_";
+    const DEFINITION: &'static str = super::definitions::BOUNDING_BOXES;
+}
+
+/// `darknet_ros_msgs/msg/ObjectCount`: how many boxes one image gave.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ObjectCount {
+    /// Stamp.
+    pub header: Header,
+    /// Boxes.
+    pub count: i8,
+}
+
+impl RosMessage for ObjectCount {
+    const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::ObjectCount_";
+    const DEFINITION: &'static str = super::definitions::OBJECT_COUNT;
 }
 
 #[cfg(test)]

@@ -2,15 +2,18 @@
 //! thread. Names, frames and joints come from the ROS 1 bridge's plan ([`RosPlan`]); stamps
 //! are sim time.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use rover_sim::{ControlSample, LaserScan, ODOM_POSE_COVARIANCE_DIAGONAL, Pose};
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{DomainParticipant, QosPolicies, QosPolicyBuilder};
 
 use super::dds::{Writer, default_qos, writer};
-use super::msgs::{self, Covariance, Header, Lent, Time};
+use super::mcap::{McapRecorder, McapSummary};
+use super::msgs::{self, Covariance, Header, Lent, RosMessage, Time};
 use crate::ros::RosPlan;
-use crate::ros::shared::{JointSample, joints_on_tf};
+use crate::ros::shared::{
+    BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, JointSample, joints_on_tf,
+};
 
 /// `/tf_static`'s QoS: reliable, transient local, keep last 1 (tf2's static broadcaster): a
 /// late joiner gets it.
@@ -75,15 +78,62 @@ fn transform(parent: &str, child: &str, pose: Pose) -> msgs::TransformStamped {
     }
 }
 
-/// The writers and the messages they reuse.
+/// Where one topic's messages go: its DDS writer (`--ros2`) and its MCAP channel
+/// (`--record-mcap`), either or both.
+struct Out<M: RosMessage> {
+    dds: Option<Writer<M>>,
+    channel: Option<u16>,
+}
+
+/// What the topics are created on.
+pub(super) struct Sinks<'a> {
+    /// The DDS participant and its publisher, with `--ros2`.
+    pub dds: Option<(&'a DomainParticipant, &'a rustdds::Publisher)>,
+    /// The MCAP file, with `--record-mcap`.
+    pub mcap: Option<McapRecorder>,
+}
+
+impl Sinks<'_> {
+    /// The topic `ros_name` of messages `M` on every sink, with `qos` on DDS.
+    fn out<M: RosMessage>(&mut self, ros_name: &str, qos: &QosPolicies) -> Result<Out<M>> {
+        Ok(Out {
+            dds: match self.dds {
+                Some((participant, publisher)) => {
+                    Some(writer(participant, publisher, ros_name, qos)?)
+                }
+                None => None,
+            },
+            channel: match &mut self.mcap {
+                Some(mcap) => Some(mcap.channel::<M>(ros_name)?),
+                None => None,
+            },
+        })
+    }
+}
+
+/// Puts `msg`, stamped `stamp`, on `out`'s sinks: into the MCAP file, then to DDS (RustDDS
+/// takes what it writes, so DDS gets a copy).
+fn put<M: RosMessage + Clone>(out: &Out<M>, mcap: &mut Option<McapRecorder>, stamp: Time, msg: &M) {
+    if let (Some(file), Some(channel)) = (mcap.as_mut(), out.channel) {
+        file.write(channel, stamp, msg);
+    }
+    if let Some(w) = &out.dds {
+        let _ = w.write(msg.clone(), None);
+    }
+}
+
+/// The topics and the messages they reuse.
 pub(super) struct Topics {
-    clock: Writer<msgs::Clock>,
-    odom: Writer<msgs::Odometry>,
-    tf: Writer<msgs::TfMessage>,
-    tf_static: Writer<msgs::TfMessage>,
-    joint_states: Writer<msgs::JointState>,
-    image: Option<(Writer<msgs::Image>, Writer<msgs::CameraInfo>)>,
-    scan: Option<Writer<msgs::LaserScan>>,
+    mcap: Option<McapRecorder>,
+    clock: Out<msgs::Clock>,
+    odom: Out<msgs::Odometry>,
+    tf: Out<msgs::TfMessage>,
+    tf_static: Out<msgs::TfMessage>,
+    joint_states: Out<msgs::JointState>,
+    image: Option<(Out<msgs::Image>, Out<msgs::CameraInfo>)>,
+    scan: Option<Out<msgs::LaserScan>>,
+    boxes: Out<msgs::BoundingBoxes>,
+    found: Out<msgs::ObjectCount>,
     odom_msg: msgs::Odometry,
     /// odom -> base (with `publishOdomTF`), then the moving joints' links.
     tf_msg: msgs::TfMessage,
@@ -92,15 +142,14 @@ pub(super) struct Topics {
     joints_on_tf: Vec<usize>,
     joints_msg: msgs::JointState,
     info_msg: Option<msgs::CameraInfo>,
+    boxes_msg: msgs::BoundingBoxes,
+    found_msg: msgs::ObjectCount,
 }
 
 impl Topics {
-    /// The robot's topics on `participant`.
-    pub(super) fn create(participant: &DomainParticipant, plan: &RosPlan) -> Result<Self> {
+    /// The robot's topics on `sinks`.
+    pub(super) fn create(mut sinks: Sinks<'_>, plan: &RosPlan) -> Result<Self> {
         let qos = default_qos();
-        let publisher = participant
-            .create_publisher(&qos)
-            .context("creating the DDS publisher")?;
         let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
         let mut odom_msg = msgs::Odometry {
             header: header(&plan.odom_frame),
@@ -121,24 +170,26 @@ impl Topics {
         }));
         let sensor = sensor_qos();
         let image = match (&plan.image_topic, &plan.info_topic) {
-            (Some(image), Some(info)) => Some((
-                writer(participant, &publisher, image, &sensor)?,
-                writer(participant, &publisher, info, &sensor)?,
-            )),
+            (Some(image), Some(info)) => {
+                Some((sinks.out(image, &sensor)?, sinks.out(info, &sensor)?))
+            }
             _ => None,
         };
         let scan = match &plan.scan_topic {
-            Some(topic) => Some(writer(participant, &publisher, topic, &sensor)?),
+            Some(topic) => Some(sinks.out(topic, &sensor)?),
             None => None,
         };
         Ok(Self {
-            clock: writer(participant, &publisher, "/clock", &qos)?,
-            odom: writer(participant, &publisher, &plan.odom_topic, &qos)?,
-            tf: writer(participant, &publisher, "/tf", &qos)?,
-            tf_static: writer(participant, &publisher, "/tf_static", &latched_qos())?,
-            joint_states: writer(participant, &publisher, "/joint_states", &qos)?,
+            clock: sinks.out("/clock", &qos)?,
+            odom: sinks.out(&plan.odom_topic, &qos)?,
+            tf: sinks.out("/tf", &qos)?,
+            tf_static: sinks.out("/tf_static", &latched_qos())?,
+            joint_states: sinks.out("/joint_states", &qos)?,
             image,
             scan,
+            boxes: sinks.out(BOUNDING_BOXES_TOPIC, &qos)?,
+            found: sinks.out(FOUND_OBJECT_TOPIC, &qos)?,
+            mcap: sinks.mcap,
             odom_msg,
             tf_msg: msgs::TfMessage { transforms },
             odom_tf: plan.odom_tf,
@@ -149,7 +200,20 @@ impl Topics {
                 ..msgs::JointState::default()
             },
             info_msg: None,
+            boxes_msg: msgs::BoundingBoxes {
+                header: header("detection"),
+                ..msgs::BoundingBoxes::default()
+            },
+            found_msg: msgs::ObjectCount {
+                header: header("detection"),
+                count: 0,
+            },
         })
+    }
+
+    /// Closes the MCAP file, if one is written: what it holds.
+    pub(super) fn finish(self) -> Option<Result<McapSummary>> {
+        self.mcap.map(McapRecorder::finish)
     }
 
     /// The run starts: `/tf_static` once (kept for late joiners), the camera's calibration.
@@ -178,7 +242,11 @@ impl Topics {
                 },
             })
             .collect();
-        let _ = self.tf_static.write(msgs::TfMessage { transforms }, None);
+        let msg = msgs::TfMessage { transforms };
+        put(&self.tf_static, &mut self.mcap, Time::default(), &msg);
+        if let Some(c) = camera {
+            self.boxes_msg.image_header.frame_id.clone_from(&c.frame_id);
+        }
         self.info_msg = camera.map(|c| msgs::CameraInfo {
             header: header(&c.frame_id),
             height: c.height,
@@ -196,7 +264,12 @@ impl Topics {
     pub(super) fn control(&mut self, sample: &ControlSample, joints: &[JointSample]) {
         let stamp = Time::from_secs(sample.sim_time_s);
         let o = sample.odometry;
-        let _ = self.clock.write(msgs::Clock { clock: stamp }, None);
+        put(
+            &self.clock,
+            &mut self.mcap,
+            stamp,
+            &msgs::Clock { clock: stamp },
+        );
         let msg = &mut self.odom_msg;
         msg.header.stamp = stamp;
         msg.pose.pose.position = msgs::Vector3 {
@@ -207,7 +280,7 @@ impl Topics {
         msg.pose.pose.orientation = msgs::Quaternion::from_yaw(o.yaw_rad);
         msg.twist.twist.linear.x = o.linear_mps;
         msg.twist.twist.angular.z = o.angular_radps;
-        let _ = self.odom.write(msg.clone(), None);
+        put(&self.odom, &mut self.mcap, stamp, msg);
         let first_joint = usize::from(self.odom_tf);
         if let Some(t) = self.tf_msg.transforms.first_mut().filter(|_| self.odom_tf) {
             t.transform.translation = msg.pose.pose.position;
@@ -225,7 +298,7 @@ impl Topics {
             t.header.stamp = stamp;
         }
         if !self.tf_msg.transforms.is_empty() {
-            let _ = self.tf.write(self.tf_msg.clone(), None);
+            put(&self.tf, &mut self.mcap, stamp, &self.tf_msg);
         }
         let js = &mut self.joints_msg;
         js.header.stamp = stamp;
@@ -236,7 +309,7 @@ impl Topics {
         js.effort.clear();
         js.effort.extend(joints.iter().map(|j| j.effort));
         if !js.name.is_empty() {
-            let _ = self.joint_states.write(js.clone(), None);
+            put(&self.joint_states, &mut self.mcap, stamp, js);
         }
     }
 
@@ -267,8 +340,9 @@ impl Topics {
             step: width * 3,
             data: pixels.clone(),
         };
-        let _ = image.write(msg, None);
-        let _ = info.write(info_msg.clone(), None);
+        put(image, &mut self.mcap, stamp, &msg);
+        put(info, &mut self.mcap, stamp, info_msg);
+        drop(msg);
         pixels.take_back()
     }
 
@@ -293,7 +367,35 @@ impl Topics {
             ranges: ranges.clone(),
             intensities: Vec::new(),
         };
-        let _ = writer.write(msg, None);
+        put(writer, &mut self.mcap, msg.header.stamp, &msg);
+        drop(msg);
         ranges.take_back()
+    }
+
+    /// darknet_ros's topics for one detector result: `found_object` always, `bounding_boxes`
+    /// when there are boxes (as darknet_ros does). Class strings keep their capacity.
+    pub(super) fn detections(&mut self, d: &Detections) {
+        let stamp = Time::from_secs(d.stamp_s);
+        self.found_msg.header.stamp = stamp;
+        self.found_msg.count = i8::try_from(d.boxes.len()).unwrap_or(i8::MAX);
+        put(&self.found, &mut self.mcap, stamp, &self.found_msg);
+        if d.boxes.is_empty() {
+            return;
+        }
+        let out = &mut self.boxes_msg;
+        out.header.stamp = stamp;
+        out.image_header.stamp = Time::from_secs(d.image_stamp_s);
+        out.bounding_boxes
+            .resize_with(d.boxes.len(), msgs::BoundingBox::default);
+        for (m, b) in out.bounding_boxes.iter_mut().zip(&d.boxes) {
+            m.probability = b.probability;
+            m.xmin = b.xmin;
+            m.ymin = b.ymin;
+            m.xmax = b.xmax;
+            m.ymax = b.ymax;
+            m.id = b.id;
+            m.class_id.clone_from(&b.class);
+        }
+        put(&self.boxes, &mut self.mcap, stamp, out);
     }
 }

@@ -1,0 +1,218 @@
+//! The message definitions an MCAP file carries with each schema (`ros2msg`): the type's own
+//! fields, then every type it uses under a line of 80 `=` and `MSG: pkg/Type` (the layout of
+//! MCAP's `ros2msg` encoding), so `ros2 bag play`, Foxglove, rosbags and Rerun decode the file
+//! without the packages installed. Written from the ROS 2 Humble/Jazzy definitions (comments left out);
+//! app/tests/mcap.rs checks every field against rosbags' Humble types.
+
+/// A dependency block: the separator line, its `MSG:` line, its fields.
+macro_rules! block {
+    ($name:literal, $fields:expr) => {
+        concat!(
+            "================================================================================\nMSG: ",
+            $name,
+            "\n",
+            $fields
+        )
+    };
+}
+
+macro_rules! time {
+    () => {
+        block!("builtin_interfaces/Time", "int32 sec\nuint32 nanosec\n")
+    };
+}
+
+macro_rules! header {
+    () => {
+        concat!(
+            block!(
+                "std_msgs/Header",
+                "builtin_interfaces/Time stamp\nstring frame_id\n"
+            ),
+            time!()
+        )
+    };
+}
+
+macro_rules! vector3 {
+    () => {
+        block!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n")
+    };
+}
+
+macro_rules! point {
+    () => {
+        block!("geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n")
+    };
+}
+
+macro_rules! quaternion {
+    () => {
+        block!(
+            "geometry_msgs/Quaternion",
+            "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n"
+        )
+    };
+}
+
+macro_rules! twist_fields {
+    () => {
+        "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular\n"
+    };
+}
+
+macro_rules! transform_stamped {
+    () => {
+        concat!(
+            block!(
+                "geometry_msgs/TransformStamped",
+                "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n"
+            ),
+            header!(),
+            block!(
+                "geometry_msgs/Transform",
+                "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n"
+            ),
+            vector3!(),
+            quaternion!()
+        )
+    };
+}
+
+/// `geometry_msgs/msg/Twist`.
+pub const TWIST: &str = concat!(twist_fields!(), vector3!());
+
+/// `nav_msgs/msg/Odometry`.
+pub const ODOMETRY: &str = concat!(
+    "std_msgs/Header header\nstring child_frame_id\n",
+    "geometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist\n",
+    header!(),
+    block!(
+        "geometry_msgs/PoseWithCovariance",
+        "geometry_msgs/Pose pose\nfloat64[36] covariance\n"
+    ),
+    block!(
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n"
+    ),
+    point!(),
+    quaternion!(),
+    block!(
+        "geometry_msgs/TwistWithCovariance",
+        "geometry_msgs/Twist twist\nfloat64[36] covariance\n"
+    ),
+    block!("geometry_msgs/Twist", twist_fields!()),
+    vector3!()
+);
+
+/// `rosgraph_msgs/msg/Clock`.
+pub const CLOCK: &str = concat!("builtin_interfaces/Time clock\n", time!());
+
+/// `tf2_msgs/msg/TFMessage`.
+pub const TF_MESSAGE: &str = concat!(
+    "geometry_msgs/TransformStamped[] transforms\n",
+    transform_stamped!()
+);
+
+/// `sensor_msgs/msg/JointState`.
+pub const JOINT_STATE: &str = concat!(
+    "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n",
+    header!()
+);
+
+/// `sensor_msgs/msg/Image`.
+pub const IMAGE: &str = concat!(
+    "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\n",
+    "uint32 step\nuint8[] data\n",
+    header!()
+);
+
+/// `sensor_msgs/msg/CameraInfo`.
+pub const CAMERA_INFO: &str = concat!(
+    "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n",
+    "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\nuint32 binning_y\n",
+    "sensor_msgs/RegionOfInterest roi\n",
+    header!(),
+    block!(
+        "sensor_msgs/RegionOfInterest",
+        "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n"
+    )
+);
+
+/// `sensor_msgs/msg/LaserScan`.
+pub const LASER_SCAN: &str = concat!(
+    "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n",
+    "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n",
+    "float32[] ranges\nfloat32[] intensities\n",
+    header!()
+);
+
+/// `darknet_ros_msgs/msg/BoundingBoxes` (darknet_ros's ROS 2 branch).
+pub const BOUNDING_BOXES: &str = concat!(
+    "std_msgs/Header header\nstd_msgs/Header image_header\n",
+    "darknet_ros_msgs/BoundingBox[] bounding_boxes\n",
+    header!(),
+    block!(
+        "darknet_ros_msgs/BoundingBox",
+        "float64 probability\nint64 xmin\nint64 ymin\nint64 xmax\nint64 ymax\nint16 id\nstring class_id\n"
+    )
+);
+
+/// `darknet_ros_msgs/msg/ObjectCount`.
+pub const OBJECT_COUNT: &str = concat!("std_msgs/Header header\nint8 count\n", header!());
+
+/// `pkg::msg::dds_::Type_` as `pkg/msg/Type`, the name ROS 2 tools give a type.
+pub fn ros_type_name(dds_type: &str) -> String {
+    dds_type
+        .trim_end_matches('_')
+        .replace("::dds_::", "::")
+        .replace("::", "/")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dds_type_names_become_ros_type_names() {
+        assert_eq!(
+            ros_type_name("geometry_msgs::msg::dds_::Twist_"),
+            "geometry_msgs/msg/Twist"
+        );
+        assert_eq!(
+            ros_type_name("tf2_msgs::msg::dds_::TFMessage_"),
+            "tf2_msgs/msg/TFMessage"
+        );
+    }
+
+    /// Every type a definition names is defined once in it.
+    #[test]
+    fn every_used_type_is_defined_once() {
+        for def in [
+            TWIST,
+            ODOMETRY,
+            CLOCK,
+            TF_MESSAGE,
+            JOINT_STATE,
+            IMAGE,
+            CAMERA_INFO,
+            LASER_SCAN,
+            BOUNDING_BOXES,
+            OBJECT_COUNT,
+        ] {
+            let defined: Vec<&str> = def
+                .lines()
+                .filter_map(|l| l.strip_prefix("MSG: "))
+                .collect();
+            for used in def.lines().filter_map(|l| l.split_whitespace().next()) {
+                let Some((pkg, name)) = used.trim_end_matches("[]").split_once('/') else {
+                    continue;
+                };
+                let name = name.split('[').next().unwrap_or(name);
+                let full = format!("{pkg}/{name}");
+                let count = defined.iter().filter(|d| **d == full).count();
+                assert_eq!(count, 1, "{full} defined {count} times in\n{def}");
+            }
+        }
+    }
+}

@@ -1,0 +1,338 @@
+//! `--record-mcap`: the ROS 2 topics in an MCAP file, read back by a third-party reader —
+//! `rosbags` (pure Python ROS 2 bag/MCAP reading, Humble's message types) and Rerun's own MCAP
+//! importer. Skipped, with the reason, where rosbags is not installed (scripts/setup.sh puts it
+//! in the tests' Python environment).
+
+use std::path::Path;
+use std::process::Command;
+
+use anyhow::{Context, Result, ensure};
+use rover_core::parse_trace;
+
+/// Reads `run.mcap` with rosbags and prints, per line:
+/// - `topic NAME TYPE COUNT` for every channel, with the messages it holds;
+/// - `deffield TYPE` for a type whose definition in the file differs from Humble's;
+/// - `image K EQUAL` for the K-th image against frames/frame_K.png;
+/// - `odom SEC NSEC X Y YAW` for every odometry message;
+/// - `box CLASS XMIN YMIN XMAX YMAX W H` for every darknet box.
+const READER: &str = r#"
+import math, sys
+from collections import Counter
+from pathlib import Path
+import numpy as np
+from skimage.io import imread
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore, get_types_from_msg
+
+humble = get_typestore(Stores.ROS2_HUMBLE)
+ours = get_typestore(Stores.EMPTY)
+counts = Counter()
+with Reader(Path(sys.argv[1])) as reader:
+    for c in reader.connections:
+        print('topic', c.topic, c.msgtype, c.msgcount)
+        types = get_types_from_msg(c.msgdef.data, c.msgtype)
+        ours.register(types)
+        for name, (_, fields) in types.items():
+            if name in humble.fielddefs and repr(humble.fielddefs[name][1]) != repr(fields):
+                print('deffield', name)
+    info = None
+    for c, t, raw in reader.messages():
+        counts[c.topic] += 1
+        store = humble if c.msgtype in humble.fielddefs else ours
+        m = store.deserialize_cdr(raw, c.msgtype)
+        if c.topic == '/camera/camera_info':
+            info = m
+        elif c.msgtype == 'sensor_msgs/msg/Image':
+            k = counts[c.topic] - 1
+            image = m.data.reshape(m.height, m.width, 3)
+            frame = imread(Path(sys.argv[2]) / ('frame_%06d.png' % k))[:, :, :3]
+            print('image', k, int(np.array_equal(image, frame)), m.encoding, m.header.frame_id)
+        elif c.msgtype == 'nav_msgs/msg/Odometry':
+            p = m.pose.pose
+            yaw = 2 * math.atan2(p.orientation.z, p.orientation.w)
+            print('odom %d %d %.9f %.9f %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec,
+                                                 p.position.x, p.position.y, yaw))
+            assert t == m.header.stamp.sec * 10**9 + m.header.stamp.nanosec
+        elif c.msgtype == 'darknet_ros_msgs/msg/BoundingBoxes':
+            for b in m.bounding_boxes:
+                print('box', b.class_id.replace(' ', '_'), b.xmin, b.ymin, b.xmax, b.ymax,
+                      info.width, info.height)
+    for topic, n in counts.items():
+        print('read', topic, n)
+"#;
+
+fn rosbags_available() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import rosbags.rosbag2, skimage.io, numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        eprintln!(
+            "SKIP: python3 cannot import rosbags, scikit-image and numpy (scripts/setup.sh installs them)"
+        );
+    }
+    ok
+}
+
+/// rover headless in the playground, driving a curve, recording to `dir/run.mcap`: its stdout.
+fn record(dir: &Path, name: &str) -> Result<String> {
+    let script = dir.join("drive.toml");
+    std::fs::write(
+        &script,
+        "steps = [ { at = 0.0, cmd_vel = [0.4, 0.3] }, { at = 3.0, cmd_vel = [0.0, 0.0] } ]\n",
+    )?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(["--headless", "--duration", "4", "--script"])
+        .arg(&script)
+        .arg("--trace")
+        .arg(dir.join(format!("{name}.csv")))
+        .arg("--save-frames")
+        .arg(dir.join(format!("{name}_frames")))
+        .arg("--record-mcap")
+        .arg(dir.join(format!("{name}.mcap")))
+        .output()
+        .context("starting rover")?;
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    ensure!(
+        out.status.success(),
+        "rover failed: {stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Ok(stdout)
+}
+
+/// rosbags reads rover's MCAP: every topic with its ROS 2 type and as many messages as rover
+/// says it wrote; every type's definition in the file equal to Humble's; every image equal to
+/// the PNG rover saved of the same frame; odometry equal to the trace at the same stamps
+/// (log time = header stamp); darknet boxes with `person` inside the image. Two runs of the
+/// same script write byte-identical data sections.
+#[test]
+fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
+    if !rosbags_available() {
+        return Ok(());
+    }
+    let dir = tempfile::tempdir()?;
+    let stdout = record(dir.path(), "run")?;
+    let said = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("MCAP: "))
+        .with_context(|| format!("rover did not say what it recorded:\n{stdout}"))?;
+    println!("rover: MCAP: {said}");
+    let reader = dir.path().join("read.py");
+    std::fs::write(&reader, READER)?;
+    let out = Command::new("python3")
+        .arg(&reader)
+        .arg(dir.path().join("run.mcap"))
+        .arg(dir.path().join("run_frames"))
+        .output()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    ensure!(
+        out.status.success(),
+        "the rosbags reader failed:\n{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<Vec<&str>> = text.lines().map(|l| l.split(' ').collect()).collect();
+    let field = |tag: &'static str| lines.iter().filter(move |l| l[0] == tag);
+
+    // Topics, types and counts.
+    let topics: Vec<(&str, &str, usize)> = field("topic")
+        .map(|l| Ok((l[1], l[2], l[3].parse()?)))
+        .collect::<Result<_>>()?;
+    for (topic, msgtype, _) in &topics {
+        println!("{topic} {msgtype}");
+    }
+    let expected = [
+        ("/clock", "rosgraph_msgs/msg/Clock"),
+        ("/odom", "nav_msgs/msg/Odometry"),
+        ("/tf", "tf2_msgs/msg/TFMessage"),
+        ("/tf_static", "tf2_msgs/msg/TFMessage"),
+        ("/joint_states", "sensor_msgs/msg/JointState"),
+        ("/camera/image_raw", "sensor_msgs/msg/Image"),
+        ("/camera/camera_info", "sensor_msgs/msg/CameraInfo"),
+        ("/scan", "sensor_msgs/msg/LaserScan"),
+        (
+            "/darknet_ros/bounding_boxes",
+            "darknet_ros_msgs/msg/BoundingBoxes",
+        ),
+        (
+            "/darknet_ros/found_object",
+            "darknet_ros_msgs/msg/ObjectCount",
+        ),
+    ];
+    for (topic, msgtype) in expected {
+        ensure!(
+            topics.iter().any(|t| t.0 == topic && t.1 == msgtype),
+            "no {topic} of {msgtype} in {topics:?}"
+        );
+    }
+    let total: usize = topics.iter().map(|t| t.2).sum();
+    ensure!(
+        said.contains(&format!("({total} messages on {} topics)", topics.len())),
+        "rover said \"{said}\"; rosbags counts {total} on {}",
+        topics.len()
+    );
+    for (topic, _, count) in &topics {
+        let read = field("read")
+            .find(|l| l[1] == *topic)
+            .map_or(Ok(0), |l| l[2].parse::<usize>())?;
+        ensure!(read == *count, "{topic}: {read} read, {count} indexed");
+    }
+    let differing: Vec<&str> = field("deffield").map(|l| l[1]).collect();
+    ensure!(
+        differing.is_empty(),
+        "definitions unlike Humble's: {differing:?}"
+    );
+
+    // Images: every one equal to the frame rover rendered.
+    let frames = std::fs::read_dir(dir.path().join("run_frames"))?.count();
+    let images: Vec<&Vec<&str>> = field("image").collect();
+    ensure!(
+        images.len() == frames && frames >= 100,
+        "{} images in the MCAP, {frames} frames saved",
+        images.len()
+    );
+    let unequal = images.iter().filter(|l| l[2] != "1").count();
+    ensure!(unequal == 0, "{unequal} images differ from their frames");
+    ensure!(
+        images
+            .iter()
+            .all(|l| l[3] == "rgb8" && l[4] == "camera_link_optical"),
+        "{:?}",
+        images[0]
+    );
+
+    // Odometry: every message equal to the trace at its stamp; one per control update.
+    let rows = parse_trace(&std::fs::read_to_string(dir.path().join("run.csv"))?)?;
+    let odom: Vec<&Vec<&str>> = field("odom").collect();
+    ensure!(odom.len() >= 390, "{} odometry messages", odom.len());
+    let mut compared = 0;
+    for f in &odom {
+        let stamp_s = f[1].parse::<f64>()? + f[2].parse::<f64>()? * 1e-9;
+        let Some(row) = rows.iter().find(|r| (r.sim_time_s - stamp_s).abs() < 5e-5) else {
+            continue;
+        };
+        let (x, y, yaw): (f64, f64, f64) = (f[3].parse()?, f[4].parse()?, f[5].parse()?);
+        ensure!(
+            (x - row.odom_x_m).abs() <= 1e-6
+                && (y - row.odom_y_m).abs() <= 1e-6
+                && rover_sim::wrap_angle(yaw - row.odom_yaw_rad).abs() <= 1e-6,
+            "at {stamp_s} s: odom ({x}, {y}, {yaw}) vs trace ({}, {}, {})",
+            row.odom_x_m,
+            row.odom_y_m,
+            row.odom_yaw_rad
+        );
+        compared += 1;
+    }
+    let last = rows.last().context("an empty trace")?;
+    println!(
+        "{} images equal to their frames; {compared} of {} odometry messages equal to the trace; the car drove to ({:.2}, {:.2})",
+        images.len(),
+        odom.len(),
+        last.odom_x_m,
+        last.odom_y_m
+    );
+    ensure!(
+        compared == rows.len().min(odom.len()) && last.odom_x_m > 0.5,
+        "{compared} of {} compared ({} trace rows)",
+        odom.len(),
+        rows.len()
+    );
+
+    // The detector's boxes.
+    let boxes: Vec<&Vec<&str>> = field("box").collect();
+    let people = boxes.iter().filter(|b| b[1] == "person").count();
+    println!("{} boxes, {people} of them person", boxes.len());
+    ensure!(people > 0, "no person box: {boxes:?}");
+    for b in &boxes {
+        let v: Vec<i64> = b[2..].iter().map(|s| s.parse()).collect::<Result<_, _>>()?;
+        ensure!(
+            0 <= v[0] && v[0] < v[2] && v[2] <= v[4] && 0 <= v[1] && v[1] < v[3] && v[3] <= v[5],
+            "a box out of the image: {b:?}"
+        );
+    }
+
+    // The same run again: the same messages, byte for byte.
+    record(dir.path(), "again")?;
+    let first = std::fs::read(dir.path().join("run.mcap"))?;
+    let second = std::fs::read(dir.path().join("again.mcap"))?;
+    let same = data_section(&first)? == data_section(&second)?;
+    println!(
+        "{} bytes; a second run: data section identical {same}",
+        first.len()
+    );
+    ensure!(
+        same && first.len() == second.len(),
+        "two runs wrote different messages"
+    );
+    Ok(())
+}
+
+/// An MCAP file's data section (header, schemas, channels, chunks; everything before the
+/// summary), from the footer's `summary_start`. The summary after it lists channels and
+/// schemas in the order of the mcap crate's hash maps, which differs between processes.
+fn data_section(file: &[u8]) -> Result<&[u8]> {
+    // Footer record: opcode 1 + length 8 + summary_start 8 + summary_offset_start 8 + crc 4,
+    // then the 8-byte magic.
+    let footer = file.len().checked_sub(8 + 29).context("not an MCAP file")?;
+    ensure!(file[footer] == 0x02, "no MCAP footer record");
+    let start: [u8; 8] = file[footer + 9..footer + 17].try_into()?;
+    let start = usize::try_from(u64::from_le_bytes(start))?;
+    ensure!(
+        start > 0 && start <= footer,
+        "summary_start {start} out of the file"
+    );
+    Ok(&file[..start])
+}
+
+/// Rerun opens rover's MCAP with its own importer (`rerun mcap convert`): every channel's
+/// schema resolves (no "cannot be reflected"), the images become Image, camera_info a
+/// Pinhole, /tf Transform3D. Skipped without the `rerun` CLI of rover's Rerun version.
+#[test]
+fn rerun_imports_the_recording() -> Result<()> {
+    let rerun_ok = Command::new("rerun")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains(" 0.36.3"));
+    if !rerun_ok {
+        eprintln!("SKIP: no `rerun` 0.36.3 CLI on PATH (scripts/setup.sh installs rerun-sdk)");
+        return Ok(());
+    }
+    let dir = tempfile::tempdir()?;
+    record(dir.path(), "run")?;
+    let rrd = dir.path().join("run.rrd");
+    let out = Command::new("rerun")
+        .args(["mcap", "convert"])
+        .arg(dir.path().join("run.mcap"))
+        .arg("-o")
+        .arg(&rrd)
+        .output()?;
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
+    ensure!(out.status.success(), "rerun mcap convert failed:\n{log}");
+    ensure!(
+        !log.contains("ERROR") && !log.contains("cannot be reflected"),
+        "rerun could not decode every channel:\n{log}"
+    );
+    let printed = Command::new("rerun")
+        .args(["rrd", "print"])
+        .arg(&rrd)
+        .output()?;
+    let text = String::from_utf8_lossy(&printed.stdout);
+    for (entity, component) in [
+        ("/camera/image_raw", "Image:buffer"),
+        ("/camera/camera_info", "Pinhole:"),
+        ("/tf", "Transform3D:"),
+        ("/odom", "nav_msgs.msg.Odometry:message"),
+        (
+            "/darknet_ros/bounding_boxes",
+            "darknet_ros_msgs.msg.BoundingBoxes:message",
+        ),
+    ] {
+        ensure!(
+            text.lines()
+                .any(|l| l.contains(&format!("- {entity} -")) && l.contains(component)),
+            "no {component} on {entity} in the converted recording"
+        );
+    }
+    println!("rerun imported every channel of the MCAP");
+    Ok(())
+}
