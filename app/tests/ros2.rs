@@ -3,7 +3,7 @@
 //! under their DDS type names as rmw does. Skipped, with the reason, where the wheel cannot be
 //! had. Each test runs in its own DDS domain, so tests and other peers do not meet.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -119,6 +119,12 @@ impl Graph {
     fn python(&self, name: &str, script: &str, timeout: Duration) -> Result<String> {
         let path = self.dir.path().join(name);
         std::fs::write(&path, format!("{MESSAGES}\n{script}"))?;
+        self.python_file(name, &path, timeout)
+    }
+
+    /// Runs the Python file `path` with cyclonedds importable, stopping it after `timeout`;
+    /// its output (logged as `name`).
+    fn python_file(&self, name: &str, path: &Path, timeout: Duration) -> Result<String> {
         // Output into a file: a pipe would fill up and stall the peer.
         let log_path = self.dir.path().join(format!("{name}.log"));
         let log = std::fs::File::create(&log_path)?;
@@ -294,8 +300,24 @@ for m in got:
     Ok(())
 }
 
-/// tf2's and sensor_msgs' messages for the peer.
+/// tf2's, sensor_msgs' and darknet_ros's (ROS 2 branch) messages for the peer.
 const MORE_MESSAGES: &str = r#"
+@dataclass
+class BoundingBox(IdlStruct, typename="darknet_ros_msgs::msg::dds_::BoundingBox_"):
+    probability: types.float64
+    xmin: types.int64
+    ymin: types.int64
+    xmax: types.int64
+    ymax: types.int64
+    id: types.int16
+    class_id: str
+
+@dataclass
+class BoundingBoxes(IdlStruct, typename="darknet_ros_msgs::msg::dds_::BoundingBoxes_"):
+    header: Header
+    image_header: Header
+    bounding_boxes: types.sequence[BoundingBox]
+
 @dataclass
 class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
     translation: Vector3
@@ -357,13 +379,21 @@ latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durabilit
 static = DataReader(dp, Topic(dp, 'rt/tf_static', TFMessage), qos=latched)
 images = DataReader(dp, Topic(dp, 'rt/camera/image_raw', Image), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(100)))
 joints = DataReader(dp, Topic(dp, 'rt/joint_states', JointState), qos=Qos(Policy.History.KeepLast(1000)))
-got_static, got_images, got_joints = [], [], []
+boxes = DataReader(dp, Topic(dp, 'rt/darknet_ros/bounding_boxes', BoundingBoxes), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100)))
+got_static, got_images, got_joints, got_boxes = [], [], [], []
 start = time.time()
 while time.time() < start + 6:
     got_static += static.take(N=10)
     got_images += images.take(N=100)
     got_joints += joints.take(N=1000)
+    got_boxes += boxes.take(N=100)
     time.sleep(0.02)
+for m in got_boxes:
+    t = m.header.stamp.sec + m.header.stamp.nanosec * 1e-9
+    ti = m.image_header.stamp.sec + m.image_header.stamp.nanosec * 1e-9
+    for b in m.bounding_boxes:
+        print('box %s %.3f %d %d %d %d %d %s %.3f %.3f' % (b.class_id.replace(' ', '_'), b.probability,
+              b.xmin, b.ymin, b.xmax, b.ymax, b.id, m.image_header.frame_id, ti, t))
 wall = time.time() - start
 for m in got_static:
     print('static ' + ','.join(t.header.frame_id + '>' + t.child_frame_id for t in m.transforms))
@@ -427,6 +457,39 @@ if got_joints:
             .any(|l| l.starts_with("joints ") && l.contains("left_wheel_joint")),
         "{out}"
     );
+    // darknet_ros's boxes: the person, inside the 640x480 image, from an image no newer than
+    // the message.
+    let boxes: Vec<Vec<&str>> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("box "))
+        .map(|l| l.split(' ').collect())
+        .collect();
+    let people = boxes.iter().filter(|b| b[0] == "person").count();
+    println!("{} boxes, {people} of them person", boxes.len());
+    ensure!(people >= 5, "{out}");
+    for b in &boxes {
+        let p: f64 = b[1].parse()?;
+        let v: Vec<i64> = b[2..6]
+            .iter()
+            .map(|s| s.parse())
+            .collect::<Result<_, _>>()?;
+        let (image_s, sent_s): (f64, f64) = (b[8].parse()?, b[9].parse()?);
+        ensure!(
+            p > 0.0
+                && p <= 1.0
+                && 0 <= v[0]
+                && v[0] < v[2]
+                && v[2] <= 640
+                && 0 <= v[1]
+                && v[1] < v[3]
+                && v[3] <= 480,
+            "a box {b:?}"
+        );
+        ensure!(
+            b[7] == "camera_link_optical" && image_s <= sent_s,
+            "a box {b:?}"
+        );
+    }
     Ok(())
 }
 
@@ -477,5 +540,43 @@ print('done')
         "the car drove {driven} m after the garbage:\n{log}"
     );
     ensure!(warnings <= 1, "{warnings} warnings:\n{log}");
+    Ok(())
+}
+
+/// The tutorial's listener_yolo node ported to ROS 2's wire (examples/ros2/listener_yolo.py,
+/// Cyclone DDS) drives rover toward the person: it prints `person` from
+/// `rt/darknet_ros/bounding_boxes` and its 0.1 m/s on `rt/cmd_vel` moves the car >= 0.3 m.
+#[test]
+fn the_listener_yolo_port_drives_the_car_toward_the_person() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(4))?;
+    graph.spawn_rover(12.0, &[])?;
+    let listener = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/ros2/listener_yolo.py");
+    let said = graph.python_file("listener", &listener, Duration::from_secs(14))?;
+    graph.wait_rover(Duration::from_secs(60))?;
+    let rows = parse_trace(&std::fs::read_to_string(graph.trace_path())?)?;
+    let people = said.lines().filter(|l| l.trim() == "person").count();
+    let went = said.lines().filter(|l| l.trim() == "go on").count();
+    ensure!(people > 0 && went > 0, "the listener said:\n{said}");
+    ensure!(
+        rows.iter()
+            .any(|r| (r.cmd_linear_mps - 0.1).abs() < 1e-9 && r.cmd_angular_radps == 0.0),
+        "no 0.1 m/s command in the trace"
+    );
+    let at = |t: f64| {
+        rows.iter()
+            .find(|r| r.sim_time_s >= t)
+            .context("the trace ends early")
+    };
+    let moved_m = at(10.0)?.x_m - at(0.0)?.x_m;
+    println!(
+        "the listener saw `person` {people} times and said `go on` {went} times; the car moved {moved_m:.3} m in 10 s"
+    );
+    ensure!(
+        moved_m >= 0.3,
+        "the car moved {moved_m:.3} m (want >= 0.3 m)"
+    );
     Ok(())
 }
