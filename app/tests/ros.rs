@@ -115,8 +115,15 @@ impl RosGraph {
             .env("ROS_HOME", self.dir.path())
             .env("ROS_LOG_DIR", self.dir.path().join("log"))
             .env("PYTHONUNBUFFERED", "1")
+            // A DDS domain of the graph's own, for rover's --ros2 and its peers.
+            .env("ROS_DOMAIN_ID", self.dds_domain().to_string())
             .stdin(Stdio::null());
         c
+    }
+
+    /// The graph's DDS domain (ROS 2 allows 0..=232), from its master's port.
+    fn dds_domain(&self) -> u16 {
+        120 + self.port % 100
     }
 
     /// Starts a process whose output goes to `<dir>/<name>.log`.
@@ -967,5 +974,114 @@ fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Resul
         "goal ({x}, {y}, {z}) is not 10 cm short of the ball"
     );
     graph.wait_rover(Duration::from_secs(120))?;
+    Ok(())
+}
+
+/// `--ros` and `--ros2` in one run: a Cyclone DDS peer drives the car on `rt/cmd_vel` while a
+/// rospy node reads `/odom` through the ROS 1 master, and the DDS peer reads `rt/odom` too;
+/// both see the same odometry.
+#[test]
+fn the_ros1_and_ros2_bridges_run_at_once() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(cyclonedds) = rover_tests::pypi("cyclonedds", "11.0.1") else {
+        return skip("no cyclonedds wheel");
+    };
+    let mut graph = RosGraph::start()?;
+    let examples = repo().join("examples/ros2");
+    let python_path = std::env::join_paths([&cyclonedds, &examples])?;
+    graph.spawn_rover(12.0, &["--ros2", "--no-detector"])?;
+    let ros2_peer = graph.dir.path().join("ros2_peer.py");
+    std::fs::write(
+        &ros2_peer,
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+from rover_msgs import Odometry, Twist, Vector3
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
+cmd = DataWriter(dp, Topic(dp, 'rt/cmd_vel', Twist), qos=qos)
+odom = DataReader(dp, Topic(dp, 'rt/odom', Odometry), qos=qos)
+got = []
+end = time.time() + 8
+while time.time() < end:
+    cmd.write(Twist(linear=Vector3(0.3, 0.0, 0.0), angular=Vector3(0.0, 0.0, 0.0)))
+    got += odom.take(N=1000)
+    time.sleep(0.1)
+for m in got:
+    print('o %d %d %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec, m.pose.pose.position.x))
+"#,
+    )?;
+    let mut peer = graph.command("python3");
+    peer.arg(&ros2_peer).env("PYTHONPATH", &python_path);
+    graph.spawn("ros2_peer", peer)?;
+    let ros1 = graph.run_python(
+        "ros1_odom.py",
+        r#"
+import rospy
+from nav_msgs.msg import Odometry
+got = []
+rospy.init_node('odom_reader')
+rospy.Subscriber('/odom', Odometry, lambda m: got.append(m))
+rospy.sleep(6.0)
+for m in got:
+    print('o %d %d %.9f' % (m.header.stamp.secs, m.header.stamp.nsecs, m.pose.pose.position.x))
+"#,
+        Duration::from_secs(30),
+    )?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let ros2 = graph.log("ros2_peer");
+    let parse = |text: &str| -> Vec<(i64, i64, f64)> {
+        text.lines()
+            .filter_map(|l| l.strip_prefix("o "))
+            .filter_map(|l| {
+                let f: Vec<&str> = l.split(' ').collect();
+                Some((
+                    f.first()?.parse().ok()?,
+                    f.get(1)?.parse().ok()?,
+                    f.get(2)?.parse().ok()?,
+                ))
+            })
+            .collect()
+    };
+    let (from_ros1, from_ros2) = (parse(&ros1), parse(&ros2));
+    let common: Vec<_> = from_ros1
+        .iter()
+        .filter_map(|a| {
+            from_ros2
+                .iter()
+                .find(|b| (b.0, b.1) == (a.0, a.1))
+                .map(|b| (a, b))
+        })
+        .collect();
+    let driven_m = rows.last().context("an empty trace")?.x_m;
+    println!(
+        "ROS 1 /odom: {} messages, ROS 2 rt/odom: {}; {} stamps in common; the ROS 2 peer drove the car {driven_m:.2} m",
+        from_ros1.len(),
+        from_ros2.len(),
+        common.len()
+    );
+    ensure!(
+        from_ros1.len() >= 100 && from_ros2.len() >= 100,
+        "rospy:\n{ros1}\nCyclone:\n{ros2}"
+    );
+    ensure!(driven_m >= 0.3, "the car drove {driven_m} m");
+    ensure!(common.len() >= 100, "{} common stamps", common.len());
+    ensure!(
+        common.iter().all(|(a, b)| (a.2 - b.2).abs() < 1e-9),
+        "ROS 1 and ROS 2 odometry differ"
+    );
+    ensure!(
+        from_ros1.iter().any(|a| a.2 > 0.3),
+        "rospy never saw the car move"
+    );
     Ok(())
 }
