@@ -580,3 +580,166 @@ fn the_listener_yolo_port_drives_the_car_toward_the_person() -> Result<()> {
     );
     Ok(())
 }
+
+/// ros2_control's and rover's own messages for the controller test.
+const CONTROL_MESSAGES: &str = r#"
+@dataclass
+class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+
+@dataclass
+class MultiArrayDimension(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayDimension_"):
+    label: str
+    size: types.uint32
+    stride: types.uint32
+
+@dataclass
+class MultiArrayLayout(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayLayout_"):
+    dim: types.sequence[MultiArrayDimension]
+    data_offset: types.uint32
+
+@dataclass
+class Float64MultiArray(IdlStruct, typename="std_msgs::msg::dds_::Float64MultiArray_"):
+    layout: MultiArrayLayout
+    data: types.sequence[types.float64]
+
+@dataclass
+class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+@dataclass
+class JointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectoryPoint_"):
+    positions: types.sequence[types.float64]
+    velocities: types.sequence[types.float64]
+    accelerations: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+    time_from_start: Duration
+
+@dataclass
+class JointTrajectory(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectory_"):
+    header: Header
+    joint_names: types.sequence[str]
+    points: types.sequence[JointTrajectoryPoint]
+"#;
+
+/// TIAGo (example-robot-data 6.0.0) with its controllers over ROS 2, as ros2_control names
+/// the topics: a late Cyclone peer gets `/robot_description` (transient local, the URDF);
+/// a Float64MultiArray on `/torso_controller/commands` moves the torso to 0.2 m; a two-point
+/// JointTrajectory on `/arm_controller/joint_trajectory` is followed to its goal within the
+/// controller's tolerances; `look` on `/rover/arm/task` comes back on `/rover/arm/state`.
+#[test]
+fn a_cyclone_peer_drives_tiagos_controllers_and_arm_task() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
+    };
+    let controllers =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/controllers/tiago_no_hand.yaml");
+    let mut graph = Graph::new(cyclonedds, domain(5))?;
+    let (urdf, controllers) = (urdf.to_string_lossy(), controllers.to_string_lossy());
+    graph.spawn_rover(
+        16.0,
+        &[
+            "--robot",
+            urdf.as_ref(),
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+            "--controllers",
+            controllers.as_ref(),
+            "--ee-link",
+            "arm_tool_link",
+            "--arm-base",
+            "torso_lift_link",
+        ],
+    )?;
+    std::thread::sleep(Duration::from_secs(2));
+    let script = format!(
+        "{CONTROL_MESSAGES}\n{}",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(10))
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+description = DataReader(dp, Topic(dp, 'rt/robot_description', String_), qos=latched)
+state = DataReader(dp, Topic(dp, 'rt/rover/arm/state', String_), qos=latched)
+torso = DataWriter(dp, Topic(dp, 'rt/torso_controller/commands', Float64MultiArray), qos=reliable)
+arm = DataWriter(dp, Topic(dp, 'rt/arm_controller/joint_trajectory', JointTrajectory), qos=reliable)
+task = DataWriter(dp, Topic(dp, 'rt/rover/arm/task', String_), qos=reliable)
+urdf = None
+end = time.time() + 10
+while urdf is None and time.time() < end:
+    for m in description.take(N=1):
+        urdf = getattr(m, 'data', None)
+    time.sleep(0.05)
+print('description %d %s' % (len(urdf or ''), (urdf or '').find('<robot') >= 0))
+time.sleep(1.0)  # the writers have matched rover's readers
+torso.write(Float64MultiArray(layout=MultiArrayLayout(dim=[], data_offset=0), data=[0.2]))
+names = ['arm_%d_joint' % i for i in range(1, 8)]
+point = lambda q, t: JointTrajectoryPoint(positions=q, velocities=[], accelerations=[], effort=[], time_from_start=Duration(t, 0))
+arm.write(JointTrajectory(header=Header(stamp=Time(0, 0), frame_id=''), joint_names=names,
+          points=[point([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 2), point([0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0], 4)]))
+task.write(String_(data='look'))
+seen = []
+end = time.time() + 3
+while time.time() < end:
+    seen += [m.data for m in state.take(N=10) if hasattr(m, 'data')]
+    time.sleep(0.05)
+print('states ' + ','.join(s.replace(' ', '_') for s in seen))
+"#
+    );
+    let out = graph.python("control.py", &script, Duration::from_secs(30))?;
+    graph.wait_rover(Duration::from_secs(90))?;
+    println!("{out}");
+    let log = std::fs::read_to_string(graph.dir.path().join("rover.log"))?;
+    let description = out
+        .lines()
+        .find_map(|l| l.strip_prefix("description "))
+        .unwrap_or_default();
+    ensure!(
+        description.ends_with(" True") && !description.starts_with("0 "),
+        "no URDF on /robot_description: {out}"
+    );
+    ensure!(
+        out.lines()
+            .any(|l| l.starts_with("states ") && l.contains("look")),
+        "the arm's state never said look:\n{out}\nrover:\n{log}"
+    );
+    let trace = std::fs::read_to_string(graph.trace_path())?;
+    let rows = parse_trace(&trace)?;
+    let names = rover_core::trace_joints(&trace);
+    let last_q = |joint: &str| -> Result<Vec<f64>> {
+        let k = names
+            .iter()
+            .position(|n| n == joint)
+            .with_context(|| format!("no {joint} column"))?;
+        Ok(rows.iter().map(|r| r.joints[k].position).collect())
+    };
+    let torso = last_q("torso_lift_joint")?;
+    ensure!(
+        torso.iter().any(|q| (q - 0.2).abs() < 0.005),
+        "the torso never reached 0.2 m; rover:\n{log}"
+    );
+    ensure!(
+        log.contains("controller arm_controller: trajectory reached its goal")
+            && !log.contains("VIOLATED"),
+        "the trajectory was not followed within its tolerances; rover:\n{log}"
+    );
+    let goal = [0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0];
+    for (i, g) in goal.iter().enumerate() {
+        let joint = format!("arm_{}_joint", i + 1);
+        let q = last_q(&joint)?.last().copied().unwrap_or(f64::NAN);
+        ensure!((q - g).abs() < 0.02, "{joint} ended at {q:.4}, goal {g}");
+    }
+    println!("torso at 0.2 m, the arm at its trajectory's goal, state `look`");
+    Ok(())
+}

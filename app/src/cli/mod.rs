@@ -26,7 +26,7 @@ pub fn main() -> ExitCode {
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
                 tracing_subscriber::EnvFilter::new(
-                    "info,tract_onnx=error,tract_hir=error,tract_core=error",
+                    "info,tract_onnx=error,tract_hir=error,tract_core=error,rustdds=warn",
                 )
             }),
         )

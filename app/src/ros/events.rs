@@ -32,7 +32,7 @@ pub(super) struct ControlUpdate {
 
 /// The arm's task at a control update, its points in the robot's base frame.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct ArmSample {
+pub(crate) struct ArmSample {
     /// Which task runs.
     pub mode: rover_core::ArmMode,
     /// What reach is doing.

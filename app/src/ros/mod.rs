@@ -49,11 +49,12 @@ pub use cmd_vel::RosCmdVel;
 /// What the ROS 2 bridge shares with this one: the static transforms, the moving joints'
 /// sampling, and their types.
 pub(crate) mod shared {
+    pub(crate) use super::arm_sample;
     pub(crate) use super::detections::{
         BOUNDING_BOXES_TOPIC, FOUND_OBJECT_TOPIC, capture as capture_detections,
     };
     pub(crate) use super::events::{
-        BufferPool, BufferReturn, Detections, JointSample, buffer_pool,
+        ArmSample, BufferPool, BufferReturn, Detections, JointSample, buffer_pool,
     };
     pub(crate) use super::joint_states::sample as sample_joints;
     pub(crate) use super::laser::capture as capture_scan;
@@ -308,7 +309,7 @@ impl Observer for RosBridge {
 }
 
 /// The arm's status with its points moved from the world into the robot's base frame.
-fn arm_sample(sim: &Simulation, arm: &rover_core::ArmStatus) -> events::ArmSample {
+pub(crate) fn arm_sample(sim: &Simulation, arm: &rover_core::ArmStatus) -> events::ArmSample {
     let base_from_world = sim.world_from_base().inverse();
     let to_base = |p: Option<[f64; 3]>| {
         p.map(|[x, y, z]| {

@@ -37,12 +37,12 @@ pub struct RosPlan {
     /// every control update.
     pub joint_states_hz: Option<f64>,
     /// The controllers file's command topics.
-    pub(super) controllers: Vec<ControllerTopic>,
+    pub(crate) controllers: Vec<ControllerTopic>,
 }
 
 /// A controller's topics (`/<namespace>/<controller>/command`).
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct ControllerTopic {
+pub(crate) struct ControllerTopic {
     /// Controller name.
     pub name: String,
     /// Its `command` topic.

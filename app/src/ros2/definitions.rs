@@ -161,6 +161,40 @@ pub const BOUNDING_BOXES: &str = concat!(
 /// `darknet_ros_msgs/msg/ObjectCount`.
 pub const OBJECT_COUNT: &str = concat!("std_msgs/Header header\nint8 count\n", header!());
 
+/// `std_msgs/msg/String`.
+pub const STRING: &str = "string data\n";
+
+/// `geometry_msgs/msg/PointStamped`.
+pub const POINT_STAMPED: &str = concat!(
+    "std_msgs/Header header\ngeometry_msgs/Point point\n",
+    header!(),
+    point!()
+);
+
+/// `trajectory_msgs/msg/JointTrajectory`.
+pub const JOINT_TRAJECTORY: &str = concat!(
+    "std_msgs/Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint[] points\n",
+    header!(),
+    block!(
+        "trajectory_msgs/JointTrajectoryPoint",
+        "float64[] positions\nfloat64[] velocities\nfloat64[] accelerations\nfloat64[] effort\nbuiltin_interfaces/Duration time_from_start\n"
+    ),
+    block!("builtin_interfaces/Duration", "int32 sec\nuint32 nanosec\n")
+);
+
+/// `std_msgs/msg/Float64MultiArray`.
+pub const FLOAT64_MULTI_ARRAY: &str = concat!(
+    "std_msgs/MultiArrayLayout layout\nfloat64[] data\n",
+    block!(
+        "std_msgs/MultiArrayLayout",
+        "std_msgs/MultiArrayDimension[] dim\nuint32 data_offset\n"
+    ),
+    block!(
+        "std_msgs/MultiArrayDimension",
+        "string label\nuint32 size\nuint32 stride\n"
+    )
+);
+
 /// `pkg::msg::dds_::Type_` as `pkg/msg/Type`, the name ROS 2 tools give a type.
 pub fn ros_type_name(dds_type: &str) -> String {
     dds_type
@@ -199,6 +233,10 @@ mod tests {
             LASER_SCAN,
             BOUNDING_BOXES,
             OBJECT_COUNT,
+            STRING,
+            POINT_STAMPED,
+            JOINT_TRAJECTORY,
+            FLOAT64_MULTI_ARRAY,
         ] {
             let defined: Vec<&str> = def
                 .lines()

@@ -26,6 +26,7 @@
 
 mod dds;
 mod definitions;
+mod input;
 mod mcap;
 mod msgs;
 mod topics;
@@ -35,22 +36,21 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
-use rover_core::{Action, InputSource, LoopStats, Observer};
+use rover_core::{LoopStats, Observer};
 use rover_perception::BoundingBoxes;
-use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation, Twist};
-use rustdds::no_key::DataReader;
-use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
+use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation};
+use rustdds::DomainParticipant;
 
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    BufferPool, BufferReturn, Detections, JointSample, buffer_pool, capture_detections,
-    capture_scan, sample_joints, static_transforms,
+    ArmSample, BufferPool, BufferReturn, Detections, JointSample, arm_sample, buffer_pool,
+    capture_detections, capture_scan, sample_joints, static_transforms,
 };
-use msgs::RosMessage;
 use topics::{Sinks, Topics};
 
 pub use dds::dds_topic;
 use dds::default_qos;
+pub use input::Ros2Input;
 pub use mcap::McapSummary;
 
 /// `--ros2` and `--record-mcap` settings.
@@ -100,8 +100,8 @@ enum Event {
         static_tf: Vec<rover_ros1::msgs::TransformStamped>,
         camera: Option<rover_sim::CameraInfo>,
     },
-    /// A control update: its sample and the moving joints (the plan's order).
-    Control(ControlSample, Vec<JointSample>),
+    /// A control update: its sample, the moving joints (the plan's order), the arm's task.
+    Control(ControlSample, Vec<JointSample>, ArmSample),
     /// A camera image: stamp, size, RGB8 pixels.
     Image {
         stamp_s: f64,
@@ -141,40 +141,6 @@ impl std::fmt::Debug for Ros2Bridge {
     }
 }
 
-/// The input half: `rt/cmd_vel` (geometry_msgs/msg/Twist) as manual input.
-pub struct Ros2Input {
-    cmd_vel: DataReader<msgs::Twist, CDRDeserializerAdapter<msgs::Twist>>,
-    warned: bool,
-}
-
-impl std::fmt::Debug for Ros2Input {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Ros2Input").finish_non_exhaustive()
-    }
-}
-
-impl InputSource for Ros2Input {
-    fn poll(&mut self) -> Option<Action> {
-        let mut newest = None;
-        loop {
-            match self.cmd_vel.take_next_sample() {
-                Ok(Some(sample)) => {
-                    let t = sample.value();
-                    newest = Some(Action::CmdVel(Twist::new(t.linear.x, t.angular.z)));
-                }
-                Ok(None) => return newest,
-                Err(e) => {
-                    // A peer's garbage or a wrong type: said once, the run goes on.
-                    if !std::mem::replace(&mut self.warned, true) {
-                        tracing::warn!("ROS 2: a cmd_vel sample could not be read ({e}); ignored");
-                    }
-                    return newest;
-                }
-            }
-        }
-    }
-}
-
 impl Ros2Bridge {
     /// Joins DDS domain `options.domain_id` (when set) and creates the robot's topics there,
     /// opens the MCAP file (when set), and starts the publishing thread. The input half
@@ -189,7 +155,7 @@ impl Ros2Bridge {
             None => None,
         };
         let input = match &participant {
-            Some(p) => Some(cmd_vel_input(p, &plan)?),
+            Some(p) => Some(Ros2Input::subscribe(p, &plan)?),
             None => None,
         };
         let publisher = match &participant {
@@ -207,7 +173,7 @@ impl Ros2Bridge {
             dds: participant.as_ref().zip(publisher.as_ref()),
             mcap,
         };
-        let topics = Topics::create(sinks, &plan)?;
+        let topics = Topics::create(sinks, &plan, &robot.description)?;
         let (tx, rx) = sync_channel::<Event>(64);
         let (buffers, returns) = buffer_pool();
         let thread = std::thread::Builder::new()
@@ -298,11 +264,11 @@ impl Observer for Ros2Bridge {
         });
     }
 
-    fn control(&mut self, sim: &Simulation, sample: &ControlSample, _stats: &LoopStats) {
+    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
         self.now_s = sample.sim_time_s;
         let mut joints = self.buffers.take_joints();
         sample_joints(sim, sample, &self.plan.joints, &mut joints);
-        self.send(Event::Control(*sample, joints));
+        self.send(Event::Control(*sample, joints, arm_sample(sim, &stats.arm)));
     }
 
     fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {
@@ -328,31 +294,6 @@ impl Observer for Ros2Bridge {
     }
 }
 
-/// `rt/cmd_vel`'s reader.
-fn cmd_vel_input(participant: &DomainParticipant, plan: &RosPlan) -> Result<Ros2Input> {
-    let qos = default_qos();
-    let subscriber = participant
-        .create_subscriber(&qos)
-        .context("creating the DDS subscriber")?;
-    let cmd_topic = participant
-        .create_topic(
-            dds_topic(&plan.cmd_topic),
-            msgs::Twist::DDS_TYPE.to_owned(),
-            &qos,
-            TopicKind::NoKey,
-        )
-        .context("creating the cmd_vel topic")?;
-    let cmd_vel = subscriber
-        .create_datareader_no_key::<msgs::Twist, CDRDeserializerAdapter<msgs::Twist>>(
-            &cmd_topic, None,
-        )
-        .context("creating the cmd_vel reader")?;
-    Ok(Ros2Input {
-        cmd_vel,
-        warned: false,
-    })
-}
-
 /// The publishing thread: every event to the topics, until the bridge hangs up; then the MCAP
 /// file is closed. The buffers events carry go back to the loop thread once published.
 fn run(
@@ -363,8 +304,9 @@ fn run(
     for event in events {
         match event {
             Event::Start { static_tf, camera } => topics.start(&static_tf, camera.as_ref()),
-            Event::Control(sample, joints) => {
+            Event::Control(sample, joints, arm) => {
                 topics.control(&sample, &joints);
+                topics.arm(sample.sim_time_s, &arm);
                 returns.joints(joints);
             }
             Event::Image {

@@ -450,6 +450,108 @@ impl RosMessage for ObjectCount {
     const DEFINITION: &'static str = super::definitions::OBJECT_COUNT;
 }
 
+/// `std_msgs/msg/String`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Text {
+    /// The text.
+    pub data: String,
+}
+
+impl RosMessage for Text {
+    const DDS_TYPE: &'static str = "std_msgs::msg::dds_::String_";
+    const DEFINITION: &'static str = super::definitions::STRING;
+}
+
+/// `geometry_msgs/msg/PointStamped`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PointStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The point (m).
+    pub point: Vector3,
+}
+
+impl RosMessage for PointStamped {
+    const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::PointStamped_";
+    const DEFINITION: &'static str = super::definitions::POINT_STAMPED;
+}
+
+/// `builtin_interfaces/msg/Duration`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Duration {
+    /// Whole seconds.
+    pub sec: i32,
+    /// Nanoseconds, 0..1e9.
+    pub nanosec: u32,
+}
+
+/// `trajectory_msgs/msg/JointTrajectoryPoint`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointTrajectoryPoint {
+    /// Positions (rad or m).
+    pub positions: Vec<f64>,
+    /// Velocities; may be empty.
+    pub velocities: Vec<f64>,
+    /// Accelerations; may be empty.
+    pub accelerations: Vec<f64>,
+    /// Efforts; may be empty.
+    pub effort: Vec<f64>,
+    /// When the point is due after the trajectory's start.
+    pub time_from_start: Duration,
+}
+
+/// `trajectory_msgs/msg/JointTrajectory`: what ros2_control's joint_trajectory_controller
+/// takes on `~/joint_trajectory`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointTrajectory {
+    /// Stamp: when it starts (0: on arrival).
+    pub header: Header,
+    /// The joints each point lists.
+    pub joint_names: Vec<String>,
+    /// The points.
+    pub points: Vec<JointTrajectoryPoint>,
+}
+
+impl RosMessage for JointTrajectory {
+    const DDS_TYPE: &'static str = "trajectory_msgs::msg::dds_::JointTrajectory_";
+    const DEFINITION: &'static str = super::definitions::JOINT_TRAJECTORY;
+}
+
+/// `std_msgs/msg/MultiArrayDimension`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MultiArrayDimension {
+    /// Label.
+    pub label: String,
+    /// Size.
+    pub size: u32,
+    /// Stride.
+    pub stride: u32,
+}
+
+/// `std_msgs/msg/MultiArrayLayout`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MultiArrayLayout {
+    /// Dimensions.
+    pub dim: Vec<MultiArrayDimension>,
+    /// Offset of the first value.
+    pub data_offset: u32,
+}
+
+/// `std_msgs/msg/Float64MultiArray`: what ros2_control's forward command controllers take on
+/// `~/commands`, one value per joint.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Float64MultiArray {
+    /// Layout (ignored: the values are the controller's joints in order).
+    pub layout: MultiArrayLayout,
+    /// Values.
+    pub data: Vec<f64>,
+}
+
+impl RosMessage for Float64MultiArray {
+    const DDS_TYPE: &'static str = "std_msgs::msg::dds_::Float64MultiArray_";
+    const DEFINITION: &'static str = super::definitions::FLOAT64_MULTI_ARRAY;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

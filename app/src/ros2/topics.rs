@@ -12,8 +12,18 @@ use super::mcap::{McapRecorder, McapSummary};
 use super::msgs::{self, Covariance, Header, Lent, RosMessage, Time};
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, JointSample, joints_on_tf,
+    ArmSample, BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, JointSample, joints_on_tf,
 };
+use rover_core::{ArmMode, ReachState};
+
+/// Where robot_state_publisher keeps the URDF in ROS 2.
+const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";
+/// The arm's task and reach state (`off`, `look`, `reach <state>`), on every change.
+const ARM_STATE_TOPIC: &str = "/rover/arm/state";
+/// The object reach goes for, in the base frame.
+const ARM_OBJECT_TOPIC: &str = "/rover/arm/object";
+/// The pre-grasp point the tool is sent to, in the base frame.
+const ARM_GOAL_TOPIC: &str = "/rover/arm/goal";
 
 /// `/tf_static`'s QoS: reliable, transient local, keep last 1 (tf2's static broadcaster): a
 /// late joiner gets it.
@@ -125,6 +135,8 @@ fn put<M: RosMessage + Clone>(out: &Out<M>, mcap: &mut Option<McapRecorder>, sta
 /// The topics and the messages they reuse.
 pub(super) struct Topics {
     mcap: Option<McapRecorder>,
+    /// Kept for late joiners (transient local): written once, at creation.
+    _robot_description: Out<msgs::Text>,
     clock: Out<msgs::Clock>,
     odom: Out<msgs::Odometry>,
     tf: Out<msgs::TfMessage>,
@@ -134,6 +146,9 @@ pub(super) struct Topics {
     scan: Option<Out<msgs::LaserScan>>,
     boxes: Out<msgs::BoundingBoxes>,
     found: Out<msgs::ObjectCount>,
+    arm_state: Out<msgs::Text>,
+    arm_object: Out<msgs::PointStamped>,
+    arm_goal: Out<msgs::PointStamped>,
     odom_msg: msgs::Odometry,
     /// odom -> base (with `publishOdomTF`), then the moving joints' links.
     tf_msg: msgs::TfMessage,
@@ -144,12 +159,23 @@ pub(super) struct Topics {
     info_msg: Option<msgs::CameraInfo>,
     boxes_msg: msgs::BoundingBoxes,
     found_msg: msgs::ObjectCount,
+    arm_text: msgs::Text,
+    arm_point: msgs::PointStamped,
+    /// The arm's task and reach state last published.
+    arm_last: Option<(ArmMode, ReachState)>,
 }
 
 impl Topics {
-    /// The robot's topics on `sinks`.
-    pub(super) fn create(mut sinks: Sinks<'_>, plan: &RosPlan) -> Result<Self> {
+    /// The robot's topics on `sinks`; `/robot_description` (the URDF, transient local, as
+    /// robot_state_publisher keeps it) goes out at once.
+    pub(super) fn create(mut sinks: Sinks<'_>, plan: &RosPlan, description: &str) -> Result<Self> {
         let qos = default_qos();
+        let robot_description: Out<msgs::Text> =
+            sinks.out(ROBOT_DESCRIPTION_TOPIC, &latched_qos())?;
+        let msg = msgs::Text {
+            data: description.to_owned(),
+        };
+        put(&robot_description, &mut sinks.mcap, Time::default(), &msg);
         let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
         let mut odom_msg = msgs::Odometry {
             header: header(&plan.odom_frame),
@@ -189,6 +215,10 @@ impl Topics {
             scan,
             boxes: sinks.out(BOUNDING_BOXES_TOPIC, &qos)?,
             found: sinks.out(FOUND_OBJECT_TOPIC, &qos)?,
+            _robot_description: robot_description,
+            arm_state: sinks.out(ARM_STATE_TOPIC, &latched_qos())?,
+            arm_object: sinks.out(ARM_OBJECT_TOPIC, &qos)?,
+            arm_goal: sinks.out(ARM_GOAL_TOPIC, &qos)?,
             mcap: sinks.mcap,
             odom_msg,
             tf_msg: msgs::TfMessage { transforms },
@@ -208,6 +238,12 @@ impl Topics {
                 header: header("detection"),
                 count: 0,
             },
+            arm_text: msgs::Text::default(),
+            arm_point: msgs::PointStamped {
+                header: header(&plan.base_frame),
+                ..msgs::PointStamped::default()
+            },
+            arm_last: None,
         })
     }
 
@@ -397,5 +433,35 @@ impl Topics {
             m.class_id.clone_from(&b.class);
         }
         put(&self.boxes, &mut self.mcap, stamp, out);
+    }
+
+    /// The arm's topics at a control update: its state on every change; with reach on, the
+    /// object and goal points it has.
+    pub(super) fn arm(&mut self, sim_time_s: f64, arm: &ArmSample) {
+        let stamp = Time::from_secs(sim_time_s);
+        if self.arm_last != Some((arm.mode, arm.reach)) {
+            self.arm_last = Some((arm.mode, arm.reach));
+            let text = &mut self.arm_text.data;
+            text.clear();
+            text.push_str(arm.mode.as_str());
+            if arm.mode == ArmMode::Reach {
+                text.push(' ');
+                text.push_str(arm.reach.as_str());
+            }
+            put(&self.arm_state, &mut self.mcap, stamp, &self.arm_text);
+        }
+        if arm.mode != ArmMode::Reach {
+            return;
+        }
+        self.arm_point.header.stamp = stamp;
+        for (out, p) in [
+            (&self.arm_object, arm.object_base_m),
+            (&self.arm_goal, arm.goal_base_m),
+        ] {
+            if let Some([x, y, z]) = p {
+                self.arm_point.point = msgs::Vector3 { x, y, z };
+                put(out, &mut self.mcap, stamp, &self.arm_point);
+            }
+        }
     }
 }

@@ -1,0 +1,221 @@
+//! The bridge's input half: what ROS 2 peers send rover, as rover input — `rt/cmd_vel`
+//! (geometry_msgs/msg/Twist, like a key press), `rt/rover/arm/task` (std_msgs/msg/String:
+//! `off`, `look`, `reach`) and each controller's command topic as ros2_control names it:
+//! `/<controller>/joint_trajectory` (trajectory_msgs/msg/JointTrajectory) for a joint
+//! trajectory controller, `/<controller>/commands` (std_msgs/msg/Float64MultiArray, its joint's
+//! value) for a single-joint controller, as forward_command_controller takes it. A sample that
+//! does not decode (a peer's garbage, a wrong type) is one warning per topic; the run goes on.
+
+use anyhow::{Context, Result};
+use rover_core::{Action, ArmMode, InputSource, JointAction};
+use rover_sim::{JointTrajectory, TrajectoryPoint, Twist};
+use rustdds::no_key::DataReader;
+use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
+use serde::de::DeserializeOwned;
+
+use super::dds::{dds_topic, default_qos};
+use super::msgs::{self, RosMessage};
+use crate::ros::RosPlan;
+
+/// rover's arm task topic (as the ROS 1 bridge's).
+pub(super) const ARM_TASK_TOPIC: &str = "/rover/arm/task";
+
+/// A reader of `M` on one topic that warns once about samples it cannot read.
+struct Reader<M: RosMessage + DeserializeOwned> {
+    reader: DataReader<M, CDRDeserializerAdapter<M>>,
+    ros_name: String,
+    warned: bool,
+}
+
+impl<M: RosMessage + DeserializeOwned> Reader<M> {
+    fn new(
+        participant: &DomainParticipant,
+        subscriber: &rustdds::Subscriber,
+        ros_name: &str,
+    ) -> Result<Self> {
+        let topic = participant
+            .create_topic(
+                dds_topic(ros_name),
+                M::DDS_TYPE.to_owned(),
+                &default_qos(),
+                TopicKind::NoKey,
+            )
+            .with_context(|| format!("creating the DDS topic for {ros_name}"))?;
+        let reader = subscriber
+            .create_datareader_no_key::<M, CDRDeserializerAdapter<M>>(&topic, None)
+            .with_context(|| format!("creating the reader of {ros_name}"))?;
+        Ok(Self {
+            reader,
+            ros_name: ros_name.to_owned(),
+            warned: false,
+        })
+    }
+
+    /// The next sample, if one came.
+    fn next(&mut self) -> Option<M> {
+        match self.reader.take_next_sample() {
+            Ok(Some(sample)) => Some(sample.into_value()),
+            Ok(None) => None,
+            Err(e) => {
+                // A peer's garbage or a wrong type: said once, the run goes on.
+                if !std::mem::replace(&mut self.warned, true) {
+                    tracing::warn!(
+                        "ROS 2: a {} sample could not be read ({e}); ignored",
+                        self.ros_name
+                    );
+                }
+                None
+            }
+        }
+    }
+}
+
+/// A controller's command topic.
+enum Command {
+    /// A joint trajectory controller's `~/joint_trajectory`.
+    Trajectory(Reader<msgs::JointTrajectory>),
+    /// A single-joint controller's `~/commands`.
+    Value(Reader<msgs::Float64MultiArray>),
+}
+
+/// The input half of the bridge.
+pub struct Ros2Input {
+    cmd_vel: Reader<msgs::Twist>,
+    task: Reader<msgs::Text>,
+    /// Each controller's name and command topic.
+    controllers: Vec<(String, Command)>,
+    /// Where the next poll of the controllers starts, so that every topic gets its turn.
+    next: usize,
+    /// The participant, kept until the readers are gone (the bridge thread may stop first;
+    /// a reader outliving its participant cannot say goodbye to it).
+    _participant: DomainParticipant,
+}
+
+impl std::fmt::Debug for Ros2Input {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Ros2Input")
+            .field("controllers", &self.controllers.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// A controller's ROS 2 command topic from its ROS 1 one (`/<ns>/<name>/command`).
+fn ros2_command_topic(ros1_topic: &str, trajectory: bool) -> String {
+    let base = ros1_topic.strip_suffix("/command").unwrap_or(ros1_topic);
+    if trajectory {
+        format!("{base}/joint_trajectory")
+    } else {
+        format!("{base}/commands")
+    }
+}
+
+/// A trajectory message as the simulation takes it.
+fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
+    let secs = |sec: i32, nanosec: u32| f64::from(sec) + f64::from(nanosec) * 1e-9;
+    JointTrajectory {
+        start_s: secs(msg.header.stamp.sec, msg.header.stamp.nanosec),
+        joint_names: msg.joint_names,
+        points: msg
+            .points
+            .into_iter()
+            .map(|p| TrajectoryPoint {
+                positions: p.positions,
+                velocities: p.velocities,
+                accelerations: p.accelerations,
+                time_from_start_s: secs(p.time_from_start.sec, p.time_from_start.nanosec),
+            })
+            .collect(),
+    }
+}
+
+impl Ros2Input {
+    /// Subscribes to the robot's input topics.
+    pub(super) fn subscribe(participant: &DomainParticipant, plan: &RosPlan) -> Result<Self> {
+        let subscriber = participant
+            .create_subscriber(&default_qos())
+            .context("creating the DDS subscriber")?;
+        let mut controllers = Vec::with_capacity(plan.controllers.len());
+        for c in &plan.controllers {
+            let topic = ros2_command_topic(&c.command_topic, c.trajectory);
+            let command = if c.trajectory {
+                Command::Trajectory(Reader::new(participant, &subscriber, &topic)?)
+            } else {
+                Command::Value(Reader::new(participant, &subscriber, &topic)?)
+            };
+            controllers.push((c.name.clone(), command));
+        }
+        Ok(Self {
+            cmd_vel: Reader::new(participant, &subscriber, &plan.cmd_topic)?,
+            task: Reader::new(participant, &subscriber, ARM_TASK_TOPIC)?,
+            controllers,
+            next: 0,
+            _participant: participant.clone(),
+        })
+    }
+
+    /// The next controller command, every topic in turn.
+    fn controller(&mut self) -> Option<Action> {
+        let n = self.controllers.len();
+        for k in 0..n {
+            let i = (self.next + k) % n;
+            let (name, command) = &mut self.controllers[i];
+            let action = match command {
+                Command::Trajectory(reader) => reader.next().map(|m| JointAction::Trajectory {
+                    controller: name.clone(),
+                    trajectory: Box::new(trajectory(m)),
+                }),
+                Command::Value(reader) => reader.next().and_then(|m| {
+                    m.data.first().map(|&value| JointAction::Controller {
+                        name: name.clone(),
+                        value,
+                    })
+                }),
+            };
+            if let Some(action) = action {
+                self.next = (i + 1) % n;
+                return Some(Action::Joint(action));
+            }
+        }
+        None
+    }
+}
+
+impl InputSource for Ros2Input {
+    fn poll(&mut self) -> Option<Action> {
+        let mut newest = None;
+        while let Some(t) = self.cmd_vel.next() {
+            newest = Some(Action::CmdVel(Twist::new(t.linear.x, t.angular.z)));
+        }
+        if newest.is_some() {
+            return newest;
+        }
+        while let Some(task) = self.task.next() {
+            match task.data.trim() {
+                "off" => return Some(Action::Arm(ArmMode::Off)),
+                "look" => return Some(Action::Arm(ArmMode::Look)),
+                "reach" => return Some(Action::Arm(ArmMode::Reach)),
+                other => tracing::warn!(
+                    "{ARM_TASK_TOPIC}: \"{other}\" is not a task; expected off, look or reach"
+                ),
+            }
+        }
+        self.controller()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn controller_topics_take_ros2_control_names() {
+        assert_eq!(
+            ros2_command_topic("/arm_controller/command", true),
+            "/arm_controller/joint_trajectory"
+        );
+        assert_eq!(
+            ros2_command_topic("/my_robot/joint1_position_controller/command", false),
+            "/my_robot/joint1_position_controller/commands"
+        );
+    }
+}
