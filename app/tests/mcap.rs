@@ -336,3 +336,88 @@ fn rerun_imports_the_recording() -> Result<()> {
     println!("rerun imported every channel of the MCAP");
     Ok(())
 }
+
+/// A depth camera in the recording: TIAGo's xtion gives `/xtion/depth_registered/image_raw`
+/// as 32FC1 (metres within the sensor's 0.3-8 m clip range, or NaN) with a camera_info of the
+/// same size and frame, one per colour image.
+#[test]
+fn a_depth_camera_is_recorded_as_32fc1() -> Result<()> {
+    if !rosbags_available() {
+        return Ok(());
+    }
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let mcap = dir.path().join("tiago.mcap");
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(["--headless", "--duration", "1", "--robot"])
+        .arg(&urdf)
+        .args([
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+            "--record-mcap",
+        ])
+        .arg(&mcap)
+        .output()?;
+    ensure!(
+        out.status.success(),
+        "rover failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let script = r#"
+import sys
+from pathlib import Path
+import numpy as np
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+store = get_typestore(Stores.ROS2_HUMBLE)
+with Reader(Path(sys.argv[1])) as reader:
+    for c, t, raw in reader.messages():
+        if not c.topic.startswith('/xtion/'):
+            continue
+        m = store.deserialize_cdr(raw, c.msgtype)
+        if c.msgtype == 'sensor_msgs/msg/Image':
+            if m.encoding == '32FC1':
+                d = m.data.view('<f4')
+                ok = np.isnan(d) | ((d >= 0.3) & (d <= 8.0))
+                print('depth', c.topic, m.width, m.height, m.step, m.header.frame_id, int(ok.all()), int(np.isfinite(d).sum()))
+            else:
+                print('rgb', c.topic, m.width, m.height, m.encoding, m.header.frame_id)
+        else:
+            print('info', c.topic, m.width, m.height, m.header.frame_id)
+"#;
+    let reader = dir.path().join("depth.py");
+    std::fs::write(&reader, script)?;
+    let out = Command::new("python3").arg(&reader).arg(&mcap).output()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    ensure!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<Vec<&str>> = text.lines().map(|l| l.split(' ').collect()).collect();
+    let depth: Vec<&Vec<&str>> = lines.iter().filter(|l| l[0] == "depth").collect();
+    let rgb = lines.iter().filter(|l| l[0] == "rgb").count();
+    let first = depth.first().context(format!("no depth image:\n{text}"))?;
+    println!("{} depth images ({rgb} colour): {first:?}", depth.len());
+    ensure!(depth.len() == rgb && rgb >= 20, "{text}");
+    for d in &depth {
+        let (w, step): (u32, u32) = (d[2].parse()?, d[4].parse()?);
+        ensure!(
+            d[1] == "/xtion/depth_registered/image_raw" && step == w * 4 && d[6] == "1",
+            "{d:?}"
+        );
+        let finite: u32 = d[7].parse()?;
+        ensure!(finite > 0, "a depth image without a single distance: {d:?}");
+    }
+    ensure!(
+        lines.iter().any(|l| l[0] == "info"
+            && l[1] == "/xtion/depth_registered/camera_info"
+            && l[2] == first[2]
+            && l[3] == first[3]
+            && l[4] == first[5]),
+        "no depth camera_info like the image:\n{text}"
+    );
+    Ok(())
+}

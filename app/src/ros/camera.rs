@@ -150,7 +150,7 @@ fn publish_image(
 
 /// The image to hand over (on the loop thread): `frame` copied into the recycled `pixels`,
 /// its depth image (if any) into `depth` as 32FC1 bytes.
-pub(super) fn capture(
+pub(crate) fn capture(
     frame: &CameraFrame<'_>,
     mut pixels: Vec<u8>,
     mut depth: Vec<u8>,

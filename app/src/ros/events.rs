@@ -60,7 +60,7 @@ pub(crate) struct JointSample {
 }
 
 /// A camera image.
-pub(super) struct ImageFrame {
+pub(crate) struct ImageFrame {
     /// Sim time it was taken (s).
     pub stamp_s: f64,
     /// The camera's frame number.

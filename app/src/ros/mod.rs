@@ -50,11 +50,12 @@ pub use cmd_vel::RosCmdVel;
 /// sampling, and their types.
 pub(crate) mod shared {
     pub(crate) use super::arm_sample;
+    pub(crate) use super::camera::capture as capture_image;
     pub(crate) use super::detections::{
         BOUNDING_BOXES_TOPIC, FOUND_OBJECT_TOPIC, capture as capture_detections,
     };
     pub(crate) use super::events::{
-        ArmSample, BufferPool, BufferReturn, Detections, JointSample, buffer_pool,
+        ArmSample, BufferPool, BufferReturn, Detections, ImageFrame, JointSample, buffer_pool,
     };
     pub(crate) use super::joint_states::sample as sample_joints;
     pub(crate) use super::laser::capture as capture_scan;

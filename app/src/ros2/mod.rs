@@ -43,8 +43,8 @@ use rustdds::DomainParticipant;
 
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    ArmSample, BufferPool, BufferReturn, Detections, JointSample, arm_sample, buffer_pool,
-    capture_detections, capture_scan, sample_joints, static_transforms,
+    ArmSample, BufferPool, BufferReturn, Detections, ImageFrame, JointSample, arm_sample,
+    buffer_pool, capture_detections, capture_image, capture_scan, sample_joints, static_transforms,
 };
 use topics::{Sinks, Topics};
 
@@ -102,13 +102,8 @@ enum Event {
     },
     /// A control update: its sample, the moving joints (the plan's order), the arm's task.
     Control(ControlSample, Vec<JointSample>, ArmSample),
-    /// A camera image: stamp, size, RGB8 pixels.
-    Image {
-        stamp_s: f64,
-        width: u32,
-        height: u32,
-        pixels: Vec<u8>,
-    },
+    /// A camera image (and a depth camera's depth image).
+    Image(ImageFrame),
     /// A laser scan.
     Scan(LaserScan),
     /// A detector result.
@@ -272,15 +267,13 @@ impl Observer for Ros2Bridge {
     }
 
     fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {
-        let mut pixels = self.buffers.take_pixels();
-        pixels.clear();
-        pixels.extend_from_slice(frame.rgb);
-        self.send(Event::Image {
-            stamp_s: frame.sim_time_s,
-            width: frame.width,
-            height: frame.height,
-            pixels,
-        });
+        let depth = if frame.depth_m.is_some() {
+            self.buffers.take_pixels()
+        } else {
+            Vec::new()
+        };
+        let image = capture_image(frame, self.buffers.take_pixels(), depth);
+        self.send(Event::Image(image));
     }
 
     fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
@@ -309,15 +302,10 @@ fn run(
                 topics.arm(sample.sim_time_s, &arm);
                 returns.joints(joints);
             }
-            Event::Image {
-                stamp_s,
-                width,
-                height,
-                pixels,
-            } => {
-                if let Some(pixels) = topics.image(stamp_s, width, height, pixels) {
-                    returns.pixels(pixels);
-                }
+            Event::Image(mut frame) => {
+                topics.image(&mut frame);
+                returns.pixels(frame.pixels);
+                returns.pixels(frame.depth);
             }
             Event::Scan(scan) => {
                 if let Some(ranges) = topics.scan(scan) {

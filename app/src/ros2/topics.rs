@@ -12,7 +12,8 @@ use super::mcap::{McapRecorder, McapSummary};
 use super::msgs::{self, Covariance, Header, Lent, RosMessage, Time};
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    ArmSample, BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, JointSample, joints_on_tf,
+    ArmSample, BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, ImageFrame, JointSample,
+    joints_on_tf,
 };
 use rover_core::{ArmMode, ReachState};
 
@@ -132,6 +133,33 @@ fn put<M: RosMessage + Clone>(out: &Out<M>, mcap: &mut Option<McapRecorder>, sta
     }
 }
 
+/// Puts `data` (`encoding`, `(width, height)`) on `out` as an Image stamped and framed like
+/// `info`: lent to the message, back in `data` once it is written.
+fn put_image(
+    out: &Out<msgs::Image>,
+    mcap: &mut Option<McapRecorder>,
+    info: &msgs::CameraInfo,
+    (width, height): (u32, u32),
+    encoding: &str,
+    data: &mut Vec<u8>,
+) {
+    let bytes_per_px = if encoding == "32FC1" { 4 } else { 3 };
+    let lent = Lent::new(std::mem::take(data));
+    let msg = msgs::Image {
+        header: info.header.clone(),
+        height,
+        width,
+        encoding: encoding.to_owned(),
+        is_bigendian: 0,
+        step: width * bytes_per_px,
+        data: lent.clone(),
+    };
+    put(out, mcap, info.header.stamp, &msg);
+    drop(msg);
+    // A buffer still held elsewhere is let go; the pool makes a new one.
+    *data = lent.take_back().unwrap_or_default();
+}
+
 /// The topics and the messages they reuse.
 pub(super) struct Topics {
     mcap: Option<McapRecorder>,
@@ -143,6 +171,8 @@ pub(super) struct Topics {
     tf_static: Out<msgs::TfMessage>,
     joint_states: Out<msgs::JointState>,
     image: Option<(Out<msgs::Image>, Out<msgs::CameraInfo>)>,
+    /// A depth camera's depth image and camera_info.
+    depth: Option<(Out<msgs::Image>, Out<msgs::CameraInfo>)>,
     scan: Option<Out<msgs::LaserScan>>,
     boxes: Out<msgs::BoundingBoxes>,
     found: Out<msgs::ObjectCount>,
@@ -201,6 +231,12 @@ impl Topics {
             }
             _ => None,
         };
+        let depth = match (&plan.depth_image_topic, &plan.depth_info_topic) {
+            (Some(image), Some(info)) => {
+                Some((sinks.out(image, &sensor)?, sinks.out(info, &sensor)?))
+            }
+            _ => None,
+        };
         let scan = match &plan.scan_topic {
             Some(topic) => Some(sinks.out(topic, &sensor)?),
             None => None,
@@ -212,6 +248,7 @@ impl Topics {
             tf_static: sinks.out("/tf_static", &latched_qos())?,
             joint_states: sinks.out("/joint_states", &qos)?,
             image,
+            depth,
             scan,
             boxes: sinks.out(BOUNDING_BOXES_TOPIC, &qos)?,
             found: sinks.out(FOUND_OBJECT_TOPIC, &qos)?,
@@ -349,37 +386,26 @@ impl Topics {
         }
     }
 
-    /// A camera image (RGB8) and its camera_info, with the image's stamp; the pixels' buffer
-    /// back, for the next image.
-    pub(super) fn image(
-        &mut self,
-        stamp_s: f64,
-        width: u32,
-        height: u32,
-        pixels: Vec<u8>,
-    ) -> Option<Vec<u8>> {
-        let (Some((image, info)), Some(info_msg)) = (&self.image, &mut self.info_msg) else {
-            return Some(pixels);
+    /// A camera image (RGB8) and its camera_info with the image's stamp; a depth camera's
+    /// depth image (32FC1) and camera_info too. The frame's buffers are lent to the messages
+    /// and stay with the frame.
+    pub(super) fn image(&mut self, frame: &mut ImageFrame) {
+        let Some(info_msg) = &mut self.info_msg else {
+            return;
         };
-        let pixels = Lent::new(pixels);
-        let stamp = Time::from_secs(stamp_s);
+        let stamp = Time::from_secs(frame.stamp_s);
         info_msg.header.stamp = stamp;
-        let msg = msgs::Image {
-            header: Header {
-                stamp,
-                frame_id: info_msg.header.frame_id.clone(),
-            },
-            height,
-            width,
-            encoding: "rgb8".to_owned(),
-            is_bigendian: 0,
-            step: width * 3,
-            data: pixels.clone(),
-        };
-        put(image, &mut self.mcap, stamp, &msg);
-        put(info, &mut self.mcap, stamp, info_msg);
-        drop(msg);
-        pixels.take_back()
+        let size = (frame.width, frame.height);
+        if let Some((image, info)) = &self.image {
+            put(info, &mut self.mcap, stamp, info_msg);
+            let pixels = &mut frame.pixels;
+            put_image(image, &mut self.mcap, info_msg, size, "rgb8", pixels);
+        }
+        if let (Some((image, info)), false) = (&self.depth, frame.depth.is_empty()) {
+            put(info, &mut self.mcap, stamp, info_msg);
+            let depth = &mut frame.depth;
+            put_image(image, &mut self.mcap, info_msg, size, "32FC1", depth);
+        }
     }
 
     /// A laser scan; its ranges' buffer back, for the next scan.
