@@ -129,7 +129,7 @@ impl Graph {
         let log_path = self.dir.path().join(format!("{name}.log"));
         let log = std::fs::File::create(&log_path)?;
         let mut child = Command::new("python3")
-            .arg(&path)
+            .arg(path)
             .env("PYTHONPATH", &self.cyclonedds)
             .env("PYTHONUNBUFFERED", "1")
             .env("ROS_DOMAIN_ID", self.domain.to_string())

@@ -14,10 +14,12 @@
 //! Sensor data (the camera's image and camera_info, the laser's scan) best effort, keep last 5
 //! (rclcpp's SensorDataQoS); `/tf_static` transient local, keep last 1 (a late joiner gets it).
 //!
-//! Carried so far: `/cmd_vel` in; `/clock`, odometry, `/tf` (odom -> base and the moving joints'
-//! links), `/tf_static`, `/joint_states`, the camera's image and camera_info, the laser's scan
-//! out (`topics.rs`). Not yet: the detector's boxes, depth images, the controllers' and the
-//! arm's topics, MCAP recording (docs/ROS2.md).
+//! Carried: `/cmd_vel`, the controllers' commands and `/rover/arm/task` in (`input.rs`);
+//! `/clock`, odometry, `/tf`, `/tf_static`, `/joint_states`, `/robot_description`, the camera's
+//! image and camera_info (and a depth camera's), darknet_ros's boxes and object count, the
+//! arm's state and points, the laser's scan out (`topics.rs`). The same messages can go into
+//! an MCAP file (`--record-mcap`, `mcap.rs`), with DDS or without; recording never drops an
+//! event (the loop waits for the disk), DDS alone drops what its thread cannot keep up with.
 //!
 //! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): the bridge needs
 //! topics, writers and readers with chosen QoS — what RustDDS offers directly — and nothing of
