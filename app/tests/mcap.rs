@@ -42,7 +42,7 @@ with Reader(Path(sys.argv[1])) as reader:
         m = store.deserialize_cdr(raw, c.msgtype)
         if c.topic == '/camera/camera_info':
             info = m
-        elif c.msgtype == 'sensor_msgs/msg/Image':
+        elif c.topic == '/camera/image_raw':
             k = counts[c.topic] - 1
             image = m.data.reshape(m.height, m.width, 3)
             frame = imread(Path(sys.argv[2]) / ('frame_%06d.png' % k))[:, :, :3]
@@ -236,6 +236,16 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         "{compared} of {} compared ({} trace rows)",
         odom.len(),
         rows.len()
+    );
+
+    // darknet_ros's detection image: one per detection, the size of the camera's.
+    let count = |topic: &str| topics.iter().find(|t| t.0 == topic).map_or(0, |t| t.2);
+    ensure!(
+        count("/darknet_ros/detection_image") == count("/darknet_ros/found_object")
+            && count("/darknet_ros/found_object") > 0,
+        "{} detection images for {} detections",
+        count("/darknet_ros/detection_image"),
+        count("/darknet_ros/found_object")
     );
 
     // The detector's boxes.

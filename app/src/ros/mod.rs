@@ -52,7 +52,8 @@ pub(crate) mod shared {
     pub(crate) use super::arm_sample;
     pub(crate) use super::camera::capture as capture_image;
     pub(crate) use super::detections::{
-        BOUNDING_BOXES_TOPIC, FOUND_OBJECT_TOPIC, capture as capture_detections,
+        BOUNDING_BOXES_TOPIC, DETECTION_IMAGE_TOPIC, DetectionImages, FOUND_OBJECT_TOPIC,
+        capture as capture_detections,
     };
     pub(crate) use super::events::{
         ArmSample, BufferPool, BufferReturn, Detections, ImageFrame, JointSample, buffer_pool,

@@ -12,8 +12,8 @@ use super::mcap::{McapRecorder, McapSummary};
 use super::msgs::{self, Covariance, Header, Lent, RosMessage, Time};
 use crate::ros::RosPlan;
 use crate::ros::shared::{
-    ArmSample, BOUNDING_BOXES_TOPIC, Detections, FOUND_OBJECT_TOPIC, ImageFrame, JointSample,
-    joints_on_tf,
+    ArmSample, BOUNDING_BOXES_TOPIC, DETECTION_IMAGE_TOPIC, DetectionImages, Detections,
+    FOUND_OBJECT_TOPIC, ImageFrame, JointSample, joints_on_tf,
 };
 use rover_core::{ArmMode, ReachState};
 
@@ -133,12 +133,12 @@ fn put<M: RosMessage + Clone>(out: &Out<M>, mcap: &mut Option<McapRecorder>, sta
     }
 }
 
-/// Puts `data` (`encoding`, `(width, height)`) on `out` as an Image stamped and framed like
-/// `info`: lent to the message, back in `data` once it is written.
+/// Puts `data` (`encoding`, `(width, height)`) on `out` as an Image with `header`: lent to
+/// the message, back in `data` once it is written.
 fn put_image(
     out: &Out<msgs::Image>,
     mcap: &mut Option<McapRecorder>,
-    info: &msgs::CameraInfo,
+    header: &Header,
     (width, height): (u32, u32),
     encoding: &str,
     data: &mut Vec<u8>,
@@ -146,7 +146,7 @@ fn put_image(
     let bytes_per_px = if encoding == "32FC1" { 4 } else { 3 };
     let lent = Lent::new(std::mem::take(data));
     let msg = msgs::Image {
-        header: info.header.clone(),
+        header: header.clone(),
         height,
         width,
         encoding: encoding.to_owned(),
@@ -154,7 +154,7 @@ fn put_image(
         step: width * bytes_per_px,
         data: lent.clone(),
     };
-    put(out, mcap, info.header.stamp, &msg);
+    put(out, mcap, header.stamp, &msg);
     drop(msg);
     // A buffer still held elsewhere is let go; the pool makes a new one.
     *data = lent.take_back().unwrap_or_default();
@@ -176,6 +176,11 @@ pub(super) struct Topics {
     scan: Option<Out<msgs::LaserScan>>,
     boxes: Out<msgs::BoundingBoxes>,
     found: Out<msgs::ObjectCount>,
+    detection_image: Out<msgs::Image>,
+    /// The newest images, for the detection image.
+    detection_images: DetectionImages,
+    /// The detection image's pixels, reused.
+    detection_pixels: Vec<u8>,
     arm_state: Out<msgs::Text>,
     arm_object: Out<msgs::PointStamped>,
     arm_goal: Out<msgs::PointStamped>,
@@ -252,6 +257,9 @@ impl Topics {
             scan,
             boxes: sinks.out(BOUNDING_BOXES_TOPIC, &qos)?,
             found: sinks.out(FOUND_OBJECT_TOPIC, &qos)?,
+            detection_image: sinks.out(DETECTION_IMAGE_TOPIC, &latched_qos())?,
+            detection_images: DetectionImages::default(),
+            detection_pixels: Vec::new(),
             _robot_description: robot_description,
             arm_state: sinks.out(ARM_STATE_TOPIC, &latched_qos())?,
             arm_object: sinks.out(ARM_OBJECT_TOPIC, &qos)?,
@@ -399,13 +407,29 @@ impl Topics {
         if let Some((image, info)) = &self.image {
             put(info, &mut self.mcap, stamp, info_msg);
             let pixels = &mut frame.pixels;
-            put_image(image, &mut self.mcap, info_msg, size, "rgb8", pixels);
+            put_image(
+                image,
+                &mut self.mcap,
+                &info_msg.header,
+                size,
+                "rgb8",
+                pixels,
+            );
         }
         if let (Some((image, info)), false) = (&self.depth, frame.depth.is_empty()) {
             put(info, &mut self.mcap, stamp, info_msg);
             let depth = &mut frame.depth;
-            put_image(image, &mut self.mcap, info_msg, size, "32FC1", depth);
+            put_image(
+                image,
+                &mut self.mcap,
+                &info_msg.header,
+                size,
+                "32FC1",
+                depth,
+            );
         }
+        // Kept for the detection image; an older buffer takes its place in the frame.
+        self.detection_images.keep(frame);
     }
 
     /// A laser scan; its ranges' buffer back, for the next scan.
@@ -434,16 +458,14 @@ impl Topics {
         ranges.take_back()
     }
 
-    /// darknet_ros's topics for one detector result: `found_object` always, `bounding_boxes`
-    /// when there are boxes (as darknet_ros does). Class strings keep their capacity.
+    /// darknet_ros's topics for one detector result: `found_object` and `detection_image` (the
+    /// boxes drawn on their image, transient local as darknet_ros latches it) always,
+    /// `bounding_boxes` when there are boxes. Class strings keep their capacity.
     pub(super) fn detections(&mut self, d: &Detections) {
         let stamp = Time::from_secs(d.stamp_s);
         self.found_msg.header.stamp = stamp;
         self.found_msg.count = i8::try_from(d.boxes.len()).unwrap_or(i8::MAX);
         put(&self.found, &mut self.mcap, stamp, &self.found_msg);
-        if d.boxes.is_empty() {
-            return;
-        }
         let out = &mut self.boxes_msg;
         out.header.stamp = stamp;
         out.image_header.stamp = Time::from_secs(d.image_stamp_s);
@@ -458,7 +480,21 @@ impl Topics {
             m.id = b.id;
             m.class_id.clone_from(&b.class);
         }
-        put(&self.boxes, &mut self.mcap, stamp, out);
+        if !d.boxes.is_empty() {
+            put(&self.boxes, &mut self.mcap, stamp, out);
+        }
+        let pixels = &mut self.detection_pixels;
+        if let Some(size) = self.detection_images.draw(d.image_seq, &d.boxes, pixels) {
+            let header = &self.boxes_msg.image_header;
+            put_image(
+                &self.detection_image,
+                &mut self.mcap,
+                header,
+                size,
+                "rgb8",
+                pixels,
+            );
+        }
     }
 
     /// The arm's topics at a control update: its state on every change; with reach on, the
