@@ -22,7 +22,8 @@ fi
 #          keyboard/cursor libraries winit loads for the window
 #   test:  darknet (its sample photos), xvfb/xauth/xdotool (the window test), chromium (the web
 #          viewer test), python3 with venv and pip (onnxruntime and scikit-image references),
-#          Debian's ROS 1 packages and tmux (the ROS bridge tests; rover itself needs no ROS)
+#          Debian's ROS 1 packages and tmux (the ROS bridge tests; rover itself needs no ROS),
+#          Slurm and munge (the test starts a one-node cluster of its own: scripts/slurm/)
 packages=(gcc libc6-dev pkg-config libudev-dev mesa-vulkan-drivers libxkbcommon-x11-0 libxcursor1 libxi6)
 if [ "$purpose" = test ]; then
   packages+=(darknet xvfb xauth xdotool chromium python3 python3-venv python3-pip npm)
@@ -31,6 +32,7 @@ if [ "$purpose" = test ]; then
   packages+=(python3-rosmaster python3-rospy python3-rostopic python3-rosbag ros-std-msgs
     python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
     python3-rosgraph-msgs python3-roslib python3-genpy python3-trajectory-msgs tmux)
+  packages+=(slurmctld slurmd slurm-client munge)
 fi
 missing=()
 if command -v dpkg-query >/dev/null 2>&1; then

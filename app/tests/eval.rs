@@ -126,8 +126,45 @@ fn parallel_and_serial_evaluations_agree_and_shards_merge() -> Result<()> {
     assert!(s0.status.success(), "{}", text(&s0.stderr));
     let (s1, j1) = run("1", "shards", &["--shard", "1/2"])?;
     assert!(s1.status.success(), "{}", text(&s1.stderr));
-    assert!(j0.contains("a_nobody") && !j0.contains("b_person"), "{j0}");
-    assert!(j1.contains("b_person"), "{j1}");
+    let names = |json: &str| -> Result<Vec<String>> {
+        let v: serde_json::Value = serde_json::from_str(json)?;
+        Ok(v["results"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|r| r["name"].as_str().map(str::to_owned))
+                    .collect()
+            })
+            .unwrap_or_default())
+    };
+    assert_eq!(names(&j0)?, ["a_nobody"], "{j0}");
+    assert_eq!(names(&j1)?, ["b_person"], "{j1}");
+    // Each shard's manifest: which shard, the whole suite, the inputs' and model's hashes.
+    let m: serde_json::Value = serde_json::from_str(&j1)?;
+    assert_eq!(m["shard"]["shard"]["index"], 1, "{j1}");
+    assert_eq!(m["shard"]["items"].as_array().map(Vec::len), Some(2));
+    assert!(
+        m["shard"]["model"]
+            .as_str()
+            .is_some_and(|s| s.contains("sha256"))
+    );
+    // One shard alone is refused, the missing one named.
+    let alone = rover(
+        &[
+            "eval",
+            "--merge",
+            "shards/eval-shard-0-of-2.json",
+            "--out",
+            "alone",
+        ],
+        dir.path(),
+    )?;
+    assert!(
+        !alone.status.success() && text(&alone.stderr).contains("shard 1 of 2 missing"),
+        "{}",
+        text(&alone.stderr)
+    );
+    assert!(!dir.path().join("alone/eval.json").exists());
     let merged = rover(
         &[
             "eval",

@@ -27,6 +27,7 @@ mod run_files;
 mod scenario;
 mod script;
 mod session;
+mod shard;
 mod teleop;
 mod trace;
 
@@ -34,7 +35,7 @@ pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
 pub use dataset::{
     COCO_CATEGORY_IDS, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox, ImageFormat,
     ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, Randomization, Shot, Split,
-    coco_category, coco_json, coco_results, data_yaml, write_dataset, yolo_class,
+    coco_category, coco_json, coco_results, data_yaml, write_dataset, write_whole, yolo_class,
 };
 pub use error::{CoreError, Result};
 pub use follower::{
@@ -59,6 +60,9 @@ pub use scenario::{
 };
 pub use script::{Script, ScriptPlayer, Step};
 pub use session::{DetectorMode, Session, SessionOptions};
+pub use shard::{
+    SHARD_FORMAT, ShardIndex, ShardManifest, check_shard_set, sha256_of as file_sha256,
+};
 pub use teleop::{KeyAction, TELEOP_KEYS, Teleop, key_action};
 pub use trace::{
     TRACE_HEADER, TRACE_TRUTH_COLUMNS, TraceParseError, TraceRow, TraceWriter, TruthColumns,

@@ -16,7 +16,8 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use rover_core::{
-    Scenario, ScenarioOptions, ScenarioResult, collect_scenario_files, robot_name, run_scenario,
+    Scenario, ScenarioOptions, ScenarioResult, ShardIndex, ShardManifest, check_shard_set,
+    collect_scenario_files, robot_name, run_scenario, write_whole,
 };
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +40,9 @@ pub struct EvalReport {
     pub results: Vec<ScenarioResult>,
     /// Wall-clock figures (the only part that differs between identical evaluations).
     pub timing: Timing,
+    /// A shard's report (`--shard I/N`): what made it, for `--merge` to check the set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardManifest>,
 }
 
 /// Wall-clock figures of an evaluation.
@@ -134,14 +138,20 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
             w[0].0
         );
     }
-    if let Some((index, count)) = args.shard {
-        jobs = jobs
-            .into_iter()
-            .enumerate()
-            .filter(|(i, _)| i % count == index)
-            .map(|(_, s)| s)
-            .collect();
-    }
+    let manifest = match args.shard {
+        Some((index, count)) => {
+            let shard = ShardIndex { index, count };
+            let manifest = shard_manifest(&args, shard, &files, &jobs)?;
+            jobs = jobs
+                .into_iter()
+                .enumerate()
+                .filter(|(i, _)| shard.owns(*i as u64))
+                .map(|(_, s)| s)
+                .collect();
+            Some(manifest)
+        }
+        None => None,
+    };
     if jobs.is_empty() {
         bail!("no scenarios to run (check --tag and --shard)");
     }
@@ -153,12 +163,38 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
         .clamp(1, jobs.len());
-    let report = run_all(&args, &jobs, workers)?;
+    let mut report = run_all(&args, &jobs, workers)?;
+    report.shard = manifest;
     let name = match args.shard {
         Some((i, n)) => format!("eval-shard-{i}-of-{n}.json"),
         None => "eval.json".to_owned(),
     };
     finish(&args, report, &name)
+}
+
+/// The manifest of shard `shard` of the evaluation of `jobs` (all of them) from `files`: the
+/// model and every input hashed.
+fn shard_manifest(
+    args: &EvalArgs,
+    shard: ShardIndex,
+    files: &[PathBuf],
+    jobs: &[Job],
+) -> Result<ShardManifest> {
+    let model = match &args.detector.model {
+        Some(m) => m.clone(),
+        None => rover_perception::ensure_default_model()?,
+    };
+    let mut inputs = files.to_vec();
+    inputs.extend(args.robot.iter().cloned());
+    let labels = jobs.iter().map(Job::label).collect();
+    Ok(ShardManifest::new(
+        "eval",
+        shard,
+        None,
+        Some(&model),
+        &inputs,
+        labels,
+    )?)
 }
 
 /// One scenario with one robot.
@@ -293,6 +329,7 @@ fn report_of(mut results: Vec<ScenarioResult>, timing: Timing) -> EvalReport {
         },
         results,
         timing,
+        shard: None,
     }
 }
 
@@ -422,15 +459,32 @@ fn worker(args: &EvalArgs, out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Reads shards' reports and puts them together (each scenario once).
+/// Reads shards' reports and puts them together (each scenario once), after checking that
+/// they are one complete set of one evaluation (their manifests; the missing shards named).
+/// The result does not depend on the order of `files`.
 fn merge(files: &[PathBuf]) -> Result<EvalReport> {
-    let mut results: Vec<ScenarioResult> = Vec::new();
-    let mut timing = Timing::default();
+    let mut reports = Vec::with_capacity(files.len());
     for f in files {
         let text =
             std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
         let report: EvalReport = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a rover eval report", f.display()))?;
+        let Some(manifest) = report.shard.clone() else {
+            bail!(
+                "{}: not a shard's report (no shard manifest: made without --shard, or by a rover before 0.1)",
+                f.display()
+            );
+        };
+        reports.push((f.clone(), manifest, report));
+    }
+    let manifests: Vec<(PathBuf, ShardManifest)> = reports
+        .iter()
+        .map(|(f, m, _)| (f.clone(), m.clone()))
+        .collect();
+    check_shard_set(&manifests)?;
+    let mut results: Vec<ScenarioResult> = Vec::new();
+    let mut timing = Timing::default();
+    for (f, _, report) in reports {
         for r in report.results {
             if results
                 .iter()
@@ -448,6 +502,13 @@ fn merge(files: &[PathBuf]) -> Result<EvalReport> {
         timing.jobs += report.timing.jobs;
         timing.wall_s = timing.wall_s.max(report.timing.wall_s);
     }
+    let expected = manifests.first().map_or(0, |(_, m)| m.items.len());
+    if results.len() != expected {
+        bail!(
+            "the shards hold {} results for an evaluation of {expected} runs",
+            results.len()
+        );
+    }
     let sim: f64 = results.iter().map(|r| r.metrics.sim_s).sum();
     timing.sim_per_wall = sim / timing.wall_s.max(1e-9);
     Ok(report_of(results, timing))
@@ -458,8 +519,13 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
     let mut stdout = std::io::stdout().lock();
     write_table(&mut stdout, &report)?;
     let json_path = args.out.join(json_name);
-    std::fs::write(&json_path, serde_json::to_string_pretty(&report)?)
-        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    // Whole or not at all: a shard cancelled while writing leaves no report, so a merge names
+    // it missing instead of reading half of it.
+    write_whole(
+        &json_path,
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )
+    .with_context(|| format!("cannot write {}", json_path.display()))?;
     let csv_path = json_path.with_extension("csv");
     let mut csv = Vec::new();
     write_csv(&mut csv, &report)?;

@@ -15,7 +15,6 @@ use std::time::Instant;
 
 use rover_perception::{CocoEvaluator, DetectionMetrics, Detector, FrameStamp, RgbView};
 use rover_sim::{CameraSensor, SimOptions, Simulation};
-use sha2::{Digest, Sha256};
 
 pub use export::{
     COCO_CATEGORY_IDS, DetectedBox, ImageRecord, LabelledBox, coco_category, coco_json,
@@ -26,6 +25,7 @@ pub use store::{ImageFormat, MANIFEST, MANIFEST_FORMAT, Manifest, Split, Store, 
 
 use crate::error::{CoreError, Result};
 use crate::headless::RunConfig;
+use crate::shard::sha256_of;
 use randomize::{BaseLayout, Rng, lay_out};
 
 /// What dataset to make.
@@ -221,12 +221,6 @@ fn check_spec(spec: &DatasetSpec) -> Result<()> {
         ));
     }
     spec.randomization.check().map_err(CoreError::Option)
-}
-
-fn sha256_of(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| CoreError::Option(format!("cannot read {}: {e}", path.display())))?;
-    Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
 
 fn manifest(
