@@ -10,68 +10,21 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, ensure};
 use rover_core::parse_trace;
 
-/// The ROS 2 messages the peer uses, as cyclonedds IdlStructs named like rmw names them.
+/// The ROS 2 messages the peer uses, as cyclonedds IdlStructs named like rmw names them:
+/// examples/ros2/rover_msgs.py's, and (below) the tests' own.
 const MESSAGES: &str = r#"
 from dataclasses import dataclass
 from cyclonedds.idl import IdlStruct
 import cyclonedds.idl.types as types
-
-@dataclass
-class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-    sec: types.int32
-    nanosec: types.uint32
-
-@dataclass
-class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-    stamp: Time
-    frame_id: str
-
-@dataclass
-class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-
-@dataclass
-class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-
-@dataclass
-class Quaternion(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-    w: types.float64
-
-@dataclass
-class Pose(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
-    position: Point
-    orientation: Quaternion
-
-@dataclass
-class PoseWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
-    pose: Pose
-    covariance: types.array[types.float64, 36]
-
-@dataclass
-class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
-    linear: Vector3
-    angular: Vector3
-
-@dataclass
-class TwistWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
-    twist: Twist
-    covariance: types.array[types.float64, 36]
-
-@dataclass
-class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
-    header: Header
-    child_frame_id: str
-    pose: PoseWithCovariance
-    twist: TwistWithCovariance
+from rover_msgs import (BoundingBox, BoundingBoxes, Header, Odometry, Point, Pose,
+                        PoseWithCovariance, Quaternion, Time, Twist, TwistWithCovariance, Vector3)
 "#;
+
+/// examples/ros2: `rover_msgs.py`, the ROS 2 messages declared for Cyclone DDS, which the
+/// peers import (so the tests check the examples' declarations too).
+fn examples_ros2() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/ros2")
+}
 
 /// A rover and a Python peer in DDS domain `domain`, logs in `dir`.
 struct Graph {
@@ -130,7 +83,10 @@ impl Graph {
         let log = std::fs::File::create(&log_path)?;
         let mut child = Command::new("python3")
             .arg(path)
-            .env("PYTHONPATH", &self.cyclonedds)
+            .env(
+                "PYTHONPATH",
+                std::env::join_paths([&self.cyclonedds, &examples_ros2()])?,
+            )
             .env("PYTHONUNBUFFERED", "1")
             .env("ROS_DOMAIN_ID", self.domain.to_string())
             .stdin(Stdio::null())
@@ -302,22 +258,6 @@ for m in got:
 
 /// tf2's, sensor_msgs' and darknet_ros's (ROS 2 branch) messages for the peer.
 const MORE_MESSAGES: &str = r#"
-@dataclass
-class BoundingBox(IdlStruct, typename="darknet_ros_msgs::msg::dds_::BoundingBox_"):
-    probability: types.float64
-    xmin: types.int64
-    ymin: types.int64
-    xmax: types.int64
-    ymax: types.int64
-    id: types.int16
-    class_id: str
-
-@dataclass
-class BoundingBoxes(IdlStruct, typename="darknet_ros_msgs::msg::dds_::BoundingBoxes_"):
-    header: Header
-    image_header: Header
-    bounding_boxes: types.sequence[BoundingBox]
-
 @dataclass
 class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
     translation: Vector3
@@ -553,7 +493,7 @@ fn the_listener_yolo_port_drives_the_car_toward_the_person() -> Result<()> {
     };
     let mut graph = Graph::new(cyclonedds, domain(4))?;
     graph.spawn_rover(12.0, &[])?;
-    let listener = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/ros2/listener_yolo.py");
+    let listener = examples_ros2().join("listener_yolo.py");
     let said = graph.python_file("listener", &listener, Duration::from_secs(14))?;
     graph.wait_rover(Duration::from_secs(60))?;
     let rows = parse_trace(&std::fs::read_to_string(graph.trace_path())?)?;

@@ -65,13 +65,31 @@ fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
     }
 }
 
+/// The first command among `topics`, each topic in turn from `*next` on (so that a busy one
+/// does not starve the others); `*next` moves past the one that had it. Shared by the ROS 1
+/// and ROS 2 bridges.
+pub(crate) fn poll_in_turn<T>(
+    topics: &mut [T],
+    next: &mut usize,
+    mut poll: impl FnMut(&mut T) -> Option<JointAction>,
+) -> Option<Action> {
+    let n = topics.len();
+    for k in 0..n {
+        let i = (*next + k) % n;
+        if let Some(action) = poll(&mut topics[i]) {
+            *next = (i + 1) % n;
+            return Some(Action::Joint(action));
+        }
+    }
+    None
+}
+
 impl InputSource for ControllerCommands {
     fn poll(&mut self) -> Option<Action> {
-        let n = self.topics.len();
-        for k in 0..n {
-            let i = (self.next + k) % n;
-            let (name, topic) = &self.topics[i];
-            let action = match topic {
+        poll_in_turn(
+            &mut self.topics,
+            &mut self.next,
+            |(name, topic)| match topic {
                 Topic::Value(sub) => sub.try_recv().map(|m| JointAction::Controller {
                     name: name.clone(),
                     value: m.data,
@@ -80,12 +98,7 @@ impl InputSource for ControllerCommands {
                     controller: name.clone(),
                     trajectory: Box::new(trajectory(m)),
                 }),
-            };
-            if let Some(action) = action {
-                self.next = (i + 1) % n;
-                return Some(Action::Joint(action));
-            }
-        }
-        None
+            },
+        )
     }
 }

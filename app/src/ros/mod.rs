@@ -51,6 +51,7 @@ pub use cmd_vel::RosCmdVel;
 pub(crate) mod shared {
     pub(crate) use super::arm_sample;
     pub(crate) use super::camera::capture as capture_image;
+    pub(crate) use super::controllers::poll_in_turn;
     pub(crate) use super::detections::{
         BOUNDING_BOXES_TOPIC, DETECTION_IMAGE_TOPIC, DetectionImages, FOUND_OBJECT_TOPIC,
         capture as capture_detections,

@@ -16,6 +16,7 @@ use serde::de::DeserializeOwned;
 use super::dds::{dds_topic, default_qos};
 use super::msgs::{self, RosMessage};
 use crate::ros::RosPlan;
+use crate::ros::shared::poll_in_turn;
 
 /// rover's arm task topic (as the ROS 1 bridge's).
 pub(super) const ARM_TASK_TOPIC: &str = "/rover/arm/task";
@@ -155,11 +156,10 @@ impl Ros2Input {
 
     /// The next controller command, every topic in turn.
     fn controller(&mut self) -> Option<Action> {
-        let n = self.controllers.len();
-        for k in 0..n {
-            let i = (self.next + k) % n;
-            let (name, command) = &mut self.controllers[i];
-            let action = match command {
+        poll_in_turn(
+            &mut self.controllers,
+            &mut self.next,
+            |(name, command)| match command {
                 Command::Trajectory(reader) => reader.next().map(|m| JointAction::Trajectory {
                     controller: name.clone(),
                     trajectory: Box::new(trajectory(m)),
@@ -170,13 +170,8 @@ impl Ros2Input {
                         value,
                     })
                 }),
-            };
-            if let Some(action) = action {
-                self.next = (i + 1) % n;
-                return Some(Action::Joint(action));
-            }
-        }
-        None
+            },
+        )
     }
 }
 
