@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use anyhow::{Context, Result, ensure};
-use sha2::{Digest, Sha256};
 
 fn repo(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,22 +42,8 @@ fn dataset(out: &Path, images: u32, seed: u32, extra: &[&str]) -> Result<Output>
     rover(&args)
 }
 
-/// Every file under `dir` (relative path -> SHA-256), temporaries included (there must be none).
 fn hashes(dir: &Path) -> Result<BTreeMap<String, String>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d)? {
-            let path = entry?.path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                let rel = path.strip_prefix(dir)?.display().to_string();
-                out.insert(rel, format!("{:x}", Sha256::digest(std::fs::read(&path)?)));
-            }
-        }
-    }
-    Ok(out)
+    rover_tests::file_hashes(dir)
 }
 
 fn has_pycocotools() -> bool {
@@ -175,7 +160,7 @@ fn check_formats(dir: &Path) -> Result<usize> {
 fn a_dataset_is_valid_yolo_and_coco_and_the_same_twice() -> Result<()> {
     let tmp = tempfile::tempdir()?;
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
-    let out = dataset(&a, 12, 5, &[])?;
+    let out = dataset(&a, 12, 5, &["--jobs", "1"])?;
     let stdout = text(&out.stdout);
     ensure!(out.status.success(), "{stdout}{}", text(&out.stderr));
     assert!(stdout.contains("12 images (12 made now"), "{stdout}");
@@ -192,7 +177,8 @@ fn a_dataset_is_valid_yolo_and_coco_and_the_same_twice() -> Result<()> {
     assert!(compared >= 6, "only {compared} labelled boxes in 12 images");
     println!("{stdout}{compared} boxes agree between YOLO and COCO within 0.5 px");
 
-    let out = dataset(&b, 12, 5, &[])?;
+    // The second run makes its images three at a time: the files must not depend on it.
+    let out = dataset(&b, 12, 5, &["--jobs", "3"])?;
     ensure!(out.status.success(), "{}", text(&out.stderr));
     let (ha, hb) = (hashes(&a)?, hashes(&b)?);
     assert_eq!(ha.keys().collect::<Vec<_>>(), hb.keys().collect::<Vec<_>>());
@@ -202,7 +188,7 @@ fn a_dataset_is_valid_yolo_and_coco_and_the_same_twice() -> Result<()> {
         "differ between two runs with one seed: {differing:?}"
     );
     println!(
-        "two runs with seed 5: {} files, sha256-identical (images, labels, COCO JSON, records)",
+        "two runs with seed 5 (--jobs 1 and 3): {} files, sha256-identical (images, labels, COCO JSON, records)",
         ha.len()
     );
     assert!(
@@ -470,6 +456,90 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
                 "{name} {split}: rover {ap} / {ap50} vs pycocotools {t_ap} / {t_ap50}"
             );
         }
+    }
+    Ok(())
+}
+
+/// `--shard I/N` and `--merge` without a cluster (app/tests/slurm.rs runs them on Slurm): three
+/// shards merged equal a one-machine run file for file; a missing shard, an unfinished one and
+/// a shard of another seed are refused with what is wrong; merging twice changes nothing.
+#[test]
+fn shards_merge_into_the_one_machine_dataset_and_a_broken_set_is_refused() -> Result<()> {
+    let tmp = tempfile::tempdir()?;
+    let (one, shards) = (tmp.path().join("one"), tmp.path().join("shards"));
+    let out = dataset(&one, 10, 3, &[])?;
+    ensure!(out.status.success(), "{}", text(&out.stderr));
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let out = dataset(&shards, 10, 3, &["--shard", &shard, "--jobs", "1"])?;
+        ensure!(out.status.success(), "{}", text(&out.stderr));
+        let made = text(&out.stdout);
+        let owned = (0..10).filter(|n| n % 3 == i).count();
+        ensure!(
+            made.contains(&format!("{owned} images ({owned} made now")),
+            "shard {shard}: {made}"
+        );
+    }
+    let dir = |i: u32| shards.join(format!("shard-{i}-of-3")).display().to_string();
+    let merged = tmp.path().join("merged").display().to_string();
+    let merge = |dirs: &[String], out: &str| {
+        let mut args = vec!["dataset", "--out", out, "--merge"];
+        args.extend(dirs.iter().map(String::as_str));
+        rover(&args)
+    };
+
+    let out = merge(&[dir(0), dir(2)], &merged)?;
+    let error = text(&out.stderr);
+    ensure!(
+        !out.status.success() && error.contains("shard 1 of 3 missing"),
+        "{error}"
+    );
+    std::fs::rename(
+        Path::new(&dir(1)).join("rover-shard.json"),
+        tmp.path().join("kept.json"),
+    )?;
+    let out = merge(&[dir(0), dir(1), dir(2)], &merged)?;
+    let error = text(&out.stderr);
+    ensure!(
+        !out.status.success()
+            && error.contains("shard 1 of 3 missing")
+            && error.contains("shard 1 of 3 did not finish"),
+        "{error}"
+    );
+    std::fs::rename(
+        tmp.path().join("kept.json"),
+        Path::new(&dir(1)).join("rover-shard.json"),
+    )?;
+    let other = tmp.path().join("other");
+    let out = dataset(&other, 10, 4, &["--shard", "1/3"])?;
+    ensure!(out.status.success(), "{}", text(&out.stderr));
+    let out = merge(
+        &[
+            dir(0),
+            other.join("shard-1-of-3").display().to_string(),
+            dir(2),
+        ],
+        &merged,
+    )?;
+    let error = text(&out.stderr);
+    ensure!(
+        !out.status.success() && error.contains("seed: Some(3) vs Some(4)"),
+        "{error}"
+    );
+    ensure!(!Path::new(&merged).exists(), "a refused merge wrote files");
+
+    for round in 0..2 {
+        let out = merge(&[dir(2), dir(0), dir(1)], &merged)?;
+        ensure!(out.status.success(), "{}", text(&out.stderr));
+        let (a, b) = (hashes(Path::new(&merged))?, hashes(&one)?);
+        ensure!(
+            a == b,
+            "merge {round}: differs from the one-machine run: {:?}",
+            a.keys()
+                .filter(|k| a.get(*k) != b.get(*k))
+                .collect::<Vec<_>>()
+        );
+        println!("merge {round}: {} files equal to the one-machine run's", a.len());
     }
     Ok(())
 }

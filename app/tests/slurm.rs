@@ -375,3 +375,188 @@ fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
     println!("re-running shard 1 alone completed the set: the same report");
     Ok(())
 }
+
+/// How many images the Slurm dataset test makes (24 per shard; `ROVER_SLURM_DATASET_IMAGES`
+/// sets another number, to measure throughput on a dataset large enough that start-up does not
+/// dominate) and from which seed.
+fn dataset_images() -> String {
+    std::env::var("ROVER_SLURM_DATASET_IMAGES").unwrap_or_else(|_| "96".into())
+}
+const DATASET_SEED: &str = "7";
+
+/// `rover dataset --jobs 2` of the playground world on one machine, into `out`.
+fn one_machine_dataset(rover: &Path, world: &Path, out: &Path) -> Result<f64> {
+    let started = Instant::now();
+    let output = Command::new(rover)
+        .arg("dataset")
+        .arg("--world")
+        .arg(world)
+        .args(["--images", &dataset_images(), "--seed", DATASET_SEED])
+        .args(["--jobs", "2", "--out"])
+        .arg(out)
+        .output()?;
+    ensure!(
+        output.status.success(),
+        "the one-machine dataset failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    Ok(started.elapsed().as_secs_f64())
+}
+
+/// The labels, records, COCO JSON, data.yaml and manifest of two dataset folders are equal
+/// file for file (SHA-256); so are the images. Returns how many files were compared.
+fn same_dataset(merged: &Path, one: &Path) -> Result<usize> {
+    let (a, b) = (
+        rover_tests::file_hashes(merged)?,
+        rover_tests::file_hashes(one)?,
+    );
+    let only = |x: &std::collections::BTreeMap<String, String>,
+                y: &std::collections::BTreeMap<String, String>| {
+        x.keys()
+            .filter(|k| !y.contains_key(*k))
+            .cloned()
+            .collect::<Vec<_>>()
+    };
+    ensure!(
+        a.keys().eq(b.keys()),
+        "different files: only in the merge {:?}, only in the one-machine run {:?}",
+        only(&a, &b),
+        only(&b, &a)
+    );
+    let differing: Vec<&String> = a.keys().filter(|k| a[*k] != b[*k]).collect();
+    ensure!(
+        differing.is_empty(),
+        "{} files differ from the one-machine run's, e.g. {:?}",
+        differing.len(),
+        &differing[..differing.len().min(5)]
+    );
+    ensure!(
+        a.keys().any(|k| k.starts_with("labels/"))
+            && a.contains_key("annotations/instances_train.json")
+            && a.contains_key("data.yaml"),
+        "the dataset lacks labels, COCO JSON or data.yaml: {:?}",
+        a.keys().take(10).collect::<Vec<_>>()
+    );
+    Ok(a.len())
+}
+
+/// scripts/slurm/dataset.sbatch as an array of 4 shards, then dataset-merge.sbatch after it:
+/// the merged dataset's labels, records, COCO JSON and images are SHA-256-equal to a
+/// one-machine run of the same seed. Then shard 1 cancelled with scancel after its first
+/// images: the merge names it missing and writes nothing; shard 1 re-run alone goes on from
+/// the images it kept, and the merge equals the one-machine run again.
+#[test]
+fn dataset_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
+    if let Some(why) = missing_slurm() {
+        eprintln!("SKIP: {why}");
+        return Ok(());
+    }
+    let cluster = match Cluster::start() {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("SKIP: Slurm will not start here: {e:#}");
+            return Ok(());
+        }
+    };
+    let rover = PathBuf::from(env!("CARGO_BIN_EXE_rover"));
+    let dir = cluster.dir.path().to_owned();
+    let world = repo().canonicalize()?.join("worlds/playground.toml");
+    let sbatch = repo().join("scripts/slurm/dataset.sbatch");
+    let merge_sbatch = repo().join("scripts/slurm/dataset-merge.sbatch");
+    let (sbatch, merge_sbatch) = (sbatch.to_string_lossy(), merge_sbatch.to_string_lossy());
+    let count = dataset_images();
+    let images: f64 = count.parse()?;
+
+    let one = dir.join("one");
+    let one_s = one_machine_dataset(&rover, &world, &one)?;
+
+    let out = dir.join("array");
+    let env = [
+        ("ROVER", rover.as_path()),
+        ("ROVER_WORLD", world.as_path()),
+        ("ROVER_IMAGES", Path::new(&count)),
+        ("ROVER_SEED", Path::new(DATASET_SEED)),
+        ("ROVER_OUT", out.as_path()),
+    ];
+    let started = Instant::now();
+    let array = cluster.sbatch(&[sbatch.as_ref()], &env)?;
+    let dependency = format!("--dependency=afterany:{array}");
+    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    cluster.wait(&merge, Duration::from_secs(600))?;
+    let wall_s = started.elapsed().as_secs_f64();
+    let merged = out.join("dataset");
+    ensure!(
+        merged.join("data.yaml").is_file(),
+        "the merge job wrote no dataset; its log:\n{}\nshard 0's log:\n{}",
+        cluster.log(&format!("rover-dataset-merge-{merge}.log")),
+        cluster.log(&format!("rover-dataset-{array}_0.log"))
+    );
+    let files = same_dataset(&merged, &one)?;
+    println!(
+        "{count} images: one machine --jobs 2 {one_s:.1} s ({:.1} images/s); 4 shards on Slurm and their merge {wall_s:.1} s ({:.1} images/s); {files} files SHA-256-equal to the one-machine run's",
+        images / one_s,
+        images / wall_s
+    );
+
+    // Shard 1 cancelled after its first complete images.
+    let out = dir.join("cancelled");
+    let env = [
+        ("ROVER", rover.as_path()),
+        ("ROVER_WORLD", world.as_path()),
+        ("ROVER_IMAGES", Path::new(&count)),
+        ("ROVER_SEED", Path::new(DATASET_SEED)),
+        ("ROVER_OUT", out.as_path()),
+    ];
+    let array = cluster.sbatch(&[sbatch.as_ref()], &env)?;
+    let dependency = format!("--dependency=afterany:{array}");
+    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    let task = format!("{array}_1");
+    let records = out.join("shards/shard-1-of-4/ground_truth/train");
+    let start = Instant::now();
+    while std::fs::read_dir(&records).map_or(0, |d| d.count()) < 2 {
+        ensure!(
+            start.elapsed() < Duration::from_secs(180),
+            "task {task} made no image: {:?}",
+            cluster.queue(&array)?
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = cluster.command("/usr/bin/scancel").arg(&task).status()?;
+    ensure!(status.success(), "scancel {task} failed");
+    cluster.wait(&merge, Duration::from_secs(600))?;
+    let log = cluster.log(&format!("rover-dataset-merge-{merge}.log"));
+    println!("merge after scancel of {task}:\n{log}");
+    ensure!(
+        log.contains("shard 1 of 4 missing") && !out.join("dataset").exists(),
+        "the merge did not name shard 1 missing:\n{log}"
+    );
+
+    // Shard 1 alone goes on from its complete images; then the merge again.
+    let rerun = cluster.sbatch(&["--array=1", sbatch.as_ref()], &{
+        let mut e = env.to_vec();
+        e.push(("ROVER_SHARDS", Path::new("4")));
+        e
+    })?;
+    let dependency = format!("--dependency=afterok:{rerun}");
+    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    cluster.wait(&merge, Duration::from_secs(600))?;
+    let rerun_log = cluster.log(&format!("rover-dataset-{rerun}_1.log"));
+    ensure!(
+        out.join("dataset/data.yaml").is_file(),
+        "the merge after the re-run wrote nothing:\n{}\nre-run:\n{rerun_log}",
+        cluster.log(&format!("rover-dataset-merge-{merge}.log"))
+    );
+    ensure!(
+        rerun_log.contains("resuming"),
+        "the re-run did not go on from the cancelled shard's images:\n{rerun_log}"
+    );
+    same_dataset(&out.join("dataset"), &one)?;
+    println!(
+        "re-running shard 1 alone went on from its kept images and completed the set: the same dataset ({})",
+        rerun_log
+            .lines()
+            .find(|l| l.contains("resuming"))
+            .unwrap_or_default()
+    );
+    Ok(())
+}

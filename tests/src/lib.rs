@@ -232,3 +232,23 @@ pub const STREET_WORLD: &str = r#"<sdf version="1.6"><world name="street">
   <include><uri>model://fire_hydrant</uri><pose>3 -1.5 0 0 0 0</pose></include>
   <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
 </world></sdf>"#;
+
+/// Every file under `dir`, by path relative to it, with its SHA-256 in hex (temporaries
+/// included: a finished run must leave none).
+pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<String, String>> {
+    use sha2::{Digest, Sha256};
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d)? {
+            let path = entry?.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let rel = path.strip_prefix(dir)?.display().to_string();
+                out.insert(rel, format!("{:x}", Sha256::digest(std::fs::read(&path)?)));
+            }
+        }
+    }
+    Ok(out)
+}

@@ -727,6 +727,10 @@ pub(crate) enum BenchKind {
         /// Image files: png or jpg
         #[arg(long, default_value = "png", value_name = "png|jpg")]
         image_format: DatasetImageFormat,
+
+        /// Images made at once, as `rover dataset --jobs` [default: the number of CPU cores]
+        #[arg(long, short = 'j', value_name = "N")]
+        jobs: Option<usize>,
     },
     /// Inverse kinematics: ms per solve (damped least squares) to targets made by forward
     /// kinematics from seeded random in-limit poses of the chain, solved from its rest pose;
@@ -836,6 +840,23 @@ pub(crate) struct DatasetArgs {
     /// OUT/detections/, and its COCO metrics (AP50, AP50:95, per class) in OUT/metrics.json
     #[arg(long)]
     pub(crate) detect: bool,
+
+    /// Images to make at once, each on a thread of its own with its own simulation, camera
+    /// and detector; the files do not depend on it [default: the number of CPU cores]
+    #[arg(long, short = 'j', value_name = "N")]
+    pub(crate) jobs: Option<usize>,
+
+    /// Make only shard I of N (counted from 0), e.g. one Slurm array task: the images whose
+    /// number modulo N is I, into OUT/shard-I-of-N/ (resumable like any dataset). Merge the N
+    /// folders with --merge once all are finished (docs/SCALE.md)
+    #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+    pub(crate) shard: Option<(usize, usize)>,
+
+    /// Merge the folders of finished shards (OUT/shard-I-of-N/ of --shard) into the dataset
+    /// folder OUT, with one COCO JSON and data.yaml, instead of making images. Refuses an
+    /// incomplete set (naming the missing shards) or shards made differently (naming the field)
+    #[arg(long, value_name = "SHARD_DIR", num_args = 1.., conflicts_with_all = ["shard", "detect", "images", "world", "robot"])]
+    pub(crate) merge: Vec<PathBuf>,
 
     #[command(flatten)]
     pub(crate) detector: DetectorArgs,

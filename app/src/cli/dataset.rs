@@ -5,7 +5,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
-use rover_core::{DatasetProgress, DatasetSpec, DatasetSummary, ImageFormat, Randomization};
+use rover_core::{
+    DatasetProgress, DatasetSpec, DatasetSummary, ImageFormat, Randomization, ShardIndex,
+};
 
 use crate::cli::args::{
     DatasetArgs, DatasetFormat, DatasetImageFormat, Randomize, spare_detect_threads,
@@ -48,13 +50,53 @@ fn randomization(args: &DatasetArgs) -> Randomization {
     }
 }
 
+/// The progress bar of making or merging images.
+fn progress_bar(images: u64) -> ProgressBar {
+    let bar = ProgressBar::new(images);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} images  {per_sec}  eta {eta}  {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// `rover dataset --merge`: the shards' folders into one dataset.
+fn merge(args: &DatasetArgs) -> Result<()> {
+    let bar = progress_bar(0);
+    let summary = rover_core::merge_dataset(&args.merge, &args.out, &mut |p: DatasetProgress| {
+        bar.set_length(p.total);
+        bar.set_position(p.done);
+    });
+    bar.finish_and_clear();
+    let (spec, summary) = summary?;
+    println!(
+        "merged {} shard folders into {}: {} images ({} gathered now, {} there before)",
+        args.merge.len(),
+        summary.out.display(),
+        summary.total,
+        summary.made,
+        summary.kept
+    );
+    print_contents(&summary, &spec);
+    Ok(())
+}
+
 /// Runs `rover dataset`.
 pub(crate) fn run(args: DatasetArgs) -> Result<()> {
+    if !args.merge.is_empty() {
+        return merge(&args);
+    }
     let mut config = args.world.run_config(None);
     config.detector = args.detector.tool_config(spare_detect_threads())?;
     config.stop = Some(stop_on_signals()?);
+    let shard = args.shard.map(|(index, count)| ShardIndex { index, count });
     let spec = DatasetSpec {
-        out: args.out.clone(),
+        out: match shard {
+            Some(s) => args.out.join(format!("shard-{}-of-{}", s.index, s.count)),
+            None => args.out.clone(),
+        },
         images: args.images,
         seed: args.world.seed,
         val_fraction: args.val,
@@ -63,14 +105,10 @@ pub(crate) fn run(args: DatasetArgs) -> Result<()> {
         coco: args.format.contains(&DatasetFormat::Coco),
         randomization: randomization(&args),
         detect: args.detect,
+        shard,
+        jobs: args.jobs.unwrap_or_else(cores),
     };
-    let bar = ProgressBar::new(spec.images);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} images  {per_sec}  eta {eta}  {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = progress_bar(spec.images);
     let mut first = true;
     let summary = rover_core::write_dataset(&config, &spec, &mut |p: DatasetProgress| {
         if first {
@@ -85,6 +123,7 @@ pub(crate) fn run(args: DatasetArgs) -> Result<()> {
                     );
                 });
             }
+            bar.set_length(p.total);
             bar.set_position(p.done);
             bar.reset_eta();
         }
@@ -117,7 +156,32 @@ fn print_summary(s: &DatasetSummary, spec: &DatasetSpec) {
         s.made,
         s.kept
     );
-    if s.interrupted {
+    if !s.interrupted {
+        print_contents(s, spec);
+    }
+}
+
+/// What the dataset (or shard) holds and which files were written.
+fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
+    if let Some(shard) = spec.shard {
+        println!(
+            "  shard {}/{}: train {} / val {} images; {} labelled boxes, {} ignore regions; wrote images/, ground_truth/{}, {}",
+            shard.index,
+            shard.count,
+            s.split_images[0],
+            s.split_images[1],
+            s.boxes,
+            s.ignored,
+            if spec.yolo { ", labels/" } else { "" },
+            rover_core::SHARD_MANIFEST
+        );
+        println!(
+            "  once every shard is finished: rover dataset --merge {}/shard-*-of-{} --out DATASET_DIR",
+            spec.out
+                .parent()
+                .map_or_else(|| ".".into(), |p| p.display().to_string()),
+            shard.count
+        );
         return;
     }
     println!(
@@ -161,11 +225,17 @@ fn print_summary(s: &DatasetSummary, spec: &DatasetSpec) {
     }
 }
 
+/// The machine's CPU cores: `--jobs`' default.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// `rover bench dataset`: images per second into a temporary folder, after one warm-up image.
 pub(crate) fn bench(
     world: crate::cli::args::WorldArgs,
     images: u64,
     format: DatasetImageFormat,
+    jobs: Option<usize>,
 ) -> Result<()> {
     let config = world.run_config(None);
     let scratch = tempfile::tempdir()?;
@@ -179,22 +249,26 @@ pub(crate) fn bench(
         coco: true,
         randomization: Randomization::default(),
         detect: false,
+        shard: None,
+        jobs: 1,
     };
     rover_core::write_dataset(&config, &spec, &mut |_| {})?;
     let spec = DatasetSpec {
         images: images.max(1) + 1,
+        jobs: jobs.unwrap_or_else(cores),
         ..spec
     };
     let start = Instant::now();
     let summary = rover_core::write_dataset(&config, &spec, &mut |_| {})?;
     let total_s = start.elapsed().as_secs_f64();
     println!(
-        "dataset benchmark: {} labelled {} images: {:.1} images/s while making them ({:.1} ms each), {:.1}/s including set-up and the COCO/YOLO files ({:.2} s in all)",
+        "dataset benchmark: {} labelled {} images, {} at once: {:.1} images/s while making them ({:.1} ms each), {:.1}/s including set-up and the COCO/YOLO files ({:.2} s in all)",
         summary.made,
         match format {
             DatasetImageFormat::Png => "PNG",
             DatasetImageFormat::Jpg => "JPEG",
         },
+        spec.jobs,
         summary.made as f64 / summary.wall_s,
         1e3 * summary.wall_s / summary.made.max(1) as f64,
         summary.made as f64 / total_s,

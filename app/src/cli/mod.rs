@@ -106,9 +106,10 @@ pub fn main() -> ExitCode {
                     world,
                     images,
                     image_format,
+                    jobs,
                 }),
             ..
-        }) => dataset::bench(world, images, image_format),
+        }) => dataset::bench(world, images, image_format, jobs),
         Some(Command::Bench {
             kind:
                 Some(BenchKind::Ik {

@@ -6,26 +6,29 @@
 //! disk ([`store`] says how the folder is kept consistent).
 
 mod export;
+mod merge;
 mod randomize;
 mod store;
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
 use rover_perception::{CocoEvaluator, DetectionMetrics, Detector, FrameStamp, RgbView};
-use rover_sim::{CameraSensor, SimOptions, Simulation};
+use rover_sim::{CameraSensor, RobotModel, SimOptions, Simulation, World};
 
 pub use export::{
     COCO_CATEGORY_IDS, DetectedBox, ImageRecord, LabelledBox, coco_category, coco_json,
     coco_results, data_yaml, yolo_class,
 };
+pub use merge::{SHARD_MANIFEST, merge_dataset};
 pub use randomize::{Randomization, Shot};
 pub use store::{ImageFormat, MANIFEST, MANIFEST_FORMAT, Manifest, Split, Store, write_whole};
 
 use crate::error::{CoreError, Result};
 use crate::headless::RunConfig;
-use crate::shard::sha256_of;
+use crate::shard::{ShardIndex, sha256_of};
 use randomize::{BaseLayout, Rng, lay_out};
 
 /// What dataset to make.
@@ -50,6 +53,13 @@ pub struct DatasetSpec {
     /// Run the detector on every image: its boxes in the records, COCO results files and
     /// rover's COCO metrics of it (`metrics.json`).
     pub detect: bool,
+    /// Make only this shard's images (those whose number modulo N is I) into `out`, and
+    /// instead of the COCO JSON and data.yaml write the shard's manifest ([`SHARD_MANIFEST`])
+    /// for [`merge_dataset`].
+    pub shard: Option<ShardIndex>,
+    /// How many images to make at once, each lane with its own simulation, camera and
+    /// detector on a thread of its own (0 or 1: one). The files do not depend on it.
+    pub jobs: usize,
 }
 
 /// How far a dataset run is.
@@ -101,6 +111,97 @@ struct Job {
     record: String,
 }
 
+/// One lane of image making: its own simulation, camera (with ground truth) and detector.
+/// `--jobs N` runs N lanes on threads of their own, each over every Nth image still to make.
+struct Lane {
+    sim: Simulation,
+    camera: CameraSensor,
+    detector: Option<Detector>,
+}
+
+impl Lane {
+    fn new(
+        config: &RunConfig,
+        spec: &DatasetSpec,
+        world: World,
+        robot: RobotModel,
+    ) -> Result<Self> {
+        let options = SimOptions {
+            seed: spec.seed,
+            ..config.options.clone()
+        };
+        let sim = Simulation::new(world, robot, &options)?;
+        let mut camera = CameraSensor::new(&sim).map_err(CoreError::Camera)?;
+        camera
+            .enable_ground_truth(&sim)
+            .map_err(CoreError::Camera)?;
+        let detector = match spec.detect {
+            true => Some(Detector::load(config.detector.clone())?),
+            false => None,
+        };
+        Ok(Self {
+            sim,
+            camera,
+            detector,
+        })
+    }
+}
+
+/// What every lane shares.
+struct Shared<'a> {
+    config: &'a RunConfig,
+    spec: &'a DatasetSpec,
+    store: &'a Store,
+    base: &'a BaseLayout,
+    /// Set when a lane fails: the others stop at their next image.
+    failed: &'a AtomicBool,
+}
+
+/// Makes `indices` with `lane`, hearing of each image on `made`. Returns whether it stopped
+/// on request (Ctrl-C); errors set `failed` so that the other lanes stop too.
+fn run_lane(
+    lane: &mut Lane,
+    shared: &Shared,
+    indices: &[u64],
+    made: &mpsc::Sender<()>,
+) -> Result<bool> {
+    let result = std::thread::scope(|scope| -> Result<bool> {
+        let (jobs, inbox) = mpsc::sync_channel::<Job>(2);
+        let (returns, recycled) = mpsc::channel::<Vec<u8>>();
+        let writer_store = shared.store.clone();
+        let format = shared.spec.image_format;
+        let writer = scope.spawn(move || write_jobs(&writer_store, inbox, format, returns));
+        let mut interrupted = false;
+        for &index in indices {
+            if shared.config.stop_requested() {
+                interrupted = true;
+                break;
+            }
+            if shared.failed.load(Ordering::Relaxed) {
+                break;
+            }
+            let rgb = recycled.try_recv().unwrap_or_default();
+            let job = make_image(lane, (shared.base, shared.spec, shared.store), index, rgb)?;
+            if jobs.send(job).is_err() {
+                break; // the writer stopped on an error, joined below
+            }
+            let _ = made.send(());
+        }
+        drop(jobs);
+        match writer.join() {
+            Ok(Ok(())) => Ok(interrupted),
+            Ok(Err((path, e))) => Err(disk_error(&path, e, shared.store, shared.spec.images)),
+            Err(_) => Err(CoreError::Option(
+                "the dataset writer thread panicked".into(),
+            )),
+        }
+    });
+    if result.is_err() {
+        shared.failed.store(true, Ordering::Relaxed);
+    }
+    result
+}
+
 /// Makes (or resumes) the dataset `spec` asks for from the world and robot `config` names.
 /// `progress` hears of every image completed. Errors: bad options, a folder that holds
 /// something else, a disk that fills up (what was written stays complete and resumable).
@@ -115,92 +216,109 @@ pub fn write_dataset(
         // Still scenes: people stand where the layout puts them.
         person.walk = None;
     }
-    let options = SimOptions {
-        seed: spec.seed,
-        ..config.options.clone()
-    };
-    let mut sim = Simulation::new(world, robot, &options)?;
-    let mut camera = CameraSensor::new(&sim).map_err(CoreError::Camera)?;
-    camera
-        .enable_ground_truth(&sim)
-        .map_err(CoreError::Camera)?;
-    let mut detector = match spec.detect {
-        true => Some(Detector::load(config.detector.clone())?),
-        false => None,
-    };
-    let manifest = manifest(spec, &sim, &camera, detector.as_ref())?;
+    let first = Lane::new(config, spec, world.clone(), robot.clone())?;
+    let manifest = manifest(spec, &first.sim, &first.camera, first.detector.as_ref())?;
+    let model = first
+        .detector
+        .as_ref()
+        .map(|d| d.model_path().to_path_buf());
     let (store, done) = Store::open(&spec.out, &manifest)?;
-    let base = BaseLayout::new(&sim);
+    if spec.shard.is_some() {
+        merge::forget_shard_manifest(&store)?;
+    }
+    let base = BaseLayout::new(&first.sim);
     if base.targets() == 0 {
         tracing::warn!(
             "{}: nothing in the world is labelled (people, objects with class = \"...\", Gazebo models of a known class): every image will be a background image",
-            sim.world().source.display()
+            first.sim.world().source.display()
         );
     }
-    let kept = done.len() as u64;
+    let owned: Vec<u64> = (0..spec.images)
+        .filter(|i| spec.shard.is_none_or(|s| s.owns(*i)))
+        .collect();
+    let todo: Vec<u64> = owned
+        .iter()
+        .copied()
+        .filter(|i| !done.contains(i))
+        .collect();
+    let (total, kept) = (owned.len() as u64, owned.len() as u64 - todo.len() as u64);
     progress(DatasetProgress {
         done: kept,
-        total: spec.images,
+        total,
         kept,
     });
+    let lanes = spec.jobs.clamp(1, todo.len().max(1));
+    let failed = AtomicBool::new(false);
+    let shared = Shared {
+        config,
+        spec,
+        store: &store,
+        base: &base,
+        failed: &failed,
+    };
     let start = Instant::now();
-    let (made, interrupted) = std::thread::scope(|scope| -> Result<(u64, bool)> {
-        let (jobs, inbox) = mpsc::sync_channel::<Job>(2);
-        let (returns, recycled) = mpsc::channel::<Vec<u8>>();
-        let writer_store = store.clone();
-        let writer =
-            scope.spawn(move || write_jobs(&writer_store, inbox, spec.image_format, returns));
+    let mut first = Some(first);
+    let (results, made) = std::thread::scope(|scope| {
+        let (made_tx, made_rx) = mpsc::channel::<()>();
+        let mut handles = Vec::with_capacity(lanes);
+        for l in 0..lanes {
+            let indices: Vec<u64> = todo.iter().copied().skip(l).step_by(lanes).collect();
+            let (made_tx, shared, lane) = (made_tx.clone(), &shared, first.take());
+            let (world, robot) = (&world, &robot);
+            handles.push(scope.spawn(move || {
+                let mut lane = match lane {
+                    Some(lane) => lane,
+                    None => Lane::new(config, spec, world.clone(), robot.clone())
+                        .inspect_err(|_| shared.failed.store(true, Ordering::Relaxed))?,
+                };
+                run_lane(&mut lane, shared, &indices, &made_tx)
+            }));
+        }
+        drop(made_tx);
         let mut made = 0;
-        let mut interrupted = false;
-        for index in (0..spec.images).filter(|i| !done.contains(i)) {
-            if config.stop_requested() {
-                interrupted = true;
-                break;
-            }
-            let rgb = recycled.try_recv().unwrap_or_default();
-            let job = make_image(
-                &mut sim,
-                &mut camera,
-                detector.as_mut(),
-                (&base, spec, &store),
-                index,
-                rgb,
-            )?;
-            if jobs.send(job).is_err() {
-                break; // the writer stopped on an error, joined below
-            }
+        for () in made_rx {
             made += 1;
             progress(DatasetProgress {
                 done: kept + made,
-                total: spec.images,
+                total,
                 kept,
             });
         }
-        drop(jobs);
-        match writer.join() {
-            Ok(Ok(())) => Ok((made, interrupted)),
-            Ok(Err((path, e))) => Err(disk_error(&path, e, &store, spec.images)),
-            Err(_) => Err(CoreError::Option(
-                "the dataset writer thread panicked".into(),
-            )),
-        }
-    })?;
-    let wall_s = start.elapsed().as_secs_f64();
+        let results: Vec<Result<bool>> = handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err(CoreError::Option("a dataset lane panicked".into())))
+            })
+            .collect();
+        (results, made)
+    });
+    let mut interrupted = false;
+    for result in results {
+        interrupted |= result?;
+    }
     let mut summary = DatasetSummary {
         out: spec.out.clone(),
-        total: spec.images,
+        total,
         made,
         kept,
         split_images: [0; 2],
         boxes: 0,
         ignored: 0,
         backgrounds: 0,
-        wall_s,
+        wall_s: start.elapsed().as_secs_f64(),
         interrupted,
         metrics: None,
     };
-    if !interrupted {
-        finish(&store, spec, &mut summary)?;
+    match (interrupted, spec.shard) {
+        (true, _) => {}
+        (false, None) => finish(&store, spec, &mut summary)?,
+        (false, Some(shard)) => {
+            let records = read_records(&store, owned.into_iter())?;
+            count(&records, &mut summary);
+            let inputs = [world.source.clone(), robot.source.clone()];
+            merge::write_shard_manifest(&store, &inputs, spec, shard, model.as_deref())?;
+        }
     }
     Ok(summary)
 }
@@ -264,18 +382,22 @@ fn manifest(
         height: camera.info().height,
         randomization: spec.randomization.clone(),
         detector,
+        shard: spec.shard,
     })
 }
 
 /// Lays out, renders and labels image `index`.
 fn make_image(
-    sim: &mut Simulation,
-    camera: &mut CameraSensor,
-    detector: Option<&mut Detector>,
+    lane: &mut Lane,
     (base, spec, store): (&BaseLayout, &DatasetSpec, &Store),
     index: u64,
     mut rgb: Vec<u8>,
 ) -> Result<Job> {
+    let Lane {
+        sim,
+        camera,
+        detector,
+    } = lane;
     let mut rng = Rng::for_image(spec.seed, index);
     let split = if rng.uniform() < spec.val_fraction {
         Split::Val
@@ -293,7 +415,7 @@ fn make_image(
         .iter()
         .map(LabelledBox::from_truth)
         .collect();
-    let detections = match detector {
+    let detections = match detector.as_mut() {
         Some(d) => {
             let view = RgbView::new(width as usize, height as usize, &rgb)?;
             let stamp = FrameStamp {
@@ -425,29 +547,8 @@ fn disk_error(path: &Path, e: std::io::Error, store: &Store, total: u64) -> Core
 /// Reads every record back and writes what is made from all of them: data.yaml, COCO JSON,
 /// detections and metrics.
 fn finish(store: &Store, spec: &DatasetSpec, summary: &mut DatasetSummary) -> Result<()> {
-    let mut records = Vec::with_capacity(spec.images as usize);
-    for index in 0..spec.images {
-        let record = Split::ALL
-            .iter()
-            .map(|s| store.record_path(*s, index))
-            .find(|p| p.is_file())
-            .ok_or_else(|| CoreError::Option(format!("image {index}'s record is missing")))?;
-        let text = std::fs::read_to_string(&record).map_err(|e| CoreError::write(&record, e))?;
-        let r: ImageRecord = serde_json::from_str(&text).map_err(|e| {
-            CoreError::Option(format!(
-                "{}: not an image record ({e}); delete it and run again to remake that image",
-                record.display()
-            ))
-        })?;
-        records.push(r);
-    }
-    for r in &records {
-        summary.split_images[usize::from(r.split == Split::Val)] += 1;
-        let boxes = r.objects.iter().filter(|o| !o.ignore).count() as u64;
-        summary.boxes += boxes;
-        summary.ignored += r.objects.len() as u64 - boxes;
-        summary.backgrounds += u64::from(boxes == 0);
-    }
+    let records = read_records(store, 0..spec.images)?;
+    count(&records, summary);
     let root = store.root();
     let write = |path: PathBuf, text: &str| -> Result<()> {
         write_whole(&path, text.as_bytes()).map_err(|e| disk_error(&path, e, store, spec.images))
@@ -490,6 +591,38 @@ fn finish(store: &Store, spec: &DatasetSpec, summary: &mut DatasetSummary) -> Re
         summary.metrics = Some(metrics);
     }
     Ok(())
+}
+
+/// The records of images `indices`, read back from the store.
+fn read_records(store: &Store, indices: impl Iterator<Item = u64>) -> Result<Vec<ImageRecord>> {
+    let mut records = Vec::new();
+    for index in indices {
+        let record = Split::ALL
+            .iter()
+            .map(|s| store.record_path(*s, index))
+            .find(|p| p.is_file())
+            .ok_or_else(|| CoreError::Option(format!("image {index}'s record is missing")))?;
+        let text = std::fs::read_to_string(&record).map_err(|e| CoreError::write(&record, e))?;
+        let r: ImageRecord = serde_json::from_str(&text).map_err(|e| {
+            CoreError::Option(format!(
+                "{}: not an image record ({e}); delete it and run again to remake that image",
+                record.display()
+            ))
+        })?;
+        records.push(r);
+    }
+    Ok(records)
+}
+
+/// Adds `records`' splits, boxes, ignore regions and background images to `summary`.
+fn count(records: &[ImageRecord], summary: &mut DatasetSummary) {
+    for r in records {
+        summary.split_images[usize::from(r.split == Split::Val)] += 1;
+        let boxes = r.objects.iter().filter(|o| !o.ignore).count() as u64;
+        summary.boxes += boxes;
+        summary.ignored += r.objects.len() as u64 - boxes;
+        summary.backgrounds += u64::from(boxes == 0);
+    }
 }
 
 /// How many of the first `total` images have their record (are complete).

@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::dataset::randomize::Randomization;
 use crate::error::{CoreError, Result};
+use crate::shard::ShardIndex;
 
 /// The manifest's file name.
 pub const MANIFEST: &str = "rover-dataset.json";
@@ -106,6 +107,10 @@ pub struct Manifest {
     pub randomization: Randomization,
     /// The detector run on every image (`--detect`): model file name and SHA-256, threshold.
     pub detector: Option<String>,
+    /// The shard this folder holds (`--shard I/N`), absent for a whole dataset (made on one
+    /// machine or merged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardIndex>,
 }
 
 /// The manifest's current format.
@@ -165,6 +170,12 @@ impl Manifest {
             format!("{:?}", self.detector),
             format!("{:?}", other.detector),
         );
+        let shard = |s: Option<ShardIndex>| {
+            s.map_or("none (a whole dataset)".to_owned(), |s| {
+                format!("{}/{}", s.index, s.count)
+            })
+        };
+        check("shard", shard(self.shard), shard(other.shard));
         out
     }
 }
@@ -228,6 +239,16 @@ impl Store {
             .map_err(|e| CoreError::write(&manifest_path, e))?;
         let done = store.complete(manifest.images)?;
         Ok((store, done))
+    }
+
+    /// The folder `root` made with `manifest`'s layout, to read from: nothing is checked or
+    /// created.
+    pub fn at(root: &Path, manifest: &Manifest) -> Self {
+        Self {
+            root: root.to_path_buf(),
+            image_format: manifest.image_format,
+            yolo: manifest.yolo,
+        }
     }
 
     fn split_dirs(&self, split: Split) -> Vec<PathBuf> {
