@@ -93,3 +93,11 @@ fi
 # One build folder outside the clone, shared by ./run, ./test and CI (incremental rebuilds).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$cache/target}"
 mkdir -p "$CARGO_TARGET_DIR"
+
+# Without a desktop session (no XDG_RUNTIME_DIR: a server, CI, ssh) Mesa's device-select Vulkan
+# layer probes for a Wayland display to pick the GPU and libwayland prints "error:
+# XDG_RUNTIME_DIR is invalid or not set" once per renderer. There is no display to choose
+# by then: turn the probe off.
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+  export NODEVICE_SELECT=1
+fi
