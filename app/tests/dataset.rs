@@ -539,7 +539,10 @@ fn shards_merge_into_the_one_machine_dataset_and_a_broken_set_is_refused() -> Re
                 .filter(|k| a.get(*k) != b.get(*k))
                 .collect::<Vec<_>>()
         );
-        println!("merge {round}: {} files equal to the one-machine run's", a.len());
+        println!(
+            "merge {round}: {} files equal to the one-machine run's",
+            a.len()
+        );
     }
     Ok(())
 }

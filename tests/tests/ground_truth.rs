@@ -385,3 +385,35 @@ fn yolo_finds_the_textured_street_models() -> Result<()> {
     assert!((0.8..1.25).contains(&aspect), "stop sign box {sign:?}");
     Ok(())
 }
+
+/// Eleven labelled boxes in a row across the view (more than one silhouette pass holds: layers
+/// go eight to a pass), none in front of another: every box's silhouette counts exactly the
+/// pixels the id image gives it, so every visibility is 1, whichever pass drew it.
+#[test]
+fn every_thing_of_many_gets_its_own_silhouette() -> Result<()> {
+    let boxes: Vec<String> = (0..11)
+        .map(|i| {
+            format!(
+                "[[box]]\nname = \"b{i}\"\nsize_m = [0.3, 0.3, 0.6]\nposition_m = [6.0, {:.2}]\ncolor = \"#ff0000\"\nclass = \"suitcase\"\n",
+                2.5 - 0.5 * f64::from(i)
+            )
+        })
+        .collect();
+    let parts: Vec<&str> = boxes.iter().map(String::as_str).collect();
+    let shot = shoot(&parts, None)?;
+    let seen: Vec<&GroundTruthBox> = shot.truth.iter().filter(|b| b.visible_px > 0).collect();
+    assert!(seen.len() >= 9, "only {} of 11 boxes in view", seen.len());
+    for b in &seen {
+        let drawn = shot.ids.iter().filter(|&&id| id == b.id).count() as u32;
+        assert_eq!(b.visible_px, drawn, "{b:?}");
+        assert!(
+            b.unoccluded_px.abs_diff(b.visible_px) <= 2 && b.visibility > 0.99,
+            "box {} (id {}): {} visible px, silhouette {} px",
+            b.class,
+            b.id,
+            b.visible_px,
+            b.unoccluded_px
+        );
+    }
+    Ok(())
+}

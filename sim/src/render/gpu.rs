@@ -192,7 +192,6 @@ fn read_mapped(
 /// A mappable copy of a GPU buffer, allocated once.
 pub(crate) struct BufferReadback {
     buffer: wgpu::Buffer,
-    size: u64,
     mapped: Arc<AtomicU8>,
 }
 
@@ -206,14 +205,13 @@ impl BufferReadback {
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            size,
             mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
         }
     }
 
-    /// Records the copy of `source` (at least as large) into the buffer.
-    pub(crate) fn copy_from(&self, encoder: &mut wgpu::CommandEncoder, source: &wgpu::Buffer) {
-        encoder.copy_buffer_to_buffer(source, 0, &self.buffer, 0, self.size);
+    /// The buffer, for copies into it.
+    pub(crate) fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
     }
 
     /// Waits for the submitted copy and hands its bytes to `read`.

@@ -281,13 +281,11 @@ impl CameraRenderer {
             ids.silhouette.prepare(&self.gpu.queue, &view);
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        let scene = &self.scene;
         self.colour
-            .encode(&self.gpu.queue, &mut encoder, scene, &view, |pass| {
-                if let Some(ids) = silhouette {
-                    ids.silhouette.draw(pass, scene);
-                }
-            });
+            .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
+        if let Some(ids) = silhouette {
+            ids.silhouette.encode(&mut encoder, &self.scene);
+        }
         self.readback.copy_from(&mut encoder, &self.colour.target);
         if let Some(ids) = &self.ids {
             ids.readback.copy_from(&mut encoder, &self.colour.ids);

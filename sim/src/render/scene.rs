@@ -117,6 +117,13 @@ pub(crate) struct Scene {
     objects: Vec<usize>,
 }
 
+impl Scene {
+    /// The labelled entity mesh `mesh` belongs to (0: none).
+    pub(crate) fn entity_of(&self, mesh: u32) -> u32 {
+        self.instances.get(mesh as usize).map_or(0, |i| i.entity)
+    }
+}
+
 /// Collects meshes and instances before the instance buffer exists.
 struct Builder<'d> {
     device: &'d wgpu::Device,

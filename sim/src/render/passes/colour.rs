@@ -148,16 +148,13 @@ impl ColourPass {
         self.light = light;
     }
 
-    /// Uploads this frame's uniforms and records the pass; `after` records more draws into
-    /// the same pass (same targets and depth buffer; one pass is far cheaper than two on a
-    /// software rasterizer).
+    /// Uploads this frame's uniforms and records the pass.
     pub(crate) fn encode(
         &self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         scene: &Scene,
         view: &View,
-        after: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) {
         let world_from_optical = view.world_from_optical;
         let view_matrix = Mat4::from_rotation_translation(
@@ -232,7 +229,6 @@ impl ColourPass {
                 pass.draw_indexed(indices, 0, i as u32..i as u32 + 1);
             }
         }
-        after(&mut pass);
     }
 }
 
