@@ -185,6 +185,71 @@ impl Cluster {
     }
 }
 
+impl Cluster {
+    /// A started cluster, or `None` after saying why this test skips.
+    fn start_or_skip() -> Option<Self> {
+        if let Some(why) = missing_slurm() {
+            eprintln!("SKIP: {why}");
+            return None;
+        }
+        match Self::start() {
+            Ok(c) => Some(c),
+            Err(e) => {
+                eprintln!("SKIP: Slurm will not start here: {e:#}");
+                None
+            }
+        }
+    }
+
+    /// Submits `scripts`' array (with `extra` sbatch options, e.g. `--array=1`) and its merge,
+    /// which runs once the array is over (`after`: `afterany`, or `afterok`): their job ids.
+    fn submit(
+        &self,
+        scripts: &Scripts,
+        extra: &[&str],
+        after: &str,
+        env: &[(&str, &Path)],
+    ) -> Result<(String, String)> {
+        let mut args = extra.to_vec();
+        args.push(&scripts.array);
+        let array = self.sbatch(&args, env)?;
+        let dependency = format!("--dependency={after}:{array}");
+        let merge = self.sbatch(&[dependency.as_str(), &scripts.merge], env)?;
+        Ok((array, merge))
+    }
+
+    /// Shard 1 of 4 alone (`ROVER_SHARDS=4 sbatch --array=1`, as docs/SCALE.md says), then the
+    /// merge once it succeeded: their job ids.
+    fn rerun_shard_1(&self, scripts: &Scripts, env: &[(&str, &Path)]) -> Result<(String, String)> {
+        let mut env = env.to_vec();
+        env.push(("ROVER_SHARDS", Path::new("4")));
+        self.submit(scripts, &["--array=1"], "afterok", &env)
+    }
+}
+
+/// A sharded job's two sbatch files in scripts/slurm/, submitted unchanged.
+struct Scripts {
+    array: String,
+    merge: String,
+}
+
+impl Scripts {
+    /// scripts/slurm/NAME.sbatch and NAME-merge.sbatch.
+    fn new(name: &str) -> Self {
+        let path = |file: String| {
+            repo()
+                .join("scripts/slurm")
+                .join(file)
+                .display()
+                .to_string()
+        };
+        Self {
+            array: path(format!("{name}.sbatch")),
+            merge: path(format!("{name}-merge.sbatch")),
+        }
+    }
+}
+
 impl Drop for Cluster {
     fn drop(&mut self) {
         for pid_file in ["slurmd.pid", "slurmctld.pid", "munged.pid"] {
@@ -244,26 +309,13 @@ fn without_timing(path: &Path) -> Result<serde_json::Value> {
 /// gives the same report again.
 #[test]
 fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
-    if let Some(why) = missing_slurm() {
-        eprintln!("SKIP: {why}");
+    let Some(cluster) = Cluster::start_or_skip() else {
         return Ok(());
-    }
-    let cluster = match Cluster::start() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("SKIP: Slurm will not start here: {e:#}");
-            return Ok(());
-        }
     };
     let rover = PathBuf::from(env!("CARGO_BIN_EXE_rover"));
     let dir = cluster.dir.path().to_owned();
     let scenarios = scenarios(&dir)?;
-    let eval_sbatch = repo().join("scripts/slurm/eval.sbatch");
-    let merge_sbatch = repo().join("scripts/slurm/eval-merge.sbatch");
-    let (eval_s, merge_s) = (
-        eval_sbatch.to_string_lossy(),
-        merge_sbatch.to_string_lossy(),
-    );
+    let scripts = Scripts::new("eval");
 
     // One machine.
     let one = dir.join("one");
@@ -289,9 +341,7 @@ fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
         ("ROVER_OUT", out.as_path()),
     ];
     let started = Instant::now();
-    let array = cluster.sbatch(&[eval_s.as_ref()], &env)?;
-    let dependency = format!("--dependency=afterany:{array}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_s.as_ref()], &env)?;
+    let (_, merge) = cluster.submit(&scripts, &[], "afterany", &env)?;
     cluster.wait(&merge, Duration::from_secs(600))?;
     let wall_s = started.elapsed().as_secs_f64();
     let merged = out.join("eval.json");
@@ -326,9 +376,7 @@ fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
         ("ROVER_SCENARIOS", scenarios.as_path()),
         ("ROVER_OUT", out.as_path()),
     ];
-    let array = cluster.sbatch(&[eval_s.as_ref()], &env)?;
-    let dependency = format!("--dependency=afterany:{array}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_s.as_ref()], &env)?;
+    let (array, merge) = cluster.submit(&scripts, &[], "afterany", &env)?;
     let task = format!("{array}_1");
     let start = Instant::now();
     loop {
@@ -355,13 +403,7 @@ fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
     ensure!(!out.join("eval-shard-1-of-4.json").exists());
 
     // Shard 1 alone, then the merge again.
-    let rerun = cluster.sbatch(&["--array=1", eval_s.as_ref()], &{
-        let mut e = env.to_vec();
-        e.push(("ROVER_SHARDS", Path::new("4")));
-        e
-    })?;
-    let dependency = format!("--dependency=afterok:{rerun}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_s.as_ref()], &env)?;
+    let (_, merge) = cluster.rerun_shard_1(&scripts, &env)?;
     cluster.wait(&merge, Duration::from_secs(600))?;
     ensure!(
         out.join("eval.json").is_file(),
@@ -383,6 +425,22 @@ fn dataset_images() -> String {
     std::env::var("ROVER_SLURM_DATASET_IMAGES").unwrap_or_else(|_| "96".into())
 }
 const DATASET_SEED: &str = "7";
+
+/// What dataset.sbatch reads: rover, the world, the image count, the seed, the output folder.
+fn dataset_env<'a>(
+    rover: &'a Path,
+    world: &'a Path,
+    images: &'a Path,
+    out: &'a Path,
+) -> [(&'static str, &'a Path); 5] {
+    [
+        ("ROVER", rover),
+        ("ROVER_WORLD", world),
+        ("ROVER_IMAGES", images),
+        ("ROVER_SEED", Path::new(DATASET_SEED)),
+        ("ROVER_OUT", out),
+    ]
+}
 
 /// `rover dataset --jobs 2` of the playground world on one machine, into `out`.
 fn one_machine_dataset(rover: &Path, world: &Path, out: &Path) -> Result<f64> {
@@ -447,41 +505,24 @@ fn same_dataset(merged: &Path, one: &Path) -> Result<usize> {
 /// the images it kept, and the merge equals the one-machine run again.
 #[test]
 fn dataset_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
-    if let Some(why) = missing_slurm() {
-        eprintln!("SKIP: {why}");
+    let Some(cluster) = Cluster::start_or_skip() else {
         return Ok(());
-    }
-    let cluster = match Cluster::start() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("SKIP: Slurm will not start here: {e:#}");
-            return Ok(());
-        }
     };
     let rover = PathBuf::from(env!("CARGO_BIN_EXE_rover"));
     let dir = cluster.dir.path().to_owned();
     let world = repo().canonicalize()?.join("worlds/playground.toml");
-    let sbatch = repo().join("scripts/slurm/dataset.sbatch");
-    let merge_sbatch = repo().join("scripts/slurm/dataset-merge.sbatch");
-    let (sbatch, merge_sbatch) = (sbatch.to_string_lossy(), merge_sbatch.to_string_lossy());
+    let scripts = Scripts::new("dataset");
     let count = dataset_images();
     let images: f64 = count.parse()?;
 
     let one = dir.join("one");
     let one_s = one_machine_dataset(&rover, &world, &one)?;
 
+    let images_arg = PathBuf::from(&count);
+    let env = |out| dataset_env(&rover, &world, &images_arg, out);
     let out = dir.join("array");
-    let env = [
-        ("ROVER", rover.as_path()),
-        ("ROVER_WORLD", world.as_path()),
-        ("ROVER_IMAGES", Path::new(&count)),
-        ("ROVER_SEED", Path::new(DATASET_SEED)),
-        ("ROVER_OUT", out.as_path()),
-    ];
     let started = Instant::now();
-    let array = cluster.sbatch(&[sbatch.as_ref()], &env)?;
-    let dependency = format!("--dependency=afterany:{array}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    let (array, merge) = cluster.submit(&scripts, &[], "afterany", &env(&out))?;
     cluster.wait(&merge, Duration::from_secs(600))?;
     let wall_s = started.elapsed().as_secs_f64();
     let merged = out.join("dataset");
@@ -500,16 +541,7 @@ fn dataset_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
 
     // Shard 1 cancelled after its first complete images.
     let out = dir.join("cancelled");
-    let env = [
-        ("ROVER", rover.as_path()),
-        ("ROVER_WORLD", world.as_path()),
-        ("ROVER_IMAGES", Path::new(&count)),
-        ("ROVER_SEED", Path::new(DATASET_SEED)),
-        ("ROVER_OUT", out.as_path()),
-    ];
-    let array = cluster.sbatch(&[sbatch.as_ref()], &env)?;
-    let dependency = format!("--dependency=afterany:{array}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    let (array, merge) = cluster.submit(&scripts, &[], "afterany", &env(&out))?;
     let task = format!("{array}_1");
     let records = out.join("shards/shard-1-of-4/ground_truth/train");
     let start = Instant::now();
@@ -532,13 +564,7 @@ fn dataset_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
     );
 
     // Shard 1 alone goes on from its complete images; then the merge again.
-    let rerun = cluster.sbatch(&["--array=1", sbatch.as_ref()], &{
-        let mut e = env.to_vec();
-        e.push(("ROVER_SHARDS", Path::new("4")));
-        e
-    })?;
-    let dependency = format!("--dependency=afterok:{rerun}");
-    let merge = cluster.sbatch(&[dependency.as_str(), merge_sbatch.as_ref()], &env)?;
+    let (rerun, merge) = cluster.rerun_shard_1(&scripts, &env(&out))?;
     cluster.wait(&merge, Duration::from_secs(600))?;
     let rerun_log = cluster.log(&format!("rover-dataset-{rerun}_1.log"));
     ensure!(

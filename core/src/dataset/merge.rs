@@ -157,7 +157,8 @@ pub fn merge_dataset(
             )));
         }
     }
-    let mut by_index: Vec<&Path> = vec![Path::new(""); first.shard.map_or(0, |s| s.count)];
+    // The shards by index: check_shard_set found each of 0..count once.
+    let mut by_index: Vec<&Path> = vec![Path::new(""); shards[0].1.shard.count];
     for (dir, shard, _) in &shards {
         by_index[shard.shard.index] = dir;
     }
@@ -193,19 +194,7 @@ pub fn merge_dataset(
         shard: None,
         jobs: 1,
     };
-    let mut summary = DatasetSummary {
-        out: out.to_path_buf(),
-        total,
-        made,
-        kept,
-        split_images: [0; 2],
-        boxes: 0,
-        ignored: 0,
-        backgrounds: 0,
-        wall_s: start.elapsed().as_secs_f64(),
-        interrupted: false,
-        metrics: None,
-    };
+    let mut summary = DatasetSummary::new(out, [total, made, kept], start, false);
     finish(&store, &spec, &mut summary)?;
     Ok((spec, summary))
 }

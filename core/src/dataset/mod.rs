@@ -100,6 +100,26 @@ pub struct DatasetSummary {
     pub metrics: Option<[DetectionMetrics; 3]>,
 }
 
+impl DatasetSummary {
+    /// A summary of `[total, made, kept]` images in `out`, made since `start`, before the
+    /// records are counted.
+    fn new(out: &Path, [total, made, kept]: [u64; 3], start: Instant, interrupted: bool) -> Self {
+        Self {
+            out: out.to_path_buf(),
+            total,
+            made,
+            kept,
+            split_images: [0; 2],
+            boxes: 0,
+            ignored: 0,
+            backgrounds: 0,
+            wall_s: start.elapsed().as_secs_f64(),
+            interrupted,
+            metrics: None,
+        }
+    }
+}
+
 /// One image on its way to the disk.
 struct Job {
     split: Split,
@@ -297,19 +317,7 @@ pub fn write_dataset(
     for result in results {
         interrupted |= result?;
     }
-    let mut summary = DatasetSummary {
-        out: spec.out.clone(),
-        total,
-        made,
-        kept,
-        split_images: [0; 2],
-        boxes: 0,
-        ignored: 0,
-        backgrounds: 0,
-        wall_s: start.elapsed().as_secs_f64(),
-        interrupted,
-        metrics: None,
-    };
+    let mut summary = DatasetSummary::new(&spec.out, [total, made, kept], start, interrupted);
     match (interrupted, spec.shard) {
         (true, _) => {}
         (false, None) => finish(&store, spec, &mut summary)?,

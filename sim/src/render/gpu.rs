@@ -79,12 +79,15 @@ const MAP_PENDING: u8 = 0;
 const MAP_OK: u8 = 1;
 const MAP_FAILED: u8 = 2;
 
-/// A mappable buffer a texture of 4-byte texels is copied into, allocated once.
+/// A mappable buffer a texture (all its array layers) is copied into, allocated once.
 pub(crate) struct Readback {
     buffer: wgpu::Buffer,
     padded_row: u32,
+    /// Bytes of a row's texels.
+    row_bytes: u32,
     width: u32,
     height: u32,
+    layers: u32,
     /// One flag for the renderer's life (no channel per frame): the map callback has run once
     /// the blocking poll returns.
     mapped: Arc<AtomicU8>,
@@ -93,24 +96,38 @@ pub(crate) struct Readback {
 impl Readback {
     /// A buffer for `width` x `height` texels of 4 bytes.
     pub(crate) fn new(device: &wgpu::Device, label: &str, width: u32, height: u32) -> Self {
-        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        Self::layered(device, label, [width, height, 1], 4)
+    }
+
+    /// A buffer for the first `size[2]` layers of a `size[0]` x `size[1]` texture array of
+    /// `texel_bytes`-byte texels.
+    pub(crate) fn layered(
+        device: &wgpu::Device,
+        label: &str,
+        [width, height, layers]: [u32; 3],
+        texel_bytes: u32,
+    ) -> Self {
+        let row_bytes = width * texel_bytes;
+        let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
-            size: u64::from(padded_row) * u64::from(height),
+            size: u64::from(padded_row) * u64::from(height) * u64::from(layers.max(1)),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Self {
             buffer,
             padded_row,
+            row_bytes,
             width,
             height,
+            layers,
             mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
         }
     }
 
-    /// Records the copy of `texture` (same size) into the buffer.
+    /// Records the copy of `texture` (same size, at least as many layers) into the buffer.
     pub(crate) fn copy_from(&self, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
@@ -125,22 +142,22 @@ impl Readback {
             wgpu::Extent3d {
                 width: self.width,
                 height: self.height,
-                depth_or_array_layers: 1,
+                depth_or_array_layers: self.layers,
             },
         );
     }
 
-    /// Waits for the submitted copy and hands each row's `width * 4` bytes, top to bottom, to
-    /// `row`.
+    /// Waits for the submitted copy and hands each row's texel bytes to `row`, top to bottom
+    /// and layer after layer: row `y` is row `y % height` of layer `y / height`.
     pub(crate) fn read_rows(
         &self,
         device: &wgpu::Device,
         mut row: impl FnMut(usize, &[u8]),
     ) -> Result<(), RenderError> {
-        let (w, padded) = (self.width as usize, self.padded_row as usize);
+        let (bytes, padded) = (self.row_bytes as usize, self.padded_row as usize);
         read_mapped(device, &self.buffer, &self.mapped, |data| {
-            for y in 0..self.height as usize {
-                row(y, &data[y * padded..][..w * 4]);
+            for y in 0..(self.height * self.layers) as usize {
+                row(y, &data[y * padded..][..bytes]);
             }
         })
     }
@@ -187,39 +204,4 @@ fn read_mapped(
     }
     buffer.unmap();
     Ok(())
-}
-
-/// A mappable copy of a GPU buffer, allocated once.
-pub(crate) struct BufferReadback {
-    buffer: wgpu::Buffer,
-    mapped: Arc<AtomicU8>,
-}
-
-impl BufferReadback {
-    /// A buffer of `size` bytes.
-    pub(crate) fn new(device: &wgpu::Device, label: &str, size: u64) -> Self {
-        Self {
-            buffer: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
-        }
-    }
-
-    /// The buffer, for copies into it.
-    pub(crate) fn buffer(&self) -> &wgpu::Buffer {
-        &self.buffer
-    }
-
-    /// Waits for the submitted copy and hands its bytes to `read`.
-    pub(crate) fn read(
-        &self,
-        device: &wgpu::Device,
-        read: impl FnOnce(&[u8]),
-    ) -> Result<(), RenderError> {
-        read_mapped(device, &self.buffer, &self.mapped, read)
-    }
 }

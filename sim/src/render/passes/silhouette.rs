@@ -11,7 +11,7 @@
 
 use glam::Mat4;
 
-use crate::render::gpu::{BufferReadback, RenderError};
+use crate::render::gpu::{Readback, RenderError};
 use crate::render::passes::colour::View;
 use crate::render::scene::{Scene, vertex_buffer_layouts};
 
@@ -36,11 +36,9 @@ pub(crate) struct SilhouettePass {
     layers: wgpu::Texture,
     /// One view per layer (entity `id` in layer `id - 1`; the last pass's spare layers unused).
     views: Vec<wgpu::TextureView>,
-    readback: BufferReadback,
-    width: u32,
-    height: u32,
-    /// Bytes per row of a layer in the read back (copies need 256-byte rows).
-    padded_row: u32,
+    /// The entities' layers (not the last pass's spare ones).
+    readback: Readback,
+    height: usize,
     entities: u32,
 }
 
@@ -60,8 +58,6 @@ impl SilhouettePass {
                 "{entities} labelled things need {layer_count} silhouette layers, more than this adapter allows ({max_layers})"
             )));
         }
-        let padded_row =
-            width.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let layers = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("silhouette layers"),
             size: wgpu::Extent3d {
@@ -114,17 +110,19 @@ impl SilhouettePass {
                 resource: globals.as_entire_binding(),
             }],
         });
-        let readback_bytes = u64::from(padded_row) * u64::from(height) * u64::from(entities.max(1));
         Ok(Self {
             pipelines: pipelines(device, &layout, per_pass),
             globals,
             bind_group,
             layers,
             views,
-            readback: BufferReadback::new(device, "silhouette readback", readback_bytes),
-            width,
-            height,
-            padded_row,
+            readback: Readback::layered(
+                device,
+                "silhouette readback",
+                [width, height, entities.max(1)],
+                1,
+            ),
+            height: height as usize,
             entities,
         })
     }
@@ -187,34 +185,7 @@ impl SilhouettePass {
 
     /// Records the copy of every entity's layer for read back (after [`Self::encode`]).
     pub(crate) fn copy_out(&self, encoder: &mut wgpu::CommandEncoder) {
-        let layer_bytes = u64::from(self.padded_row) * u64::from(self.height);
-        for layer in 0..self.entities {
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &self.layers,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: self.readback.buffer(),
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: u64::from(layer) * layer_bytes,
-                        bytes_per_row: Some(self.padded_row),
-                        rows_per_image: Some(self.height),
-                    },
-                },
-                wgpu::Extent3d {
-                    width: self.width,
-                    height: self.height,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
+        self.readback.copy_from(encoder, &self.layers);
     }
 
     /// After the submitted frame: the number of pixels each entity covers (index `id - 1`),
@@ -225,17 +196,12 @@ impl SilhouettePass {
         counts: &mut Vec<u32>,
     ) -> Result<(), RenderError> {
         counts.clear();
-        counts.resize(self.entities as usize, 0);
-        let (w, padded) = (self.width as usize, self.padded_row as usize);
-        let layer_bytes = padded * self.height as usize;
-        self.readback.read(device, |bytes| {
-            for (count, layer) in counts.iter_mut().zip(bytes.chunks_exact(layer_bytes)) {
-                *count = layer
-                    .chunks_exact(padded)
-                    .map(|row| covered(&row[..w]))
-                    .sum();
-            }
-        })
+        counts.resize(self.entities.max(1) as usize, 0);
+        self.readback.read_rows(device, |y, row| {
+            counts[y / self.height] += covered(row);
+        })?;
+        counts.truncate(self.entities as usize);
+        Ok(())
     }
 }
 
