@@ -182,6 +182,7 @@ mod tests {
             unoccluded_px: visible_px,
             visibility: 1.0,
             truncated: false,
+            truncation: 0.0,
             ignore: visible_px < 100,
         }
     }

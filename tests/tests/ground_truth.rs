@@ -167,6 +167,41 @@ fn a_labelled_cubes_boxes_are_its_projection_and_where_it_is_drawn() -> Result<(
     // ground goes to the ground in the depth test.
     assert!(b.visibility > 0.999, "{}", b.visibility);
     assert!(b.unoccluded_px - b.visible_px <= 2, "{b:?}");
+    assert_eq!(b.truncation, 0.0);
+    Ok(())
+}
+
+/// Truncation: a cube half out of view on the left is `truncated`, its full box is clipped at
+/// the image's edge, and `truncation` is the share of its K-projected box the edge cut off.
+#[test]
+fn a_cube_cut_by_the_image_edge_reports_its_truncation() -> Result<()> {
+    let cube = CUBE
+        .replace("position_m = [5.0, 0.3]", "position_m = [4.0, 3.0]")
+        .replace("yaw_deg = 25.0", "yaw_deg = 0.0");
+    let shot = shoot(&[&cube], None)?;
+    let b = shot.truth.first().context("the cube is not in view")?;
+    let whole = projected_corners(&shot, Vec3::new(4.0, 3.0, 0.5), Vec3::ONE, 0.0);
+    let width = f64::from(shot.info.width);
+    let clipped = [
+        whole[0].clamp(0.0, width),
+        whole[1],
+        whole[2].clamp(0.0, width),
+        whole[3],
+    ];
+    let area = |b: [f64; 4]| (b[2] - b[0]) * (b[3] - b[1]);
+    let want = 1.0 - area(clipped) / area(whole);
+    println!("truncation {} (K: {want}), full {:?}", b.truncation, b.full);
+    assert!(
+        whole[0] < 0.0 && whole[2] > 0.0,
+        "not cut by the edge: {whole:?}"
+    );
+    assert!(b.truncated && !b.ignore, "{b:?}");
+    assert_within_1px("full box vs clipped K", edges(&b.full), clipped);
+    assert!(
+        (b.truncation - want).abs() < 0.01,
+        "{} vs {want}",
+        b.truncation
+    );
     Ok(())
 }
 

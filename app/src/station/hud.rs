@@ -235,6 +235,7 @@ mod tests {
             unoccluded_px: 0,
             visibility: 0.0,
             truncated: false,
+            truncation: 0.0,
             ignore,
         };
         let matched = rover_perception::FrameMatch {

@@ -48,6 +48,10 @@ pub struct LabelledBox {
     pub visibility: f64,
     /// The image border cut it.
     pub truncated: bool,
+    /// Fraction of its full box outside the image (0..1, KITTI's `truncated`; 1 when part of
+    /// it was behind the camera). Records written before it existed read as 0.
+    #[serde(default)]
+    pub truncation: f64,
     /// Too small or too hidden to ask a detector for: COCO's `iscrowd`, left out of YOLO
     /// labels.
     pub ignore: bool,
@@ -64,6 +68,7 @@ impl LabelledBox {
             visible_px: t.visible_px,
             visibility: t.visibility,
             truncated: t.truncated,
+            truncation: t.truncation,
             ignore: t.ignore || t.visible.is_none(),
         }
     }
@@ -209,6 +214,7 @@ struct CocoAnnotation<'a> {
     amodal_bbox: [f64; 4],
     visibility: f64,
     truncated: bool,
+    truncation: f64,
 }
 
 #[derive(Serialize)]
@@ -261,6 +267,7 @@ pub fn coco_json(records: &[ImageRecord], split: Split) -> serde_json::Result<St
                 amodal_bbox: o.full_bbox,
                 visibility: o.visibility,
                 truncated: o.truncated,
+                truncation: o.truncation,
             });
         }
     }
@@ -340,6 +347,7 @@ mod tests {
             visible_px: 100,
             visibility: 1.0,
             truncated: false,
+            truncation: 0.0,
             ignore,
         };
         let record = ImageRecord {

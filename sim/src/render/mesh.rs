@@ -426,18 +426,20 @@ fn limbs(f: &mut Figure) {
         let y = 0.09 * side;
         f.add(
             ellipsoid(0.1 * f.s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
-            f.at(0.035, y, 0.045),
+            f.at(0.035, y * 1.3, 0.045),
             Paint::Fixed(shoe),
         );
-        // Leg: ankle, calf, knee, thigh, hip.
+        // Leg: ankle, calf, knee, thigh, hip; loose trousers, feet a little apart. A low
+        // camera at the follower's standoff sees no more than the legs and the shirt's hem:
+        // drawn thin and parallel, YOLO called them a chair (docs/GROUND_TRUTH.md).
         let leg = f.scaled(&[
-            Section::new(0.06, 0.045, 0.042).at(0.0, y),
-            Section::new(0.2, 0.05, 0.045).at(0.0, y),
-            Section::new(0.36, 0.06, 0.055).at(0.0, y),
-            Section::new(0.5, 0.052, 0.05).at(0.0, y),
-            Section::new(0.7, 0.07, 0.068).at(0.0, y * 0.97),
-            Section::new(0.86, 0.08, 0.08).at(0.0, y * 0.9),
-            Section::new(0.9, 0.07, 0.07).at(0.0, y * 0.85),
+            Section::new(0.06, 0.055, 0.052).at(0.0, y * 1.3),
+            Section::new(0.2, 0.058, 0.055).at(0.0, y * 1.22),
+            Section::new(0.36, 0.064, 0.062).at(0.0, y * 1.13),
+            Section::new(0.5, 0.062, 0.06).at(0.0, y * 1.05),
+            Section::new(0.7, 0.078, 0.078).at(0.0, y * 0.95),
+            Section::new(0.86, 0.085, 0.088).at(0.0, y * 0.9),
+            Section::new(0.9, 0.075, 0.078).at(0.0, y * 0.85),
         ]);
         f.add(loft(&leg, 2.0, 16), Pose::IDENTITY, Paint::Trousers);
         // Arm: shoulder, elbow, wrist hanging just off the body.
@@ -458,7 +460,8 @@ fn limbs(f: &mut Figure) {
 
 /// Pelvis, torso and neck.
 fn trunk(f: &mut Figure) {
-    // Pelvis in trousers, torso in the shirt: shoulders broad, waist narrower.
+    // Pelvis in trousers, torso in the shirt (worn untucked, over the hips): shoulders broad,
+    // waist narrower.
     let pelvis = f.scaled(&[
         Section::new(0.8, 0.06, 0.1),
         Section::new(0.86, 0.1, 0.165),
@@ -467,7 +470,9 @@ fn trunk(f: &mut Figure) {
     ]);
     f.add(loft(&pelvis, 2.6, 24), Pose::IDENTITY, Paint::Trousers);
     let torso = f.scaled(&[
-        Section::new(0.98, 0.1, 0.16),
+        Section::new(0.84, 0.118, 0.185),
+        Section::new(0.9, 0.118, 0.185),
+        Section::new(0.98, 0.112, 0.175),
         Section::new(1.1, 0.1, 0.155),
         Section::new(1.22, 0.11, 0.165),
         Section::new(1.33, 0.115, 0.18),

@@ -55,9 +55,10 @@ pub struct EntityImage {
     /// The id of every pixel of the output image (distorted like the colour image, nearest
     /// pixel), rows top to bottom.
     pub ids: Vec<u32>,
-    /// The id of every pixel of the ideal pinhole image (before distortion).
+    /// The id of every pixel of the ideal pinhole image (before distortion); empty when the
+    /// lens does not distort (`ids` is then the ideal image).
     pub ideal_ids: Vec<u32>,
-    /// Whether the lens distorts (otherwise `ids` equals `ideal_ids`).
+    /// Whether the lens distorts.
     pub distorted: bool,
     /// Per entity (index `id - 1`): the pixels of the ideal image it covers with nothing in
     /// front of it.
@@ -120,7 +121,11 @@ impl CameraRenderer {
                 width: w,
                 height: h,
                 ids: vec![0; pixels],
-                ideal_ids: vec![0; pixels],
+                ideal_ids: if self.post.distorts() {
+                    vec![0; pixels]
+                } else {
+                    Vec::new()
+                },
                 distorted: self.post.distorts(),
                 silhouette_px: vec![0; self.entities as usize],
             },
@@ -309,12 +314,19 @@ impl CameraRenderer {
         self.read_depth()?;
         if let Some(ids) = &mut self.ids {
             let image = &mut ids.image;
-            let ideal = &mut image.ideal_ids;
+            // Without distortion the pinhole image is the output: read straight into it.
+            let ideal = if image.distorted {
+                &mut image.ideal_ids
+            } else {
+                &mut image.ids
+            };
             ids.readback.read_rows(&self.gpu.device, |y, row| {
                 let out: &mut [u8] = bytemuck::cast_slice_mut(&mut ideal[y * w..][..w]);
                 out.copy_from_slice(row);
             })?;
-            self.post.remap_ids(&image.ideal_ids, &mut image.ids);
+            if image.distorted {
+                self.post.remap_ids(&image.ideal_ids, &mut image.ids);
+            }
             if self.entities > 0 {
                 ids.silhouette
                     .read_counts(&self.gpu.device, &mut image.silhouette_px)?;

@@ -3,7 +3,8 @@
 //!
 //! * The **full box** (amodal): the projection of the thing's whole mesh through the camera's
 //!   K (and its lens distortion), occluders ignored, clipped to the image; `truncated` when the
-//!   clip cut it or part of it is behind the camera. The meshes are the ones the camera renders,
+//!   clip cut it or part of it is behind the camera, `truncation` the fraction of the box's area
+//!   the clip cut off (as KITTI's labels). The meshes are the ones the camera renders,
 //!   built once.
 //! * The **visible box** (tight) and visible pixel count: from the instance-id image the colour
 //!   pass writes in the same draw, distorted like the colour image with nearest sampling.
@@ -23,6 +24,9 @@ use crate::model::sensors::Distortion;
 use crate::model::world::World;
 use crate::physics::Simulation;
 use crate::render::{EntityImage, RenderError, object_mesh, person_parts, shape_mesh};
+
+/// Pixels checked at once for "nothing labelled here" when counting the id image.
+const ZERO_RUN_PX: usize = 32;
 
 /// Points closer to the camera than this along its axis (m) count as behind it.
 const NEAR_M: f32 = 1e-3;
@@ -102,8 +106,12 @@ pub struct GroundTruthBox {
     pub visibility: f64,
     /// The image border or the camera's plane cut its full box.
     pub truncated: bool,
+    /// The fraction of its full box's area outside the image (0..1, as KITTI's `truncated`);
+    /// 1 when part of it is behind the camera (its projection is then unbounded).
+    pub truncation: f64,
     /// Too small or too occluded to ask a detector for (see [`MIN_VISIBLE_PX`],
-    /// [`MIN_VISIBILITY`]): neither a miss nor a false positive.
+    /// [`MIN_VISIBILITY`]): neither a miss nor a false positive. A truncated thing is asked
+    /// for: its visible box is what a detector should draw.
     pub ignore: bool,
 }
 
@@ -302,6 +310,7 @@ impl GroundTruth {
                 unoccluded_px: 0,
                 visibility: 0.0,
                 truncated: false,
+                truncation: 0.0,
                 ignore: true,
             })
             .collect();
@@ -360,19 +369,25 @@ impl GroundTruth {
         self.visible.fill(Visible::default());
         let w = image.width as usize;
         for (y, row) in image.ids.chunks_exact(w).enumerate() {
-            for (x, &id) in row.iter().enumerate() {
-                if id == 0 {
+            // Most of an image shows nothing labelled: skip it a run of pixels at a time.
+            for (c, run) in row.chunks(ZERO_RUN_PX).enumerate() {
+                if run.iter().fold(0, |any, &id| any | id) == 0 {
                     continue;
                 }
-                if let Some(v) = self.visible.get_mut(id as usize - 1) {
-                    let (x, y) = (x as u32, y as u32);
-                    v.px += 1;
-                    v.bounds = [
-                        v.bounds[0].min(x),
-                        v.bounds[1].min(y),
-                        v.bounds[2].max(x),
-                        v.bounds[3].max(y),
-                    ];
+                for (k, &id) in run.iter().enumerate() {
+                    if id == 0 {
+                        continue;
+                    }
+                    if let Some(v) = self.visible.get_mut(id as usize - 1) {
+                        let (x, y) = ((c * ZERO_RUN_PX + k) as u32, y as u32);
+                        v.px += 1;
+                        v.bounds = [
+                            v.bounds[0].min(x),
+                            v.bounds[1].min(y),
+                            v.bounds[2].max(x),
+                            v.bounds[3].max(y),
+                        ];
+                    }
                 }
             }
         }
@@ -465,6 +480,14 @@ impl GroundTruth {
                     ymax: 0.0,
                 }
             };
+            let whole_area = (bounds[2] - bounds[0]) * (bounds[3] - bounds[1]);
+            out.truncation = if behind {
+                1.0
+            } else if whole_area > 0.0 {
+                (1.0 - full.area() / whole_area).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             out.full = full;
             out.truncated = behind || clipped != bounds;
         }
@@ -493,6 +516,7 @@ mod tests {
             unoccluded_px: px,
             visibility: 1.0,
             truncated: false,
+            truncation: 0.0,
             ignore: false,
         }
     }
