@@ -1040,7 +1040,9 @@ impl Follower {
         } else if bearing.abs() > c.bearing_deadband_rad || moving {
             self.heading_settled = false;
         }
-        if range_error.abs() < 0.05 {
+        // A walking target's range never settles: its speed is fed forward below, and a
+        // car that stops each time the error crosses zero falls behind at every crossing.
+        if range_error.abs() < 0.05 && !moving {
             self.range_settled = true;
         } else if range_error.abs() > c.standoff_band_m || moving {
             self.range_settled = false;
@@ -1706,6 +1708,32 @@ mod tests {
         }
         let here = f.target().expect("target").position_at(8.0);
         assert!(here[0] > forward + 3.6 + 0.5, "{here:?}");
+    }
+
+    #[test]
+    fn a_walker_at_the_kept_range_is_followed_without_stopping() {
+        // A person walks away at 0.4 m/s; the car drives as commanded. Once it has caught up
+        // to the range it keeps, the range error crosses zero again and again: the walker's
+        // speed must stay fed forward. (The range used to settle at each crossing and the car
+        // slowed, here to 0.33 m/s; in the walk_away scenario it stopped and fell 3.01 m
+        // behind.)
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let mut odom = Odometry::default();
+        let forward = camera().forward_m;
+        let mut slowest_mps = f64::INFINITY;
+        for i in 0..1500 {
+            let t = f64::from(i) * 0.02;
+            let person = [forward + 3.0 + 0.4 * t, 0.0];
+            if i % 10 == 0 {
+                f.observe(&message(t, vec![seen_box(odom, person)]));
+            }
+            let cmd = f.command(t + 0.001, odom, true);
+            odom.x_m += cmd.linear_mps * 0.02;
+            if t > 10.0 {
+                slowest_mps = slowest_mps.min(cmd.linear_mps);
+            }
+        }
+        assert!(slowest_mps > 0.35, "it slowed to {slowest_mps} m/s");
     }
 
     #[test]
