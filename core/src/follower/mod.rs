@@ -347,8 +347,9 @@ const TRAIL_WIDTH_M: f64 = 0.12;
 /// Laser returns within this distance of the target's prediction are taken to be the target
 /// (m), and returns this close to it are not obstacles.
 const LASER_GATE_M: f64 = 0.4;
-/// A track the laser picks up again may be this far from the returns (m), at most.
-const LASER_PICKUP_M: f64 = 1.0;
+/// A track the laser picks up again may be this far from the returns (m), at most, and
+/// within 3 sigma of its own uncertainty.
+const LASER_PICKUP_M: f64 = 2.5;
 /// The target's returns are its near surface: the centre is about this much further (m).
 const BODY_DEPTH_M: f64 = 0.1;
 /// Laser returns keep following a target seen this recently (s): a few scans.
@@ -848,20 +849,42 @@ impl Follower {
         // A track the laser picks up (the camera lost the person on the way in, the pursuit
         // brought them into range) may be off by its own uncertainty: the gate grows with it,
         // and only a compact cluster (a person, not a wall) is taken.
+        // The uncertainty is the track's own covariance: a camera's range is weakest along its
+        // line of sight (a low camera's foot point moves a few pixels over metres), so the
+        // gate is long that way and narrow across it (3 sigma, Mahalanobis).
         let picking_up = scan.stamp_s - t.seen_s > LASER_CONTINUITY_S;
-        let reach_m = if picking_up {
-            let cov = t.filter.position_covariance();
-            let sigma_m = cov[(0, 0)].max(cov[(1, 1)]).max(0.0).sqrt();
-            (3.0 * sigma_m).clamp(LASER_GATE_M, LASER_PICKUP_M)
-        } else {
-            LASER_GATE_M
-        };
         let distance = |p: &[f64; 2]| (p[0] - expected[0]).hypot(p[1] - expected[1]);
+        let gate = if picking_up {
+            let cov =
+                t.filter.position_covariance() + Matrix2::identity() * (LASER_GATE_M / 3.0).powi(2);
+            cov.try_inverse()
+        } else {
+            None
+        };
+        let sigmas = |p: &[f64; 2]| {
+            gate.map_or(f64::INFINITY, |inverse| {
+                let d = nalgebra::Vector2::new(p[0] - expected[0], p[1] - expected[1]);
+                (d.transpose() * inverse * d)[(0, 0)].max(0.0).sqrt()
+            })
+        };
+        let inside = |p: &[f64; 2]| {
+            if picking_up {
+                distance(p) <= LASER_PICKUP_M && sigmas(p) <= 3.0
+            } else {
+                distance(p) <= LASER_GATE_M
+            }
+        };
         let Some(seed) = self
             .returns_odom
             .iter()
-            .filter(|p| distance(p) <= reach_m)
-            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .filter(|p| inside(p))
+            .min_by(|a, b| {
+                if picking_up {
+                    sigmas(a).total_cmp(&sigmas(b))
+                } else {
+                    distance(a).total_cmp(&distance(b))
+                }
+            })
             .copied()
         else {
             return;
@@ -1639,6 +1662,40 @@ mod tests {
         assert_eq!(f.state(), FollowState::Tracking);
         let here = f.target().expect("target").position_at(2.0);
         assert!((here[1] - 0.5).abs() < 0.15, "{here:?}");
+    }
+
+    #[test]
+    fn the_laser_picks_up_a_lost_track_along_the_cameras_line_of_sight() {
+        // A track from a far camera box: long along the line of sight (1.1 m sigma), narrow
+        // across it (0.14 m). Lost a second ago, it is predicted at `expected`; one compact
+        // laser cluster shows a person at `person`.
+        let pick_up = |expected: [f64; 2], person: [f64; 2]| {
+            let mut f = Follower::new(FollowerConfig::default(), camera())
+                .with_laser(LaserMount::default());
+            let odom = Odometry::default();
+            f.command(0.0, odom, true);
+            f.observe(&message(0.0, vec![person_box(2.0, 0.0)]));
+            let t = f.target.as_mut().expect("target");
+            let cov = Matrix2::new(1.2, 0.0, 0.0, 0.02);
+            t.filter = TargetFilter::new(0.0, expected, cov);
+            f.observe(&message(1.0, vec![]));
+            let range = person[0].hypot(person[1]);
+            let bearing = person[1].atan2(person[0]);
+            f.observe_scan(&scan_with_person_at(range as f32, bearing as f32, 1.0));
+            f.target().expect("target").position_at(1.0)
+        };
+        // 1.5 m short of the prediction, straight ahead: the camera's range was long. Taken.
+        let here = pick_up([4.0, 0.0], [2.5, 0.0]);
+        assert!(
+            (here[0] - 2.5).abs() < 0.3 && here[1].abs() < 0.1,
+            "{here:?}"
+        );
+        // As far from the prediction but to its side, where the track is certain: not taken.
+        let here = pick_up([3.0, 0.0], [3.0, 1.2]);
+        assert!(
+            (here[0] - 3.0).abs() < 0.1 && here[1].abs() < 0.1,
+            "{here:?}"
+        );
     }
 
     /// The box the test camera sees of a person standing at `person` (odometry frame) from a
