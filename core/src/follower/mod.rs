@@ -847,11 +847,10 @@ impl Follower {
         let expected = t.position_at(scan.stamp_s);
         // A track the laser follows scan after scan moves little between scans: a tight gate.
         // A track the laser picks up (the camera lost the person on the way in, the pursuit
-        // brought them into range) may be off by its own uncertainty: the gate grows with it,
-        // and only a compact cluster (a person, not a wall) is taken.
-        // The uncertainty is the track's own covariance: a camera's range is weakest along its
-        // line of sight (a low camera's foot point moves a few pixels over metres), so the
-        // gate is long that way and narrow across it (3 sigma, Mahalanobis).
+        // brought them into range) may be off by its own uncertainty: the gate is 3 sigma of
+        // the track's covariance (Mahalanobis), long along the camera's line of sight, where
+        // its range is weakest (a low camera's foot point moves a few pixels over metres), and
+        // narrow across it. Only a compact cluster (a person, not a wall) is taken.
         let picking_up = scan.stamp_s - t.seen_s > LASER_CONTINUITY_S;
         let distance = |p: &[f64; 2]| (p[0] - expected[0]).hypot(p[1] - expected[1]);
         let gate = if picking_up {
@@ -1690,7 +1689,7 @@ mod tests {
             (here[0] - 2.5).abs() < 0.3 && here[1].abs() < 0.1,
             "{here:?}"
         );
-        // As far from the prediction but to its side, where the track is certain: not taken.
+        // 1.2 m to the side of the prediction, where the track is certain: not taken.
         let here = pick_up([3.0, 0.0], [3.0, 1.2]);
         assert!(
             (here[0] - 3.0).abs() < 0.1 && here[1].abs() < 0.1,
