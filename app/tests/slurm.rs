@@ -218,6 +218,38 @@ impl Cluster {
         Ok((array, merge))
     }
 
+    /// Cancels array task `task` (`ARRAY_1`) of `array` with scancel once `started` holds
+    /// (polled every 50 ms; an error after `limit`), then waits for the merge `merge` and
+    /// returns its log, `{log_prefix}-{merge}.log`.
+    fn cancel_then_merge(
+        &self,
+        array: &str,
+        task: &str,
+        limit: Duration,
+        mut started: impl FnMut(&[String]) -> bool,
+        merge: &str,
+        log_prefix: &str,
+    ) -> Result<String> {
+        let start = Instant::now();
+        loop {
+            let queue = self.queue(array)?;
+            if started(&queue) {
+                break;
+            }
+            ensure!(
+                start.elapsed() < limit,
+                "task {task} did not start: {queue:?}"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let status = self.command("/usr/bin/scancel").arg(task).status()?;
+        ensure!(status.success(), "scancel {task} failed");
+        self.wait(merge, Duration::from_secs(600))?;
+        let log = self.log(&format!("{log_prefix}-{merge}.log"));
+        println!("merge after scancel of {task}:\n{log}");
+        Ok(log)
+    }
+
     /// Shard 1 of 4 alone (`ROVER_SHARDS=4 sbatch --array=1`, as docs/SCALE.md says), then the
     /// merge once it succeeded: their job ids.
     fn rerun_shard_1(&self, scripts: &Scripts, env: &[(&str, &Path)]) -> Result<(String, String)> {
@@ -378,24 +410,18 @@ fn eval_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
     ];
     let (array, merge) = cluster.submit(&scripts, &[], "afterany", &env)?;
     let task = format!("{array}_1");
-    let start = Instant::now();
-    loop {
-        let queue = cluster.queue(&array)?;
-        if queue.iter().any(|l| l == &format!("{task} RUNNING")) {
-            break;
+    let running = format!("{task} RUNNING");
+    // Cancelled a second into its run.
+    let started = |queue: &[String]| {
+        let running = queue.contains(&running);
+        if running {
+            std::thread::sleep(Duration::from_secs(1));
         }
-        ensure!(
-            start.elapsed() < Duration::from_secs(120),
-            "task {task} never ran: {queue:?}"
-        );
-        std::thread::sleep(Duration::from_millis(200));
-    }
-    std::thread::sleep(Duration::from_secs(1));
-    let status = cluster.command("/usr/bin/scancel").arg(&task).status()?;
-    ensure!(status.success(), "scancel {task} failed");
-    cluster.wait(&merge, Duration::from_secs(600))?;
-    let log = cluster.log(&format!("rover-eval-merge-{merge}.log"));
-    println!("merge after scancel of {task}:\n{log}");
+        running
+    };
+    let limit = Duration::from_secs(120);
+    let log =
+        cluster.cancel_then_merge(&array, &task, limit, started, &merge, "rover-eval-merge")?;
     ensure!(
         log.contains("shard 1 of 4 missing") && !out.join("eval.json").exists(),
         "the merge did not name shard 1 missing:\n{log}"
@@ -544,20 +570,16 @@ fn dataset_shards_on_slurm_equal_a_one_machine_run() -> Result<()> {
     let (array, merge) = cluster.submit(&scripts, &[], "afterany", &env(&out))?;
     let task = format!("{array}_1");
     let records = out.join("shards/shard-1-of-4/ground_truth/train");
-    let start = Instant::now();
-    while std::fs::read_dir(&records).map_or(0, |d| d.count()) < 2 {
-        ensure!(
-            start.elapsed() < Duration::from_secs(180),
-            "task {task} made no image: {:?}",
-            cluster.queue(&array)?
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let status = cluster.command("/usr/bin/scancel").arg(&task).status()?;
-    ensure!(status.success(), "scancel {task} failed");
-    cluster.wait(&merge, Duration::from_secs(600))?;
-    let log = cluster.log(&format!("rover-dataset-merge-{merge}.log"));
-    println!("merge after scancel of {task}:\n{log}");
+    let made_two = |_: &[String]| std::fs::read_dir(&records).map_or(0, |d| d.count()) >= 2;
+    let limit = Duration::from_secs(180);
+    let log = cluster.cancel_then_merge(
+        &array,
+        &task,
+        limit,
+        made_two,
+        &merge,
+        "rover-dataset-merge",
+    )?;
     ensure!(
         log.contains("shard 1 of 4 missing") && !out.join("dataset").exists(),
         "the merge did not name shard 1 missing:\n{log}"

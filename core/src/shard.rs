@@ -143,6 +143,20 @@ impl ShardManifest {
     }
 }
 
+/// An error naming the fields in which shard `b` differs from shard `a` (of one `what`: a
+/// job, a dataset), when there are any.
+pub(crate) fn not_one_set(a: &Path, b: &Path, what: &str, differences: &[String]) -> Result<()> {
+    if differences.is_empty() {
+        return Ok(());
+    }
+    Err(CoreError::Option(format!(
+        "{} and {} are not shards of one {what}:\n  {}",
+        a.display(),
+        b.display(),
+        differences.join("\n  ")
+    )))
+}
+
 /// Checks that `shards` (each with the file it came from) are one complete, consistent set:
 /// the same job in every field, every index 0..count once. The error names the missing
 /// shards, a shard given twice, or the fields in which a file differs from the first.
@@ -151,15 +165,7 @@ pub fn check_shard_set(shards: &[(PathBuf, ShardManifest)]) -> Result<()> {
         return Err(CoreError::Option("no shards to merge".into()));
     };
     for (path, m) in &shards[1..] {
-        let differences = first.differences(m);
-        if !differences.is_empty() {
-            return Err(CoreError::Option(format!(
-                "{} and {} are not shards of one job:\n  {}",
-                first_path.display(),
-                path.display(),
-                differences.join("\n  ")
-            )));
-        }
+        not_one_set(first_path, path, "job", &first.differences(m))?;
     }
     let count = first.shard.count;
     let mut seen: Vec<Option<&Path>> = vec![None; count];

@@ -47,30 +47,26 @@ impl CrateSources {
     /// Reads every `.rs` file under `src`.
     pub fn read(src: &Path) -> std::io::Result<Self> {
         let mut files = BTreeMap::new();
-        let mut stack = vec![src.to_path_buf()];
-        while let Some(dir) = stack.pop() {
-            for entry in std::fs::read_dir(&dir)? {
-                let path = entry?.path();
-                if path.is_dir() {
-                    stack.push(path);
-                } else if path.extension().is_some_and(|e| e == "rs")
-                    // A binary's main.rs beside lib.rs is another crate (it uses the library).
-                    && !(path.ends_with("main.rs") && dir == src && src.join("lib.rs").exists())
-                {
-                    let relative = path.strip_prefix(src).unwrap_or(&path).to_path_buf();
-                    let module = module_of(&relative);
-                    let text = std::fs::read_to_string(&path)?;
-                    let code = without_test_items(&blank_literals(&text));
-                    files.insert(
-                        module.clone(),
-                        SourceFile {
-                            relative,
-                            module,
-                            code,
-                        },
-                    );
-                }
+        for path in crate::files_under(src)? {
+            // A binary's main.rs beside lib.rs is another crate (it uses the library).
+            let other_crate = path.ends_with("main.rs")
+                && path.parent() == Some(src)
+                && src.join("lib.rs").exists();
+            if path.extension().is_none_or(|e| e != "rs") || other_crate {
+                continue;
             }
+            let relative = path.strip_prefix(src).unwrap_or(&path).to_path_buf();
+            let module = module_of(&relative);
+            let text = std::fs::read_to_string(&path)?;
+            let code = without_test_items(&blank_literals(&text));
+            files.insert(
+                module.clone(),
+                SourceFile {
+                    relative,
+                    module,
+                    code,
+                },
+            );
         }
         Ok(Self {
             root: src.to_path_buf(),

@@ -233,11 +233,9 @@ pub const STREET_WORLD: &str = r#"<sdf version="1.6"><world name="street">
   <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
 </world></sdf>"#;
 
-/// Every file under `dir`, by path relative to it, with its SHA-256 in hex (temporaries
-/// included: a finished run must leave none).
-pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<String, String>> {
-    use sha2::{Digest, Sha256};
-    let mut out = std::collections::BTreeMap::new();
+/// Every file under `dir`, at any depth, in name order.
+pub fn files_under(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for entry in std::fs::read_dir(&d)? {
@@ -245,10 +243,22 @@ pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<Stri
             if path.is_dir() {
                 stack.push(path);
             } else {
-                let rel = path.strip_prefix(dir)?.display().to_string();
-                out.insert(rel, format!("{:x}", Sha256::digest(std::fs::read(&path)?)));
+                files.push(path);
             }
         }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// Every file under `dir`, by path relative to it, with its SHA-256 in hex (temporaries
+/// included: a finished run must leave none).
+pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<String, String>> {
+    use sha2::{Digest, Sha256};
+    let mut out = std::collections::BTreeMap::new();
+    for path in files_under(dir)? {
+        let rel = path.strip_prefix(dir)?.display().to_string();
+        out.insert(rel, format!("{:x}", Sha256::digest(std::fs::read(&path)?)));
     }
     Ok(out)
 }

@@ -10,7 +10,7 @@ use rover_core::{
 };
 
 use crate::cli::args::{
-    DatasetArgs, DatasetFormat, DatasetImageFormat, Randomize, spare_detect_threads,
+    DatasetArgs, DatasetFormat, DatasetImageFormat, Randomize, cores, spare_detect_threads,
 };
 use crate::cli::{Interrupted, stop_on_signals};
 
@@ -223,11 +223,6 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
             );
         }
     }
-}
-
-/// The machine's CPU cores: `--jobs`' default.
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// `rover bench dataset`: images per second into a temporary folder, after one warm-up image.

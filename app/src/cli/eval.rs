@@ -161,7 +161,7 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
     }
     let workers = args
         .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .unwrap_or_else(crate::cli::args::cores)
         .clamp(1, jobs.len());
     let mut report = run_all(&args, &jobs, workers)?;
     report.shard = manifest;

@@ -14,7 +14,7 @@ use std::time::Instant;
 use super::store::{MANIFEST, Manifest, Split, Store, write_whole};
 use super::{DatasetProgress, DatasetSpec, DatasetSummary, disk_error, finish};
 use crate::error::{CoreError, Result};
-use crate::shard::{ShardIndex, ShardManifest, check_shard_set};
+use crate::shard::{ShardIndex, ShardManifest, check_shard_set, not_one_set};
 
 /// The shard manifest's file name, in a shard's folder; written when the shard is complete.
 pub const SHARD_MANIFEST: &str = "rover-shard.json";
@@ -148,14 +148,7 @@ pub fn merge_dataset(
             shard: None,
             ..dataset.clone()
         });
-        if !differences.is_empty() {
-            return Err(CoreError::Option(format!(
-                "{} and {} are not shards of one dataset:\n  {}",
-                first_dir.display(),
-                dir.display(),
-                differences.join("\n  ")
-            )));
-        }
+        not_one_set(first_dir, dir, "dataset", &differences)?;
     }
     // The shards by index: check_shard_set found each of 0..count once.
     let mut by_index: Vec<&Path> = vec![Path::new(""); shards[0].1.shard.count];

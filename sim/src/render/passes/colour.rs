@@ -7,7 +7,8 @@ use glam::{Mat4, Vec3};
 
 use crate::geometry::{Pose, Rgba};
 use crate::model::world::World;
-use crate::render::scene::{Scene, vertex_buffer_layouts};
+use crate::render::passes::scene_pipeline;
+use crate::render::scene::Scene;
 
 const SKY: [f32; 3] = [0.62, 0.75, 0.9];
 /// The colour target's format.
@@ -246,40 +247,20 @@ fn pipeline(
         bind_group_layouts: &[Some(layout), Some(materials)],
         immediate_size: 0,
     });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("camera pipeline"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &vertex_buffer_layouts(),
-        },
-        primitive: wgpu::PrimitiveState {
-            // Meshes wind counter-clockwise seen from outside. Culling back faces also hides
-            // the inside of the camera's own link visual, which the camera sits in (as in
-            // Gazebo).
-            front_face: wgpu::FrontFace::Ccw,
-            cull_mode: Some(wgpu::Face::Back),
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
+    scene_pipeline(
+        device,
+        "camera pipeline",
+        &pipeline_layout,
+        &shader,
+        Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
             depth_write_enabled: Some(true),
             depth_compare: Some(wgpu::CompareFunction::Less),
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &shader,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into()), Some(ID_FORMAT.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+        &[Some(COLOR_FORMAT.into()), Some(ID_FORMAT.into())],
+    )
 }
 
 /// A 2D render target; `readable` ones can be copied out.

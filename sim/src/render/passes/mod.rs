@@ -5,3 +5,45 @@
 
 pub(crate) mod colour;
 pub(crate) mod silhouette;
+
+use crate::render::scene::vertex_buffer_layouts;
+
+/// A pipeline that draws the scene's meshes with `shader` (`vs_main`, `fs_main`) into
+/// `targets`. Every pass culls the same back faces as the colour pass, so what another pass
+/// draws of a thing is what the colour pass would (meshes wind counter-clockwise seen from
+/// outside; culling back faces also hides the inside of the camera's own link visual, which the
+/// camera sits in, as in Gazebo).
+pub(crate) fn scene_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &vertex_buffer_layouts(),
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: Some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

@@ -13,7 +13,8 @@ use glam::Mat4;
 
 use crate::render::gpu::{Readback, RenderError};
 use crate::render::passes::colour::View;
-use crate::render::scene::{Scene, vertex_buffer_layouts};
+use crate::render::passes::scene_pipeline;
+use crate::render::scene::Scene;
 
 /// A silhouette layer's format: 0 outside, 255 inside.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
@@ -145,23 +146,22 @@ impl SilhouettePass {
     pub(crate) fn encode(&self, encoder: &mut wgpu::CommandEncoder, scene: &Scene) {
         let per_pass = self.pipelines.len();
         for (chunk, views) in self.views.chunks(per_pass).enumerate() {
-            let attachments: Vec<Option<wgpu::RenderPassColorAttachment<'_>>> = views
-                .iter()
-                .map(|view| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
+            // On the stack: no allocation per frame.
+            let attachments: [Option<wgpu::RenderPassColorAttachment<'_>>;
+                LAYERS_PER_PASS as usize] = std::array::from_fn(|k| {
+                views.get(k).map(|view| wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })
-                .collect();
+            });
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("silhouettes"),
-                color_attachments: &attachments,
+                color_attachments: &attachments[..views.len()],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
                 occlusion_query_set: None,
@@ -256,33 +256,15 @@ fn pipelines(
                     })
                 })
                 .collect();
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("silhouette pipeline"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &shader,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &vertex_buffer_layouts(),
-                },
-                primitive: wgpu::PrimitiveState {
-                    // Back faces culled as in the colour pass, so a silhouette is what that pass
-                    // would draw with nothing in front.
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: Some(wgpu::Face::Back),
-                    ..Default::default()
-                },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &shader,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &targets,
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            // No depth test: nothing hides anything.
+            scene_pipeline(
+                device,
+                "silhouette pipeline",
+                &pipeline_layout,
+                &shader,
+                None,
+                &targets,
+            )
         })
         .collect()
 }
