@@ -272,6 +272,15 @@ pub struct FollowTarget {
 }
 
 impl FollowTarget {
+    /// Whether the track was walking when last seen (its estimate's own velocity, not the
+    /// prediction's, which runs out when the target is lost: that a prediction stopped does
+    /// not mean the person did). A track halted because the person was not where the
+    /// prediction walked them (see `Follower::note_missed`) stands.
+    pub fn last_seen_walking(&self) -> bool {
+        let [vx, vy] = self.filter.velocity_mps();
+        vx.hypot(vy) > MOVING_MPS
+    }
+
     /// Estimated position now-ish (m, odometry frame): the filter's prediction at `time_s`.
     pub fn position_at(&self, time_s: f64) -> [f64; 2] {
         self.filter
@@ -283,6 +292,9 @@ impl FollowTarget {
 const MAX_EXTRA_STANDOFF_M: f64 = 1.5;
 /// A box edge this close to the image edge (px) is cut off there.
 const EDGE_PX: i64 = 2;
+/// A box top within this fraction of the image's height of its top border may be cut off
+/// there (the detector's edges wander): see `Follower::measure`.
+const TOP_EDGE_SLACK: f64 = 0.02;
 
 /// How quickly a target's learned width follows its whole boxes (fraction per box).
 const WIDTH_LEARNING: f64 = 0.2;
@@ -344,6 +356,12 @@ const TRAIL_POINTS: usize = 400;
 const REVERSE_LOOK_M: f64 = 0.35;
 /// ... to be within this of the trail (m): ground the robot has driven over.
 const TRAIL_WIDTH_M: f64 = 0.12;
+/// The trail points a camera-only car lines its back up with before backing away: this far
+/// from its base (m, nearest and furthest).
+const TRAIL_AHEAD_M: [f64; 2] = [0.3, 0.6];
+/// A camera-only car turning its back to its trail keeps the target at least this far
+/// inside the camera's side edges (rad): nearer the edge a close person's box is cut off.
+const GIVE_WAY_FOV_MARGIN_RAD: f64 = 0.35;
 /// Laser returns within this distance of the target's prediction are taken to be the target
 /// (m), and returns this close to it are not obstacles.
 const LASER_GATE_M: f64 = 0.4;
@@ -594,13 +612,21 @@ impl Follower {
         let down = c.dip_rad(bottom);
         let span = up.tan() + down.tan();
         let from_height = (span > 1e-6).then(|| self.config.target_height_m / span);
-        let clipped_top = b.ymin <= EDGE_PX;
         let clipped_bottom = bottom >= c.height_px - 1.0 - EDGE_PX as f64;
         let clipped_side = b.xmin <= EDGE_PX || b.xmax as f64 >= c.width_px - 1.0 - EDGE_PX as f64;
         let width_px = (b.xmax - b.xmin).max(1) as f64;
         let from_width = (!clipped_side).then(|| c.fx * width_m / width_px);
         let from_feet =
             (!clipped_bottom && down > (1.0 / c.fy).atan()).then(|| c.height_m / down.tan());
+        // A detector's box edge at the image's border wanders a few pixels: a top edge near
+        // the top border is cut off there when, at the range the feet give, the head would be
+        // above the image (taking it for the head put a person 1.6 m away at 3 m).
+        let head_out_of_view = from_feet.is_some_and(|d| {
+            let head_up = ((self.config.target_height_m - c.height_m) / d).atan();
+            head_up > -c.dip_rad(0.0)
+        });
+        let clipped_top =
+            b.ymin <= EDGE_PX || (head_out_of_view && top <= TOP_EDGE_SLACK * c.height_px);
         // A bottom edge above the horizon is not a person's feet (the camera is above the
         // ground): something hides their legs, and the top of their head gives the range.
         let feet_hidden = down <= 0.0 && !clipped_top;
@@ -983,9 +1009,9 @@ impl Follower {
         match self.state {
             FollowState::Searching => FollowState::Searching,
             FollowState::Pursuing => {
-                // Standing, or lost long enough that the prediction has stopped moving.
-                let [vx, vy] = t.filter.predicted_velocity_mps(now_s, PREDICTION_HORIZON_S);
-                let standing = vx.hypot(vy) <= MOVING_MPS;
+                // A close standing target is held on the track; a walker whose prediction
+                // ran out is not known to stand: it is looked for briefly, then searched.
+                let standing = !t.last_seen_walking();
                 let look_s = if t.close_and_centred && standing {
                     c.close_hold_s
                 } else {
@@ -1042,13 +1068,14 @@ impl Follower {
         let here = t.position_at(now_s);
         let [vx, vy] = t.filter.predicted_velocity_mps(now_s, PREDICTION_HORIZON_S);
         let moving = vx.hypot(vy) > MOVING_MPS;
+        let walker = moving || t.last_seen_walking();
         let tracking = state == FollowState::Tracking;
         let lead = if tracking && moving { c.lead_s } else { 0.0 };
         let aim = [here[0] + vx * lead, here[1] + vy * lead];
         self.goal = Some(aim);
         let (range, _) = range_bearing_from(odom, here);
         let (_, bearing) = range_bearing_from(odom, aim);
-        let range_error = range - self.keep_range_m(moving);
+        let range_error = range - self.keep_range_m(walker);
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -1104,13 +1131,63 @@ impl Follower {
             0.0
         };
         // Without a range sensor, backing up is blind: only over ground already driven.
-        let linear = if linear < 0.0 && self.laser.is_none() && !self.driven_behind(odom) {
-            0.0
+        let (linear, angular) = if linear < 0.0 && self.laser.is_none() {
+            self.give_way_over_trail(odom, linear, angular, bearing)
         } else {
-            linear
+            (linear, angular)
         };
         let preferred = Twist::new(linear, angular);
         self.avoid(preferred, here, speed_cap, now_s, odom)
+    }
+
+    /// A camera-only car that should back away from a person coming too close backs only
+    /// over ground it has driven over (nothing tells it what else is behind). When its trail
+    /// is not straight behind it, it turns toward the heading that puts the trail behind —
+    /// as far as keeps the target well inside the camera's view — and backs once it is.
+    /// `linear` (< 0) and `angular` are what it would do with a free way back; `bearing` is
+    /// the target's from the base's heading.
+    fn give_way_over_trail(
+        &self,
+        odom: Odometry,
+        linear: f64,
+        angular: f64,
+        bearing: f64,
+    ) -> (f64, f64) {
+        let c = &self.config;
+        let linear = if self.driven_behind(odom) {
+            linear
+        } else {
+            0.0
+        };
+        let Some(back_yaw) = self.trail_behind_yaw(odom) else {
+            return (linear, angular);
+        };
+        let target_yaw = odom.yaw_rad + bearing;
+        let reach = (self.half_fov_rad - GIVE_WAY_FOV_MARGIN_RAD).max(0.0);
+        let wanted_yaw = target_yaw + wrap_angle(back_yaw - target_yaw).clamp(-reach, reach);
+        let turn = wrap_angle(wanted_yaw - odom.yaw_rad);
+        let angular = (c.turn_gain * turn).clamp(-c.max_turn_radps, c.max_turn_radps);
+        (linear, angular)
+    }
+
+    /// The heading (odometry frame, rad) that would put the robot's trail straight behind
+    /// it: toward the base from the trail point [`TRAIL_AHEAD_M`] away that lies most nearly
+    /// behind it. None when no trail point lies that far away.
+    fn trail_behind_yaw(&self, odom: Odometry) -> Option<f64> {
+        let rear_yaw = odom.yaw_rad + std::f64::consts::PI;
+        self.trail
+            .iter()
+            .filter_map(|p| {
+                let (dx, dy) = (p[0] - odom.x_m, p[1] - odom.y_m);
+                let d = dx.hypot(dy);
+                (d >= TRAIL_AHEAD_M[0] && d <= TRAIL_AHEAD_M[1]).then(|| dy.atan2(dx))
+            })
+            .min_by(|a, b| {
+                wrap_angle(a - rear_yaw)
+                    .abs()
+                    .total_cmp(&wrap_angle(b - rear_yaw).abs())
+            })
+            .map(|toward_trail| wrap_angle(toward_trail + std::f64::consts::PI))
     }
 
     /// The range to keep from the target (m, from the base). A walking person is kept where
@@ -1790,6 +1867,98 @@ mod tests {
             }
         }
         assert!(slowest_mps > 0.35, "it slowed to {slowest_mps} m/s");
+    }
+
+    #[test]
+    fn a_box_top_at_the_border_is_cut_off_when_the_feet_put_the_head_out_of_view() {
+        // A person 1.6 m away: the 18 cm camera sees them from the chest down, but a detector's
+        // box top wanders a few pixels below the border. Taken for the head, that box put
+        // them at ~3 m; the feet say 1.6 m and that the head is out of view.
+        let f = Follower::new(FollowerConfig::default(), camera());
+        let mut b = person_box(1.6, 0.0);
+        assert!(b.ymin < 0, "the head is out of view at 1.6 m");
+        b.ymin = 3;
+        let (range_m, _) = f.range_bearing(&b);
+        assert!((range_m - 1.6).abs() < 0.1, "range {range_m} m");
+        // A person just far enough to be seen whole, their head a few pixels below the border,
+        // is still ranged from their height.
+        let whole_m = camera().whole_view_range_m(1.75);
+        let b = person_box(whole_m + 0.05, 0.0);
+        assert!(b.ymin > 0 && f64::from(b.ymin as i32) < 0.02 * 480.0, "top {}", b.ymin);
+        let (range_m, _) = f.range_bearing(&b);
+        assert!((range_m - (whole_m + 0.05)).abs() < 0.1, "range {range_m} m");
+    }
+
+    #[test]
+    fn a_camera_only_car_turns_its_back_to_its_trail_to_give_way() {
+        // The car drove 3 m along +x, then turned 0.5 rad left to face a person who now walks
+        // straight at it. Its trail is not behind it, so it may not back up as it stands: it
+        // turns toward the heading that puts the trail behind (keeping them in view) and backs.
+        let config = FollowerConfig::default();
+        let mut f = Follower::new(config, camera());
+        for i in 0..=100 {
+            let pose = Odometry {
+                x_m: -3.0 * (1.0 - f64::from(i) / 100.0),
+                ..Odometry::default()
+            };
+            f.record_pose(-1.0 + f64::from(i) * 0.01, pose);
+        }
+        let mut odom = Odometry {
+            yaw_rad: 0.5,
+            ..Odometry::default()
+        };
+        let start = [2.2 * 0.5f64.cos(), 2.2 * 0.5f64.sin()];
+        let (mut widest_rad, mut nearest_m) = (0.0f64, f64::INFINITY);
+        for i in 0..=600 {
+            let t = f64::from(i) * 0.01;
+            let walked = (0.4 * t).min(1.4);
+            let person = [start[0] * (1.0 - walked / 2.2), start[1] * (1.0 - walked / 2.2)];
+            let (range_m, bearing_rad) = range_bearing_from(odom, person);
+            if i % 20 == 0 {
+                f.observe(&message(t, vec![seen_box(odom, person)]));
+                widest_rad = widest_rad.max(bearing_rad.abs());
+            }
+            nearest_m = nearest_m.min(range_m);
+            let cmd = f.command(t, odom, true);
+            drive(&mut odom, cmd, 0.01);
+        }
+        assert!(odom.x_m < -0.5, "backed to x = {} m", odom.x_m);
+        assert!(odom.y_m.abs() < 0.15, "left its trail: y = {} m", odom.y_m);
+        assert!(widest_rad < 0.5, "turned them to {widest_rad} rad off the axis");
+        assert!(nearest_m > 1.2, "let them within {nearest_m} m");
+    }
+
+    #[test]
+    fn a_camera_only_car_pursues_a_lost_walker_to_the_walking_distance() {
+        // A person walking away 4.5 m ahead is lost from view at 1 s (hidden), long before the
+        // car is near. The prediction walks them on and stops; that it stopped does not mean
+        // they did: the camera-only car ends where its camera would see them whole, not at
+        // the standoff, and then looks for them.
+        let config = FollowerConfig::default();
+        let whole_m = camera().whole_view_range_m(config.target_height_m) + camera().forward_m;
+        let mut f = Follower::new(config.clone(), camera());
+        let mut odom = Odometry::default();
+        for i in 0..=1000 {
+            let t = f64::from(i) * 0.01;
+            if i % 20 == 0 {
+                let person = [4.5 + 0.5 * t, 0.0];
+                let boxes = if t <= 1.0 {
+                    vec![seen_box(odom, person)]
+                } else {
+                    vec![]
+                };
+                f.observe(&message(t, boxes));
+            }
+            let cmd = f.command(t, odom, true);
+            drive(&mut odom, cmd, 0.01);
+        }
+        let target = f.target().expect("the target is kept");
+        let (range_m, _) = range_bearing_from(odom, target.position_at(10.0));
+        assert!(target.last_seen_walking());
+        assert!(
+            range_m > whole_m - config.standoff_band_m - 0.1,
+            "closed in to {range_m} m of a walker it lost (walking distance {whole_m} m)"
+        );
     }
 
     #[test]
