@@ -179,6 +179,19 @@ impl RosGraph {
         self.dir.path().join("trace.csv")
     }
 
+    /// Whether rover is still running, for a failure's message: a subscriber that heard
+    /// nothing may have come after rover finished.
+    fn rover_state(&mut self) -> String {
+        match self.rover.and_then(|i| self.children.get_mut(i)) {
+            None => "not started".to_owned(),
+            Some(rover) => match rover.try_wait() {
+                Ok(None) => "still running".to_owned(),
+                Ok(Some(status)) => format!("already exited ({status})"),
+                Err(e) => format!("unknown ({e})"),
+            },
+        }
+    }
+
     /// Waits for rover (the first child named rover) to exit; returns its trace.
     fn wait_rover(&mut self, timeout: Duration) -> Result<Vec<TraceRow>> {
         let start = Instant::now();
@@ -510,7 +523,13 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["echo", "-n", "1", "/darknet_ros/bounding_boxes"])
         .env("PYTHONPATH", &py);
+    let echo_start = Instant::now();
     let boxes = graph.run(c, Duration::from_secs(30))?;
+    let after_echo = format!(
+        "rostopic echo ran {:.1} s; rover then {}",
+        echo_start.elapsed().as_secs_f64(),
+        graph.rover_state()
+    );
 
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["hz", "/camera/image_raw"]);
@@ -542,7 +561,7 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     // rostopic echo: darknet_ros's message, a person with pixel bounds inside the image.
     assert!(
         boxes.contains("Class: \"person\""),
-        "no person in\n{boxes}\nrover:\n{rover_log}"
+        "no person in\n{boxes}\n{after_echo}\nrover:\n{rover_log}"
     );
     check_person_box(&boxes)?;
 
@@ -628,12 +647,18 @@ fn the_ground_truth_topic_carries_the_person_in_view() -> Result<()> {
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["echo", "-n", "3", "/rover/ground_truth/bounding_boxes"])
         .env("PYTHONPATH", &py);
+    let echo_start = Instant::now();
     let truth = graph.run(c, Duration::from_secs(30))?;
+    let after_echo = format!(
+        "rostopic echo ran {:.1} s; rover then {}",
+        echo_start.elapsed().as_secs_f64(),
+        graph.rover_state()
+    );
     graph.wait_rover(Duration::from_secs(120))?;
     let rover_log = graph.log("rover");
     assert!(
         truth.contains("Class: \"person\""),
-        "no person in\n{truth}\nrover:\n{rover_log}"
+        "no person in\n{truth}\n{after_echo}\nrover:\n{rover_log}"
     );
     assert_eq!(echoed(&truth, "probability")?, 1.0);
     assert_eq!(echoed(&truth, "id")?, 0.0, "person is COCO's class 0");

@@ -53,8 +53,8 @@ pub use physics::{
     TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{
-    CameraRenderer, EntityImage, Light, Paint, PersonPart, RenderError, object_mesh, person_parts,
-    shape_mesh, visual_mesh,
+    CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError, Swing,
+    object_mesh, person_parts, shape_mesh, visual_mesh,
 };
 pub use sensors::{
     CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, LaserScan, LaserSensor, MIN_VISIBILITY,

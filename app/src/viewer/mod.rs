@@ -12,6 +12,7 @@
 //! world                                  ViewCoordinates RIGHT_HAND_Z_UP (REP-103), static
 //! world/ground, world/objects/<name>     Mesh3D, static
 //! world/people/<name>                    Transform3D (per control update when walking) + Mesh3D
+//! world/people/<name>/limb<k>            a walking person's legs and arms: Transform3D per update
 //! world/robot                            Transform3D world_from_base, per control update
 //! world/robot/<link>                     Transform3D base_from_link (wheels turn) + Mesh3D visuals
 //! world/robot/camera                     Transform3D base_from_camera_optical, static
@@ -242,6 +243,10 @@ impl Observer for Recorder {
             if sim.world().people[i].walk.is_some() {
                 self.log(path, &transform(sim.world_from_person(i)));
             }
+        }
+        for (i, path, swing, standing) in &self.paths.limbs {
+            let phase_rad = sim.person_gait_phase_rad(*i);
+            self.log(path, &transform(swing.pose_at(*standing, phase_rad)));
         }
         let o = sample.odometry;
         let here = [o.x_m as f32, o.y_m as f32, 0.02];

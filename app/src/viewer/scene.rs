@@ -3,7 +3,7 @@
 
 use rerun::RecordingStream;
 use rover_sim::{
-    CameraInfo, MeshData, Pose, Rgba, Simulation, Visual, link_from_optical, object_mesh,
+    CameraInfo, MeshData, Pose, Rgba, Simulation, Swing, Visual, link_from_optical, object_mesh,
     person_parts, shape_mesh,
 };
 
@@ -16,6 +16,10 @@ pub(super) struct ScenePaths {
     pub links: Vec<String>,
     /// `world/people/<name>` per person.
     pub people: Vec<String>,
+    /// `world/people/<name>/limb<k>` per limb of a walking person (legs, arms with their
+    /// hands, shoes), with the person's index, how the limb swings and where it sits standing
+    /// (its mesh is in that frame).
+    pub limbs: Limbs,
     /// `world/models/<model>/<link>` of SDF model links that move, with their index among all
     /// model links.
     pub moving_model_links: Vec<(usize, String)>,
@@ -38,9 +42,12 @@ pub(super) fn log_scene(
         "world/robot",
         &rerun::ViewCoordinates::RIGHT_HAND_Z_UP(),
     );
+    let moving_model_links = log_world(rec, sim);
+    let (people, limbs) = log_people(rec, sim);
     let paths = ScenePaths {
-        moving_model_links: log_world(rec, sim),
-        people: log_people(rec, sim),
+        moving_model_links,
+        people,
+        limbs,
         links: log_robot(rec, sim),
         joints: log_joint_series(rec, sim),
     };
@@ -122,43 +129,89 @@ fn log_world(rec: &RecordingStream, sim: &Simulation) -> Vec<(usize, String)> {
     moving
 }
 
-/// The people, each one mesh of its parts; returns their paths.
-fn log_people(rec: &RecordingStream, sim: &Simulation) -> Vec<String> {
-    let mut paths = Vec::new();
-    for (i, person) in sim.world().people.iter().enumerate() {
-        let path = format!("world/people/{}", person.name);
-        let mut positions = Vec::new();
-        let mut normals = Vec::new();
-        let mut colors = Vec::new();
-        let mut triangles = Vec::new();
-        for part in person_parts(person) {
-            let base = positions.len() as u32;
-            for v in &part.mesh.vertices {
-                positions.push((part.pose * glam::Vec3::from_array(v.position)).to_array());
-                normals.push((part.pose.rotation * glam::Vec3::from_array(v.normal)).to_array());
-                colors.push(color(part.color));
-            }
-            triangles.extend(
-                part.mesh
-                    .indices
-                    .chunks_exact(3)
-                    .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-            );
+/// One mesh gathered from figure parts that move together (the body, or one limb).
+#[derive(Default)]
+struct PartsMesh {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    colors: Vec<[u8; 4]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl PartsMesh {
+    /// Adds `part`'s mesh, placed at `frame_from_part`.
+    fn add(&mut self, part: &rover_sim::PersonPart, frame_from_part: Pose) {
+        let base = self.positions.len() as u32;
+        for v in &part.mesh.vertices {
+            self.positions
+                .push((frame_from_part * glam::Vec3::from_array(v.position)).to_array());
+            self.normals
+                .push((frame_from_part.rotation * glam::Vec3::from_array(v.normal)).to_array());
+            self.colors.push(color(part.color));
         }
+        self.triangles.extend(
+            part.mesh
+                .indices
+                .chunks_exact(3)
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+    }
+
+    fn log(self, rec: &RecordingStream, path: &str) {
         log(
             rec,
-            &format!("{path}/body"),
-            &rerun::Mesh3D::new(positions)
-                .with_vertex_normals(normals)
-                .with_vertex_colors(colors)
-                .with_triangle_indices(triangles),
+            path,
+            &rerun::Mesh3D::new(self.positions)
+                .with_vertex_normals(self.normals)
+                .with_vertex_colors(self.colors)
+                .with_triangle_indices(self.triangles),
         );
-        if person.walk.is_none() {
+    }
+}
+
+/// A walking person's limbs: the person's index, the limb's path, how it swings, and where it
+/// sits standing (its mesh is in that frame).
+type Limbs = Vec<(usize, String, Swing, Pose)>;
+
+/// The people: each one mesh of its body and, for a walking person, one per limb that swings
+/// (`<path>/limb<k>`, moved per tick); returns the people's paths and the limbs'.
+fn log_people(rec: &RecordingStream, sim: &Simulation) -> (Vec<String>, Limbs) {
+    let mut paths = Vec::new();
+    let mut limbs = Vec::new();
+    for (i, person) in sim.world().people.iter().enumerate() {
+        let path = format!("world/people/{}", person.name);
+        let walking = person.walk.is_some();
+        let mut body = PartsMesh::default();
+        // Parts that turn about one joint share a mesh in the figure's frame; a part kept
+        // level (a shoe) has its own, in its own frame.
+        let mut swinging: Vec<(Swing, Pose, PartsMesh)> = Vec::new();
+        for part in person_parts(person) {
+            if !walking || part.swing.gain == 0.0 {
+                body.add(&part, part.pose);
+            } else if part.swing.level {
+                let mut mesh = PartsMesh::default();
+                mesh.add(&part, Pose::IDENTITY);
+                swinging.push((part.swing, part.pose, mesh));
+            } else if let Some((.., mesh)) = swinging.iter_mut().find(|(s, ..)| *s == part.swing) {
+                mesh.add(&part, part.pose);
+            } else {
+                let mut mesh = PartsMesh::default();
+                mesh.add(&part, part.pose);
+                swinging.push((part.swing, Pose::IDENTITY, mesh));
+            }
+        }
+        body.log(rec, &format!("{path}/body"));
+        for (k, (swing, standing, mesh)) in swinging.into_iter().enumerate() {
+            let limb = format!("{path}/limb{k}");
+            mesh.log(rec, &limb);
+            limbs.push((i, limb, swing, standing));
+        }
+        if !walking {
             log(rec, &path, &transform(sim.world_from_person(i)));
         }
         paths.push(path);
     }
-    paths
+    (paths, limbs)
 }
 
 /// The robot: one entity per link under world/robot, visuals as meshes; returns their paths.

@@ -296,6 +296,14 @@ const EDGE_PX: i64 = 2;
 /// there (the detector's edges wander): see `Follower::measure`.
 const TOP_EDGE_SLACK: f64 = 0.02;
 
+/// How much nearer than the walking distance a camera-only car follows a person walking away
+/// (m). Tuned on the scenarios: 0.1 and 0.3 each fail crossing's `max_range_after_acquire_m`
+/// and walking_square's `min_person_range_m` (docs/FOLLOWER.md).
+const RECEDING_ALLOWANCE_M: f64 = 0.2;
+/// How far a walking person's range from one box may be off with their gait (m, 1 sigma):
+/// about half a step.
+const GAIT_RANGE_SIGMA_M: f64 = 0.15;
+
 /// How quickly a target's learned width follows its whole boxes (fraction per box).
 const WIDTH_LEARNING: f64 = 0.2;
 
@@ -359,9 +367,6 @@ const TRAIL_WIDTH_M: f64 = 0.12;
 /// The trail points a camera-only car lines its back up with before backing away: this far
 /// from its base (m, nearest and furthest).
 const TRAIL_AHEAD_M: [f64; 2] = [0.3, 0.6];
-/// A camera-only car turning its back to its trail keeps the target at least this far
-/// inside the camera's side edges (rad): nearer the edge a close person's box is cut off.
-const GIVE_WAY_FOV_MARGIN_RAD: f64 = 0.35;
 /// Laser returns within this distance of the target's prediction are taken to be the target
 /// (m), and returns this close to it are not obstacles.
 const LASER_GATE_M: f64 = 0.4;
@@ -792,7 +797,19 @@ impl Follower {
     fn fold_in(&mut self, t_image: f64, yaw_rad: f64, keeping: bool, c: &Candidate) {
         let (position, range_m, bearing_rad) = (c.position, c.seen.range_m, c.bearing_rad);
         let heading = yaw_rad + bearing_rad;
-        let cov = polar_covariance(heading, c.seen.range_sigma_m, 0.05 + 0.02 * range_m);
+        // A walking person's feet are up to half a step either side of their centre, and the
+        // box's bottom is the nearer foot's: the range wanders with the gait.
+        let walking = keeping
+            && self
+                .target
+                .as_ref()
+                .is_some_and(FollowTarget::last_seen_walking);
+        let range_sigma_m = if walking {
+            c.seen.range_sigma_m.hypot(GAIT_RANGE_SIGMA_M)
+        } else {
+            c.seen.range_sigma_m
+        };
+        let cov = polar_covariance(heading, range_sigma_m, 0.05 + 0.02 * range_m);
         let near_m = (self.config.standoff_m + 0.8).max(self.whole_view_m + 0.3);
         let close_and_centred = range_m < near_m && bearing_rad.abs() < 0.3;
         // Only confident whole boxes teach the width.
@@ -1075,7 +1092,7 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = range_bearing_from(odom, here);
         let (_, bearing) = range_bearing_from(odom, aim);
-        let range_error = range - self.keep_range_m(walker);
+        let range_error = range - self.keep_range_m(walker) + self.receding_allowance_m(odom, here);
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -1143,7 +1160,7 @@ impl Follower {
     /// A camera-only car that should back away from a person coming too close backs only
     /// over ground it has driven over (nothing tells it what else is behind). When its trail
     /// is not straight behind it, it turns toward the heading that puts the trail behind —
-    /// as far as keeps the target well inside the camera's view — and backs once it is.
+    /// as far as keeps the target inside the camera's view — and backs once it is.
     /// `linear` (< 0) and `angular` are what it would do with a free way back; `bearing` is
     /// the target's from the base's heading.
     fn give_way_over_trail(
@@ -1163,7 +1180,10 @@ impl Follower {
             return (linear, angular);
         };
         let target_yaw = odom.yaw_rad + bearing;
-        let reach = (self.half_fov_rad - GIVE_WAY_FOV_MARGIN_RAD).max(0.0);
+        // Turned as far as the target's centre stays in view: a walking person is seen on
+        // the image's edge (measured: 20 degrees short of the edge, the walking world's
+        // walker came round to 0.56 m before the trail was behind the car).
+        let reach = self.half_fov_rad;
         let wanted_yaw = target_yaw + wrap_angle(back_yaw - target_yaw).clamp(-reach, reach);
         let turn = wrap_angle(wanted_yaw - odom.yaw_rad);
         let angular = (c.turn_gain * turn).clamp(-c.max_turn_radps, c.max_turn_radps);
@@ -1195,6 +1215,25 @@ impl Follower {
     /// that closes in on a walking person loses them at every step, and one who walks toward
     /// the car walks into its blind zone unless it gives way. Once they stand, the car closes
     /// in to the standoff.
+    /// How much nearer than the walking distance a camera-only car follows a person walking
+    /// away from it (m): they cannot walk into it, and a car that keeps the full distance
+    /// from a receding walker lags a step behind it at every turn of their path.
+    fn receding_allowance_m(&self, odom: Odometry, person: [f64; 2]) -> f64 {
+        if self.laser.is_some() {
+            return 0.0;
+        }
+        let Some(t) = &self.target else {
+            return 0.0;
+        };
+        let [vx, vy] = t.filter.velocity_mps();
+        let (dx, dy) = (person[0] - odom.x_m, person[1] - odom.y_m);
+        let range = dx.hypot(dy);
+        if range < 1e-6 || (vx * dx + vy * dy) / range <= MOVING_MPS {
+            return 0.0;
+        }
+        RECEDING_ALLOWANCE_M
+    }
+
     fn keep_range_m(&self, moving: bool) -> f64 {
         let c = &self.config;
         if !moving || self.laser.is_some() {
@@ -1884,9 +1923,16 @@ mod tests {
         // is still ranged from their height.
         let whole_m = camera().whole_view_range_m(1.75);
         let b = person_box(whole_m + 0.05, 0.0);
-        assert!(b.ymin > 0 && f64::from(b.ymin as i32) < 0.02 * 480.0, "top {}", b.ymin);
+        assert!(
+            b.ymin > 0 && f64::from(b.ymin as i32) < 0.02 * 480.0,
+            "top {}",
+            b.ymin
+        );
         let (range_m, _) = f.range_bearing(&b);
-        assert!((range_m - (whole_m + 0.05)).abs() < 0.1, "range {range_m} m");
+        assert!(
+            (range_m - (whole_m + 0.05)).abs() < 0.1,
+            "range {range_m} m"
+        );
     }
 
     #[test]
@@ -1912,7 +1958,10 @@ mod tests {
         for i in 0..=600 {
             let t = f64::from(i) * 0.01;
             let walked = (0.4 * t).min(1.4);
-            let person = [start[0] * (1.0 - walked / 2.2), start[1] * (1.0 - walked / 2.2)];
+            let person = [
+                start[0] * (1.0 - walked / 2.2),
+                start[1] * (1.0 - walked / 2.2),
+            ];
             let (range_m, bearing_rad) = range_bearing_from(odom, person);
             if i % 20 == 0 {
                 f.observe(&message(t, vec![seen_box(odom, person)]));
@@ -1924,7 +1973,10 @@ mod tests {
         }
         assert!(odom.x_m < -0.5, "backed to x = {} m", odom.x_m);
         assert!(odom.y_m.abs() < 0.15, "left its trail: y = {} m", odom.y_m);
-        assert!(widest_rad < 0.5, "turned them to {widest_rad} rad off the axis");
+        assert!(
+            widest_rad < 0.5,
+            "turned them to {widest_rad} rad off the axis"
+        );
         assert!(nearest_m > 1.2, "let them within {nearest_m} m");
     }
 

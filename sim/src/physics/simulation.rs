@@ -344,6 +344,15 @@ impl Simulation {
             .map_or(Pose::IDENTITY, |p| p.world_from_person(self.sim_time_s()))
     }
 
+    /// Where person `index` (world order) is in their gait now (rad; 0 standing): see
+    /// [`crate::model::person::Person::gait_phase_rad`].
+    pub fn person_gait_phase_rad(&self, index: usize) -> f64 {
+        self.world
+            .people
+            .get(index)
+            .map_or(0.0, |p| p.gait_phase_rad(self.sim_time_s()))
+    }
+
     /// Commands a joint by name (a controller's command, a script step, a key). Errors: no
     /// such joint, a joint without an actuator, a non-finite value (the command is dropped and
     /// the last one stays in force). Positions outside the joint's limits stop at the limit.

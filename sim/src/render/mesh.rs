@@ -205,12 +205,64 @@ pub fn visual_mesh(visual: &Visual) -> Result<MeshData> {
 pub struct PersonPart {
     /// The mesh, in the part's frame.
     pub mesh: MeshData,
-    /// Where the part sits in the figure's frame.
+    /// Where the part sits in the figure's frame, standing.
     pub pose: Pose,
     /// Its colour.
     pub color: Rgba,
     /// Where the colour comes from (re-dressing a person repaints the clothes).
     pub paint: Paint,
+    /// How it moves as the person walks.
+    pub swing: Swing,
+}
+
+impl PersonPart {
+    /// Where the part sits in the figure's frame at gait phase `phase_rad`
+    /// ([`Person::gait_phase_rad`]; 0: standing, `pose`).
+    pub fn pose_at(&self, phase_rad: f64) -> Pose {
+        self.swing.pose_at(self.pose, phase_rad)
+    }
+}
+
+/// How far the legs swing forward and back from the hips as a person walks (rad, each way).
+pub const LEG_SWING_RAD: f64 = 0.4;
+
+/// How a figure part moves with the gait: it turns about `pivot` (the hip for a leg, the
+/// shoulder for an arm) by `gain` times the legs' swing, and the whole figure sinks as far as
+/// the swung legs (`leg_m` long) reach less far down, so both feet stay on the ground.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Swing {
+    /// The joint it turns about (figure frame, m).
+    pub pivot: Vec3,
+    /// Its turn about the figure's y axis per radian of leg swing (0: carried along only).
+    pub gain: f32,
+    /// Hip height (m): how far the legs reach down.
+    pub leg_m: f32,
+    /// Carried round the pivot but kept level (a shoe stays flat on the ground).
+    pub level: bool,
+}
+
+impl Swing {
+    /// `pose` (figure frame, standing) at gait phase `phase_rad`: the legs swing
+    /// `LEG_SWING_RAD * sin(phase)`, the figure sinks `leg_m * (1 - cos(swing))`.
+    pub fn pose_at(&self, pose: Pose, phase_rad: f64) -> Pose {
+        if phase_rad == 0.0 {
+            return pose;
+        }
+        let swing = (LEG_SWING_RAD * phase_rad.sin()) as f32;
+        let sink = Pose::from_translation(Vec3::new(0.0, 0.0, -self.leg_m * (1.0 - swing.cos())));
+        if self.gain == 0.0 {
+            return sink * pose;
+        }
+        let turn = Quat::from_rotation_y(self.gain * swing);
+        if self.level {
+            let origin = self.pivot + turn * (pose.translation - self.pivot);
+            return sink * Pose::from_parts(origin, pose.rotation);
+        }
+        let turn = Pose::from_translation(self.pivot)
+            * Pose::from_parts(Vec3::ZERO, turn)
+            * Pose::from_translation(-self.pivot);
+        sink * turn * pose
+    }
 }
 
 /// Where a figure part's colour comes from.
@@ -409,25 +461,64 @@ impl Figure<'_> {
     }
 
     fn add(&mut self, mesh: MeshData, pose: Pose, paint: Paint) {
+        self.add_swinging(mesh, pose, paint, Vec3::ZERO, 0.0);
+    }
+
+    /// A part that turns about `pivot` by `gain` times the legs' swing as the person walks.
+    fn add_swinging(&mut self, mesh: MeshData, pose: Pose, paint: Paint, pivot: Vec3, gain: f32) {
+        self.add_moving(mesh, pose, paint, pivot, gain, false);
+    }
+
+    /// A part that moves about `pivot` by `gain` times the legs' swing, turning with it or
+    /// (`level`) kept level.
+    fn add_moving(
+        &mut self,
+        mesh: MeshData,
+        pose: Pose,
+        paint: Paint,
+        pivot: Vec3,
+        gain: f32,
+        level: bool,
+    ) {
         let color = paint.of(self.person);
+        let swing = Swing {
+            pivot,
+            gain,
+            leg_m: HIP_Z * self.s,
+            level,
+        };
         self.parts.push(PersonPart {
             mesh,
             pose,
             color,
             paint,
+            swing,
         });
     }
 }
+
+/// The hip joints' height on a 1.75 m figure (m): where the legs swing from.
+const HIP_Z: f32 = 0.9;
+/// How far the arms swing against the legs (each arm opposite its own side's leg).
+const ARM_SWING_GAIN: f32 = 0.6;
 
 /// Shoes, legs and arms.
 fn limbs(f: &mut Figure) {
     let shoe = Rgba::rgb(0.1, 0.08, 0.07);
     for side in [-1.0f32, 1.0] {
         let y = 0.09 * side;
-        f.add(
+        // Walking, the left leg (side +1) swings forward (a turn about -y) as the left arm
+        // swings back.
+        let hip = f.v(0.0, 0.0, HIP_Z);
+        let leg_gain = -side;
+        // The shoes go with the legs but stay flat (a foot bends at the ankle).
+        f.add_moving(
             ellipsoid(0.1 * f.s, Vec3::new(1.25, 0.48, 0.45), 8, 12),
             f.at(0.035, y * 1.3, 0.045),
             Paint::Fixed(shoe),
+            hip,
+            leg_gain,
+            true,
         );
         // Leg: ankle, calf, knee, thigh, hip; loose trousers, feet a little apart. A low
         // camera at the follower's standoff sees no more than the legs and the shirt's hem:
@@ -441,19 +532,28 @@ fn limbs(f: &mut Figure) {
             Section::new(0.86, 0.085, 0.088).at(0.0, y * 0.9),
             Section::new(0.9, 0.075, 0.078).at(0.0, y * 0.85),
         ]);
-        f.add(loft(&leg, 2.0, 16), Pose::IDENTITY, Paint::Trousers);
+        f.add_swinging(
+            loft(&leg, 2.0, 16),
+            Pose::IDENTITY,
+            Paint::Trousers,
+            hip,
+            leg_gain,
+        );
         // Arm: shoulder, elbow, wrist hanging just off the body.
         let shoulder = f.v(0.0, 0.185 * side, 1.42);
         let elbow = f.v(-0.03, 0.225 * side, 1.14);
         let wrist = f.v(0.07, 0.24 * side, 0.9);
+        let arm_gain = -leg_gain * ARM_SWING_GAIN;
         let (mesh, pose) = limb(shoulder, elbow, 0.052 * f.s, 0.042 * f.s);
-        f.add(mesh, pose, Paint::Shirt);
+        f.add_swinging(mesh, pose, Paint::Shirt, shoulder, arm_gain);
         let (mesh, pose) = limb(elbow, wrist, 0.036 * f.s, 0.027 * f.s);
-        f.add(mesh, pose, Paint::Skin);
-        f.add(
+        f.add_swinging(mesh, pose, Paint::Skin, shoulder, arm_gain);
+        f.add_swinging(
             ellipsoid(0.045 * f.s, Vec3::new(0.65, 0.5, 1.3), 8, 12),
             Pose::from_parts(f.v(0.09, 0.243 * side, 0.84), Quat::from_rotation_y(-0.35)),
             Paint::Skin,
+            shoulder,
+            arm_gain,
         );
     }
 }
@@ -558,5 +658,68 @@ mod tests {
             .iter()
             .fold(Vec3::ZERO, |m, v| m.max(Vec3::from_array(v.position)));
         assert!((max - Vec3::new(0.5, 0.5, 1.0)).length() < 1e-3);
+    }
+
+    /// The lowest point and the furthest forward point of a person's feet on one side
+    /// (y > 0: left; what of the swinging parts is within 0.2 m of the figure's lowest point),
+    /// at gait phase `phase_rad`.
+    fn reach(parts: &[PersonPart], left: bool, phase_rad: f64) -> (f32, f32) {
+        let (mut low, mut ahead) = (f32::INFINITY, f32::NEG_INFINITY);
+        for part in parts.iter().filter(|p| p.swing.gain != 0.0) {
+            let pose = part.pose_at(phase_rad);
+            for v in &part.mesh.vertices {
+                let p = pose * Vec3::from_array(v.position);
+                if (p.y > 0.0) == left && p.z < 0.2 {
+                    low = low.min(p.z);
+                    ahead = ahead.max(p.x);
+                }
+            }
+        }
+        (low, ahead)
+    }
+
+    #[test]
+    fn a_walking_person_strides_with_both_feet_on_the_ground() {
+        let parts = person_parts(&Person::standing("p", [0.0, 0.0], 0.0));
+        let (standing_low, standing_ahead) = reach(&parts, true, 0.0);
+        assert!(
+            standing_low.abs() < 0.01,
+            "standing feet at {standing_low} m"
+        );
+        // A quarter cycle in: the left leg forward, the right back, both feet down (the
+        // figure sinks as far as the swung legs reach less far down).
+        let quarter = std::f64::consts::FRAC_PI_2;
+        let (left_low, left_ahead) = reach(&parts, true, quarter);
+        let (right_low, right_ahead) = reach(&parts, false, quarter);
+        assert!(
+            left_ahead > standing_ahead + 0.25,
+            "left foot at {left_ahead} m"
+        );
+        assert!(
+            right_ahead < standing_ahead - 0.2,
+            "right foot at {right_ahead} m"
+        );
+        for low in [left_low, right_low] {
+            assert!(low.abs() < 0.03, "a foot at {low} m above the ground");
+        }
+        // The arms swing against the legs: the left hand goes back.
+        let left_hand = |phase_rad: f64| {
+            parts
+                .iter()
+                .filter(|p| p.swing.gain > 0.0)
+                .flat_map(|p| {
+                    let pose = p.pose_at(phase_rad);
+                    p.mesh
+                        .vertices
+                        .iter()
+                        .map(move |v| pose * Vec3::from_array(v.position))
+                })
+                .filter(|p| p.y > 0.0)
+                .map(|p| p.x)
+                .fold(f32::INFINITY, f32::min)
+        };
+        assert!(left_hand(quarter) < left_hand(0.0) - 0.05);
+        // Standing (phase 0) every part sits where the figure was built.
+        assert!(parts.iter().all(|p| p.pose_at(0.0) == p.pose));
     }
 }

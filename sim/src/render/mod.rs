@@ -12,6 +12,8 @@ pub(crate) mod renderer;
 pub(crate) mod scene;
 
 pub use gpu::RenderError;
-pub use mesh::{Paint, PersonPart, object_mesh, person_parts, shape_mesh, visual_mesh};
+pub use mesh::{
+    LEG_SWING_RAD, Paint, PersonPart, Swing, object_mesh, person_parts, shape_mesh, visual_mesh,
+};
 pub use passes::colour::Light;
 pub use renderer::{CameraRenderer, EntityImage};

@@ -233,9 +233,12 @@ impl CameraRenderer {
         self.scene.set_model_link_poses(world_from_model_links);
     }
 
-    /// Moves person `index` (world order) to `world_from_person` for the following renders.
-    pub fn set_person_pose(&mut self, index: usize, world_from_person: Pose) {
-        self.scene.set_person_pose(index, world_from_person);
+    /// Moves person `index` (world order) to `world_from_person`, their limbs to gait phase
+    /// `gait_phase_rad` ([`crate::Simulation::person_gait_phase_rad`]; 0: standing), for the
+    /// following renders.
+    pub fn set_person_pose(&mut self, index: usize, world_from_person: Pose, gait_phase_rad: f64) {
+        self.scene
+            .set_person_pose(index, world_from_person, gait_phase_rad);
     }
 
     /// Paints person `index` (world order) in `person`'s clothes for the following renders.

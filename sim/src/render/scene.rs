@@ -14,7 +14,7 @@ use crate::model::robot::RobotModel;
 use crate::model::world::World;
 use crate::render::gpu::RenderError;
 use crate::render::material::Materials;
-use crate::render::mesh::{Paint, cuboid, object_mesh, person_parts, visual_mesh};
+use crate::render::mesh::{Paint, Swing, cuboid, object_mesh, person_parts, visual_mesh};
 
 /// Per-instance vertex data: the model matrix, the colour (alpha < 0 marks the checkered
 /// ground) and the labelled entity the mesh belongs to ([`EntityIds`]; 0: none).
@@ -108,7 +108,7 @@ pub(crate) struct Scene {
     pub(crate) instance_buffer: wgpu::Buffer,
     robot: Vec<Attached>,
     /// Every figure part, with where its colour comes from.
-    people: Vec<(Attached, Paint)>,
+    people: Vec<(Attached, Paint, Swing)>,
     /// Visuals of every SDF model link.
     models: Vec<Attached>,
     /// Whether some model link can move on its own (physics).
@@ -299,16 +299,23 @@ impl Scene {
         move_attached(&mut self.instances, &self.models, world_from_model_links);
     }
 
-    /// Moves person `index` (world order) to `world_from_person`.
-    pub(crate) fn set_person_pose(&mut self, index: usize, world_from_person: Pose) {
-        for (a, _) in self.people.iter().filter(|(a, _)| a.frame == index) {
-            self.instances[a.instance].model = matrix(world_from_person * a.frame_from_shape);
+    /// Moves person `index` (world order) to `world_from_person`, their limbs to gait phase
+    /// `gait_phase_rad` (0: standing).
+    pub(crate) fn set_person_pose(
+        &mut self,
+        index: usize,
+        world_from_person: Pose,
+        gait_phase_rad: f64,
+    ) {
+        for (a, _, swing) in self.people.iter().filter(|(a, ..)| a.frame == index) {
+            let person_from_shape = swing.pose_at(a.frame_from_shape, gait_phase_rad);
+            self.instances[a.instance].model = matrix(world_from_person * person_from_shape);
         }
     }
 
     /// Paints person `index` (world order) in `person`'s colours.
     pub(crate) fn dress_person(&mut self, index: usize, person: &Person) {
-        for (a, paint) in self.people.iter().filter(|(a, _)| a.frame == index) {
+        for (a, paint, _) in self.people.iter().filter(|(a, ..)| a.frame == index) {
             self.instances[a.instance].color = paint.of(person).0;
         }
     }
@@ -386,7 +393,11 @@ fn add_models(
     Ok(moving)
 }
 
-fn add_people(b: &mut Builder<'_>, world: &World, ids: &EntityIds) -> Vec<(Attached, Paint)> {
+fn add_people(
+    b: &mut Builder<'_>,
+    world: &World,
+    ids: &EntityIds,
+) -> Vec<(Attached, Paint, Swing)> {
     let mut parts = Vec::new();
     for (person_index, person) in world.people.iter().enumerate() {
         let world_from_person = person.world_from_person(0.0);
@@ -397,7 +408,7 @@ fn add_people(b: &mut Builder<'_>, world: &World, ids: &EntityIds) -> Vec<(Attac
                 frame: person_index,
                 frame_from_shape: part.pose,
             };
-            parts.push((attached, part.paint));
+            parts.push((attached, part.paint, part.swing));
         }
     }
     parts

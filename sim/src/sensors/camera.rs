@@ -189,8 +189,11 @@ impl CameraSensor {
         self.layout_seen = sim.layout_version();
         for (index, person) in sim.world().people.iter().enumerate() {
             if person.walk.is_some() || relaid {
-                self.renderer
-                    .set_person_pose(index, sim.world_from_person(index));
+                self.renderer.set_person_pose(
+                    index,
+                    sim.world_from_person(index),
+                    sim.person_gait_phase_rad(index),
+                );
             }
             if relaid {
                 self.renderer.dress_person(index, person);

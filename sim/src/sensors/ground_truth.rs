@@ -23,7 +23,7 @@ use crate::model::classes::Labelled;
 use crate::model::sensors::Distortion;
 use crate::model::world::World;
 use crate::physics::Simulation;
-use crate::render::{EntityImage, RenderError, object_mesh, person_parts, shape_mesh};
+use crate::render::{EntityImage, RenderError, Swing, object_mesh, person_parts, shape_mesh};
 
 /// Pixels checked at once for "nothing labelled here" when counting the id image.
 const ZERO_RUN_PX: usize = 32;
@@ -164,8 +164,9 @@ fn copy_boxes_from<'a>(
 enum Frame {
     /// On a world object (index), at this pose in the object's frame.
     Object(usize, Pose),
-    /// On a person (index), at this pose in the person's frame.
-    Person(usize, Pose),
+    /// On a person (index), at this pose in the person's frame standing, moving so as they
+    /// walk.
+    Person(usize, Pose, Swing),
     /// On a model link (index among all model links), at this pose in the link's frame.
     ModelLink(usize, Pose),
 }
@@ -238,7 +239,7 @@ impl GroundTruth {
                 parts: person_parts(person)
                     .into_iter()
                     .map(|p| Part {
-                        frame: Frame::Person(i, p.pose),
+                        frame: Frame::Person(i, p.pose, p.swing),
                         vertices: vertices(&p.mesh),
                     })
                     .collect(),
@@ -431,7 +432,9 @@ impl GroundTruth {
                     Frame::Object(i, pose) => {
                         self.object_poses.get(i).copied().unwrap_or_default() * pose
                     }
-                    Frame::Person(i, pose) => sim.world_from_person(i) * pose,
+                    Frame::Person(i, pose, swing) => {
+                        sim.world_from_person(i) * swing.pose_at(pose, sim.person_gait_phase_rad(i))
+                    }
                     Frame::ModelLink(i, pose) => {
                         self.model_poses.get(i).copied().unwrap_or_default() * pose
                     }
