@@ -100,7 +100,8 @@ fn machine() -> Result<String> {
 }
 
 // Re-recorded when the follower gained its states, estimator and laser (the walking world now
-// carries the laser car).
+// carries the laser car), and when walking people got a gait (the same follow state on all
+// 1,200 rows, the path within 9.6 cm).
 #[test]
 fn following_a_walking_person_reproduces_the_golden_trace() -> Result<()> {
     // Detection on the loop's thread (--serial-detect): unchanged by pipelined detection.
