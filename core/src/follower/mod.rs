@@ -1200,7 +1200,9 @@ impl Follower {
             .filter_map(|p| {
                 let (dx, dy) = (p[0] - odom.x_m, p[1] - odom.y_m);
                 let d = dx.hypot(dy);
-                (d >= TRAIL_AHEAD_M[0] && d <= TRAIL_AHEAD_M[1]).then(|| dy.atan2(dx))
+                (TRAIL_AHEAD_M[0]..=TRAIL_AHEAD_M[1])
+                    .contains(&d)
+                    .then(|| dy.atan2(dx))
             })
             .min_by(|a, b| {
                 wrap_angle(a - rear_yaw)
