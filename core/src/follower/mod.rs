@@ -1916,6 +1916,12 @@ mod tests {
             furthest_m - nearest_m < 0.05,
             "the range wandered {nearest_m}..{furthest_m} m"
         );
+        // A receding walker is followed a little nearer than the walking distance.
+        let walking_m = camera().whole_view_range_m(1.75) + forward - RECEDING_ALLOWANCE_M;
+        assert!(
+            (nearest_m - walking_m).abs() < 0.1,
+            "followed at {nearest_m} m, not {walking_m} m"
+        );
     }
 
     #[test]
