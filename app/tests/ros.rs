@@ -918,6 +918,9 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
         "camera_info {info:?} vs image {image:?}"
     );
     ensure!(info[4] == image[7], "frames: {} vs {}", info[4], image[7]);
+    // The plugin's frameName, a link of TIAGo's URDF (it used to come out with a second
+    // `_optical` on the end).
+    ensure!(info[4] == "xtion_rgb_optical_frame", "frame {}", info[4]);
     let values = line("values ");
     ensure!(values.len() == 4, "{out}");
     let (finite, lo, hi): (usize, f64, f64) =

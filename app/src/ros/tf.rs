@@ -103,7 +103,8 @@ pub(crate) fn joints_on_tf(plan: &RosPlan) -> Vec<usize> {
 }
 
 /// What `/tf_static` says for `robot` (on the loop thread, once): every fixed joint, the
-/// camera's optical frame under `camera_link`, and each laser's frame when it is not its link.
+/// camera's optical frame under `camera_link` when the URDF has no link of that name, and each
+/// laser's frame when it is not its link.
 pub(crate) fn static_transforms(
     robot: &RobotModel,
     camera: Option<&CameraInfo>,
@@ -118,7 +119,11 @@ pub(crate) fn static_transforms(
             transform(&parent.name, &child.name, 0.0, j.parent_from_child)
         })
         .collect();
-    if let (Some(info), Some(link)) = (camera, camera_link) {
+    // The camera's optical frame, unless the URDF has it (TIAGo's xtion_rgb_optical_frame: its
+    // own fixed joint is above).
+    if let (Some(info), Some(link)) = (camera, camera_link)
+        && robot.link_id(&info.frame_id).is_none()
+    {
         let optical = Pose::from_parts(glam::Vec3::ZERO, link_from_optical());
         static_tf.push(transform(link, &info.frame_id, 0.0, optical));
     }

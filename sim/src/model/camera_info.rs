@@ -39,7 +39,7 @@ impl CameraInfo {
         Self {
             width: config.width_px,
             height: config.height_px,
-            frame_id: format!("{}_optical", config.frame_name),
+            frame_id: optical_frame_id(config),
             distortion_model: "plumb_bob",
             d: [k1, k2, p1, p2, k3],
             k: [fx, 0.0, cx, 0.0, fx, cy, 0.0, 0.0, 1.0],
@@ -61,6 +61,20 @@ impl CameraInfo {
     /// Projects a point in the optical frame (m) to pixel coordinates (no distortion).
     pub fn project(&self, x: f64, y: f64, z: f64) -> Option<(f64, f64)> {
         (z > 0.0).then(|| (self.k[0] * x / z + self.k[2], self.k[4] * y / z + self.k[5]))
+    }
+}
+
+/// The frame a camera's images are in. A `frameName` naming another frame than the sensor's
+/// link is that frame, as gazebo_ros_camera has it (TIAGo's `xtion_rgb_optical_frame`, a URDF
+/// link turned the optical way). Left at the sensor's link (the tutorial car's `camera_link`,
+/// x forward), it would put the images in a frame that does not look the way they do: rover
+/// names the optical frame under it `<link>_optical` instead (REP-103: z forward, x right, y
+/// down) and publishes it on /tf_static.
+pub(crate) fn optical_frame_id(config: &CameraConfig) -> String {
+    if config.frame_name == config.link {
+        format!("{}_optical", config.frame_name)
+    } else {
+        config.frame_name.clone()
     }
 }
 
@@ -112,5 +126,24 @@ pub(crate) mod tests {
         assert!((q * glam::Vec3::Z - glam::Vec3::X).length() < 1e-6);
         assert!((q * glam::Vec3::X + glam::Vec3::Y).length() < 1e-6);
         assert!((q * glam::Vec3::Y + glam::Vec3::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn the_images_frame_is_the_plugins_frame_name_or_the_links_optical_frame() {
+        // frameName left at the sensor's link: rover's optical frame under it.
+        assert_eq!(
+            CameraInfo::from_config(&seed_config()).frame_id,
+            "camera_link_optical"
+        );
+        // TIAGo's xtion: frameName names its URDF's optical link; taken as it is.
+        let xtion = CameraConfig {
+            link: "xtion_rgb_frame".into(),
+            frame_name: "xtion_rgb_optical_frame".into(),
+            ..seed_config()
+        };
+        assert_eq!(
+            CameraInfo::from_config(&xtion).frame_id,
+            "xtion_rgb_optical_frame"
+        );
     }
 }
