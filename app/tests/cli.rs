@@ -23,6 +23,30 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// `rover ... | head`: a reader that stops reading is no reason to panic. The run finishes
+/// (its trace is written) and exits 0; it used to die with "failed printing to stdout".
+#[test]
+fn a_reader_that_stops_reading_stdout_does_not_make_rover_panic() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("trace.csv");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(["--headless", "--duration", "0.5", "--trace"])
+        .arg(&trace)
+        .current_dir(dir.path())
+        .env("RUST_LOG", "warn")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()?;
+    // Close the reading end at once: every line rover prints meets a broken pipe.
+    drop(child.stdout.take());
+    let out = child.wait_with_output()?;
+    let stderr = text(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(std::fs::read_to_string(&trace)?.lines().count() > 10);
+    Ok(())
+}
+
 #[test]
 fn plain_headless_run_uses_the_default_world_and_robot_from_anywhere() -> Result<()> {
     let dir = tempfile::tempdir()?;

@@ -173,16 +173,20 @@ fn profile_detector(
     let ort_ops = match ort {
         Ok(run) => run.ops,
         Err(e) => {
-            println!("onnxruntime: not profiled ({e:#})");
+            say!("onnxruntime: not profiled ({e:#})");
             Vec::new()
         }
     };
     let tract_total: f64 = tract.iter().map(|g| g.ms).sum();
     let ort_total: f64 = ort_ops.iter().map(|(_, ms)| ms).sum();
-    println!("per-op profile, ms per run (sum of node times), one thread, {runs} runs:");
-    println!(
+    say!("per-op profile, ms per run (sum of node times), one thread, {runs} runs:");
+    say!(
         "{:<20} {:>6} {:>9} {:>9} {:>7}   tract's ops (ms)",
-        "ONNX op", "nodes", "tract", "ort", "ratio"
+        "ONNX op",
+        "nodes",
+        "tract",
+        "ort",
+        "ratio"
     );
     for g in &tract {
         let ort_ms = ort_ops
@@ -195,7 +199,7 @@ fn profile_detector(
             .take(3)
             .map(|(op, ms)| format!("{op} {ms:.1}"))
             .collect();
-        println!(
+        say!(
             "{:<20} {:>6} {:>9.2} {:>9} {:>7}   {}",
             g.onnx_op,
             g.nodes,
@@ -207,10 +211,10 @@ fn profile_detector(
     }
     for (op, ms) in &ort_ops {
         if !tract.iter().any(|g| g.onnx_op == *op) {
-            println!("{op:<20} {:>6} {:>9} {ms:>9.2}", "-", "-");
+            say!("{op:<20} {:>6} {:>9} {ms:>9.2}", "-", "-");
         }
     }
-    println!(
+    say!(
         "{:<20} {:>6} {:>9.2} {:>9.2} {:>7.2}x",
         "total",
         "",
@@ -218,7 +222,7 @@ fn profile_detector(
         ort_total,
         tract_total / ort_total
     );
-    println!();
+    say!();
     Ok(())
 }
 
@@ -409,7 +413,7 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
 pub(crate) fn bench_laser(world: WorldArgs, scans: usize) -> Result<()> {
     let config = world.run_config(None);
     let b = laser(&config, scans)?;
-    println!(
+    say!(
         "laser benchmark: {} rays at {} Hz, {scans} scans: median {:.3} ms, best {:.3} ms per scan ({:.2}% of a core at {} Hz); follower command {:.1} us; avoidance window search (worst case, every return) {:.0} us",
         b.rays,
         b.rate_hz,
@@ -498,14 +502,17 @@ pub(crate) fn bench_cmd(
     let config = world.run_config(None);
     let mut plan: Vec<Option<f64>> = vec![world.physics_hz];
     plan.extend(rates.into_iter().map(Some));
-    println!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
-    println!(
+    say!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
+    say!(
         "{:>10} {:>12} {:>12} {:>14}",
-        "step_hz", "wall_s", "us/step", "real-time x"
+        "step_hz",
+        "wall_s",
+        "us/step",
+        "real-time x"
     );
     for step_hz in plan {
         let b = physics(&config, step_hz, sim_seconds, repeats)?;
-        println!(
+        say!(
             "{:>10.0} {:>12.3} {:>12.1} {:>14.0}",
             b.step_hz,
             b.wall_s,
@@ -528,7 +535,7 @@ pub(crate) fn bench_record(
     };
     let dir = std::env::temp_dir().join(format!("rover-bench-record-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
-    println!(
+    say!(
         "recording overhead: {duration} sim s headless, camera + lockstep detector on, best of {repeats}"
     );
     let b = record(
@@ -542,13 +549,13 @@ pub(crate) fn bench_record(
     );
     let _ = std::fs::remove_dir_all(&dir);
     let b = b?;
-    println!("without --record: {:.2} s wall", b.plain_s);
-    println!(
+    say!("without --record: {:.2} s wall", b.plain_s);
+    say!(
         "with --record:    {:.2} s wall ({:.1} MB .rrd)",
         b.recorded_s,
         b.rrd_bytes as f64 / 1e6
     );
-    println!("ratio: {:.2}x (goal <= 1.3x)", b.ratio());
+    say!("ratio: {:.2}x (goal <= 1.3x)", b.ratio());
     Ok(())
 }
 
@@ -681,21 +688,24 @@ pub(crate) fn bench_ros(world: WorldArgs, duration: f64, repeats: u32) -> Result
         duration_s: Some(duration),
         ..world.run_config(None)
     };
-    println!(
+    say!(
         "ROS bridge cost: {duration} sim s headless, camera + lockstep detector on, unpaced, best of {repeats}"
     );
     let b = ros(&config, repeats)?;
-    println!("without --ros: {:.2} s wall", b.plain_s);
-    println!(
+    say!("without --ros: {:.2} s wall", b.plain_s);
+    say!(
         "with --ros and 3 subscribers: {:.2} s wall (received {} images, {} odom, {} tf)",
-        b.bridged_s, b.received[0], b.received[1], b.received[2]
+        b.bridged_s,
+        b.received[0],
+        b.received[1],
+        b.received[2]
     );
-    println!(
+    say!(
         "ratio: {:.3}x; {:+.2} ms per sim second",
         b.bridged_s / b.plain_s,
         (b.bridged_s - b.plain_s) * 1e3 / duration
     );
-    println!(
+    say!(
         "the bridge on the loop thread: {:.2} ms per sim second ({:.3}% of real time)",
         b.bridge_loop_s * 1e3 / duration,
         b.bridge_loop_s * 100.0 / duration
@@ -706,17 +716,21 @@ pub(crate) fn bench_ros(world: WorldArgs, duration: f64, repeats: u32) -> Result
 pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
     let config = world.run_config(None);
     let b = camera(&config, frames)?;
-    println!(
+    say!(
         "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",
-        b.size.0, b.size.1, b.adapter, b.median_ms, b.best_ms
+        b.size.0,
+        b.size.1,
+        b.adapter,
+        b.median_ms,
+        b.best_ms
     );
-    println!(
+    say!(
         "with ground truth ({} labelled things: id image, silhouettes, boxes): median {:.2} ms, +{:.2} ms",
         b.labelled,
         b.truth_median_ms,
         b.truth_median_ms - b.median_ms
     );
-    println!(
+    say!(
         "with a depth image (the depth buffer read back as metres): median {:.2} ms, +{:.2} ms",
         b.depth_median_ms,
         b.depth_median_ms - b.median_ms
@@ -746,7 +760,7 @@ pub(crate) fn bench_detect(
             }
         }
     };
-    println!(
+    say!(
         "detector benchmark on {}: {runs} runs after a warm-up, {} thread(s) for both runtimes (--detect-threads)",
         image.display(),
         config.threads
@@ -764,16 +778,16 @@ pub(crate) fn bench_detect(
         )?;
     }
     let b = detector(config, &image, runs)?;
-    println!("input {}x{}", b.input_size.0, b.input_size.1);
-    println!("{:<28} {:>10}", "stage (median)", "ms");
-    println!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
-    println!(
+    say!("input {}x{}", b.input_size.0, b.input_size.1);
+    say!("{:<28} {:>10}", "stage (median)", "ms");
+    say!("{:<28} {:>10.1}", "preprocess (letterbox)", b.preprocess_ms);
+    say!(
         "{:<28} {:>10.1}",
         format!("{} inference", b.runtime),
         b.inference_ms
     );
-    println!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
-    println!(
+    say!("{:<28} {:>10.1}", "decode + NMS", b.decode_ms);
+    say!(
         "{:<28} {:>10.1}   ({:.1} Hz)",
         "end to end",
         b.total_ms,
@@ -781,14 +795,14 @@ pub(crate) fn bench_detect(
     );
     match b.onnxruntime_ms {
         Ok(ort) => {
-            println!("{:<28} {:>10.1}", "onnxruntime inference", ort);
-            println!(
+            say!("{:<28} {:>10.1}", "onnxruntime inference", ort);
+            say!(
                 "{:<28} {:>10.2}x",
                 format!("{} / onnxruntime (Python)", b.runtime),
                 b.inference_ms / ort
             );
         }
-        Err(e) => println!("onnxruntime: not measured ({e}); pip install onnxruntime"),
+        Err(e) => say!("onnxruntime: not measured ({e}); pip install onnxruntime"),
     }
     Ok(())
 }

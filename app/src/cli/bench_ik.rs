@@ -92,7 +92,7 @@ pub(crate) fn bench(
 ) -> Result<()> {
     let config = world.run_config(None);
     let b = ik(&config, base, ee_link, targets, pose)?;
-    println!(
+    say!(
         "ik benchmark: {} ({} joints), {} {} targets: median {:.3} ms, slowest {:.3} ms per solve; {} of {} within tolerance (0.1 mm{}), worst error {:.2e} m, median {} iterations",
         b.chain,
         b.joints,

@@ -71,7 +71,7 @@ fn merge(args: &DatasetArgs) -> Result<()> {
     });
     bar.finish_and_clear();
     let (spec, summary) = summary?;
-    println!(
+    say!(
         "merged {} shard folders into {}: {} images ({} gathered now, {} there before)",
         args.merge.len(),
         summary.out.display(),
@@ -115,7 +115,7 @@ pub(crate) fn run(args: DatasetArgs) -> Result<()> {
             first = false;
             if p.kept > 0 {
                 bar.suspend(|| {
-                    println!(
+                    say!(
                         "resuming {}: {} of {} images already complete",
                         spec.out.display(),
                         p.kept,
@@ -133,7 +133,7 @@ pub(crate) fn run(args: DatasetArgs) -> Result<()> {
     let summary = summary?;
     print_summary(&summary, &spec);
     if summary.interrupted {
-        println!(
+        say!(
             "interrupted: {} of {} images complete; run the same command again to go on",
             summary.kept + summary.made,
             summary.total
@@ -149,7 +149,7 @@ fn print_summary(s: &DatasetSummary, spec: &DatasetSpec) {
     } else {
         0.0
     };
-    println!(
+    say!(
         "dataset {}: {} images ({} made now at {rate:.1}/s, {} kept from before)",
         s.out.display(),
         s.total,
@@ -164,7 +164,7 @@ fn print_summary(s: &DatasetSummary, spec: &DatasetSpec) {
 /// What the dataset (or shard) holds and which files were written.
 fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
     if let Some(shard) = spec.shard {
-        println!(
+        say!(
             "  shard {}/{}: train {} / val {} images; {} labelled boxes, {} ignore regions; wrote images/, ground_truth/{}, {}",
             shard.index,
             shard.count,
@@ -175,7 +175,7 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
             if spec.yolo { ", labels/" } else { "" },
             rover_core::SHARD_MANIFEST
         );
-        println!(
+        say!(
             "  once every shard is finished: rover dataset --merge {}/shard-*-of-{} --out DATASET_DIR",
             spec.out
                 .parent()
@@ -184,9 +184,13 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
         );
         return;
     }
-    println!(
+    say!(
         "  train {} / val {} images; {} labelled boxes, {} ignore regions, {} images with no box",
-        s.split_images[0], s.split_images[1], s.boxes, s.ignored, s.backgrounds
+        s.split_images[0],
+        s.split_images[1],
+        s.boxes,
+        s.ignored,
+        s.backgrounds
     );
     let mut wrote = Vec::new();
     if spec.yolo {
@@ -195,15 +199,15 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
     if spec.coco {
         wrote.push("annotations/instances_{train,val}.json (COCO)");
     }
-    println!(
+    say!(
         "  wrote images/{{train,val}}/, {}, ground_truth/",
         wrote.join(", ")
     );
     if let Some([train, val, all]) = &s.metrics {
         let f = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
-        println!("  detector (COCO rules; metrics.json, detections/):");
+        say!("  detector (COCO rules; metrics.json, detections/):");
         for (name, m) in [("train", train), ("val", val), ("all", all)] {
-            println!(
+            say!(
                 "    {name:<5} {} images  AP50 {}  AP50:95 {}",
                 m.images,
                 f(m.ap50),
@@ -211,7 +215,7 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
             );
         }
         for c in &all.classes {
-            println!(
+            say!(
                 "    {:<14} AP50 {}  precision {}  recall {}  mean IoU {}  ({} truth, {} detections)",
                 c.class,
                 f(c.ap50),
@@ -256,7 +260,7 @@ pub(crate) fn bench(
     let start = Instant::now();
     let summary = rover_core::write_dataset(&config, &spec, &mut |_| {})?;
     let total_s = start.elapsed().as_secs_f64();
-    println!(
+    say!(
         "dataset benchmark: {} labelled {} images, {} at once: {:.1} images/s while making them ({:.1} ms each), {:.1}/s including set-up and the COCO/YOLO files ({:.2} s in all)",
         summary.made,
         match format {
@@ -269,9 +273,11 @@ pub(crate) fn bench(
         summary.made as f64 / total_s,
         total_s
     );
-    println!(
+    say!(
         "  {} labelled boxes, {} ignore regions in {} images",
-        summary.boxes, summary.ignored, summary.total
+        summary.boxes,
+        summary.ignored,
+        summary.total
     );
     Ok(())
 }

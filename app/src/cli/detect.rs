@@ -37,7 +37,7 @@ pub fn run(options: &DetectOptions) -> Result<()> {
     let mut detector = Detector::load(options.detector.clone())?;
     let (w, h) = detector.input_size();
     if !options.json {
-        println!(
+        say!(
             "model {} ({}x{}, {}, {} classes), threshold {}, NMS IoU {}, {} on {} thread(s)",
             detector.model_path().display(),
             w,
@@ -71,18 +71,23 @@ pub fn run(options: &DetectOptions) -> Result<()> {
                 height,
                 result: &result,
             };
-            println!("{}", serde_json::to_string(&line)?);
+            say!("{}", serde_json::to_string(&line)?);
         } else {
-            println!(
+            say!(
                 "{}: {} object(s), {:.0} ms",
                 path.display(),
                 result.bounding_boxes.len(),
                 result.latency_ms
             );
             for b in &result.bounding_boxes {
-                println!(
+                say!(
                     "{} {:.3} {} {} {} {}",
-                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
+                    b.class,
+                    b.probability,
+                    b.xmin,
+                    b.ymin,
+                    b.xmax,
+                    b.ymax
                 );
             }
         }
@@ -105,7 +110,7 @@ pub fn run(options: &DetectOptions) -> Result<()> {
                 .save(&target)
                 .with_context(|| format!("cannot write {}", target.display()))?;
             if !options.json {
-                println!("wrote {}", target.display());
+                say!("wrote {}", target.display());
             }
         }
     }

@@ -514,10 +514,9 @@ fn merge(files: &[PathBuf]) -> Result<EvalReport> {
     Ok(report_of(results, timing))
 }
 
-/// Prints the table, writes JSON and CSV; fails (exit 1) when a scenario failed.
+/// Writes JSON and CSV, prints the table; fails (exit 1) when a scenario failed. The files
+/// come first: a reader who stops reading the table (`rover eval | head`) loses nothing.
 fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
-    let mut stdout = std::io::stdout().lock();
-    write_table(&mut stdout, &report)?;
     let json_path = args.out.join(json_name);
     // Whole or not at all: a shard cancelled while writing leaves no report, so a merge names
     // it missing instead of reading half of it.
@@ -531,26 +530,31 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
     write_csv(&mut csv, &report)?;
     std::fs::write(&csv_path, csv)
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
-    writeln!(
-        stdout,
-        "\n{}/{} scenarios passed ({:.0}%){}; {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",
+    let skipped = if report.skipped > 0 {
+        format!(
+            ", {} skipped (a sensor they need is missing)",
+            report.skipped
+        )
+    } else {
+        String::new()
+    };
+    let summary = format!(
+        "\n{}/{} scenarios passed ({:.0}%){skipped}; {} jobs, {:.1} s wall, {:.2} sim s per wall s\nresults: {}, {}",
         report.passed,
         report.scenarios,
         100.0 * report.pass_rate,
-        if report.skipped > 0 {
-            format!(
-                ", {} skipped (a sensor they need is missing)",
-                report.skipped
-            )
-        } else {
-            String::new()
-        },
         report.timing.jobs,
         report.timing.wall_s,
         report.timing.sim_per_wall,
         json_path.display(),
         csv_path.display()
-    )?;
+    );
+    let mut stdout = std::io::stdout().lock();
+    let printed = write_table(&mut stdout, &report).and_then(|()| writeln!(stdout, "{summary}"));
+    match printed {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
+        _ => {}
+    }
     if report.passed < report.scenarios {
         bail!(
             "{} of {} scenarios failed",

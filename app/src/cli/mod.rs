@@ -3,6 +3,17 @@
 //! `rover dataset` (`dataset`). `anyhow` errors, `tracing`
 //! logs; the binary's `main` only calls [`main`].
 
+/// `println!` that takes a reader who stopped reading (`rover ... | head`) in its stride: the
+/// line is dropped and the command goes on to finish its files, where `println!` would panic.
+/// Other write errors on stdout are dropped too: stdout is for people, and nothing rover
+/// keeps depends on it.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod args;
 pub mod bench;
 pub mod bench_ik;

@@ -57,7 +57,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     }
     let mut recorder = Recorder::start(&recorder_options)?;
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.as_ref()) {
-        println!("Rerun web viewer: {url}");
+        say!("Rerun web viewer: {url}");
     }
     let summary = if args.ros.bridges() {
         run_with_ros(&config, &args.ros, recorder.as_mut())
@@ -72,17 +72,17 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(rec) = recorder.as_mut() {
         record_failed = rec.finish().err();
         if let Some(path) = &recorder_options.record {
-            println!("recording: {}", viewer::describe_file(path));
+            say!("recording: {}", viewer::describe_file(path));
         }
         if let (Some(url), Ok(_)) = (&rec.web_url, &summary) {
-            println!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
+            say!("run finished; still serving the web viewer at {url} (Ctrl-C to quit)");
             while !stop.load(Ordering::Relaxed) {
                 std::thread::sleep(Duration::from_millis(100));
             }
         }
     }
     let summary = summary?;
-    println!(
+    say!(
         "rover: world \"{}\", robot \"{}\": {:.2} s sim time in {} physics steps, {:.3} s wall ({:.2}x real time)",
         summary.world,
         summary.robot,
@@ -94,7 +94,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
     if let Some(last) = summary.last {
         let g = last.ground_truth;
         let o = last.odometry;
-        println!(
+        say!(
             "final pose: x {:.3} m, y {:.3} m, yaw {:.1} deg (odometry: x {:.3} m, y {:.3} m, yaw {:.1} deg); mode {}",
             g.x_m,
             g.y_m,
@@ -106,7 +106,7 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         );
     }
     if let Some(path) = &args.trace {
-        println!("trace: {} ({} rows)", path.display(), summary.rows);
+        say!("trace: {} ({} rows)", path.display(), summary.rows);
     }
     end_of_run(
         record_failed,
@@ -179,7 +179,7 @@ fn end_of_run(
         _ => {}
     }
     if interrupted {
-        println!(
+        say!(
             "interrupted by a signal at {sim_time_s:.2} s sim time: the trace and recording end there, complete"
         );
         return Err(super::Interrupted.into());
@@ -209,7 +209,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         }
     };
     if let Some(url) = recorder.as_ref().and_then(|r| r.web_url.clone()) {
-        println!("Rerun web viewer: {url}");
+        say!("Rerun web viewer: {url}");
     }
     let mut files = RunFiles::open(
         args.trace.as_deref(),
@@ -276,7 +276,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         .as_mut()
         .map(|bridge| finish_ros2(bridge, args.ros.record_mcap.as_deref()));
     recorded.transpose()?;
-    println!(
+    say!(
         "rover: {:.1} s sim time in {:.1} s wall; mode {}",
         summary.sim_time_s,
         summary.wall_s,
@@ -284,10 +284,10 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     );
     let written = files.finish()?;
     if let Some(path) = &args.trace {
-        println!("trace: {} ({} rows)", path.display(), written.rows);
+        say!("trace: {} ({} rows)", path.display(), written.rows);
     }
     if let Some(path) = &recorder_options.record {
-        println!("recording: {}", viewer::describe_file(path));
+        say!("recording: {}", viewer::describe_file(path));
     }
     end_of_run(
         record_failed,
@@ -323,7 +323,7 @@ fn finish_ros2(bridge: &mut Ros2Bridge, mcap: Option<&std::path::Path>) -> Resul
     }
     if let (Some(recorded), Some(path)) = (recorded, mcap) {
         let summary = recorded?;
-        println!(
+        say!(
             "MCAP: {} ({} messages on {} topics)",
             path.display(),
             summary.messages,
