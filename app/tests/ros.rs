@@ -179,17 +179,25 @@ impl RosGraph {
         self.dir.path().join("trace.csv")
     }
 
-    /// Whether rover is still running, for a failure's message: a subscriber that heard
-    /// nothing may have come after rover finished.
-    fn rover_state(&mut self) -> String {
-        match self.rover.and_then(|i| self.children.get_mut(i)) {
+    /// Runs a subscriber like [`Self::run`]; also says how long it ran and whether rover was
+    /// still running after it, for a failure's message (one that heard nothing may have come
+    /// after rover finished).
+    fn run_subscriber(&mut self, command: Command, timeout: Duration) -> Result<(String, String)> {
+        let start = Instant::now();
+        let out = self.run(command, timeout)?;
+        let rover = match self.rover.and_then(|i| self.children.get_mut(i)) {
             None => "not started".to_owned(),
             Some(rover) => match rover.try_wait() {
                 Ok(None) => "still running".to_owned(),
                 Ok(Some(status)) => format!("already exited ({status})"),
                 Err(e) => format!("unknown ({e})"),
             },
-        }
+        };
+        let note = format!(
+            "it ran {:.1} s; rover then {rover}",
+            start.elapsed().as_secs_f64()
+        );
+        Ok((out, note))
     }
 
     /// Waits for rover (the first child named rover) to exit; returns its trace.
@@ -523,13 +531,7 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["echo", "-n", "1", "/darknet_ros/bounding_boxes"])
         .env("PYTHONPATH", &py);
-    let echo_start = Instant::now();
-    let boxes = graph.run(c, Duration::from_secs(30))?;
-    let after_echo = format!(
-        "rostopic echo ran {:.1} s; rover then {}",
-        echo_start.elapsed().as_secs_f64(),
-        graph.rover_state()
-    );
+    let (boxes, after_echo) = graph.run_subscriber(c, Duration::from_secs(30))?;
 
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["hz", "/camera/image_raw"]);
@@ -561,7 +563,7 @@ fn rostopic_and_rosbag_see_gazebos_and_darknets_topics() -> Result<()> {
     // rostopic echo: darknet_ros's message, a person with pixel bounds inside the image.
     assert!(
         boxes.contains("Class: \"person\""),
-        "no person in\n{boxes}\n{after_echo}\nrover:\n{rover_log}"
+        "no person in\n{boxes}\nrostopic echo: {after_echo}\nrover:\n{rover_log}"
     );
     check_person_box(&boxes)?;
 
@@ -647,18 +649,12 @@ fn the_ground_truth_topic_carries_the_person_in_view() -> Result<()> {
     let mut c = graph.command("/usr/bin/rostopic");
     c.args(["echo", "-n", "3", "/rover/ground_truth/bounding_boxes"])
         .env("PYTHONPATH", &py);
-    let echo_start = Instant::now();
-    let truth = graph.run(c, Duration::from_secs(30))?;
-    let after_echo = format!(
-        "rostopic echo ran {:.1} s; rover then {}",
-        echo_start.elapsed().as_secs_f64(),
-        graph.rover_state()
-    );
+    let (truth, after_echo) = graph.run_subscriber(c, Duration::from_secs(30))?;
     graph.wait_rover(Duration::from_secs(120))?;
     let rover_log = graph.log("rover");
     assert!(
         truth.contains("Class: \"person\""),
-        "no person in\n{truth}\n{after_echo}\nrover:\n{rover_log}"
+        "no person in\n{truth}\nrostopic echo: {after_echo}\nrover:\n{rover_log}"
     );
     assert_eq!(echoed(&truth, "probability")?, 1.0);
     assert_eq!(echoed(&truth, "id")?, 0.0, "person is COCO's class 0");

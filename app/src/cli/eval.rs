@@ -551,9 +551,10 @@ fn finish(args: &EvalArgs, report: EvalReport, json_name: &str) -> Result<()> {
     );
     let mut stdout = std::io::stdout().lock();
     let printed = write_table(&mut stdout, &report).and_then(|()| writeln!(stdout, "{summary}"));
-    match printed {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
-        _ => {}
+    if let Err(e) = printed
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        return Err(e.into());
     }
     if report.passed < report.scenarios {
         bail!(

@@ -87,7 +87,7 @@ impl Person {
             let (a, b) = (corner(i), corner(i + 1));
             (a, b, (b[0] - a[0]).hypot(b[1] - a[1]))
         };
-        let length: f64 = (0..legs).map(|i| leg(i).2).sum();
+        let length = self.walk_length_m();
         if length <= 1e-9 {
             return (x0, y0, self.heading_rad);
         }
@@ -143,20 +143,18 @@ impl Person {
         let Some(walk) = &self.walk else {
             return 0.0;
         };
-        let mut corners = std::iter::once(self.position_m).chain(walk.waypoints_m.iter().copied());
-        let Some(first) = corners.next() else {
-            return 0.0;
-        };
-        let mut last = first;
-        let mut length = 0.0;
-        for c in corners {
-            length += (c[0] - last[0]).hypot(c[1] - last[1]);
-            last = c;
-        }
-        if walk.repeat {
-            length += (first[0] - last[0]).hypot(first[1] - last[1]);
-        }
-        length
+        let back = walk.repeat.then_some(self.position_m);
+        let mut from = self.position_m;
+        walk.waypoints_m
+            .iter()
+            .copied()
+            .chain(back)
+            .map(|to| {
+                let leg_m = (to[0] - from[0]).hypot(to[1] - from[1]);
+                from = to;
+                leg_m
+            })
+            .sum()
     }
 
     /// Radius of the upright capsule that stands in for the person in physics (m).
