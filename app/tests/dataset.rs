@@ -205,7 +205,9 @@ fn a_dataset_is_valid_yolo_and_coco_and_the_same_twice() -> Result<()> {
         ensure!(out.status.success(), "COCO() failed: {}", text(&out.stderr));
         println!("pycocotools COCO() loads: {}", text(&out.stdout));
     } else {
-        eprintln!("SKIP (COCO() part): python3 cannot import pycocotools (./test installs it)");
+        rover_tests::skip(
+            "the COCO() part: python3 cannot import pycocotools (./test installs it)",
+        )?;
     }
     Ok(())
 }
@@ -297,8 +299,9 @@ fn a_full_disk_stops_the_dataset_cleanly_and_it_resumes() -> Result<()> {
         .arg(&mount)
         .output();
     if !mounted.as_ref().is_ok_and(|o| o.status.success()) {
-        eprintln!("SKIP: cannot mount a small tmpfs here (needs root): {mounted:?}");
-        return Ok(());
+        return rover_tests::skip(format!(
+            "cannot mount a small tmpfs here (needs root): {mounted:?}"
+        ));
     }
     let result = (|| -> Result<()> {
         let dir = mount.join("d");
@@ -380,8 +383,9 @@ fn a_full_disk_stops_the_dataset_cleanly_and_it_resumes() -> Result<()> {
 #[test]
 fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result<()> {
     if !has_pycocotools() {
-        eprintln!("SKIP: python3 cannot import pycocotools and numpy (./test installs them)");
-        return Ok(());
+        return rover_tests::skip(
+            "python3 cannot import pycocotools and numpy (./test installs them)",
+        );
     }
     let tmp = tempfile::tempdir()?;
     let mut runs = vec![(
@@ -424,6 +428,7 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
         println!("{name}:\n{stdout}");
         let metrics: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json"))?)?;
+        let mut compared = Vec::new();
         for split in ["train", "val"] {
             let script = "import sys, json, io, contextlib\nfrom pycocotools.coco import COCO\nfrom pycocotools.cocoeval import COCOeval\nstats = None\nwith contextlib.redirect_stdout(io.StringIO()):\n    gt = COCO(sys.argv[1])\n    dets = json.load(open(sys.argv[2]))\n    if dets:\n        e = COCOeval(gt, gt.loadRes(dets), 'bbox'); e.evaluate(); e.accumulate(); e.summarize()\n        stats = [e.stats[0], e.stats[1]]\nprint(json.dumps(stats))\n";
             let out = Command::new("python3")
@@ -434,6 +439,11 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
             ensure!(out.status.success(), "pycocotools: {}", text(&out.stderr));
             let theirs: serde_json::Value = serde_json::from_str(text(&out.stdout).trim())?;
             let ours = &metrics[split];
+            // Both sides agree on whether the split has anything to score.
+            ensure!(
+                theirs.as_array().is_some() == ours["ap50_95"].as_f64().is_some(),
+                "{name} {split}: one side scored the split and the other did not: rover {ours}, pycocotools {theirs}"
+            );
             let (Some(t), Some(ap), Some(ap50)) = (
                 theirs.as_array(),
                 ours["ap50_95"].as_f64(),
@@ -444,6 +454,7 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
                 );
                 continue;
             };
+            compared.push(split);
             let (t_ap, t_ap50) = (
                 t[0].as_f64().unwrap_or(f64::NAN),
                 t[1].as_f64().unwrap_or(f64::NAN),
@@ -456,6 +467,11 @@ fn pycocotools_on_the_exported_dataset_gives_rovers_detector_metrics() -> Result
                 "{name} {split}: rover {ap} / {ap50} vs pycocotools {t_ap} / {t_ap50}"
             );
         }
+        ensure!(
+            !compared.is_empty(),
+            "{name}: no split had scores to compare (rover {metrics})"
+        );
+        println!("{name}: compared {compared:?}");
     }
     Ok(())
 }

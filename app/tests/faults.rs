@@ -35,9 +35,9 @@ fn rrd_verify(path: &Path, footers: bool) -> Result<Option<Output>> {
     match c.arg(path).output() {
         Ok(out) => Ok(Some(out)),
         Err(e) => {
-            eprintln!(
-                "SKIP rrd verify: no `rerun` CLI on PATH ({e}); ./test installs rerun-sdk 0.36.3"
-            );
+            rover_tests::skip(format!(
+                "rrd verify: no `rerun` CLI on PATH ({e}); ./test installs rerun-sdk 0.36.3"
+            ))?;
             Ok(None)
         }
     }
@@ -370,14 +370,14 @@ impl SmallDisk {
         match out {
             Ok(o) if o.status.success() => Ok(Some(Self { dir })),
             Ok(o) => {
-                eprintln!(
-                    "SKIP disk-full test: cannot mount a small tmpfs ({}); run as root",
+                rover_tests::skip(format!(
+                    "disk-full test: cannot mount a small tmpfs ({}); run as root",
                     text(&o.stderr).trim()
-                );
+                ))?;
                 Ok(None)
             }
             Err(e) => {
-                eprintln!("SKIP disk-full test: no mount command ({e})");
+                rover_tests::skip(format!("disk-full test: no mount command ({e})"))?;
                 Ok(None)
             }
         }

@@ -67,8 +67,8 @@ fn rosbags_available() -> bool {
         .status()
         .is_ok_and(|s| s.success());
     if !ok {
-        eprintln!(
-            "SKIP: python3 cannot import rosbags, scikit-image and numpy (scripts/setup.sh installs them)"
+        rover_tests::skip::skip_or_panic(
+            "python3 cannot import rosbags, scikit-image and numpy (scripts/setup.sh installs them)",
         );
     }
     ok
@@ -304,8 +304,9 @@ fn rerun_imports_the_recording() -> Result<()> {
         .output()
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains(" 0.36.3"));
     if !rerun_ok {
-        eprintln!("SKIP: no `rerun` 0.36.3 CLI on PATH (scripts/setup.sh installs rerun-sdk)");
-        return Ok(());
+        return rover_tests::skip(
+            "no `rerun` 0.36.3 CLI on PATH (scripts/setup.sh installs rerun-sdk)",
+        );
     }
     let dir = tempfile::tempdir()?;
     record(dir.path(), "run")?;

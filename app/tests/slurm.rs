@@ -1,6 +1,6 @@
 //! rover's shards on a real Slurm: Debian's slurm-wlm (slurmctld, slurmd) and munge, started
 //! by the test on localhost in a folder of its own (no cgroups, no systemd), and the sbatch
-//! files of scripts/slurm/ submitted unchanged. Skipped, with the reason, where Slurm is not
+//! files of scripts/slurm/ submitted unchanged. Skipped (counted and listed; a failure in strict mode) where Slurm is not
 //! installed (`./test` installs it) or will not start.
 
 use std::path::{Path, PathBuf};
@@ -186,16 +186,18 @@ impl Cluster {
 }
 
 impl Cluster {
-    /// A started cluster, or `None` after saying why this test skips.
+    /// A started cluster, or `None` after recording why this test skips. Where Slurm is
+    /// installed but will not start, that is a failure in strict mode like any skip (CI
+    /// installs it and must be able to start it).
     fn start_or_skip() -> Option<Self> {
         if let Some(why) = missing_slurm() {
-            eprintln!("SKIP: {why}");
+            rover_tests::skip::skip_or_panic(why);
             return None;
         }
         match Self::start() {
             Ok(c) => Some(c),
             Err(e) => {
-                eprintln!("SKIP: Slurm will not start here: {e:#}");
+                rover_tests::skip::skip_or_panic(format!("Slurm will not start here: {e:#}"));
                 None
             }
         }

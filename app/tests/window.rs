@@ -173,3 +173,81 @@ fn the_arm_car_drives_with_keys_and_its_arm_jogs() -> Result<()> {
     assert_eq!((run.shot.width(), run.shot.height()), (640, 592));
     Ok(())
 }
+
+/// `h` in the real window, end to end: on the arm car, `2` and five `]` jog the shoulder lift
+/// to 0.5 rad and `3` and three `]` the elbow to 0.3 rad; the trace shows the arm holding
+/// there, then, after `h`, every joint back at the controllers file's "home" pose
+/// (assets/controllers/my_robot_arm.yaml, read with rover's own loader) within 0.03 rad. A
+/// script cannot press `h` (scripts take teleop keys only; `pose = "home"` is what it sends,
+/// tested in named_poses.rs), so this is the test that the key itself moves the arm.
+#[test]
+fn h_in_the_real_window_brings_the_jogged_arm_home() -> Result<()> {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut robot =
+        rover_sim::RobotModel::load(&repo.join("assets/robots/my_robot_arm.urdf.xacro"))?;
+    robot.load_controllers(&repo.join("assets/controllers/my_robot_arm.yaml"))?;
+    let home = robot
+        .controllers
+        .as_ref()
+        .and_then(|c| c.named_pose("home"))
+        .map(|p| p.joints.clone())
+        .ok_or_else(|| anyhow::anyhow!("no \"home\" pose in my_robot_arm.yaml"))?;
+    let run = run_window(
+        "worlds/arm_car.toml",
+        14,
+        "xdotool key 2\nfor n in 1 2 3 4 5; do xdotool key bracketright; sleep 0.3; done\nxdotool key 3\nfor n in 1 2 3; do xdotool key bracketright; sleep 0.3; done\nsleep 3\nxdotool key h",
+        None,
+    )?;
+    let (rows, log) = (&run.rows, &run.log);
+    let column = |name: &str| {
+        run.joints
+            .iter()
+            .position(|j| j == name)
+            .ok_or_else(|| anyhow::anyhow!("no {name} column in {:?}", run.joints))
+    };
+    let (lift, elbow) = (column("shoulder_lift_joint")?, column("elbow_joint")?);
+    // The jog took the arm well away from home first...
+    for (joint, jogged) in [("shoulder_lift_joint", 0.5), ("elbow_joint", 0.3)] {
+        let q = home
+            .iter()
+            .find(|(j, _)| j == joint)
+            .map_or(f64::NAN, |(_, q)| *q);
+        assert!(
+            (q - jogged).abs() > 0.2,
+            "home's {joint} ({q}) is too close to the jogged {jogged} rad to show `h` moved it"
+        );
+    }
+    let jogged = rows
+        .iter()
+        .rev()
+        .find(|r| {
+            (r.joints[lift].position - 0.5).abs() < 0.05
+                && (r.joints[elbow].position - 0.3).abs() < 0.05
+        })
+        .ok_or_else(|| {
+            let end = rows.last().map(|r| r.joints.clone()).unwrap_or_default();
+            anyhow::anyhow!(
+                "the arm never held the jogged pose (lift 0.5, elbow 0.3 rad); joints {:?} end at {end:?}; log:\n{log}",
+                run.joints
+            )
+        })?;
+    // ...and after `h` every joint of the pose is back there.
+    let end = rows.last().ok_or_else(|| anyhow::anyhow!("empty trace"))?;
+    for (joint, q) in &home {
+        let k = column(joint)?;
+        let at = end.joints[k].position;
+        assert!(
+            (at - q).abs() < 0.03,
+            "after `h` {joint} should be at home's {q} rad: it ends at {at:.3} ({:.2} s; the jogged \
+             pose last held at {:.2} s); log:\n{log}",
+            end.sim_time_s,
+            jogged.sim_time_s
+        );
+    }
+    assert!(
+        end.sim_time_s > jogged.sim_time_s + 1.0,
+        "home was reached only {:.2} s after the jogged pose",
+        end.sim_time_s - jogged.sim_time_s
+    );
+    Ok(())
+}

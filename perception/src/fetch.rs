@@ -19,7 +19,7 @@ const MODEL_LICENSE: &str =
     "AGPL-3.0 (Ultralytics YOLOv12n weights, shipped in the crates.io package easy-yolo 0.1.3)";
 
 /// rover's cache folder: `$ROVER_CACHE_DIR`, else `$XDG_CACHE_HOME/rover`, else `~/.cache/rover`.
-pub(crate) fn cache_dir() -> PathBuf {
+pub fn cache_dir() -> PathBuf {
     if let Some(dir) = std::env::var_os("ROVER_CACHE_DIR") {
         return PathBuf::from(dir);
     }

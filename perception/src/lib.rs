@@ -43,7 +43,7 @@ pub use detector::{
 pub use draw::{PixelRect, box_outline, draw_box_rgb8};
 pub use error::{PerceptionError, Result};
 pub use fault::{FaultInjector, FaultKind, InjectedFault};
-pub use fetch::{default_model_path, ensure_default_model};
+pub use fetch::{cache_dir, default_model_path, ensure_default_model};
 pub use head::Head;
 pub use labels::{COCO80, parse_metadata_names, read_labels_file};
 pub use lockstep::LockstepDetector;

@@ -128,6 +128,13 @@ struct Shared {
     subscriptions: Mutex<BTreeMap<String, Arc<Subscription>>>,
     params: Mutex<Vec<(String, Value)>>,
     master: Mutex<MasterState>,
+    /// Held while a topic, subscription or parameter is added and (when registered) told to
+    /// the master, and while the master watch registers everything: a topic added during a
+    /// registration is either in its snapshot or registered by `advertise` itself once the
+    /// watch has set `registered` (without it, one added between the snapshot and `registered
+    /// = true` was never told to the master: `rostopic echo` waited for it for ever). Taken
+    /// before any other lock of this struct.
+    registration: Mutex<()>,
     shutdown: AtomicBool,
 }
 
@@ -169,6 +176,7 @@ impl Node {
             subscriptions: Mutex::default(),
             params: Mutex::default(),
             master: Mutex::default(),
+            registration: Mutex::default(),
             shutdown: AtomicBool::new(false),
         });
         let mut threads = Vec::new();
@@ -226,6 +234,7 @@ impl Node {
             published: AtomicU64::new(0),
             dropped: AtomicU64::new(0),
         });
+        let _registering = lock(&self.shared.registration);
         lock(&self.shared.publications).insert(topic, publication.clone());
         if lock(&self.shared.master).registered
             && let Err(e) = register_publication(&self.shared, &publication)
@@ -290,6 +299,7 @@ impl Node {
                 Ok(())
             }),
         });
+        let _registering = lock(&self.shared.registration);
         lock(&self.shared.subscriptions).insert(topic, subscription.clone());
         if lock(&self.shared.master).registered
             && let Err(e) = register_subscription(&self.shared, &subscription)
@@ -304,6 +314,7 @@ impl Node {
     /// registers (a restarted master has lost it).
     pub fn set_param(&self, key: &str, value: Value) -> Result<()> {
         let key = global_name(key)?;
+        let _registering = lock(&self.shared.registration);
         {
             let mut params = lock(&self.shared.params);
             params.retain(|(k, _)| *k != key);
@@ -432,10 +443,14 @@ impl<T: Message> Publisher<T> {
         msg.encode(buf);
         let len = u32::try_from(buf.len() - 4).unwrap_or(u32::MAX);
         buf[..4].copy_from_slice(&len.to_le_bytes());
+        // The last message is set under the subscribers' lock, which a new subscriber holds
+        // while it takes the last message and joins: it gets each message once, this one
+        // either as the latched one or from the queue.
+        let mut conns = lock(&p.conns);
         if p.latched {
             *lock(&p.last) = Some(frame.clone());
         }
-        lock(&p.conns).retain(|tx| match tx.try_send(frame.clone()) {
+        conns.retain(|tx| match tx.try_send(frame.clone()) {
             Ok(()) => true,
             Err(TrySendError::Full(_)) => {
                 p.dropped.fetch_add(1, Ordering::Relaxed);
@@ -443,6 +458,7 @@ impl<T: Message> Publisher<T> {
             }
             Err(TrySendError::Disconnected(_)) => false,
         });
+        drop(conns);
         p.published.fetch_add(1, Ordering::Relaxed);
         if self.pool.len() < 4 {
             self.pool.push(frame);
@@ -662,12 +678,17 @@ fn serve_subscriber(shared: Arc<Shared>, stream: TcpStream) -> Result<()> {
     }
     stream.set_write_timeout(Some(Duration::from_secs(5)))?;
     let (tx, rx) = sync_channel::<Arc<Vec<u8>>>(p.queue);
-    if p.latched
-        && let Some(last) = lock(&p.last).clone()
     {
-        let _ = tx.try_send(last);
+        // Under the lock `publish` sets the last message in: no message falls between the
+        // latched one and the queue.
+        let mut conns = lock(&p.conns);
+        if p.latched
+            && let Some(last) = lock(&p.last).clone()
+        {
+            let _ = tx.try_send(last);
+        }
+        conns.push(tx);
     }
-    lock(&p.conns).push(tx);
     drop(p);
     for frame in rx {
         stream.write_all(&frame)?;
@@ -825,6 +846,8 @@ fn watch_master(shared: &Arc<Shared>) {
                     (!m.registered || m.pid != Some(pid), m.ever_registered)
                 };
                 if needed {
+                    // Everything added from here on waits until `registered` says so.
+                    let _registering = lock(&shared.registration);
                     match register_all(shared) {
                         Ok(()) => {
                             let mut m = lock(&shared.master);
@@ -887,6 +910,75 @@ mod tests {
         assert!(global_name("").is_err());
         assert!(global_name("1abc").is_err());
         assert!(global_name("a b").is_err());
+        Ok(())
+    }
+
+    /// A master on a free port that takes `delay` over each registration and remembers the
+    /// topics registered with it (XML-RPC over real sockets; its threads end with the test
+    /// process).
+    fn slow_master(delay: Duration) -> Result<(String, Arc<Mutex<Vec<String>>>)> {
+        let listener = TcpListener::bind(("127.0.0.1", 0))?;
+        let uri = format!("http://127.0.0.1:{}/", listener.local_addr()?.port());
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let topics = seen.clone();
+        std::thread::spawn(move || {
+            for stream in listener.incoming() {
+                let Ok(stream) = stream else { break };
+                let topics = topics.clone();
+                std::thread::spawn(move || -> Result<()> {
+                    let mut reader = BufReader::new(stream.try_clone()?);
+                    let (_, body) = xmlrpc::read_http(&mut reader)?;
+                    let (method, params) = xmlrpc::parse_call(&body)?;
+                    let value = match method.as_str() {
+                        "getPid" => Value::Int(42),
+                        "registerPublisher" | "registerSubscriber" => {
+                            std::thread::sleep(delay);
+                            if let Some(topic) = params.get(1).and_then(Value::as_str) {
+                                lock(&topics).push(topic.to_owned());
+                            }
+                            Value::Array(vec![])
+                        }
+                        _ => Value::Int(0),
+                    };
+                    let reply = Value::Array(vec![Value::Int(1), Value::from(""), value]);
+                    let mut out = stream;
+                    xmlrpc::write_response(&mut out, &xmlrpc::response_body(&reply))?;
+                    Ok(())
+                });
+            }
+        });
+        Ok((uri, seen))
+    }
+
+    /// Topics advertised while the node is registering with a slow master all reach it. Before
+    /// the registration lock, one advertised between the watch's snapshot and `registered =
+    /// true` was never registered, and `rostopic echo` waited for it until killed (the ROS 1
+    /// tests' intermittent failure, a different topic each time).
+    #[test]
+    fn topics_advertised_during_registration_all_reach_the_master() -> Result<()> {
+        let (master_uri, seen) = slow_master(Duration::from_millis(15))?;
+        let node = Node::start(NodeOptions {
+            name: "/racer".into(),
+            master_uri,
+            host: "127.0.0.1".into(),
+        })?;
+        let mut publishers = Vec::new();
+        let topics: Vec<String> = (0..40).map(|i| format!("/topic_{i}")).collect();
+        for topic in &topics {
+            publishers.push(node.advertise::<Twist>(topic, 1, false)?);
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        assert!(node.wait_registered(Duration::from_secs(20)));
+        let start = Instant::now();
+        let missing = loop {
+            let got = lock(&seen).clone();
+            let missing: Vec<&String> = topics.iter().filter(|t| !got.contains(t)).collect();
+            if missing.is_empty() || start.elapsed() > Duration::from_secs(5) {
+                break missing.into_iter().cloned().collect::<Vec<_>>();
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        };
+        assert!(missing.is_empty(), "never registered: {missing:?}");
         Ok(())
     }
 

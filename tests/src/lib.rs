@@ -2,7 +2,11 @@
 
 pub mod architecture;
 pub mod fuzz;
+pub mod golden;
+pub mod skip;
 pub mod sweep;
+
+pub use skip::skip;
 
 use std::path::{Path, PathBuf};
 
@@ -99,27 +103,25 @@ pub fn photo(name: &str, dir: &Path) -> anyhow::Result<PathBuf> {
 }
 
 /// A folder of `../shared` (test material beside the repository: real robots and worlds, ROS
-/// clients). `None`, with the reason printed, when it is absent, so tests can skip.
+/// clients). `None` when it is absent (a user's own clone), after recording the skip (a
+/// failure in strict mode: [`skip`]).
 pub fn shared(relative: &str) -> Option<PathBuf> {
     let path = repo("../shared").join(relative);
     if path.exists() {
         Some(path)
     } else {
-        eprintln!(
-            "SKIP: {} is absent (../shared beside the repository holds the third-party test files)",
+        skip::skip_or_panic(format!(
+            "{} is absent (../shared beside the repository holds the third-party test files)",
             path.display()
-        );
+        ));
         None
     }
 }
 
 /// A robot from PyPI `example-robot-data` 6.0.0 (`file` under its `robots/` folder, e.g.
-/// [`TIAGO_NO_HAND`]); `None`, with the reason printed, when the wheel cannot be had.
+/// [`TIAGO_NO_HAND`]); `None`, after recording the skip, when set-up has not fetched it.
 pub fn example_robot_data(file: &str) -> Option<PathBuf> {
-    let Some(wheel) = pypi("example-robot-data", "6.0.0") else {
-        eprintln!("skipped: PyPI example-robot-data 6.0.0 is not available (no network, no cache)");
-        return None;
-    };
+    let wheel = pypi("example-robot-data", "6.0.0")?;
     Some(
         wheel
             .join("cmeel.prefix/share/example-robot-data/robots")
@@ -131,7 +133,7 @@ pub fn example_robot_data(file: &str) -> Option<PathBuf> {
 pub const TIAGO_NO_HAND: &str = "tiago_description/robots/tiago_no_hand.urdf";
 
 /// TIAGo without its hand ([`TIAGO_NO_HAND`]), its wheels driven like gazebo_ros_diff_drive;
-/// `None`, with the reason printed, when example-robot-data cannot be had.
+/// `None`, after recording the skip, when example-robot-data has not been fetched.
 pub fn tiago() -> anyhow::Result<Option<RobotModel>> {
     let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
         return Ok(None);
@@ -152,60 +154,27 @@ pub fn tiago_drive() -> rover_sim::DriveSpec {
     }
 }
 
-/// A PyPI wheel unpacked into `~/.cache/rover/pypi/NAME-VERSION` (downloaded with pip the first
-/// time; nothing is committed). `None`, with the reason printed, when it cannot be had (offline,
-/// no pip), so tests can skip.
+/// Where set-up unpacks the PyPI wheel `name` `version`: `<rover's cache>/pypi/NAME-VERSION`
+/// (rover's cache: `ROVER_CACHE_DIR`, else `XDG_CACHE_HOME/rover`, else `~/.cache/rover`).
+pub fn pypi_dir(name: &str, version: &str) -> PathBuf {
+    rover_perception::cache_dir()
+        .join("pypi")
+        .join(format!("{name}-{version}"))
+}
+
+/// A PyPI wheel that set-up fetched, checked against its pinned SHA-256 and unpacked
+/// (`scripts/setup.sh test`, the wheels listed in `scripts/test-data.tsv`). Tests never
+/// download: `None`, after recording the skip, when set-up has not fetched it.
 pub fn pypi(name: &str, version: &str) -> Option<PathBuf> {
-    let cache = std::env::var_os("HOME")
-        .map(PathBuf::from)
-        .unwrap_or_else(std::env::temp_dir)
-        .join(".cache/rover");
-    let dir = cache.join("pypi").join(format!("{name}-{version}"));
+    let dir = pypi_dir(name, version);
     if dir.join(".complete").is_file() {
         return Some(dir);
     }
-    let fetch = || -> anyhow::Result<()> {
-        let wheels = cache.join("wheels");
-        std::fs::create_dir_all(&wheels)?;
-        let status = std::process::Command::new("python3")
-            .args([
-                "-m",
-                "pip",
-                "download",
-                "--quiet",
-                "--no-deps",
-                "--only-binary=:all:",
-            ])
-            .arg(format!("{name}=={version}"))
-            .arg("-d")
-            .arg(&wheels)
-            .status()?;
-        anyhow::ensure!(status.success(), "pip download {name}=={version} failed");
-        let prefix = format!("{}-{version}-", name.replace('-', "_"));
-        let wheel = std::fs::read_dir(&wheels)?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .find(|p| {
-                p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".whl"))
-            })
-            .ok_or_else(|| anyhow::anyhow!("no {prefix}*.whl in {}", wheels.display()))?;
-        let status = std::process::Command::new("python3")
-            .args(["-m", "zipfile", "-e"])
-            .arg(&wheel)
-            .arg(&dir)
-            .status()?;
-        anyhow::ensure!(status.success(), "cannot unpack {}", wheel.display());
-        std::fs::write(dir.join(".complete"), "")?;
-        Ok(())
-    };
-    match fetch() {
-        Ok(()) => Some(dir),
-        Err(e) => {
-            eprintln!("SKIP: PyPI {name}=={version} unavailable: {e}");
-            None
-        }
-    }
+    skip::skip_or_panic(format!(
+        "PyPI {name}=={version} is not in {} (scripts/setup.sh test fetches it; ./test runs that)",
+        dir.display()
+    ));
+    None
 }
 
 /// Turns `sim`'s robot at 1 rad/s for pi seconds, lets it settle for 1 s, and returns how far

