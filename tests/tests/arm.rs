@@ -166,12 +166,11 @@ fn tiago_arm_2_steps_within_its_limits() -> Result<()> {
     Ok(())
 }
 
-/// UR5 (root link `world`): anchored like Gazebo anchors it, it settles on the outstretched zero
-/// pose it starts in (within 0.01 rad by [`SETTLE_BOUND_S`]), follows a joint command and then
-/// holds that pose.
-/// How long UR5 may take to settle within 0.01 rad on its zero pose, holding it from the
-/// start under gravity with the default position hold (measured: SETTLE_MEASURED).
-const SETTLE_BOUND_S: f64 = 12.0;
+/// UR5 (root link `world`): anchored like Gazebo anchors it, it follows a joint command
+/// (every joint within 0.01 rad of it by [`SETTLE_BOUND_S`]) and then holds that pose.
+/// How long UR5 may take to settle within 0.01 rad after shoulder_lift is commanded from 0 to
+/// -1 rad (measured: 0.6 s).
+const SETTLE_BOUND_S: f64 = 1.0;
 
 #[test]
 fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
@@ -201,28 +200,32 @@ fn ur5_is_anchored_follows_a_command_and_holds() -> Result<()> {
     .into_iter()
     .map(|j| (j, 0.0))
     .collect();
-    // Holding the outstretched zero pose from the start: when the worst joint is within
-    // 0.01 rad for good (checked every 0.1 s over 15 s).
+    // The outstretched zero pose it starts in, held for 5 s. It cannot settle there: anchored
+    // at z = 0 as Gazebo spawns it, that pose lies partly inside the ground, which pushes
+    // shoulder_lift and wrist_1 off while the hold pushes back at their effort limits (150 and
+    // 28 N m; wrist_1 0.10 rad off at 5 s, 0.12 at 15 s: docs/ARM.md). Printed, not judged.
+    run_for(&mut sim, 5.0);
+    let from_zero = worst_error(&sim, &target)?;
+    target[1].1 = -1.0;
+    sim.command_joint("shoulder_lift_joint", JointCommand::Position(-1.0))?;
+    // The settling time of the command: from when every joint is within 0.01 rad for good
+    // (checked every 0.1 s over 3 s).
     let mut settled_s = 0.0;
-    for k in 1..=150 {
+    for k in 1..=30 {
         run_for(&mut sim, 0.1);
         if worst_error(&sim, &target)?.1 >= 0.01 {
             settled_s = f64::from(k) * 0.1;
         }
     }
-    let from_zero = worst_error(&sim, &target)?;
-    target[1].1 = -1.0;
-    sim.command_joint("shoulder_lift_joint", JointCommand::Position(-1.0))?;
-    run_for(&mut sim, 3.0);
     let moved = worst_error(&sim, &target)?;
     let held = worst_error_over(&mut sim, &target, 5.0)?;
     let base_moved_m = sim.world_from_link(base).translation.distance(base_start);
     println!(
-        "UR5: the zero pose settled within 0.01 rad after {settled_s:.1} s ({from_zero:?} at 15 s); 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
+        "UR5: zero pose after 5 s {from_zero:?}; shoulder_lift -> -1 settled within 0.01 rad after {settled_s:.1} s; 3 s after the command {moved:?}; held 5 s {held:?}; base moved {base_moved_m} m"
     );
     assert!(
         settled_s <= SETTLE_BOUND_S,
-        "the zero pose took {settled_s:.1} s to settle within 0.01 rad"
+        "shoulder_lift -> -1 took {settled_s:.1} s to settle within 0.01 rad"
     );
     assert!(
         base_moved_m < 0.001,
