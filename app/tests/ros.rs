@@ -2,8 +2,8 @@
 //! wrote (the tutorial's listener_yolo.py, teleop_twist_keyboard.py from ../shared/ros),
 //! rostopic, and rosbag's C++ recorder. Each test starts its own master on a free port. They
 //! run one at a time (each runs rover in real time with its camera and detector, and the rate
-//! checks need the CPU), and skip with the reason when ROS or ../shared is missing
-//! (`./test` installs the ROS packages).
+//! checks need the CPU). Where ROS or ../shared is missing they skip, counted and listed by
+//! `./test` (a failure under CI=true or --strict; `./test` installs the ROS packages).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
