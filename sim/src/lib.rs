@@ -33,6 +33,9 @@ pub use description::{
 };
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
+/// People with MakeHuman's body: its assets fetched from PyPI, shaped, dressed and posed (a
+/// namespace: nothing in it is re-exported at the root).
+pub use model::human;
 pub use model::{
     COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
     ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DepthOutput,

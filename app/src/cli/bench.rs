@@ -806,3 +806,135 @@ pub(crate) fn bench_detect(
     }
     Ok(())
 }
+
+/// `rover bench people`: the sweep table per body and posture, and the cost of posing a body.
+pub(crate) fn bench_people(kind: super::args::BenchKind) -> Result<()> {
+    use super::args::{BenchKind, SweepBody, SweepPostureArg};
+    let BenchKind::People {
+        world,
+        detector,
+        bodies,
+        postures,
+        save,
+    } = kind
+    else {
+        anyhow::bail!("rover bench people: not a people benchmark");
+    };
+    let config = detector.tool_config(super::args::spare_detect_threads())?;
+    use rover_core::{SWEEP_DISTANCES_M, SWEEP_HEADINGS_DEG, SWEEP_POSTURES, SweepPosture};
+    let mut run = world.run_config(None);
+    if run.world.is_none() {
+        run.world = Some(rover_core::bundled_path("worlds/people.toml"));
+    }
+    let mut detector = rover_perception::Detector::load(config)?;
+    let wants = |p: &SweepPosture| {
+        postures.is_empty()
+            || postures.iter().any(|w| {
+                matches!(
+                    (w, p),
+                    (SweepPostureArg::Standing, SweepPosture::Standing)
+                        | (SweepPostureArg::Walk, SweepPosture::Walking(_))
+                )
+            })
+    };
+    say!(
+        "people sweep on {}: 8 headings x {} distances per posture, IoU >= 0.5 against ground truth; cells: detection confidence, `-` missed",
+        run.world
+            .as_deref()
+            .unwrap_or(std::path::Path::new("?"))
+            .display(),
+        SWEEP_DISTANCES_M.len()
+    );
+    for body in &bodies {
+        let (name, shape) = match body {
+            SweepBody::Makehuman => {
+                if rover_sim::human::shared().is_none() {
+                    say!("makehuman: not available (see the warning above); skipped");
+                    continue;
+                }
+                ("makehuman", Some(rover_sim::human::BodyShape::default()))
+            }
+            SweepBody::Figure => ("figure", None),
+        };
+        let dir = match &save {
+            Some(d) => {
+                let dir = d.join(name);
+                std::fs::create_dir_all(&dir)?;
+                Some(dir)
+            }
+            None => None,
+        };
+        let (mut all_found, mut all, mut near_found, mut near) = (0, 0, 0, 0);
+        for posture in SWEEP_POSTURES.iter().filter(|p| wants(p)) {
+            let views = rover_core::sweep(&run, &mut detector, shape, *posture, dir.as_deref())?;
+            say!("");
+            say!("{name}, {posture}:");
+            let mut header = format!("{:>8}", "m \\ deg");
+            for h in SWEEP_HEADINGS_DEG {
+                header.push_str(&format!("{h:>6.0}"));
+            }
+            say!("{header}   found");
+            for d in SWEEP_DISTANCES_M {
+                let row: Vec<_> = views.iter().filter(|v| v.distance_m == d).collect();
+                let mut line = format!("{d:>8.1}");
+                for v in &row {
+                    if v.found {
+                        line.push_str(&format!("{:>6.2}", v.confidence));
+                    } else {
+                        line.push_str(&format!("{:>6}", "-"));
+                    }
+                }
+                let found = row.iter().filter(|v| v.found).count();
+                say!("{line}   {found}/{}", row.len());
+            }
+            let found = views.iter().filter(|v| v.found).count();
+            let at_near: Vec<_> = views
+                .iter()
+                .filter(|v| v.distance_m == SWEEP_DISTANCES_M[0])
+                .collect();
+            let near_hits = at_near.iter().filter(|v| v.found).count();
+            say!(
+                "{name}, {posture}: {found}/{} views found, {near_hits}/{} at {} m",
+                views.len(),
+                at_near.len(),
+                SWEEP_DISTANCES_M[0]
+            );
+            (all_found, all, near_found, near) = (
+                all_found + found,
+                all + views.len(),
+                near_found + near_hits,
+                near + at_near.len(),
+            );
+        }
+        say!("");
+        say!(
+            "{name} in all: {all_found}/{all} views found, {near_found}/{near} at {} m",
+            SWEEP_DISTANCES_M[0]
+        );
+    }
+    time_posing()
+}
+
+/// Times posing (skinning) the default MakeHuman body through a walk.
+fn time_posing() -> Result<()> {
+    if let Some(human) = rover_sim::human::shared() {
+        let body = human.body(rover_sim::human::BodyShape::default(), 1.75)?;
+        let mut posed = rover_sim::human::PosedBody::default();
+        let mut times = Vec::new();
+        for k in 0..200 {
+            let posture = rover_sim::human::Posture::Walking {
+                phase_rad: 0.05 * f64::from(k + 1),
+                stride_m: 1.2,
+            };
+            let start = Instant::now();
+            body.pose(posture, &mut posed);
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        say!(
+            "posing one body ({} vertices, linear-blend skinning on the CPU): median {:.3} ms",
+            body.vertex_count(),
+            median(&mut times)
+        );
+    }
+    Ok(())
+}

@@ -59,6 +59,10 @@ pub fn main() -> ExitCode {
             .tool_config(args::spare_detect_threads())
             .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
+            kind: Some(kind @ BenchKind::People { .. }),
+            ..
+        }) => bench::bench_people(kind),
+        Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
             ..
         }) => bench::bench_camera(world, frames),

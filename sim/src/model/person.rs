@@ -2,6 +2,7 @@
 //! physics.
 
 use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
+use crate::model::human::BodyShape;
 
 /// Height of a person whose world file gives none (m).
 pub const DEFAULT_PERSON_HEIGHT_M: f64 = 1.75;
@@ -27,6 +28,10 @@ pub struct Person {
     pub hair_color: Rgba,
     /// A walk: `position_m`, then each waypoint, then back to `position_m`, repeated.
     pub walk: Option<Walk>,
+    /// MakeHuman's body in this shape, or `None` for rover's own figure of primitives (the
+    /// default for now: the camera-only follower is still tuned to it; also drawn when
+    /// MakeHuman's body cannot be fetched).
+    pub shape: Option<BodyShape>,
 }
 
 /// A person's walk: a path at a constant speed, closed and repeated (the default) or walked
@@ -57,6 +62,7 @@ impl Person {
             skin_color: Rgba::rgb(0.87, 0.67, 0.53),
             hair_color: Rgba::rgb(0.2, 0.13, 0.08),
             walk: None,
+            shape: None,
         }
     }
 

@@ -8,6 +8,7 @@ use wgpu::util::DeviceExt;
 
 use crate::geometry::{Pose, Rgba};
 use crate::model::classes::EntityIds;
+use crate::model::human::{Body, Layer, PosedBody, Posture};
 use crate::model::mesh::MeshData;
 use crate::model::person::Person;
 use crate::model::robot::RobotModel;
@@ -109,6 +110,8 @@ pub(crate) struct Scene {
     robot: Vec<Attached>,
     /// Every figure part, with where its colour comes from.
     people: Vec<(Attached, Paint, Swing)>,
+    /// The people drawn with MakeHuman's body.
+    bodies: Vec<SkinnedPerson>,
     /// Visuals of every SDF model link.
     models: Vec<Attached>,
     /// Whether some model link can move on its own (physics).
@@ -257,7 +260,7 @@ impl Scene {
             .models
             .iter()
             .any(|m| m.links.iter().any(|l| l.is_dynamic(m)));
-        let people = add_people(&mut b, world, ids);
+        let (people, bodies) = add_people(&mut b, world, ids);
         let mut attached = Vec::new();
         for (link_index, link) in robot.links.iter().enumerate() {
             for visual in &link.visuals {
@@ -283,6 +286,7 @@ impl Scene {
             instance_buffer,
             robot: attached,
             people,
+            bodies,
             models,
             moving_models,
             objects,
@@ -311,12 +315,28 @@ impl Scene {
             let person_from_shape = swing.pose_at(a.frame_from_shape, gait_phase_rad);
             self.instances[a.instance].model = matrix(world_from_person * person_from_shape);
         }
+        for body in self.bodies.iter_mut().filter(|b| b.person == index) {
+            for &(instance, _) in &body.instances {
+                self.instances[instance].model = matrix(world_from_person);
+            }
+            let posture = body.posture(gait_phase_rad);
+            if posture != body.posture {
+                body.posture = posture;
+                body.body.pose(posture, &mut body.posed);
+                body.dirty = true;
+            }
+        }
     }
 
     /// Paints person `index` (world order) in `person`'s colours.
     pub(crate) fn dress_person(&mut self, index: usize, person: &Person) {
         for (a, paint, _) in self.people.iter().filter(|(a, ..)| a.frame == index) {
             self.instances[a.instance].color = paint.of(person).0;
+        }
+        for body in self.bodies.iter().filter(|b| b.person == index) {
+            for &(instance, paint) in &body.instances {
+                self.instances[instance].color = paint.of(person).0;
+            }
         }
     }
 
@@ -332,13 +352,16 @@ impl Scene {
         move_attached(&mut self.instances, &self.robot, world_from_links);
     }
 
-    /// Uploads this frame's instance transforms.
-    pub(crate) fn upload(&self, queue: &wgpu::Queue) {
+    /// Uploads this frame's instance transforms and the bodies posed since the last upload.
+    pub(crate) fn upload(&mut self, queue: &wgpu::Queue) {
         queue.write_buffer(
             &self.instance_buffer,
             0,
             bytemuck::cast_slice(&self.instances),
         );
+        for body in self.bodies.iter_mut().filter(|b| b.dirty) {
+            body.upload(queue);
+        }
     }
 }
 
@@ -393,15 +416,147 @@ fn add_models(
     Ok(moving)
 }
 
+/// A person drawn with MakeHuman's body: one vertex buffer posed on the CPU each time the
+/// gait moves, drawn as one mesh per layer (skin, shirt, ...) with that layer's paint.
+struct SkinnedPerson {
+    /// The person's index (world order).
+    person: usize,
+    body: Body,
+    /// Their stride (m per gait cycle), for the walk.
+    stride_m: f64,
+    posture: Posture,
+    posed: PosedBody,
+    /// Reused: the posed vertices as the GPU reads them.
+    staged: Vec<GpuVertex>,
+    vertices: wgpu::Buffer,
+    /// Instance and paint of each layer's mesh.
+    instances: Vec<(usize, Paint)>,
+    /// Posed since the last upload.
+    dirty: bool,
+}
+
+impl SkinnedPerson {
+    fn posture(&self, gait_phase_rad: f64) -> Posture {
+        Posture::from_gait(gait_phase_rad, self.stride_m)
+    }
+
+    fn upload(&mut self, queue: &wgpu::Queue) {
+        self.staged.clear();
+        self.staged.extend(
+            self.posed
+                .positions
+                .iter()
+                .zip(&self.posed.normals)
+                .map(|(p, n)| GpuVertex {
+                    position: p.to_array(),
+                    normal: n.to_array(),
+                    uv: [0.0; 2],
+                }),
+        );
+        queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&self.staged));
+        self.dirty = false;
+    }
+}
+
+/// The paint a body layer wears.
+pub(crate) fn layer_paint(layer: Layer) -> Paint {
+    match layer {
+        Layer::Skin => Paint::Skin,
+        Layer::Shirt => Paint::Shirt,
+        Layer::Trousers => Paint::Trousers,
+        Layer::Hair => Paint::Hair,
+        Layer::Shoes => Paint::Fixed(Rgba::rgb(0.08, 0.08, 0.09)),
+        Layer::Eyes => Paint::Fixed(Rgba::rgb(0.12, 0.09, 0.07)),
+    }
+}
+
+/// MakeHuman's body for `person` (`None`: drawn as rover's figure).
+pub(crate) fn person_body(person: &Person) -> Option<Body> {
+    let shape = person.shape?;
+    let human = crate::model::human::shared()?;
+    match human.body(shape, person.height_m) {
+        Ok(body) => Some(body),
+        Err(e) => {
+            tracing::warn!("{}: drawn as rover's figure: {e}", person.name);
+            None
+        }
+    }
+}
+
+impl Builder<'_> {
+    /// A person with MakeHuman's body, standing at `world_from_person`.
+    fn add_body(
+        &mut self,
+        index: usize,
+        person: &Person,
+        body: Body,
+        world_from_person: Pose,
+        entity: u32,
+    ) -> SkinnedPerson {
+        let mut posed = PosedBody::default();
+        body.pose(Posture::Standing, &mut posed);
+        let vertices = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("person"),
+            size: (body.vertex_count() * std::mem::size_of::<GpuVertex>()) as u64,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut instances = Vec::new();
+        for (layer, indices) in body.layers() {
+            let paint = layer_paint(*layer);
+            self.meshes.push(GpuMesh {
+                vertices: vertices.clone(),
+                indices: self
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: None,
+                        contents: bytemuck::cast_slice(indices),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                count: indices.len() as u32,
+                draws: vec![Draw {
+                    first_index: 0,
+                    count: indices.len() as u32,
+                    material: 0,
+                }],
+            });
+            self.instances
+                .push(Instance::new(world_from_person, paint.of(person), entity));
+            if entity != 0 {
+                self.labelled.push(self.meshes.len() as u32 - 1);
+            }
+            instances.push((self.instances.len() - 1, paint));
+        }
+        let mut skinned = SkinnedPerson {
+            person: index,
+            body,
+            stride_m: person.stride_m(),
+            posture: Posture::Standing,
+            posed,
+            staged: Vec::new(),
+            vertices,
+            instances,
+            dirty: true,
+        };
+        skinned.upload(self.queue);
+        skinned
+    }
+}
+
 fn add_people(
     b: &mut Builder<'_>,
     world: &World,
     ids: &EntityIds,
-) -> Vec<(Attached, Paint, Swing)> {
+) -> (Vec<(Attached, Paint, Swing)>, Vec<SkinnedPerson>) {
     let mut parts = Vec::new();
+    let mut bodies = Vec::new();
     for (person_index, person) in world.people.iter().enumerate() {
         let world_from_person = person.world_from_person(0.0);
         let id = ids.person(person_index);
+        if let Some(body) = person_body(person) {
+            bodies.push(b.add_body(person_index, person, body, world_from_person, id));
+            continue;
+        }
         for part in person_parts(person) {
             let attached = Attached {
                 instance: b.add(&part.mesh, world_from_person * part.pose, part.color, id),
@@ -411,5 +566,5 @@ fn add_people(
             parts.push((attached, part.paint, part.swing));
         }
     }
-    parts
+    (parts, bodies)
 }

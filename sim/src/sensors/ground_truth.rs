@@ -20,10 +20,13 @@ use crate::geometry::Pose;
 use crate::model::camera_info::{CameraInfo, link_from_optical};
 use crate::model::classes::EntityIds;
 use crate::model::classes::Labelled;
+use crate::model::human::{Body, PosedBody, Posture};
 use crate::model::sensors::Distortion;
 use crate::model::world::World;
 use crate::physics::Simulation;
-use crate::render::{EntityImage, RenderError, Swing, object_mesh, person_parts, shape_mesh};
+use crate::render::{
+    EntityImage, RenderError, Swing, object_mesh, person_body, person_parts, shape_mesh,
+};
 
 /// Pixels checked at once for "nothing labelled here" when counting the id image.
 const ZERO_RUN_PX: usize = 32;
@@ -169,6 +172,18 @@ enum Frame {
     Person(usize, Pose, Swing),
     /// On a model link (index among all model links), at this pose in the link's frame.
     ModelLink(usize, Pose),
+    /// MakeHuman's body of a person (index), posed as they walk: its vertices are
+    /// `GroundTruth::bodies[k]`'s, posed each frame (the part's own `vertices` stay empty).
+    Body(usize, usize),
+}
+
+/// A person's MakeHuman body and its posed vertices, reused frame to frame.
+#[derive(Debug, Clone)]
+struct PosedPerson {
+    body: Body,
+    stride_m: f64,
+    posture: Option<Posture>,
+    posed: PosedBody,
 }
 
 #[derive(Debug, Clone)]
@@ -199,6 +214,8 @@ pub struct GroundTruth {
     visible: Vec<Visible>,
     /// Every entity's box this frame, in id order (strings made once).
     all: Vec<GroundTruthBox>,
+    /// The people drawn with MakeHuman's body.
+    bodies: Vec<PosedPerson>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -230,19 +247,35 @@ impl GroundTruth {
     pub fn new(world: &World) -> Result<Self, RenderError> {
         let ids = EntityIds::new(world);
         let mut entities = Vec::new();
+        let mut bodies = Vec::new();
         for (i, person) in world.people.iter().enumerate() {
-            entities.push(Entity {
-                id: ids.person(i),
-                label: Labelled::Person(i),
-                class: "person".to_owned(),
-                name: person.name.clone(),
-                parts: person_parts(person)
+            let parts = match person_body(person) {
+                Some(body) => {
+                    bodies.push(PosedPerson {
+                        body,
+                        stride_m: person.stride_m(),
+                        posture: None,
+                        posed: PosedBody::default(),
+                    });
+                    vec![Part {
+                        frame: Frame::Body(i, bodies.len() - 1),
+                        vertices: Vec::new(),
+                    }]
+                }
+                None => person_parts(person)
                     .into_iter()
                     .map(|p| Part {
                         frame: Frame::Person(i, p.pose, p.swing),
                         vertices: vertices(&p.mesh),
                     })
                     .collect(),
+            };
+            entities.push(Entity {
+                id: ids.person(i),
+                label: Labelled::Person(i),
+                class: "person".to_owned(),
+                name: person.name.clone(),
+                parts,
             });
         }
         for (i, object) in world.objects.iter().enumerate() {
@@ -321,6 +354,7 @@ impl GroundTruth {
             model_poses: Vec::new(),
             object_poses: Vec::new(),
             all,
+            bodies,
         })
     }
 
@@ -438,9 +472,25 @@ impl GroundTruth {
                     Frame::ModelLink(i, pose) => {
                         self.model_poses.get(i).copied().unwrap_or_default() * pose
                     }
+                    Frame::Body(i, _) => sim.world_from_person(i),
+                };
+                let part_vertices = match part.frame {
+                    Frame::Body(i, k) => match self.bodies.get_mut(k) {
+                        Some(p) => {
+                            let posture =
+                                Posture::from_gait(sim.person_gait_phase_rad(i), p.stride_m);
+                            if p.posture != Some(posture) {
+                                p.body.pose(posture, &mut p.posed);
+                                p.posture = Some(posture);
+                            }
+                            &p.posed.positions
+                        }
+                        None => &part.vertices,
+                    },
+                    _ => &part.vertices,
                 };
                 let optical_from_part = optical_from_world * world_from_part;
-                for v in &part.vertices {
+                for v in part_vertices {
                     let p = optical_from_part * *v;
                     if p.z <= NEAR_M {
                         behind = true;

@@ -1,0 +1,212 @@
+//! People with MakeHuman's body (issue 46): the real MPFB2 assets from the PyPI wheel that
+//! set-up fetched, posed, walking without sliding their feet, seen as people by the real
+//! detector from every side, and bad asset files reported with their file and line.
+
+use std::path::Path;
+
+use rover_core::{RunConfig, SWEEP_DISTANCES_M, SweepPosture, sweep};
+use rover_perception::{Detector, DetectorConfig};
+use rover_sim::human::{BodyShape, Human, Layer, PosedBody, Posture, STANCE_FRACTION};
+use rover_tests::{makehuman, repo};
+
+#[test]
+fn the_body_stands_its_height_with_its_feet_on_the_ground() -> anyhow::Result<()> {
+    let Some(human) = makehuman()? else {
+        return Ok(());
+    };
+    for (shape, height_m) in [
+        (BodyShape::default(), 1.75),
+        (
+            BodyShape {
+                gender: 0.0,
+                age: 0.15,
+                muscle: 0.3,
+                weight: 0.8,
+            },
+            1.2,
+        ),
+    ] {
+        let body = human.body(shape, height_m)?;
+        let mut posed = PosedBody::default();
+        body.pose(Posture::Standing, &mut posed);
+        let low = posed.positions.iter().map(|p| p.z).fold(f32::MAX, f32::min);
+        let high = posed.positions.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+        println!(
+            "{shape:?}: {} vertices, z {low:.3}..{high:.3} m",
+            body.vertex_count()
+        );
+        assert!(low.abs() < 0.02, "feet at {low} m");
+        assert!(
+            (f64::from(high) - height_m).abs() < 0.03,
+            "{high} m tall, asked {height_m}"
+        );
+        let layers: Vec<Layer> = body.layers().iter().map(|l| l.0).collect();
+        for layer in [Layer::Skin, Layer::Shirt, Layer::Trousers, Layer::Hair] {
+            assert!(layers.contains(&layer), "no {layer:?} in {layers:?}");
+        }
+        // Facing +x: the nose is the front-most point of the head.
+        let head = posed
+            .positions
+            .iter()
+            .filter(|p| p.z > 0.9 * high)
+            .fold(f32::MIN, |m, p| m.max(p.x));
+        assert!(head > 0.05, "the face looks along +x ({head})");
+    }
+    Ok(())
+}
+
+#[test]
+fn a_walking_body_keeps_its_planted_foot_still() -> anyhow::Result<()> {
+    let Some(human) = makehuman()? else {
+        return Ok(());
+    };
+    let body = human.body(BodyShape::default(), 1.75)?;
+    let mut posed = PosedBody::default();
+    let stride_m = 1.3;
+    // The left sole over the middle of its stance: the lowest vertex of the left half of the
+    // body, in the world, as the body walks along +x.
+    let steps = 40;
+    let mut xs = Vec::new();
+    for k in 0..=steps {
+        let cycle = STANCE_FRACTION * (0.25 + 0.5 * k as f32 / steps as f32);
+        let phase = f64::from(cycle) * std::f64::consts::TAU;
+        body.pose(
+            Posture::Walking {
+                phase_rad: phase,
+                stride_m,
+            },
+            &mut posed,
+        );
+        let sole = posed
+            .positions
+            .iter()
+            .filter(|p| p.y > 0.03)
+            .min_by(|a, b| a.z.total_cmp(&b.z))
+            .copied()
+            .unwrap_or_default();
+        let walked_m = stride_m * phase / std::f64::consts::TAU;
+        xs.push(walked_m + f64::from(sole.x));
+        assert!(
+            sole.z.abs() < 0.02,
+            "the planted sole is on the ground: {sole}"
+        );
+    }
+    let slide =
+        xs.iter().copied().fold(f64::MIN, f64::max) - xs.iter().copied().fold(f64::MAX, f64::min);
+    println!("planted foot slide over mid-stance: {:.1} mm", slide * 1e3);
+    assert!(slide < 0.05, "the planted foot slid {slide} m");
+    Ok(())
+}
+
+#[test]
+fn the_default_person_is_a_person_from_every_side() -> anyhow::Result<()> {
+    if makehuman()?.is_none() {
+        return Ok(());
+    }
+    let config = RunConfig {
+        world: Some(repo("worlds/people.toml")),
+        ..RunConfig::default()
+    };
+    let mut detector = Detector::load(DetectorConfig::default())?;
+    for posture in [SweepPosture::Standing, SweepPosture::Walking(0.25)] {
+        let views = sweep(
+            &config,
+            &mut detector,
+            Some(BodyShape::default()),
+            posture,
+            None,
+        )?;
+        let found = views.iter().filter(|v| v.found).count();
+        let near = views
+            .iter()
+            .filter(|v| v.distance_m == SWEEP_DISTANCES_M[0] && v.found)
+            .count();
+        println!(
+            "{posture}: {found}/{} found, {near}/8 at 1.5 m",
+            views.len()
+        );
+        let missed: Vec<_> = views
+            .iter()
+            .filter(|v| !v.found)
+            .map(|v| format!("{} deg {} m", v.heading_deg, v.distance_m))
+            .collect();
+        assert_eq!(found, views.len(), "{posture}: missed {missed:?}");
+    }
+    Ok(())
+}
+
+fn copy_assets(to: &Path) -> anyhow::Result<()> {
+    let from = rover_sim::human::fetch::assets_dir();
+    for relative in [
+        "3dobjs/base.obj",
+        "rigs/standard/rig.default.json",
+        "rigs/standard/weights.default.json",
+    ] {
+        let out = to.join(relative);
+        std::fs::create_dir_all(out.parent().unwrap_or(to))?;
+        std::fs::copy(from.join(relative), out)?;
+    }
+    Ok(())
+}
+
+#[test]
+fn broken_assets_are_located_errors() -> anyhow::Result<()> {
+    if makehuman()?.is_none() {
+        return Ok(());
+    }
+    let dir = tempfile::tempdir()?;
+    copy_assets(dir.path())?;
+    let obj = dir.path().join("3dobjs/base.obj");
+    let text = std::fs::read_to_string(&obj)?;
+    // A face naming a vertex past the end, on line 40,600.
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.insert(40_599, "f 1 2 999999");
+    std::fs::write(&obj, lines.join("\n"))?;
+    let e = Human::load(dir.path())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    println!("{e}");
+    assert!(e.contains("base.obj:40600:") && e.contains("999999"), "{e}");
+
+    copy_assets(dir.path())?;
+    let rig = dir.path().join("rigs/standard/rig.default.json");
+    let text = std::fs::read_to_string(&rig)?.replacen(
+        "\"parent\": \"spine02\"",
+        "\"parent\": \"spine99\"",
+        1,
+    );
+    std::fs::write(&rig, text)?;
+    let e = Human::load(dir.path())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    println!("{e}");
+    assert!(
+        e.contains("rig.default.json") && e.contains("spine99"),
+        "{e}"
+    );
+
+    copy_assets(dir.path())?;
+    let text = std::fs::read_to_string(&rig)?.replacen("\"joint-spine-1\"", "\"joint-nowhere\"", 1);
+    std::fs::write(&rig, text)?;
+    let e = Human::load(dir.path())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    println!("{e}");
+    assert!(e.contains("joint-nowhere"), "{e}");
+
+    copy_assets(dir.path())?;
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\ng body\nf 1 2 3\n")?;
+    let e = Human::load(dir.path())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    println!("{e}");
+    assert!(
+        e.contains("weights.default.json") && e.contains("the mesh has 3"),
+        "{e}"
+    );
+    Ok(())
+}
