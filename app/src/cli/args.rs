@@ -766,31 +766,7 @@ pub(crate) enum BenchKind {
     /// headings at 1.5, 2, 3, 5 and 8 m, standing and at 4 phases of the walk, one image each,
     /// found when a detection matches the ground truth at IoU >= 0.5; MakeHuman's body and
     /// rover's figure side by side. Also times posing (skinning) a body
-    People {
-        #[command(flatten)]
-        world: WorldArgs,
-
-        #[command(flatten)]
-        detector: DetectorArgs,
-
-        /// Bodies to sweep: makehuman (MakeHuman's, the default person) and/or figure (rover's
-        /// own figure of primitives)
-        #[arg(
-            long,
-            value_delimiter = ',',
-            default_value = "makehuman,figure",
-            value_name = "BODY,..."
-        )]
-        bodies: Vec<SweepBody>,
-
-        /// Only these postures: standing, walk (4 phases) [default: both]
-        #[arg(long, value_delimiter = ',', value_name = "POSTURE,...")]
-        postures: Vec<SweepPostureArg>,
-
-        /// Save every image into this folder (BODY/POSTURE_HEADING_DISTANCE.png)
-        #[arg(long, value_name = "DIR")]
-        save: Option<PathBuf>,
-    },
+    People(PeopleBenchArgs),
     /// Detector latency: tract (rover) vs onnxruntime on the same graph, input and thread count
     Detect {
         #[command(flatten)]
@@ -810,10 +786,38 @@ pub(crate) enum BenchKind {
     },
 }
 
+/// `rover bench people`'s options.
+#[derive(Debug, Args)]
+pub(crate) struct PeopleBenchArgs {
+    #[command(flatten)]
+    pub(crate) world: WorldArgs,
+
+    #[command(flatten)]
+    pub(crate) detector: DetectorArgs,
+
+    /// Bodies to sweep: makehuman (MakeHuman's body) and/or figure (rover's
+    /// own figure of primitives)
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "makehuman,figure",
+        value_name = "BODY,..."
+    )]
+    pub(crate) bodies: Vec<SweepBody>,
+
+    /// Only these postures: standing, walk (4 phases) [default: both]
+    #[arg(long, value_delimiter = ',', value_name = "POSTURE,...")]
+    pub(crate) postures: Vec<SweepPostureArg>,
+
+    /// Save every image into this folder (BODY/POSTURE_HEADING_DISTANCE.png)
+    #[arg(long, value_name = "DIR")]
+    pub(crate) save: Option<PathBuf>,
+}
+
 /// A body `rover bench people` sweeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum SweepBody {
-    /// MakeHuman's body (the default person).
+    /// MakeHuman's body.
     Makehuman,
     /// rover's own figure of primitives.
     Figure,

@@ -808,18 +808,15 @@ pub(crate) fn bench_detect(
 }
 
 /// `rover bench people`: the sweep table per body and posture, and the cost of posing a body.
-pub(crate) fn bench_people(kind: super::args::BenchKind) -> Result<()> {
-    use super::args::{BenchKind, SweepBody, SweepPostureArg};
-    let BenchKind::People {
+pub(crate) fn bench_people(args: super::args::PeopleBenchArgs) -> Result<()> {
+    use super::args::{PeopleBenchArgs, SweepBody, SweepPostureArg};
+    let PeopleBenchArgs {
         world,
         detector,
         bodies,
         postures,
         save,
-    } = kind
-    else {
-        anyhow::bail!("rover bench people: not a people benchmark");
-    };
+    } = args;
     let config = detector.tool_config(super::args::spare_detect_threads())?;
     use rover_core::{SWEEP_DISTANCES_M, SWEEP_HEADINGS_DEG, SWEEP_POSTURES, SweepPosture};
     let mut run = world.run_config(None);

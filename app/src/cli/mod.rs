@@ -59,9 +59,9 @@ pub fn main() -> ExitCode {
             .tool_config(args::spare_detect_threads())
             .and_then(|config| bench::bench_detect(config, image, runs, profile)),
         Some(Command::Bench {
-            kind: Some(kind @ BenchKind::People { .. }),
+            kind: Some(BenchKind::People(people)),
             ..
-        }) => bench::bench_people(kind),
+        }) => bench::bench_people(people),
         Some(Command::Bench {
             kind: Some(BenchKind::Camera { world, frames }),
             ..

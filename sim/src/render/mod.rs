@@ -17,4 +17,3 @@ pub use mesh::{
 };
 pub use passes::colour::Light;
 pub use renderer::{CameraRenderer, EntityImage};
-pub(crate) use scene::person_body;

@@ -241,6 +241,12 @@ impl CameraRenderer {
             .set_person_pose(index, world_from_person, gait_phase_rad);
     }
 
+    /// The vertices of person `index` (world order) as last posed (m, their own frame), when
+    /// they are drawn with MakeHuman's body; `None` for rover's figure.
+    pub(crate) fn posed_person(&self, index: usize) -> Option<&[glam::Vec3]> {
+        self.scene.posed_person(index)
+    }
+
     /// Paints person `index` (world order) in `person`'s clothes for the following renders.
     pub fn dress_person(&mut self, index: usize, person: &Person) {
         self.scene.dress_person(index, person);

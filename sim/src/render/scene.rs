@@ -328,6 +328,14 @@ impl Scene {
         }
     }
 
+    /// The posed vertices of person `index` (world order) drawn with MakeHuman's body.
+    pub(crate) fn posed_person(&self, index: usize) -> Option<&[Vec3]> {
+        self.bodies
+            .iter()
+            .find(|b| b.person == index)
+            .map(|b| b.posed.positions.as_slice())
+    }
+
     /// Paints person `index` (world order) in `person`'s colours.
     pub(crate) fn dress_person(&mut self, index: usize, person: &Person) {
         for (a, paint, _) in self.people.iter().filter(|(a, ..)| a.frame == index) {
@@ -459,7 +467,7 @@ impl SkinnedPerson {
 }
 
 /// The paint a body layer wears.
-pub(crate) fn layer_paint(layer: Layer) -> Paint {
+fn layer_paint(layer: Layer) -> Paint {
     match layer {
         Layer::Skin => Paint::Skin,
         Layer::Shirt => Paint::Shirt,
@@ -471,7 +479,7 @@ pub(crate) fn layer_paint(layer: Layer) -> Paint {
 }
 
 /// MakeHuman's body for `person` (`None`: drawn as rover's figure).
-pub(crate) fn person_body(person: &Person) -> Option<Body> {
+fn person_body(person: &Person) -> Option<Body> {
     let shape = person.shape?;
     let human = crate::model::human::shared()?;
     match human.body(shape, person.height_m) {

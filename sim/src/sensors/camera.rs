@@ -97,7 +97,7 @@ impl CameraSensor {
     pub fn enable_ground_truth(&mut self, sim: &Simulation) -> Result<(), RenderError> {
         if self.truth.is_none() {
             self.renderer.enable_entity_image()?;
-            self.truth = Some((GroundTruth::new(sim.world())?, Vec::new()));
+            self.truth = Some((GroundTruth::new(sim.world(), &self.renderer)?, Vec::new()));
         }
         Ok(())
     }
@@ -212,7 +212,7 @@ impl CameraSensor {
         let entities = self.renderer.entity_image();
         let ground_truth = match (&mut self.truth, entities) {
             (Some((truth, boxes)), Some(image)) => {
-                truth.measure(sim, self.renderer.info(), camera, image, boxes);
+                truth.measure(sim, &self.renderer, camera, image, boxes);
                 boxes.as_slice()
             }
             _ => &[],

@@ -17,15 +17,14 @@
 use glam::Vec3;
 
 use crate::geometry::Pose;
-use crate::model::camera_info::{CameraInfo, link_from_optical};
+use crate::model::camera_info::link_from_optical;
 use crate::model::classes::EntityIds;
 use crate::model::classes::Labelled;
-use crate::model::human::{Body, PosedBody, Posture};
 use crate::model::sensors::Distortion;
 use crate::model::world::World;
 use crate::physics::Simulation;
 use crate::render::{
-    EntityImage, RenderError, Swing, object_mesh, person_body, person_parts, shape_mesh,
+    CameraRenderer, EntityImage, RenderError, Swing, object_mesh, person_parts, shape_mesh,
 };
 
 /// Pixels checked at once for "nothing labelled here" when counting the id image.
@@ -172,18 +171,9 @@ enum Frame {
     Person(usize, Pose, Swing),
     /// On a model link (index among all model links), at this pose in the link's frame.
     ModelLink(usize, Pose),
-    /// MakeHuman's body of a person (index), posed as they walk: its vertices are
-    /// `GroundTruth::bodies[k]`'s, posed each frame (the part's own `vertices` stay empty).
-    Body(usize, usize),
-}
-
-/// A person's MakeHuman body and its posed vertices, reused frame to frame.
-#[derive(Debug, Clone)]
-struct PosedPerson {
-    body: Body,
-    stride_m: f64,
-    posture: Option<Posture>,
-    posed: PosedBody,
+    /// MakeHuman's body of a person (index), as the renderer posed it this frame (the part's
+    /// own `vertices` stay empty).
+    Body(usize),
 }
 
 #[derive(Debug, Clone)]
@@ -214,8 +204,6 @@ pub struct GroundTruth {
     visible: Vec<Visible>,
     /// Every entity's box this frame, in id order (strings made once).
     all: Vec<GroundTruthBox>,
-    /// The people drawn with MakeHuman's body.
-    bodies: Vec<PosedPerson>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -243,32 +231,25 @@ fn vertices(mesh: &crate::model::MeshData) -> Vec<Vec3> {
 }
 
 impl GroundTruth {
-    /// Collects the world's labelled things (their meshes as the camera renders them).
-    pub fn new(world: &World) -> Result<Self, RenderError> {
+    /// Collects the world's labelled things (their meshes as `renderer` draws them: people
+    /// with MakeHuman's body are read from its posed vertices each frame).
+    pub fn new(world: &World, renderer: &CameraRenderer) -> Result<Self, RenderError> {
         let ids = EntityIds::new(world);
         let mut entities = Vec::new();
-        let mut bodies = Vec::new();
         for (i, person) in world.people.iter().enumerate() {
-            let parts = match person_body(person) {
-                Some(body) => {
-                    bodies.push(PosedPerson {
-                        body,
-                        stride_m: person.stride_m(),
-                        posture: None,
-                        posed: PosedBody::default(),
-                    });
-                    vec![Part {
-                        frame: Frame::Body(i, bodies.len() - 1),
-                        vertices: Vec::new(),
-                    }]
-                }
-                None => person_parts(person)
+            let parts = if renderer.posed_person(i).is_some() {
+                vec![Part {
+                    frame: Frame::Body(i),
+                    vertices: Vec::new(),
+                }]
+            } else {
+                person_parts(person)
                     .into_iter()
                     .map(|p| Part {
                         frame: Frame::Person(i, p.pose, p.swing),
                         vertices: vertices(&p.mesh),
                     })
-                    .collect(),
+                    .collect()
             };
             entities.push(Entity {
                 id: ids.person(i),
@@ -354,7 +335,6 @@ impl GroundTruth {
             model_poses: Vec::new(),
             object_poses: Vec::new(),
             all,
-            bodies,
         })
     }
 
@@ -364,13 +344,13 @@ impl GroundTruth {
     pub fn measure(
         &mut self,
         sim: &Simulation,
-        info: &CameraInfo,
+        renderer: &CameraRenderer,
         world_from_camera: Pose,
         image: &EntityImage,
         out: &mut Vec<GroundTruthBox>,
     ) {
         self.count_visible(image);
-        self.full_boxes(sim, info, world_from_camera);
+        self.full_boxes(sim, renderer, world_from_camera);
         for (b, seen) in self.all.iter_mut().zip(&self.visible) {
             let i = (b.id - 1) as usize;
             b.visible_px = seen.px;
@@ -443,7 +423,8 @@ impl GroundTruth {
 
     /// The full box and truncation of every labelled thing (`self.all`); an entity wholly
     /// outside the image gets an empty box.
-    fn full_boxes(&mut self, sim: &Simulation, info: &CameraInfo, world_from_camera: Pose) {
+    fn full_boxes(&mut self, sim: &Simulation, renderer: &CameraRenderer, world_from_camera: Pose) {
+        let info = renderer.info();
         sim.model_link_poses_into(&mut self.model_poses);
         sim.object_poses_into(&mut self.object_poses);
         let optical_from_world =
@@ -472,21 +453,10 @@ impl GroundTruth {
                     Frame::ModelLink(i, pose) => {
                         self.model_poses.get(i).copied().unwrap_or_default() * pose
                     }
-                    Frame::Body(i, _) => sim.world_from_person(i),
+                    Frame::Body(i) => sim.world_from_person(i),
                 };
                 let part_vertices = match part.frame {
-                    Frame::Body(i, k) => match self.bodies.get_mut(k) {
-                        Some(p) => {
-                            let posture =
-                                Posture::from_gait(sim.person_gait_phase_rad(i), p.stride_m);
-                            if p.posture != Some(posture) {
-                                p.body.pose(posture, &mut p.posed);
-                                p.posture = Some(posture);
-                            }
-                            &p.posed.positions
-                        }
-                        None => &part.vertices,
-                    },
+                    Frame::Body(i) => renderer.posed_person(i).unwrap_or(&part.vertices),
                     _ => &part.vertices,
                 };
                 let optical_from_part = optical_from_world * world_from_part;

@@ -71,20 +71,16 @@ impl Default for BodyShape {
 /// Weights of the two targets either side of `value` on a slider whose stops are `stops`
 /// (names with their positions).
 fn slider<'a>(value: f32, stops: &[(&'a str, f32)]) -> Vec<(&'a str, f32)> {
-    let v = value.clamp(stops[0].1, stops[stops.len() - 1].1);
-    for pair in stops.windows(2) {
-        let ((lo, a), (hi, b)) = (pair[0], pair[1]);
-        if v <= b {
-            let t = (v - a) / (b - a);
-            return [(lo, 1.0 - t), (hi, t)]
-                .into_iter()
-                .filter(|(_, w)| *w > 1e-4)
-                .collect();
-        }
-    }
-    vec![stops[stops.len() - 1]]
+    // The pair of stops around the value (the last pair for a value at or past its end).
+    let pair = stops
+        .windows(2)
+        .find(|pair| value <= pair[1].1)
+        .unwrap_or(&stops[stops.len() - 2..]);
+    let ((lo, a), (hi, b)) = (pair[0], pair[1]);
+    let t = ((value - a) / (b - a)).clamp(0.0, 1.0);
+    [(lo, 1.0 - t), (hi, t)]
         .into_iter()
-        .map(|(n, _)| (n, 1.0))
+        .filter(|(_, w)| *w > 1e-4)
         .collect()
 }
 
