@@ -56,6 +56,28 @@ fn the_body_stands_its_height_with_its_feet_on_the_ground() -> anyhow::Result<()
 }
 
 #[test]
+fn far_people_are_drawn_with_fewer_triangles_of_the_same_vertices() -> anyhow::Result<()> {
+    let Some(human) = makehuman()? else {
+        return Ok(());
+    };
+    let body = human.body(BodyShape::default(), 1.75)?;
+    let full: usize = body.layers().iter().map(|l| l.1.len() / 3).sum();
+    let mut last = full;
+    for cell_m in [0.03, 0.06] {
+        let coarse = body.coarse_layers(cell_m);
+        let triangles: usize = coarse.iter().map(|l| l.len() / 3).sum();
+        println!("cell {cell_m} m: {triangles} of {full} triangles");
+        assert!(triangles < last / 2, "{triangles} triangles at {cell_m} m, {last} before");
+        assert!(triangles > 200, "the coarse body keeps its shape ({triangles} triangles)");
+        assert_eq!(coarse.len(), body.layers().len(), "every layer keeps a level");
+        let n = body.vertex_count() as u32;
+        assert!(coarse.iter().flatten().all(|&i| i < n), "indices address the posed vertices");
+        last = triangles;
+    }
+    Ok(())
+}
+
+#[test]
 fn a_walking_body_keeps_its_planted_foot_still() -> anyhow::Result<()> {
     let Some(human) = makehuman()? else {
         return Ok(());

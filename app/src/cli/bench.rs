@@ -909,7 +909,77 @@ pub(crate) fn bench_people(args: super::args::PeopleBenchArgs) -> Result<()> {
             SWEEP_DISTANCES_M[0]
         );
     }
-    time_posing()
+    time_posing()?;
+    time_frames(&run)
+}
+
+/// Median camera frame time (ms; render + readback, posing included) with `count` people of
+/// `shape` (`None`: the figure) walking side by side 3-7 m ahead of the robot.
+fn frame_ms(
+    run: &RunConfig,
+    count: usize,
+    shape: Option<rover_sim::human::BodyShape>,
+) -> Result<f64> {
+    let (mut world, robot) = run.load_world_and_robot()?;
+    let template = world.people.first().cloned();
+    world.people.clear();
+    let [rx, ry] = world.robot.position_m;
+    for i in 0..count {
+        let Some(mut p) = template.clone() else {
+            anyhow::bail!("the frame cost needs a world with a person to copy");
+        };
+        let x = rx + 3.0 + (i % 3) as f64 * 1.5;
+        let y = ry + (i as f64 - (count as f64 - 1.0) / 2.0) * 0.7;
+        p.name = format!("p{i}");
+        p.position_m = [x, y];
+        p.shape = shape;
+        p.walk = Some(rover_sim::Walk {
+            waypoints_m: vec![[x + 1.0, y]],
+            speed_mps: 0.8,
+            repeat: true,
+            start_after_s: 0.0,
+        });
+        world.people.push(p);
+    }
+    let mut sim = Simulation::new(world, robot, &run.options)?;
+    let mut camera = rover_sim::CameraSensor::new(&sim)?;
+    camera.disable_depth();
+    camera.capture(&sim)?;
+    let mut times = Vec::new();
+    for _ in 0..60 {
+        for _ in 0..5 {
+            sim.step();
+        }
+        let start = Instant::now();
+        camera.capture(&sim)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(median(&mut times))
+}
+
+/// What walking people add to a 640x480 camera frame: 0, 1 and 10 of them, MakeHuman's body
+/// beside the figure.
+fn time_frames(run: &RunConfig) -> Result<()> {
+    let none = frame_ms(run, 0, None)?;
+    say!("");
+    say!("camera frame (median of 60, posing + render + readback): {none:.2} ms with nobody");
+    let mut bodies = vec![("figure", None)];
+    if rover_sim::human::shared().is_some() {
+        bodies.insert(
+            0,
+            ("makehuman", Some(rover_sim::human::BodyShape::default())),
+        );
+    }
+    for (name, shape) in bodies {
+        for count in [1, 10] {
+            let ms = frame_ms(run, count, shape)?;
+            say!(
+                "{name}: {count:>2} walking 3-7 m ahead: {ms:.2} ms, +{:.2} ms",
+                ms - none
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Times posing (skinning) the default MakeHuman body through a walk.

@@ -283,6 +283,7 @@ impl CameraRenderer {
         world_from_camera: Pose,
     ) -> Result<&[u8], RenderError> {
         self.scene.set_robot_link_poses(world_from_links);
+        self.scene.choose_detail(world_from_camera.translation);
         self.scene.upload(&self.gpu.queue);
         let view = View {
             projection: self.projection(),

@@ -76,7 +76,6 @@ pub(crate) struct GpuVertex {
 pub(crate) struct GpuMesh {
     pub(crate) vertices: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
-    pub(crate) count: u32,
     /// Runs of indices and the material (bind group in [`Materials`]) each is drawn with.
     pub(crate) draws: Vec<Draw>,
 }
@@ -163,7 +162,6 @@ impl Builder<'_> {
                 contents: bytemuck::cast_slice(&mesh.indices),
                 usage: wgpu::BufferUsages::INDEX,
             }),
-            count: mesh.indices.len() as u32,
         });
         self.instances.push(Instance::new(pose, color, entity));
         if entity != 0 {
@@ -316,6 +314,7 @@ impl Scene {
             self.instances[a.instance].model = matrix(world_from_person * person_from_shape);
         }
         for body in self.bodies.iter_mut().filter(|b| b.person == index) {
+            body.at = world_from_person.translation;
             for &(instance, _) in &body.instances {
                 self.instances[instance].model = matrix(world_from_person);
             }
@@ -358,6 +357,20 @@ impl Scene {
     /// Moves the robot's visuals to its link poses (URDF order).
     pub(crate) fn set_robot_link_poses(&mut self, world_from_links: &[Pose]) {
         move_attached(&mut self.instances, &self.robot, world_from_links);
+    }
+
+    /// Draws each MakeHuman body at the level of detail its distance from `camera_m` calls for.
+    pub(crate) fn choose_detail(&mut self, camera_m: Vec3) {
+        for body in &self.bodies {
+            let d = body.at.distance(camera_m);
+            let level = DETAIL_FROM_M.iter().filter(|&&from| d >= from).count();
+            for (&(mesh, _), runs) in body.instances.iter().zip(&body.levels) {
+                if let Some(m) = self.meshes.get_mut(mesh) {
+                    m.draws.clear();
+                    m.draws.push(runs[level]);
+                }
+            }
+        }
     }
 
     /// Uploads this frame's instance transforms and the bodies posed since the last upload.
@@ -424,6 +437,12 @@ fn add_models(
     Ok(moving)
 }
 
+/// Grid cells (m) of the coarser levels of detail of MakeHuman's bodies
+/// ([`Body::coarse_layers`]), drawn from [`DETAIL_FROM_M`] on.
+const DETAIL_CELLS_M: [f32; 2] = [0.03, 0.06];
+/// Distances from the camera (m) from which each coarser level is drawn.
+const DETAIL_FROM_M: [f32; 2] = [3.5, 7.0];
+
 /// A person drawn with MakeHuman's body: one vertex buffer posed on the CPU each time the
 /// gait moves, drawn as one mesh per layer (skin, shirt, ...) with that layer's paint.
 struct SkinnedPerson {
@@ -437,8 +456,12 @@ struct SkinnedPerson {
     /// Reused: the posed vertices as the GPU reads them.
     staged: Vec<GpuVertex>,
     vertices: wgpu::Buffer,
-    /// Instance and paint of each layer's mesh.
+    /// Instance (= mesh) and paint of each layer's mesh.
     instances: Vec<(usize, Paint)>,
+    /// Each layer mesh's runs of indices: full detail, then coarser ([`DETAIL_CELLS_M`]).
+    levels: Vec<[Draw; 3]>,
+    /// Where the person stands (world, m).
+    at: Vec3,
     /// Posed since the last upload.
     dirty: bool,
 }
@@ -510,23 +533,40 @@ impl Builder<'_> {
             mapped_at_creation: false,
         });
         let mut instances = Vec::new();
-        for (layer, indices) in body.layers() {
+        let mut levels = Vec::new();
+        let coarse: Vec<Vec<Vec<u32>>> = DETAIL_CELLS_M
+            .iter()
+            .map(|&cell| body.coarse_layers(cell))
+            .collect();
+        for (k, (layer, indices)) in body.layers().iter().enumerate() {
             let paint = layer_paint(*layer);
+            // Every level of detail in one index buffer; each frame draws one run of it.
+            let mut all = indices.clone();
+            let mut runs = [Draw {
+                first_index: 0,
+                count: indices.len() as u32,
+                material: 0,
+            }; 3];
+            for (run, level) in runs.iter_mut().skip(1).zip(&coarse) {
+                let part = level.get(k).map_or(&[][..], Vec::as_slice);
+                *run = Draw {
+                    first_index: all.len() as u32,
+                    count: part.len() as u32,
+                    material: 0,
+                };
+                all.extend_from_slice(part);
+            }
+            levels.push(runs);
             self.meshes.push(GpuMesh {
                 vertices: vertices.clone(),
                 indices: self
                     .device
                     .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: None,
-                        contents: bytemuck::cast_slice(indices),
+                        contents: bytemuck::cast_slice(&all),
                         usage: wgpu::BufferUsages::INDEX,
                     }),
-                count: indices.len() as u32,
-                draws: vec![Draw {
-                    first_index: 0,
-                    count: indices.len() as u32,
-                    material: 0,
-                }],
+                draws: vec![runs[0]],
             });
             self.instances
                 .push(Instance::new(world_from_person, paint.of(person), entity));
@@ -544,6 +584,8 @@ impl Builder<'_> {
             staged: Vec::new(),
             vertices,
             instances,
+            levels,
+            at: world_from_person.translation,
             dirty: true,
         };
         skinned.upload(self.queue);

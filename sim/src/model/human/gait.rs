@@ -52,8 +52,10 @@ const FOOT_LIFT_M: f32 = 0.07;
 const ARM_HANG_RAD: f32 = 0.28;
 /// Arm swing per radian of the legs' scissor angle.
 const ARM_SWING_GAIN: f32 = 0.5;
-/// Elbow bend while walking (rad).
+/// Elbow bend standing: the forearm's angle forward of the upper arm (rad).
 const ELBOW_BEND_RAD: f32 = 0.2;
+/// Elbow bend while walking (rad), more as the arm swings forward.
+const ELBOW_WALK_BEND_RAD: f32 = 0.35;
 
 /// One leg: the bones that turn and the rest positions of their joints (body frame, m).
 #[derive(Debug, Clone, Copy)]
@@ -73,6 +75,7 @@ pub(crate) struct Arm {
     pub(crate) elbow_bone: usize,
     pub(crate) shoulder: Vec3,
     pub(crate) elbow: Vec3,
+    pub(crate) wrist: Vec3,
     /// +1 for the left arm (+y), -1 for the right.
     pub(crate) side: f32,
 }
@@ -101,7 +104,7 @@ impl Limbs {
     pub(crate) fn pose(&self, posture: Posture, rotations: &mut [Quat]) -> Vec3 {
         rotations.fill(Quat::IDENTITY);
         let mut arm_swing = [0.0f32; 2];
-        let mut elbow = 0.0;
+        let mut elbow = ELBOW_BEND_RAD;
         let mut offset = Vec3::ZERO;
         if let Posture::Walking {
             phase_rad,
@@ -146,14 +149,17 @@ impl Limbs {
             }
             let scissor = 0.5 * (thigh[0] - thigh[1]);
             arm_swing = [-ARM_SWING_GAIN * scissor, ARM_SWING_GAIN * scissor];
-            elbow = ELBOW_BEND_RAD;
+            elbow = ELBOW_WALK_BEND_RAD;
         }
         for (arm, swing) in self.arms.iter().zip(arm_swing) {
             let down = arm.elbow - arm.shoulder;
             let from_vertical = (down.y * arm.side).atan2(-down.z);
             let hang = Quat::from_rotation_x(-arm.side * (from_vertical - ARM_HANG_RAD).max(0.0));
             rotations[arm.shoulder_bone] = Quat::from_rotation_y(-swing) * hang;
-            rotations[arm.elbow_bone] = Quat::from_rotation_y(-(elbow + 0.25 * swing.max(0.0)));
+            // MakeHuman's rest pose bends the forearms ~50 degrees forward: set the bend.
+            let bend = elbow + 0.3 * swing.max(0.0);
+            let rest_bend = sagittal_angle(arm.wrist - arm.elbow);
+            rotations[arm.elbow_bone] = Quat::from_rotation_y(-(bend - rest_bend));
         }
         offset
     }
@@ -196,6 +202,7 @@ mod tests {
             elbow_bone: i + 1,
             shoulder: Vec3::new(0.0, 0.18 * side, 1.4),
             elbow: Vec3::new(0.0, 0.38 * side, 1.2),
+            wrist: Vec3::new(0.15, 0.45 * side, 1.08),
             side,
         };
         Limbs {

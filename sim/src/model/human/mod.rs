@@ -151,14 +151,22 @@ pub struct Human {
     targets: Mutex<HashMap<String, Arc<Target>>>,
 }
 
+/// Bones (name prefixes) whose part of the bodysuit is left off: forearms and hands are bare.
+const BARE_BONES: [&str; 4] = ["lowerarm", "wrist", "finger", "metacarpal"];
+/// Bones (name prefixes) whose skin the rest of the bodysuit covers.
+const COVERED_BONES: [&str; 11] = [
+    "root", "spine", "pelvis", "breast", "clavicle", "shoulder", "upperarm", "upperleg",
+    "lowerleg", "foot", "toe",
+];
+
 /// The bones the gait turns, by name in the default rig.
 const LEG_BONES: [[&str; 3]; 2] = [
     ["upperleg01.L", "lowerleg01.L", "foot.L"],
     ["upperleg01.R", "lowerleg01.R", "foot.R"],
 ];
-const ARM_BONES: [[&str; 2]; 2] = [
-    ["upperarm01.L", "lowerarm01.L"],
-    ["upperarm01.R", "lowerarm01.R"],
+const ARM_BONES: [[&str; 3]; 2] = [
+    ["upperarm01.L", "lowerarm01.L", "wrist.L"],
+    ["upperarm01.R", "lowerarm01.R", "wrist.R"],
 ];
 
 impl Human {
@@ -283,32 +291,29 @@ impl Human {
                 _ => continue,
             };
             for &t in &group.triangles {
-                if fixed == Some(Layer::Hair) && !keep_hair((at(t[0]) + at(t[1]) + at(t[2])) / 3.0)
-                {
-                    continue;
-                }
+                let bone = self.main_bone(t[0]);
+                let bare = BARE_BONES.iter().any(|p| bone.starts_with(p));
                 let layer = match fixed {
-                    Some(l) => l,
-                    None => {
-                        let bone = self.main_bone(t[0]);
-                        let z = (at(t[0]).z + at(t[1]).z + at(t[2]).z) / 3.0;
-                        if ["lowerarm", "wrist", "finger", "metacarpal"]
-                            .iter()
-                            .any(|p| bone.starts_with(p))
-                        {
-                            continue;
-                        } else if bone.starts_with("foot") || bone.starts_with("toe") {
-                            Layer::Shoes
-                        } else if bone.starts_with("upperarm")
-                            || bone.starts_with("clavicle")
-                            || bone.starts_with("shoulder")
-                            || z > hem_z
-                        {
-                            Layer::Shirt
-                        } else {
-                            Layer::Trousers
-                        }
+                    Some(Layer::Hair) if !keep_hair((at(t[0]) + at(t[1]) + at(t[2])) / 3.0) => {
+                        continue;
                     }
+                    // Skin the bodysuit covers is never seen: not drawn (half the triangles).
+                    Some(Layer::Skin)
+                        if !bare && COVERED_BONES.iter().any(|p| bone.starts_with(p)) =>
+                    {
+                        continue;
+                    }
+                    Some(l) => l,
+                    None if bare => continue,
+                    None if bone.starts_with("foot") || bone.starts_with("toe") => Layer::Shoes,
+                    None if bone.starts_with("upperarm")
+                        || bone.starts_with("clavicle")
+                        || bone.starts_with("shoulder")
+                        || (at(t[0]).z + at(t[1]).z + at(t[2]).z) / 3.0 > hem_z =>
+                    {
+                        Layer::Shirt
+                    }
+                    None => Layer::Trousers,
                 };
                 push(layer, t);
             }
@@ -424,13 +429,14 @@ impl Human {
                 ankle: joints[a],
             }
         };
-        let arm = |names: [&str; 2], side: f32| {
-            let [s, e] = names.map(bone);
+        let arm = |names: [&str; 3], side: f32| {
+            let [s, e, w] = names.map(bone);
             Arm {
                 shoulder_bone: s,
                 elbow_bone: e,
                 shoulder: joints[s],
                 elbow: joints[e],
+                wrist: joints[w],
                 side,
             }
         };
@@ -507,6 +513,55 @@ impl Body {
             *n = n.normalize_or_zero();
         }
         normals
+    }
+
+    /// The layers' triangles (in [`Body::layers`]' order) at a coarser level of detail for
+    /// people far from the camera: vertices of the same main bone within a `cell_m` grid cell
+    /// are merged into the one nearest their mean, and triangles that collapse are dropped.
+    /// The indices address the same vertices, so one skinning serves every level.
+    pub fn coarse_layers(&self, cell_m: f32) -> Vec<Vec<u32>> {
+        let main_bone = |v: usize| {
+            self.weights
+                .of(v)
+                .iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(0, |p| p.0)
+        };
+        let key = |v: usize| {
+            let cell = (self.rest[v] / cell_m).floor().as_ivec3();
+            (main_bone(v), cell.x, cell.y, cell.z)
+        };
+        let keys: Vec<_> = (0..self.rest.len()).map(key).collect();
+        let mut means: HashMap<(u16, i32, i32, i32), (Vec3, f32)> = HashMap::new();
+        for (v, k) in keys.iter().enumerate() {
+            let m = means.entry(*k).or_insert((Vec3::ZERO, 0.0));
+            (m.0, m.1) = (m.0 + self.rest[v], m.1 + 1.0);
+        }
+        let mut nearest: HashMap<(u16, i32, i32, i32), (u32, f32)> = HashMap::new();
+        for (v, k) in keys.iter().enumerate() {
+            let (sum, n) = means.get(k).copied().unwrap_or((self.rest[v], 1.0));
+            let d = self.rest[v].distance_squared(sum / n);
+            let best = nearest.entry(*k).or_insert((v as u32, d));
+            if d < best.1 {
+                *best = (v as u32, d);
+            }
+        }
+        let merged: Vec<u32> = keys
+            .iter()
+            .enumerate()
+            .map(|(v, k)| nearest.get(k).map_or(v as u32, |n| n.0))
+            .collect();
+        self.layers
+            .iter()
+            .map(|(_, indices)| {
+                indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0], t[1], t[2]].map(|i| merged[i as usize]))
+                    .filter(|[a, b, c]| a != b && b != c && a != c)
+                    .flatten()
+                    .collect()
+            })
+            .collect()
     }
 
     /// Poses the body for `posture` into `out` (linear-blend skinning).

@@ -178,7 +178,10 @@ impl SilhouettePass {
                 pass.set_pipeline(&self.pipelines[layer % per_pass]);
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                 pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.count, 0, i..i + 1);
+                for draw in &mesh.draws {
+                    let indices = draw.first_index..draw.first_index + draw.count;
+                    pass.draw_indexed(indices, 0, i..i + 1);
+                }
             }
         }
     }
