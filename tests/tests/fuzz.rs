@@ -19,6 +19,8 @@ fn limits(hang_scale: f64) -> Limits {
 fn quick_cases(target: &Target) -> u32 {
     match target.name {
         "onnx" => 16,
+        // Megabyte seeds (MakeHuman's base mesh and weights).
+        "human_obj" | "human_weights" => 1000,
         "xacro" | "sdf" | "urdf" | "mesh_dae" | "image_jpeg" => 1000,
         _ => 2000,
     }

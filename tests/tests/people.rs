@@ -67,11 +67,24 @@ fn far_people_are_drawn_with_fewer_triangles_of_the_same_vertices() -> anyhow::R
         let coarse = body.coarse_layers(cell_m);
         let triangles: usize = coarse.iter().map(|l| l.len() / 3).sum();
         println!("cell {cell_m} m: {triangles} of {full} triangles");
-        assert!(triangles < last / 2, "{triangles} triangles at {cell_m} m, {last} before");
-        assert!(triangles > 200, "the coarse body keeps its shape ({triangles} triangles)");
-        assert_eq!(coarse.len(), body.layers().len(), "every layer keeps a level");
+        assert!(
+            triangles < last / 2,
+            "{triangles} triangles at {cell_m} m, {last} before"
+        );
+        assert!(
+            triangles > 200,
+            "the coarse body keeps its shape ({triangles} triangles)"
+        );
+        assert_eq!(
+            coarse.len(),
+            body.layers().len(),
+            "every layer keeps a level"
+        );
         let n = body.vertex_count() as u32;
-        assert!(coarse.iter().flatten().all(|&i| i < n), "indices address the posed vertices");
+        assert!(
+            coarse.iter().flatten().all(|&i| i < n),
+            "indices address the posed vertices"
+        );
         last = triangles;
     }
     Ok(())
