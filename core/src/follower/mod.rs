@@ -300,6 +300,10 @@ const TOP_EDGE_SLACK: f64 = 0.02;
 /// (m). Tuned on the scenarios: 0.1 and 0.3 each fail crossing's `max_range_after_acquire_m`
 /// and walking_square's `min_person_range_m` (docs/FOLLOWER.md).
 const RECEDING_ALLOWANCE_M: f64 = 0.2;
+/// How much less a range from the feet is trusted when the box is cut off at a side of the
+/// image (m, 1 sigma): the nearer foot may be the part cut off (with MakeHuman's walking body,
+/// a range 0.45 m too far pulled the track off the person).
+const SIDE_CUT_FEET_SIGMA_M: f64 = 0.3;
 /// How far a walking person's range from one box may be off with their gait (m, 1 sigma):
 /// about half a step.
 const GAIT_RANGE_SIGMA_M: f64 = 0.15;
@@ -648,7 +652,13 @@ impl Follower {
             ),
             // A box's bottom below the horizon is the feet (the hem of a torso box is above a
             // low camera): the feet are exact, the width depends on how the person stands.
-            (false, _, Some(d), ..) => (d, 0.05 + d * d * pixel_rad / c.height_m.max(0.05)),
+            // A box cut off at a side may have lost the nearer foot: the bottom is then the
+            // other one's, up to a step further.
+            (false, _, Some(d), ..) => (
+                d,
+                0.05 + d * d * pixel_rad / c.height_m.max(0.05)
+                    + if clipped_side { SIDE_CUT_FEET_SIGMA_M } else { 0.0 },
+            ),
             (false, _, None, Some(d), _) => (
                 d,
                 0.05 + 0.1 * d + d * d * pixel_rad / self.config.target_height_m,

@@ -666,9 +666,7 @@ impl RawPerson {
                 ));
             }
         }
-        let sliders_given = sliders.iter().any(|s| s.1.is_some());
-        let default = if sliders_given { "makehuman" } else { "figure" };
-        match self.body.as_deref().unwrap_or(default) {
+        match self.body.as_deref().unwrap_or("makehuman") {
             "makehuman" => {
                 let d = BodyShape::default();
                 let or = |v: Option<f64>, d: f32| v.map_or(d, |v| v as f32);

@@ -62,7 +62,7 @@ impl Person {
             skin_color: Rgba::rgb(0.87, 0.67, 0.53),
             hair_color: Rgba::rgb(0.2, 0.13, 0.08),
             walk: None,
-            shape: None,
+            shape: Some(BodyShape::default()),
         }
     }
 

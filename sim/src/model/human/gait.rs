@@ -47,6 +47,10 @@ pub const STANCE_FRACTION: f32 = 0.6;
 const MAX_PELVIS_DROP: f32 = 0.03;
 /// How high a swinging foot is lifted at most, for a 1.75 m person (m).
 const FOOT_LIFT_M: f32 = 0.07;
+/// Where the ankles stand, each side of the body's centre line, for a 1.75 m person (m):
+/// MakeHuman's rest pose has them 0.18 m out, a wide stance; people stand and walk with their
+/// feet closer.
+const ANKLE_HALF_SPACING_M: f32 = 0.08;
 /// How far the arms are brought in from MakeHuman's A-pose, towards hanging (rad from
 /// vertical, the angle they are left at).
 const ARM_HANG_RAD: f32 = 0.28;
@@ -98,21 +102,45 @@ fn xz_len(v: Vec3) -> f32 {
     v.x.hypot(v.z)
 }
 
+impl Leg {
+    /// The leg brought in towards the centre line (turned about the body's forward axis at
+    /// the hip): the turn, and the knee and ankle where it puts them.
+    fn brought_in(&self, height_m: f32) -> (Quat, Vec3, Vec3) {
+        let side = self.ankle.y.signum();
+        let target_y = side * ANKLE_HALF_SPACING_M * height_m / 1.75;
+        let drop = self.hip.z - self.ankle.z;
+        let turn = (target_y - self.hip.y).atan2(drop) - (self.ankle.y - self.hip.y).atan2(drop);
+        let q = Quat::from_rotation_x(turn);
+        (
+            q,
+            self.hip + q * (self.knee - self.hip),
+            self.hip + q * (self.ankle - self.hip),
+        )
+    }
+}
+
 impl Limbs {
     /// Sets `rotations` (one per bone, in the body's rest frame, about each bone's head) and
     /// returns how far the whole body moves (m) for `posture`.
     pub(crate) fn pose(&self, posture: Posture, rotations: &mut [Quat]) -> Vec3 {
         rotations.fill(Quat::IDENTITY);
-        let mut arm_swing = [0.0f32; 2];
-        let mut elbow = ELBOW_BEND_RAD;
-        let mut offset = Vec3::ZERO;
+        let legs = self.legs.map(|leg| {
+            let (turn, knee, ankle) = leg.brought_in(self.height_m);
+            (leg, turn, Leg { knee, ankle, ..leg })
+        });
+        // Legs brought in reach a little lower: the body rises as much, feet on the ground.
+        let lift = self.legs[0].ankle.z - legs[0].2.ankle.z;
+        let mut offset = Vec3::new(0.0, 0.0, lift);
+        // How far each thigh and shank turn forward (rad); standing, not at all.
+        let mut turns = [(0.0f32, 0.0f32); 2];
+        let (mut arm_swing, mut elbow) = ([0.0f32; 2], ELBOW_BEND_RAD);
         if let Posture::Walking {
             phase_rad,
             stride_m,
         } = posture
         {
             let stride = stride_m as f32;
-            let leg = &self.legs[0];
+            let leg = &legs[0].2;
             let (a, b) = (xz_len(leg.knee - leg.hip), xz_len(leg.ankle - leg.knee));
             let reach = 0.98 * (a + b);
             // Half the ground a planted foot covers, limited so the legs can reach it.
@@ -120,36 +148,39 @@ impl Limbs {
             // The pelvis sinks a little (at most MAX_PELVIS_DROP); where the legs still cannot
             // reach a planted ankle (heel strike ahead, push-off behind) the heel rises
             // instead, as a foot rolls over its heel and toes.
-            let rest_drop = leg.hip.z - leg.ankle.z;
+            let rest_drop = leg.hip.z + lift - self.legs[0].ankle.z;
             let drop = (rest_drop - (reach * reach - half * half).sqrt())
                 .clamp(0.0, MAX_PELVIS_DROP * self.height_m / 1.75);
-            offset = Vec3::new(0.0, 0.0, -drop);
-            let lift = FOOT_LIFT_M * self.height_m / 1.75;
-            let mut thigh = [0.0f32; 2];
-            for (side, leg) in self.legs.iter().enumerate() {
+            offset.z -= drop;
+            let foot_lift = FOOT_LIFT_M * self.height_m / 1.75;
+            for (side, (rest, _, leg)) in legs.iter().enumerate() {
                 let cycle = (phase_rad as f32 / TAU + 0.5 * side as f32).rem_euclid(1.0);
                 let (x, z) = if cycle < STANCE_FRACTION {
                     (half - 2.0 * half * cycle / STANCE_FRACTION, 0.0)
                 } else {
                     let s = (cycle - STANCE_FRACTION) / (1.0 - STANCE_FRACTION);
                     let smooth = s * s * (3.0 - 2.0 * s);
-                    (-half + 2.0 * half * smooth, lift * (PI * s).sin())
+                    (-half + 2.0 * half * smooth, foot_lift * (PI * s).sin())
                 };
                 let hip = leg.hip + offset;
-                let mut target = Vec3::new(leg.ankle.x + x, 0.0, leg.ankle.z + z);
+                // Planted, the ankle is where it stands at rest: on the ground.
+                let mut target = Vec3::new(leg.ankle.x + x, 0.0, rest.ankle.z + z);
                 let across = target.x - hip.x;
                 let lowest = hip.z - (reach * reach - across * across).max(0.0).sqrt();
                 target.z = target.z.max(lowest);
-                let (d_thigh, d_shank) = leg_ik(leg, target - hip);
-                rotations[leg.hip_bone] = Quat::from_rotation_y(-d_thigh);
-                rotations[leg.knee_bone] = Quat::from_rotation_y(-(d_shank - d_thigh));
-                // The foot stays level.
-                rotations[leg.ankle_bone] = Quat::from_rotation_y(d_shank);
-                thigh[side] = d_thigh;
+                turns[side] = leg_ik(leg, target - hip);
             }
-            let scissor = 0.5 * (thigh[0] - thigh[1]);
+            let scissor = 0.5 * (turns[0].0 - turns[1].0);
             arm_swing = [-ARM_SWING_GAIN * scissor, ARM_SWING_GAIN * scissor];
             elbow = ELBOW_WALK_BEND_RAD;
+        }
+        for ((rest, turn, _), (d_thigh, d_shank)) in legs.iter().zip(turns) {
+            // Bring the leg in, then swing it in the sagittal plane: the knee and foot turn
+            // about the brought-in axes, and the foot stays level.
+            rotations[rest.hip_bone] = Quat::from_rotation_y(-d_thigh) * *turn;
+            rotations[rest.knee_bone] =
+                turn.inverse() * Quat::from_rotation_y(-(d_shank - d_thigh)) * *turn;
+            rotations[rest.ankle_bone] = turn.inverse() * Quat::from_rotation_y(d_shank);
         }
         for (arm, swing) in self.arms.iter().zip(arm_swing) {
             let down = arm.elbow - arm.shoulder;
@@ -248,21 +279,30 @@ mod tests {
             last = Some(a);
             // The feet are opposite: the right one is mid-swing when the left is planted.
             let foot = r[limbs.legs[0].hip_bone] * r[limbs.legs[0].knee_bone] * r[2];
-            assert!(
-                foot.angle_between(Quat::IDENTITY) < 1e-3,
-                "the foot stays level"
-            );
+            let level = (foot * Vec3::X - Vec3::X).length() + (foot * Vec3::Z - Vec3::Z).length();
+            assert!(level < 1e-3, "the foot stays level ({foot})");
         }
     }
 
     #[test]
-    fn standing_lets_the_arms_hang_and_keeps_the_legs_straight() {
-        let limbs = limbs();
+    fn standing_lets_the_arms_hang_and_brings_the_feet_in_level_on_the_ground() {
+        let mut limbs = limbs();
+        // Legs splayed as MakeHuman's rest pose has them: ankles 0.18 m out.
+        for leg in &mut limbs.legs {
+            leg.ankle.y = 0.18 * leg.ankle.y.signum();
+        }
         let mut r = vec![Quat::IDENTITY; 10];
         let offset = limbs.pose(Posture::Standing, &mut r);
-        assert_eq!(offset, Vec3::ZERO);
         for leg in &limbs.legs {
-            assert_eq!(r[leg.hip_bone], Quat::IDENTITY);
+            let a = ankle(leg, &r, offset);
+            assert!(
+                (a.y.abs() - ANKLE_HALF_SPACING_M).abs() < 1e-4,
+                "ankle at {a}"
+            );
+            assert!((a.z - leg.ankle.z).abs() < 1e-4, "ankle height {a}");
+            let foot = r[leg.hip_bone] * r[leg.knee_bone] * r[leg.ankle_bone];
+            let level = (foot * Vec3::X - Vec3::X).length() + (foot * Vec3::Z - Vec3::Z).length();
+            assert!(level < 1e-4, "the foot stays level ({foot})");
         }
         for arm in &limbs.arms {
             let down = r[arm.shoulder_bone] * (arm.elbow - arm.shoulder);

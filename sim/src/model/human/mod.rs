@@ -384,16 +384,17 @@ impl Human {
             }
             layers.push((*layer, out));
         }
-        let body_vertices = self
+        // Standing height: from the soles of the shoes (the lowest drawn point, on the ground)
+        // to the top of the head (the skin's highest point; hair adds a little).
+        let z_of = |v: &u32| from_obj(positions_dm[*v as usize]).z;
+        let low = used.iter().map(z_of).fold(f32::INFINITY, f32::min);
+        let high = self
             .mesh
             .group("body")
             .into_iter()
-            .flat_map(|g| g.triangles.iter().flatten());
-        let (mut low, mut high) = (f32::INFINITY, f32::NEG_INFINITY);
-        for &v in body_vertices {
-            let z = from_obj(positions_dm[v as usize]).z;
-            (low, high) = (low.min(z), high.max(z));
-        }
+            .flat_map(|g| g.triangles.iter().flatten())
+            .map(z_of)
+            .fold(f32::NEG_INFINITY, f32::max);
         let scale = if high > low {
             height_m as f32 / (high - low)
         } else {
