@@ -657,7 +657,11 @@ impl Follower {
             (false, _, Some(d), ..) => (
                 d,
                 0.05 + d * d * pixel_rad / c.height_m.max(0.05)
-                    + if clipped_side { SIDE_CUT_FEET_SIGMA_M } else { 0.0 },
+                    + if clipped_side {
+                        SIDE_CUT_FEET_SIGMA_M
+                    } else {
+                        0.0
+                    },
             ),
             (false, _, None, Some(d), _) => (
                 d,
