@@ -33,6 +33,8 @@ pub use description::{
 };
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};
+/// Gazebo actors: their scripts, skins and animations (a namespace, as `human`).
+pub use model::actor;
 /// People with MakeHuman's body: its assets fetched from PyPI, shaped, dressed and posed (a
 /// namespace: nothing in it is re-exported at the root).
 pub use model::human;
@@ -52,12 +54,12 @@ pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
     HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory,
-    ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, SimOptions, Simulation, TrajectoryPoint,
+    ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions, Simulation, TrajectoryPoint,
     TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{
-    CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError, Swing,
-    object_mesh, person_parts, shape_mesh, visual_mesh,
+    BodyLayer, CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError,
+    SkinnedBody, Swing, object_mesh, person_parts, shape_mesh, visual_mesh,
 };
 pub use sensors::{
     CameraFrame, CameraSensor, GroundTruth, GroundTruthBox, LaserScan, LaserSensor, MIN_VISIBILITY,

@@ -249,3 +249,72 @@ fn broken_assets_are_located_errors() -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+#[test]
+fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
+    if makehuman()?.is_none() {
+        return Ok(());
+    }
+    let dir = tempfile::tempdir()?;
+    let spec = rover_core::DatasetSpec {
+        out: dir.path().join("people"),
+        images: 16,
+        seed: 3,
+        val_fraction: 0.0,
+        image_format: rover_core::ImageFormat::Png,
+        yolo: false,
+        coco: true,
+        randomization: rover_core::Randomization {
+            background: 0.0,
+            distance_m: [2.0, 4.0],
+            ..rover_core::Randomization::default()
+        },
+        detect: false,
+        shard: None,
+        jobs: 1,
+    };
+    let config = RunConfig {
+        world: Some(repo("worlds/playground.toml")),
+        ..RunConfig::default()
+    };
+    rover_core::write_dataset(&config, &spec, &mut |_| {})?;
+    let mut looks = Vec::new();
+    let mut box_heights = Vec::new();
+    for entry in std::fs::read_dir(spec.out.join("ground_truth/train"))? {
+        let record: rover_core::ImageRecord =
+            serde_json::from_str(&std::fs::read_to_string(entry?.path())?)?;
+        for (person, thing) in record.shot.people.iter().zip(&record.objects) {
+            looks.push(person.clone());
+            if !thing.ignore {
+                box_heights.push(thing.bbox[3]);
+            }
+        }
+    }
+    let count = |f: &dyn Fn(&rover_core::PersonShot) -> bool| looks.iter().filter(|p| f(p)).count();
+    let children = count(&|p| p.shape.is_some_and(|s| s[1] < 0.36));
+    let mid_stride = count(&|p| p.gait_phase_deg > 0.0);
+    let shapes: std::collections::BTreeSet<String> = looks
+        .iter()
+        .filter_map(|p| p.shape.map(|s| format!("{s:?}")))
+        .collect();
+    let skins: std::collections::BTreeSet<String> =
+        looks.iter().map(|p| format!("{:?}", p.colors[0])).collect();
+    println!(
+        "{} people: {} shapes, {children} children, {mid_stride} mid-stride, {} skin tones; \
+         box heights {:.0}-{:.0} px",
+        looks.len(),
+        shapes.len(),
+        skins.len(),
+        box_heights.iter().copied().fold(f64::MAX, f64::min),
+        box_heights.iter().copied().fold(0.0, f64::max)
+    );
+    assert_eq!(looks.len(), 16);
+    assert_eq!(shapes.len(), 16, "every image its own body");
+    assert!(children >= 1 && children <= 8, "{children} children");
+    assert!(
+        (3..=13).contains(&mid_stride),
+        "{mid_stride} caught mid-stride"
+    );
+    assert!(skins.len() >= 4, "{} skin tones", skins.len());
+    Ok(())
+}

@@ -864,11 +864,11 @@ pub(crate) struct DatasetArgs {
     pub(crate) image_format: DatasetImageFormat,
 
     /// What to randomize: robot, things (people's and labelled things' poses), clothes,
-    /// light, noise; `none` for none
+    /// bodies (people's shapes, heights, skin, hair, gait phase), light, noise; `none` for none
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "robot,things,clothes,light,noise",
+        default_value = "robot,things,clothes,bodies,light,noise",
         value_name = "WHAT,..."
     )]
     pub(crate) randomize: Vec<Randomize>,
@@ -946,6 +946,9 @@ pub(crate) enum Randomize {
     Things,
     /// People's shirt and trousers colours
     Clothes,
+    /// People's bodies (shape sliders, height, children too), skin tones, hair colours, and
+    /// half of them caught mid-stride
+    Bodies,
     /// The sun's direction and strength, the sky's light
     Light,
     /// The camera's noise

@@ -41,6 +41,7 @@ fn randomization(args: &DatasetArgs) -> Randomization {
             0.0
         },
         clothes: on(Randomize::Clothes),
+        bodies: on(Randomize::Bodies),
         light: on(Randomize::Light),
         noise_max: if on(Randomize::Noise) {
             args.noise_max

@@ -73,6 +73,10 @@ fn detection_boxes<'a>(
     )
 }
 
+/// How often a walking person's skinned body is re-posed and logged (s of sim time): 10 Hz,
+/// smooth enough to watch, a fraction of the control rate's data.
+const BODY_LOG_PERIOD_S: f64 = 0.1;
+
 /// The Rerun recorder.
 pub struct Recorder {
     rec: RecordingStream,
@@ -80,6 +84,8 @@ pub struct Recorder {
     frame: i64,
     trail: Vec<[f32; 3]>,
     trail_logged_s: f64,
+    /// When the moving skinned bodies were last re-posed and logged (sim s).
+    bodies_logged_s: f64,
     paths: ScenePaths,
     /// Reused buffer for SDF model link poses.
     model_poses: Vec<Pose>,
@@ -140,6 +146,7 @@ impl Recorder {
             frame: 0,
             trail: Vec::with_capacity(4096),
             trail_logged_s: f64::NEG_INFINITY,
+            bodies_logged_s: f64::NEG_INFINITY,
             model_poses: Vec::new(),
             laser: None,
             scan_points: Vec::new(),
@@ -240,8 +247,21 @@ impl Observer for Recorder {
             }
         }
         for (i, path) in self.paths.people.iter().enumerate() {
-            if sim.world().people[i].walk.is_some() {
+            if sim.world().people[i].moves() {
                 self.log(path, &transform(sim.world_from_person(i)));
+            }
+        }
+        if sample.sim_time_s - self.bodies_logged_s >= BODY_LOG_PERIOD_S {
+            self.bodies_logged_s = sample.sim_time_s;
+            for (i, path, body) in &mut self.paths.bodies {
+                let person = &sim.world().people[*i];
+                body.pose(sim.person_gait_phase_rad(*i), person.stride_m());
+                let mesh = rerun::Mesh3D::update_fields()
+                    .with_vertex_positions(body.positions().iter().map(|p| p.to_array()))
+                    .with_vertex_normals(body.normals().iter().map(|n| n.to_array()));
+                if let Err(e) = self.rec.log(path.as_str(), &mesh) {
+                    tracing::warn!("rerun: {path}: {e}");
+                }
             }
         }
         for (i, path, swing, standing) in &self.paths.limbs {

@@ -3,8 +3,8 @@
 
 use rerun::RecordingStream;
 use rover_sim::{
-    CameraInfo, MeshData, Pose, Rgba, Simulation, Swing, Visual, link_from_optical, object_mesh,
-    person_parts, shape_mesh,
+    CameraInfo, MeshData, Pose, Rgba, Simulation, SkinnedBody, Swing, Visual, link_from_optical,
+    object_mesh, person_parts, shape_mesh,
 };
 
 use super::images::{IMAGE_PATH, ImageOptions};
@@ -20,6 +20,9 @@ pub(super) struct ScenePaths {
     /// hands, shoes), with the person's index, how the limb swings and where it sits standing
     /// (its mesh is in that frame).
     pub limbs: Limbs,
+    /// `world/people/<name>/body` of each moving person drawn with a skinned body (MakeHuman's
+    /// or an actor's skin), with the person's index and the body, re-posed as they walk.
+    pub bodies: Vec<(usize, String, SkinnedBody)>,
     /// `world/models/<model>/<link>` of SDF model links that move, with their index among all
     /// model links.
     pub moving_model_links: Vec<(usize, String)>,
@@ -43,11 +46,12 @@ pub(super) fn log_scene(
         &rerun::ViewCoordinates::RIGHT_HAND_Z_UP(),
     );
     let moving_model_links = log_world(rec, sim);
-    let (people, limbs) = log_people(rec, sim);
+    let (people, limbs, bodies) = log_people(rec, sim);
     let paths = ScenePaths {
         moving_model_links,
         people,
         limbs,
+        bodies,
         links: log_robot(rec, sim),
         joints: log_joint_series(rec, sim),
     };
@@ -173,14 +177,35 @@ impl PartsMesh {
 /// sits standing (its mesh is in that frame).
 type Limbs = Vec<(usize, String, Swing, Pose)>;
 
-/// The people: each one mesh of its body and, for a walking person, one per limb that swings
-/// (`<path>/limb<k>`, moved per tick); returns the people's paths and the limbs'.
-fn log_people(rec: &RecordingStream, sim: &Simulation) -> (Vec<String>, Limbs) {
+/// The people: a skinned body as one mesh (`<path>/body`, its vertices re-logged as a moving
+/// person walks), or rover's figure as one mesh of its body and, for a walking person, one
+/// per limb that swings (`<path>/limb<k>`, moved per tick); returns the people's paths, the
+/// limbs' and the moving skinned bodies'.
+#[allow(clippy::type_complexity)]
+fn log_people(
+    rec: &RecordingStream,
+    sim: &Simulation,
+) -> (Vec<String>, Limbs, Vec<(usize, String, SkinnedBody)>) {
     let mut paths = Vec::new();
     let mut limbs = Vec::new();
+    let mut bodies = Vec::new();
     for (i, person) in sim.world().people.iter().enumerate() {
         let path = format!("world/people/{}", person.name);
-        let walking = person.walk.is_some();
+        let walking = person.moves();
+        if let Some(skinned) = SkinnedBody::of(person) {
+            log(
+                rec,
+                &format!("{path}/body"),
+                &skinned_mesh(&skinned, person),
+            );
+            if walking {
+                bodies.push((i, format!("{path}/body"), skinned));
+            } else {
+                log(rec, &path, &transform(sim.world_from_person(i)));
+            }
+            paths.push(path);
+            continue;
+        }
         let mut body = PartsMesh::default();
         // Parts that turn about one joint share a mesh in the figure's frame; a part kept
         // level (a shoe) has its own, in its own frame.
@@ -211,7 +236,28 @@ fn log_people(rec: &RecordingStream, sim: &Simulation) -> (Vec<String>, Limbs) {
         }
         paths.push(path);
     }
-    (paths, limbs)
+    (paths, limbs, bodies)
+}
+
+/// A skinned body as one Rerun mesh: its posed vertices, each coloured by its layer's paint.
+fn skinned_mesh(body: &SkinnedBody, person: &rover_sim::Person) -> rerun::Mesh3D {
+    let mut colors = vec![rerun::Color::from_rgb(128, 128, 128); body.positions().len()];
+    let mut triangles = Vec::new();
+    for layer in body.layers() {
+        let [r, g, b, _] = layer.paint.of(person).0.map(|c| (c * 255.0).round() as u8);
+        for t in layer.indices.chunks_exact(3) {
+            for &i in t {
+                if let Some(c) = colors.get_mut(i as usize) {
+                    *c = rerun::Color::from_rgb(r, g, b);
+                }
+            }
+            triangles.push([t[0], t[1], t[2]]);
+        }
+    }
+    rerun::Mesh3D::new(body.positions().iter().map(|p| p.to_array()))
+        .with_vertex_normals(body.normals().iter().map(|n| n.to_array()))
+        .with_triangle_indices(triangles)
+        .with_vertex_colors(colors)
 }
 
 /// The robot: one entity per link under world/robot, visuals as meshes; returns their paths.

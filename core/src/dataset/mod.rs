@@ -23,7 +23,7 @@ pub use export::{
     coco_results, data_yaml, yolo_class,
 };
 pub use merge::{SHARD_MANIFEST, merge_dataset};
-pub use randomize::{Randomization, Shot};
+pub use randomize::{PersonShot, Randomization, Shot};
 pub use store::{ImageFormat, MANIFEST, MANIFEST_FORMAT, Manifest, Split, Store, write_whole};
 
 use crate::error::{CoreError, Result};

@@ -28,6 +28,11 @@ pub struct Randomization {
     pub turn_deg: f64,
     /// Dress people in random shirt and trousers colours.
     pub clothes: bool,
+    /// Give people other bodies (MakeHuman's shape sliders: gender, age — children too —,
+    /// muscle and weight; height), skin tones and hair colours, and catch half of them
+    /// mid-stride at any phase of the walk.
+    #[serde(default)]
+    pub bodies: bool,
     /// Put the sun anywhere 20-80 degrees above the horizon, vary its and the sky's strength.
     pub light: bool,
     /// Gaussian noise with a standard deviation drawn from 0 up to this (0..1 of full scale; 0:
@@ -44,6 +49,7 @@ impl Default for Randomization {
             move_m: 0.5,
             turn_deg: 180.0,
             clothes: true,
+            bodies: true,
             light: true,
             noise_max: 0.02,
         }
@@ -105,6 +111,67 @@ impl Rng {
     fn color(&mut self) -> Rgba {
         let mut c = || self.between(0.04, 0.95) as f32;
         Rgba::rgb(c(), c(), c())
+    }
+}
+
+/// Skin tones, light to dark (sRGB), people's skin is drawn from.
+const SKIN_TONES: [[f32; 3]; 6] = [
+    [0.96, 0.80, 0.69],
+    [0.89, 0.70, 0.56],
+    [0.78, 0.57, 0.42],
+    [0.63, 0.43, 0.29],
+    [0.45, 0.29, 0.19],
+    [0.29, 0.18, 0.12],
+];
+/// Hair colours: black, dark brown, brown, blond, red, grey.
+const HAIR_COLORS: [[f32; 3]; 6] = [
+    [0.05, 0.04, 0.04],
+    [0.18, 0.11, 0.07],
+    [0.36, 0.22, 0.12],
+    [0.78, 0.64, 0.40],
+    [0.55, 0.22, 0.09],
+    [0.62, 0.62, 0.60],
+];
+/// Fraction of people drawn as children (MakeHuman's age 0.19-0.35, 1.1-1.5 m).
+const CHILD_FRACTION: f64 = 0.2;
+
+/// A person's random look: MakeHuman's body in a random shape and height (a person drawn as
+/// rover's figure or an actor's skin keeps it), a skin tone, a hair colour, and half of them
+/// mid-stride.
+fn random_look(person: &rover_sim::Person, rng: &mut Rng) -> rover_sim::PersonLook {
+    let child = rng.uniform() < CHILD_FRACTION;
+    let (age, height_m) = if child {
+        (rng.between(0.19, 0.35), rng.between(1.1, 1.5))
+    } else {
+        (rng.between(0.4, 0.9), rng.between(1.55, 1.95))
+    };
+    let shape = rover_sim::human::BodyShape {
+        gender: rng.uniform() as f32,
+        age: age as f32,
+        muscle: rng.between(0.2, 0.8) as f32,
+        weight: rng.between(0.1, 0.9) as f32,
+    };
+    let pick = |palette: &[[f32; 3]; 6], rng: &mut Rng| {
+        let [r, g, b] = palette[rng.below(palette.len())];
+        Rgba::rgb(r, g, b)
+    };
+    let skin_color = pick(&SKIN_TONES, rng);
+    let hair_color = pick(&HAIR_COLORS, rng);
+    let still_gait_phase_rad = if rng.uniform() < 0.5 {
+        0.0
+    } else {
+        rng.between(0.01, 2.0 * PI)
+    };
+    rover_sim::PersonLook {
+        shape: person.shape.map(|_| shape),
+        height_m: if person.shape.is_some() {
+            height_m
+        } else {
+            person.height_m
+        },
+        skin_color,
+        hair_color,
+        still_gait_phase_rad,
     }
 }
 
@@ -171,6 +238,43 @@ pub struct Shot {
     pub ambient: f64,
     /// Gaussian noise standard deviation (0..1 of full scale; `None`: the camera's own).
     pub noise_stddev: Option<f64>,
+    /// How each person looked (world order).
+    #[serde(default)]
+    pub people: Vec<PersonShot>,
+}
+
+/// How one person looked in an image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PersonShot {
+    /// Their name in the world.
+    pub name: String,
+    /// MakeHuman's sliders (gender, age, muscle, weight; 0..1), `None` for rover's figure or
+    /// an actor's skin.
+    pub shape: Option<[f32; 4]>,
+    /// Standing height (m).
+    pub height_m: f64,
+    /// Where in the gait cycle they were caught (deg; 0: standing).
+    pub gait_phase_deg: f64,
+    /// Skin, hair, shirt and trousers colours (sRGB, 0..1).
+    pub colors: [[f32; 3]; 4],
+}
+
+impl PersonShot {
+    fn of(person: &rover_sim::Person) -> Self {
+        let rgb = |c: Rgba| [c.0[0], c.0[1], c.0[2]];
+        Self {
+            name: person.name.clone(),
+            shape: person.shape.map(|s| [s.gender, s.age, s.muscle, s.weight]),
+            height_m: person.height_m,
+            gait_phase_deg: person.gait_phase_rad(0.0).to_degrees(),
+            colors: [
+                rgb(person.skin_color),
+                rgb(person.hair_color),
+                rgb(person.shirt_color),
+                rgb(person.trousers_color),
+            ],
+        }
+    }
 }
 
 /// Lays out image `rng`'s scene in `sim` and `camera`. Returns what it did.
@@ -198,6 +302,10 @@ pub(crate) fn lay_out(
         if how.clothes {
             let (shirt, trousers) = (rng.color(), rng.color());
             sim.dress_person(i, shirt, trousers)?;
+        }
+        if how.bodies {
+            let look = random_look(&sim.world().people[i], rng);
+            sim.restyle_person(i, &look)?;
         }
         spots.push((sim.world().people[i].name.clone(), position));
     }
@@ -238,6 +346,7 @@ pub(crate) fn lay_out(
         sun: f64::from(Light::default().sun),
         ambient: f64::from(Light::default().ambient),
         noise_stddev: None,
+        people: sim.world().people.iter().map(PersonShot::of).collect(),
     };
     if how.light {
         let azimuth = rng.between(-PI, PI);

@@ -46,27 +46,7 @@ pub(crate) fn load_collada(path: &Path, text: &str, scale: Vec3) -> Result<TriMe
         .descendants()
         .filter_map(|n| n.attribute("id").map(|id| (id, n)))
         .collect();
-    let asset = child(root, "asset");
-    let unit = asset
-        .and_then(|a| child(a, "unit"))
-        .and_then(|u| u.attribute("meter"))
-        .and_then(|m| m.trim().parse::<f32>().ok())
-        .filter(|m| m.is_finite() && *m > 0.0)
-        .unwrap_or(1.0);
-    let up = asset
-        .and_then(|a| child(a, "up_axis"))
-        .and_then(|u| u.text())
-        .map(str::trim)
-        .unwrap_or("Y_UP");
-    // COLLADA's default is y up; rover (and Gazebo) draw z up.
-    let to_z_up = match up {
-        "Z_UP" => Mat4::IDENTITY,
-        "X_UP" => Mat4::from_cols_array(&[
-            0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-        ]),
-        _ => Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
-    };
-    let base = Mat4::from_scale(scale) * to_z_up * Mat4::from_scale(Vec3::splat(unit));
+    let base = Mat4::from_scale(scale) * file_basis(root);
     let scene = child(root, "scene")
         .and_then(|s| child(s, "instance_visual_scene"))
         .and_then(|i| i.attribute("url"))
@@ -86,18 +66,43 @@ pub(crate) fn load_collada(path: &Path, text: &str, scale: Vec3) -> Result<TriMe
     mesh.finish(path)
 }
 
-type NodeError<'a> = (Node<'a, 'a>, String);
+/// A COLLADA file's units and axes to rover's: its `<unit meter>` and its `<up_axis>` turned
+/// to z up (COLLADA's default is y up; rover and Gazebo draw z up).
+pub(super) fn file_basis(root: Node<'_, '_>) -> Mat4 {
+    let asset = child(root, "asset");
+    let unit = asset
+        .and_then(|a| child(a, "unit"))
+        .and_then(|u| u.attribute("meter"))
+        .and_then(|m| m.trim().parse::<f32>().ok())
+        .filter(|m| m.is_finite() && *m > 0.0)
+        .unwrap_or(1.0);
+    let up = asset
+        .and_then(|a| child(a, "up_axis"))
+        .and_then(|u| u.text())
+        .map(str::trim)
+        .unwrap_or("Y_UP");
+    let to_z_up = match up {
+        "Z_UP" => Mat4::IDENTITY,
+        "X_UP" => Mat4::from_cols_array(&[
+            0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ]),
+        _ => Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
+    };
+    to_z_up * Mat4::from_scale(Vec3::splat(unit))
+}
 
-fn child<'a>(node: Node<'a, 'a>, tag: &str) -> Option<Node<'a, 'a>> {
+pub(super) type NodeError<'a> = (Node<'a, 'a>, String);
+
+pub(super) fn child<'a>(node: Node<'a, 'a>, tag: &str) -> Option<Node<'a, 'a>> {
     node.children().find(|c| c.has_tag_name(tag))
 }
 
-fn children<'a>(node: Node<'a, 'a>, tag: &'a str) -> impl Iterator<Item = Node<'a, 'a>> {
+pub(super) fn children<'a>(node: Node<'a, 'a>, tag: &'a str) -> impl Iterator<Item = Node<'a, 'a>> {
     node.children().filter(move |c| c.has_tag_name(tag))
 }
 
 /// The whitespace-separated numbers of `node`'s text.
-fn floats<'a>(node: Node<'a, 'a>) -> std::result::Result<Vec<f32>, NodeError<'a>> {
+pub(super) fn floats<'a>(node: Node<'a, 'a>) -> std::result::Result<Vec<f32>, NodeError<'a>> {
     node.text()
         .unwrap_or("")
         .split_whitespace()
@@ -124,39 +129,7 @@ fn walk<'a>(
             format!("<node> nested deeper than {MAX_DEPTH}: do nodes instance each other?"),
         ));
     }
-    let mut transform = parent;
-    for t in node.children().filter(Node::is_element) {
-        let v = || floats(t);
-        let m = match t.tag_name().name() {
-            "matrix" => match v()?[..] {
-                [a, b, c, d, e, f, g, h, i, j, k, l, m, n, o, p] => {
-                    // COLLADA writes matrices row by row.
-                    Mat4::from_cols_array(&[a, e, i, m, b, f, j, n, c, g, k, o, d, h, l, p])
-                }
-                _ => return Err((t, "<matrix>: expected 16 numbers".into())),
-            },
-            "translate" => match v()?[..] {
-                [x, y, z] => Mat4::from_translation(Vec3::new(x, y, z)),
-                _ => return Err((t, "<translate>: expected 3 numbers".into())),
-            },
-            "rotate" => match v()?[..] {
-                [x, y, z, deg] => {
-                    let axis = Vec3::new(x, y, z);
-                    match axis.try_normalize() {
-                        Some(a) => Mat4::from_axis_angle(a, deg.to_radians()),
-                        None => Mat4::IDENTITY,
-                    }
-                }
-                _ => return Err((t, "<rotate>: expected 4 numbers".into())),
-            },
-            "scale" => match v()?[..] {
-                [x, y, z] => Mat4::from_scale(Vec3::new(x, y, z)),
-                _ => return Err((t, "<scale>: expected 3 numbers".into())),
-            },
-            _ => continue,
-        };
-        transform *= m;
-    }
+    let transform = parent * node_transform(node)?;
     for item in node.children().filter(Node::is_element) {
         match item.tag_name().name() {
             "instance_geometry" => {
@@ -197,13 +170,51 @@ fn walk<'a>(
     Ok(())
 }
 
-/// A `<source>`'s values with their stride.
-struct Source {
-    values: Vec<f32>,
-    stride: usize,
+/// A node's own transform: its `<matrix>`, `<translate>`, `<rotate>` and `<scale>` in order.
+pub(super) fn node_transform<'a>(node: Node<'a, 'a>) -> std::result::Result<Mat4, NodeError<'a>> {
+    let mut transform = Mat4::IDENTITY;
+    for t in node.children().filter(Node::is_element) {
+        let v = || floats(t);
+        let m = match t.tag_name().name() {
+            "matrix" => match v()?[..] {
+                [a, b, c, d, e, f, g, h, i, j, k, l, m, n, o, p] => {
+                    // COLLADA writes matrices row by row.
+                    Mat4::from_cols_array(&[a, e, i, m, b, f, j, n, c, g, k, o, d, h, l, p])
+                }
+                _ => return Err((t, "<matrix>: expected 16 numbers".into())),
+            },
+            "translate" => match v()?[..] {
+                [x, y, z] => Mat4::from_translation(Vec3::new(x, y, z)),
+                _ => return Err((t, "<translate>: expected 3 numbers".into())),
+            },
+            "rotate" => match v()?[..] {
+                [x, y, z, deg] => {
+                    let axis = Vec3::new(x, y, z);
+                    match axis.try_normalize() {
+                        Some(a) => Mat4::from_axis_angle(a, deg.to_radians()),
+                        None => Mat4::IDENTITY,
+                    }
+                }
+                _ => return Err((t, "<rotate>: expected 4 numbers".into())),
+            },
+            "scale" => match v()?[..] {
+                [x, y, z] => Mat4::from_scale(Vec3::new(x, y, z)),
+                _ => return Err((t, "<scale>: expected 3 numbers".into())),
+            },
+            _ => continue,
+        };
+        transform *= m;
+    }
+    Ok(transform)
 }
 
-fn source<'a>(
+/// A `<source>`'s values with their stride.
+pub(super) struct Source {
+    pub(super) values: Vec<f32>,
+    pub(super) stride: usize,
+}
+
+pub(super) fn source<'a>(
     node: Node<'a, 'a>,
     ids: &HashMap<&str, Node<'a, 'a>>,
 ) -> std::result::Result<Source, NodeError<'a>> {
@@ -340,7 +351,7 @@ fn add_geometry<'a>(
 
 /// A primitive's index lists and its polygons' corner counts: one `<p>` per polygon for
 /// `<polygons>`, else one `<p>` with `<vcount>` (polylist) or threes (triangles).
-fn index_lists<'a>(
+pub(super) fn index_lists<'a>(
     prim: Node<'a, 'a>,
     kind: &str,
     stride: usize,
@@ -381,7 +392,7 @@ fn index_lists<'a>(
 /// A material's diffuse colour and image file: material -> `<instance_effect>` -> effect ->
 /// `<diffuse>` `<color>` or `<texture texture="...">` (a sampler -> surface -> image, or an
 /// image directly) -> `<image><init_from>`.
-fn material_of<'a>(
+pub(super) fn material_of<'a>(
     material: Node<'a, 'a>,
     ids: &HashMap<&str, Node<'a, 'a>>,
 ) -> (Option<Rgba>, Option<PathBuf>) {

@@ -8,6 +8,7 @@
 //! nothing here is needed to run a model built in code.
 
 pub(crate) mod collada;
+pub(crate) mod collada_skin;
 pub(crate) mod controllers;
 pub(crate) mod gazebo;
 pub(crate) mod mesh_file;

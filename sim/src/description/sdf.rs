@@ -8,18 +8,21 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::Vec3;
 use roxmltree::Node;
 
+use crate::description::collada_skin;
 use crate::description::resource::ResourcePaths;
 use crate::description::xml::{child, children, line_of, parse_xml};
 use crate::error::{Result, SimError};
 use crate::geometry::{
     MAX_COORDINATE_M, MAX_MAGNITUDE, Pose, Rgba, Shape, pose_from_xyz_rpy, yaw_of,
 };
+use crate::model::actor::{Actor, ActorSkin, Script, Trajectory, Waypoint};
 use crate::model::classes::{class_of_model, label_part_of_model};
-use crate::model::person::{Person, Walk};
+use crate::model::person::Person;
 use crate::model::robot::{Collision, Visual};
 use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
 
@@ -166,7 +169,7 @@ fn read_world_entities(
                     world.sun_direction = direction;
                 }
             }
-            "actor" => world.people.push(actor(ctx, node)?),
+            "actor" => world.people.push(actor(ctx, loader, node)?),
             "physics" | "gravity" | "state" => {}
             other => {
                 loader.skipped.insert(format!("<{other}>"));
@@ -665,9 +668,12 @@ fn person_model(include: Node<'_, '_>) -> Option<String> {
     matches!(name, "person_standing" | "person_walking").then(|| name.to_owned())
 }
 
-/// An `<actor>`: a rover person at the actor's pose, walking its `<script><trajectory>`
-/// waypoints (at the speed that covers them in the trajectory's time) when it has one.
-fn actor(ctx: &Ctx<'_, '_>, node: Node<'_, '_>) -> Result<Person> {
+/// An `<actor>` as Gazebo plays it: its `<skin>` (a skinned COLLADA mesh, drawn in place of
+/// rover's person) posed by its `<animation>`, moved by its `<script>` (timed waypoints on a
+/// spline, `loop`, `delay_start`, `auto_start`), the animation following the distance walked
+/// with `<interpolate_x>`. Without a script it stands at its `<pose>`; without a skin it is
+/// drawn as a rover person.
+fn actor(ctx: &Ctx<'_, '_>, loader: &Loader<'_>, node: Node<'_, '_>) -> Result<Person> {
     let name = node.attribute("name").unwrap_or("actor").to_owned();
     let pose = ctx.local_pose(node)?;
     let mut person = Person::standing(
@@ -675,48 +681,159 @@ fn actor(ctx: &Ctx<'_, '_>, node: Node<'_, '_>) -> Result<Person> {
         [f64::from(pose.translation.x), f64::from(pose.translation.y)],
         yaw_of(pose.rotation),
     );
-    let Some(trajectory) = child(node, "script").and_then(|s| child(s, "trajectory")) else {
-        return Ok(person);
+    let script = match child(node, "script") {
+        Some(s) => actor_script(ctx, s)?,
+        None => None,
     };
-    let mut points: Vec<(f64, [f64; 2])> = Vec::new();
-    for w in trajectory.children().filter(|n| n.has_tag_name("waypoint")) {
-        let time = child(w, "time")
-            .ok_or_else(|| ctx.err(w, "<waypoint> needs a <time>"))
-            .and_then(|t| ctx.number(t))?;
-        let p = child(w, "pose")
-            .ok_or_else(|| ctx.err(w, "<waypoint> needs a <pose>"))
-            .and_then(|p| ctx.pose(p))?;
-        points.push((
-            time,
-            [f64::from(p.translation.x), f64::from(p.translation.y)],
-        ));
+    if let Some(first) = script
+        .as_ref()
+        .and_then(|s| s.trajectories().first())
+        .and_then(|t| t.waypoints().first())
+    {
+        person.position_m = first.position_m;
+        person.heading_rad = first.yaw_rad;
     }
-    points.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (Some(first), Some(last)) = (points.first(), points.last()) else {
-        return Ok(person);
+    let skin = match child(node, "skin") {
+        Some(skin) => Some(Arc::new(actor_skin(ctx, loader, node, skin)?)),
+        None => None,
     };
-    let duration = last.0 - first.0;
-    let length: f64 = points
-        .windows(2)
-        .map(|w| (w[1].1[0] - w[0].1[0]).hypot(w[1].1[1] - w[0].1[1]))
-        .sum();
-    if duration <= 0.0 || length <= 1e-6 {
-        return Ok(person);
-    }
-    let speed = (length / duration).clamp(0.05, 3.0);
-    person.position_m = first.1;
-    let mut waypoints: Vec<[f64; 2]> = points[1..].iter().map(|p| p.1).collect();
-    // rover's walks close the loop themselves.
-    if waypoints.last() == Some(&first.1) {
-        waypoints.pop();
-    }
-    person.walk = (!waypoints.is_empty()).then_some(Walk {
-        waypoints_m: waypoints,
-        speed_mps: speed,
-        repeat: true,
-        start_after_s: 0.0,
-    });
+    person.actor = Some(Arc::new(Actor { script, skin }));
     Ok(person)
+}
+
+/// An `<actor>`'s `<skin>` and its `<animation>`s (the first one is played).
+fn actor_skin(
+    ctx: &Ctx<'_, '_>,
+    loader: &Loader<'_>,
+    actor: Node<'_, '_>,
+    skin: Node<'_, '_>,
+) -> Result<ActorSkin> {
+    let base = ctx.path.parent().unwrap_or(Path::new("."));
+    let file = |el: Node<'_, '_>| -> Result<(PathBuf, f32)> {
+        let name = child(el, "filename")
+            .ok_or_else(|| ctx.err(el, format!("<{}> needs a <filename>", el.tag_name().name())))?;
+        let uri = name.text().unwrap_or("").trim();
+        let path = loader
+            .resources
+            .resolve(uri, base)
+            .map_err(|e| ctx.err(name, format!("<filename>: {e}")))?;
+        let scale = match child(el, "scale") {
+            Some(s) => {
+                let v = ctx.number(s)?;
+                if v <= 0.0 {
+                    return Err(
+                        ctx.err(s, format!("<scale>{v}</scale>: expected a positive factor"))
+                    );
+                }
+                v as f32
+            }
+            None => 1.0,
+        };
+        Ok((path, scale))
+    };
+    let (skin_path, skin_scale) = file(skin)?;
+    let mut loaded = collada_skin::load_skin(&skin_path, skin_scale)?;
+    if let Some(animation) = child(actor, "animation") {
+        let (path, scale) = file(animation)?;
+        let interpolate_x = child(animation, "interpolate_x").is_some_and(|n| ctx.flag(n));
+        loaded.clip = Some(collada_skin::load_clip(
+            &path,
+            scale,
+            interpolate_x,
+            &loaded,
+        )?);
+    }
+    Ok(loaded)
+}
+
+/// An `<actor>`'s `<script>`: its trajectories in id order (`None` when it has none).
+fn actor_script(ctx: &Ctx<'_, '_>, script: Node<'_, '_>) -> Result<Option<Script>> {
+    let flag = |tag: &str, default: bool| child(script, tag).map_or(default, |n| ctx.flag(n));
+    let delay_start_s = match child(script, "delay_start") {
+        Some(d) => ctx.number(d)?.max(0.0),
+        None => 0.0,
+    };
+    let mut trajectories = Vec::new();
+    for t in script.children().filter(|n| n.has_tag_name("trajectory")) {
+        let id: i64 = t
+            .attribute("id")
+            .map(|v| {
+                v.trim().parse().map_err(|_| {
+                    ctx.err(
+                        t,
+                        format!("<trajectory id=\"{v}\">: expected an integer id"),
+                    )
+                })
+            })
+            .transpose()?
+            .unwrap_or(0);
+        let tension = t
+            .attribute("tension")
+            .map(|v| {
+                v.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| (0.0..=1.0).contains(v))
+                    .ok_or_else(|| {
+                        ctx.err(t, format!("<trajectory tension=\"{v}\">: expected 0 to 1"))
+                    })
+            })
+            .transpose()?
+            .unwrap_or(0.0);
+        let mut points = Vec::new();
+        for w in t.children().filter(|n| n.has_tag_name("waypoint")) {
+            let time_s = child(w, "time")
+                .ok_or_else(|| ctx.err(w, "<waypoint> needs a <time>"))
+                .and_then(|n| ctx.number(n))?;
+            let pose = child(w, "pose").ok_or_else(|| ctx.err(w, "<waypoint> needs a <pose>"))?;
+            ctx.pose(pose)?;
+            let [x, y, _, _, _, yaw_rad] = ctx.numbers::<6>(pose)?;
+            points.push(Waypoint {
+                time_s,
+                position_m: [x, y],
+                yaw_rad,
+            });
+        }
+        points.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        if points.len() < 2 {
+            return Err(ctx.err(
+                t,
+                format!(
+                    "<trajectory> has {} waypoint(s): expected at least two",
+                    points.len()
+                ),
+            ));
+        }
+        // Gazebo's first keyframe is at time 0, with the first waypoint's pose.
+        if points[0].time_s > 0.0 {
+            let first = Waypoint {
+                time_s: 0.0,
+                ..points[0]
+            };
+            points.insert(0, first);
+        } else if points[0].time_s < 0.0 {
+            return Err(ctx.err(t, "<waypoint><time> is negative: expected times from 0"));
+        }
+        trajectories.push((id, Trajectory::new(points, tension)));
+    }
+    if trajectories.is_empty() {
+        return Ok(None);
+    }
+    trajectories.sort_by_key(|t| t.0);
+    let auto_start = flag("auto_start", true);
+    if !auto_start {
+        tracing::warn!(
+            "{}: <actor> <script><auto_start>false: rover has no way to start it later; it \
+             stays at its first waypoint",
+            ctx.path.display()
+        );
+    }
+    Ok(Some(Script::new(
+        trajectories.into_iter().map(|t| t.1).collect(),
+        flag("loop", true),
+        delay_start_s,
+        auto_start,
+    )))
 }
 
 /// The SDF file of a model folder: the newest `<sdf>` model.config names, else model.sdf.

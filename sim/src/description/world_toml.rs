@@ -743,6 +743,8 @@ impl RawPerson {
             name: p.name.unwrap_or_else(|| format!("person_{i}")),
             walk,
             shape,
+            actor: None,
+            still_gait_phase_rad: 0.0,
             position_m: p.position_m,
             heading_rad: p.heading_deg.to_radians(),
             height_m: p.height_m,

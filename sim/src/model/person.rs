@@ -1,7 +1,10 @@
 //! People in a world: standing or walking a path, drawn as a human figure, obstacles for
 //! physics.
 
+use std::sync::Arc;
+
 use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
+use crate::model::actor::Actor;
 use crate::model::human::BodyShape;
 
 /// Height of a person whose world file gives none (m).
@@ -32,6 +35,12 @@ pub struct Person {
     /// default for now: the camera-only follower is still tuned to it; also drawn when
     /// MakeHuman's body cannot be fetched).
     pub shape: Option<BodyShape>,
+    /// A Gazebo actor's script and skin (SDF `<actor>`): it moves by the script instead of
+    /// `walk`, and is drawn with its own skin when it has one.
+    pub actor: Option<Arc<Actor>>,
+    /// A person without a walk caught mid-stride at this gait phase (rad; 0: standing), as a
+    /// still scene (a dataset's image) may show them.
+    pub still_gait_phase_rad: f64,
 }
 
 /// A person's walk: a path at a constant speed, closed and repeated (the default) or walked
@@ -63,6 +72,8 @@ impl Person {
             hair_color: Rgba::rgb(0.2, 0.13, 0.08),
             walk: None,
             shape: Some(BodyShape::default()),
+            actor: None,
+            still_gait_phase_rad: 0.0,
         }
     }
 
@@ -75,6 +86,9 @@ impl Person {
     /// Where the person is at sim time `t_s`: (x m, y m, heading rad). Standing people stay
     /// put; walking people follow their closed path at their speed, facing where they go.
     pub fn pose_at(&self, t_s: f64) -> (f64, f64, f64) {
+        if let Some(pose) = self.actor.as_ref().and_then(|a| a.pose_at(t_s)) {
+            return pose;
+        }
         let [x0, y0] = self.position_m;
         let Some(walk) = &self.walk else {
             return (x0, y0, self.heading_rad);
@@ -120,11 +134,22 @@ impl Person {
     }
 
     /// Where the person is in their gait at sim time `t_s` (rad): 0 while standing (before
-    /// the walk starts, at the end of a single walk, without one); walking, the legs go
-    /// through one cycle — two steps — per stride, [`Person::stride_m`].
+    /// the walk starts, at the end of a single walk), [`Person::still_gait_phase_rad`] without
+    /// a walk; walking, the legs go through one cycle — two steps — per stride,
+    /// [`Person::stride_m`]. An actor with an animation: where its clip is, as a fraction of a
+    /// turn (see [`Actor::clip_time_s`]).
     pub fn gait_phase_rad(&self, t_s: f64) -> f64 {
+        if let Some(actor) = &self.actor {
+            let clip = actor.skin.as_ref().and_then(|s| s.clip.as_ref());
+            return match (clip, actor.clip_time_s(t_s)) {
+                (Some(clip), Some(time_s)) if clip.duration_s > 0.0 => {
+                    std::f64::consts::TAU * time_s / clip.duration_s
+                }
+                _ => 0.0,
+            };
+        }
         let Some(walk) = &self.walk else {
-            return 0.0;
+            return self.still_gait_phase_rad;
         };
         if t_s < walk.start_after_s {
             return 0.0;
@@ -161,6 +186,11 @@ impl Person {
                 leg_m
             })
             .sum()
+    }
+
+    /// Whether the person moves (a walk or an actor's script).
+    pub fn moves(&self) -> bool {
+        self.walk.is_some() || self.actor.as_ref().is_some_and(|a| a.script.is_some())
     }
 
     /// Radius of the upright capsule that stands in for the person in physics (m).

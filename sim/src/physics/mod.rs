@@ -19,4 +19,5 @@ pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
     WheelSpeeds, wrap_angle,
 };
+pub use placement::PersonLook;
 pub use simulation::{ControlSample, SimOptions, Simulation};

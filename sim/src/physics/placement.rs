@@ -7,9 +7,25 @@ use rapier3d::prelude::*;
 
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Rgba};
+use crate::model::human::BodyShape;
 use crate::physics::build::person_body_pose;
 use crate::physics::diff_drive::EncoderOdometry;
 use crate::physics::simulation::{Simulation, planar};
+
+/// What [`Simulation::restyle_person`] gives a person.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PersonLook {
+    /// MakeHuman's body in this shape (`None`: rover's figure).
+    pub shape: Option<BodyShape>,
+    /// Standing height (m, 0.5 to 2.5).
+    pub height_m: f64,
+    /// Skin colour.
+    pub skin_color: Rgba,
+    /// Hair colour.
+    pub hair_color: Rgba,
+    /// The gait phase they are caught at when they do not walk (rad; 0: standing).
+    pub still_gait_phase_rad: f64,
+}
 
 impl Simulation {
     /// Changes whenever something is placed or re-dressed, so a camera knows to move its
@@ -93,6 +109,31 @@ impl Simulation {
             .ok_or_else(|| no_such("person", index))?;
         person.shirt_color = shirt;
         person.trousers_color = trousers;
+        self.layout += 1;
+        Ok(())
+    }
+
+    /// Gives person `index` (world order) another look for the next image: their body's shape
+    /// (`None`: rover's figure) and height, skin and hair colours, and the gait phase they are
+    /// caught at when they do not walk. Their physics capsule keeps its first size.
+    pub fn restyle_person(&mut self, index: usize, look: &PersonLook) -> Result<()> {
+        let height_ok = look.height_m.is_finite() && (0.5..=2.5).contains(&look.height_m);
+        if !(height_ok && look.still_gait_phase_rad.is_finite()) {
+            return Err(SimError::Setup(format!(
+                "person height must be 0.5 to 2.5 m and the gait phase finite, found {} m, {} rad",
+                look.height_m, look.still_gait_phase_rad
+            )));
+        }
+        let person = self
+            .world
+            .people
+            .get_mut(index)
+            .ok_or_else(|| no_such("person", index))?;
+        person.shape = look.shape;
+        person.height_m = look.height_m;
+        person.skin_color = look.skin_color;
+        person.hair_color = look.hair_color;
+        person.still_gait_phase_rad = look.still_gait_phase_rad;
         self.layout += 1;
         Ok(())
     }

@@ -250,7 +250,7 @@ impl Simulation {
         // of this step (rapier derives their velocity, so contacts push correctly).
         let next_t = (self.step_index + 1) as f64 * self.dt_s;
         for (person, handle) in self.world.people.iter().zip(&self.people) {
-            if person.walk.is_some()
+            if person.moves()
                 && let Some(body) = self.physics.bodies.get_mut(*handle)
             {
                 body.set_next_kinematic_position(person_body_pose(person, next_t));

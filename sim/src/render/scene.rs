@@ -8,11 +8,12 @@ use wgpu::util::DeviceExt;
 
 use crate::geometry::{Pose, Rgba};
 use crate::model::classes::EntityIds;
-use crate::model::human::{Body, Layer, PosedBody, Posture};
+use crate::model::human::BodyShape;
 use crate::model::mesh::MeshData;
 use crate::model::person::Person;
 use crate::model::robot::RobotModel;
 use crate::model::world::World;
+use crate::render::body::{BodyLayer, SkinnedBody};
 use crate::render::gpu::RenderError;
 use crate::render::material::Materials;
 use crate::render::mesh::{Paint, Swing, cuboid, object_mesh, person_parts, visual_mesh};
@@ -318,10 +319,9 @@ impl Scene {
             for &(instance, _) in &body.instances {
                 self.instances[instance].model = matrix(world_from_person);
             }
-            let posture = body.posture(gait_phase_rad);
-            if posture != body.posture {
-                body.posture = posture;
-                body.body.pose(posture, &mut body.posed);
+            if gait_phase_rad != body.phase_rad {
+                body.phase_rad = gait_phase_rad;
+                body.skin.pose(gait_phase_rad, body.stride_m);
                 body.dirty = true;
             }
         }
@@ -332,7 +332,7 @@ impl Scene {
         self.bodies
             .iter()
             .find(|b| b.person == index)
-            .map(|b| b.posed.positions.as_slice())
+            .map(|b| b.skin.positions())
     }
 
     /// Paints person `index` (world order) in `person`'s colours.
@@ -340,9 +340,23 @@ impl Scene {
         for (a, paint, _) in self.people.iter().filter(|(a, ..)| a.frame == index) {
             self.instances[a.instance].color = paint.of(person).0;
         }
-        for body in self.bodies.iter().filter(|b| b.person == index) {
+        for body in self.bodies.iter_mut().filter(|b| b.person == index) {
             for &(instance, paint) in &body.instances {
                 self.instances[instance].color = paint.of(person).0;
+            }
+            if body.look != (person.shape, person.height_m) {
+                // Reshaped (a dataset's next image): the same mesh and layers, other rest
+                // vertices; the figure is not swapped in or out here.
+                match SkinnedBody::of(person) {
+                    Some(mut skin) if skin.positions().len() == body.skin.positions().len() => {
+                        skin.pose(body.phase_rad, person.stride_m());
+                        body.skin = skin;
+                        body.stride_m = person.stride_m();
+                        body.dirty = true;
+                    }
+                    _ => tracing::warn!("{}: cannot be reshaped", person.name),
+                }
+                body.look = (person.shape, person.height_m);
             }
         }
     }
@@ -437,28 +451,28 @@ fn add_models(
     Ok(moving)
 }
 
-/// Grid cells (m) of the coarser levels of detail of MakeHuman's bodies
-/// ([`Body::coarse_layers`]), drawn from [`DETAIL_FROM_M`] on.
-const DETAIL_CELLS_M: [f32; 2] = [0.03, 0.06];
 /// Distances from the camera (m) from which each coarser level is drawn.
 const DETAIL_FROM_M: [f32; 2] = [3.5, 7.0];
 
-/// A person drawn with MakeHuman's body: one vertex buffer posed on the CPU each time the
-/// gait moves, drawn as one mesh per layer (skin, shirt, ...) with that layer's paint.
+/// A person drawn with a skinned body (MakeHuman's, or a Gazebo actor's skin): one vertex
+/// buffer posed on the CPU each time the gait or clip moves, drawn as one mesh per layer
+/// (skin, shirt, ...) with that layer's paint.
 struct SkinnedPerson {
     /// The person's index (world order).
     person: usize,
-    body: Body,
-    /// Their stride (m per gait cycle), for the walk.
+    skin: SkinnedBody,
+    /// Their stride (m per gait cycle), for MakeHuman's walk.
     stride_m: f64,
-    posture: Posture,
-    posed: PosedBody,
+    /// The gait phase the vertices are posed for.
+    phase_rad: f64,
+    /// The shape and height (m) the body was built for.
+    look: (Option<BodyShape>, f64),
     /// Reused: the posed vertices as the GPU reads them.
     staged: Vec<GpuVertex>,
     vertices: wgpu::Buffer,
     /// Instance (= mesh) and paint of each layer's mesh.
     instances: Vec<(usize, Paint)>,
-    /// Each layer mesh's runs of indices: full detail, then coarser ([`DETAIL_CELLS_M`]).
+    /// Each layer mesh's runs of indices: full detail, then coarser (`render::body::DETAIL_CELLS_M`).
     levels: Vec<[Draw; 3]>,
     /// Where the person stands (world, m).
     at: Vec3,
@@ -467,17 +481,13 @@ struct SkinnedPerson {
 }
 
 impl SkinnedPerson {
-    fn posture(&self, gait_phase_rad: f64) -> Posture {
-        Posture::from_gait(gait_phase_rad, self.stride_m)
-    }
-
     fn upload(&mut self, queue: &wgpu::Queue) {
         self.staged.clear();
         self.staged.extend(
-            self.posed
-                .positions
+            self.skin
+                .positions()
                 .iter()
-                .zip(&self.posed.normals)
+                .zip(self.skin.normals())
                 .map(|(p, n)| GpuVertex {
                     position: p.to_array(),
                     normal: n.to_array(),
@@ -489,66 +499,40 @@ impl SkinnedPerson {
     }
 }
 
-/// The paint a body layer wears.
-fn layer_paint(layer: Layer) -> Paint {
-    match layer {
-        Layer::Skin => Paint::Skin,
-        Layer::Shirt => Paint::Shirt,
-        Layer::Trousers => Paint::Trousers,
-        Layer::Hair => Paint::Hair,
-        Layer::Shoes => Paint::Fixed(Rgba::rgb(0.08, 0.08, 0.09)),
-        Layer::Eyes => Paint::Fixed(Rgba::rgb(0.12, 0.09, 0.07)),
-    }
-}
-
-/// MakeHuman's body for `person` (`None`: drawn as rover's figure).
-fn person_body(person: &Person) -> Option<Body> {
-    let shape = person.shape?;
-    let human = crate::model::human::shared()?;
-    match human.body(shape, person.height_m) {
-        Ok(body) => Some(body),
-        Err(e) => {
-            tracing::warn!("{}: drawn as rover's figure: {e}", person.name);
-            None
-        }
-    }
-}
-
 impl Builder<'_> {
-    /// A person with MakeHuman's body, standing at `world_from_person`.
+    /// A person with a skinned body, at `world_from_person`, posed as at sim time 0.
     fn add_body(
         &mut self,
         index: usize,
         person: &Person,
-        body: Body,
+        skin: SkinnedBody,
         world_from_person: Pose,
         entity: u32,
     ) -> SkinnedPerson {
-        let mut posed = PosedBody::default();
-        body.pose(Posture::Standing, &mut posed);
+        let phase_rad = person.gait_phase_rad(0.0);
         let vertices = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("person"),
-            size: (body.vertex_count() * std::mem::size_of::<GpuVertex>()) as u64,
+            size: (skin.positions().len() * std::mem::size_of::<GpuVertex>()) as u64,
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let mut instances = Vec::new();
         let mut levels = Vec::new();
-        let coarse: Vec<Vec<Vec<u32>>> = DETAIL_CELLS_M
-            .iter()
-            .map(|&cell| body.coarse_layers(cell))
-            .collect();
-        for (k, (layer, indices)) in body.layers().iter().enumerate() {
-            let paint = layer_paint(*layer);
+        for BodyLayer {
+            paint,
+            indices,
+            coarse,
+        } in skin.layers()
+        {
             // Every level of detail in one index buffer; each frame draws one run of it.
-            let mut all = indices.clone();
-            let mut runs = [Draw {
+            let mut all = indices;
+            let full = Draw {
                 first_index: 0,
-                count: indices.len() as u32,
+                count: all.len() as u32,
                 material: 0,
-            }; 3];
-            for (run, level) in runs.iter_mut().skip(1).zip(&coarse) {
-                let part = level.get(k).map_or(&[][..], Vec::as_slice);
+            };
+            let mut runs = [full; 3];
+            for (run, part) in runs.iter_mut().skip(1).zip(&coarse) {
                 *run = Draw {
                     first_index: all.len() as u32,
                     count: part.len() as u32,
@@ -566,7 +550,7 @@ impl Builder<'_> {
                         contents: bytemuck::cast_slice(&all),
                         usage: wgpu::BufferUsages::INDEX,
                     }),
-                draws: vec![runs[0]],
+                draws: vec![full],
             });
             self.instances
                 .push(Instance::new(world_from_person, paint.of(person), entity));
@@ -577,10 +561,10 @@ impl Builder<'_> {
         }
         let mut skinned = SkinnedPerson {
             person: index,
-            body,
+            skin,
             stride_m: person.stride_m(),
-            posture: Posture::Standing,
-            posed,
+            phase_rad,
+            look: (person.shape, person.height_m),
             staged: Vec::new(),
             vertices,
             instances,
@@ -603,8 +587,8 @@ fn add_people(
     for (person_index, person) in world.people.iter().enumerate() {
         let world_from_person = person.world_from_person(0.0);
         let id = ids.person(person_index);
-        if let Some(body) = person_body(person) {
-            bodies.push(b.add_body(person_index, person, body, world_from_person, id));
+        if let Some(skin) = SkinnedBody::of(person) {
+            bodies.push(b.add_body(person_index, person, skin, world_from_person, id));
             continue;
         }
         for part in person_parts(person) {

@@ -188,7 +188,7 @@ impl CameraSensor {
         let relaid = self.layout_seen != sim.layout_version();
         self.layout_seen = sim.layout_version();
         for (index, person) in sim.world().people.iter().enumerate() {
-            if person.walk.is_some() || relaid {
+            if person.moves() || relaid {
                 self.renderer.set_person_pose(
                     index,
                     sim.world_from_person(index),
