@@ -369,6 +369,7 @@ mod tests {
                 sun: 0.75,
                 ambient: 1.0,
                 noise_stddev: None,
+                people: Vec::new(),
             },
         };
         assert_eq!(
