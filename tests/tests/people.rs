@@ -310,7 +310,7 @@ fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
     );
     assert_eq!(looks.len(), 16);
     assert_eq!(shapes.len(), 16, "every image its own body");
-    assert!(children >= 1 && children <= 8, "{children} children");
+    assert!((1..=8).contains(&children), "{children} children");
     assert!(
         (3..=13).contains(&mid_stride),
         "{mid_stride} caught mid-stride"
