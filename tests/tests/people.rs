@@ -2,6 +2,7 @@
 //! set-up fetched, posed, walking without sliding their feet, seen as people by the real
 //! detector from every side, and bad asset files reported with their file and line.
 
+use std::f64::consts::FRAC_1_SQRT_2;
 use std::path::Path;
 
 use rover_core::{RunConfig, SWEEP_DISTANCES_M, SweepPosture, sweep};
@@ -316,5 +317,81 @@ fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
         "{mid_stride} caught mid-stride"
     );
     assert!(skins.len() >= 4, "{} skin tones", skins.len());
+    Ok(())
+}
+
+/// The laser's hits within `radius_m` of `centre` (world xy), as clusters of neighbouring rays:
+/// each cluster's nearest range from the sensor.
+fn laser_clusters(
+    sim: &rover_sim::Simulation,
+    laser: &mut rover_sim::LaserSensor,
+    centre: [f64; 2],
+    radius_m: f64,
+) -> Vec<f64> {
+    let world_from_sensor = laser.world_from_sensor(sim);
+    let scan = laser.scan_now(sim).clone();
+    let mut clusters: Vec<f64> = Vec::new();
+    let mut last: Option<(usize, f32)> = None;
+    for (i, &r) in scan.ranges_m.iter().enumerate() {
+        if !r.is_finite() {
+            continue;
+        }
+        let a = scan.angle_rad(i);
+        let p = world_from_sensor.transform_point(glam::Vec3::new(r * a.cos(), r * a.sin(), 0.0));
+        let near = (f64::from(p.x) - centre[0]).hypot(f64::from(p.y) - centre[1]) < radius_m;
+        if !near {
+            continue;
+        }
+        if std::env::var("LASER_DEBUG").is_ok() {
+            println!("ray {i} angle {a:.3} range {r:.3} at {:.3} {:.3}", p.x, p.y);
+        }
+        match last {
+            Some((j, rj)) if i == j + 1 && (r - rj).abs() < 0.08 => {
+                if let Some(c) = clusters.last_mut() {
+                    *c = c.min(f64::from(r));
+                }
+            }
+            _ => clusters.push(f64::from(r)),
+        }
+        last = Some((i, r));
+    }
+    clusters
+}
+
+#[test]
+fn the_laser_sees_the_legs_of_a_posed_body() -> anyhow::Result<()> {
+    if makehuman()?.is_none() {
+        return Ok(());
+    }
+    let config = RunConfig {
+        world: Some(repo("worlds/people.toml")),
+        robot: Some(repo("assets/robots/my_robot_laser.urdf.xacro")),
+        // 1.5 m from the person, who is 45 degrees to the left (not where the scan wraps).
+        spawn: Some([-1.5 * FRAC_1_SQRT_2, -1.5 * FRAC_1_SQRT_2, 0.0]),
+        ..RunConfig::default()
+    };
+    let mut report = Vec::new();
+    // Side on (facing across the line of sight), at the left foot's touch-down: two legs a
+    // stride apart; standing: the legs together.
+    for (heading_deg, phase_rad, want) in [(135.0f64, 0.01, 2), (135.0, 0.0, 1)] {
+        let (mut world, robot) = config.load_world_and_robot()?;
+        world.people[0].heading_rad = heading_deg.to_radians();
+        world.people[0].still_gait_phase_rad = phase_rad;
+        let sim = rover_sim::Simulation::new(world, robot, &config.options)?;
+        let mut laser = rover_sim::LaserSensor::new(&sim, 0)?;
+        let clusters = laser_clusters(&sim, &mut laser, [0.0, 0.0], 0.6);
+        report.push(format!(
+            "phase {phase_rad:.2} rad: {} cluster(s) {clusters:.2?}",
+            clusters.len()
+        ));
+        assert_eq!(clusters.len(), want, "{report:?}");
+        // The shins, a stride apart: hits from 1.3 to 1.7 m (the sensor is 1.5 m from the
+        // person's centre line; the old capsule's surface was at 1.37 m from every side).
+        assert!(
+            clusters.iter().all(|r| (1.3..1.7).contains(r)),
+            "{report:?}"
+        );
+    }
+    println!("{}", report.join("; "));
     Ok(())
 }

@@ -1074,7 +1074,7 @@ pub(crate) enum Command {
     /// Every image is a scene laid out anew from --seed and the image's number: the robot
     /// faces a labelled thing (a person, an object with class = "...", a Gazebo model of a
     /// known class) from 1.5-8 m, people and labelled things move and turn, people change
-    /// clothes, the sun moves, the camera's noise varies (--randomize chooses). The labels are
+    /// clothes and bodies, the sun moves, the camera's noise varies (--randomize chooses). The labels are
     /// the renderer's own ground truth: visible (tight) boxes, ignore regions for things too
     /// small or hidden (COCO iscrowd; left out of YOLO labels). Layout: OUT/data.yaml,
     /// OUT/images/{train,val}, OUT/labels/{train,val} (Ultralytics), OUT/annotations/

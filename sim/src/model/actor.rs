@@ -374,6 +374,69 @@ impl Clip {
     }
 }
 
+/// A bone as a capsule for range sensors: between two joints of a posed skeleton.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoneCapsule {
+    /// The joint it starts at (index into the posed joints).
+    pub from: usize,
+    /// The joint it ends at.
+    pub to: usize,
+    /// Its radius (m).
+    pub radius_m: f32,
+}
+
+/// Smallest and largest capsule radius (m): a bone with almost no skin of its own still
+/// stops a ray, and a loose vertex does not make a barrel.
+const CAPSULE_RADIUS_M: [f32; 2] = [0.02, 0.2];
+
+/// Capsules for a skeleton's bones, from its rest pose: each bone from a joint to one of its
+/// children, as thick as the skin it moves — the 70th percentile of the distances to the bone
+/// of the rest vertices whose strongest joint is the bone's own and that lie alongside it.
+/// Bones without such skin (fingers, twist bones, the eyes) get none.
+pub(crate) fn bone_capsules(
+    rest: &[Vec3],
+    main_joint: &[usize],
+    joints: &[Vec3],
+    parents: &[Option<usize>],
+) -> Vec<BoneCapsule> {
+    let mut by_joint: Vec<Vec<Vec3>> = vec![Vec::new(); joints.len()];
+    for (v, &j) in rest.iter().zip(main_joint) {
+        if let Some(list) = by_joint.get_mut(j) {
+            list.push(*v);
+        }
+    }
+    let mut capsules = Vec::new();
+    for (to, parent) in parents.iter().enumerate() {
+        let Some(from) = *parent else { continue };
+        let (Some(a), Some(b)) = (joints.get(from), joints.get(to)) else {
+            continue;
+        };
+        let axis = *b - *a;
+        let length_sq = axis.length_squared();
+        if length_sq < 1e-6 {
+            continue;
+        }
+        let mut distances: Vec<f32> = by_joint[from]
+            .iter()
+            .filter_map(|v| {
+                let t = (*v - *a).dot(axis) / length_sq;
+                (0.0..=1.0).contains(&t).then(|| v.distance(*a + t * axis))
+            })
+            .collect();
+        if distances.len() < 8 {
+            continue;
+        }
+        distances.sort_by(f32::total_cmp);
+        let radius_m = distances[distances.len() * 7 / 10];
+        capsules.push(BoneCapsule {
+            from,
+            to,
+            radius_m: radius_m.clamp(CAPSULE_RADIUS_M[0], CAPSULE_RADIUS_M[1]),
+        });
+    }
+    capsules
+}
+
 /// Scratch and result of posing an actor's skin.
 #[derive(Debug, Clone, Default)]
 pub struct PosedSkin {
@@ -403,9 +466,43 @@ impl ActorSkin {
         &self.joints
     }
 
-    /// Poses the skin at the clip's time `clip_time_s` into `out`; `carried`: the script
-    /// moves the actor, so the root's forward travel in the clip is dropped.
-    pub fn pose(&self, clip_time_s: f64, carried: bool, out: &mut PosedSkin) {
+    /// The skeleton's bones as capsules for range sensors (indices into
+    /// [`PosedSkin::joints`]), as thick as the skin they move.
+    pub fn bone_capsules(&self) -> Vec<BoneCapsule> {
+        let mut rest_world: Vec<Mat4> = Vec::with_capacity(self.joints.len());
+        for (j, joint) in self.joints.iter().enumerate() {
+            let parent = match joint.parent {
+                Some(p) if p < j => rest_world[p],
+                _ => self.above_root,
+            };
+            rest_world.push(parent * joint.rest_local);
+        }
+        let heads: Vec<Vec3> = rest_world
+            .iter()
+            .map(|m| self.to_rover.transform_point3(m.w_axis.truncate()))
+            .collect();
+        let rest: Vec<Vec3> = self
+            .rest
+            .iter()
+            .map(|p| self.to_rover.transform_point3(*p))
+            .collect();
+        let main_joint: Vec<usize> = self
+            .weights
+            .iter()
+            .map(|w| {
+                let k = w
+                    .iter()
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map_or(0, |p| usize::from(p.0));
+                self.bind.get(k).map_or(0, |b| b.0)
+            })
+            .collect();
+        let parents: Vec<Option<usize>> = self.joints.iter().map(|j| j.parent).collect();
+        bone_capsules(&rest, &main_joint, &heads, &parents)
+    }
+
+    /// Poses the skeleton only (no skinning) at the clip's time: [`PosedSkin::joints`].
+    pub fn pose_joints(&self, clip_time_s: f64, carried: bool, out: &mut PosedSkin) {
         let n = self.joints.len();
         out.world.clear();
         out.world.extend(self.joints.iter().map(|j| j.rest_local));
@@ -426,17 +523,23 @@ impl ActorSkin {
             };
             out.world[j] = parent * out.world[j];
         }
-        out.skinning.clear();
-        out.skinning.extend(
-            self.bind
-                .iter()
-                .map(|&(joint, inverse_bind)| out.world[joint] * inverse_bind),
-        );
         out.joints.clear();
         out.joints.extend(
             out.world
                 .iter()
                 .map(|m| Affine3A::from_mat4(self.to_rover * *m)),
+        );
+    }
+
+    /// Poses the skin at the clip's time `clip_time_s` into `out`; `carried`: the script
+    /// moves the actor, so the root's forward travel in the clip is dropped.
+    pub fn pose(&self, clip_time_s: f64, carried: bool, out: &mut PosedSkin) {
+        self.pose_joints(clip_time_s, carried, out);
+        out.skinning.clear();
+        out.skinning.extend(
+            self.bind
+                .iter()
+                .map(|&(joint, inverse_bind)| out.world[joint] * inverse_bind),
         );
         out.positions.resize(self.rest.len(), Vec3::ZERO);
         for ((p, rest), weights) in out.positions.iter_mut().zip(&self.rest).zip(&self.weights) {

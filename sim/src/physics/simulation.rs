@@ -297,6 +297,38 @@ impl Simulation {
             .map(|(_, toi)| toi)
     }
 
+    /// As [`Simulation::cast_world_ray`], but through the physics capsules of the people
+    /// `skip` marks (world order): a range sensor that sees those people's posed bodies
+    /// instead.
+    pub(crate) fn cast_world_ray_past_people(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        max_m: f32,
+        skip: &[bool],
+    ) -> Option<f32> {
+        let skipped = |c: &Collider| {
+            c.parent().is_some_and(|body| {
+                self.people
+                    .iter()
+                    .zip(skip)
+                    .any(|(handle, s)| *s && *handle == body)
+            })
+        };
+        let keep = |_: ColliderHandle, c: &Collider| !skipped(c);
+        let filter = QueryFilter::default()
+            .groups(InteractionGroups::new(
+                Group::ALL,
+                WORLD_GROUP,
+                InteractionTestMode::And,
+            ))
+            .predicate(&keep);
+        let ray = Ray::new(origin, dir);
+        self.physics
+            .cast_ray(&ray, max_m, true, filter)
+            .map(|(_, toi)| toi)
+    }
+
     /// The smallest distance (m) between the robot's collision shapes and the world's
     /// obstacles (objects, walls, SDF models; not the ground, not people), looking no further
     /// than `within_m`: returns `within_m` when nothing is closer. 0 when touching.

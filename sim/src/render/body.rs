@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::geometry::Rgba;
-use crate::model::actor::{Actor, PosedSkin};
+use crate::model::actor::{Actor, BoneCapsule, PosedSkin};
 use crate::model::human::{Body, Layer, PosedBody, Posture};
 use crate::model::person::Person;
 use crate::render::mesh::Paint;
@@ -163,6 +163,38 @@ impl SkinnedBody {
     /// The layers, each with its paint and triangles.
     pub fn layers(&self) -> Vec<BodyLayer> {
         self.0.layers()
+    }
+
+    /// The body's bones as capsules for range sensors (indices into the joints
+    /// [`SkinnedBody::pose_joints`] gives), each as thick as the skin it moves.
+    pub fn bone_capsules(&self) -> Vec<BoneCapsule> {
+        match &self.0 {
+            Skin::Human(body, _) => body.bone_capsules(),
+            Skin::Actor(actor, _) => actor
+                .skin
+                .as_ref()
+                .map(|s| s.bone_capsules())
+                .unwrap_or_default(),
+        }
+    }
+
+    /// The skeleton's joints (m, the person's frame) at gait phase `phase_rad` and stride
+    /// `stride_m` (as [`SkinnedBody::pose`]), into `joints`; the vertices are left as they were.
+    pub fn pose_joints(&mut self, phase_rad: f64, stride_m: f64, joints: &mut Vec<Vec3>) {
+        match &mut self.0 {
+            Skin::Human(body, posed) => {
+                body.pose_joints(Posture::from_gait(phase_rad, stride_m), posed, joints);
+            }
+            Skin::Actor(actor, posed) => {
+                if let Some(skin) = &actor.skin {
+                    let duration_s = skin.clip.as_ref().map_or(0.0, |c| c.duration_s);
+                    let time_s = phase_rad / std::f64::consts::TAU * duration_s;
+                    skin.pose_joints(time_s, actor.carried(), posed);
+                }
+                joints.clear();
+                joints.extend(posed.joints.iter().map(|m| Vec3::from(m.translation)));
+            }
+        }
     }
 }
 

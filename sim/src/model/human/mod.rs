@@ -565,8 +565,35 @@ impl Body {
             .collect()
     }
 
-    /// Poses the body for `posture` into `out` (linear-blend skinning).
-    pub fn pose(&self, posture: Posture, out: &mut PosedBody) {
+    /// The body's bones as capsules for range sensors: each bone from its head to a child's
+    /// head, as thick as the skin it moves (see [`crate::model::actor::bone_capsules`]).
+    pub fn bone_capsules(&self) -> Vec<crate::model::actor::BoneCapsule> {
+        let main_bone: Vec<usize> = (0..self.rest.len())
+            .map(|v| {
+                self.weights
+                    .of(v)
+                    .iter()
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map_or(0, |p| usize::from(p.0))
+            })
+            .collect();
+        crate::model::actor::bone_capsules(&self.rest, &main_bone, &self.joints, &self.parents)
+    }
+
+    /// Poses the bones only (no skinning) for `posture`: each bone head's position (m, the
+    /// person's frame) into `heads`.
+    pub fn pose_joints(&self, posture: Posture, out: &mut PosedBody, heads: &mut Vec<Vec3>) {
+        self.pose_bones(posture, out);
+        heads.clear();
+        heads.extend(
+            out.bones
+                .iter()
+                .zip(&self.joints)
+                .map(|(m, head)| m.transform_point3(*head)),
+        );
+    }
+
+    fn pose_bones(&self, posture: Posture, out: &mut PosedBody) {
         out.rotations.resize(self.parents.len(), Quat::IDENTITY);
         let offset = self.limbs.pose(posture, &mut out.rotations);
         out.bones.clear();
@@ -582,6 +609,11 @@ impl Body {
             };
             out.bones.push(m);
         }
+    }
+
+    /// Poses the body for `posture` into `out` (linear-blend skinning).
+    pub fn pose(&self, posture: Posture, out: &mut PosedBody) {
+        self.pose_bones(posture, out);
         out.positions.resize(self.rest.len(), Vec3::ZERO);
         out.normals.resize(self.rest.len(), Vec3::ZERO);
         for (v, (p, n)) in out
