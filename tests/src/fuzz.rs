@@ -558,6 +558,27 @@ fn simulate(
 
 /// Every parser rover has, with its seeds, laid out under `work` (a scratch folder). Targets
 /// whose seeds are absent (no ../shared, no darknet photos, no model) are left out with a line
+/// The world the `actor_dae` target loads: one actor whose skin and animation are the input.
+const ACTOR_WORLD: &str = r#"<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="actor">
+    <actor name="walker">
+      <skin><filename>walk.dae</filename></skin>
+      <animation name="walking">
+        <filename>walk.dae</filename>
+        <interpolate_x>true</interpolate_x>
+      </animation>
+      <script>
+        <trajectory id="0" type="walking">
+          <waypoint><time>0</time><pose>0 0 0 0 0 0</pose></waypoint>
+          <waypoint><time>4</time><pose>3 0 0 0 0 0</pose></waypoint>
+        </trajectory>
+      </script>
+    </actor>
+  </world>
+</sdf>
+"#;
+
 /// on stderr saying so.
 pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     use rover_sim::{LoadOptions, ResourcePaths};
@@ -718,6 +739,27 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             seeds: vec![text],
             input_path: dir.join("body.target"),
             load: Box::new(move |p| outcome(rover_sim::human::Target::load(p, vertices))),
+            hang_limit: text_limit,
+        });
+    }
+
+    // Gazebo actors: walk.dae (a skinned COLLADA skin and its animation) as an <actor>'s
+    // skin and animation in a world, loaded as a world (the skin, the clip, the script).
+    if let Some(c) = corpus.as_ref() {
+        let dir = work.join("actor");
+        std::fs::create_dir_all(&dir)?;
+        let world = dir.join("actor.world");
+        std::fs::write(&world, ACTOR_WORLD)?;
+        out.push(Target {
+            name: "actor_dae",
+            seeds: read_all(&[c.join("gazebo_actor/walk.dae")])?,
+            input_path: dir.join("walk.dae"),
+            load: Box::new(move |_| {
+                outcome(rover_sim::World::load_with(
+                    &world,
+                    &ResourcePaths::default(),
+                ))
+            }),
             hang_limit: text_limit,
         });
     }

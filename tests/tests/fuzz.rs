@@ -19,6 +19,8 @@ fn limits(hang_scale: f64) -> Limits {
 fn quick_cases(target: &Target) -> u32 {
     match target.name {
         "onnx" => 16,
+        // A 2.2 MB COLLADA file, parsed twice per input (skin and animation).
+        "actor_dae" => 150,
         // Megabyte seeds (MakeHuman's base mesh and weights).
         "human_obj" | "human_weights" => 1000,
         "xacro" | "sdf" | "urdf" | "mesh_dae" | "image_jpeg" => 1000,

@@ -165,18 +165,22 @@ fn gazebo_people_and_actors_become_rover_people() -> Result<()> {
     assert_eq!(alice.name, "alice");
     assert_eq!(alice.position_m, [4.0, 0.0]);
     assert!((alice.heading_rad - 3.0).abs() < 1e-6);
+    // The actor walks its script as Gazebo does (a spline through the timed waypoints, here
+    // with zero tangents: the loop closes on its start), drawn as a rover person (no <skin>).
     let walker = &world.people[1];
-    let walk = walker
-        .walk
+    let actor = walker
+        .actor
         .as_ref()
-        .ok_or_else(|| anyhow::anyhow!("the actor does not walk"))?;
+        .ok_or_else(|| anyhow::anyhow!("the <actor> is not an actor"))?;
+    assert!(actor.skin.is_none() && walker.moves());
     assert_eq!(walker.position_m, [0.0, 5.0]);
-    assert_eq!(walk.waypoints_m, [[5.0, 5.0]]);
-    assert!(
-        (walk.speed_mps - 1.0).abs() < 1e-9,
-        "speed {}",
-        walk.speed_mps
-    );
+    for (t, want) in [(2.5, [2.5, 5.0]), (5.0, [5.0, 5.0]), (12.5, [2.5, 5.0])] {
+        let (x, y, _) = walker.pose_at(t);
+        assert!(
+            (x - want[0]).abs() < 1e-9 && (y - want[1]).abs() < 1e-9,
+            "at {t} s: ({x}, {y}), want {want:?}"
+        );
+    }
     let crate_color = world.models[0].links[0].visuals[0].color;
     assert_eq!(crate_color, rover_sim::Rgba([0.6, 0.3, 0.1, 1.0]));
     Ok(())

@@ -167,6 +167,24 @@ impl Recorder {
         }
     }
 
+    /// Re-poses and logs the walking people's skinned bodies, every [`BODY_LOG_PERIOD_S`].
+    fn log_bodies(&mut self, sim: &Simulation, sim_time_s: f64) {
+        if sim_time_s - self.bodies_logged_s < BODY_LOG_PERIOD_S {
+            return;
+        }
+        self.bodies_logged_s = sim_time_s;
+        for (i, path, body) in &mut self.paths.bodies {
+            let person = &sim.world().people[*i];
+            body.pose(sim.person_gait_phase_rad(*i), person.stride_m());
+            let mesh = rerun::Mesh3D::update_fields()
+                .with_vertex_positions(body.positions().iter().map(|p| p.to_array()))
+                .with_vertex_normals(body.normals().iter().map(|n| n.to_array()));
+            if let Err(e) = self.rec.log(path.as_str(), &mesh) {
+                tracing::warn!("rerun: {path}: {e}");
+            }
+        }
+    }
+
     fn set_time(&self, sim_time_s: f64) {
         self.rec.set_duration_secs("sim_time", sim_time_s);
         self.rec.set_time_sequence("frame", self.frame);
@@ -251,19 +269,7 @@ impl Observer for Recorder {
                 self.log(path, &transform(sim.world_from_person(i)));
             }
         }
-        if sample.sim_time_s - self.bodies_logged_s >= BODY_LOG_PERIOD_S {
-            self.bodies_logged_s = sample.sim_time_s;
-            for (i, path, body) in &mut self.paths.bodies {
-                let person = &sim.world().people[*i];
-                body.pose(sim.person_gait_phase_rad(*i), person.stride_m());
-                let mesh = rerun::Mesh3D::update_fields()
-                    .with_vertex_positions(body.positions().iter().map(|p| p.to_array()))
-                    .with_vertex_normals(body.normals().iter().map(|n| n.to_array()));
-                if let Err(e) = self.rec.log(path.as_str(), &mesh) {
-                    tracing::warn!("rerun: {path}: {e}");
-                }
-            }
-        }
+        self.log_bodies(sim, sample.sim_time_s);
         for (i, path, swing, standing) in &self.paths.limbs {
             let phase_rad = sim.person_gait_phase_rad(*i);
             self.log(path, &transform(swing.pose_at(*standing, phase_rad)));

@@ -299,6 +299,7 @@ const TOP_EDGE_SLACK: f64 = 0.02;
 /// How much nearer than the walking distance a camera-only car follows a person walking away
 /// (m). Measured on the camera-only car's scenarios with MakeHuman's body: 0.1 and 0.2 pass all
 /// 14, 0.0 fails walking_square's `max_range_after_acquire_m` and 0.3 circling's
+/// `min_person_range_m`; the walking speed away times `lead_s` failed walking_square's
 /// `min_person_range_m` (docs/FOLLOWER.md).
 const RECEDING_ALLOWANCE_M: f64 = 0.2;
 /// How much less a range from the feet is trusted when the box is cut off at a side of the
@@ -378,8 +379,11 @@ const LASER_GATE_M: f64 = 0.4;
 /// A track the laser picks up again may be this far from the returns (m), at most, and
 /// within 3 sigma of its own uncertainty.
 const LASER_PICKUP_M: f64 = 2.5;
-/// The target's returns are its near surface: the centre is about this much further (m).
-const BODY_DEPTH_M: f64 = 0.1;
+/// The target's returns are the near surfaces of its legs (the laser sees a skinned person's
+/// shins, about 5.5 cm in radius at a scan plane 0.17 m up: docs/WORLDS.md); the centroid of
+/// a round leg's visible half is 2r/pi in front of its axis, and the person's centre is between
+/// their legs: about this much further than the returns (m).
+const BODY_DEPTH_M: f64 = 0.035;
 /// Laser returns keep following a target seen this recently (s): a few scans.
 const LASER_CONTINUITY_S: f64 = 0.35;
 /// Returns further than this from the target's prediction are obstacles (m).
