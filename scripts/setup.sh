@@ -17,6 +17,16 @@ if ! command -v cargo >/dev/null 2>&1; then
   exit 1
 fi
 
+# ./test checks formatting and clippy: their toolchain components.
+if [ "$purpose" = test ] && ! { cargo fmt --version && cargo clippy --version; } >/dev/null 2>&1; then
+  if command -v rustup >/dev/null 2>&1; then
+    say "adding the rustfmt and clippy components (./test checks formatting and lints)"
+    rustup component add rustfmt clippy >&2
+  else
+    say "cargo fmt or cargo clippy is missing and there is no rustup to add them"
+  fi
+fi
+
 # --- Debian packages -------------------------------------------------------------------------
 #   build: a C compiler and pkg-config; libudev-dev for gilrs (the gamepad library)
 #   run:   mesa-vulkan-drivers (software Vulkan: the camera renders without a GPU), the X11
