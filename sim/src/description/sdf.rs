@@ -786,6 +786,8 @@ fn actor_script(ctx: &Ctx<'_, '_>, script: Node<'_, '_>) -> Result<Option<Script
                 .ok_or_else(|| ctx.err(w, "<waypoint> needs a <time>"))
                 .and_then(|n| ctx.number(n))?;
             let pose = child(w, "pose").ok_or_else(|| ctx.err(w, "<waypoint> needs a <pose>"))?;
+            // Checked as a pose (positions in range); the yaw read as written, in f64, not
+            // taken back out of the pose's f32 quaternion.
             ctx.pose(pose)?;
             let [x, y, _, _, _, yaw_rad] = ctx.numbers::<6>(pose)?;
             points.push(Waypoint {

@@ -286,15 +286,7 @@ impl Simulation {
     /// first surface of the world (ground, objects, walls, models, people), not the robot
     /// itself; `None` when nothing is hit within `max_m`.
     pub fn cast_world_ray(&self, origin: Vec3, dir: Vec3, max_m: f32) -> Option<f32> {
-        let filter = QueryFilter::default().groups(InteractionGroups::new(
-            Group::ALL,
-            WORLD_GROUP,
-            InteractionTestMode::And,
-        ));
-        let ray = Ray::new(origin, dir);
-        self.physics
-            .cast_ray(&ray, max_m, true, filter)
-            .map(|(_, toi)| toi)
+        self.cast_world_ray_past_people(origin, dir, max_m, &[])
     }
 
     /// As [`Simulation::cast_world_ray`], but through the physics capsules of the people
