@@ -7,7 +7,9 @@ use std::path::Path;
 
 use rover_core::{RunConfig, SWEEP_DISTANCES_M, SweepPosture, sweep};
 use rover_perception::{Detector, DetectorConfig};
-use rover_sim::human::{BodyShape, Human, Layer, PosedBody, Posture, STANCE_FRACTION};
+use rover_sim::human::{
+    BodyShape, HairStyle, Human, Layer, Legwear, Outfit, PosedBody, Posture, STANCE_FRACTION,
+};
 use rover_tests::{makehuman, repo};
 
 #[test]
@@ -27,7 +29,7 @@ fn the_body_stands_its_height_with_its_feet_on_the_ground() -> anyhow::Result<()
             1.2,
         ),
     ] {
-        let body = human.body(shape, height_m)?;
+        let body = human.body(shape, height_m, Outfit::default())?;
         let mut posed = PosedBody::default();
         body.pose(Posture::Standing, &mut posed);
         let low = posed.positions.iter().map(|p| p.z).fold(f32::MAX, f32::min);
@@ -57,11 +59,113 @@ fn the_body_stands_its_height_with_its_feet_on_the_ground() -> anyhow::Result<()
 }
 
 #[test]
+fn outfits_cut_the_hair_and_dress_the_legs() -> anyhow::Result<()> {
+    let Some(human) = makehuman()? else {
+        return Ok(());
+    };
+    let height_m = 1.75_f32;
+    let mut posed = PosedBody::default();
+    // The lowest point of a layer's drawn vertices, and whether it has any vertex in a band
+    // of heights near the body's middle plane (|y| < 3 cm), as fractions of the height.
+    let mut look = |outfit: Outfit| -> anyhow::Result<(usize, f32, f32, bool, bool)> {
+        let body = human.body(BodyShape::default(), f64::from(height_m), outfit)?;
+        body.pose(Posture::Standing, &mut posed);
+        let layer = |which: Layer| {
+            body.layers()
+                .iter()
+                .find(|l| l.0 == which)
+                .map(|l| l.1.clone())
+                .unwrap_or_default()
+        };
+        let z = |i: &u32| posed.positions[*i as usize].z / height_m;
+        let hair = layer(Layer::Hair);
+        let hair_low = hair.iter().map(z).fold(f32::MAX, f32::min);
+        let trousers = layer(Layer::Trousers);
+        let legs_low = trousers.iter().map(z).fold(f32::MAX, f32::min);
+        // At the shins: a long skirt spans the gap between the legs, trousers do not.
+        let between_shins = trousers.iter().any(|&i| {
+            let p = posed.positions[i as usize];
+            (0.12..0.2).contains(&(p.z / height_m)) && p.y.abs() < 0.01
+        });
+        // Bare shins: skin drawn half-way between knee and ankle.
+        let shins = layer(Layer::Skin)
+            .iter()
+            .any(|i| (0.15..0.2).contains(&z(i)));
+        println!(
+            "{outfit:?}: {} vertices, hair {} triangles down to {hair_low:.2} h, legwear down to \
+             {legs_low:.2} h, between the shins {between_shins}, bare shins {shins}",
+            body.vertex_count(),
+            hair.len() / 3
+        );
+        Ok((hair.len(), hair_low, legs_low, between_shins, shins))
+    };
+    let short = look(Outfit::default())?;
+    let long = look(Outfit::new(HairStyle::Long, Legwear::Trousers))?;
+    let bald = look(Outfit::new(HairStyle::Bald, Legwear::Trousers))?;
+    let skirt = look(Outfit::new(HairStyle::Short, Legwear::Skirt))?;
+    let long_skirt = look(Outfit::new(HairStyle::Long, Legwear::LongSkirt))?;
+    // Short hair ends at the jaw (~87 % of the height), long hair far below it.
+    assert!(short.1 > 0.85, "short hair reaches {} h", short.1);
+    assert!(long.1 < short.1 - 0.05, "long hair reaches {} h", long.1);
+    assert!(long.0 > short.0, "long hair has more triangles");
+    assert_eq!(bald.0, 0, "a bald head has no hair");
+    // Trousers reach the shoes, one leg each, over no skin; a skirt stops below the knees
+    // (~27 % of the height) over bare shins; a long skirt reaches the ankles in one piece.
+    assert!(short.2 < 0.1 && !short.3 && !short.4, "trousers: {short:?}");
+    assert!((0.2..0.3).contains(&skirt.2) && skirt.4, "skirt: {skirt:?}");
+    assert!(
+        long_skirt.2 < 0.1 && long_skirt.3,
+        "long skirt: {long_skirt:?}"
+    );
+    Ok(())
+}
+
+#[test]
+fn a_skirt_and_long_hair_are_a_person_from_every_side() -> anyhow::Result<()> {
+    if makehuman()?.is_none() {
+        return Ok(());
+    }
+    // worlds/people.toml with its person in a skirt and long hair.
+    let dir = tempfile::tempdir()?;
+    let world = dir.path().join("people_skirt.toml");
+    let text = std::fs::read_to_string(repo("worlds/people.toml"))?
+        .replace("\"../", &format!("\"{}/", repo("").display()))
+        .replace(
+            "body = \"makehuman\"",
+            "body = \"makehuman\"\nhair_style = \"long\"\nlegwear = \"skirt\"",
+        );
+    std::fs::write(&world, text)?;
+    let config = RunConfig {
+        world: Some(world),
+        ..RunConfig::default()
+    };
+    let mut detector = Detector::load(DetectorConfig::default())?;
+    for posture in [SweepPosture::Standing, SweepPosture::Walking(0.25)] {
+        let views = sweep(
+            &config,
+            &mut detector,
+            Some(BodyShape::default()),
+            posture,
+            None,
+        )?;
+        let found = views.iter().filter(|v| v.found).count();
+        let missed: Vec<_> = views
+            .iter()
+            .filter(|v| !v.found)
+            .map(|v| format!("{} deg {} m", v.heading_deg, v.distance_m))
+            .collect();
+        println!("skirt, long hair, {posture}: {found}/{} found", views.len());
+        assert_eq!(found, views.len(), "{posture}: missed {missed:?}");
+    }
+    Ok(())
+}
+
+#[test]
 fn far_people_are_drawn_with_fewer_triangles_of_the_same_vertices() -> anyhow::Result<()> {
     let Some(human) = makehuman()? else {
         return Ok(());
     };
-    let body = human.body(BodyShape::default(), 1.75)?;
+    let body = human.body(BodyShape::default(), 1.75, Outfit::default())?;
     let full: usize = body.layers().iter().map(|l| l.1.len() / 3).sum();
     let mut last = full;
     for cell_m in [0.03, 0.06] {
@@ -96,7 +200,7 @@ fn a_walking_body_keeps_its_planted_foot_still() -> anyhow::Result<()> {
     let Some(human) = makehuman()? else {
         return Ok(());
     };
-    let body = human.body(BodyShape::default(), 1.75)?;
+    let body = human.body(BodyShape::default(), 1.75, Outfit::default())?;
     let mut posed = PosedBody::default();
     let stride_m = 1.3;
     // The left sole over the middle of its stance: the lowest vertex of the left half of the
@@ -317,6 +421,12 @@ fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
         "{mid_stride} caught mid-stride"
     );
     assert!(skins.len() >= 4, "{} skin tones", skins.len());
+    let skirts = count(&|p| p.legwear.as_deref() == Some("skirt"));
+    let long_hair = count(&|p| p.hair_style.as_deref() == Some("long"));
+    let bald = count(&|p| p.hair_style.as_deref() == Some("bald"));
+    println!("{skirts} skirts, {long_hair} long-haired, {bald} bald");
+    assert!((1..=10).contains(&skirts), "{skirts} skirts");
+    assert!((1..=12).contains(&long_hair), "{long_hair} long-haired");
     Ok(())
 }
 

@@ -946,8 +946,8 @@ pub(crate) enum Randomize {
     Things,
     /// People's shirt and trousers colours
     Clothes,
-    /// People's bodies (shape sliders, height, children too), skin tones, hair colours, and
-    /// half of them caught mid-stride
+    /// People's bodies (shape sliders, height, children too), skin tones, hair colours and
+    /// styles, trousers or skirts, and half of them caught mid-stride
     Bodies,
     /// The sun's direction and strength, the sky's light
     Light,

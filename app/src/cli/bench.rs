@@ -985,7 +985,11 @@ fn time_frames(run: &RunConfig) -> Result<()> {
 /// Times posing (skinning) the default MakeHuman body through a walk.
 fn time_posing() -> Result<()> {
     if let Some(human) = rover_sim::human::shared() {
-        let body = human.body(rover_sim::human::BodyShape::default(), 1.75)?;
+        let body = human.body(
+            rover_sim::human::BodyShape::default(),
+            1.75,
+            rover_sim::human::Outfit::default(),
+        )?;
         let mut posed = rover_sim::human::PosedBody::default();
         let mut times = Vec::new();
         for k in 0..200 {

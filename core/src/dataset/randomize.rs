@@ -134,10 +134,18 @@ const HAIR_COLORS: [[f32; 3]; 6] = [
 ];
 /// Fraction of people drawn as children (MakeHuman's age 0.19-0.35, 1.1-1.5 m).
 const CHILD_FRACTION: f64 = 0.2;
+/// Hair styles and how often each is drawn.
+const HAIR_STYLES: [(rover_sim::human::HairStyle, f64); 3] = [
+    (rover_sim::human::HairStyle::Short, 0.5),
+    (rover_sim::human::HairStyle::Long, 0.35),
+    (rover_sim::human::HairStyle::Bald, 0.15),
+];
+/// Fraction of people drawn in a skirt (knee-length or long, one as often as the other).
+const SKIRT_FRACTION: f64 = 0.3;
 
 /// A person's random look: MakeHuman's body in a random shape and height (a person drawn as
-/// rover's figure or an actor's skin keeps it), a skin tone, a hair colour, and half of them
-/// mid-stride.
+/// rover's figure or an actor's skin keeps it), a skin tone, a hair colour and style,
+/// trousers or a skirt, and half of them mid-stride.
 fn random_look(person: &rover_sim::Person, rng: &mut Rng) -> rover_sim::PersonLook {
     let child = rng.uniform() < CHILD_FRACTION;
     let (age, height_m) = if child {
@@ -162,8 +170,22 @@ fn random_look(person: &rover_sim::Person, rng: &mut Rng) -> rover_sim::PersonLo
     } else {
         rng.between(0.01, 2.0 * PI)
     };
+    let mut style_draw = rng.uniform();
+    let hair = HAIR_STYLES
+        .iter()
+        .find(|(_, share)| {
+            style_draw -= share;
+            style_draw < 0.0
+        })
+        .map_or(rover_sim::human::HairStyle::Short, |(h, _)| *h);
+    let legwear = match rng.uniform() {
+        u if u < SKIRT_FRACTION / 2.0 => rover_sim::human::Legwear::Skirt,
+        u if u < SKIRT_FRACTION => rover_sim::human::Legwear::LongSkirt,
+        _ => rover_sim::human::Legwear::Trousers,
+    };
     rover_sim::PersonLook {
         shape: person.shape.map(|_| shape),
+        outfit: rover_sim::human::Outfit::new(hair, legwear),
         height_m: if person.shape.is_some() {
             height_m
         } else {
@@ -257,6 +279,13 @@ pub struct PersonShot {
     pub gait_phase_deg: f64,
     /// Skin, hair, shirt and trousers colours (sRGB, 0..1).
     pub colors: [[f32; 3]; 4],
+    /// MakeHuman's hair style (`short`, `long`, `bald`), `None` for rover's figure or an
+    /// actor's skin.
+    #[serde(default)]
+    pub hair_style: Option<String>,
+    /// Trousers or a skirt, as `hair_style`.
+    #[serde(default)]
+    pub legwear: Option<String>,
 }
 
 impl PersonShot {
@@ -273,6 +302,10 @@ impl PersonShot {
                 rgb(person.shirt_color),
                 rgb(person.trousers_color),
             ],
+            hair_style: person.shape.map(|_| person.outfit.hair.as_str().to_owned()),
+            legwear: person
+                .shape
+                .map(|_| person.outfit.legwear.as_str().to_owned()),
         }
     }
 }

@@ -269,6 +269,9 @@ pub struct FollowTarget {
     /// The width of its box in the world (m), learned from its whole boxes: the range of a box
     /// cut off at the top or bottom comes from its width.
     pub width_m: f64,
+    /// Sim time of the last update after which its estimate walked (faster than
+    /// `MOVING_MPS`); None while it has not, or since it was halted.
+    pub walked_s: Option<f64>,
 }
 
 impl FollowTarget {
@@ -276,9 +279,21 @@ impl FollowTarget {
     /// prediction's, which runs out when the target is lost: that a prediction stopped does
     /// not mean the person did). A track halted because the person was not where the
     /// prediction walked them (see `Follower::note_missed`) stands.
+    ///
+    /// A walker's estimate dips below walking speed for a moment now and then (each box's range
+    /// wanders with the gait: up to 0.6 s at a time with MakeHuman's walking body): it stays a
+    /// walker until it has not walked for [`WALKER_HOLD_S`] of the time it was seen.
     pub fn last_seen_walking(&self) -> bool {
+        self.walked_s
+            .is_some_and(|walked| self.seen_s - walked <= WALKER_HOLD_S)
+    }
+
+    /// Notes, after an update at sim time `t_s`, whether the estimate walks.
+    fn note_speed(&mut self, t_s: f64) {
         let [vx, vy] = self.filter.velocity_mps();
-        vx.hypot(vy) > MOVING_MPS
+        if vx.hypot(vy) > MOVING_MPS {
+            self.walked_s = Some(self.walked_s.map_or(t_s, |w| w.max(t_s)));
+        }
     }
 
     /// Estimated position now-ish (m, odometry frame): the filter's prediction at `time_s`.
@@ -296,12 +311,6 @@ const EDGE_PX: i64 = 2;
 /// there (the detector's edges wander): see `Follower::measure`.
 const TOP_EDGE_SLACK: f64 = 0.02;
 
-/// How much nearer than the walking distance a camera-only car follows a person walking away
-/// (m). Measured on the camera-only car's scenarios with MakeHuman's body: 0.1 and 0.2 pass all
-/// 14, 0.0 fails walking_square's `max_range_after_acquire_m` and 0.3 circling's
-/// `min_person_range_m`; the walking speed away times `lead_s` failed walking_square's
-/// `min_person_range_m` (docs/FOLLOWER.md).
-const RECEDING_ALLOWANCE_M: f64 = 0.2;
 /// How much less a range from the feet is trusted when the box is cut off at a side of the
 /// image (m, 1 sigma): the nearer foot may be the part cut off (with MakeHuman's walking body,
 /// a range 0.45 m too far pulled the track off the person).
@@ -347,6 +356,9 @@ pub fn range_bearing_from(odom: Odometry, point: [f64; 2]) -> (f64, f64) {
 const REVERSE_FRACTION: f64 = 0.6;
 /// A target faster than this is moving (m/s): no calm deadbands, lead it.
 const MOVING_MPS: f64 = 0.25;
+/// How long after its estimate last walked a track still counts as a walker (s of the time it
+/// was seen): see [`FollowTarget::last_seen_walking`].
+const WALKER_HOLD_S: f64 = 1.0;
 /// A pursuit has arrived when the pursued point is at most this far off the heading (rad) and
 /// within the standoff band.
 const ARRIVED_BEARING_RAD: f64 = 0.15;
@@ -808,6 +820,7 @@ impl Follower {
         }
         if self.contradictions >= CONTRADICTED_MESSAGES {
             t.filter.halt(t_image);
+            t.walked_s = None;
             self.contradictions = 0;
         }
     }
@@ -839,6 +852,7 @@ impl Follower {
         match (keeping, self.target.as_mut()) {
             (true, Some(t)) => {
                 t.filter.update(t_image, position, &cov);
+                t.note_speed(t_image);
                 if (bearing_rad - t.bearing_rad).abs() > 1e-3 {
                     self.search_sign = (bearing_rad - t.bearing_rad).signum();
                 }
@@ -864,6 +878,7 @@ impl Follower {
                     probability: c.probability,
                     close_and_centred,
                     width_m: learned_width.unwrap_or(self.config.target_width_m),
+                    walked_s: None,
                 });
             }
         }
@@ -975,6 +990,7 @@ impl Follower {
         ];
         let cov = Matrix2::identity() * 0.08f64.powi(2);
         t.filter.update(scan.stamp_s, centre, &cov);
+        t.note_speed(scan.stamp_s);
         t.seen_s = t.seen_s.max(scan.stamp_s);
     }
 
@@ -1111,7 +1127,7 @@ impl Follower {
         self.goal = Some(aim);
         let (range, _) = range_bearing_from(odom, here);
         let (_, bearing) = range_bearing_from(odom, aim);
-        let range_error = range - self.keep_range_m(walker) + self.receding_allowance_m(odom, here);
+        let range_error = range - self.keep_range_m(walker);
         if !tracking
             && self.arrived_s.is_none()
             && range_error < c.standoff_band_m
@@ -1201,8 +1217,15 @@ impl Follower {
         let target_yaw = odom.yaw_rad + bearing;
         // Turned as far as the target's centre stays in view: a walking person is seen on
         // the image's edge (measured: 20 degrees short of the edge, the walking world's
-        // walker came round to 0.56 m before the trail was behind the car).
-        let reach = self.half_fov_rad;
+        // walker came round to 0.56 m before the trail was behind the car). A target lost
+        // from view is kept where the camera would see them whole, to find them again
+        // (at the edge, Gazebo's actor was lost for 7.6 s on its loop, 2.8 s so).
+        let reach = if self.state == FollowState::Tracking {
+            self.half_fov_rad
+        } else {
+            let range_m = self.target.as_ref().map_or(c.standoff_m, |t| t.range_m);
+            self.half_fov_rad - (0.5 * c.target_width_m / range_m.max(0.5)).atan()
+        };
         let wanted_yaw = target_yaw + wrap_angle(back_yaw - target_yaw).clamp(-reach, reach);
         let turn = wrap_angle(wanted_yaw - odom.yaw_rad);
         let angular = (c.turn_gain * turn).clamp(-c.max_turn_radps, c.max_turn_radps);
@@ -1236,25 +1259,6 @@ impl Follower {
     /// that closes in on a walking person loses them at every step, and one who walks toward
     /// the car walks into its blind zone unless it gives way. Once they stand, the car closes
     /// in to the standoff.
-    /// How much nearer than the walking distance a camera-only car follows a person walking
-    /// away from it (m): they cannot walk into it, and a car that keeps the full distance
-    /// from a receding walker lags a step behind it at every turn of their path.
-    fn receding_allowance_m(&self, odom: Odometry, person: [f64; 2]) -> f64 {
-        if self.laser.is_some() {
-            return 0.0;
-        }
-        let Some(t) = &self.target else {
-            return 0.0;
-        };
-        let [vx, vy] = t.filter.velocity_mps();
-        let (dx, dy) = (person[0] - odom.x_m, person[1] - odom.y_m);
-        let range = dx.hypot(dy);
-        if range < 1e-6 || (vx * dx + vy * dy) / range <= MOVING_MPS {
-            return 0.0;
-        }
-        RECEDING_ALLOWANCE_M
-    }
-
     fn keep_range_m(&self, moving: bool) -> f64 {
         let c = &self.config;
         if !moving || self.laser.is_some() {
@@ -1935,8 +1939,8 @@ mod tests {
             furthest_m - nearest_m < 0.05,
             "the range wandered {nearest_m}..{furthest_m} m"
         );
-        // A receding walker is followed a little nearer than the walking distance.
-        let walking_m = camera().whole_view_range_m(1.75) + forward - RECEDING_ALLOWANCE_M;
+        // A receding walker is followed at the walking distance.
+        let walking_m = camera().whole_view_range_m(1.75) + forward;
         assert!(
             (nearest_m - walking_m).abs() < 0.1,
             "followed at {nearest_m} m, not {walking_m} m"
@@ -2013,6 +2017,44 @@ mod tests {
             "turned them to {widest_rad} rad off the axis"
         );
         assert!(nearest_m > 1.2, "let them within {nearest_m} m");
+    }
+
+    #[test]
+    fn a_walker_whose_estimate_dips_below_walking_speed_stays_a_walker_for_a_while() {
+        // A person walking across 4 m ahead, then standing still where they are. The car
+        // stands: only the estimate moves. (A walking body's boxes make the estimate dip below
+        // walking speed for a moment now and then; that must not make the car close in to
+        // the standoff and back off again at each dip.)
+        let mut f = Follower::new(FollowerConfig::default(), camera());
+        let odom = Odometry::default();
+        let person = |t: f64| [4.0, -1.0 + 0.6 * t.min(3.0)];
+        let mut walked = false;
+        let mut first_slow: Option<(f64, bool)> = None;
+        for i in 0..=300 {
+            let t = f64::from(i) * 0.02;
+            f.record_pose(t, odom);
+            if i % 10 == 0 {
+                f.observe(&message(t, vec![seen_box(odom, person(t))]));
+            }
+            let Some(target) = f.target() else { continue };
+            let [vx, vy] = target.filter.velocity_mps();
+            let fast = vx.hypot(vy) > MOVING_MPS;
+            walked |= fast && target.last_seen_walking();
+            if walked && !fast && first_slow.is_none() {
+                first_slow = Some((t, target.last_seen_walking()));
+            }
+        }
+        assert!(walked, "the walk was never seen as walking");
+        let Some((slow_s, still_walker)) = first_slow else {
+            panic!("the estimate never slowed down");
+        };
+        assert!(
+            still_walker,
+            "let go as soon as the estimate slowed ({slow_s} s)"
+        );
+        // Three seconds of standing: they stand.
+        let standing = f.target().map(|t| !t.last_seen_walking());
+        assert_eq!(standing, Some(true), "still a walker after 3 s of standing");
     }
 
     #[test]

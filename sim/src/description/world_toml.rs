@@ -11,7 +11,7 @@ use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
 use crate::model::classes::{COCO_CLASSES, is_known_class};
 use crate::model::drive::DriveSpec;
-use crate::model::human::BodyShape;
+use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
     DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World, check_step_hz,
@@ -249,6 +249,8 @@ struct RawPerson {
     #[serde(default)]
     start_after_s: f64,
     body: Option<String>,
+    hair_style: Option<String>,
+    legwear: Option<String>,
     gender: Option<f64>,
     age: Option<f64>,
     muscle: Option<f64>,
@@ -647,7 +649,7 @@ impl RawWall {
 }
 
 impl RawPerson {
-    /// `body = "makehuman"` with its shape sliders, or `body = "figure"` (the default).
+    /// `body = "makehuman"` (the default) with its shape sliders, or `body = "figure"`.
     fn shape(&self, i: usize, c: &Checker<'_>) -> Result<Option<BodyShape>> {
         let key = |field: &str| format!("person[{i}].{field}");
         let sliders = [
@@ -686,14 +688,52 @@ impl RawPerson {
             },
             other => Err(c.fail(
                 &key("body"),
-                format!("expected \"makehuman\" (MakeHuman's body) or \"figure\" (rover's own, the default), found \"{other}\""),
+                format!("expected \"makehuman\" (MakeHuman's body, the default) or \"figure\" (rover's own), found \"{other}\""),
             )),
         }
+    }
+
+    /// `hair_style` and `legwear`, MakeHuman's body only.
+    fn outfit(&self, i: usize, c: &Checker<'_>, figure: bool) -> Result<Outfit> {
+        let key = |field: &str| format!("person[{i}].{field}");
+        let word = |field: &str, value: Option<&str>| -> Result<()> {
+            match value {
+                Some(_) if figure => Err(c.fail(
+                    &key(field),
+                    "rover's figure has one outfit: drop it, or use body = \"makehuman\"",
+                )),
+                _ => Ok(()),
+            }
+        };
+        word("hair_style", self.hair_style.as_deref())?;
+        word("legwear", self.legwear.as_deref())?;
+        let hair = match self.hair_style.as_deref() {
+            None => HairStyle::default(),
+            Some(w) => HairStyle::parse(w).ok_or_else(|| {
+                c.fail(
+                    &key("hair_style"),
+                    format!(
+                        "expected \"short\" (the default), \"long\" or \"bald\", found \"{w}\""
+                    ),
+                )
+            })?,
+        };
+        let legwear = match self.legwear.as_deref() {
+            None => Legwear::default(),
+            Some(w) => Legwear::parse(w).ok_or_else(|| {
+                c.fail(
+                    &key("legwear"),
+                    format!("expected \"trousers\" (the default), \"skirt\" (to the knees) or \"long_skirt\" (to the ankles), found \"{w}\""),
+                )
+            })?,
+        };
+        Ok(Outfit::new(hair, legwear))
     }
 
     fn into_person(self, i: usize, c: &Checker<'_>) -> Result<Person> {
         let p = self;
         let shape = p.shape(i, c)?;
+        let outfit = p.outfit(i, c, shape.is_none())?;
         let key = |field: &str| format!("person[{i}].{field}");
         c.coordinates(&key("position_m"), &p.position_m)?;
         c.finite(&key("heading_deg"), &[p.heading_deg])?;
@@ -743,6 +783,7 @@ impl RawPerson {
             name: p.name.unwrap_or_else(|| format!("person_{i}")),
             walk,
             shape,
+            outfit,
             actor: None,
             still_gait_phase_rad: 0.0,
             position_m: p.position_m,
@@ -817,5 +858,26 @@ mod tests {
         let e =
             world("position_m = [0.0, 0.0]\nwaypoints_m = [[1.0, 0.0]]\nspeed_mps = -1.0").err();
         assert!(e.is_some_and(|e| e.to_string().contains("person[0].speed_mps")));
+    }
+
+    #[test]
+    fn hair_style_and_legwear_dress_makehumans_body_and_bad_words_are_errors() -> Result<()> {
+        let w = world("position_m = [0.0, 0.0]\nhair_style = \"long\"\nlegwear = \"skirt\"")?;
+        assert_eq!(
+            w.people[0].outfit,
+            Outfit::new(HairStyle::Long, Legwear::Skirt)
+        );
+        let w = world("position_m = [0.0, 0.0]")?;
+        assert_eq!(w.people[0].outfit, Outfit::default());
+        let e = world("position_m = [0.0, 0.0]\nlegwear = \"kilt\"").err();
+        assert!(e.is_some_and(|e| {
+            let m = e.to_string();
+            m.contains("person[0].legwear") && m.contains("\"kilt\"") && m.contains("\"skirt\"")
+        }));
+        let e = world("position_m = [0.0, 0.0]\nhair_style = \"mohawk\"").err();
+        assert!(e.is_some_and(|e| e.to_string().contains("person[0].hair_style")));
+        let e = world("position_m = [0.0, 0.0]\nbody = \"figure\"\nhair_style = \"long\"").err();
+        assert!(e.is_some_and(|e| e.to_string().contains("figure has one outfit")));
+        Ok(())
     }
 }

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use crate::geometry::{Pose, Rgba, pose_from_position_yaw};
 use crate::model::actor::Actor;
-use crate::model::human::BodyShape;
+use crate::model::human::{BodyShape, Outfit};
 
 /// Height of a person whose world file gives none (m).
 pub const DEFAULT_PERSON_HEIGHT_M: f64 = 1.75;
@@ -35,6 +35,8 @@ pub struct Person {
     /// default for now: the camera-only follower is still tuned to it; also drawn when
     /// MakeHuman's body cannot be fetched).
     pub shape: Option<BodyShape>,
+    /// What MakeHuman's body wears besides its colours: hair style, trousers or a skirt.
+    pub outfit: Outfit,
     /// A Gazebo actor's script and skin (SDF `<actor>`): it moves by the script instead of
     /// `walk`, and is drawn with its own skin when it has one.
     pub actor: Option<Arc<Actor>>,
@@ -72,6 +74,7 @@ impl Person {
             hair_color: Rgba::rgb(0.2, 0.13, 0.08),
             walk: None,
             shape: Some(BodyShape::default()),
+            outfit: Outfit::default(),
             actor: None,
             still_gait_phase_rad: 0.0,
         }

@@ -7,7 +7,7 @@ use rapier3d::prelude::*;
 
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, Rgba};
-use crate::model::human::BodyShape;
+use crate::model::human::{BodyShape, Outfit};
 use crate::physics::build::person_body_pose;
 use crate::physics::diff_drive::EncoderOdometry;
 use crate::physics::simulation::{Simulation, planar};
@@ -17,6 +17,8 @@ use crate::physics::simulation::{Simulation, planar};
 pub struct PersonLook {
     /// MakeHuman's body in this shape (`None`: rover's figure).
     pub shape: Option<BodyShape>,
+    /// What that body wears besides its colours (hair style, trousers or a skirt).
+    pub outfit: Outfit,
     /// Standing height (m, 0.5 to 2.5).
     pub height_m: f64,
     /// Skin colour.
@@ -130,6 +132,7 @@ impl Simulation {
             .get_mut(index)
             .ok_or_else(|| no_such("person", index))?;
         person.shape = look.shape;
+        person.outfit = look.outfit;
         person.height_m = look.height_m;
         person.skin_color = look.skin_color;
         person.hair_color = look.hair_color;

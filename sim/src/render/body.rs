@@ -131,7 +131,7 @@ impl SkinnedBody {
         } else {
             let shape = person.shape?;
             let human = crate::model::human::shared()?;
-            match human.body(shape, person.height_m) {
+            match human.body(shape, person.height_m, person.outfit) {
                 Ok(body) => Skin::Human(Box::new(body), PosedBody::default()),
                 Err(e) => {
                     tracing::warn!("{}: drawn as rover's figure: {e}", person.name);

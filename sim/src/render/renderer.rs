@@ -249,7 +249,7 @@ impl CameraRenderer {
 
     /// Paints person `index` (world order) in `person`'s clothes for the following renders.
     pub fn dress_person(&mut self, index: usize, person: &Person) {
-        self.scene.dress_person(index, person);
+        self.scene.dress_person(&self.gpu.device, index, person);
     }
 
     /// Moves the world objects (every object in world order) for the following renders.

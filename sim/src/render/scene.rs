@@ -8,7 +8,7 @@ use wgpu::util::DeviceExt;
 
 use crate::geometry::{Pose, Rgba};
 use crate::model::classes::EntityIds;
-use crate::model::human::BodyShape;
+use crate::model::human::{BodyShape, Outfit};
 use crate::model::mesh::MeshData;
 use crate::model::person::Person;
 use crate::model::robot::RobotModel;
@@ -335,8 +335,9 @@ impl Scene {
             .map(|b| b.skin.positions())
     }
 
-    /// Paints person `index` (world order) in `person`'s colours.
-    pub(crate) fn dress_person(&mut self, index: usize, person: &Person) {
+    /// Paints person `index` (world order) in `person`'s colours, and reshapes or re-dresses
+    /// a skinned body whose shape, height or outfit changed.
+    pub(crate) fn dress_person(&mut self, device: &wgpu::Device, index: usize, person: &Person) {
         for (a, paint, _) in self.people.iter().filter(|(a, ..)| a.frame == index) {
             self.instances[a.instance].color = paint.of(person).0;
         }
@@ -344,20 +345,38 @@ impl Scene {
             for &(instance, paint) in &body.instances {
                 self.instances[instance].color = paint.of(person).0;
             }
-            if body.look != (person.shape, person.height_m) {
-                // Reshaped (a dataset's next image): the same mesh and layers, other rest
-                // vertices; the figure is not swapped in or out here.
-                match SkinnedBody::of(person) {
-                    Some(mut skin) if skin.positions().len() == body.skin.positions().len() => {
-                        skin.pose(body.phase_rad, person.stride_m());
-                        body.skin = skin;
-                        body.stride_m = person.stride_m();
-                        body.dirty = true;
-                    }
-                    _ => tracing::warn!("{}: cannot be reshaped", person.name),
-                }
-                body.look = (person.shape, person.height_m);
+            if body.look == look_of(person) {
+                continue;
             }
+            // Reshaped or re-dressed (a dataset's next image); the figure is not swapped in
+            // or out here.
+            let Some(mut skin) = SkinnedBody::of(person) else {
+                tracing::warn!("{}: cannot be reshaped", person.name);
+                continue;
+            };
+            skin.pose(body.phase_rad, person.stride_m());
+            if body.look.1 != person.outfit || skin.positions().len() != body.skin.positions().len()
+            {
+                // Other triangles: new buffers for the same meshes (a MakeHuman body has
+                // every layer, worn or not, so the layers line up).
+                let (vertices, meshes) = body_meshes(device, &skin);
+                if meshes.len() != body.instances.len() {
+                    tracing::warn!("{}: cannot be re-dressed", person.name);
+                    continue;
+                }
+                body.levels.clear();
+                for (&(instance, _), (mesh, runs, _)) in body.instances.iter().zip(meshes) {
+                    if let Some(slot) = self.meshes.get_mut(instance) {
+                        *slot = mesh;
+                    }
+                    body.levels.push(runs);
+                }
+                body.vertices = vertices;
+            }
+            body.skin = skin;
+            body.stride_m = person.stride_m();
+            body.look = look_of(person);
+            body.dirty = true;
         }
     }
 
@@ -465,8 +484,8 @@ struct SkinnedPerson {
     stride_m: f64,
     /// The gait phase the vertices are posed for.
     phase_rad: f64,
-    /// The shape and height (m) the body was built for.
-    look: (Option<BodyShape>, f64),
+    /// The shape, outfit and height (m) the body was built for.
+    look: Look,
     /// Reused: the posed vertices as the GPU reads them.
     staged: Vec<GpuVertex>,
     vertices: wgpu::Buffer,
@@ -510,48 +529,12 @@ impl Builder<'_> {
         entity: u32,
     ) -> SkinnedPerson {
         let phase_rad = person.gait_phase_rad(0.0);
-        let vertices = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("person"),
-            size: (skin.positions().len() * std::mem::size_of::<GpuVertex>()) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let (vertices, meshes) = body_meshes(self.device, &skin);
         let mut instances = Vec::new();
         let mut levels = Vec::new();
-        for BodyLayer {
-            paint,
-            indices,
-            coarse,
-        } in skin.layers()
-        {
-            // Every level of detail in one index buffer; each frame draws one run of it.
-            let mut all = indices;
-            let full = Draw {
-                first_index: 0,
-                count: all.len() as u32,
-                material: 0,
-            };
-            let mut runs = [full; 3];
-            for (run, part) in runs.iter_mut().skip(1).zip(&coarse) {
-                *run = Draw {
-                    first_index: all.len() as u32,
-                    count: part.len() as u32,
-                    material: 0,
-                };
-                all.extend_from_slice(part);
-            }
+        for (mesh, runs, paint) in meshes {
             levels.push(runs);
-            self.meshes.push(GpuMesh {
-                vertices: vertices.clone(),
-                indices: self
-                    .device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: None,
-                        contents: bytemuck::cast_slice(&all),
-                        usage: wgpu::BufferUsages::INDEX,
-                    }),
-                draws: vec![full],
-            });
+            self.meshes.push(mesh);
             self.instances
                 .push(Instance::new(world_from_person, paint.of(person), entity));
             if entity != 0 {
@@ -564,7 +547,7 @@ impl Builder<'_> {
             skin,
             stride_m: person.stride_m(),
             phase_rad,
-            look: (person.shape, person.height_m),
+            look: look_of(person),
             staged: Vec::new(),
             vertices,
             instances,
@@ -575,6 +558,71 @@ impl Builder<'_> {
         skinned.upload(self.queue);
         skinned
     }
+}
+
+/// What a skinned body is built from: shape, outfit and height (m).
+type Look = (Option<BodyShape>, Outfit, f64);
+
+fn look_of(person: &Person) -> Look {
+    (person.shape, person.outfit, person.height_m)
+}
+
+/// A body mesh with its levels of detail and its paint.
+type LayerMesh = (GpuMesh, [Draw; 3], Paint);
+
+/// A skinned body's GPU meshes: one vertex buffer (written by [`SkinnedPerson::upload`])
+/// shared by one mesh per layer, each layer's index buffer holding every level of detail one
+/// after the other, with the run of each level.
+fn body_meshes(device: &wgpu::Device, skin: &SkinnedBody) -> (wgpu::Buffer, Vec<LayerMesh>) {
+    let vertices = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("person"),
+        size: (skin.positions().len() * std::mem::size_of::<GpuVertex>()) as u64,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let meshes = skin
+        .layers()
+        .into_iter()
+        .map(
+            |BodyLayer {
+                 paint,
+                 indices,
+                 coarse,
+             }| {
+                let mut all = indices;
+                let full = Draw {
+                    first_index: 0,
+                    count: all.len() as u32,
+                    material: 0,
+                };
+                let mut runs = [full; 3];
+                for (run, part) in runs.iter_mut().skip(1).zip(&coarse) {
+                    *run = Draw {
+                        first_index: all.len() as u32,
+                        count: part.len() as u32,
+                        material: 0,
+                    };
+                    all.extend_from_slice(part);
+                }
+                // A layer this outfit does not wear (a bald head's hair) draws nothing, but an
+                // index buffer may not be empty.
+                if all.is_empty() {
+                    all.extend_from_slice(&[0; 3]);
+                }
+                let mesh = GpuMesh {
+                    vertices: vertices.clone(),
+                    indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: None,
+                        contents: bytemuck::cast_slice(&all),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    draws: vec![full],
+                };
+                (mesh, runs, paint)
+            },
+        )
+        .collect();
+    (vertices, meshes)
 }
 
 fn add_people(

@@ -43,6 +43,107 @@ pub enum Layer {
     Eyes,
 }
 
+impl Layer {
+    /// Every layer, in the order a body lists them.
+    pub const ALL: [Layer; 6] = [
+        Layer::Skin,
+        Layer::Shirt,
+        Layer::Trousers,
+        Layer::Shoes,
+        Layer::Hair,
+        Layer::Eyes,
+    ];
+}
+
+/// How a person's hair is cut from MakeHuman's hair helper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum HairStyle {
+    /// Cut at the jaw (the default).
+    #[default]
+    Short,
+    /// The whole helper: down to the shoulder blades at the back.
+    Long,
+    /// No hair.
+    Bald,
+}
+
+/// What a person wears on their legs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Legwear {
+    /// Trousers: the bodysuit helper below the hips (the default).
+    #[default]
+    Trousers,
+    /// MakeHuman's skirt helper cut just below the knees, over bare legs.
+    Skirt,
+    /// MakeHuman's whole skirt helper, down to the ankles.
+    LongSkirt,
+}
+
+/// What a MakeHuman body wears, besides its colours.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Outfit {
+    /// The hair.
+    pub hair: HairStyle,
+    /// Trousers or a skirt (in the trousers' colour).
+    pub legwear: Legwear,
+}
+
+impl Outfit {
+    /// Every outfit.
+    pub const ALL: [Outfit; 9] = {
+        let hair = [HairStyle::Short, HairStyle::Long, HairStyle::Bald];
+        let legwear = [Legwear::Trousers, Legwear::Skirt, Legwear::LongSkirt];
+        let mut all = [Outfit::new(HairStyle::Short, Legwear::Trousers); 9];
+        let mut i = 0;
+        while i < 9 {
+            all[i] = Outfit::new(hair[i % 3], legwear[i / 3]);
+            i += 1;
+        }
+        all
+    };
+
+    /// An outfit of this hair and legwear.
+    pub const fn new(hair: HairStyle, legwear: Legwear) -> Self {
+        Self { hair, legwear }
+    }
+}
+
+impl HairStyle {
+    /// The world file's word for it (`hair_style`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Short => "short",
+            Self::Long => "long",
+            Self::Bald => "bald",
+        }
+    }
+
+    /// The style a world file's word names.
+    pub fn parse(word: &str) -> Option<Self> {
+        [Self::Short, Self::Long, Self::Bald]
+            .into_iter()
+            .find(|h| h.as_str() == word)
+    }
+}
+
+impl Legwear {
+    /// The world file's word for it (`legwear`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Trousers => "trousers",
+            Self::Skirt => "skirt",
+            Self::LongSkirt => "long_skirt",
+        }
+    }
+
+    /// The legwear a world file's word names.
+    pub fn parse(word: &str) -> Option<Self> {
+        [Self::Trousers, Self::Skirt, Self::LongSkirt]
+            .into_iter()
+            .find(|l| l.as_str() == word)
+    }
+}
+
 /// A body shape from MakeHuman's macro sliders, each 0..1 as MakeHuman has them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyShape {
@@ -145,11 +246,15 @@ pub struct Human {
     mesh: BaseMesh,
     rig: Rig,
     weights: SkinWeights,
-    /// Per drawn layer, its triangles (base mesh vertex indices).
-    layers: Vec<(Layer, Vec<[u32; 3]>)>,
+    /// Per outfit, each layer's triangles (base mesh vertex indices), in [`Layer::ALL`]'s
+    /// order (a layer the outfit does not wear is empty).
+    layers: Vec<(Outfit, Vec<LayerTriangles>)>,
     /// Macro targets by name, read when a body first needs them.
     targets: Mutex<HashMap<String, Arc<Target>>>,
 }
+
+/// A layer and its triangles (base mesh vertex indices).
+type LayerTriangles = (Layer, Vec<[u32; 3]>);
 
 /// Bones (name prefixes) whose part of the bodysuit is left off: forearms and hands are bare.
 const BARE_BONES: [&str; 4] = ["lowerarm", "wrist", "finger", "metacarpal"];
@@ -236,7 +341,10 @@ impl Human {
             layers: Vec::new(),
             targets: Mutex::new(HashMap::new()),
         };
-        human.layers = human.cut_layers();
+        human.layers = Outfit::ALL
+            .iter()
+            .map(|&outfit| (outfit, human.cut_layers(outfit)))
+            .collect();
         Ok(human)
     }
 
@@ -256,16 +364,30 @@ impl Human {
         self.rig.bones.get(best).map_or("", |b| b.name.as_str())
     }
 
-    /// Splits the drawn groups into layers: the bodysuit helper into shirt, trousers and shoes
-    /// by the bone that moves each triangle most and, on the trunk, by height (the shirt's hem
-    /// a little below the hip joints); forearms and hands are left bare.
-    fn cut_layers(&self) -> Vec<(Layer, Vec<[u32; 3]>)> {
+    /// Splits the drawn groups into layers for `outfit`: the bodysuit helper into shirt,
+    /// trousers and shoes by the bone that moves each triangle most and, on the trunk, by
+    /// height (the shirt's hem a little below the hip joints); forearms and hands are left
+    /// bare. With a skirt, the skirt helper takes the trousers' place and the legs are bare
+    /// (the bodysuit stays on the hips, under the skirt).
+    fn cut_layers(&self, outfit: Outfit) -> Vec<LayerTriangles> {
+        let skirt = outfit.legwear != Legwear::Trousers;
+        // Where the bodysuit is left off: forearms and hands, and the legs under a skirt.
+        let uncovered = |bone: &str| {
+            BARE_BONES.iter().any(|p| bone.starts_with(p))
+                || (skirt && (bone.starts_with("upperleg") || bone.starts_with("lowerleg")))
+        };
         let at = |v: u32| from_obj(self.mesh.positions_dm[v as usize]);
         let hip_z = self.rig.bone("upperleg01.L").map_or(0.0, |b| {
             self.joint(&self.rig.bones[b].head, &self.mesh.positions_dm)
                 .z
         });
         let hem_z = hip_z + 0.03;
+        // A knee-length skirt's hem: a little below the knee joints.
+        let knee_z = self.rig.bone("lowerleg01.L").map_or(0.0, |b| {
+            self.joint(&self.rig.bones[b].head, &self.mesh.positions_dm)
+                .z
+        });
+        let short_skirt = outfit.legwear == Legwear::Skirt;
         // Hair: MakeHuman's hair helper reaches the shoulder blades and over the face; cut
         // short at the jaw and above the brows in front.
         let centre = |name: &str| {
@@ -275,36 +397,48 @@ impl Human {
         };
         let jaw_z = centre("joint-head").map_or(f32::NEG_INFINITY, |p| p.z);
         let eye = centre("helper-l-eye");
-        let keep_hair =
-            |c: Vec3| c.z > jaw_z && eye.is_none_or(|eye| c.x < eye.x - 0.05 || c.z > eye.z + 0.04);
-        let mut layers: Vec<(Layer, Vec<[u32; 3]>)> = Vec::new();
-        let mut push = |layer: Layer, t: [u32; 3]| match layers.iter_mut().find(|l| l.0 == layer) {
-            Some(l) => l.1.push(t),
-            None => layers.push((layer, vec![t])),
+        let off_face = |c: Vec3| eye.is_none_or(|eye| c.x < eye.x - 0.05 || c.z > eye.z + 0.04);
+        let keep_hair = |c: Vec3| match outfit.hair {
+            HairStyle::Short => c.z > jaw_z && off_face(c),
+            HairStyle::Long => off_face(c),
+            HairStyle::Bald => false,
+        };
+        let mut layers: Vec<LayerTriangles> = Layer::ALL.iter().map(|&l| (l, Vec::new())).collect();
+        let mut push = |layer: Layer, t: [u32; 3]| {
+            if let Some(l) = layers.iter_mut().find(|l| l.0 == layer) {
+                l.1.push(t);
+            }
         };
         for group in &self.mesh.groups {
             let fixed = match group.name.as_str() {
                 "body" => Some(Layer::Skin),
                 "helper-hair" => Some(Layer::Hair),
                 "helper-l-eye" | "helper-r-eye" => Some(Layer::Eyes),
+                "helper-skirt" if skirt => Some(Layer::Trousers),
                 "helper-tights" => None,
                 _ => continue,
             };
             for &t in &group.triangles {
                 let bone = self.main_bone(t[0]);
-                let bare = BARE_BONES.iter().any(|p| bone.starts_with(p));
                 let layer = match fixed {
                     Some(Layer::Hair) if !keep_hair((at(t[0]) + at(t[1]) + at(t[2])) / 3.0) => {
                         continue;
                     }
+                    Some(Layer::Trousers)
+                        if short_skirt
+                            && (at(t[0]).z + at(t[1]).z + at(t[2]).z) / 3.0 < knee_z - 0.05 =>
+                    {
+                        continue;
+                    }
                     // Skin the bodysuit covers is never seen: not drawn (half the triangles).
                     Some(Layer::Skin)
-                        if !bare && COVERED_BONES.iter().any(|p| bone.starts_with(p)) =>
+                        if !uncovered(bone)
+                            && COVERED_BONES.iter().any(|p| bone.starts_with(p)) =>
                     {
                         continue;
                     }
                     Some(l) => l,
-                    None if bare => continue,
+                    None if uncovered(bone) => continue,
                     None if bone.starts_with("foot") || bone.starts_with("toe") => Layer::Shoes,
                     None if bone.starts_with("upperarm")
                         || bone.starts_with("clavicle")
@@ -359,8 +493,13 @@ impl Human {
         Ok(t)
     }
 
-    /// A body of `shape`, `height_m` tall, feet on z = 0, facing +x.
-    pub fn body(self: &Arc<Self>, shape: BodyShape, height_m: f64) -> Result<Body> {
+    /// A body of `shape` in `outfit`, `height_m` tall, feet on z = 0, facing +x.
+    pub fn body(self: &Arc<Self>, shape: BodyShape, height_m: f64, outfit: Outfit) -> Result<Body> {
+        let outfit_layers = self
+            .layers
+            .iter()
+            .find(|(o, _)| *o == outfit)
+            .map_or(&[][..], |(_, layers)| layers.as_slice());
         let mut positions_dm = self.mesh.positions_dm.clone();
         for (name, w) in shape.targets() {
             let target = self.target(&name)?;
@@ -368,11 +507,11 @@ impl Human {
                 positions_dm[v as usize] += d * w;
             }
         }
-        let mut layers = Vec::with_capacity(self.layers.len());
+        let mut layers = Vec::with_capacity(outfit_layers.len());
         // Only the vertices some drawn triangle uses, renumbered.
         let mut new_index = vec![u32::MAX; positions_dm.len()];
         let mut used = Vec::new();
-        for (layer, triangles) in &self.layers {
+        for (layer, triangles) in outfit_layers {
             let mut out = Vec::with_capacity(triangles.len() * 3);
             for &v in triangles.iter().flatten() {
                 let slot = &mut new_index[v as usize];
