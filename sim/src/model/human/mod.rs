@@ -372,10 +372,9 @@ impl Human {
     fn cut_layers(&self, outfit: Outfit) -> Vec<LayerTriangles> {
         let skirt = outfit.legwear != Legwear::Trousers;
         // Where the bodysuit is left off: forearms and hands, and the legs under a skirt.
-        let uncovered = |bone: &str| {
-            BARE_BONES.iter().any(|p| bone.starts_with(p))
-                || (skirt && (bone.starts_with("upperleg") || bone.starts_with("lowerleg")))
-        };
+        let leg = |bone: &str| bone.starts_with("upperleg") || bone.starts_with("lowerleg");
+        let uncovered =
+            |bone: &str| BARE_BONES.iter().any(|p| bone.starts_with(p)) || (skirt && leg(bone));
         let at = |v: u32| from_obj(self.mesh.positions_dm[v as usize]);
         let hip_z = self.rig.bone("upperleg01.L").map_or(0.0, |b| {
             self.joint(&self.rig.bones[b].head, &self.mesh.positions_dm)
@@ -388,6 +387,26 @@ impl Human {
                 .z
         });
         let short_skirt = outfit.legwear == Legwear::Skirt;
+        // A skirt's waistband: the bodysuit stops a little below it; and its hem: the bare
+        // legs' skin starts a little above it (higher up, a heavy body's thighs showed
+        // through the skirt).
+        let skirt_z = |pick: fn(f32, f32) -> f32, from: f32| {
+            self.mesh.group("helper-skirt").map_or(from, |g| {
+                g.triangles
+                    .iter()
+                    .flatten()
+                    .map(|&v| at(v).z)
+                    .fold(from, pick)
+            })
+        };
+        let (tuck_z, bare_below_z) = match outfit.legwear {
+            Legwear::Trousers => (f32::NEG_INFINITY, f32::INFINITY),
+            Legwear::Skirt => (skirt_z(f32::max, f32::NEG_INFINITY) - 0.03, knee_z),
+            Legwear::LongSkirt => (
+                skirt_z(f32::max, f32::NEG_INFINITY) - 0.03,
+                skirt_z(f32::min, f32::INFINITY) + 0.05,
+            ),
+        };
         // Hair: MakeHuman's hair helper reaches the shoulder blades and over the face; cut
         // short at the jaw and above the brows in front.
         let centre = |name: &str| {
@@ -424,9 +443,11 @@ impl Human {
                     Some(Layer::Hair) if !keep_hair((at(t[0]) + at(t[1]) + at(t[2])) / 3.0) => {
                         continue;
                     }
+                    // The hem along a row of the helper's vertices: a triangle goes when any
+                    // corner is below it (both halves of a quad go together).
                     Some(Layer::Trousers)
                         if short_skirt
-                            && (at(t[0]).z + at(t[1]).z + at(t[2]).z) / 3.0 < knee_z - 0.05 =>
+                            && at(t[0]).z.min(at(t[1]).z).min(at(t[2]).z) < knee_z - 0.05 =>
                     {
                         continue;
                     }
@@ -437,9 +458,19 @@ impl Human {
                     {
                         continue;
                     }
+                    Some(Layer::Skin)
+                        if skirt
+                            && leg(bone)
+                            && at(t[0]).z.min(at(t[1]).z).min(at(t[2]).z) > bare_below_z =>
+                    {
+                        continue;
+                    }
                     Some(l) => l,
                     None if uncovered(bone) => continue,
                     None if bone.starts_with("foot") || bone.starts_with("toe") => Layer::Shoes,
+                    // The shirt is tucked into a skirt: the bodysuit under it is not drawn
+                    // (it showed through the skirt on heavy bodies).
+                    None if (at(t[0]).z + at(t[1]).z + at(t[2]).z) / 3.0 < tuck_z => continue,
                     None if bone.starts_with("upperarm")
                         || bone.starts_with("clavicle")
                         || bone.starts_with("shoulder")
