@@ -1109,3 +1109,168 @@ for m in got:
     );
     Ok(())
 }
+
+/// gazebo_ros_diff_drive with `odometrySource` world publishes the model's full world pose on
+/// /odom and /tf's odom -> base: the arm car's base_link stands 8 cm up (the tutorial car's:
+/// wheel axles 3 cm below it, wheels of radius 5 cm; the caster reaches as low), and both
+/// transports say so (rospy through the master, a Cyclone DDS peer on `rt/odom` and `rt/tf`), level,
+/// /tf equal to /odom.
+#[test]
+fn both_transports_carry_the_bases_height_and_tilt_on_odom_and_tf() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(cyclonedds) = rover_tests::pypi("cyclonedds", "11.0.1") else {
+        return Ok(());
+    };
+    let mut graph = RosGraph::start()?;
+    let examples = repo().join("examples/ros2");
+    let python_path = std::env::join_paths([&cyclonedds, &examples])?;
+    let arm_car = repo().join("assets/robots/my_robot_arm.urdf.xacro");
+    let arm_car = arm_car.to_string_lossy();
+    graph.spawn_rover(10.0, &["--ros2", "--no-detector", "--robot", &arm_car])?;
+    let ros2_peer = graph.dir.path().join("ros2_peer.py");
+    std::fs::write(
+        &ros2_peer,
+        r#"
+import os, time
+from dataclasses import dataclass
+import cyclonedds.idl.types as types
+from cyclonedds.idl import IdlStruct
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+from rover_msgs import Header, Odometry, Quaternion, Vector3
+
+@dataclass
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3
+    rotation: Quaternion
+
+@dataclass
+class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header
+    child_frame_id: str
+    transform: Transform
+
+@dataclass
+class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    transforms: types.sequence[TransformStamped]
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
+odom = DataReader(dp, Topic(dp, 'rt/odom', Odometry), qos=qos)
+tf = DataReader(dp, Topic(dp, 'rt/tf', TFMessage), qos=qos)
+end = time.time() + 6
+while time.time() < end:
+    for m in odom.take(N=1000):
+        p = m.pose.pose
+        print('o %d %d %.9f %.9f %.9f %.9f %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec,
+              p.position.z, p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w))
+    for m in tf.take(N=1000):
+        for t in m.transforms:
+            if t.header.frame_id == 'odom' and t.child_frame_id == 'base_link':
+                r, q = t.transform.translation, t.transform.rotation
+                print('t %d %d %.9f %.9f %.9f %.9f %.9f' % (t.header.stamp.sec,
+                      t.header.stamp.nanosec, r.z, q.x, q.y, q.z, q.w))
+    time.sleep(0.1)
+"#,
+    )?;
+    let mut peer = graph.command("python3");
+    peer.arg(&ros2_peer).env("PYTHONPATH", &python_path);
+    graph.spawn("ros2_peer", peer)?;
+    let ros1 = graph.run_python(
+        "ros1_odom.py",
+        r#"
+import rospy
+from nav_msgs.msg import Odometry
+from tf2_msgs.msg import TFMessage
+lines = []
+def on_odom(m):
+    p = m.pose.pose
+    lines.append('o %d %d %.9f %.9f %.9f %.9f %.9f' % (m.header.stamp.secs, m.header.stamp.nsecs,
+                 p.position.z, p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w))
+def on_tf(m):
+    for t in m.transforms:
+        if t.header.frame_id == 'odom' and t.child_frame_id == 'base_link':
+            r, q = t.transform.translation, t.transform.rotation
+            lines.append('t %d %d %.9f %.9f %.9f %.9f %.9f' % (t.header.stamp.secs,
+                         t.header.stamp.nsecs, r.z, q.x, q.y, q.z, q.w))
+rospy.init_node('odom_reader')
+rospy.Subscriber('/odom', Odometry, on_odom)
+rospy.Subscriber('/tf', TFMessage, on_tf)
+rospy.sleep(5.0)
+print('\n'.join(lines))
+"#,
+        Duration::from_secs(30),
+    )?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    let ros2 = graph.log("ros2_peer");
+    // (kind, stamp in ns, z, quaternion)
+    type Pose3 = (char, i64, f64, [f64; 4]);
+    let parse = |text: &str| -> Vec<Pose3> {
+        text.lines()
+            .filter_map(|l| {
+                let f: Vec<&str> = l.split(' ').collect();
+                let kind = match *f.first()? {
+                    "o" => 'o',
+                    "t" => 't',
+                    _ => return None,
+                };
+                let n = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok());
+                let stamp = f.get(1)?.parse::<i64>().ok()? * 1_000_000_000
+                    + f.get(2)?.parse::<i64>().ok()?;
+                Some((kind, stamp, n(3)?, [n(4)?, n(5)?, n(6)?, n(7)?]))
+            })
+            .collect()
+    };
+    for (transport, text) in [("ROS 1", ros1.as_str()), ("ROS 2", ros2.as_str())] {
+        let poses = parse(text);
+        let odom: Vec<&Pose3> = poses.iter().filter(|p| p.0 == 'o').collect();
+        let tf: Vec<&Pose3> = poses.iter().filter(|p| p.0 == 't').collect();
+        let z_range = odom.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            (lo.min(p.2), hi.max(p.2))
+        });
+        let tilt = odom
+            .iter()
+            .map(|p| p.3[0].hypot(p.3[1]))
+            .fold(0.0, f64::max);
+        println!(
+            "{transport}: {} /odom, {} /tf odom -> base_link; z {:.4}..{:.4} m, tilt quaternion \
+             x, y up to {tilt:.5}",
+            odom.len(),
+            tf.len(),
+            z_range.0,
+            z_range.1
+        );
+        ensure!(
+            odom.len() >= 50 && tf.len() >= 50,
+            "{transport}: {} /odom, {} /tf:\n{text}",
+            odom.len(),
+            tf.len()
+        );
+        ensure!(
+            z_range.0 > 0.075 && z_range.1 < 0.085,
+            "{transport}: the base's height on /odom is {:.4}..{:.4} m, not 0.08 m",
+            z_range.0,
+            z_range.1
+        );
+        ensure!(tilt < 0.01, "{transport}: the standing car tilts ({tilt})");
+        let mut matched = 0;
+        for t in &tf {
+            if let Some(o) = odom.iter().find(|o| o.1 == t.1) {
+                ensure!(
+                    (o.2 - t.2).abs() < 1e-9
+                        && o.3.iter().zip(&t.3).all(|(a, b)| (a - b).abs() < 1e-9),
+                    "{transport}: /tf {t:?} differs from /odom {o:?}"
+                );
+                matched += 1;
+            }
+        }
+        ensure!(matched >= 50, "{transport}: {matched} /tf stamps on /odom");
+    }
+    Ok(())
+}

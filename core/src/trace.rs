@@ -332,6 +332,7 @@ mod tests {
             sim_time_s: t,
             ground_truth: Default::default(),
             odometry: Default::default(),
+            odometry_z_roll_pitch: [0.0; 3],
             cmd: Default::default(),
             wheel_targets_radps: [0.0; 2],
             wheel_measured_radps: [0.0; 2],

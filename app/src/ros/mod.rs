@@ -61,6 +61,7 @@ pub(crate) mod shared {
     };
     pub(crate) use super::joint_states::sample as sample_joints;
     pub(crate) use super::laser::capture as capture_scan;
+    pub(crate) use super::odom::odom_pose;
     pub(crate) use super::tf::{joints_on_tf, static_transforms};
 }
 use controllers::ControllerCommands;

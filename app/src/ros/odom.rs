@@ -4,7 +4,7 @@
 use anyhow::Result;
 use rover_ros1::msgs::{self, Quaternion, Vector3};
 use rover_ros1::{Node, Publisher};
-use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
+use rover_sim::{ControlSample, ODOM_POSE_COVARIANCE_DIAGONAL};
 
 use super::convert::{header, seq_of};
 use super::events::{ControlUpdate, TopicFamily};
@@ -45,20 +45,72 @@ impl Odom {
     }
 }
 
+/// The base's pose in the odometry frame as /odom and /tf's odom -> base carry it, on either
+/// transport: position (x, y, z in m) and orientation (a unit quaternion x, y, z, w). With
+/// `odometrySource` world that is the base's full pose, height and tilt included, as
+/// gazebo_ros_diff_drive publishes the model's world pose; with encoder it is planar.
+pub(crate) fn odom_pose(sample: &ControlSample) -> ([f64; 3], [f64; 4]) {
+    let o = sample.odometry;
+    let [z, roll, pitch] = sample.odometry_z_roll_pitch;
+    // Roll, then pitch, then yaw (REP-103's fixed-axis x-y-z), as tf's setRPY builds it.
+    let (sr, cr) = (roll / 2.0).sin_cos();
+    let (sp, cp) = (pitch / 2.0).sin_cos();
+    let (sy, cy) = (o.yaw_rad / 2.0).sin_cos();
+    let quaternion = [
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    ];
+    ([o.x_m, o.y_m, z], quaternion)
+}
+
 impl TopicFamily for Odom {
     fn control(&mut self, update: &ControlUpdate) {
         let o = update.sample.odometry;
+        let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(&update.sample);
         let msg = &mut self.msg;
         msg.header.seq = seq_of(&self.publisher);
         msg.header.stamp_s = update.sample.sim_time_s;
-        msg.position = Vector3 {
-            x: o.x_m,
-            y: o.y_m,
-            z: 0.0,
+        msg.position = Vector3 { x, y, z };
+        msg.orientation = Quaternion {
+            x: qx,
+            y: qy,
+            z: qz,
+            w: qw,
         };
-        msg.orientation = Quaternion::from_yaw(o.yaw_rad);
         msg.linear.x = o.linear_mps;
         msg.angular.z = o.angular_radps;
         self.publisher.publish(msg);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_odometry_orientation_is_roll_then_pitch_then_yaw() {
+        let mut sample = ControlSample {
+            sim_time_s: 0.0,
+            ground_truth: Default::default(),
+            odometry: Default::default(),
+            odometry_z_roll_pitch: [0.05, 0.1, -0.2],
+            cmd: Default::default(),
+            wheel_targets_radps: [0.0; 2],
+            wheel_measured_radps: [0.0; 2],
+        };
+        sample.odometry.x_m = 1.0;
+        sample.odometry.yaw_rad = 2.5;
+        let (position, [x, y, z, w]) = odom_pose(&sample);
+        assert_eq!(position, [1.0, 0.0, 0.05]);
+        let expected = glam::DQuat::from_euler(glam::EulerRot::ZYX, 2.5, -0.2, 0.1);
+        let got = glam::DQuat::from_xyzw(x, y, z, w);
+        assert!(got.angle_between(expected) < 1e-12, "{got} vs {expected}");
+        // Planar odometry (encoder, or level ground) is a rotation about z alone.
+        sample.odometry_z_roll_pitch = [0.0; 3];
+        let (_, q) = odom_pose(&sample);
+        let (s, c) = (1.25_f64).sin_cos();
+        assert_eq!(q, [0.0, 0.0, s, c]);
     }
 }

@@ -9,6 +9,7 @@ use rover_sim::{CameraInfo, JointKind, Pose, RobotModel, link_from_optical};
 
 use super::convert::{quat, transform, vec3};
 use super::events::{ControlUpdate, Start, TopicFamily};
+use super::odom::odom_pose;
 use super::plan::{JointSource, RosPlan};
 
 /// Publishes `/tf` and `/tf_static`.
@@ -68,14 +69,15 @@ impl TopicFamily for Tf {
         if self.odom_tf
             && let Some(tr) = next.next()
         {
-            let o = update.sample.odometry;
+            let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(&update.sample);
             tr.header.stamp_s = t;
-            tr.translation = Vector3 {
-                x: o.x_m,
-                y: o.y_m,
-                z: 0.0,
+            tr.translation = Vector3 { x, y, z };
+            tr.rotation = Quaternion {
+                x: qx,
+                y: qy,
+                z: qz,
+                w: qw,
             };
-            tr.rotation = Quaternion::from_yaw(o.yaw_rad);
         }
         for (&i, tr) in self.joints_on_tf.iter().zip(next) {
             if let Some(s) = update.joints.get(i) {

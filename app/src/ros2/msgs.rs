@@ -84,19 +84,6 @@ impl Default for Quaternion {
     }
 }
 
-impl Quaternion {
-    /// A rotation by `yaw_rad` about +z.
-    pub fn from_yaw(yaw_rad: f64) -> Self {
-        let (s, c) = (yaw_rad / 2.0).sin_cos();
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: s,
-            w: c,
-        }
-    }
-}
-
 /// `geometry_msgs/msg/Twist`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Twist {

@@ -13,7 +13,7 @@ use super::msgs::{self, Covariance, Header, Lent, RosMessage, Time};
 use crate::ros::RosPlan;
 use crate::ros::shared::{
     ArmSample, BOUNDING_BOXES_TOPIC, DETECTION_IMAGE_TOPIC, DetectionImages, Detections,
-    FOUND_OBJECT_TOPIC, ImageFrame, JointSample, joints_on_tf,
+    FOUND_OBJECT_TOPIC, ImageFrame, JointSample, joints_on_tf, odom_pose,
 };
 use rover_core::{ArmMode, ReachState};
 
@@ -345,6 +345,7 @@ impl Topics {
     pub(super) fn control(&mut self, sample: &ControlSample, joints: &[JointSample]) {
         let stamp = Time::from_secs(sample.sim_time_s);
         let o = sample.odometry;
+        let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(sample);
         put(
             &self.clock,
             &mut self.mcap,
@@ -353,12 +354,13 @@ impl Topics {
         );
         let msg = &mut self.odom_msg;
         msg.header.stamp = stamp;
-        msg.pose.pose.position = msgs::Vector3 {
-            x: o.x_m,
-            y: o.y_m,
-            z: 0.0,
+        msg.pose.pose.position = msgs::Vector3 { x, y, z };
+        msg.pose.pose.orientation = msgs::Quaternion {
+            x: qx,
+            y: qy,
+            z: qz,
+            w: qw,
         };
-        msg.pose.pose.orientation = msgs::Quaternion::from_yaw(o.yaw_rad);
         msg.twist.twist.linear.x = o.linear_mps;
         msg.twist.twist.angular.z = o.angular_radps;
         put(&self.odom, &mut self.mcap, stamp, msg);

@@ -45,6 +45,10 @@ pub struct ControlSample {
     pub ground_truth: Odometry,
     /// Odometry from the plugin's configured `odometrySource`.
     pub odometry: Odometry,
+    /// The base's height (m), roll and pitch (rad) that go with `odometry` in 3D: with
+    /// `odometrySource` world, the base's own (gazebo_ros_diff_drive publishes the model's full
+    /// world pose, `parent->WorldPose()`); with encoder, zeros (its odometry is planar).
+    pub odometry_z_roll_pitch: [f64; 3],
     /// The cmd_vel in force (zero after a command timeout).
     pub cmd: Twist,
     /// Wheel joint speed targets sent to the motors (rad/s).
@@ -272,10 +276,19 @@ impl Simulation {
     }
 
     fn sample(&self, now: f64) -> ControlSample {
+        let odometry_z_roll_pitch = match self.drive.config().odometry_source {
+            OdometrySource::World => {
+                let base = self.world_from_base();
+                let (_, pitch, roll) = base.rotation.to_euler(glam::EulerRot::ZYX);
+                [base.translation.z, roll, pitch].map(f64::from)
+            }
+            OdometrySource::Encoder => [0.0; 3],
+        };
         ControlSample {
             sim_time_s: now,
             ground_truth: self.ground_truth(),
             odometry: self.odometry(),
+            odometry_z_roll_pitch,
             cmd: self.drive.command(),
             wheel_targets_radps: self.drive.wheel_targets_radps(),
             wheel_measured_radps: self.wheel_speeds_radps(),
