@@ -49,7 +49,9 @@ with Reader(Path(sys.argv[1])) as reader:
             print('image', k, int(np.array_equal(image, frame)), m.encoding, m.header.frame_id)
         elif c.msgtype == 'nav_msgs/msg/Odometry':
             p = m.pose.pose
-            yaw = 2 * math.atan2(p.orientation.z, p.orientation.w)
+            # The heading of a base that may tilt (odometrySource world), as tf reads it.
+            q = p.orientation
+            yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
             print('odom %d %d %.9f %.9f %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec,
                                                  p.position.x, p.position.y, yaw))
             assert t == m.header.stamp.sec * 10**9 + m.header.stamp.nanosec

@@ -355,24 +355,22 @@ impl Scene {
                 continue;
             };
             skin.pose(body.phase_rad, person.stride_m());
-            if body.look.1 != person.outfit || skin.positions().len() != body.skin.positions().len()
-            {
-                // Other triangles: new buffers for the same meshes (a MakeHuman body has
-                // every layer, worn or not, so the layers line up).
-                let (vertices, meshes) = body_meshes(device, &skin);
-                if meshes.len() != body.instances.len() {
-                    tracing::warn!("{}: cannot be re-dressed", person.name);
-                    continue;
-                }
-                body.levels.clear();
-                for (&(instance, _), (mesh, runs, _)) in body.instances.iter().zip(meshes) {
-                    if let Some(slot) = self.meshes.get_mut(instance) {
-                        *slot = mesh;
-                    }
-                    body.levels.push(runs);
-                }
-                body.vertices = vertices;
+            // New buffers for the same meshes: an outfit has its own triangles, and a shape
+            // its own coarser levels (reusing the last body's made an image depend on the
+            // one before it). A MakeHuman body has every layer, worn or not, so they line up.
+            let (vertices, meshes) = body_meshes(device, &skin);
+            if meshes.len() != body.instances.len() {
+                tracing::warn!("{}: cannot be re-dressed", person.name);
+                continue;
             }
+            body.levels.clear();
+            for (&(instance, _), (mesh, runs, _)) in body.instances.iter().zip(meshes) {
+                if let Some(slot) = self.meshes.get_mut(instance) {
+                    *slot = mesh;
+                }
+                body.levels.push(runs);
+            }
+            body.vertices = vertices;
             body.skin = skin;
             body.stride_m = person.stride_m();
             body.look = look_of(person);
