@@ -542,8 +542,9 @@ fn expand_tree(tree: &str) -> Vec<(Vec<String>, Option<String>)> {
     out
 }
 
-/// Paths written in code outside `use` declarations that start with `crate::`, `super::` or
-/// `self::`.
+/// Paths written in code outside `use` declarations that start with `crate::`, `super::`,
+/// `self::`, or any other lower-case name followed by `::` (`merge::f()` names the child module
+/// `merge`; [`CrateSources::absolute`] keeps only those that are the file's child modules).
 fn inline_paths(code: &str) -> Vec<Vec<String>> {
     let b = code.as_bytes();
     let mut use_spans = Vec::new();
@@ -554,32 +555,39 @@ fn inline_paths(code: &str) -> Vec<Vec<String>> {
         i = end;
     }
     let mut out = Vec::new();
-    for start_word in ["crate", "super", "self"] {
-        let mut i = 0;
-        while let Some(at) = find_word(code, start_word, i) {
-            i = at + start_word.len();
-            if use_spans.iter().any(|s| s.contains(&at))
-                || !code[i..].starts_with("::")
-                || at >= 2 && &b[at - 2..at] == b"::"
-            {
-                continue;
-            }
-            let mut path = vec![start_word.to_owned()];
-            let mut j = i;
-            while code[j..].starts_with("::") {
-                j += 2;
-                let seg: String = code[j..]
-                    .chars()
-                    .take_while(|c| is_ident(*c as u8))
-                    .collect();
-                if seg.is_empty() {
-                    break;
-                }
-                j += seg.len();
-                path.push(seg);
-            }
-            out.push(path);
+    let mut at = 0;
+    while at < b.len() {
+        let starts_word = (b[at].is_ascii_lowercase() || b[at] == b'_')
+            && (at == 0 || !is_ident(b[at - 1]))
+            && !(at >= 2 && &b[at - 2..at] == b"::");
+        if !starts_word || use_spans.iter().any(|s| s.contains(&at)) {
+            at += 1;
+            continue;
         }
+        let first: String = code[at..]
+            .chars()
+            .take_while(|c| is_ident(*c as u8))
+            .collect();
+        let mut j = at + first.len();
+        at = j;
+        if !code[j..].starts_with("::") {
+            continue;
+        }
+        let mut path = vec![first];
+        while code[j..].starts_with("::") {
+            j += 2;
+            let seg: String = code[j..]
+                .chars()
+                .take_while(|c| is_ident(*c as u8))
+                .collect();
+            if seg.is_empty() {
+                break;
+            }
+            j += seg.len();
+            path.push(seg);
+        }
+        at = j;
+        out.push(path);
     }
     out
 }

@@ -38,6 +38,29 @@ fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Writes `files` (path under `src`, text) and checks that the import circle found in the
+/// crate at `src` takes in both `expected` files.
+fn assert_circle(
+    src: &std::path::Path,
+    files: [(&str, &str); 2],
+    expected: [&str; 2],
+) -> anyhow::Result<()> {
+    for (path, text) in files {
+        std::fs::write(src.join(path), text)?;
+    }
+    let names: Vec<String> = CrateSources::read(src)?
+        .find_cycle()
+        .iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    assert!(
+        expected.iter().all(|e| names.iter().any(|n| n == e)),
+        "expected {expected:?} in a circle, found {names:?}"
+    );
+    Ok(())
+}
+
 #[test]
 fn the_circle_check_finds_a_known_circle_and_follows_reexports() -> anyhow::Result<()> {
     // A crate where a.rs uses b's item through the root's re-export, and b.rs uses a: a circle
@@ -53,25 +76,35 @@ fn the_circle_check_finds_a_known_circle_and_follows_reexports() -> anyhow::Resu
         src.join("a.rs"),
         "use crate::Thing;\npub struct Other(Thing);\n",
     )?;
-    std::fs::write(src.join("b/mod.rs"), "pub(crate) mod inner;\n")?;
-    std::fs::write(
-        src.join("b/inner.rs"),
-        "pub struct Thing;\nfn f() -> Option<crate::a::Other> { None }\n// crate::c::Ignored\n",
+    let inner =
+        "pub struct Thing;\nfn f() -> Option<crate::a::Other> { None }\n// crate::c::Ignored\n";
+    assert_circle(
+        &src,
+        [
+            ("b/mod.rs", "pub(crate) mod inner;\n"),
+            ("b/inner.rs", inner),
+        ],
+        ["a.rs", "b/inner.rs"],
     )?;
-    let sources = CrateSources::read(&src)?;
-    let cycle = sources.find_cycle();
-    let names: Vec<String> = cycle
-        .iter()
-        .flatten()
-        .map(|p| p.display().to_string())
-        .collect();
-    assert!(
-        names.contains(&"a.rs".to_owned()) && names.contains(&"b/inner.rs".to_owned()),
-        "expected a.rs <-> b/inner.rs, found {names:?}"
-    );
     // Without the back edge there is none.
     std::fs::write(src.join("b/inner.rs"), "pub struct Thing;\n")?;
     assert_eq!(CrateSources::read(&src)?.find_cycle(), None);
+    // A parent naming its child inline (`inner::f()`, no `use`) while the child uses the
+    // parent: a circle too.
+    assert_circle(
+        &src,
+        [
+            (
+                "b/mod.rs",
+                "pub(crate) mod inner;\npub struct Shared;\nfn g() { inner::f(); }\n",
+            ),
+            (
+                "b/inner.rs",
+                "pub struct Thing;\npub fn f() -> Option<super::Shared> { None }\n",
+            ),
+        ],
+        ["b/mod.rs", "b/inner.rs"],
+    )?;
     Ok(())
 }
 

@@ -12,7 +12,7 @@ use rover_core::{
 use crate::cli::args::{
     DatasetArgs, DatasetFormat, DatasetImageFormat, Randomize, cores, spare_detect_threads,
 };
-use crate::cli::{Interrupted, stop_on_signals};
+use crate::cli::signals::{Interrupted, stop_on_signals};
 
 impl DatasetImageFormat {
     pub(crate) fn format(self) -> ImageFormat {

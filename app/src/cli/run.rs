@@ -17,7 +17,7 @@ use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
 pub(crate) fn run(args: RunArgs) -> Result<()> {
-    let stop = super::stop_on_signals()?;
+    let stop = super::signals::stop_on_signals()?;
     if !args.headless {
         return run_window(args, stop);
     }
@@ -161,7 +161,7 @@ const LONG_RECORDING_S: f64 = 1800.0;
 
 /// How a run ends once its files are written: a recording that could not be written in full
 /// (the file sink stopped: disk full, file removed) is an error; a run ended by a signal says
-/// so and exits with 130 ([`super::Interrupted`]).
+/// so and exits with 130 ([`super::signals::Interrupted`]).
 fn end_of_run(
     record_failed: Option<String>,
     record: Option<&std::path::Path>,
@@ -182,7 +182,7 @@ fn end_of_run(
         say!(
             "interrupted by a signal at {sim_time_s:.2} s sim time: the trace and recording end there, complete"
         );
-        return Err(super::Interrupted.into());
+        return Err(super::signals::Interrupted.into());
     }
     Ok(())
 }

@@ -11,8 +11,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::finish::{DatasetProgress, DatasetSpec, DatasetSummary, disk_error, finish};
 use super::store::{MANIFEST, Manifest, Split, Store, write_whole};
-use super::{DatasetProgress, DatasetSpec, DatasetSummary, disk_error, finish};
 use crate::error::{CoreError, Result};
 use crate::shard::{ShardIndex, ShardManifest, check_shard_set, not_one_set};
 
