@@ -5,6 +5,7 @@
 //! checks need the CPU). Where ROS or ../shared is missing they skip, counted and listed by
 //! `./test` (a failure under CI=true or --strict; `./test` installs the ROS packages).
 
+use std::ffi::{OsStr, OsString};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -246,6 +247,16 @@ impl RosGraph {
         let mut c = self.command(PYTHON);
         c.arg(&path);
         self.run(c, timeout)
+    }
+
+    /// Starts the Python `script` as the child `ros2_peer` (its output in that log), with
+    /// `python_path` (see [`both_transports`]).
+    fn spawn_ros2_peer(&mut self, python_path: &OsStr, script: &str) -> Result<()> {
+        let path = self.dir.path().join("ros2_peer.py");
+        std::fs::write(&path, script)?;
+        let mut peer = self.command("python3");
+        peer.arg(&path).env("PYTHONPATH", python_path);
+        self.spawn("ros2_peer", peer)
     }
 
     /// Starts rover with TIAGo (`urdf`), its wheels driven, and `extra` arguments.
@@ -1001,25 +1012,34 @@ fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Resul
     Ok(())
 }
 
+/// A ROS master for a run with both bridges: the tests' lock, the graph, and the PYTHONPATH of
+/// a Cyclone DDS peer (cyclonedds and examples/ros2's `rover_msgs`). `None` with the skip
+/// recorded (a failure in strict mode) when ROS or the cyclonedds wheel is missing.
+fn both_transports() -> Result<Option<(std::sync::MutexGuard<'static, ()>, RosGraph, OsString)>> {
+    let one = lock();
+    if let Some(why) = missing_ros() {
+        skip(&why)?;
+        return Ok(None);
+    }
+    let Some(cyclonedds) = rover_tests::pypi("cyclonedds", "11.0.1") else {
+        return Ok(None);
+    };
+    let graph = RosGraph::start()?;
+    let python_path = std::env::join_paths([cyclonedds, repo().join("examples/ros2")])?;
+    Ok(Some((one, graph, python_path)))
+}
+
 /// `--ros` and `--ros2` in one run: a Cyclone DDS peer drives the car on `rt/cmd_vel` while a
 /// rospy node reads `/odom` through the ROS 1 master, and the DDS peer reads `rt/odom` too;
 /// both see the same odometry.
 #[test]
 fn the_ros1_and_ros2_bridges_run_at_once() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing_ros() {
-        return skip(&why);
-    }
-    let Some(cyclonedds) = rover_tests::pypi("cyclonedds", "11.0.1") else {
+    let Some((_one, mut graph, python_path)) = both_transports()? else {
         return Ok(());
     };
-    let mut graph = RosGraph::start()?;
-    let examples = repo().join("examples/ros2");
-    let python_path = std::env::join_paths([&cyclonedds, &examples])?;
     graph.spawn_rover(12.0, &["--ros2", "--no-detector"])?;
-    let ros2_peer = graph.dir.path().join("ros2_peer.py");
-    std::fs::write(
-        &ros2_peer,
+    graph.spawn_ros2_peer(
+        &python_path,
         r#"
 import os, time
 from cyclonedds.domain import DomainParticipant
@@ -1044,9 +1064,6 @@ for m in got:
     print('o %d %d %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec, m.pose.pose.position.x))
 "#,
     )?;
-    let mut peer = graph.command("python3");
-    peer.arg(&ros2_peer).env("PYTHONPATH", &python_path);
-    graph.spawn("ros2_peer", peer)?;
     let ros1 = graph.run_python(
         "ros1_odom.py",
         r#"
@@ -1117,48 +1134,22 @@ for m in got:
 /// /tf equal to /odom.
 #[test]
 fn both_transports_carry_the_bases_height_and_tilt_on_odom_and_tf() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing_ros() {
-        return skip(&why);
-    }
-    let Some(cyclonedds) = rover_tests::pypi("cyclonedds", "11.0.1") else {
+    let Some((_one, mut graph, python_path)) = both_transports()? else {
         return Ok(());
     };
-    let mut graph = RosGraph::start()?;
-    let examples = repo().join("examples/ros2");
-    let python_path = std::env::join_paths([&cyclonedds, &examples])?;
     let arm_car = repo().join("assets/robots/my_robot_arm.urdf.xacro");
     let arm_car = arm_car.to_string_lossy();
     graph.spawn_rover(10.0, &["--ros2", "--no-detector", "--robot", &arm_car])?;
-    let ros2_peer = graph.dir.path().join("ros2_peer.py");
-    std::fs::write(
-        &ros2_peer,
+    graph.spawn_ros2_peer(
+        &python_path,
         r#"
 import os, time
-from dataclasses import dataclass
-import cyclonedds.idl.types as types
-from cyclonedds.idl import IdlStruct
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.sub import DataReader
 from cyclonedds.qos import Qos, Policy
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
-from rover_msgs import Header, Odometry, Quaternion, Vector3
-
-@dataclass
-class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
-    translation: Vector3
-    rotation: Quaternion
-
-@dataclass
-class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
-    header: Header
-    child_frame_id: str
-    transform: Transform
-
-@dataclass
-class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
-    transforms: types.sequence[TransformStamped]
+from rover_msgs import Odometry, TFMessage
 
 dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
 qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
@@ -1179,9 +1170,6 @@ while time.time() < end:
     time.sleep(0.1)
 "#,
     )?;
-    let mut peer = graph.command("python3");
-    peer.arg(&ros2_peer).env("PYTHONPATH", &python_path);
-    graph.spawn("ros2_peer", peer)?;
     let ros1 = graph.run_python(
         "ros1_odom.py",
         r#"

@@ -263,22 +263,10 @@ for m in got:
     Ok(())
 }
 
-/// tf2's, sensor_msgs' and darknet_ros's (ROS 2 branch) messages for the peer.
+/// tf2's (from examples/ros2/rover_msgs.py), sensor_msgs' and darknet_ros's (ROS 2 branch)
+/// messages for the peer.
 const MORE_MESSAGES: &str = r#"
-@dataclass
-class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
-    translation: Vector3
-    rotation: Quaternion
-
-@dataclass
-class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
-    header: Header
-    child_frame_id: str
-    transform: Transform
-
-@dataclass
-class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
-    transforms: types.sequence[TransformStamped]
+from rover_msgs import Transform, TransformStamped, TFMessage
 
 @dataclass
 class Image(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):

@@ -79,6 +79,26 @@ class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
 
 
 @dataclass
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3
+    rotation: Quaternion
+
+
+@dataclass
+class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header
+    child_frame_id: str
+    transform: Transform
+
+
+@dataclass
+class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    """``/tf`` and ``/tf_static``."""
+
+    transforms: types.sequence[TransformStamped]
+
+
+@dataclass
 class BoundingBox(IdlStruct, typename="darknet_ros_msgs::msg::dds_::BoundingBox_"):
     """darknet_ros's ROS 2 branch: ROS 1's ``Class`` is ``class_id``, last."""
 

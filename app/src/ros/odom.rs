@@ -65,20 +65,25 @@ pub(crate) fn odom_pose(sample: &ControlSample) -> ([f64; 3], [f64; 4]) {
     ([o.x_m, o.y_m, z], quaternion)
 }
 
+/// [`odom_pose`] as ROS 1's message types (the odometry's pose and /tf's odom -> base).
+pub(super) fn odom_pose_msg(sample: &ControlSample) -> (Vector3, Quaternion) {
+    let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(sample);
+    let rotation = Quaternion {
+        x: qx,
+        y: qy,
+        z: qz,
+        w: qw,
+    };
+    (Vector3 { x, y, z }, rotation)
+}
+
 impl TopicFamily for Odom {
     fn control(&mut self, update: &ControlUpdate) {
         let o = update.sample.odometry;
-        let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(&update.sample);
         let msg = &mut self.msg;
         msg.header.seq = seq_of(&self.publisher);
         msg.header.stamp_s = update.sample.sim_time_s;
-        msg.position = Vector3 { x, y, z };
-        msg.orientation = Quaternion {
-            x: qx,
-            y: qy,
-            z: qz,
-            w: qw,
-        };
+        (msg.position, msg.orientation) = odom_pose_msg(&update.sample);
         msg.linear.x = o.linear_mps;
         msg.angular.z = o.angular_radps;
         self.publisher.publish(msg);

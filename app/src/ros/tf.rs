@@ -3,13 +3,13 @@
 //! frames), as tf2_msgs/TFMessage.
 
 use anyhow::Result;
-use rover_ros1::msgs::{self, Quaternion, TransformStamped, Vector3};
+use rover_ros1::msgs::{self, TransformStamped};
 use rover_ros1::{Node, Publisher};
 use rover_sim::{CameraInfo, JointKind, Pose, RobotModel, link_from_optical};
 
 use super::convert::{quat, transform, vec3};
 use super::events::{ControlUpdate, Start, TopicFamily};
-use super::odom::odom_pose;
+use super::odom::odom_pose_msg;
 use super::plan::{JointSource, RosPlan};
 
 /// Publishes `/tf` and `/tf_static`.
@@ -69,15 +69,8 @@ impl TopicFamily for Tf {
         if self.odom_tf
             && let Some(tr) = next.next()
         {
-            let ([x, y, z], [qx, qy, qz, qw]) = odom_pose(&update.sample);
             tr.header.stamp_s = t;
-            tr.translation = Vector3 { x, y, z };
-            tr.rotation = Quaternion {
-                x: qx,
-                y: qy,
-                z: qz,
-                w: qw,
-            };
+            (tr.translation, tr.rotation) = odom_pose_msg(&update.sample);
         }
         for (&i, tr) in self.joints_on_tf.iter().zip(next) {
             if let Some(s) = update.joints.get(i) {
