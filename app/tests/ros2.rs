@@ -678,3 +678,127 @@ print('states ' + ','.join(s.replace(' ', '_') for s in seen))
     println!("torso at 0.2 m, the arm at its trajectory's goal, state `look`");
     Ok(())
 }
+
+/// Prints what `ros_discovery_info` says of rover's participant (`node NS NAME READERS
+/// WRITERS`, then a `match` line: whether its Gids are the GUIDs of rover's DDS readers and
+/// writers as DDS discovery reports them), read by a peer that joins late, with Gids of
+/// `GID_BYTES` bytes.
+const DISCOVERY_PEER: &str = r#"
+import os, sys, time, uuid
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.sub import DataReader
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+N = GID_BYTES
+
+@dataclass
+class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
+    data: types.array[types.uint8, N]
+
+@dataclass
+class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):
+    node_namespace: types.bounded_str[256]
+    node_name: types.bounded_str[256]
+    reader_gid_seq: types.sequence[Gid]
+    writer_gid_seq: types.sequence[Gid]
+
+@dataclass
+class ParticipantEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"):
+    gid: Gid
+    node_entities_info_seq: types.sequence[NodeEntitiesInfo]
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+info = DataReader(dp, Topic(dp, 'ros_discovery_info', ParticipantEntitiesInfo), qos=latched)
+pubs = BuiltinDataReader(dp, BuiltinTopicDcpsPublication)
+subs = BuiltinDataReader(dp, BuiltinTopicDcpsSubscription)
+got, writers, readers = [], {}, {}
+end = time.time() + 5
+while time.time() < end:
+    got += info.take(N=10)
+    for e in pubs.take(N=1000):
+        writers[e.key.bytes] = (e.participant_key.bytes, e.topic_name)
+    for e in subs.take(N=1000):
+        readers[e.key.bytes] = (e.participant_key.bytes, e.topic_name)
+    time.sleep(0.05)
+print('messages %d' % len(got))
+for m in got:
+    participant = bytes(m.gid.data[:16])
+    # rover's endpoints as DDS discovery saw them, ros_discovery_info's own writer excepted.
+    dds_w = {k for k, (p, t) in writers.items() if p == participant and t != 'ros_discovery_info'}
+    dds_r = {k for k, (p, t) in readers.items() if p == participant}
+    print('padding %s' % all(b == 0 for b in m.gid.data[16:]))
+    for n in m.node_entities_info_seq:
+        w = {bytes(g.data[:16]) for g in n.writer_gid_seq}
+        r = {bytes(g.data[:16]) for g in n.reader_gid_seq}
+        print('node %s %s %d %d' % (n.node_namespace, n.node_name, len(n.reader_gid_seq), len(n.writer_gid_seq)))
+        print('match %s %s %d %d' % (w == dds_w, r == dds_r, len(dds_r), len(dds_w)))
+        print('topics %s' % ' '.join(sorted(t for k, (p, t) in writers.items() if k in w)))
+"#;
+
+/// `ros2 node list` finds rover: a Cyclone DDS peer that joins 4 s late reads
+/// `ros_discovery_info` (transient local) and finds one node, `/rover`, whose reader and
+/// writer Gids are exactly rover's DDS readers and writers as DDS discovery reports them (one
+/// per topic: cmd_vel, the arm's task in; clock, odom, tf, the camera's ... out), for both Gid
+/// sizes: 24 bytes with `--ros-distro humble`, 16 by default.
+#[test]
+fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    for (salt, gid_bytes, extra) in [(7, 24, &["--ros-distro", "humble"][..]), (8, 16, &[])] {
+        let mut graph = Graph::new(cyclonedds.clone(), domain(salt))?;
+        graph.spawn_rover(14.0, extra)?;
+        std::thread::sleep(Duration::from_secs(4));
+        let script = DISCOVERY_PEER.replace("GID_BYTES", &gid_bytes.to_string());
+        let out = graph.python("discovery.py", &script, Duration::from_secs(30))?;
+        graph.wait_rover(Duration::from_secs(60))?;
+        let lines: Vec<&str> = out.lines().collect();
+        ensure!(
+            lines
+                .iter()
+                .any(|l| l.starts_with("messages ") && *l != "messages 0"),
+            "{gid_bytes}-byte Gids: no ros_discovery_info reached the late peer:\n{out}"
+        );
+        let nodes: Vec<&&str> = lines.iter().filter(|l| l.starts_with("node ")).collect();
+        ensure!(
+            nodes.len() == 1 && nodes[0].starts_with("node / rover "),
+            "{gid_bytes}-byte Gids: expected one node /rover:\n{out}"
+        );
+        let counts: Vec<usize> = nodes[0]
+            .split(' ')
+            .skip(3)
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
+        // The car: cmd_vel and the arm's task in; out at least clock, odom, tf, tf_static,
+        // joint_states, robot_description, image and camera_info, darknet_ros's three.
+        ensure!(
+            counts.len() == 2 && counts[0] == 2 && counts[1] >= 11,
+            "{gid_bytes}-byte Gids: readers, writers {counts:?}:\n{out}"
+        );
+        ensure!(
+            lines.contains(&format!("match True True {} {}", counts[0], counts[1]).as_str())
+                && lines.contains(&"padding True"),
+            "{gid_bytes}-byte Gids: the Gids are not rover's DDS endpoints:\n{out}"
+        );
+        let topics = lines
+            .iter()
+            .find(|l| l.starts_with("topics "))
+            .context("no topics line")?;
+        for t in [
+            "rt/odom",
+            "rt/clock",
+            "rt/tf",
+            "rt/darknet_ros/bounding_boxes",
+        ] {
+            ensure!(
+                topics.split(' ').any(|w| w == t),
+                "{gid_bytes}-byte Gids: {t} is not among the node's writers: {topics}"
+            );
+        }
+    }
+    Ok(())
+}

@@ -206,9 +206,16 @@ pub(crate) struct RosArgs {
     #[arg(long, value_name = "FILE.mcap")]
     pub(crate) record_mcap: Option<PathBuf>,
 
-    /// With --ros: the node name
-    #[arg(long, value_name = "NAME", default_value = "rover", requires = "ros")]
+    /// With --ros or --ros2: the node's name (ROS 2's tools list it, with `ros2 node list`,
+    /// as `/NAME`)
+    #[arg(long, value_name = "NAME", default_value = "rover")]
     pub(crate) ros_name: String,
+
+    /// With --ros2: the ROS 2 distribution the peers run, for what differs on the wire
+    /// (`ros_discovery_info`'s ids: 24 bytes on Humble, 16 from Iron on). Default:
+    /// `ROS_DISTRO` when it names one of these, else lyrical (the newest LTS)
+    #[arg(long, value_enum, value_name = "DISTRO")]
+    pub(crate) ros_distro: Option<crate::ros2::RosDistro>,
 
     /// With --ros: also set /use_sim_time so ROS nodes follow rover's /clock
     #[arg(long, requires = "ros")]
@@ -229,7 +236,12 @@ impl RosArgs {
 
     /// The ROS 2 bridge's settings (--ros2 and/or --record-mcap), `None` when it is off.
     pub(crate) fn ros2_options(&self) -> anyhow::Result<Option<crate::ros2::Ros2Options>> {
-        crate::ros2::Ros2Options::new(self.ros2, self.record_mcap.as_deref())
+        crate::ros2::Ros2Options::new(
+            self.ros2,
+            self.record_mcap.as_deref(),
+            &self.ros_name,
+            self.ros_distro,
+        )
     }
 
     /// The bridge's settings, when --ros is on; `ground_truth`: the run measures it

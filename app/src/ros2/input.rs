@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use rover_core::{Action, ArmMode, InputSource, JointAction};
 use rover_sim::{JointTrajectory, TrajectoryPoint, Twist};
 use rustdds::no_key::DataReader;
-use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
+use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;
 
 use super::dds::{dds_topic, default_qos};
@@ -152,6 +152,16 @@ impl Ros2Input {
             next: 0,
             _participant: participant.clone(),
         })
+    }
+
+    /// The readers' GUIDs, for `ros_discovery_info`.
+    pub(super) fn reader_gids(&self) -> Vec<GUID> {
+        let mut gids = vec![self.cmd_vel.reader.guid(), self.task.reader.guid()];
+        gids.extend(self.controllers.iter().map(|(_, c)| match c {
+            Command::Trajectory(r) => r.reader.guid(),
+            Command::Value(r) => r.reader.guid(),
+        }));
+        gids
     }
 
     /// The next controller command, every topic in turn.

@@ -21,13 +21,17 @@
 //! an MCAP file (`--record-mcap`, `mcap.rs`), with DDS or without; recording never drops an
 //! event (the loop waits for the disk), DDS alone drops what its thread cannot keep up with.
 //!
-//! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): the bridge needs
-//! topics, writers and readers with chosen QoS — what RustDDS offers directly — and nothing of
-//! ros2-client's node machinery (parameters, rosout, actions, async executors) yet; one crate
-//! less to build (RustDDS's cold build: 2 min on 2 cores).
+//! `ros_discovery_info` names rover's node and its readers and writers, so `ros2 node list`
+//! finds it (`discovery.rs`).
+//!
+//! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): ros2-client picks
+//! the distribution, and with it the size of `ros_discovery_info`'s ids, with a cargo feature,
+//! where rover picks it per run (`--ros-distro`); and the bridge needs topics, writers and
+//! readers with chosen QoS, which RustDDS offers directly (docs/ROS2.md).
 
 mod dds;
 mod definitions;
+mod discovery;
 mod input;
 mod mcap;
 mod msgs;
@@ -52,6 +56,7 @@ use topics::{Sinks, Topics};
 
 pub use dds::dds_topic;
 use dds::default_qos;
+pub use discovery::RosDistro;
 pub use input::Ros2Input;
 pub use mcap::McapSummary;
 
@@ -62,18 +67,37 @@ pub struct Ros2Options {
     pub domain_id: Option<u16>,
     /// Record the topics into this MCAP file (`--record-mcap`).
     pub mcap: Option<PathBuf>,
+    /// The node's name as ROS 2's tools list it (`--ros-name`).
+    pub node_name: String,
+    /// The distribution the peers run (`--ros-distro`, else `ROS_DISTRO`, else the newest
+    /// LTS): what `ros_discovery_info`'s ids look like.
+    pub distro: RosDistro,
 }
 
 impl Ros2Options {
     /// `--ros2` (`dds`: its domain from the environment) and/or `--record-mcap`; `None` when
-    /// neither is asked for.
-    pub fn new(dds: bool, mcap: Option<&Path>) -> Result<Option<Self>> {
+    /// neither is asked for. `distro`: `--ros-distro`, when given.
+    pub fn new(
+        dds: bool,
+        mcap: Option<&Path>,
+        node_name: &str,
+        distro: Option<RosDistro>,
+    ) -> Result<Option<Self>> {
         if !dds && mcap.is_none() {
             return Ok(None);
         }
+        let distro = distro
+            .or_else(|| {
+                std::env::var("ROS_DISTRO")
+                    .ok()
+                    .and_then(|name| RosDistro::from_name(&name))
+            })
+            .unwrap_or_default();
         Ok(Some(Self {
             domain_id: if dds { Some(domain_from_env()?) } else { None },
             mcap: mcap.map(Path::to_owned),
+            node_name: node_name.to_owned(),
+            distro,
         }))
     }
 }
@@ -169,14 +193,25 @@ impl Ros2Bridge {
         let sinks = Sinks {
             dds: participant.as_ref().zip(publisher.as_ref()),
             mcap,
+            writers: Vec::new(),
         };
         let topics = Topics::create(sinks, &plan, &robot.description)?;
+        let discovery = match (&participant, &publisher, &input) {
+            (Some(p), Some(publisher), Some(input)) => {
+                let mut d =
+                    discovery::Discovery::new(p, publisher, &options.node_name, options.distro)?;
+                d.add(&input.reader_gids(), topics.writer_gids())?;
+                Some(d)
+            }
+            _ => None,
+        };
         let (tx, rx) = sync_channel::<Event>(64);
         let (buffers, returns) = buffer_pool();
         let thread = std::thread::Builder::new()
             .name("ros2-bridge".into())
             .spawn(move || {
                 let recorded = run(topics, &rx, &returns);
+                drop(discovery);
                 drop(publisher);
                 drop(participant);
                 recorded
@@ -184,7 +219,9 @@ impl Ros2Bridge {
             .context("starting the ROS 2 bridge thread")?;
         if let Some(domain) = options.domain_id {
             tracing::info!(
-                "ROS 2: DDS domain {domain}; cmd_vel on {}, odometry on {}",
+                "ROS 2: node {} ({}'s ros_discovery_info) in DDS domain {domain}; cmd_vel on {}, odometry on {}",
+                options.node_name,
+                options.distro.as_str(),
                 dds_topic(&plan.cmd_topic),
                 dds_topic(&plan.odom_topic)
             );

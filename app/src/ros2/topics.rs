@@ -5,7 +5,7 @@
 use anyhow::Result;
 use rover_sim::{ControlSample, LaserScan, ODOM_POSE_COVARIANCE_DIAGONAL, Pose};
 use rustdds::policy::{Durability, History, Reliability};
-use rustdds::{DomainParticipant, QosPolicies, QosPolicyBuilder};
+use rustdds::{DomainParticipant, GUID, QosPolicies, QosPolicyBuilder, RTPSEntity};
 
 use super::dds::{Writer, default_qos, writer};
 use super::mcap::{McapRecorder, McapSummary};
@@ -102,6 +102,8 @@ pub(super) struct Sinks<'a> {
     pub dds: Option<(&'a DomainParticipant, &'a rustdds::Publisher)>,
     /// The MCAP file, with `--record-mcap`.
     pub mcap: Option<McapRecorder>,
+    /// The DDS writers made so far (for `ros_discovery_info`).
+    pub writers: Vec<GUID>,
 }
 
 impl Sinks<'_> {
@@ -110,7 +112,9 @@ impl Sinks<'_> {
         Ok(Out {
             dds: match self.dds {
                 Some((participant, publisher)) => {
-                    Some(writer(participant, publisher, ros_name, qos)?)
+                    let w = writer(participant, publisher, ros_name, qos)?;
+                    self.writers.push(w.guid());
+                    Some(w)
                 }
                 None => None,
             },
@@ -163,6 +167,8 @@ fn put_image(
 /// The topics and the messages they reuse.
 pub(super) struct Topics {
     mcap: Option<McapRecorder>,
+    /// The DDS writers' GUIDs (none without DDS).
+    writer_gids: Vec<GUID>,
     /// Kept for late joiners (transient local): written once, at creation.
     _robot_description: Out<msgs::Text>,
     clock: Out<msgs::Clock>,
@@ -289,7 +295,13 @@ impl Topics {
                 ..msgs::PointStamped::default()
             },
             arm_last: None,
+            writer_gids: std::mem::take(&mut sinks.writers),
         })
+    }
+
+    /// The DDS writers' GUIDs, for `ros_discovery_info`.
+    pub(super) fn writer_gids(&self) -> &[GUID] {
+        &self.writer_gids
     }
 
     /// Closes the MCAP file, if one is written: what it holds.
