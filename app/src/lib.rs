@@ -11,6 +11,7 @@
 //! The binary `rover` is a thin `main` over [`cli::main`], so tests drive exactly what users
 //! run.
 
+mod bridge;
 pub mod cli;
 pub mod palette;
 pub mod ros;

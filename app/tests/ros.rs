@@ -1262,3 +1262,118 @@ print('\n'.join(lines))
     }
     Ok(())
 }
+
+/// The worked example of a topic family (docs/ARCHITECTURE.md): `/rover/status` reaches a
+/// rospy node through a ROS 1 master and a Cyclone DDS peer as `rt/rover/status` in the same
+/// run, once a second of sim time, the same lines on both, and they say where the odometry
+/// is.
+#[test]
+fn rover_status_reaches_rostopic_and_a_cyclone_peer() -> Result<()> {
+    let Some((_one, mut graph, python_path)) = both_transports()? else {
+        return Ok(());
+    };
+    graph.spawn_rover(12.0, &["--ros2", "--no-detector"])?;
+    graph.spawn_ros2_peer(
+        &python_path,
+        r#"
+import os, time
+from dataclasses import dataclass
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+from cyclonedds.idl import IdlStruct
+from cyclonedds.pub import DataWriter
+from rover_msgs import Twist, Vector3
+
+@dataclass
+class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
+status = DataReader(dp, Topic(dp, 'rt/rover/status', String_), qos=qos)
+cmd = DataWriter(dp, Topic(dp, 'rt/cmd_vel', Twist), qos=qos)
+got = []
+end = time.time() + 9
+while time.time() < end:
+    cmd.write(Twist(linear=Vector3(0.3, 0.0, 0.0), angular=Vector3(0.0, 0.0, 0.0)))
+    got += status.take(N=100)
+    time.sleep(0.1)
+for m in got:
+    print('s ' + m.data)
+"#,
+    )?;
+    let ros1 = graph.run_python(
+        "ros1_status.py",
+        r#"
+import rospy
+from std_msgs.msg import String
+got = []
+rospy.init_node('status_reader')
+rospy.Subscriber('/rover/status', String, lambda m: got.append(m.data))
+rospy.sleep(8.0)
+for m in got:
+    print('s ' + m)
+"#,
+        Duration::from_secs(30),
+    )?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let ros2 = graph.log("ros2_peer");
+    let lines = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter_map(|l| l.strip_prefix("s "))
+            .map(str::to_owned)
+            .collect()
+    };
+    let (from_ros1, from_ros2) = (lines(&ros1), lines(&ros2));
+    println!(
+        "/rover/status: {} lines on ROS 1, {} on ROS 2; first {:?}",
+        from_ros1.len(),
+        from_ros2.len(),
+        from_ros1.first()
+    );
+    // Once a second: 8 s of listening hears 6 to 9 of them.
+    for (name, got) in [("ROS 1", &from_ros1), ("ROS 2", &from_ros2)] {
+        ensure!(
+            (5..=10).contains(&got.len()),
+            "{name}: {} status lines:\nrospy:\n{ros1}\nCyclone:\n{ros2}",
+            got.len()
+        );
+        ensure!(
+            got.iter()
+                .all(|l| l.starts_with("sim ") && l.contains(" odom ") && l.ends_with("arm off")),
+            "{name}: {got:?}"
+        );
+    }
+    ensure!(
+        rows.last().is_some_and(|r| r.odom_x_m > 0.3),
+        "the Cyclone peer did not drive the car"
+    );
+    let common = from_ros1.iter().filter(|l| from_ros2.contains(l)).count();
+    ensure!(
+        common >= 4,
+        "{common} lines in common: {from_ros1:?} vs {from_ros2:?}"
+    );
+    // Each line's sim time and odometry are the trace's at that time.
+    for line in &from_ros1 {
+        let f: Vec<&str> = line.split(' ').collect();
+        let (t, x): (f64, f64) = (f[1].parse()?, f[4].parse()?);
+        let row = rows
+            .iter()
+            .min_by(|a, b| {
+                (a.sim_time_s - t)
+                    .abs()
+                    .total_cmp(&(b.sim_time_s - t).abs())
+            })
+            .context("an empty trace")?;
+        ensure!(
+            (row.sim_time_s - t).abs() < 0.06 && (row.odom_x_m - x).abs() < 0.03,
+            "{line} vs the trace at {:.2} s: odometry x {:.3}",
+            row.sim_time_s,
+            row.odom_x_m
+        );
+    }
+    Ok(())
+}

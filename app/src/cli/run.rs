@@ -130,7 +130,7 @@ fn run_with_ros(
         }
         None => (None, None),
     };
-    let (mut ros2, mut ros2_input) = start_ros2(ros, &robot)?;
+    let (mut ros2, mut ros2_input) = start_ros2(ros, &robot, config.ground_truth)?;
     let result = {
         let mut fan = Fanout::default();
         fan.push_some(ros1.as_mut());
@@ -242,7 +242,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         }
         None => (None, None),
     };
-    let (mut ros2, mut ros2_input) = start_ros2(&args.ros, &robot)?;
+    let (mut ros2, mut ros2_input) = start_ros2(&args.ros, &robot, args.follow.ground_truth)?;
     let summary = {
         let mut fan = Fanout::default();
         fan.push(&mut files);
@@ -297,14 +297,16 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     )
 }
 
-/// The ROS 2 bridge (--ros2 and/or --record-mcap) and its input (with --ros2), when asked for.
+/// The ROS 2 bridge (--ros2 and/or --record-mcap) and its input (with --ros2), when asked for;
+/// `ground_truth`: the run measures it, the bridge publishes it.
 fn start_ros2(
     ros: &super::args::RosArgs,
     robot: &rover_sim::RobotModel,
+    ground_truth: bool,
 ) -> Result<(Option<Ros2Bridge>, Option<Ros2Input>)> {
     Ok(match ros.ros2_options()? {
         Some(options) => {
-            let (bridge, input) = Ros2Bridge::start(&options, robot)?;
+            let (bridge, input) = Ros2Bridge::start(&options, robot, ground_truth)?;
             (Some(bridge), input)
         }
         None => (None, None),
@@ -314,7 +316,7 @@ fn start_ros2(
 /// Stops the ROS 2 bridge and says what it did: events dropped while behind, what the MCAP
 /// file holds (an error when it could not be written in full).
 fn finish_ros2(bridge: &mut Ros2Bridge, mcap: Option<&std::path::Path>) -> Result<()> {
-    let recorded = bridge.finish();
+    let recorded = bridge.finish().flatten();
     if bridge.dropped() > 0 {
         tracing::info!(
             "ROS 2 bridge: {} events dropped while it was behind",

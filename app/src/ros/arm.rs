@@ -1,20 +1,14 @@
-//! The arm's look and reach over ROS: `/rover/arm/task` in (std_msgs/String: `off`, `look`
-//! or `reach`, as rover input), and out `/rover/arm/state` (std_msgs/String, latched, on every
-//! change: `off`, `look`, or `reach <state>`), `/rover/arm/object` and `/rover/arm/goal`
-//! (geometry_msgs/PointStamped in the robot's base frame, every control update while reach
-//! has them: the object point it reaches for and the pre-grasp point the tool is sent to).
+//! The arm's look and reach on ROS 1: `/rover/arm/task` in, its state and points out.
 
 use anyhow::Result;
-use rover_core::{Action, ArmMode, InputSource};
+use rover_core::{Action, InputSource};
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher, Subscriber};
 
-use super::convert::header;
-use super::events::{ArmSample, ControlUpdate, TopicFamily};
-use super::plan::RosPlan;
-
-/// The task topic.
-pub(super) const TASK_TOPIC: &str = "/rover/arm/task";
+use super::convert::{header, seq_of};
+use crate::bridge::RosPlan;
+use crate::bridge::arm::{ArmPoint, ArmWire, GOAL_TOPIC, OBJECT_TOPIC, STATE_TOPIC};
+use crate::bridge::input::{TASK_TOPIC, arm_task};
 
 /// `/rover/arm/task` as rover input.
 #[derive(Debug)]
@@ -34,87 +28,54 @@ impl ArmTaskInput {
 impl InputSource for ArmTaskInput {
     fn poll(&mut self) -> Option<Action> {
         while let Some(msg) = self.sub.try_recv() {
-            match msg.data.trim() {
-                "off" => return Some(Action::Arm(ArmMode::Off)),
-                "look" => return Some(Action::Arm(ArmMode::Look)),
-                "reach" => return Some(Action::Arm(ArmMode::Reach)),
-                other => tracing::warn!(
-                    "{TASK_TOPIC}: \"{other}\" is not a task; expected off, look or reach"
-                ),
+            if let Some(action) = arm_task(&msg.data) {
+                return Some(action);
             }
         }
         None
     }
 }
 
-/// Publishes the arm's state and points.
-pub(super) struct ArmTopics {
+/// The arm's publishers.
+pub(super) struct Arm {
     state: Publisher<msgs::Text>,
     object: Publisher<msgs::PointStamped>,
     goal: Publisher<msgs::PointStamped>,
     text: msgs::Text,
     point: msgs::PointStamped,
-    last: Option<(ArmMode, rover_core::ReachState)>,
 }
 
-impl ArmTopics {
-    /// Advertises the topics.
+impl Arm {
+    /// Advertises the topics (the state latched).
     pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
         Ok(Self {
-            state: node.advertise("/rover/arm/state", 10, true)?,
-            object: node.advertise("/rover/arm/object", 10, false)?,
-            goal: node.advertise("/rover/arm/goal", 10, false)?,
+            state: node.advertise(STATE_TOPIC, 10, true)?,
+            object: node.advertise(OBJECT_TOPIC, 10, false)?,
+            goal: node.advertise(GOAL_TOPIC, 10, false)?,
             text: msgs::Text::default(),
             point: msgs::PointStamped {
                 header: header(&plan.base_frame),
                 ..msgs::PointStamped::default()
             },
-            last: None,
         })
     }
+}
 
-    fn publish_point(&mut self, which: Which, p: Option<[f64; 3]>, stamp_s: f64) {
-        let Some([x, y, z]) = p else {
-            return;
+impl ArmWire for Arm {
+    fn state(&mut self, _stamp_s: f64, text: &str) {
+        self.text.data.clear();
+        self.text.data.push_str(text);
+        self.state.publish(&self.text);
+    }
+
+    fn point(&mut self, which: ArmPoint, stamp_s: f64, [x, y, z]: [f64; 3]) {
+        let publisher = match which {
+            ArmPoint::Object => &mut self.object,
+            ArmPoint::Goal => &mut self.goal,
         };
         self.point.header.stamp_s = stamp_s;
+        self.point.header.seq = seq_of(publisher);
         self.point.point = msgs::Vector3 { x, y, z };
-        let publisher = match which {
-            Which::Object => &mut self.object,
-            Which::Goal => &mut self.goal,
-        };
-        self.point.header.seq = super::convert::seq_of(publisher);
         publisher.publish(&self.point);
-    }
-}
-
-enum Which {
-    Object,
-    Goal,
-}
-
-impl TopicFamily for ArmTopics {
-    fn control(&mut self, update: &ControlUpdate) {
-        let ArmSample {
-            mode,
-            reach,
-            object_base_m,
-            goal_base_m,
-        } = update.arm;
-        if self.last != Some((mode, reach)) {
-            self.last = Some((mode, reach));
-            self.text.data.clear();
-            self.text.data.push_str(mode.as_str());
-            if mode == ArmMode::Reach {
-                self.text.data.push(' ');
-                self.text.data.push_str(reach.as_str());
-            }
-            self.state.publish(&self.text);
-        }
-        if mode == ArmMode::Reach {
-            let t = update.sample.sim_time_s;
-            self.publish_point(Which::Object, object_base_m, t);
-            self.publish_point(Which::Goal, goal_base_m, t);
-        }
     }
 }

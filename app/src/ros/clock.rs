@@ -1,13 +1,12 @@
-//! `/clock` (rosgraph_msgs/Clock): sim time, every control update.
+//! `/clock` (rosgraph_msgs/Clock) on ROS 1.
 
 use anyhow::Result;
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
 
-use super::events::{ControlUpdate, TopicFamily};
-use super::plan::RosPlan;
+use crate::bridge::clock::ClockWire;
 
-/// Publishes `/clock`.
+/// `/clock`'s publisher.
 pub(super) struct Clock {
     publisher: Publisher<msgs::Clock>,
     msg: msgs::Clock,
@@ -15,7 +14,7 @@ pub(super) struct Clock {
 
 impl Clock {
     /// Advertises `/clock`.
-    pub fn advertise(node: &Node, _plan: &RosPlan) -> Result<Self> {
+    pub fn advertise(node: &Node) -> Result<Self> {
         Ok(Self {
             publisher: node.advertise("/clock", 10, false)?,
             msg: msgs::Clock::default(),
@@ -23,9 +22,9 @@ impl Clock {
     }
 }
 
-impl TopicFamily for Clock {
-    fn control(&mut self, update: &ControlUpdate) {
-        self.msg.clock_s = update.sample.sim_time_s;
+impl ClockWire for Clock {
+    fn clock(&mut self, sim_time_s: f64) {
+        self.msg.clock_s = sim_time_s;
         self.publisher.publish(&self.msg);
     }
 }

@@ -6,7 +6,7 @@ use rover_ros1::msgs;
 use rover_ros1::{Node, Subscriber};
 use rover_sim::Twist;
 
-use super::plan::RosPlan;
+use crate::bridge::RosPlan;
 
 /// `/cmd_vel` as rover input: the newest command since the last poll, as manual input (it
 /// takes control from the follower; `--cmd-timeout` applies).

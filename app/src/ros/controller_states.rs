@@ -9,8 +9,8 @@ use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
 
 use super::convert::seq_of;
-use super::events::{ControlUpdate, JointSample, TopicFamily};
-use super::plan::{ControllerTopic, RosPlan};
+use crate::bridge::events::{ControlUpdate, JointSample, TopicFamily};
+use crate::bridge::plan::{ControllerTopic, RosPlan};
 
 enum StatePublisher {
     Position(

@@ -9,7 +9,8 @@ use rover_ros1::msgs;
 use rover_ros1::{Node, Subscriber};
 use rover_sim::{JointTrajectory, TrajectoryPoint};
 
-use super::plan::RosPlan;
+use crate::bridge::RosPlan;
+use crate::bridge::input::poll_in_turn;
 
 enum Topic {
     Value(Subscriber<msgs::Float64>),
@@ -63,25 +64,6 @@ fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
             })
             .collect(),
     }
-}
-
-/// The first command among `topics`, each topic in turn from `*next` on (so that a busy one
-/// does not starve the others); `*next` moves past the one that had it. Shared by the ROS 1
-/// and ROS 2 bridges.
-pub(crate) fn poll_in_turn<T>(
-    topics: &mut [T],
-    next: &mut usize,
-    mut poll: impl FnMut(&mut T) -> Option<JointAction>,
-) -> Option<Action> {
-    let n = topics.len();
-    for k in 0..n {
-        let i = (*next + k) % n;
-        if let Some(action) = poll(&mut topics[i]) {
-            *next = (i + 1) % n;
-            return Some(Action::Joint(action));
-        }
-    }
-    None
 }
 
 impl InputSource for ControllerCommands {

@@ -1,15 +1,14 @@
-//! The first laser's scans (sensor_msgs/LaserScan on its `topicName`, in its `frameName`), at
-//! its update rate.
+//! The laser's scans (sensor_msgs/LaserScan) on ROS 1.
 
 use anyhow::Result;
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
 use rover_sim::LaserScan;
 
-use super::events::TopicFamily;
-use super::plan::RosPlan;
+use crate::bridge::RosPlan;
+use crate::bridge::laser::ScanWire;
 
-/// Publishes the laser's topic (nothing when the robot has no laser).
+/// The scan topic's publisher (none when the robot has no laser).
 pub(super) struct Laser {
     publisher: Option<Publisher<msgs::LaserScan>>,
     msg: msgs::LaserScan,
@@ -29,7 +28,7 @@ impl Laser {
     }
 }
 
-impl TopicFamily for Laser {
+impl ScanWire for Laser {
     fn scan(&mut self, scan: &mut LaserScan) {
         let Some(p) = self.publisher.as_mut() else {
             return;
@@ -47,20 +46,9 @@ impl TopicFamily for Laser {
         msg.scan_time = scan.scan_time_s;
         msg.range_min = scan.range_min_m;
         msg.range_max = scan.range_max_m;
-        // Published from the event's buffer, which stays with the event.
+        // Published from the scan's buffer, which stays with it.
         std::mem::swap(&mut msg.ranges, &mut scan.ranges_m);
         p.publish(msg);
         std::mem::swap(&mut msg.ranges, &mut scan.ranges_m);
-    }
-}
-
-/// The scan to hand over (on the loop thread): `scan` copied, its ranges into the recycled
-/// `ranges_m`.
-pub(crate) fn capture(scan: &LaserScan, mut ranges_m: Vec<f32>) -> LaserScan {
-    ranges_m.clone_from(&scan.ranges_m);
-    LaserScan {
-        frame_id: scan.frame_id.clone(),
-        ranges_m,
-        ..*scan
     }
 }

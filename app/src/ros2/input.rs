@@ -7,7 +7,7 @@
 //! does not decode (a peer's garbage, a wrong type) is one warning per topic; the run goes on.
 
 use anyhow::{Context, Result};
-use rover_core::{Action, ArmMode, InputSource, JointAction};
+use rover_core::{Action, InputSource, JointAction};
 use rover_sim::{JointTrajectory, TrajectoryPoint, Twist};
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
@@ -15,11 +15,8 @@ use serde::de::DeserializeOwned;
 
 use super::dds::{dds_topic, default_qos};
 use super::msgs::{self, RosMessage};
-use crate::ros::RosPlan;
-use crate::ros::shared::poll_in_turn;
-
-/// rover's arm task topic (as the ROS 1 bridge's).
-pub(super) const ARM_TASK_TOPIC: &str = "/rover/arm/task";
+use crate::bridge::RosPlan;
+use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn};
 
 /// A reader of `M` on one topic that warns once about samples it cannot read.
 struct Reader<M: RosMessage + DeserializeOwned> {
@@ -147,7 +144,7 @@ impl Ros2Input {
         }
         Ok(Self {
             cmd_vel: Reader::new(participant, &subscriber, &plan.cmd_topic)?,
-            task: Reader::new(participant, &subscriber, ARM_TASK_TOPIC)?,
+            task: Reader::new(participant, &subscriber, TASK_TOPIC)?,
             controllers,
             next: 0,
             _participant: participant.clone(),
@@ -195,13 +192,8 @@ impl InputSource for Ros2Input {
             return newest;
         }
         while let Some(task) = self.task.next() {
-            match task.data.trim() {
-                "off" => return Some(Action::Arm(ArmMode::Off)),
-                "look" => return Some(Action::Arm(ArmMode::Look)),
-                "reach" => return Some(Action::Arm(ArmMode::Reach)),
-                other => tracing::warn!(
-                    "{ARM_TASK_TOPIC}: \"{other}\" is not a task; expected off, look or reach"
-                ),
+            if let Some(action) = arm_task(&task.data) {
+                return Some(action);
             }
         }
         self.controller()

@@ -3,23 +3,24 @@
 //! ROS install): topic `/odom` is DDS topic `rt/odom`, type `nav_msgs/msg/Odometry` is
 //! `nav_msgs::msg::dds_::Odometry_`, CDR little-endian, domain `ROS_DOMAIN_ID`.
 //!
-//! Like the ROS 1 bridge it is an adapter at the edge: an [`Observer`] that copies what the
-//! session does into a channel for its publishing thread (never waiting: a full channel drops
-//! the event and counts it), and an [`InputSource`] ([`Ros2Input`]) that turns `rt/cmd_vel`
-//! into rover input like a key press. Stamps are sim time; `/clock` carries it.
+//! It is the shared bridge (app/src/bridge/: the plan, the observer, the publishing thread,
+//! the topic families) on this wire: here are the encoders, one file per topic family, each
+//! implementing its family's wire trait with ROS 2's messages (`msgs.rs`) on the topic's sinks
+//! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
+//! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
+//! `laser.rs`, `arm.rs`, `status.rs`; `/robot_description` is written once, at the start
+//! (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
+//! `rt/cmd_vel`, the controllers' commands and `/rover/arm/task` into rover input like a key
+//! press. Stamps are sim time; `/clock` carries it.
 //!
 //! QoS as ROS 2 nodes expect: reliable, volatile, keep last 10 for `/odom`, `/tf`, `/clock` and
-//! the command topic (rclcpp's default).
+//! the command topics (rclcpp's default); sensor data (images, camera_info, scans) best
+//! effort, keep last 5 (rclcpp's SensorDataQoS); `/tf_static` and the other latched topics
+//! transient local, keep last 1 (a late joiner gets them).
 //!
-//! Sensor data (the camera's image and camera_info, the laser's scan) best effort, keep last 5
-//! (rclcpp's SensorDataQoS); `/tf_static` transient local, keep last 1 (a late joiner gets it).
-//!
-//! Carried: `/cmd_vel`, the controllers' commands and `/rover/arm/task` in (`input.rs`);
-//! `/clock`, odometry, `/tf`, `/tf_static`, `/joint_states`, `/robot_description`, the camera's
-//! image and camera_info (and a depth camera's), darknet_ros's boxes and object count, the
-//! arm's state and points, the laser's scan out (`topics.rs`). The same messages can go into
-//! an MCAP file (`--record-mcap`, `mcap.rs`), with DDS or without; recording never drops an
-//! event (the loop waits for the disk), DDS alone drops what its thread cannot keep up with.
+//! With `--record-mcap` the same messages go into an MCAP file (`mcap.rs`), with DDS or
+//! without; recording never drops an event (the loop waits for the disk), DDS alone drops what
+//! its thread cannot keep up with.
 //!
 //! `ros_discovery_info` names rover's node and its readers and writers, so `ros2 node list`
 //! finds it (`discovery.rs`).
@@ -29,36 +30,44 @@
 //! where rover picks it per run (`--ros-distro`); and the bridge needs topics, writers and
 //! readers with chosen QoS, which RustDDS offers directly (docs/ROS2.md).
 
+mod arm;
+mod camera;
+mod clock;
 mod dds;
 mod definitions;
+mod detections;
 mod discovery;
 mod input;
+mod joint_states;
+mod laser;
 mod mcap;
 mod msgs;
-mod topics;
+mod odom;
+mod sinks;
+mod status;
+mod tf;
 
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
-use std::thread::JoinHandle;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use anyhow::{Context, Result};
-use rover_core::{LoopStats, Observer};
-use rover_perception::BoundingBoxes;
-use rover_sim::{ControlSample, LaserScan, Pose, RobotModel, Simulation};
+use rover_sim::RobotModel;
 use rustdds::DomainParticipant;
 
-use crate::ros::RosPlan;
-use crate::ros::shared::{
-    ArmSample, BufferPool, BufferReturn, Detections, ImageFrame, JointSample, arm_sample,
-    buffer_pool, capture_detections, capture_image, capture_scan, sample_joints, static_transforms,
-};
-use topics::{Sinks, Topics};
+use crate::bridge::{Backlog, Bridge, RosPlan, Transport};
+use crate::bridge::{arm as arm_family, camera as camera_family, clock as clock_family};
+use crate::bridge::{darknet, joint_states as joint_states_family, laser as laser_family};
+use crate::bridge::{odom as odom_family, status as status_family, tf as tf_family};
+use sinks::{Sinks, latched_qos};
 
 pub use dds::dds_topic;
 use dds::default_qos;
 pub use discovery::RosDistro;
 pub use input::Ros2Input;
 pub use mcap::McapSummary;
+
+/// Where robot_state_publisher keeps the URDF in ROS 2.
+const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";
 
 /// `--ros2` and `--record-mcap` settings.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -119,54 +128,73 @@ fn domain_from_env() -> Result<u16> {
     }
 }
 
-/// What the loop thread hands the publishing thread.
-enum Event {
-    /// The run starts: the static transforms and the camera's calibration.
-    Start {
-        static_tf: Vec<rover_ros1::msgs::TransformStamped>,
-        camera: Option<rover_sim::CameraInfo>,
-    },
-    /// A control update: its sample, the moving joints (the plan's order), the arm's task.
-    Control(ControlSample, Vec<JointSample>, ArmSample),
-    /// A camera image (and a depth camera's depth image).
-    Image(ImageFrame),
-    /// A laser scan.
-    Scan(LaserScan),
-    /// A detector result.
-    Detections(Detections),
-}
+impl Transport for Sinks<'_> {
+    fn clock(&mut self) -> Result<Box<dyn clock_family::ClockWire>> {
+        Ok(Box::new(clock::Clock::create(self)?))
+    }
 
-/// The observer half of the bridge.
-pub struct Ros2Bridge {
-    tx: Option<SyncSender<Event>>,
-    thread: Option<JoinHandle<Option<Result<McapSummary>>>>,
-    dropped: u64,
-    /// Recording: every event is sent, waiting for the thread when it is behind (nothing
-    /// lost); DDS alone drops what the thread cannot keep up with.
-    lossless: bool,
-    /// The MCAP file's summary, once finished.
-    recorded: Option<Result<McapSummary>>,
-    /// The newest control update's sim time: detector results are published then.
-    now_s: f64,
-    /// Recycled buffers for the events (joints, pixels, ranges).
-    buffers: BufferPool,
-    plan: RosPlan,
-    camera_link: Option<String>,
-}
+    fn odom(&mut self, plan: &RosPlan) -> Result<Box<dyn odom_family::OdomWire>> {
+        Ok(Box::new(odom::Odom::create(self, plan)?))
+    }
 
-impl std::fmt::Debug for Ros2Bridge {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Ros2Bridge")
-            .field("dropped", &self.dropped)
-            .finish_non_exhaustive()
+    fn tf(&mut self) -> Result<Box<dyn tf_family::TfWire>> {
+        Ok(Box::new(tf::Tf::create(self)?))
+    }
+
+    fn joint_states(
+        &mut self,
+        plan: &RosPlan,
+    ) -> Result<Box<dyn joint_states_family::JointStatesWire>> {
+        Ok(Box::new(joint_states::JointStates::create(self, plan)?))
+    }
+
+    fn camera(&mut self, plan: &RosPlan) -> Result<Box<dyn camera_family::CameraWire>> {
+        Ok(Box::new(camera::Camera::create(self, plan)?))
+    }
+
+    fn darknet(&mut self) -> Result<Box<dyn darknet::DarknetWire>> {
+        Ok(Box::new(detections::Darknet::create(self)?))
+    }
+
+    fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser_family::ScanWire>> {
+        Ok(Box::new(laser::Laser::create(self, plan)?))
+    }
+
+    fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm_family::ArmWire>> {
+        Ok(Box::new(arm::Arm::create(self, plan)?))
+    }
+
+    fn ground_truth(&mut self) -> Result<Box<dyn darknet::BoxesWire>> {
+        let topic = crate::bridge::ground_truth::GROUND_TRUTH_TOPIC;
+        Ok(Box::new(detections::Boxes::create(
+            self,
+            topic,
+            "ground_truth",
+        )?))
+    }
+
+    fn status(&mut self) -> Result<Box<dyn status_family::StatusWire>> {
+        Ok(Box::new(status::Status::create(self)?))
     }
 }
 
-impl Ros2Bridge {
+/// What the ROS 2 bridge's thread hands back: the MCAP file's summary, when one is recorded
+/// (an error when it could not be written in full).
+pub(crate) type Recorded = Option<Result<McapSummary>>;
+
+/// The observer half of the bridge: the shared bridge, its thread publishing on DDS and/or
+/// into the MCAP file.
+pub(crate) type Ros2Bridge = Bridge<Recorded>;
+
+impl Bridge<Recorded> {
     /// Joins DDS domain `options.domain_id` (when set) and creates the robot's topics there,
     /// opens the MCAP file (when set), and starts the publishing thread. The input half
-    /// (`rt/cmd_vel`) comes with DDS.
-    pub fn start(options: &Ros2Options, robot: &RobotModel) -> Result<(Self, Option<Ros2Input>)> {
+    /// (`rt/cmd_vel`) comes with DDS. `ground_truth`: the run measures it (`--ground-truth`).
+    pub fn start(
+        options: &Ros2Options,
+        robot: &RobotModel,
+        ground_truth: bool,
+    ) -> Result<(Self, Option<Ros2Input>)> {
         let plan = RosPlan::for_robot(robot);
         let participant = match options.domain_id {
             Some(domain) => Some(
@@ -187,36 +215,62 @@ impl Ros2Bridge {
             None => None,
         };
         let mcap = match &options.mcap {
-            Some(path) => Some(mcap::McapRecorder::create(path)?),
+            Some(path) => Some(Arc::new(Mutex::new(mcap::McapRecorder::create(path)?))),
             None => None,
         };
-        let sinks = Sinks {
+        let mut sinks = Sinks {
             dds: participant.as_ref().zip(publisher.as_ref()),
-            mcap,
+            mcap: mcap.clone(),
             writers: Vec::new(),
         };
-        let topics = Topics::create(sinks, &plan, &robot.description)?;
+        let mut description = sinks.out(ROBOT_DESCRIPTION_TOPIC, &latched_qos())?;
+        description.put(
+            msgs::Time::default(),
+            &msgs::Text {
+                data: robot.description.clone(),
+            },
+        );
+        let families = crate::bridge::families(&mut sinks, &plan, ground_truth)?;
+        let writers = std::mem::take(&mut sinks.writers);
+        drop(sinks);
         let discovery = match (&participant, &publisher, &input) {
             (Some(p), Some(publisher), Some(input)) => {
                 let mut d =
                     discovery::Discovery::new(p, publisher, &options.node_name, options.distro)?;
-                d.add(&input.reader_gids(), topics.writer_gids())?;
+                d.add(&input.reader_gids(), &writers)?;
                 Some(d)
             }
             _ => None,
         };
-        let (tx, rx) = sync_channel::<Event>(64);
-        let (buffers, returns) = buffer_pool();
-        let thread = std::thread::Builder::new()
-            .name("ros2-bridge".into())
-            .spawn(move || {
-                let recorded = run(topics, &rx, &returns);
+        let backlog = if mcap.is_some() {
+            Backlog::Wait
+        } else {
+            Backlog::Drop
+        };
+        let bridge = Bridge::spawn(
+            "ROS 2",
+            "ros2-bridge",
+            &plan,
+            robot,
+            backlog,
+            families,
+            move |families| {
+                // The topics (and their hold on the file) go first; then the file is closed.
+                drop(families);
+                drop(description);
+                let recorded = mcap.map(|file| match Arc::try_unwrap(file) {
+                    Ok(file) => file
+                        .into_inner()
+                        .unwrap_or_else(PoisonError::into_inner)
+                        .finish(),
+                    Err(_) => Err(anyhow::anyhow!("the MCAP file is still in use")),
+                });
                 drop(discovery);
                 drop(publisher);
                 drop(participant);
                 recorded
-            })
-            .context("starting the ROS 2 bridge thread")?;
+            },
+        )?;
         if let Some(domain) = options.domain_id {
             tracing::info!(
                 "ROS 2: node {} ({}'s ros_discovery_info) in DDS domain {domain}; cmd_vel on {}, odometry on {}",
@@ -229,133 +283,6 @@ impl Ros2Bridge {
         if let Some(path) = &options.mcap {
             tracing::info!("recording the ROS 2 topics to {}", path.display());
         }
-        Ok((
-            Self {
-                tx: Some(tx),
-                thread: Some(thread),
-                dropped: 0,
-                lossless: options.mcap.is_some(),
-                recorded: None,
-                now_s: 0.0,
-                buffers,
-                plan,
-                camera_link: robot.cameras.first().map(|c| c.link.clone()),
-            },
-            input,
-        ))
+        Ok((bridge, input))
     }
-
-    /// Events dropped because the publishing thread was behind.
-    pub fn dropped(&self) -> u64 {
-        self.dropped
-    }
-
-    /// Sends what is queued, stops the thread and closes the MCAP file: what it holds, when
-    /// one is recorded (an error when it could not be written in full).
-    pub fn finish(&mut self) -> Option<Result<McapSummary>> {
-        self.tx = None;
-        if let Some(thread) = self.thread.take() {
-            self.recorded = match thread.join() {
-                Ok(recorded) => recorded,
-                Err(_) => Some(Err(anyhow::anyhow!("the ROS 2 bridge thread panicked"))),
-            };
-        }
-        self.recorded.take()
-    }
-
-    fn send(&mut self, event: Event) {
-        let Some(tx) = &self.tx else { return };
-        let sent = if self.lossless {
-            tx.send(event).map_err(|_| ())
-        } else {
-            match tx.try_send(event) {
-                Ok(()) => Ok(()),
-                Err(TrySendError::Full(_)) => {
-                    self.dropped += 1;
-                    Ok(())
-                }
-                Err(TrySendError::Disconnected(_)) => Err(()),
-            }
-        };
-        if sent.is_err() {
-            self.tx = None;
-        }
-    }
-}
-
-impl Drop for Ros2Bridge {
-    fn drop(&mut self) {
-        self.finish();
-    }
-}
-
-impl Observer for Ros2Bridge {
-    fn start(&mut self, sim: &Simulation, camera: Option<&rover_sim::CameraInfo>, _: &[String]) {
-        let static_tf = static_transforms(sim.robot(), camera, self.camera_link.as_deref());
-        self.send(Event::Start {
-            static_tf,
-            camera: camera.cloned(),
-        });
-    }
-
-    fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
-        self.now_s = sample.sim_time_s;
-        let mut joints = self.buffers.take_joints();
-        sample_joints(sim, sample, &self.plan.joints, &mut joints);
-        self.send(Event::Control(*sample, joints, arm_sample(sim, &stats.arm)));
-    }
-
-    fn camera_frame(&mut self, frame: &rover_sim::CameraFrame<'_>, _world_from_camera: Pose) {
-        let depth = if frame.depth_m.is_some() {
-            self.buffers.take_pixels()
-        } else {
-            Vec::new()
-        };
-        let image = capture_image(frame, self.buffers.take_pixels(), depth);
-        self.send(Event::Image(image));
-    }
-
-    fn laser_scan(&mut self, scan: &LaserScan, _world_from_laser: Pose) {
-        let scan = capture_scan(scan, self.buffers.take_ranges());
-        self.send(Event::Scan(scan));
-    }
-
-    fn detections(&mut self, boxes: &BoundingBoxes, _labels: &[String]) {
-        let detections = capture_detections(boxes, self.now_s, self.buffers.take_boxes());
-        self.send(Event::Detections(detections));
-    }
-}
-
-/// The publishing thread: every event to the topics, until the bridge hangs up; then the MCAP
-/// file is closed. The buffers events carry go back to the loop thread once published.
-fn run(
-    mut topics: Topics,
-    events: &Receiver<Event>,
-    returns: &BufferReturn,
-) -> Option<Result<McapSummary>> {
-    for event in events {
-        match event {
-            Event::Start { static_tf, camera } => topics.start(&static_tf, camera.as_ref()),
-            Event::Control(sample, joints, arm) => {
-                topics.control(&sample, &joints);
-                topics.arm(sample.sim_time_s, &arm);
-                returns.joints(joints);
-            }
-            Event::Image(mut frame) => {
-                topics.image(&mut frame);
-                returns.pixels(frame.pixels);
-                returns.pixels(frame.depth);
-            }
-            Event::Scan(scan) => {
-                if let Some(ranges) = topics.scan(scan) {
-                    returns.ranges(ranges);
-                }
-            }
-            Event::Detections(d) => {
-                topics.detections(&d);
-                returns.boxes(d.boxes);
-            }
-        }
-    }
-    topics.finish()
 }

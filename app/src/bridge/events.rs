@@ -1,5 +1,6 @@
 //! What the loop thread hands the publishing thread, the interface every topic family
-//! implements there, and the buffers that travel back for reuse.
+//! implements there, and the buffers that travel back for reuse. Nothing here knows a
+//! transport.
 //!
 //! One [`Event`] per observer callback carries everything any family needs from it. The
 //! publishing thread shows each event to every family in turn ([`TopicFamily`]); the buffers
@@ -9,19 +10,51 @@
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use rover_perception::BoundingBox;
-use rover_ros1::msgs::TransformStamped;
 use rover_sim::{CameraInfo, ControlSample, LaserScan, Pose};
 
+/// One frame's pose in another, as tf carries it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct Transform {
+    /// The parent frame.
+    pub parent: String,
+    /// The child frame.
+    pub child: String,
+    /// The child's origin in the parent frame (m).
+    pub translation: [f64; 3],
+    /// The child's orientation in the parent frame (unit quaternion x, y, z, w).
+    pub rotation: [f64; 4],
+}
+
+impl Transform {
+    /// `parent_from_child` as the transform from `parent` to `child`.
+    pub fn new(parent: &str, child: &str, parent_from_child: Pose) -> Self {
+        let mut t = Self {
+            parent: parent.to_owned(),
+            child: child.to_owned(),
+            ..Self::default()
+        };
+        t.set_pose(parent_from_child);
+        t
+    }
+
+    /// Sets the pose, frames unchanged.
+    pub fn set_pose(&mut self, parent_from_child: Pose) {
+        let (v, q) = (parent_from_child.translation, parent_from_child.rotation);
+        self.translation = [v.x, v.y, v.z].map(f64::from);
+        self.rotation = [q.x, q.y, q.z, q.w].map(f64::from);
+    }
+}
+
 /// The run starts.
-pub(super) struct Start {
+pub(crate) struct Start {
     /// Transforms that never change (`/tf_static`).
-    pub static_tf: Vec<TransformStamped>,
+    pub static_tf: Vec<Transform>,
     /// The camera's calibration, when the robot has a camera.
     pub camera: Option<CameraInfo>,
 }
 
 /// A control update.
-pub(super) struct ControlUpdate {
+pub(crate) struct ControlUpdate {
     /// What the simulation reported.
     pub sample: ControlSample,
     /// One per joint of the plan's `joints`, in that order.
@@ -50,7 +83,7 @@ pub(crate) struct JointSample {
     pub parent_from_child: Pose,
     /// Measured speed (rad/s).
     pub velocity_radps: f64,
-    /// The joint's position (rad or m) from the simulation; wheels' angles come from the poses.
+    /// The joint's position (rad or m); a wheel's is its angle, from the poses.
     pub position: f64,
     /// The actuator's effort (N m or N); 0 for passive joints and wheels.
     pub effort: f64,
@@ -89,7 +122,7 @@ pub(crate) struct Detections {
 }
 
 /// One observer callback's worth of data, on its way to the publishing thread.
-pub(super) enum Event {
+pub(crate) enum Event {
     /// [`Start`].
     Start(Start),
     /// [`ControlUpdate`].
@@ -108,7 +141,7 @@ pub(super) enum Event {
 /// update to the next (only their numbers change). Each method sees one kind of event, in the
 /// plan's order of families; the defaults ignore it. Methods given `&mut` may swap the event's
 /// buffer for one of their own (to publish without a copy, or to keep it).
-pub(super) trait TopicFamily: Send {
+pub(crate) trait TopicFamily: Send {
     /// The run starts.
     fn start(&mut self, _start: &Start) {}
     /// A control update.
@@ -192,37 +225,17 @@ impl BufferPool {
 impl BufferReturn {
     /// Sends the event's buffer back (unless it has no capacity to offer); dropped when the
     /// pool is full or gone.
-    pub(super) fn give_back(&self, event: Event) {
+    pub(crate) fn give_back(&self, event: Event) {
         match event {
             Event::Start(_) => {}
-            Event::Control(c) => self.joints(c.joints),
+            Event::Control(c) => send(&self.joints, c.joints),
             Event::Image(i) => {
-                self.pixels(i.pixels);
-                self.pixels(i.depth);
+                send(&self.pixels, i.pixels);
+                send(&self.pixels, i.depth);
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
-            Event::Scan(s) => self.ranges(s.ranges_m),
+            Event::Scan(s) => send(&self.ranges, s.ranges_m),
         }
-    }
-
-    /// An image buffer back (the ROS 2 bridge's too).
-    pub fn pixels(&self, buffer: Vec<u8>) {
-        send(&self.pixels, buffer);
-    }
-
-    /// A ranges buffer back.
-    pub fn ranges(&self, buffer: Vec<f32>) {
-        send(&self.ranges, buffer);
-    }
-
-    /// A boxes buffer back.
-    pub fn boxes(&self, buffer: Vec<BoundingBox>) {
-        send(&self.boxes, buffer);
-    }
-
-    /// A joints buffer back.
-    pub fn joints(&self, buffer: Vec<JointSample>) {
-        send(&self.joints, buffer);
     }
 }
 

@@ -1,0 +1,46 @@
+//! `/joint_states` (sensor_msgs/JointState): every moving joint of the plan, in its order, with
+//! its position, velocity and effort, every control update (or at a joint_state_controller's
+//! `publish_rate`).
+
+use super::events::{ControlUpdate, JointSample, TopicFamily};
+use super::plan::RosPlan;
+
+/// `/joint_states` on one transport; its names are the plan's joints'.
+pub(crate) trait JointStatesWire: Send {
+    /// Publishes the joints (the plan's order) at sim time `stamp_s`.
+    fn joint_states(&mut self, stamp_s: f64, joints: &[JointSample]);
+}
+
+/// The joint states family.
+pub(crate) struct JointStates {
+    wire: Box<dyn JointStatesWire>,
+    /// Whether the robot has moving joints.
+    any: bool,
+    /// Seconds between messages (0: every control update).
+    period_s: f64,
+    /// Sim time of the next message.
+    next_s: f64,
+}
+
+impl JointStates {
+    /// The family on `wire`, at the plan's rate.
+    pub fn new(wire: Box<dyn JointStatesWire>, plan: &RosPlan) -> Self {
+        Self {
+            wire,
+            any: !plan.joints.is_empty(),
+            period_s: plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz),
+            next_s: 0.0,
+        }
+    }
+}
+
+impl TopicFamily for JointStates {
+    fn control(&mut self, update: &ControlUpdate) {
+        let now_s = update.sample.sim_time_s;
+        if !self.any || now_s + 1e-9 < self.next_s {
+            return;
+        }
+        self.next_s = now_s + self.period_s;
+        self.wire.joint_states(now_s, &update.joints);
+    }
+}

@@ -1,0 +1,89 @@
+//! The camera's images (sensor_msgs/msg/Image) and camera_info (sensor_msgs/msg/CameraInfo) on
+//! ROS 2, best effort as rclcpp's SensorDataQoS.
+
+use anyhow::Result;
+use rover_sim::CameraInfo;
+
+use super::msgs::{self, Time};
+use super::sinks::{Out, Sinks, header, sensor_qos};
+use crate::bridge::RosPlan;
+use crate::bridge::camera::{CameraWire, Channel};
+use crate::bridge::events::ImageFrame;
+
+/// One image topic and its camera_info topic.
+struct ImageTopics {
+    image: Option<Out<msgs::Image>>,
+    info: Option<Out<msgs::CameraInfo>>,
+}
+
+/// The camera's topics (none when the robot has no camera).
+pub(super) struct Camera {
+    colour: ImageTopics,
+    depth: ImageTopics,
+    info_msg: msgs::CameraInfo,
+}
+
+impl Camera {
+    /// Creates the plan's camera topics on `sinks`.
+    pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
+        let qos = sensor_qos();
+        let mut topics = |image: &Option<String>, info: &Option<String>| -> Result<ImageTopics> {
+            Ok(ImageTopics {
+                image: sinks.maybe(image.as_deref(), &qos)?,
+                info: sinks.maybe(info.as_deref(), &qos)?,
+            })
+        };
+        Ok(Self {
+            colour: topics(&plan.image_topic, &plan.info_topic)?,
+            depth: topics(&plan.depth_image_topic, &plan.depth_info_topic)?,
+            info_msg: msgs::CameraInfo::default(),
+        })
+    }
+
+    fn topics(&mut self, channel: Channel) -> &mut ImageTopics {
+        match channel {
+            Channel::Colour => &mut self.colour,
+            Channel::Depth => &mut self.depth,
+        }
+    }
+}
+
+impl CameraWire for Camera {
+    fn calibrate(&mut self, c: &CameraInfo) {
+        self.info_msg = msgs::CameraInfo {
+            header: header(&c.frame_id),
+            height: c.height,
+            width: c.width,
+            distortion_model: c.distortion_model.to_owned(),
+            d: c.d.to_vec(),
+            k: c.k,
+            r: c.r,
+            p: c.p,
+            ..msgs::CameraInfo::default()
+        };
+    }
+
+    fn info(&mut self, channel: Channel, image: &ImageFrame) {
+        let stamp = Time::from_secs(image.stamp_s);
+        self.info_msg.header.stamp = stamp;
+        let topics = match channel {
+            Channel::Colour => &mut self.colour,
+            Channel::Depth => &mut self.depth,
+        };
+        if let Some(out) = &mut topics.info {
+            out.put(stamp, &self.info_msg);
+        }
+    }
+
+    fn image(&mut self, channel: Channel, image: &mut ImageFrame) {
+        let mut header = self.info_msg.header.clone();
+        header.stamp = Time::from_secs(image.stamp_s);
+        let (data, encoding) = match channel {
+            Channel::Colour => (&mut image.pixels, "rgb8"),
+            Channel::Depth => (&mut image.depth, "32FC1"),
+        };
+        if let Some(out) = &mut self.topics(channel).image {
+            out.put_image(&header, (image.width, image.height), encoding, data);
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! `/joint_states` (sensor_msgs/msg/JointState) on ROS 2.
+
+use anyhow::Result;
+
+use super::dds::default_qos;
+use super::msgs::{self, Header, Time};
+use super::sinks::{Out, Sinks};
+use crate::bridge::RosPlan;
+use crate::bridge::events::JointSample;
+use crate::bridge::joint_states::JointStatesWire;
+
+/// `/joint_states`.
+pub(super) struct JointStates {
+    out: Out<msgs::JointState>,
+    msg: msgs::JointState,
+}
+
+impl JointStates {
+    /// Creates `/joint_states` on `sinks`, for the plan's joints.
+    pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
+        Ok(Self {
+            out: sinks.out("/joint_states", &default_qos())?,
+            msg: msgs::JointState {
+                header: Header::default(),
+                name: plan.joints.iter().map(|j| j.name.clone()).collect(),
+                ..msgs::JointState::default()
+            },
+        })
+    }
+}
+
+impl JointStatesWire for JointStates {
+    fn joint_states(&mut self, stamp_s: f64, joints: &[JointSample]) {
+        let msg = &mut self.msg;
+        msg.header.stamp = Time::from_secs(stamp_s);
+        msg.position.clear();
+        msg.position.extend(joints.iter().map(|j| j.position));
+        msg.velocity.clear();
+        msg.velocity.extend(joints.iter().map(|j| j.velocity_radps));
+        msg.effort.clear();
+        msg.effort.extend(joints.iter().map(|j| j.effort));
+        self.out.put(msg.header.stamp, msg);
+    }
+}

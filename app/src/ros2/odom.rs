@@ -1,0 +1,51 @@
+//! The diff drive's odometry (nav_msgs/msg/Odometry) on ROS 2.
+
+use anyhow::Result;
+use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
+
+use super::dds::default_qos;
+use super::msgs::{self, Covariance, Time};
+use super::sinks::{Out, Sinks, header};
+use crate::bridge::RosPlan;
+use crate::bridge::odom::{OdomSample, OdomWire};
+
+/// The odometry topic.
+pub(super) struct Odom {
+    out: Out<msgs::Odometry>,
+    msg: msgs::Odometry,
+}
+
+impl Odom {
+    /// Creates the plan's odometry topic on `sinks`.
+    pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
+        let mut cov = [0.0; 36];
+        for (i, d) in ODOM_POSE_COVARIANCE_DIAGONAL.iter().enumerate() {
+            cov[i * 7] = *d;
+        }
+        let mut msg = msgs::Odometry {
+            header: header(&plan.odom_frame),
+            child_frame_id: plan.base_frame.clone(),
+            ..msgs::Odometry::default()
+        };
+        msg.pose.covariance = Covariance(cov);
+        msg.twist.covariance = Covariance(cov);
+        Ok(Self {
+            out: sinks.out(&plan.odom_topic, &default_qos())?,
+            msg,
+        })
+    }
+}
+
+impl OdomWire for Odom {
+    fn odom(&mut self, odom: &OdomSample) {
+        let msg = &mut self.msg;
+        msg.header.stamp = Time::from_secs(odom.stamp_s);
+        let [x, y, z] = odom.position;
+        msg.pose.pose.position = msgs::Vector3 { x, y, z };
+        let [x, y, z, w] = odom.orientation;
+        msg.pose.pose.orientation = msgs::Quaternion { x, y, z, w };
+        msg.twist.twist.linear.x = odom.linear_mps;
+        msg.twist.twist.angular.z = odom.angular_radps;
+        self.out.put(msg.header.stamp, msg);
+    }
+}
