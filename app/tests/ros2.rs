@@ -742,8 +742,8 @@ for m in got:
 /// `ros2 node list` finds rover: a Cyclone DDS peer that joins 4 s late reads
 /// `ros_discovery_info` (transient local) and finds one node, `/rover`, whose reader and
 /// writer Gids are exactly rover's DDS readers and writers as DDS discovery reports them (one
-/// per topic: cmd_vel, the arm's task in; clock, odom, tf, the camera's ... out), for both Gid
-/// sizes: 24 bytes with `--ros-distro humble`, 16 by default.
+/// per topic: cmd_vel, the arm's task in; clock, odom, tf, the camera's ... out; a request
+/// reader and a reply writer per parameter service), for both Gid sizes: 24 bytes with `--ros-distro humble`, 16 by default.
 #[test]
 fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Result<()> {
     let Some(cyclonedds) = cyclonedds() else {
@@ -773,10 +773,11 @@ fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Re
             .skip(3)
             .map(str::parse)
             .collect::<Result<_, _>>()?;
-        // The car: cmd_vel and the arm's task in; out at least clock, odom, tf, tf_static,
-        // joint_states, robot_description, image and camera_info, darknet_ros's three.
+        // The car: cmd_vel and the arm's task in, and the requests of the 5 parameter services;
+        // out at least clock, odom, tf, tf_static, joint_states, robot_description, image and
+        // camera_info, darknet_ros's three, and the 5 services' replies.
         ensure!(
-            counts.len() == 2 && counts[0] == 2 && counts[1] >= 11,
+            counts.len() == 2 && counts[0] == 7 && counts[1] >= 16,
             "{gid_bytes}-byte Gids: readers, writers {counts:?}:\n{out}"
         );
         ensure!(
@@ -800,5 +801,162 @@ fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Re
             );
         }
     }
+    Ok(())
+}
+
+/// The parameter services' messages, with rmw_cyclonedds_cpp's request header (`guid`, `seq`)
+/// in front of each request's and reply's fields, as it puts it on the wire.
+const PARAMETER_MESSAGES: &str = r#"
+@dataclass
+class ParameterValue(IdlStruct, typename="rcl_interfaces::msg::dds_::ParameterValue_"):
+    type: types.uint8
+    bool_value: bool
+    integer_value: types.int64
+    double_value: types.float64
+    string_value: str
+    byte_array_value: types.sequence[types.uint8]
+    bool_array_value: types.sequence[bool]
+    integer_array_value: types.sequence[types.int64]
+    double_array_value: types.sequence[types.float64]
+    string_array_value: types.sequence[str]
+
+@dataclass
+class Parameter(IdlStruct, typename="rcl_interfaces::msg::dds_::Parameter_"):
+    name: str
+    value: ParameterValue
+
+@dataclass
+class SetParametersResult(IdlStruct, typename="rcl_interfaces::msg::dds_::SetParametersResult_"):
+    successful: bool
+    reason: str
+
+@dataclass
+class GetParameters_Request_(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameters_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    names: types.sequence[str]
+
+@dataclass
+class GetParameters_Response_(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameters_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    values: types.sequence[ParameterValue]
+
+@dataclass
+class ListParameters_Request_(IdlStruct, typename="rcl_interfaces::srv::dds_::ListParameters_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    prefixes: types.sequence[str]
+    depth: types.uint64
+
+@dataclass
+class ListParametersResult(IdlStruct, typename="rcl_interfaces::msg::dds_::ListParametersResult_"):
+    names: types.sequence[str]
+    prefixes: types.sequence[str]
+
+@dataclass
+class ListParameters_Response_(IdlStruct, typename="rcl_interfaces::srv::dds_::ListParameters_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    result: ListParametersResult
+
+@dataclass
+class SetParameters_Request_(IdlStruct, typename="rcl_interfaces::srv::dds_::SetParameters_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    parameters: types.sequence[Parameter]
+
+@dataclass
+class SetParameters_Response_(IdlStruct, typename="rcl_interfaces::srv::dds_::SetParameters_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    results: types.sequence[SetParametersResult]
+"#;
+
+/// `ros2 param get /rover use_sim_time` as a Cyclone DDS client does it: a request on
+/// `rq/rover/get_parametersRequest` comes back on `rr/rover/get_parametersReply` with the
+/// client's header, `use_sim_time` a bool that is true, `robot_description` the URDF (as
+/// `/robot_description` carries it), an unknown name not set; `list_parameters` names both; `set_parameters` is
+/// refused with a reason.
+#[test]
+fn a_cyclone_client_reads_use_sim_time_through_the_parameter_service() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(9))?;
+    graph.spawn_rover(12.0, &[])?;
+    let script = format!(
+        "{PARAMETER_MESSAGES}\n{}",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(10))
+def client(name, req, resp):
+    w = DataWriter(dp, Topic(dp, 'rq/rover/%sRequest' % name, req), qos=qos)
+    r = DataReader(dp, Topic(dp, 'rr/rover/%sReply' % name, resp), qos=qos)
+    return w, r
+@dataclass
+class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+description = DataReader(dp, Topic(dp, 'rt/robot_description', String_), qos=latched)
+get = client('get_parameters', GetParameters_Request_, GetParameters_Response_)
+lst = client('list_parameters', ListParameters_Request_, ListParameters_Response_)
+st = client('set_parameters', SetParameters_Request_, SetParameters_Response_)
+time.sleep(3)
+get[0].write(GetParameters_Request_(guid=0x1234, seq=7, names=['use_sim_time', 'robot_description', 'nope']))
+lst[0].write(ListParameters_Request_(guid=0x1234, seq=8, prefixes=[], depth=0))
+value = ParameterValue(type=1, bool_value=False, integer_value=0, double_value=0.0, string_value='', byte_array_value=[], bool_array_value=[], integer_array_value=[], double_array_value=[], string_array_value=[])
+st[0].write(SetParameters_Request_(guid=0x1234, seq=9, parameters=[Parameter(name='use_sim_time', value=value)]))
+end = time.time() + 5
+got = {}
+urdf = []
+while time.time() < end and (len(got) < 3 or not urdf):
+    urdf += description.take(N=1)
+    for name, (_, r) in (('get', get), ('list', lst), ('set', st)):
+        for m in r.take(N=10):
+            got[name] = m
+    time.sleep(0.05)
+g = got.get('get')
+if g:
+    print('get header %x %d' % (g.guid, g.seq))
+    for v in g.values:
+        same = bool(urdf) and v.string_value == urdf[0].data
+        print('value %d %s %s' % (v.type, v.bool_value, 'urdf' if same else len(v.string_value)))
+l = got.get('list')
+if l:
+    print('list %d %s' % (l.seq, ' '.join(sorted(l.result.names))))
+s = got.get('set')
+if s:
+    for x in s.results:
+        print('set %d %s %s' % (s.seq, x.successful, x.reason))
+"#
+    );
+    let out = graph.python("parameters.py", &script, Duration::from_secs(30))?;
+    graph.wait_rover(Duration::from_secs(60))?;
+    let lines: Vec<&str> = out.lines().collect();
+    let expect = [
+        "get header 1234 7",
+        "value 1 True 0",
+        "value 4 False urdf",
+        "value 0 False 0",
+        "list 8 robot_description use_sim_time",
+    ];
+    for e in &expect {
+        ensure!(lines.contains(e), "expected \"{e}\":\n{out}");
+    }
+    ensure!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("set 9 False use_sim_time is read-only")),
+        "set_parameters was not refused:\n{out}"
+    );
     Ok(())
 }

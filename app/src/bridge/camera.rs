@@ -18,6 +18,25 @@ pub(crate) enum Channel {
     Depth,
 }
 
+/// One thing per channel (a topic, its publisher), looked up by channel.
+#[derive(Debug, Default)]
+pub(crate) struct Channels<T> {
+    /// The colour image's.
+    pub colour: T,
+    /// The depth image's.
+    pub depth: T,
+}
+
+impl<T> Channels<T> {
+    /// `channel`'s.
+    pub fn get_mut(&mut self, channel: Channel) -> &mut T {
+        match channel {
+            Channel::Colour => &mut self.colour,
+            Channel::Depth => &mut self.depth,
+        }
+    }
+}
+
 /// The camera's topics on one transport (publishing nothing the robot has no topic for).
 pub(crate) trait CameraWire: Send {
     /// The camera's calibration, at the start.

@@ -23,13 +23,11 @@ const IMAGE_RING: usize = 16;
 /// Outline width in the detection image (px).
 const BOX_THICKNESS_PX: u32 = 2;
 
-/// A darknet_ros_msgs/BoundingBoxes topic on one transport: `image_header` names the camera's
-/// optical frame, and the image the boxes came from.
+/// A darknet_ros_msgs/BoundingBoxes topic on one transport.
 pub(crate) trait BoxesWire: Send {
-    /// The camera's optical frame, at the start.
-    fn camera_frame(&mut self, frame_id: &str);
-    /// Publishes `boxes`.
-    fn boxes(&mut self, boxes: &Detections);
+    /// Publishes `boxes`; `image_header` names their image and `camera_frame`, the camera's
+    /// optical frame.
+    fn boxes(&mut self, camera_frame: &str, boxes: &Detections);
 }
 
 /// darknet_ros's topics on one transport.
@@ -37,8 +35,14 @@ pub(crate) trait DarknetWire: BoxesWire {
     /// Publishes the number of boxes.
     fn found_object(&mut self, boxes: &Detections);
     /// Publishes the detection image (`(width, height)`, RGB8 `pixels`, lent) of `boxes`'
-    /// image.
-    fn detection_image(&mut self, boxes: &Detections, size: (u32, u32), pixels: &mut Vec<u8>);
+    /// image, in `camera_frame`.
+    fn detection_image(
+        &mut self,
+        camera_frame: &str,
+        boxes: &Detections,
+        size: (u32, u32),
+        pixels: &mut Vec<u8>,
+    );
 }
 
 /// An image kept for the detection image.
@@ -92,6 +96,8 @@ impl DetectionImages {
 /// The darknet_ros family.
 pub(crate) struct Darknet {
     wire: Box<dyn DarknetWire>,
+    /// The camera's optical frame.
+    camera_frame: String,
     images: DetectionImages,
     /// The detection image's pixels, reused.
     pixels: Vec<u8>,
@@ -102,6 +108,7 @@ impl Darknet {
     pub fn new(wire: Box<dyn DarknetWire>) -> Self {
         Self {
             wire,
+            camera_frame: String::new(),
             images: DetectionImages::default(),
             pixels: Vec::new(),
         }
@@ -111,7 +118,7 @@ impl Darknet {
 impl TopicFamily for Darknet {
     fn start(&mut self, start: &Start) {
         if let Some(c) = &start.camera {
-            self.wire.camera_frame(&c.frame_id);
+            self.camera_frame.clone_from(&c.frame_id);
         }
     }
 
@@ -122,14 +129,15 @@ impl TopicFamily for Darknet {
     fn detections(&mut self, detections: &mut Detections) {
         self.wire.found_object(detections);
         if !detections.boxes.is_empty() {
-            self.wire.boxes(detections);
+            self.wire.boxes(&self.camera_frame, detections);
         }
         let pixels = &mut self.pixels;
         if let Some(size) = self
             .images
             .draw(detections.image_seq, &detections.boxes, pixels)
         {
-            self.wire.detection_image(detections, size, pixels);
+            let frame = &self.camera_frame;
+            self.wire.detection_image(frame, detections, size, pixels);
         }
     }
 }

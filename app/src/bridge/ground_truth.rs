@@ -15,23 +15,28 @@ pub(crate) const GROUND_TRUTH_TOPIC: &str = "/rover/ground_truth/bounding_boxes"
 /// The ground-truth family.
 pub(crate) struct GroundTruth {
     wire: Box<dyn BoxesWire>,
+    /// The camera's optical frame.
+    camera_frame: String,
 }
 
 impl GroundTruth {
     /// The family on `wire`.
     pub fn new(wire: Box<dyn BoxesWire>) -> Self {
-        Self { wire }
+        Self {
+            wire,
+            camera_frame: String::new(),
+        }
     }
 }
 
 impl TopicFamily for GroundTruth {
     fn start(&mut self, start: &Start) {
         if let Some(c) = &start.camera {
-            self.wire.camera_frame(&c.frame_id);
+            self.camera_frame.clone_from(&c.frame_id);
         }
     }
 
     fn ground_truth(&mut self, truth: &mut Detections) {
-        self.wire.boxes(truth);
+        self.wire.boxes(&self.camera_frame, truth);
     }
 }

@@ -2,13 +2,25 @@
 //! its position, velocity and effort, every control update (or at a joint_state_controller's
 //! `publish_rate`).
 
-use super::events::{ControlUpdate, JointSample, TopicFamily};
+use super::events::{ControlUpdate, TopicFamily};
 use super::plan::RosPlan;
+
+/// The joints' state at a control update, in the plan's order, as sensor_msgs/JointState's
+/// arrays.
+#[derive(Debug, Default)]
+pub(crate) struct JointArrays {
+    /// Positions (rad or m; a wheel's angle).
+    pub position: Vec<f64>,
+    /// Velocities (rad/s or m/s).
+    pub velocity: Vec<f64>,
+    /// Efforts (N m or N).
+    pub effort: Vec<f64>,
+}
 
 /// `/joint_states` on one transport; its names are the plan's joints'.
 pub(crate) trait JointStatesWire: Send {
-    /// Publishes the joints (the plan's order) at sim time `stamp_s`.
-    fn joint_states(&mut self, stamp_s: f64, joints: &[JointSample]);
+    /// Publishes the joints at sim time `stamp_s`.
+    fn joint_states(&mut self, stamp_s: f64, joints: &JointArrays);
 }
 
 /// The joint states family.
@@ -20,6 +32,8 @@ pub(crate) struct JointStates {
     period_s: f64,
     /// Sim time of the next message.
     next_s: f64,
+    /// The arrays, reused.
+    arrays: JointArrays,
 }
 
 impl JointStates {
@@ -30,6 +44,7 @@ impl JointStates {
             any: !plan.joints.is_empty(),
             period_s: plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz),
             next_s: 0.0,
+            arrays: JointArrays::default(),
         }
     }
 }
@@ -41,6 +56,14 @@ impl TopicFamily for JointStates {
             return;
         }
         self.next_s = now_s + self.period_s;
-        self.wire.joint_states(now_s, &update.joints);
+        let a = &mut self.arrays;
+        a.position.clear();
+        a.position.extend(update.joints.iter().map(|j| j.position));
+        a.velocity.clear();
+        a.velocity
+            .extend(update.joints.iter().map(|j| j.velocity_radps));
+        a.effort.clear();
+        a.effort.extend(update.joints.iter().map(|j| j.effort));
+        self.wire.joint_states(now_s, a);
     }
 }

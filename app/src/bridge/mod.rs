@@ -48,6 +48,17 @@ use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily}
 use plan::MovingJoint;
 pub(crate) use plan::RosPlan;
 
+/// Copies the fields named, from `$from` to `$to`: `copy_fields!(msg, info; width, height)` is
+/// `msg.width = info.width; msg.height = info.height;`. ROS 1's and ROS 2's messages name
+/// their fields as the `.msg` files do, and rover's types mostly do too (camera_info's
+/// calibration, a box's corners); the encoders write such a mapping once, here.
+macro_rules! copy_fields {
+    ($to:expr, $from:expr; $($field:ident),+ $(,)?) => {
+        $( $to.$field = $from.$field; )+
+    };
+}
+pub(crate) use copy_fields;
+
 /// Makes each family's encoder on one transport (advertising its topics there).
 pub(crate) trait Transport {
     /// `/clock`.

@@ -7,7 +7,8 @@ use rover_sim::CameraInfo;
 
 use super::convert::header;
 use crate::bridge::RosPlan;
-use crate::bridge::camera::{CameraWire, Channel};
+use crate::bridge::camera::{CameraWire, Channel, Channels};
+use crate::bridge::copy_fields;
 use crate::bridge::events::ImageFrame;
 
 /// One image topic and its camera_info topic.
@@ -37,8 +38,7 @@ impl ImageTopics {
 
 /// The camera's publishers (none when the robot has no camera).
 pub(super) struct Camera {
-    colour: ImageTopics,
-    depth: ImageTopics,
+    topics: Channels<ImageTopics>,
     info_msg: msgs::CameraInfo,
 }
 
@@ -51,34 +51,25 @@ impl Camera {
             plan.depth_info_topic.as_deref(),
         );
         Ok(Self {
-            colour: ImageTopics::advertise(node, image, info, "rgb8")?,
-            depth: ImageTopics::advertise(node, depth.0, depth.1, "32FC1")?,
+            topics: Channels {
+                colour: ImageTopics::advertise(node, image, info, "rgb8")?,
+                depth: ImageTopics::advertise(node, depth.0, depth.1, "32FC1")?,
+            },
             info_msg: msgs::CameraInfo::default(),
         })
-    }
-
-    fn topics(&mut self, channel: Channel) -> &mut ImageTopics {
-        match channel {
-            Channel::Colour => &mut self.colour,
-            Channel::Depth => &mut self.depth,
-        }
     }
 }
 
 impl CameraWire for Camera {
     fn calibrate(&mut self, c: &CameraInfo) {
-        self.info_msg = msgs::CameraInfo {
-            header: header(&c.frame_id),
-            height: c.height,
-            width: c.width,
-            distortion_model: c.distortion_model.to_owned(),
-            d: c.d.to_vec(),
-            k: c.k,
-            r: c.r,
-            p: c.p,
-        };
-        self.colour.msg.header.frame_id = c.frame_id.clone();
-        self.depth.msg.header.frame_id = c.frame_id.clone();
+        let msg = &mut self.info_msg;
+        msg.header = header(&c.frame_id);
+        msg.distortion_model = c.distortion_model.to_owned();
+        msg.d = c.d.to_vec();
+        copy_fields!(msg, c; height, width, k, r, p);
+        for topics in [&mut self.topics.colour, &mut self.topics.depth] {
+            topics.msg.header.frame_id.clone_from(&c.frame_id);
+        }
     }
 
     fn info(&mut self, channel: Channel, image: &ImageFrame) {
@@ -86,17 +77,13 @@ impl CameraWire for Camera {
         // The camera's frame number, which the boxes' image_header names too.
         msg.header.seq = image.seq as u32;
         msg.header.stamp_s = image.stamp_s;
-        let publisher = match channel {
-            Channel::Colour => self.colour.info.as_mut(),
-            Channel::Depth => self.depth.info.as_mut(),
-        };
-        if let Some(p) = publisher {
+        if let Some(p) = self.topics.get_mut(channel).info.as_mut() {
             p.publish(msg);
         }
     }
 
     fn image(&mut self, channel: Channel, image: &mut ImageFrame) {
-        let topics = self.topics(channel);
+        let topics = self.topics.get_mut(channel);
         let Some(p) = topics.image.as_mut() else {
             return;
         };

@@ -7,29 +7,23 @@ use anyhow::Result;
 use rover_core::{Action, InputSource, JointAction};
 use rover_ros1::msgs;
 use rover_ros1::{Node, Subscriber};
-use rover_sim::{JointTrajectory, TrajectoryPoint};
+use rover_sim::TrajectoryPoint;
 
 use crate::bridge::RosPlan;
-use crate::bridge::input::poll_in_turn;
+use crate::bridge::input::{poll_in_turn, trajectory};
 
+#[derive(Debug)]
 enum Topic {
     Value(Subscriber<msgs::Float64>),
     Trajectory(Subscriber<msgs::JointTrajectory>),
 }
 
 /// The subscriptions to every controller's `command` topic.
+#[derive(Debug)]
 pub(super) struct ControllerCommands {
     topics: Vec<(String, Topic)>,
     /// Where the next poll starts, so that every topic gets its turn.
     next: usize,
-}
-
-impl std::fmt::Debug for ControllerCommands {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ControllerCommands")
-            .field("topics", &self.topics.len())
-            .finish()
-    }
 }
 
 impl ControllerCommands {
@@ -48,22 +42,15 @@ impl ControllerCommands {
     }
 }
 
-/// A trajectory message as the simulation takes it.
-fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
-    JointTrajectory {
-        start_s: msg.header.stamp_s,
-        joint_names: msg.joint_names,
-        points: msg
-            .points
-            .into_iter()
-            .map(|p| TrajectoryPoint {
-                positions: p.positions,
-                velocities: p.velocities,
-                accelerations: p.accelerations,
-                time_from_start_s: p.time_from_start_s,
-            })
-            .collect(),
-    }
+/// A trajectory message as `controller`'s action.
+fn trajectory_action(controller: &str, msg: msgs::JointTrajectory) -> JointAction {
+    let points = msg.points.into_iter().map(|p| TrajectoryPoint {
+        time_from_start_s: p.time_from_start_s,
+        positions: p.positions,
+        velocities: p.velocities,
+        accelerations: p.accelerations,
+    });
+    trajectory(controller, msg.header.stamp_s, msg.joint_names, points)
 }
 
 impl InputSource for ControllerCommands {
@@ -76,10 +63,7 @@ impl InputSource for ControllerCommands {
                     name: name.clone(),
                     value: m.data,
                 }),
-                Topic::Trajectory(sub) => sub.try_recv().map(|m| JointAction::Trajectory {
-                    controller: name.clone(),
-                    trajectory: Box::new(trajectory(m)),
-                }),
+                Topic::Trajectory(sub) => sub.try_recv().map(|m| trajectory_action(name, m)),
             },
         )
     }

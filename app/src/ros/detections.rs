@@ -6,6 +6,7 @@ use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
 
 use super::convert::{header, seq_of};
+use crate::bridge::copy_fields;
 use crate::bridge::darknet::{
     BOUNDING_BOXES_TOPIC, BoxesWire, DETECTION_IMAGE_TOPIC, DarknetWire, FOUND_OBJECT_TOPIC,
 };
@@ -31,14 +32,10 @@ impl Boxes {
 }
 
 impl BoxesWire for Boxes {
-    fn camera_frame(&mut self, frame_id: &str) {
-        self.msg.image_header.frame_id = frame_id.to_owned();
-    }
-
-    /// Numbered and stamped, `image_header` their image's. Class strings keep their capacity:
-    /// no allocation once warm.
-    fn boxes(&mut self, boxes: &Detections) {
+    fn boxes(&mut self, camera_frame: &str, boxes: &Detections) {
         let out = &mut self.msg;
+        out.image_header.frame_id.clear();
+        out.image_header.frame_id.push_str(camera_frame);
         out.header.seq = seq_of(&self.publisher);
         out.header.stamp_s = boxes.stamp_s;
         out.image_header.seq = boxes.image_seq as u32;
@@ -46,12 +43,7 @@ impl BoxesWire for Boxes {
         out.bounding_boxes
             .resize_with(boxes.boxes.len(), msgs::BoundingBox::default);
         for (m, b) in out.bounding_boxes.iter_mut().zip(&boxes.boxes) {
-            m.probability = b.probability;
-            m.xmin = b.xmin;
-            m.ymin = b.ymin;
-            m.xmax = b.xmax;
-            m.ymax = b.ymax;
-            m.id = b.id;
+            copy_fields!(m, b; probability, xmin, ymin, xmax, ymax, id);
             m.class.clone_from(&b.class);
         }
         self.publisher.publish(out);
@@ -87,12 +79,8 @@ impl Darknet {
 }
 
 impl BoxesWire for Darknet {
-    fn camera_frame(&mut self, frame_id: &str) {
-        self.boxes.camera_frame(frame_id);
-    }
-
-    fn boxes(&mut self, boxes: &Detections) {
-        self.boxes.boxes(boxes);
+    fn boxes(&mut self, camera_frame: &str, boxes: &Detections) {
+        self.boxes.boxes(camera_frame, boxes);
     }
 }
 
@@ -106,6 +94,7 @@ impl DarknetWire for Darknet {
 
     fn detection_image(
         &mut self,
+        camera_frame: &str,
         boxes: &Detections,
         (width, height): (u32, u32),
         pixels: &mut Vec<u8>,
@@ -113,9 +102,8 @@ impl DarknetWire for Darknet {
         let d = &mut self.detection_msg;
         d.header.seq = boxes.image_seq as u32;
         d.header.stamp_s = boxes.image_stamp_s;
-        d.header
-            .frame_id
-            .clone_from(&self.boxes.msg.image_header.frame_id);
+        d.header.frame_id.clear();
+        d.header.frame_id.push_str(camera_frame);
         d.width = width;
         d.height = height;
         d.step = width * 3;

@@ -6,8 +6,7 @@ use rover_ros1::{Node, Publisher};
 
 use super::convert::{header, seq_of};
 use crate::bridge::RosPlan;
-use crate::bridge::events::JointSample;
-use crate::bridge::joint_states::JointStatesWire;
+use crate::bridge::joint_states::{JointArrays, JointStatesWire};
 
 /// `/joint_states`' publisher.
 pub(super) struct JointStates {
@@ -30,14 +29,11 @@ impl JointStates {
 }
 
 impl JointStatesWire for JointStates {
-    fn joint_states(&mut self, stamp_s: f64, joints: &[JointSample]) {
+    fn joint_states(&mut self, stamp_s: f64, joints: &JointArrays) {
         let msg = &mut self.msg;
-        msg.position.clear();
-        msg.position.extend(joints.iter().map(|j| j.position));
-        msg.velocity.clear();
-        msg.velocity.extend(joints.iter().map(|j| j.velocity_radps));
-        msg.effort.clear();
-        msg.effort.extend(joints.iter().map(|j| j.effort));
+        msg.position.clone_from(&joints.position);
+        msg.velocity.clone_from(&joints.velocity);
+        msg.effort.clone_from(&joints.effort);
         msg.header.seq = seq_of(&self.publisher);
         msg.header.stamp_s = stamp_s;
         self.publisher.publish(msg);

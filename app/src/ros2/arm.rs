@@ -21,10 +21,12 @@ pub(super) struct Arm {
 impl Arm {
     /// Creates the arm's topics on `sinks`.
     pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
+        let state = sinks.out(STATE_TOPIC, &latched_qos())?;
+        let [object, goal] = [OBJECT_TOPIC, GOAL_TOPIC].map(|t| sinks.out(t, &default_qos()));
         Ok(Self {
-            state: sinks.out(STATE_TOPIC, &latched_qos())?,
-            object: sinks.out(OBJECT_TOPIC, &default_qos())?,
-            goal: sinks.out(GOAL_TOPIC, &default_qos())?,
+            state,
+            object: object?,
+            goal: goal?,
             text: msgs::Text::default(),
             point: msgs::PointStamped {
                 header: header(&plan.base_frame),

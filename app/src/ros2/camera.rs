@@ -7,7 +7,8 @@ use rover_sim::CameraInfo;
 use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, header, sensor_qos};
 use crate::bridge::RosPlan;
-use crate::bridge::camera::{CameraWire, Channel};
+use crate::bridge::camera::{CameraWire, Channel, Channels};
+use crate::bridge::copy_fields;
 use crate::bridge::events::ImageFrame;
 
 /// One image topic and its camera_info topic.
@@ -18,8 +19,7 @@ struct ImageTopics {
 
 /// The camera's topics (none when the robot has no camera).
 pub(super) struct Camera {
-    colour: ImageTopics,
-    depth: ImageTopics,
+    topics: Channels<ImageTopics>,
     info_msg: msgs::CameraInfo,
 }
 
@@ -34,43 +34,31 @@ impl Camera {
             })
         };
         Ok(Self {
-            colour: topics(&plan.image_topic, &plan.info_topic)?,
-            depth: topics(&plan.depth_image_topic, &plan.depth_info_topic)?,
+            topics: Channels {
+                colour: topics(&plan.image_topic, &plan.info_topic)?,
+                depth: topics(&plan.depth_image_topic, &plan.depth_info_topic)?,
+            },
             info_msg: msgs::CameraInfo::default(),
         })
-    }
-
-    fn topics(&mut self, channel: Channel) -> &mut ImageTopics {
-        match channel {
-            Channel::Colour => &mut self.colour,
-            Channel::Depth => &mut self.depth,
-        }
     }
 }
 
 impl CameraWire for Camera {
     fn calibrate(&mut self, c: &CameraInfo) {
-        self.info_msg = msgs::CameraInfo {
+        let mut msg = msgs::CameraInfo {
             header: header(&c.frame_id),
-            height: c.height,
-            width: c.width,
             distortion_model: c.distortion_model.to_owned(),
             d: c.d.to_vec(),
-            k: c.k,
-            r: c.r,
-            p: c.p,
             ..msgs::CameraInfo::default()
         };
+        copy_fields!(msg, c; height, width, k, r, p);
+        self.info_msg = msg;
     }
 
     fn info(&mut self, channel: Channel, image: &ImageFrame) {
         let stamp = Time::from_secs(image.stamp_s);
         self.info_msg.header.stamp = stamp;
-        let topics = match channel {
-            Channel::Colour => &mut self.colour,
-            Channel::Depth => &mut self.depth,
-        };
-        if let Some(out) = &mut topics.info {
+        if let Some(out) = &mut self.topics.get_mut(channel).info {
             out.put(stamp, &self.info_msg);
         }
     }
@@ -82,7 +70,7 @@ impl CameraWire for Camera {
             Channel::Colour => (&mut image.pixels, "rgb8"),
             Channel::Depth => (&mut image.depth, "32FC1"),
         };
-        if let Some(out) = &mut self.topics(channel).image {
+        if let Some(out) = &mut self.topics.get_mut(channel).image {
             out.put_image(&header, (image.width, image.height), encoding, data);
         }
     }

@@ -13,15 +13,36 @@ pub fn dds_topic(ros_name: &str) -> String {
     format!("rt/{}", ros_name.trim_start_matches('/'))
 }
 
+/// Reliable (`true`) or best effort, `durability`, keep last `depth`.
+fn qos(reliable: bool, durability: Durability, depth: i32) -> QosPolicies {
+    let reliability = if reliable {
+        Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::from_millis(100),
+        }
+    } else {
+        Reliability::BestEffort
+    };
+    QosPolicyBuilder::new()
+        .reliability(reliability)
+        .durability(durability)
+        .history(History::KeepLast { depth })
+        .build()
+}
+
 /// rclcpp's default QoS: reliable, volatile, keep last 10.
 pub(super) fn default_qos() -> QosPolicies {
-    QosPolicyBuilder::new()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: rustdds::Duration::from_millis(100),
-        })
-        .durability(Durability::Volatile)
-        .history(History::KeepLast { depth: 10 })
-        .build()
+    qos(true, Durability::Volatile, 10)
+}
+
+/// What a late joiner must still get: reliable, transient local, keep last 1 (tf2's static
+/// broadcaster, robot_state_publisher's description, rmw's `ros_discovery_info`).
+pub(super) fn latched_qos() -> QosPolicies {
+    qos(true, Durability::TransientLocal, 1)
+}
+
+/// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).
+pub(super) fn sensor_qos() -> QosPolicies {
+    qos(false, Durability::Volatile, 5)
 }
 
 pub(super) type Writer<M> = DataWriter<M, CDRSerializerAdapter<M>>;

@@ -6,6 +6,7 @@ use anyhow::Result;
 use super::dds::default_qos;
 use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, header, latched_qos};
+use crate::bridge::copy_fields;
 use crate::bridge::darknet::{
     BOUNDING_BOXES_TOPIC, BoxesWire, DETECTION_IMAGE_TOPIC, DarknetWire, FOUND_OBJECT_TOPIC,
 };
@@ -31,24 +32,16 @@ impl Boxes {
 }
 
 impl BoxesWire for Boxes {
-    fn camera_frame(&mut self, frame_id: &str) {
-        self.msg.image_header.frame_id = frame_id.to_owned();
-    }
-
-    /// Class strings keep their capacity: no allocation once warm.
-    fn boxes(&mut self, d: &Detections) {
+    fn boxes(&mut self, camera_frame: &str, d: &Detections) {
         let out = &mut self.msg;
+        out.image_header.frame_id.clear();
+        out.image_header.frame_id.push_str(camera_frame);
         out.header.stamp = Time::from_secs(d.stamp_s);
         out.image_header.stamp = Time::from_secs(d.image_stamp_s);
         out.bounding_boxes
             .resize_with(d.boxes.len(), msgs::BoundingBox::default);
         for (m, b) in out.bounding_boxes.iter_mut().zip(&d.boxes) {
-            m.probability = b.probability;
-            m.xmin = b.xmin;
-            m.ymin = b.ymin;
-            m.xmax = b.xmax;
-            m.ymax = b.ymax;
-            m.id = b.id;
+            copy_fields!(m, b; probability, xmin, ymin, xmax, ymax, id);
             m.class_id.clone_from(&b.class);
         }
         self.out.put(out.header.stamp, out);
@@ -79,12 +72,8 @@ impl Darknet {
 }
 
 impl BoxesWire for Darknet {
-    fn camera_frame(&mut self, frame_id: &str) {
-        self.boxes.camera_frame(frame_id);
-    }
-
-    fn boxes(&mut self, boxes: &Detections) {
-        self.boxes.boxes(boxes);
+    fn boxes(&mut self, camera_frame: &str, boxes: &Detections) {
+        self.boxes.boxes(camera_frame, boxes);
     }
 }
 
@@ -96,9 +85,17 @@ impl DarknetWire for Darknet {
         self.found.put(stamp, &self.found_msg);
     }
 
-    fn detection_image(&mut self, d: &Detections, size: (u32, u32), pixels: &mut Vec<u8>) {
-        let mut header = self.boxes.msg.image_header.clone();
-        header.stamp = Time::from_secs(d.image_stamp_s);
+    fn detection_image(
+        &mut self,
+        camera_frame: &str,
+        d: &Detections,
+        size: (u32, u32),
+        pixels: &mut Vec<u8>,
+    ) {
+        let header = msgs::Header {
+            stamp: Time::from_secs(d.image_stamp_s),
+            frame_id: camera_frame.to_owned(),
+        };
         self.detection_image
             .put_image(&header, size, "rgb8", pixels);
     }

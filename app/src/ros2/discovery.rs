@@ -12,11 +12,9 @@
 
 use anyhow::{Context, Result};
 use rustdds::no_key::DataWriter;
-use rustdds::policy::{Durability, History, Reliability};
-use rustdds::{
-    CDRSerializerAdapter, DomainParticipant, GUID, QosPolicies, QosPolicyBuilder, RTPSEntity,
-    TopicKind,
-};
+use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
+
+use super::dds::latched_qos;
 use serde::ser::SerializeTuple;
 use serde::{Serialize, Serializer};
 
@@ -150,7 +148,7 @@ impl Discovery {
         name: &str,
         distro: RosDistro,
     ) -> Result<Self> {
-        let qos = discovery_qos();
+        let qos = latched_qos();
         let topic = participant
             .create_topic(
                 DISCOVERY_TOPIC.to_owned(),
@@ -192,17 +190,6 @@ impl Discovery {
             .write(self.info.clone(), None)
             .context("publishing ros_discovery_info")
     }
-}
-
-/// Reliable, transient local, keep last 1, as rmw_dds_common publishes it.
-fn discovery_qos() -> QosPolicies {
-    QosPolicyBuilder::new()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: rustdds::Duration::from_millis(100),
-        })
-        .durability(Durability::TransientLocal)
-        .history(History::KeepLast { depth: 1 })
-        .build()
 }
 
 #[cfg(test)]

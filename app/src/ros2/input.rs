@@ -8,15 +8,16 @@
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
-use rover_sim::{JointTrajectory, TrajectoryPoint, Twist};
+use rover_sim::{TrajectoryPoint, Twist};
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;
 
 use super::dds::{dds_topic, default_qos};
 use super::msgs::{self, RosMessage};
+use super::parameters::Parameters;
 use crate::bridge::RosPlan;
-use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn};
+use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn, trajectory};
 
 /// A reader of `M` on one topic that warns once about samples it cannot read.
 struct Reader<M: RosMessage + DeserializeOwned> {
@@ -84,6 +85,8 @@ pub struct Ros2Input {
     controllers: Vec<(String, Command)>,
     /// Where the next poll of the controllers starts, so that every topic gets its turn.
     next: usize,
+    /// The node's parameter services, answered when polled.
+    parameters: Parameters,
     /// The participant, kept until the readers are gone (the bridge thread may stop first;
     /// a reader outliving its participant cannot say goodbye to it).
     _participant: DomainParticipant,
@@ -107,31 +110,33 @@ fn ros2_command_topic(ros1_topic: &str, trajectory: bool) -> String {
     }
 }
 
-/// A trajectory message as the simulation takes it.
-fn trajectory(msg: msgs::JointTrajectory) -> JointTrajectory {
+/// A trajectory message as `controller`'s action.
+fn trajectory_action(controller: &str, msg: msgs::JointTrajectory) -> JointAction {
     let secs = |sec: i32, nanosec: u32| f64::from(sec) + f64::from(nanosec) * 1e-9;
-    JointTrajectory {
-        start_s: secs(msg.header.stamp.sec, msg.header.stamp.nanosec),
-        joint_names: msg.joint_names,
-        points: msg
-            .points
-            .into_iter()
-            .map(|p| TrajectoryPoint {
-                positions: p.positions,
-                velocities: p.velocities,
-                accelerations: p.accelerations,
-                time_from_start_s: secs(p.time_from_start.sec, p.time_from_start.nanosec),
-            })
-            .collect(),
-    }
+    let start_s = secs(msg.header.stamp.sec, msg.header.stamp.nanosec);
+    let points = msg.points.into_iter().map(|p| TrajectoryPoint {
+        time_from_start_s: secs(p.time_from_start.sec, p.time_from_start.nanosec),
+        positions: p.positions,
+        velocities: p.velocities,
+        accelerations: p.accelerations,
+    });
+    trajectory(controller, start_s, msg.joint_names, points)
 }
 
 impl Ros2Input {
-    /// Subscribes to the robot's input topics.
-    pub(super) fn subscribe(participant: &DomainParticipant, plan: &RosPlan) -> Result<Self> {
+    /// Subscribes to the robot's input topics and serves node `node`'s parameters
+    /// (`description`: the URDF); replies go out through `publisher`.
+    pub(super) fn subscribe(
+        participant: &DomainParticipant,
+        publisher: &rustdds::Publisher,
+        plan: &RosPlan,
+        node: &str,
+        description: &str,
+    ) -> Result<Self> {
         let subscriber = participant
             .create_subscriber(&default_qos())
             .context("creating the DDS subscriber")?;
+        let parameters = Parameters::serve(participant, &subscriber, publisher, node, description)?;
         let mut controllers = Vec::with_capacity(plan.controllers.len());
         for c in &plan.controllers {
             let topic = ros2_command_topic(&c.command_topic, c.trajectory);
@@ -147,18 +152,21 @@ impl Ros2Input {
             task: Reader::new(participant, &subscriber, TASK_TOPIC)?,
             controllers,
             next: 0,
+            parameters,
             _participant: participant.clone(),
         })
     }
 
-    /// The readers' GUIDs, for `ros_discovery_info`.
-    pub(super) fn reader_gids(&self) -> Vec<GUID> {
-        let mut gids = vec![self.cmd_vel.reader.guid(), self.task.reader.guid()];
-        gids.extend(self.controllers.iter().map(|(_, c)| match c {
+    /// The readers' and writers' GUIDs (topics and services), for `ros_discovery_info`.
+    pub(super) fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
+        let mut readers = vec![self.cmd_vel.reader.guid(), self.task.reader.guid()];
+        readers.extend(self.controllers.iter().map(|(_, c)| match c {
             Command::Trajectory(r) => r.reader.guid(),
             Command::Value(r) => r.reader.guid(),
         }));
-        gids
+        let (requests, replies) = self.parameters.gids();
+        readers.extend(requests);
+        (readers, replies)
     }
 
     /// The next controller command, every topic in turn.
@@ -167,10 +175,7 @@ impl Ros2Input {
             &mut self.controllers,
             &mut self.next,
             |(name, command)| match command {
-                Command::Trajectory(reader) => reader.next().map(|m| JointAction::Trajectory {
-                    controller: name.clone(),
-                    trajectory: Box::new(trajectory(m)),
-                }),
+                Command::Trajectory(reader) => reader.next().map(|m| trajectory_action(name, m)),
                 Command::Value(reader) => reader.next().and_then(|m| {
                     m.data.first().map(|&value| JointAction::Controller {
                         name: name.clone(),
@@ -184,6 +189,7 @@ impl Ros2Input {
 
 impl InputSource for Ros2Input {
     fn poll(&mut self) -> Option<Action> {
+        self.parameters.poll();
         let mut newest = None;
         while let Some(t) = self.cmd_vel.next() {
             newest = Some(Action::CmdVel(Twist::new(t.linear.x, t.angular.z)));

@@ -6,8 +6,7 @@ use super::dds::default_qos;
 use super::msgs::{self, Header, Time};
 use super::sinks::{Out, Sinks};
 use crate::bridge::RosPlan;
-use crate::bridge::events::JointSample;
-use crate::bridge::joint_states::JointStatesWire;
+use crate::bridge::joint_states::{JointArrays, JointStatesWire};
 
 /// `/joint_states`.
 pub(super) struct JointStates {
@@ -30,15 +29,12 @@ impl JointStates {
 }
 
 impl JointStatesWire for JointStates {
-    fn joint_states(&mut self, stamp_s: f64, joints: &[JointSample]) {
+    fn joint_states(&mut self, stamp_s: f64, joints: &JointArrays) {
         let msg = &mut self.msg;
         msg.header.stamp = Time::from_secs(stamp_s);
-        msg.position.clear();
-        msg.position.extend(joints.iter().map(|j| j.position));
-        msg.velocity.clear();
-        msg.velocity.extend(joints.iter().map(|j| j.velocity_radps));
-        msg.effort.clear();
-        msg.effort.extend(joints.iter().map(|j| j.effort));
+        msg.position.clone_from(&joints.position);
+        msg.velocity.clone_from(&joints.velocity);
+        msg.effort.clone_from(&joints.effort);
         self.out.put(msg.header.stamp, msg);
     }
 }

@@ -23,7 +23,8 @@
 //! its thread cannot keep up with.
 //!
 //! `ros_discovery_info` names rover's node and its readers and writers, so `ros2 node list`
-//! finds it (`discovery.rs`).
+//! finds it (`discovery.rs`); the node's parameters are read through rclcpp's parameter
+//! services (`parameters.rs`, on `services.rs`: rmw_cyclonedds_cpp's request/reply mapping).
 //!
 //! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): ros2-client picks
 //! the distribution, and with it the size of `ros_discovery_info`'s ids, with a cargo feature,
@@ -43,6 +44,8 @@ mod laser;
 mod mcap;
 mod msgs;
 mod odom;
+mod parameters;
+mod services;
 mod sinks;
 mod status;
 mod tf;
@@ -203,15 +206,23 @@ impl Bridge<Recorded> {
             ),
             None => None,
         };
-        let input = match &participant {
-            Some(p) => Some(Ros2Input::subscribe(p, &plan)?),
-            None => None,
-        };
         let publisher = match &participant {
             Some(p) => Some(
                 p.create_publisher(&default_qos())
                     .context("creating the DDS publisher")?,
             ),
+            None => None,
+        };
+        let (namespace, name) = discovery::split_node_name(&options.node_name);
+        let node = format!("{}/{name}", namespace.trim_end_matches('/'));
+        let input = match participant.as_ref().zip(publisher.as_ref()) {
+            Some((p, publisher)) => Some(Ros2Input::subscribe(
+                p,
+                publisher,
+                &plan,
+                &node,
+                &robot.description,
+            )?),
             None => None,
         };
         let mcap = match &options.mcap {
@@ -237,7 +248,9 @@ impl Bridge<Recorded> {
             (Some(p), Some(publisher), Some(input)) => {
                 let mut d =
                     discovery::Discovery::new(p, publisher, &options.node_name, options.distro)?;
-                d.add(&input.reader_gids(), &writers)?;
+                let (readers, mut replies) = input.gids();
+                replies.extend(writers);
+                d.add(&readers, &replies)?;
                 Some(d)
             }
             _ => None,

@@ -4,36 +4,15 @@
 use std::sync::{Arc, Mutex, PoisonError};
 
 use anyhow::Result;
-use rustdds::policy::{Durability, History, Reliability};
-use rustdds::{DomainParticipant, GUID, QosPolicies, QosPolicyBuilder, RTPSEntity};
+use rustdds::{DomainParticipant, GUID, QosPolicies, RTPSEntity};
 
 use super::dds::{Writer, writer};
+pub(super) use super::dds::{latched_qos, sensor_qos};
 use super::mcap::McapRecorder;
 use super::msgs::{self, Header, Lent, RosMessage, Time};
 
 /// The MCAP file, shared by every topic's channel on the publishing thread.
 pub(super) type Recorder = Arc<Mutex<McapRecorder>>;
-
-/// `/tf_static`'s QoS, and every topic a late joiner needs: reliable, transient local, keep
-/// last 1 (tf2's static broadcaster, robot_state_publisher's description).
-pub(super) fn latched_qos() -> QosPolicies {
-    QosPolicyBuilder::new()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: rustdds::Duration::from_millis(100),
-        })
-        .durability(Durability::TransientLocal)
-        .history(History::KeepLast { depth: 1 })
-        .build()
-}
-
-/// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).
-pub(super) fn sensor_qos() -> QosPolicies {
-    QosPolicyBuilder::new()
-        .reliability(Reliability::BestEffort)
-        .durability(Durability::Volatile)
-        .history(History::KeepLast { depth: 5 })
-        .build()
-}
 
 /// A header in `frame_id`, stamped when published.
 pub(super) fn header(frame_id: &str) -> Header {
