@@ -960,3 +960,313 @@ if s:
     );
     Ok(())
 }
+
+/// control_msgs/action/FollowJointTrajectory's services and topics as rcl maps them, with
+/// rmw_cyclonedds_cpp's request header; the feedback in Humble's and Jazzy's layout.
+const ACTION_MESSAGES: &str = r#"
+from rover_msgs import Transform
+
+@dataclass
+class UUID(IdlStruct, typename="unique_identifier_msgs::msg::dds_::UUID_"):
+    uuid: types.array[types.uint8, 16]
+
+@dataclass
+class GoalInfo(IdlStruct, typename="action_msgs::msg::dds_::GoalInfo_"):
+    goal_id: UUID
+    stamp: Time
+
+@dataclass
+class GoalStatus(IdlStruct, typename="action_msgs::msg::dds_::GoalStatus_"):
+    goal_info: GoalInfo
+    status: types.int8
+
+@dataclass
+class GoalStatusArray(IdlStruct, typename="action_msgs::msg::dds_::GoalStatusArray_"):
+    status_list: types.sequence[GoalStatus]
+
+@dataclass
+class JointTolerance(IdlStruct, typename="control_msgs::msg::dds_::JointTolerance_"):
+    name: str
+    position: types.float64
+    velocity: types.float64
+    acceleration: types.float64
+
+@dataclass
+class JointComponentTolerance(IdlStruct, typename="control_msgs::msg::dds_::JointComponentTolerance_"):
+    joint_name: str
+    component: types.uint16
+    position: types.float64
+    velocity: types.float64
+    acceleration: types.float64
+
+@dataclass
+class MultiDOFJointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::MultiDOFJointTrajectoryPoint_"):
+    transforms: types.sequence[Transform]
+    velocities: types.sequence[Twist]
+    accelerations: types.sequence[Twist]
+    time_from_start: Duration
+
+@dataclass
+class MultiDOFJointTrajectory(IdlStruct, typename="trajectory_msgs::msg::dds_::MultiDOFJointTrajectory_"):
+    header: Header
+    joint_names: types.sequence[str]
+    points: types.sequence[MultiDOFJointTrajectoryPoint]
+
+@dataclass
+class FJT_Goal(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_Goal_"):
+    trajectory: JointTrajectory
+    multi_dof_trajectory: MultiDOFJointTrajectory
+    path_tolerance: types.sequence[JointTolerance]
+    component_path_tolerance: types.sequence[JointComponentTolerance]
+    goal_tolerance: types.sequence[JointTolerance]
+    component_goal_tolerance: types.sequence[JointComponentTolerance]
+    goal_time_tolerance: Duration
+
+@dataclass
+class FJT_Result(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_Result_"):
+    error_code: types.int32
+    error_string: str
+
+@dataclass
+class FJT_Feedback(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_Feedback_"):
+    header: Header
+    joint_names: types.sequence[str]
+    desired: JointTrajectoryPoint
+    actual: JointTrajectoryPoint
+    error: JointTrajectoryPoint
+    multi_dof_joint_names: types.sequence[str]
+    multi_dof_desired: MultiDOFJointTrajectoryPoint
+    multi_dof_actual: MultiDOFJointTrajectoryPoint
+    multi_dof_error: MultiDOFJointTrajectoryPoint
+
+@dataclass
+class FJT_FeedbackMessage(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_FeedbackMessage_"):
+    goal_id: UUID
+    feedback: FJT_Feedback
+
+@dataclass
+class FJT_SendGoal_Request(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_SendGoal_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    goal_id: UUID
+    goal: FJT_Goal
+
+@dataclass
+class FJT_SendGoal_Response(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_SendGoal_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    accepted: bool
+    stamp: Time
+
+@dataclass
+class FJT_GetResult_Request(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_GetResult_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    goal_id: UUID
+
+@dataclass
+class FJT_GetResult_Response(IdlStruct, typename="control_msgs::action::dds_::FollowJointTrajectory_GetResult_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    status: types.int8
+    result: FJT_Result
+
+@dataclass
+class CancelGoal_Request(IdlStruct, typename="action_msgs::srv::dds_::CancelGoal_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    goal_info: GoalInfo
+
+@dataclass
+class CancelGoal_Response(IdlStruct, typename="action_msgs::srv::dds_::CancelGoal_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    return_code: types.int8
+    goals_canceling: types.sequence[GoalInfo]
+"#;
+
+/// MoveIt's way in on ROS 2: a Cyclone DDS action client sends TIAGo's arm a two-point goal on
+/// `/arm_controller/follow_joint_trajectory`: accepted, feedback while it runs (desired,
+/// actual, error for the 7 arm joints), the status list says EXECUTING then SUCCEEDED, and
+/// get_result answers SUCCEEDED with error code 0; the arm is at the goal. A second goal,
+/// cancelled halfway, is CANCELED and the arm stops where it was: it moves no more than
+/// 0.01 rad afterwards, far from that goal.
+#[test]
+fn an_action_client_moves_tiagos_arm_and_a_cancel_stops_it() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
+    };
+    let controllers =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/controllers/tiago_no_hand.yaml");
+    let mut graph = Graph::new(cyclonedds, domain(10))?;
+    let (urdf, controllers) = (urdf.to_string_lossy(), controllers.to_string_lossy());
+    graph.spawn_rover(
+        24.0,
+        &[
+            "--robot",
+            urdf.as_ref(),
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+            "--controllers",
+            controllers.as_ref(),
+            "--ros-distro",
+            "jazzy",
+        ],
+    )?;
+    std::thread::sleep(Duration::from_secs(2));
+    let script = format!(
+        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{}",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+a = '/arm_controller/follow_joint_trajectory/_action/'
+def service(name, req, resp):
+    return (DataWriter(dp, Topic(dp, 'rq' + a + name + 'Request', req), qos=reliable),
+            DataReader(dp, Topic(dp, 'rr' + a + name + 'Reply', resp), qos=reliable))
+send = service('send_goal', FJT_SendGoal_Request, FJT_SendGoal_Response)
+cancel = service('cancel_goal', CancelGoal_Request, CancelGoal_Response)
+result = service('get_result', FJT_GetResult_Request, FJT_GetResult_Response)
+feedback = DataReader(dp, Topic(dp, 'rt' + a + 'feedback', FJT_FeedbackMessage), qos=reliable)
+status = DataReader(dp, Topic(dp, 'rt' + a + 'status', GoalStatusArray), qos=latched)
+time.sleep(3)
+
+names = ['arm_%d_joint' % i for i in range(1, 8)]
+point = lambda q, t: JointTrajectoryPoint(positions=q, velocities=[], accelerations=[], effort=[], time_from_start=Duration(t, 0))
+def goal(points):
+    return FJT_Goal(
+        trajectory=JointTrajectory(header=Header(stamp=Time(0, 0), frame_id=''), joint_names=names, points=points),
+        multi_dof_trajectory=MultiDOFJointTrajectory(header=Header(stamp=Time(0, 0), frame_id=''), joint_names=[], points=[]),
+        path_tolerance=[], component_path_tolerance=[], goal_tolerance=[], component_goal_tolerance=[],
+        goal_time_tolerance=Duration(0, 0))
+ida, idb = UUID(uuid=[1] * 16), UUID(uuid=[2] * 16)
+seen = []
+def pump(until, stop=None):
+    got = {'send': [], 'cancel': [], 'result': [], 'feedback': []}
+    while time.time() < until:
+        got['send'] += send[1].take(N=10)
+        got['cancel'] += cancel[1].take(N=10)
+        got['result'] += result[1].take(N=10)
+        got['feedback'] += feedback.take(N=100)
+        for s in status.take(N=10):
+            seen.append(tuple((bytes(g.goal_info.goal_id.uuid)[0], g.status) for g in s.status_list))
+        if stop and stop(got):
+            break
+        time.sleep(0.02)
+    return got
+
+send[0].write(FJT_SendGoal_Request(guid=1, seq=1, goal_id=ida, goal=goal(
+    [point([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 2), point([0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0], 4)])))
+got = pump(time.time() + 2, lambda g: g['send'])
+print('accepted a %s' % [r.accepted for r in got['send']])
+result[0].write(FJT_GetResult_Request(guid=1, seq=2, goal_id=ida))
+got = pump(time.time() + 9, lambda g: g['result'])
+fa = [f for f in got['feedback'] if bytes(f.goal_id.uuid)[0] == 1]
+print('feedback a %d %d' % (len(fa), min([len(f.feedback.actual.positions) for f in fa] or [0])))
+if fa:
+    f = fa[len(fa) // 2].feedback
+    print('feedback names %s' % ','.join(f.joint_names))
+    print('feedback error %.6f' % max(abs(d - x - e) for d, x, e in zip(f.desired.positions, f.actual.positions, f.error.positions)))
+for r in got['result']:
+    print('result a %d %d %s' % (r.status, r.result.error_code, r.result.error_string.replace(' ', '_')))
+
+send[0].write(FJT_SendGoal_Request(guid=1, seq=3, goal_id=idb, goal=goal([point([1.2, -0.5, -0.2, 1.0, -1.0, 0.5, 0.0], 6)])))
+got = pump(time.time() + 2.0)
+fb = [f for f in got['feedback'] if bytes(f.goal_id.uuid)[0] == 2]
+print('accepted b %s' % [r.accepted for r in got['send']])
+cancel[0].write(CancelGoal_Request(guid=1, seq=4, goal_info=GoalInfo(goal_id=idb, stamp=Time(0, 0))))
+got = pump(time.time() + 2, lambda g: g['cancel'])
+fb += [f for f in got['feedback'] if bytes(f.goal_id.uuid)[0] == 2]
+for r in got['cancel']:
+    print('cancel b %d %d' % (r.return_code, len(r.goals_canceling)))
+if fb:
+    s = fb[-1].feedback.header.stamp
+    print('cancelled at %.3f' % (s.sec + s.nanosec * 1e-9))
+result[0].write(FJT_GetResult_Request(guid=1, seq=5, goal_id=idb))
+got = pump(time.time() + 3, lambda g: g['result'])
+for r in got['result']:
+    print('result b %d %d' % (r.status, r.result.error_code))
+pump(time.time() + 1)
+print('statuses %s' % ' '.join('/'.join('%d:%d' % x for x in s) for s in seen))
+"#
+    );
+    let out = graph.python("action.py", &script, Duration::from_secs(60))?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    println!("{out}");
+    let log = std::fs::read_to_string(graph.dir.path().join("rover.log"))?;
+    let has = |line: &str| out.lines().any(|l| l == line);
+    for line in [
+        "accepted a [True]",
+        "result a 4 0 goal_reached",
+        "accepted b [True]",
+        "cancel b 0 1",
+        "result b 5 0",
+        "feedback names arm_1_joint,arm_2_joint,arm_3_joint,arm_4_joint,arm_5_joint,arm_6_joint,arm_7_joint",
+    ] {
+        ensure!(has(line), "expected \"{line}\":\n{out}\nrover:\n{log}");
+    }
+    let count = |prefix: &str| -> Option<Vec<f64>> {
+        let rest = out.lines().find_map(|l| l.strip_prefix(prefix))?;
+        rest.split(' ').map(|w| w.parse().ok()).collect()
+    };
+    let feedback = count("feedback a ").context("no feedback line")?;
+    // 20 Hz over the goal's 4 s: about 80.
+    ensure!(
+        feedback[0] >= 40.0 && feedback[1] == 7.0,
+        "feedback {feedback:?}:\n{out}"
+    );
+    let error = count("feedback error ").context("no feedback error")?;
+    ensure!(error[0] < 1e-9, "error != desired - actual: {error:?}");
+    let statuses = out
+        .lines()
+        .find_map(|l| l.strip_prefix("statuses "))
+        .unwrap_or_default();
+    ensure!(
+        statuses.contains("1:2") && statuses.contains("1:4") && statuses.contains("2:5"),
+        "the status list never said A EXECUTING, A SUCCEEDED, B CANCELED: {statuses}"
+    );
+    // The arm stops where it was when B was cancelled.
+    let cancelled_s = count("cancelled at ").context("no feedback for B")?[0];
+    let trace = std::fs::read_to_string(graph.trace_path())?;
+    let rows = parse_trace(&trace)?;
+    let names = rover_core::trace_joints(&trace);
+    let k = names
+        .iter()
+        .position(|n| n == "arm_1_joint")
+        .context("no arm_1_joint column")?;
+    let at = |t: f64| {
+        rows.iter()
+            .find(|r| r.sim_time_s >= t)
+            .map(|r| r.joints[k].position)
+    };
+    let (then, later, end) = (
+        at(cancelled_s + 0.5).context("the trace ends early")?,
+        at(cancelled_s + 1.5).context("the trace ends early")?,
+        rows.last()
+            .map(|r| r.joints[k].position)
+            .unwrap_or(f64::NAN),
+    );
+    println!(
+        "arm_1_joint: {then:.4} rad 0.5 s after the cancel, {later:.4} 1.5 s after, {end:.4} at the end (B's goal 1.2, A's 0.2)"
+    );
+    ensure!(
+        (later - then).abs() < 0.01 && (end - then).abs() < 0.01,
+        "the arm kept moving after the cancel: {then} -> {later} -> {end}"
+    );
+    ensure!(
+        then > 0.25 && (end - 1.2).abs() > 0.2,
+        "the arm did not move toward B before the cancel, or reached B: {then}, {end}"
+    );
+    Ok(())
+}

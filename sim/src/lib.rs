@@ -54,8 +54,8 @@ pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
     HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory,
-    ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions, Simulation, TrajectoryPoint,
-    TrajectoryState, Twist, WheelSpeeds, wrap_angle,
+    ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions, Simulation, TrajectoryOutcome,
+    TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{
     BodyLayer, CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError,

@@ -8,7 +8,7 @@ use rover_sim::{
     Simulation, link_from_optical,
 };
 
-use super::events::{ArmSample, Detections, ImageFrame, JointSample, Transform};
+use super::events::{ArmSample, Detections, ImageFrame, JointSample, RunSample, Transform};
 use super::plan::{JointSource, MovingJoint};
 
 /// The image to hand over: `frame` copied into the recycled `pixels`, its depth image (if
@@ -136,6 +136,21 @@ pub(crate) fn joints(
             effort: state.effort,
             setpoint,
         }
+    }));
+}
+
+/// Samples each of `controllers` (names) at a control update, into `out`: what its
+/// trajectory does.
+pub(crate) fn runs(sim: &Simulation, controllers: &[String], out: &mut Vec<RunSample>) {
+    out.clear();
+    out.extend(controllers.iter().map(|name| {
+        sim.trajectory_state(name)
+            .map(|s| RunSample {
+                active: s.active,
+                runs: s.runs,
+                outcome: s.outcome,
+            })
+            .unwrap_or_default()
     }));
 }
 

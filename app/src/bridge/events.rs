@@ -61,6 +61,20 @@ pub(crate) struct ControlUpdate {
     pub joints: Vec<JointSample>,
     /// The arm's task.
     pub arm: ArmSample,
+    /// One per controller of the plan's `controllers`, in that order: what its trajectory
+    /// does (default for controllers that take no trajectory).
+    pub runs: Vec<RunSample>,
+}
+
+/// A trajectory controller's run at a control update.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct RunSample {
+    /// Whether a trajectory runs.
+    pub active: bool,
+    /// Trajectories started so far.
+    pub runs: u64,
+    /// How the last one ended (`None` while it runs).
+    pub outcome: Option<rover_sim::TrajectoryOutcome>,
 }
 
 /// The arm's task at a control update, its points in the robot's base frame.
@@ -168,6 +182,7 @@ pub(crate) struct BufferPool {
     ranges: Receiver<Vec<f32>>,
     boxes: Receiver<Vec<BoundingBox>>,
     joints: Receiver<Vec<JointSample>>,
+    runs: Receiver<Vec<RunSample>>,
 }
 
 /// The publishing thread's end: what an event still holds after every family saw it.
@@ -176,6 +191,7 @@ pub(crate) struct BufferReturn {
     ranges: SyncSender<Vec<f32>>,
     boxes: SyncSender<Vec<BoundingBox>>,
     joints: SyncSender<Vec<JointSample>>,
+    runs: SyncSender<Vec<RunSample>>,
 }
 
 /// A pool and its return path.
@@ -184,18 +200,21 @@ pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
     let (ranges_back, ranges) = sync_channel(4);
     let (boxes_back, boxes) = sync_channel(4);
     let (joints_back, joints) = sync_channel(4);
+    let (runs_back, runs) = sync_channel(4);
     (
         BufferPool {
             pixels,
             ranges,
             boxes,
             joints,
+            runs,
         },
         BufferReturn {
             pixels: pixels_back,
             ranges: ranges_back,
             boxes: boxes_back,
             joints: joints_back,
+            runs: runs_back,
         },
     )
 }
@@ -220,6 +239,11 @@ impl BufferPool {
     pub fn take_joints(&self) -> Vec<JointSample> {
         self.joints.try_recv().unwrap_or_default()
     }
+
+    /// A trajectory runs buffer (its contents are stale).
+    pub fn take_runs(&self) -> Vec<RunSample> {
+        self.runs.try_recv().unwrap_or_default()
+    }
 }
 
 impl BufferReturn {
@@ -228,7 +252,10 @@ impl BufferReturn {
     pub(crate) fn give_back(&self, event: Event) {
         match event {
             Event::Start(_) => {}
-            Event::Control(c) => send(&self.joints, c.joints),
+            Event::Control(c) => {
+                send(&self.joints, c.joints);
+                send(&self.runs, c.runs);
+            }
             Event::Image(i) => {
                 send(&self.pixels, i.pixels);
                 send(&self.pixels, i.depth);

@@ -130,6 +130,8 @@ pub(crate) struct Bridge<R: Send + 'static> {
     thread: Option<JoinHandle<R>>,
     buffers: BufferPool,
     joints: Vec<MovingJoint>,
+    /// The plan's controllers' names, in its order.
+    controllers: Vec<String>,
     camera_link: Option<String>,
     backlog: Backlog,
     /// The newest control update's sim time: detector results are published then.
@@ -173,6 +175,7 @@ impl<R: Send + 'static> Bridge<R> {
             thread: Some(thread),
             buffers,
             joints: plan.joints.clone(),
+            controllers: plan.controllers.iter().map(|c| c.name.clone()).collect(),
             camera_link: robot.cameras.first().map(|c| c.link.clone()),
             backlog,
             now_s: 0.0,
@@ -265,10 +268,13 @@ impl<R: Send + 'static> Observer for Bridge<R> {
             b.now_s = sample.sim_time_s;
             let mut joints = b.buffers.take_joints();
             capture::joints(sim, sample, &b.joints, &mut joints);
+            let mut runs = b.buffers.take_runs();
+            capture::runs(sim, &b.controllers, &mut runs);
             b.send(Event::Control(ControlUpdate {
                 sample: *sample,
                 joints,
                 arm: capture::arm(sim, &stats.arm),
+                runs,
             }));
         });
     }

@@ -24,7 +24,7 @@ pub const DISCOVERY_TOPIC: &str = "ros_discovery_info";
 const DISCOVERY_TYPE: &str = "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_";
 
 /// A ROS 2 distribution, for what differs on the wire between them (the size of a `Gid`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, clap::ValueEnum)]
 pub enum RosDistro {
     /// Humble Hawksbill (LTS, 2022): 24-byte Gids.
     Humble,

@@ -6,6 +6,8 @@
 //! value) for a single-joint controller, as forward_command_controller takes it. A sample that
 //! does not decode (a peer's garbage, a wrong type) is one warning per topic; the run goes on.
 
+use std::sync::mpsc::Receiver;
+
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
 use rover_sim::{TrajectoryPoint, Twist};
@@ -87,6 +89,8 @@ pub struct Ros2Input {
     next: usize,
     /// The node's parameter services, answered when polled.
     parameters: Parameters,
+    /// Trajectories of the goals the action servers accepted (and stops for cancelled ones).
+    actions: Receiver<Action>,
     /// The participant, kept until the readers are gone (the bridge thread may stop first;
     /// a reader outliving its participant cannot say goodbye to it).
     _participant: DomainParticipant,
@@ -132,6 +136,7 @@ impl Ros2Input {
         plan: &RosPlan,
         node: &str,
         description: &str,
+        actions: Receiver<Action>,
     ) -> Result<Self> {
         let subscriber = participant
             .create_subscriber(&default_qos())
@@ -153,6 +158,7 @@ impl Ros2Input {
             controllers,
             next: 0,
             parameters,
+            actions,
             _participant: participant.clone(),
         })
     }
@@ -190,6 +196,9 @@ impl Ros2Input {
 impl InputSource for Ros2Input {
     fn poll(&mut self) -> Option<Action> {
         self.parameters.poll();
+        if let Ok(action) = self.actions.try_recv() {
+            return Some(action);
+        }
         let mut newest = None;
         while let Some(t) = self.cmd_vel.next() {
             newest = Some(Action::CmdVel(Twist::new(t.linear.x, t.angular.z)));

@@ -24,13 +24,16 @@
 //!
 //! `ros_discovery_info` names rover's node and its readers and writers, so `ros2 node list`
 //! finds it (`discovery.rs`); the node's parameters are read through rclcpp's parameter
-//! services (`parameters.rs`, on `services.rs`: rmw_cyclonedds_cpp's request/reply mapping).
+//! services (`parameters.rs`, on `services.rs`: rmw_cyclonedds_cpp's request/reply mapping);
+//! each trajectory controller serves `follow_joint_trajectory` (`actions.rs`).
 //!
 //! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): ros2-client picks
 //! the distribution, and with it the size of `ros_discovery_info`'s ids, with a cargo feature,
 //! where rover picks it per run (`--ros-distro`); and the bridge needs topics, writers and
 //! readers with chosen QoS, which RustDDS offers directly (docs/ROS2.md).
 
+mod action_msgs;
+mod actions;
 mod arm;
 mod camera;
 mod clock;
@@ -215,6 +218,7 @@ impl Bridge<Recorded> {
         };
         let (namespace, name) = discovery::split_node_name(&options.node_name);
         let node = format!("{}/{name}", namespace.trim_end_matches('/'));
+        let (to_session, from_actions) = std::sync::mpsc::channel();
         let input = match participant.as_ref().zip(publisher.as_ref()) {
             Some((p, publisher)) => Some(Ros2Input::subscribe(
                 p,
@@ -222,7 +226,25 @@ impl Bridge<Recorded> {
                 &plan,
                 &node,
                 &robot.description,
+                from_actions,
             )?),
+            None => None,
+        };
+        let actions = match participant.as_ref().zip(publisher.as_ref()) {
+            Some((p, publisher)) => {
+                let subscriber = p
+                    .create_subscriber(&default_qos())
+                    .context("creating the DDS subscriber")?;
+                let actions = actions::TrajectoryActions::serve(
+                    p,
+                    &subscriber,
+                    publisher,
+                    &plan,
+                    options.distro,
+                    to_session,
+                )?;
+                Some(actions)
+            }
             None => None,
         };
         let mcap = match &options.mcap {
@@ -241,16 +263,24 @@ impl Bridge<Recorded> {
                 data: robot.description.clone(),
             },
         );
-        let families = crate::bridge::families(&mut sinks, &plan, ground_truth)?;
-        let writers = std::mem::take(&mut sinks.writers);
+        let mut families = crate::bridge::families(&mut sinks, &plan, ground_truth)?;
+        let mut writers = std::mem::take(&mut sinks.writers);
+        let mut readers = Vec::new();
+        if let Some(actions) = actions {
+            let (r, w) = actions.gids();
+            readers.extend(r);
+            writers.extend(w);
+            families.push(Box::new(actions));
+        }
         drop(sinks);
         let discovery = match (&participant, &publisher, &input) {
             (Some(p), Some(publisher), Some(input)) => {
                 let mut d =
                     discovery::Discovery::new(p, publisher, &options.node_name, options.distro)?;
-                let (readers, mut replies) = input.gids();
+                let (mut input_readers, mut replies) = input.gids();
+                input_readers.extend(readers);
                 replies.extend(writers);
-                d.add(&readers, &replies)?;
+                d.add(&input_readers, &replies)?;
                 Some(d)
             }
             _ => None,

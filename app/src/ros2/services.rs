@@ -101,26 +101,35 @@ where
         })
     }
 
-    /// Answers every request that came, with `answer`. A request that does not decode, or a
-    /// reply that cannot be sent, is one warning per service.
-    pub fn serve(&mut self, mut answer: impl FnMut(S::Request) -> S::Response) {
-        loop {
-            let request = match self.requests.take_next_sample() {
-                Ok(Some(sample)) => sample.into_value(),
-                Ok(None) => return,
-                Err(e) => {
-                    // A peer's garbage or a wrong type: said once; the next poll goes on.
-                    self.warn(&format!("a request could not be read ({e})"));
-                    return;
-                }
-            };
-            let reply = WithHeader {
-                header: request.header,
-                body: answer(request.body),
-            };
-            if let Err(e) = self.replies.write(reply, None) {
-                self.warn(&format!("a reply could not be sent ({e})"));
+    /// The next request that came, if one did (with its header, for the reply). A request
+    /// that does not decode is one warning per service.
+    pub fn next_request(&mut self) -> Option<(RequestHeader, S::Request)> {
+        match self.requests.take_next_sample() {
+            Ok(Some(sample)) => {
+                let request = sample.into_value();
+                Some((request.header, request.body))
             }
+            Ok(None) => None,
+            Err(e) => {
+                // A peer's garbage or a wrong type: said once; the next poll goes on.
+                self.warn(&format!("a request could not be read ({e})"));
+                None
+            }
+        }
+    }
+
+    /// Answers the request `header` names (now or later) with `body`.
+    pub fn reply(&mut self, header: RequestHeader, body: S::Response) {
+        if let Err(e) = self.replies.write(WithHeader { header, body }, None) {
+            self.warn(&format!("a reply could not be sent ({e})"));
+        }
+    }
+
+    /// Answers every request that came, with `answer`.
+    pub fn serve(&mut self, mut answer: impl FnMut(S::Request) -> S::Response) {
+        while let Some((header, request)) = self.next_request() {
+            let body = answer(request);
+            self.reply(header, body);
         }
     }
 

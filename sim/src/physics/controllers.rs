@@ -51,6 +51,24 @@ pub struct TrajectoryState {
     pub desired_velocities: Vec<f64>,
     /// Whether a trajectory is running.
     pub active: bool,
+    /// Trajectories started so far (a new one replaces the one running).
+    pub runs: u64,
+    /// How the last trajectory ended; `None` while it runs or before the first.
+    pub outcome: Option<TrajectoryOutcome>,
+}
+
+/// How a trajectory ended, as joint_trajectory_controller's action reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrajectoryOutcome {
+    /// Within the goal tolerances, stopped, in time: SUCCESSFUL.
+    Reached,
+    /// A joint left its path tolerance while it ran: PATH_TOLERANCE_VIOLATED (-4).
+    PathToleranceViolated,
+    /// Not within the goal tolerances, or still moving, after `goal_time`:
+    /// GOAL_TOLERANCE_VIOLATED (-5).
+    GoalToleranceViolated,
+    /// Stopped by an empty trajectory (a cancel).
+    Stopped,
 }
 
 /// A controller's setpoint, for the `state` topic of a single-joint controller.
@@ -177,6 +195,8 @@ impl Controllers {
                             desired_velocities: vec![0.0; n],
                             joints: joints.clone(),
                             active: false,
+                            runs: 0,
+                            outcome: None,
                         },
                         joints,
                         constraints: t.constraints.clone(),
@@ -278,6 +298,9 @@ impl Controllers {
             });
         }
         if trajectory.points.is_empty() {
+            if run.state.active {
+                run.state.outcome = Some(TrajectoryOutcome::Stopped);
+            }
             run.stop(robot, actuators, true);
             return Ok(());
         }
@@ -289,6 +312,8 @@ impl Controllers {
         run.end_s = knots.last().map(|k| k.t_s);
         run.knots = knots;
         run.state.active = true;
+        run.state.runs += 1;
+        run.state.outcome = None;
         Ok(())
     }
 
@@ -302,7 +327,10 @@ impl Controllers {
             let Some(end_s) = run.end_s else {
                 continue;
             };
-            if let Some((event, hold_here)) = run.update(name, robot, actuators, now_s, end_s) {
+            if let Some((event, hold_here, outcome)) =
+                run.update(name, robot, actuators, now_s, end_s)
+            {
+                run.state.outcome = Some(outcome);
                 run.stop(robot, actuators, hold_here);
                 self.events.push(event);
             }
@@ -346,7 +374,7 @@ impl TrajectoryRun {
         actuators: &mut Actuators,
         now_s: f64,
         end_s: f64,
-    ) -> Option<(String, bool)> {
+    ) -> Option<(String, bool, TrajectoryOutcome)> {
         let t = now_s.min(end_s);
         let seg = self
             .knots
@@ -392,6 +420,7 @@ impl TrajectoryRun {
                     c.trajectory[k]
                 ),
                 true,
+                TrajectoryOutcome::PathToleranceViolated,
             ));
         }
         let moving = self
@@ -408,6 +437,7 @@ impl TrajectoryRun {
             return Some((
                 format!("controller {name}: trajectory reached its goal at {now_s:.3} s"),
                 false,
+                TrajectoryOutcome::Reached,
             ));
         }
         if now_s <= end_s + c.goal_time_s {
@@ -430,7 +460,7 @@ impl TrajectoryRun {
             ),
             (None, None) => format!("controller {name}: trajectory ended"),
         };
-        Some((message, false))
+        Some((message, false, TrajectoryOutcome::GoalToleranceViolated))
     }
 
     /// Ends the trajectory; the joints hold its last sample, or where they are.

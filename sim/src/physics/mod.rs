@@ -14,7 +14,9 @@ pub(crate) mod simulation;
 pub use actuators::{
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
 };
-pub use controllers::{ControllerCommandState, JointTrajectory, TrajectoryPoint, TrajectoryState};
+pub use controllers::{
+    ControllerCommandState, JointTrajectory, TrajectoryOutcome, TrajectoryPoint, TrajectoryState,
+};
 pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
     WheelSpeeds, wrap_angle,
