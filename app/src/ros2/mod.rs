@@ -202,49 +202,8 @@ impl Bridge<Recorded> {
         ground_truth: bool,
     ) -> Result<(Self, Option<Ros2Input>)> {
         let plan = RosPlan::for_robot(robot);
-        let participant = match options.domain_id {
-            Some(domain) => Some(
-                DomainParticipant::new(domain)
-                    .with_context(|| format!("joining DDS domain {domain}"))?,
-            ),
-            None => None,
-        };
-        let publisher = match &participant {
-            Some(p) => Some(
-                p.create_publisher(&default_qos())
-                    .context("creating the DDS publisher")?,
-            ),
-            None => None,
-        };
-        let (namespace, name) = discovery::split_node_name(&options.node_name);
-        let node = format!("{}/{name}", namespace.trim_end_matches('/'));
-        let (to_session, from_actions) = std::sync::mpsc::channel();
-        let input = match participant.as_ref().zip(publisher.as_ref()) {
-            Some((p, publisher)) => Some(Ros2Input::subscribe(
-                p,
-                publisher,
-                &plan,
-                &node,
-                &robot.description,
-                from_actions,
-            )?),
-            None => None,
-        };
-        let actions = match participant.as_ref().zip(publisher.as_ref()) {
-            Some((p, publisher)) => {
-                let subscriber = p
-                    .create_subscriber(&default_qos())
-                    .context("creating the DDS subscriber")?;
-                let actions = actions::TrajectoryActions::serve(
-                    p,
-                    &subscriber,
-                    publisher,
-                    &plan,
-                    options.distro,
-                    to_session,
-                )?;
-                Some(actions)
-            }
+        let dds = match options.domain_id {
+            Some(domain) => Some(DdsNode::join(domain, options, &plan, robot)?),
             None => None,
         };
         let mcap = match &options.mcap {
@@ -252,7 +211,7 @@ impl Bridge<Recorded> {
             None => None,
         };
         let mut sinks = Sinks {
-            dds: participant.as_ref().zip(publisher.as_ref()),
+            dds: dds.as_ref().map(|n| (&n.participant, &n.publisher)),
             mcap: mcap.clone(),
             writers: Vec::new(),
         };
@@ -264,26 +223,15 @@ impl Bridge<Recorded> {
             },
         );
         let mut families = crate::bridge::families(&mut sinks, &plan, ground_truth)?;
-        let mut writers = std::mem::take(&mut sinks.writers);
-        let mut readers = Vec::new();
-        if let Some(actions) = actions {
-            let (r, w) = actions.gids();
-            readers.extend(r);
-            writers.extend(w);
-            families.push(Box::new(actions));
-        }
+        let writers = std::mem::take(&mut sinks.writers);
         drop(sinks);
-        let discovery = match (&participant, &publisher, &input) {
-            (Some(p), Some(publisher), Some(input)) => {
-                let mut d =
-                    discovery::Discovery::new(p, publisher, &options.node_name, options.distro)?;
-                let (mut input_readers, mut replies) = input.gids();
-                input_readers.extend(readers);
-                replies.extend(writers);
-                d.add(&input_readers, &replies)?;
-                Some(d)
+        let (input, held) = match dds {
+            Some(node) => {
+                let (input, held, actions) = node.announce(options, writers)?;
+                families.push(Box::new(actions));
+                (Some(input), Some(held))
             }
-            _ => None,
+            None => (None, None),
         };
         let backlog = if mcap.is_some() {
             Backlog::Wait
@@ -308,9 +256,8 @@ impl Bridge<Recorded> {
                         .finish(),
                     Err(_) => Err(anyhow::anyhow!("the MCAP file is still in use")),
                 });
-                drop(discovery);
-                drop(publisher);
-                drop(participant);
+                // ros_discovery_info, then the participant, go last.
+                drop(held);
                 recorded
             },
         )?;
@@ -327,5 +274,90 @@ impl Bridge<Recorded> {
             tracing::info!("recording the ROS 2 topics to {}", path.display());
         }
         Ok((bridge, input))
+    }
+}
+
+/// What `--ros2` adds on DDS: the participant and its publisher, the input half (topics,
+/// parameter services) and the trajectory controllers' action servers.
+struct DdsNode {
+    participant: DomainParticipant,
+    publisher: rustdds::Publisher,
+    input: Ros2Input,
+    actions: actions::TrajectoryActions,
+}
+
+/// What the publishing thread keeps alive until it ends: `ros_discovery_info`'s writer, the
+/// publisher and the participant.
+type Held = (discovery::Discovery, rustdds::Publisher, DomainParticipant);
+
+impl DdsNode {
+    /// Joins DDS domain `domain`, subscribes to the input topics and serves the parameters
+    /// and actions of the node `options` names.
+    fn join(
+        domain: u16,
+        options: &Ros2Options,
+        plan: &RosPlan,
+        robot: &RobotModel,
+    ) -> Result<Self> {
+        let participant = DomainParticipant::new(domain)
+            .with_context(|| format!("joining DDS domain {domain}"))?;
+        let publisher = participant
+            .create_publisher(&default_qos())
+            .context("creating the DDS publisher")?;
+        let (namespace, name) = discovery::split_node_name(&options.node_name);
+        let node = format!("{}/{name}", namespace.trim_end_matches('/'));
+        let (to_session, from_actions) = std::sync::mpsc::channel();
+        let input = Ros2Input::subscribe(
+            &participant,
+            &publisher,
+            plan,
+            &node,
+            &robot.description,
+            from_actions,
+        )?;
+        let subscriber = participant
+            .create_subscriber(&default_qos())
+            .context("creating the DDS subscriber")?;
+        let actions = actions::TrajectoryActions::serve(
+            &participant,
+            &subscriber,
+            &publisher,
+            plan,
+            options.distro,
+            to_session,
+        )?;
+        Ok(Self {
+            participant,
+            publisher,
+            input,
+            actions,
+        })
+    }
+
+    /// Publishes `ros_discovery_info` for the node: the input's and the actions' readers and
+    /// writers, and the topics' `writers`. What the bridge runs with: the input, what its
+    /// thread holds, and the action servers (a topic family).
+    fn announce(
+        self,
+        options: &Ros2Options,
+        writers: Vec<rustdds::GUID>,
+    ) -> Result<(Ros2Input, Held, actions::TrajectoryActions)> {
+        let mut d = discovery::Discovery::new(
+            &self.participant,
+            &self.publisher,
+            &options.node_name,
+            options.distro,
+        )?;
+        let (mut readers, mut all_writers) = self.input.gids();
+        let (action_readers, action_writers) = self.actions.gids();
+        readers.extend(action_readers);
+        all_writers.extend(action_writers);
+        all_writers.extend(writers);
+        d.add(&readers, &all_writers)?;
+        Ok((
+            self.input,
+            (d, self.publisher, self.participant),
+            self.actions,
+        ))
     }
 }
