@@ -13,6 +13,7 @@
 
 mod arm_task;
 mod dataset;
+mod detection;
 mod error;
 mod follower;
 mod headless;

@@ -9,43 +9,21 @@
 use std::time::Instant;
 
 use rover_perception::{
-    BoundingBoxes, Detect, Detector, DetectorConfig, DetectorWorker, FaultInjector, Frame,
-    FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
+    BoundingBoxes, DetectorConfig, FrameStamp, InjectedFault, PerceptionError, WorkerStats,
 };
 use rover_sim::{
-    CameraFrame, CameraInfo, CameraSensor, ControlSample, GroundTruthBox, LaserSensor, LinkId,
-    RobotModel, SimOptions, Simulation, World,
+    CameraInfo, CameraSensor, ControlSample, GroundTruthBox, LaserSensor, LinkId, RobotModel,
+    SimOptions, Simulation, World,
 };
 
 use crate::arm_task::{ArmConfig, ArmMode, ArmTask};
+pub use crate::detection::DetectorMode;
+use crate::detection::{Detected, Detection};
 use crate::error::{CoreError, Result};
 use crate::follower::{CameraGeometry, Follower, FollowerConfig, LaserMount};
 use crate::input::{Action, JointAction};
 use crate::observer::{EventLevel, LoopStats, Observer};
 use crate::pilot::{Mode, Pilot};
-
-/// How detection runs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum DetectorMode {
-    /// No camera processing: the follower holds still.
-    Off,
-    /// Synchronously on the loop's thread at this rate on sim time (deterministic).
-    Lockstep {
-        /// Detections per sim second.
-        rate_hz: f64,
-    },
-    /// At this rate on sim time, on a second thread while the simulation and camera go on;
-    /// each result is handed to the follower one detection period (sim time) after its image
-    /// was taken, waiting for the thread if it is not done. Deterministic like `Lockstep`
-    /// (the same images, the same delivery times whatever the wall clock does), using two
-    /// cores.
-    Pipelined {
-        /// Detections per sim second.
-        rate_hz: f64,
-    },
-    /// On its own thread, always on the newest frame (interactive, real time).
-    Worker,
-}
 
 /// Everything a session needs besides the world and the robot.
 #[derive(Debug, Clone)]
@@ -102,25 +80,6 @@ fn emit(observer: &mut dyn Observer, sim_time_s: f64, level: EventLevel, text: &
         EventLevel::Warn => tracing::warn!("{text}"),
     }
     observer.event(sim_time_s, level, text);
-}
-
-/// The detector as the session runs it ([`DetectorMode`], once loaded).
-enum Detection {
-    Off,
-    Lockstep(Box<LockstepDetector>),
-    Pipelined(Box<Pipelined>),
-    Worker(DetectorWorker),
-}
-
-/// [`DetectorMode::Pipelined`]: a worker thread fed on a sim-time schedule, its results taken
-/// at a fixed sim-time delay. At most one image is in flight.
-struct Pipelined {
-    worker: DetectorWorker,
-    period_s: f64,
-    /// Sim time from which the next image is detected.
-    next_s: f64,
-    /// When the image in flight is due back (its stamp + one period).
-    deliver_at_s: Option<f64>,
 }
 
 /// A running session.
@@ -192,15 +151,24 @@ impl Session {
         }
         let (detection, labels) = match (options.detector, camera.is_some()) {
             (DetectorMode::Off, _) | (_, false) => (Detection::Off, Vec::new()),
-            (mode, true) => start_detection(
-                mode,
-                &options.detector_config,
-                options.inject_fault,
-                observer,
-            )?,
+            (mode, true) => {
+                let started =
+                    Detection::start(mode, &options.detector_config, options.inject_fault)?;
+                started.unwrap_or_else(|e| {
+                    emit(
+                        observer,
+                        0.0,
+                        EventLevel::Warn,
+                        &format!(
+                            "no detector ({e}); manual driving works, the follower holds still"
+                        ),
+                    );
+                    (Detection::Off, Vec::new())
+                })
+            }
         };
         let stats = LoopStats {
-            detector_ok: !matches!(detection, Detection::Off),
+            detector_ok: !detection.is_off(),
             ..LoopStats::default()
         };
         observer.start(&sim, camera.as_ref().map(|c| c.info()), &labels);
@@ -312,7 +280,7 @@ impl Session {
         if before != after {
             self.follower.reset();
             let text = match after {
-                Mode::Follow if matches!(self.detection, Detection::Off) => {
+                Mode::Follow if self.detection.is_off() => {
                     "mode: follow (no detector: holding still)"
                 }
                 Mode::Follow => "mode: follow",
@@ -457,14 +425,9 @@ impl Session {
 
     fn camera_and_detection(&mut self, observer: &mut dyn Observer) -> Result<()> {
         // Results from the worker thread arrive whenever they are ready.
-        if let Detection::Worker(worker) = &self.detection
-            && let Some(result) = worker.latest()
-        {
+        if let Some((result, stats)) = self.detection.latest() {
             match result {
-                Ok(boxes) => {
-                    let stats = worker.stats();
-                    self.accept(boxes, Some(stats), observer);
-                }
+                Ok(boxes) => self.accept(boxes, Some(stats), observer),
                 Err(e) => self.detector_failed(&e, observer),
             }
         }
@@ -473,19 +436,12 @@ impl Session {
         // starts on it the moment the owed result is done (nothing in the image depends on that
         // result: the follower acts on it at the next control update, as before).
         let now_s = self.sim.sim_time_s();
-        let mut owed = match &mut self.detection {
-            Detection::Pipelined(p) if p.deliver_at_s.is_some_and(|t| now_s + 1e-9 >= t) => {
-                p.deliver_at_s = None;
-                true
-            }
-            _ => false,
-        };
+        let mut owed = self.detection.take_owed(now_s);
         let detected = self.camera_step(observer, &mut owed)?;
         if let Some(result) = detected {
             self.take(result, observer);
         }
-        if owed && let Detection::Pipelined(p) = &self.detection {
-            let result = p.worker.wait();
+        if owed && let Some(result) = self.detection.wait_owed() {
             self.take(result, observer);
         }
         Ok(())
@@ -499,19 +455,13 @@ impl Session {
         &mut self,
         observer: &mut dyn Observer,
         owed: &mut bool,
-    ) -> Result<Option<std::result::Result<BoundingBoxes, PerceptionError>>> {
+    ) -> Result<Option<Detected>> {
         let Some(camera) = self.camera.as_mut() else {
             return Ok(None);
         };
         if !self.every_frame && camera.due(&self.sim) {
             // Nobody looks at this image unless the detector takes it.
-            let t = self.sim.sim_time_s() + 1e-9;
-            let wanted = match &self.detection {
-                Detection::Off => false,
-                Detection::Lockstep(d) => d.due(self.sim.sim_time_s()),
-                Detection::Pipelined(p) => t >= p.next_s,
-                Detection::Worker(_) => true,
-            };
+            let wanted = self.detection.wants_image(self.sim.sim_time_s());
             if !wanted {
                 camera.skip_if_due(&self.sim);
                 return Ok(None);
@@ -535,48 +485,14 @@ impl Session {
             sim_time_s: frame.sim_time_s,
             frame: frame.seq,
         };
-        let detected = match &mut self.detection {
-            Detection::Off => None,
-            Detection::Lockstep(detector) => {
-                RgbView::new(frame.width as usize, frame.height as usize, frame.rgb)
-                    .and_then(|view| detector.detect_if_due(view, stamp))
-                    .transpose()
-            }
-            Detection::Pipelined(p) => {
-                if frame.sim_time_s + 1e-9 >= p.next_s {
-                    p.next_s += p.period_s;
-                    if p.next_s + 1e-9 < frame.sim_time_s {
-                        p.next_s = frame.sim_time_s + p.period_s;
-                    }
-                    // Queued behind the one in flight; that one (due now, or still out when
-                    // the camera is slower than the detection rate) is taken right after, on
-                    // sim time like everything else: never two results outstanding.
-                    let still_out = p.deliver_at_s.take().is_some();
-                    let earlier = std::mem::take(owed) || still_out;
-                    p.worker
-                        .submit_queued(worker_frame(&p.worker, &frame, stamp));
-                    p.deliver_at_s = Some(frame.sim_time_s + p.period_s);
-                    earlier.then(|| p.worker.wait())
-                } else {
-                    None
-                }
-            }
-            Detection::Worker(worker) => {
-                let detector_frame = worker_frame(worker, &frame, stamp);
-                self.detector_started.get_or_insert_with(Instant::now);
-                worker.submit(detector_frame);
-                None
-            }
-        };
+        let detected = self
+            .detection
+            .submit(&frame, stamp, owed, &mut self.detector_started);
         Ok(detected)
     }
 
     /// A lockstep or pipelined result: its boxes, or the detector's failure.
-    fn take(
-        &mut self,
-        result: std::result::Result<BoundingBoxes, PerceptionError>,
-        observer: &mut dyn Observer,
-    ) {
+    fn take(&mut self, result: Detected, observer: &mut dyn Observer) {
         match result {
             Ok(boxes) => self.accept(boxes, None, observer),
             Err(e) => self.detector_failed(&e, observer),
@@ -688,77 +604,6 @@ fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
         config.update_rate_hz
     );
     Ok(Some(sensor))
-}
-
-/// Loads the detector and starts it in `mode` (not [`DetectorMode::Off`]); returns it with its
-/// class names. A detector that cannot be loaded is a warning to `observer` and no detection;
-/// a bad pipelined rate is an error.
-fn start_detection(
-    mode: DetectorMode,
-    config: &DetectorConfig,
-    inject_fault: Option<InjectedFault>,
-    observer: &mut dyn Observer,
-) -> Result<(Detection, Vec<String>)> {
-    let detector = match Detector::load(config.clone()) {
-        Ok(detector) => detector,
-        Err(e) => {
-            emit(
-                observer,
-                0.0,
-                EventLevel::Warn,
-                &format!("no detector ({e}); manual driving works, the follower holds still"),
-            );
-            return Ok((Detection::Off, Vec::new()));
-        }
-    };
-    let labels = detector.labels().to_vec();
-    tracing::info!(
-        "detector: {} at {}x{} on {}, {} thread(s)",
-        detector.model_path().display(),
-        detector.input_size().0,
-        detector.input_size().1,
-        detector.config().runtime.name(),
-        detector.config().threads
-    );
-    let detector: Box<dyn Detect> = match inject_fault {
-        Some(fault) => Box::new(FaultInjector::new(detector, fault)),
-        None => Box::new(detector),
-    };
-    let detection = match mode {
-        DetectorMode::Lockstep { rate_hz } => {
-            Detection::Lockstep(Box::new(LockstepDetector::new(detector, rate_hz)?))
-        }
-        DetectorMode::Pipelined { rate_hz } => {
-            if !(rate_hz.is_finite() && rate_hz > 0.0) {
-                return Err(CoreError::Option(format!(
-                    "the detection rate must be a positive number of Hz, found {rate_hz}"
-                )));
-            }
-            Detection::Pipelined(Box::new(Pipelined {
-                worker: DetectorWorker::spawn(detector)?,
-                period_s: 1.0 / rate_hz,
-                next_s: 0.0,
-                deliver_at_s: None,
-            }))
-        }
-        DetectorMode::Worker | DetectorMode::Off => {
-            Detection::Worker(DetectorWorker::spawn(detector)?)
-        }
-    };
-    Ok((detection, labels))
-}
-
-/// A camera image copied into one of `worker`'s recycled buffers, as the detector takes it.
-fn worker_frame(worker: &DetectorWorker, frame: &CameraFrame<'_>, stamp: FrameStamp) -> Frame {
-    let mut pixels = worker.buffer();
-    pixels.clear();
-    pixels.extend_from_slice(frame.rgb);
-    Frame {
-        pixels,
-        width: frame.width as usize,
-        height: frame.height as usize,
-        stamp,
-    }
 }
 
 /// The follower's view of the camera: intrinsics, and where the camera sits on the robot as
