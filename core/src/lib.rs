@@ -35,10 +35,10 @@ mod trace;
 
 pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
 pub use dataset::{
-    COCO_CATEGORY_IDS, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox, ImageFormat,
-    ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, PersonShot, Randomization,
-    SHARD_MANIFEST, Shot, Split, coco_category, coco_json, coco_results, data_yaml, merge_dataset,
-    write_dataset, write_whole, yolo_class,
+    COCO_CATEGORY_IDS, DatasetFormat, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox,
+    ImageFormat, ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, PersonShot,
+    Randomization, SHARD_MANIFEST, Shot, Split, coco_category, coco_json, coco_results, data_yaml,
+    merge_dataset, write_dataset, write_whole, yolo_class,
 };
 pub use error::{CoreError, Result};
 pub use follower::{

@@ -351,8 +351,7 @@ fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
         seed: 3,
         val_fraction: 0.0,
         image_format: rover_core::ImageFormat::Png,
-        yolo: false,
-        coco: true,
+        formats: vec![rover_core::DatasetFormat::Coco],
         randomization: rover_core::Randomization {
             background: 0.0,
             distance_m: [2.0, 4.0],

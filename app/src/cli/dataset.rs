@@ -102,8 +102,7 @@ pub(crate) fn run(args: DatasetArgs) -> Result<()> {
         seed: args.world.seed,
         val_fraction: args.val,
         image_format: args.image_format.format(),
-        yolo: args.format.contains(&DatasetFormat::Yolo),
-        coco: args.format.contains(&DatasetFormat::Coco),
+        formats: formats(&args.format),
         randomization: randomization(&args),
         detect: args.detect,
         shard,
@@ -173,7 +172,11 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
             s.split_images[1],
             s.boxes,
             s.ignored,
-            if spec.yolo { ", labels/" } else { "" },
+            if spec.formats.contains(&rover_core::DatasetFormat::Yolo) {
+                ", labels/"
+            } else {
+                ""
+            },
             rover_core::SHARD_MANIFEST
         );
         say!(
@@ -193,13 +196,14 @@ fn print_contents(s: &DatasetSummary, spec: &DatasetSpec) {
         s.ignored,
         s.backgrounds
     );
-    let mut wrote = Vec::new();
-    if spec.yolo {
-        wrote.push("data.yaml, labels/{train,val}/ (YOLO)");
-    }
-    if spec.coco {
-        wrote.push("annotations/instances_{train,val}.json (COCO)");
-    }
+    let wrote: Vec<&str> = spec
+        .formats
+        .iter()
+        .map(|f| match f {
+            rover_core::DatasetFormat::Yolo => "data.yaml, labels/{train,val}/ (YOLO)",
+            rover_core::DatasetFormat::Coco => "annotations/instances_{train,val}.json (COCO)",
+        })
+        .collect();
     say!(
         "  wrote images/{{train,val}}/, {}, ground_truth/",
         wrote.join(", ")
@@ -245,8 +249,7 @@ pub(crate) fn bench(
         seed: world.seed,
         val_fraction: 0.1,
         image_format: format.format(),
-        yolo: true,
-        coco: true,
+        formats: rover_core::DatasetFormat::ALL.to_vec(),
         randomization: Randomization::default(),
         detect: false,
         shard: None,
@@ -281,4 +284,18 @@ pub(crate) fn bench(
         summary.total
     );
     Ok(())
+}
+
+/// `--format`'s choices as the dataset's formats, each once, in `--help`'s order.
+fn formats(chosen: &[DatasetFormat]) -> Vec<rover_core::DatasetFormat> {
+    let mut formats: Vec<rover_core::DatasetFormat> = chosen
+        .iter()
+        .map(|f| match f {
+            DatasetFormat::Yolo => rover_core::DatasetFormat::Yolo,
+            DatasetFormat::Coco => rover_core::DatasetFormat::Coco,
+        })
+        .collect();
+    formats.sort();
+    formats.dedup();
+    formats
 }

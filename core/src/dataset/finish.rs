@@ -9,6 +9,7 @@ use std::time::Instant;
 use rover_perception::{CocoEvaluator, DetectionMetrics};
 
 use super::export::{ImageRecord, coco_json, coco_results, data_yaml};
+use super::format::DatasetFormat;
 use super::randomize::Randomization;
 use super::store::{ImageFormat, Split, Store, write_whole};
 use crate::error::{CoreError, Result};
@@ -27,10 +28,8 @@ pub struct DatasetSpec {
     pub val_fraction: f64,
     /// How images are stored.
     pub image_format: ImageFormat,
-    /// Write Ultralytics YOLO labels and data.yaml.
-    pub yolo: bool,
-    /// Write COCO JSON.
-    pub coco: bool,
+    /// The annotation formats to write (at least one).
+    pub formats: Vec<DatasetFormat>,
     /// What is randomized.
     pub randomization: Randomization,
     /// Run the detector on every image: its boxes in the records, COCO results files and
@@ -140,15 +139,17 @@ pub(super) fn finish(
         write_whole(&path, text.as_bytes()).map_err(|e| disk_error(&path, e, store, spec.images))
     };
     let json_error = |e: serde_json::Error| CoreError::Option(format!("JSON: {e}"));
-    if spec.yolo {
-        write(root.join("data.yaml"), &data_yaml())?;
-    }
-    if spec.coco {
-        let dir = root.join("annotations");
-        std::fs::create_dir_all(&dir).map_err(|e| CoreError::write(&dir, e))?;
-        for split in Split::ALL {
-            let text = coco_json(&records, split).map_err(json_error)?;
-            write(dir.join(format!("instances_{}.json", split.name())), &text)?;
+    for format in &spec.formats {
+        match format {
+            DatasetFormat::Yolo => write(root.join("data.yaml"), &data_yaml())?,
+            DatasetFormat::Coco => {
+                let dir = root.join("annotations");
+                std::fs::create_dir_all(&dir).map_err(|e| CoreError::write(&dir, e))?;
+                for split in Split::ALL {
+                    let text = coco_json(&records, split).map_err(json_error)?;
+                    write(dir.join(format!("instances_{}.json", split.name())), &text)?;
+                }
+            }
         }
     }
     if spec.detect {

@@ -180,8 +180,7 @@ pub fn merge_dataset(
         seed: whole.seed,
         val_fraction: whole.val_fraction,
         image_format: whole.image_format,
-        yolo: whole.yolo,
-        coco: whole.coco,
+        formats: whole.formats.clone(),
         randomization: whole.randomization.clone(),
         detect: whole.detector.is_some(),
         shard: None,
@@ -209,7 +208,7 @@ fn gather(dir: &Path, store: &Store, whole: &Manifest, index: u64) -> Result<()>
         shard.image_path(split, index),
         store.image_path(split, index),
     )];
-    if whole.yolo {
+    if whole.formats.iter().any(|f| f.image_dir().is_some()) {
         files.push((
             shard.label_path(split, index),
             store.label_path(split, index),

@@ -7,6 +7,7 @@
 
 mod export;
 mod finish;
+mod format;
 mod merge;
 mod randomize;
 mod store;
@@ -24,6 +25,7 @@ pub use export::{
     coco_results, data_yaml, yolo_class,
 };
 pub use finish::{DatasetProgress, DatasetSpec, DatasetSummary};
+pub use format::DatasetFormat;
 pub use merge::{SHARD_MANIFEST, merge_dataset};
 pub use randomize::{PersonShot, Randomization, Shot};
 pub use store::{ImageFormat, MANIFEST, MANIFEST_FORMAT, Manifest, Split, Store, write_whole};
@@ -255,10 +257,11 @@ fn check_spec(spec: &DatasetSpec) -> Result<()> {
             spec.val_fraction
         )));
     }
-    if !spec.yolo && !spec.coco {
-        return Err(CoreError::Option(
-            "choose at least one output format (yolo, coco)".into(),
-        ));
+    if spec.formats.is_empty() {
+        return Err(CoreError::Option(format!(
+            "choose at least one output format ({})",
+            format::names(&DatasetFormat::ALL)
+        )));
     }
     spec.randomization.check().map_err(CoreError::Option)
 }
@@ -288,8 +291,7 @@ fn manifest(
         images: spec.images,
         val_fraction: spec.val_fraction,
         image_format: spec.image_format,
-        yolo: spec.yolo,
-        coco: spec.coco,
+        formats: spec.formats.clone(),
         world: sim.world().source.display().to_string(),
         world_sha256: sha256_of(&sim.world().source)?,
         robot: sim.robot().source.display().to_string(),
@@ -364,7 +366,10 @@ fn make_image(
         rgb,
         width,
         height,
-        label: spec.yolo.then(|| record.yolo_label()),
+        label: spec
+            .formats
+            .contains(&DatasetFormat::Yolo)
+            .then(|| record.yolo_label()),
         record: serde_json::to_string(&record)
             .map_err(|e| CoreError::Option(format!("image record: {e}")))?,
     })

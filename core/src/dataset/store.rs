@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::dataset::format::{DatasetFormat, names};
 use crate::dataset::randomize::Randomization;
 use crate::error::{CoreError, Result};
 use crate::shard::ShardIndex;
@@ -85,10 +86,10 @@ pub struct Manifest {
     pub val_fraction: f64,
     /// How images are stored.
     pub image_format: ImageFormat,
-    /// Ultralytics YOLO labels and data.yaml.
-    pub yolo: bool,
-    /// COCO JSON annotations.
-    pub coco: bool,
+    /// The annotation formats (before 0.1's format list: `yolo` and `coco` booleans, read
+    /// into it by [`Manifest::read`]).
+    #[serde(default)]
+    pub formats: Vec<DatasetFormat>,
     /// The world file, as given.
     pub world: String,
     /// SHA-256 of the world file's bytes.
@@ -117,6 +118,24 @@ pub struct Manifest {
 pub const MANIFEST_FORMAT: &str = "rover-dataset 1";
 
 impl Manifest {
+    /// A manifest from its JSON; one written before the format list (a `yolo` and a `coco`
+    /// boolean) reads as the list they say.
+    pub fn read(text: &str) -> serde_json::Result<Self> {
+        let mut value: serde_json::Value = serde_json::from_str(text)?;
+        if let Some(fields) = value.as_object_mut()
+            && !fields.contains_key("formats")
+        {
+            // Before the format list: one boolean per format.
+            let formats: Vec<serde_json::Value> = DatasetFormat::ALL
+                .into_iter()
+                .filter(|f| fields.remove(f.name()) == Some(serde_json::Value::Bool(true)))
+                .map(|f| f.name().into())
+                .collect();
+            fields.insert("formats".into(), formats.into());
+        }
+        serde_json::from_value(value)
+    }
+
     /// The fields (by name) in which `self` and `other` differ, the image count aside.
     pub fn differences(&self, other: &Manifest) -> Vec<String> {
         let mut out = Vec::new();
@@ -142,8 +161,7 @@ impl Manifest {
             format!("{:?}", self.image_format),
             format!("{:?}", other.image_format),
         );
-        check("yolo output", self.yolo.to_string(), other.yolo.to_string());
-        check("coco output", self.coco.to_string(), other.coco.to_string());
+        check("formats", names(&self.formats), names(&other.formats));
         check(
             "world file contents",
             self.world_sha256.clone(),
@@ -185,7 +203,8 @@ impl Manifest {
 pub struct Store {
     root: PathBuf,
     image_format: ImageFormat,
-    yolo: bool,
+    /// The formats' per-image folders (`labels`).
+    image_dirs: Vec<&'static str>,
 }
 
 impl Store {
@@ -199,7 +218,7 @@ impl Store {
         if manifest_path.is_file() {
             let text = std::fs::read_to_string(&manifest_path)
                 .map_err(|e| CoreError::write(&manifest_path, e))?;
-            let old: Manifest = serde_json::from_str(&text)
+            let old = Manifest::read(&text)
                 .map_err(|e| refuse(format!("{MANIFEST} is not a rover dataset manifest ({e})")))?;
             let differences = old.differences(manifest);
             if !differences.is_empty() {
@@ -222,11 +241,7 @@ impl Store {
                 )));
             }
         }
-        let store = Self {
-            root: root.to_path_buf(),
-            image_format: manifest.image_format,
-            yolo: manifest.yolo,
-        };
+        let store = Self::at(root, manifest);
         for split in Split::ALL {
             for dir in store.split_dirs(split) {
                 std::fs::create_dir_all(&dir).map_err(|e| CoreError::write(&dir, e))?;
@@ -247,7 +262,11 @@ impl Store {
         Self {
             root: root.to_path_buf(),
             image_format: manifest.image_format,
-            yolo: manifest.yolo,
+            image_dirs: manifest
+                .formats
+                .iter()
+                .filter_map(|f| f.image_dir())
+                .collect(),
         }
     }
 
@@ -256,9 +275,11 @@ impl Store {
             self.root.join("images").join(split.name()),
             self.root.join("ground_truth").join(split.name()),
         ];
-        if self.yolo {
-            dirs.push(self.root.join("labels").join(split.name()));
-        }
+        dirs.extend(
+            self.image_dirs
+                .iter()
+                .map(|dir| self.root.join(dir).join(split.name())),
+        );
         dirs
     }
 
@@ -277,7 +298,8 @@ impl Store {
                 else {
                     continue;
                 };
-                let has_label = !self.yolo || self.label_path(split, index).is_file();
+                let has_label =
+                    !self.image_dirs.contains(&"labels") || self.label_path(split, index).is_file();
                 if index < images && self.image_path(split, index).is_file() && has_label {
                     done.insert(index);
                 }
@@ -360,4 +382,48 @@ pub fn write_whole_with(
         let _ = std::fs::remove_file(&temporary);
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_manifest_from_before_the_format_list_reads_as_its_list() -> serde_json::Result<()> {
+        let manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            rover_version: "0.1.0".into(),
+            seed: 7,
+            images: 3,
+            val_fraction: 0.1,
+            image_format: ImageFormat::Png,
+            formats: vec![DatasetFormat::Yolo],
+            world: "w.toml".into(),
+            world_sha256: String::new(),
+            robot: "r.urdf".into(),
+            robot_sha256: String::new(),
+            camera: "camera".into(),
+            width: 640,
+            height: 480,
+            randomization: Randomization::default(),
+            detector: None,
+            shard: None,
+        };
+        let mut old = serde_json::to_value(&manifest)?;
+        if let Some(fields) = old.as_object_mut() {
+            fields.remove("formats");
+            fields.insert("yolo".into(), true.into());
+            fields.insert("coco".into(), false.into());
+        }
+        let read = Manifest::read(&old.to_string())?;
+        assert_eq!(read, manifest);
+        assert!(read.differences(&manifest).is_empty());
+        let mut both = manifest.clone();
+        both.formats = DatasetFormat::ALL.to_vec();
+        assert_eq!(
+            read.differences(&both),
+            ["formats: yolo (folder) vs yolo, coco (now)"]
+        );
+        Ok(())
+    }
 }
