@@ -68,6 +68,29 @@ impl Graph {
         Ok(())
     }
 
+    /// `rover --ros2` with TIAGo (example-robot-data's, without a hand), its wheels driven and
+    /// its controllers file, and `extra` arguments; `false` (the skip recorded) without
+    /// example-robot-data.
+    fn spawn_tiago(&mut self, duration_s: f64, extra: &[&str]) -> Result<bool> {
+        let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+            return Ok(false);
+        };
+        let controllers =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/controllers/tiago_no_hand.yaml");
+        let (urdf, controllers) = (urdf.to_string_lossy(), controllers.to_string_lossy());
+        let mut args = vec![
+            "--robot",
+            urdf.as_ref(),
+            "--drive",
+            "wheel_left_joint,wheel_right_joint",
+            "--controllers",
+            controllers.as_ref(),
+        ];
+        args.extend_from_slice(extra);
+        self.spawn_rover(duration_s, &args)?;
+        Ok(true)
+    }
+
     /// Runs `script` (after the message definitions) with cyclonedds importable; its output.
     fn python(&self, name: &str, script: &str, timeout: Duration) -> Result<String> {
         let path = self.dir.path().join(name);
@@ -568,28 +591,18 @@ fn a_cyclone_peer_drives_tiagos_controllers_and_arm_task() -> Result<()> {
     let Some(cyclonedds) = cyclonedds() else {
         return Ok(());
     };
-    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
-        return Ok(());
-    };
-    let controllers =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/controllers/tiago_no_hand.yaml");
     let mut graph = Graph::new(cyclonedds, domain(5))?;
-    let (urdf, controllers) = (urdf.to_string_lossy(), controllers.to_string_lossy());
-    graph.spawn_rover(
+    if !graph.spawn_tiago(
         16.0,
         &[
-            "--robot",
-            urdf.as_ref(),
-            "--drive",
-            "wheel_left_joint,wheel_right_joint",
-            "--controllers",
-            controllers.as_ref(),
             "--ee-link",
             "arm_tool_link",
             "--arm-base",
             "torso_lift_link",
         ],
-    )?;
+    )? {
+        return Ok(());
+    }
     std::thread::sleep(Duration::from_secs(2));
     let script = format!(
         "{CONTROL_MESSAGES}\n{}",
@@ -1096,26 +1109,10 @@ fn an_action_client_moves_tiagos_arm_and_a_cancel_stops_it() -> Result<()> {
     let Some(cyclonedds) = cyclonedds() else {
         return Ok(());
     };
-    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
-        return Ok(());
-    };
-    let controllers =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/controllers/tiago_no_hand.yaml");
     let mut graph = Graph::new(cyclonedds, domain(10))?;
-    let (urdf, controllers) = (urdf.to_string_lossy(), controllers.to_string_lossy());
-    graph.spawn_rover(
-        24.0,
-        &[
-            "--robot",
-            urdf.as_ref(),
-            "--drive",
-            "wheel_left_joint,wheel_right_joint",
-            "--controllers",
-            controllers.as_ref(),
-            "--ros-distro",
-            "jazzy",
-        ],
-    )?;
+    if !graph.spawn_tiago(24.0, &["--ros-distro", "jazzy"])? {
+        return Ok(());
+    }
     std::thread::sleep(Duration::from_secs(2));
     let script = format!(
         "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{}",
