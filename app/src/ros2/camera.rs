@@ -64,14 +64,20 @@ impl CameraWire for Camera {
     }
 
     fn image(&mut self, channel: Channel, image: &mut ImageFrame) {
-        let mut header = self.info_msg.header.clone();
-        header.stamp = Time::from_secs(image.stamp_s);
+        let Self { topics, info_msg } = self;
+        // The image's header is its camera_info's: the optical frame, the image's stamp.
+        info_msg.header.stamp = Time::from_secs(image.stamp_s);
         let (data, encoding) = match channel {
             Channel::Colour => (&mut image.pixels, "rgb8"),
             Channel::Depth => (&mut image.depth, "32FC1"),
         };
-        if let Some(out) = &mut self.topics.get_mut(channel).image {
-            out.put_image(&header, (image.width, image.height), encoding, data);
+        if let Some(out) = &mut topics.get_mut(channel).image {
+            out.put_image(
+                &info_msg.header,
+                (image.width, image.height),
+                encoding,
+                data,
+            );
         }
     }
 }
