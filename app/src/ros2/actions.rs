@@ -31,7 +31,7 @@ use super::action_msgs::{
 };
 use super::dds::{default_qos, latched_qos};
 use super::discovery::RosDistro;
-use super::msgs::{Duration, Header, JointTrajectoryPoint, Time};
+use super::msgs::{Duration, Time};
 use super::services::{RequestHeader, Server};
 use crate::bridge::RosPlan;
 use crate::bridge::events::{ControlUpdate, JointSample, RunSample, TopicFamily};
@@ -401,7 +401,18 @@ impl ActionServer {
             }
             return;
         }
-        if run.active || run.runs != g.runs_before + 1 {
+        if run.runs > g.runs_before + 1 {
+            // Another trajectory (a command on `~/joint_trajectory`) replaced the goal's, as
+            // joint_trajectory_controller preempts an action goal for a topic command.
+            g.end(
+                STATUS_CANCELED,
+                0,
+                "preempted by a command on ~/joint_trajectory",
+            );
+            self.status_changed = true;
+            return;
+        }
+        if run.active {
             return;
         }
         let (status, code, why) = match run.outcome {
@@ -459,24 +470,18 @@ impl ActionServer {
         };
         let m = &mut self.feedback_msg;
         m.goal_id = g.info.goal_id;
-        m.header = Header {
-            stamp: Time::from_secs(now_s),
-            frame_id: String::new(),
-        };
+        m.header.stamp = Time::from_secs(now_s);
         m.joint_names.clone_from(&self.joint_names);
-        let samples: Vec<&JointSample> = self
-            .joints
-            .iter()
-            .filter_map(|&j| update.joints.get(j))
-            .collect();
-        let point = |f: &dyn Fn(&JointSample) -> f64| JointTrajectoryPoint {
-            positions: samples.iter().map(|s| f(s)).collect(),
-            ..JointTrajectoryPoint::default()
+        // The points' arrays are refilled in place: no allocation once warm.
+        let samples = || self.joints.iter().filter_map(|&j| update.joints.get(j));
+        let fill = |to: &mut Vec<f64>, f: fn(&JointSample) -> f64| {
+            to.clear();
+            to.extend(samples().map(f));
         };
-        m.desired = point(&|s| s.setpoint);
-        m.actual = point(&|s| s.position);
-        m.actual.velocities = samples.iter().map(|s| s.velocity_radps).collect();
-        m.error = point(&|s| s.setpoint - s.position);
+        fill(&mut m.desired.positions, |s| s.setpoint);
+        fill(&mut m.actual.positions, |s| s.position);
+        fill(&mut m.actual.velocities, |s| s.velocity_radps);
+        fill(&mut m.error.positions, |s| s.setpoint - s.position);
         let elapsed_s = now_s - g.accepted_s;
         m.index = g
             .point_times_s
