@@ -45,6 +45,8 @@ if [ "$purpose" = test ]; then
   packages+=(python3-rosmaster python3-rospy python3-rostopic python3-rosbag ros-std-msgs
     python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
     python3-rosgraph-msgs python3-roslib python3-genpy python3-trajectory-msgs tmux)
+  # roslaunch itself: `rover launch` is checked against its --dump-params, --nodes and --args.
+  packages+=(python3-roslaunch)
   packages+=(slurmctld slurmd slurm-client munge)
 fi
 missing=()

@@ -1111,7 +1111,7 @@ fn an_action_client_moves_tiagos_arm_and_a_cancel_stops_it() -> Result<()> {
         return Ok(());
     };
     let mut graph = Graph::new(cyclonedds, domain(10))?;
-    if !graph.spawn_tiago(30.0, &["--ros-distro", "jazzy"])? {
+    if !graph.spawn_tiago(40.0, &["--ros-distro", "jazzy"])? {
         return Ok(());
     }
     std::thread::sleep(Duration::from_secs(2));
@@ -1198,7 +1198,7 @@ for r in got['result']:
 # A command on ~/joint_trajectory preempts goal C, as joint_trajectory_controller does.
 topic = DataWriter(dp, Topic(dp, 'rt/arm_controller/joint_trajectory', JointTrajectory), qos=reliable)
 idc = UUID(uuid=[3] * 16)
-pump(time.time() + 2.0)  # the arm holds still after the cancel, for the trace's check
+pump(time.time() + 4.0)  # the arm holds still after the cancel, for the trace's check (2 s, with margin)
 send[0].write(FJT_SendGoal_Request(guid=1, seq=6, goal_id=idc, goal=goal([point([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 4)])))
 pump(time.time() + 1.0)
 topic.write(JointTrajectory(header=Header(stamp=Time(0, 0), frame_id=''), joint_names=names, points=[point([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 2)]))
