@@ -19,6 +19,7 @@ mod follower;
 mod headless;
 mod input;
 mod judge;
+pub mod launch;
 mod look;
 mod observer;
 mod paths;

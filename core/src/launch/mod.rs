@@ -1,0 +1,274 @@
+//! roslaunch files, read as roslaunch reads them (ROS 1 Noetic's XML format).
+//!
+//! [`load`] walks a launch file and its includes with roslaunch's rules (`<arg>` with
+//! default/value and include-scoped args, `<include>` with `ns` and `pass_all_args`,
+//! `<group>` with `ns`, `if`/`unless` on every tag, `<param>` with `value`/`type`/`textfile`/
+//! `binfile`/`command`, `<rosparam>` load/delete with inline YAML or a file, `<node>` with its
+//! `<remap>`, `<param>`, `<rosparam>` and `<env>`, `<remap>` and `<env>` in scope) and the
+//! substitution args (`$(arg)`, `$(find)`, `$(env)`, `$(optenv)`, `$(anon)`, `$(eval)`,
+//! `$(dirname)`). The result, [`Launch`], is the parameters roslaunch would set and the nodes it
+//! would start, with the file and line each came from. `rover launch` then does Gazebo's and
+//! darknet_ros's part itself ([`RoverPart`]) and starts the other nodes.
+//!
+//! `$(find xacro)/xacro FILE` in a `command` runs rover's own xacro (no ROS install needed);
+//! `$(find PKG)` of a package rover stands in for ([`PROVIDED_PACKAGES`]) does not fail when
+//! that package is not installed.
+
+mod eval;
+mod loader;
+mod rover;
+mod subst;
+mod value;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+pub use loader::{find_launch_file, load};
+pub use rover::{DetectorRequest, NodeRole, RoverPart, SpawnRequest, WorldRequest, role_of};
+pub use value::{ParamValue, convert_value, parse_bool, parse_yaml};
+
+/// Packages whose nodes and launch files rover does itself: `$(find PKG)` resolves to a
+/// placeholder (`<rover>/PKG`) when they are not installed, so a launch file that uses them
+/// still loads.
+pub const PROVIDED_PACKAGES: [&str; 8] = [
+    "gazebo_ros",
+    "darknet_ros",
+    "xacro",
+    "robot_state_publisher",
+    "joint_state_publisher",
+    "joint_state_publisher_gui",
+    "controller_manager",
+    "gazebo_plugins",
+];
+
+/// The placeholder folder `$(find PKG)` gives for a provided package that is not installed.
+pub fn provided_placeholder(package: &str) -> String {
+    format!("<rover>/{package}")
+}
+
+/// How [`load`] reads a launch file.
+#[derive(Debug, Clone, Default)]
+pub struct LaunchOptions {
+    /// `name:=value` args for the top file, as on roslaunch's command line.
+    pub args: Vec<(String, String)>,
+    /// Where `$(find)` and packages are found.
+    pub resources: rover_sim::ResourcePaths,
+    /// rover's reading: the includes rover does itself (gazebo_ros' `empty_world.launch`,
+    /// `darknet_ros.launch`) are recorded in [`Launch::provided`] and not read. Without it,
+    /// they are read like any other file when installed (roslaunch's reading, for
+    /// `--dump-params`), and skipped with a warning when not.
+    pub rover: bool,
+    /// Run `<param command=...>` commands other than xacro (on by default in `rover launch`;
+    /// off where the input is not trusted, such as fuzzing).
+    pub run_commands: bool,
+}
+
+/// Where something in a launch file is: file and 1-based line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    /// The launch file.
+    pub file: PathBuf,
+    /// Its line.
+    pub line: u32,
+}
+
+impl std::fmt::Display for Location {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}", self.file.display(), self.line)
+    }
+}
+
+/// A launch file that cannot be read: where, and what was expected.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}:{line}: {message}", file.display())]
+pub struct LaunchError {
+    /// The launch file.
+    pub file: PathBuf,
+    /// Its line (1-based; 0 when the file itself could not be read).
+    pub line: u32,
+    /// What is wrong, and what was expected.
+    pub message: String,
+}
+
+impl LaunchError {
+    pub(crate) fn new(file: &Path, line: u32, message: impl Into<String>) -> Self {
+        Self {
+            file: file.to_path_buf(),
+            line,
+            message: message.into(),
+        }
+    }
+}
+
+/// How a parameter's value was made.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamSource {
+    /// A `value` attribute.
+    Value,
+    /// `textfile`: the file's text.
+    TextFile(PathBuf),
+    /// `binfile`: the file's bytes.
+    BinFile(PathBuf),
+    /// `command` running xacro: the file and its `name:=value` args (rover expands it itself).
+    Xacro {
+        /// The xacro file.
+        file: PathBuf,
+        /// Its args.
+        args: BTreeMap<String, String>,
+    },
+    /// Another `command`: its words.
+    Command(Vec<String>),
+    /// `<rosparam>` YAML: its file, `None` when inline.
+    Yaml(Option<PathBuf>),
+}
+
+/// One parameter roslaunch would set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Param {
+    /// The value.
+    pub value: ParamValue,
+    /// How it was made.
+    pub source: ParamSource,
+    /// The tag that set it.
+    pub at: Location,
+}
+
+/// `<node output=...>`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Output {
+    /// `log` (roslaunch's default): stdout to a log file.
+    #[default]
+    Log,
+    /// `screen`: stdout to the terminal.
+    Screen,
+}
+
+/// One `<node>` roslaunch would start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaunchNode {
+    /// Its package.
+    pub pkg: String,
+    /// Its executable's name in the package (`type`).
+    pub node_type: String,
+    /// Its name (without namespace).
+    pub name: String,
+    /// Its namespace, global, with a trailing `/`.
+    pub namespace: String,
+    /// Its `args`, substitutions resolved (split like a shell when started).
+    pub args: String,
+    /// `<remap>`s in effect, `from` -> `to`, in roslaunch's order.
+    pub remaps: Vec<(String, String)>,
+    /// `<env>`s in effect.
+    pub env: Vec<(String, String)>,
+    /// Where its stdout goes.
+    pub output: Output,
+    /// Start it again when it exits.
+    pub respawn: bool,
+    /// Seconds to wait before that.
+    pub respawn_delay_s: f64,
+    /// When it exits, stop everything.
+    pub required: bool,
+    /// `launch-prefix` (a command put before it).
+    pub launch_prefix: Option<String>,
+    /// `cwd` (`node` or `ROS_HOME`).
+    pub cwd: Option<String>,
+    /// The tag.
+    pub at: Location,
+}
+
+impl LaunchNode {
+    /// The node's full name (`/ns/name`), as `roslaunch --nodes` prints it.
+    pub fn full_name(&self) -> String {
+        ns_join(&self.namespace, &self.name)
+    }
+
+    /// `ROS_NAMESPACE` for the process: the namespace without its trailing `/`, `None` at the
+    /// root.
+    pub fn ros_namespace(&self) -> Option<String> {
+        let ns = self.namespace.trim_end_matches('/');
+        (!ns.is_empty()).then(|| ns.to_owned())
+    }
+}
+
+/// An `<include>` of a launch file rover does itself (or, reading as roslaunch, one that is not
+/// installed), with the args passed to it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProvidedInclude {
+    /// The package (`gazebo_ros`, `darknet_ros`).
+    pub package: String,
+    /// The file's name (`empty_world.launch`).
+    pub file_name: String,
+    /// The `<arg>`s passed, resolved.
+    pub args: BTreeMap<String, String>,
+    /// The namespace it was included in.
+    pub namespace: String,
+    /// The `<include>` tag.
+    pub at: Location,
+}
+
+/// Everything a launch file asks for, as roslaunch reads it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Launch {
+    /// Parameters by global name (mappings unrolled, as roslaunch sets them).
+    pub params: BTreeMap<String, Param>,
+    /// Nodes, in the order they are declared.
+    pub nodes: Vec<LaunchNode>,
+    /// Namespaces cleared before setting (`clear_params`).
+    pub clear_params: Vec<String>,
+    /// Parameters deleted first (`<rosparam command="delete">`).
+    pub deletes: Vec<String>,
+    /// Every launch file read, in order.
+    pub files: Vec<PathBuf>,
+    /// Includes not read: those rover does itself.
+    pub provided: Vec<ProvidedInclude>,
+    /// What roslaunch would warn about (unknown attributes and tags, skipped tags).
+    pub warnings: Vec<String>,
+}
+
+impl Launch {
+    /// The parameters as `roslaunch --dump-params` prints them: `name: value` lines, one per
+    /// parameter, in name order (values in YAML's flow style).
+    pub fn dump_params(&self) -> String {
+        let mut out = String::new();
+        for (name, param) in &self.params {
+            out.push_str(name);
+            out.push_str(": ");
+            out.push_str(&param.value.to_yaml());
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// roslaunch's `ns_join`: `name` inside namespace `ns` (global and private names stay).
+pub fn ns_join(ns: &str, name: &str) -> String {
+    if name.starts_with('/') || name.starts_with('~') {
+        return name.to_owned();
+    }
+    if ns == "~" {
+        return format!("~{name}");
+    }
+    if ns.is_empty() {
+        return name.to_owned();
+    }
+    if ns.ends_with('/') {
+        format!("{ns}{name}")
+    } else {
+        format!("{ns}/{name}")
+    }
+}
+
+/// A ROS name without repeated or trailing slashes.
+pub fn canonical_name(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        if c == '/' && out.ends_with('/') {
+            continue;
+        }
+        out.push(c);
+    }
+    if out.len() > 1 && out.ends_with('/') {
+        out.pop();
+    }
+    out
+}
