@@ -1051,6 +1051,35 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
 // Parsed once per process: the variants' size difference costs nothing worth boxing for.
 #[allow(clippy::large_enum_variant)]
 pub(crate) enum Command {
+    /// Run a catkin package's roslaunch file: rover in Gazebo's and darknet_ros' place, the
+    /// other nodes started against a ROS master
+    ///
+    /// `rover launch PKG FILE.launch [name:=value ...]` (or a path to the file) reads the file as
+    /// roslaunch does (args, includes, groups, params, rosparam, nodes, remaps, env,
+    /// substitutions). gazebo_ros' world and spawn_model, robot_state_publisher,
+    /// joint_state_publisher, controller spawners and darknet_ros become rover's world, robot,
+    /// /tf, /joint_states, controllers and detector; every other node is started as a process
+    /// (output prefixed with its name), after the launch's parameters are set on the ROS master
+    /// at ROS_MASTER_URI, which rover starts (rosmaster) when none answers. Ctrl-C stops the
+    /// nodes, rover and that master. Run options (--headless, --duration, --trace, ...) apply
+    /// as in a plain run; --world/--robot override the launch's. See docs/ROS.md.
+    Launch(super::launch::LaunchArgs),
+
+    /// Expand a xacro file and print the URDF (as ROS' `xacro FILE [name:=value ...]` does)
+    Xacro {
+        /// The xacro file
+        file: PathBuf,
+
+        /// `name:=value` args (`$(arg name)`); options such as --inorder are accepted and
+        /// ignored
+        #[arg(value_name = "ARG", allow_hyphen_values = true)]
+        args: Vec<String>,
+
+        #[arg(long = "package-path", value_name = "NAME=DIR", value_parser = parse_package_path)]
+        /// Where ROS package NAME is, for $(find NAME) (repeatable)
+        package_paths: Vec<(String, PathBuf)>,
+    },
+
     /// Run the YOLO detector on image files and print the boxes
     ///
     /// One line per box: `class probability xmin ymin xmax ymax` (source-image pixels), or with

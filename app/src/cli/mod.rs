@@ -20,6 +20,7 @@ pub mod bench_ik;
 mod dataset;
 pub mod detect;
 pub mod eval;
+mod launch;
 mod run;
 mod signals;
 
@@ -30,6 +31,27 @@ use clap::Parser;
 use args::{BenchKind, Cli, Command};
 use detect::DetectOptions;
 use signals::Interrupted;
+
+/// `rover xacro FILE [name:=value ...]`: the expanded URDF on stdout.
+fn xacro(
+    file: &std::path::Path,
+    args: &[String],
+    package_paths: Vec<(String, std::path::PathBuf)>,
+) -> anyhow::Result<()> {
+    let mut resources = rover_sim::ResourcePaths::from_env();
+    resources.packages.extend(package_paths);
+    let xacro_args = args
+        .iter()
+        .filter_map(|a| a.split_once(":="))
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect();
+    let expanded = rover_sim::expand_xacro(file, &xacro_args, &resources)?;
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    out.write_all(expanded.text.as_bytes())?;
+    out.flush()?;
+    Ok(())
+}
 
 /// Parses the command line, runs it and turns errors into `rover: error: ...` and exit code 1.
 pub fn main() -> ExitCode {
@@ -114,6 +136,12 @@ pub fn main() -> ExitCode {
                 })
             }),
         Some(Command::Eval(args)) => eval::run(args),
+        Some(Command::Launch(args)) => launch::run(args),
+        Some(Command::Xacro {
+            file,
+            args,
+            package_paths,
+        }) => xacro(&file, &args, package_paths),
         Some(Command::Dataset(args)) => dataset::run(args),
         Some(Command::Bench {
             kind:

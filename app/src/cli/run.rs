@@ -18,6 +18,12 @@ use crate::viewer::{self, Recorder};
 
 pub(crate) fn run(args: RunArgs) -> Result<()> {
     let stop = super::signals::stop_on_signals()?;
+    run_until(args, stop)
+}
+
+/// A run that ends early when `stop` is set (the flag [`super::signals::stop_on_signals`]
+/// gives).
+pub(crate) fn run_until(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
     if !args.headless {
         return run_window(args, stop);
     }

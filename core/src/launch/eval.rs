@@ -90,8 +90,7 @@ fn tokenize(s: &str) -> Result<Vec<Tok>, String> {
                 && (chars[i].is_ascii_alphanumeric()
                     || chars[i] == '.'
                     || chars[i] == '_'
-                    || ((chars[i] == '+' || chars[i] == '-')
-                        && matches!(chars[i - 1], 'e' | 'E')))
+                    || ((chars[i] == '+' || chars[i] == '-') && matches!(chars[i - 1], 'e' | 'E')))
             {
                 i += 1;
             }
@@ -484,7 +483,10 @@ impl Parser<'_> {
             if n.contains(&args.len()) {
                 Ok(())
             } else {
-                Err(format!("{name}() takes {n:?} arguments, {} given", args.len()))
+                Err(format!(
+                    "{name}() takes {n:?} arguments, {} given",
+                    args.len()
+                ))
             }
         };
         Ok(match name {
@@ -503,7 +505,11 @@ impl Parser<'_> {
             }
             "optenv" => {
                 count(1..=2)?;
-                let default = if args.len() == 2 { text(1)? } else { String::new() };
+                let default = if args.len() == 2 {
+                    text(1)?
+                } else {
+                    String::new()
+                };
                 Val::Str(std::env::var(text(0)?).unwrap_or(default))
             }
             "find" => {
@@ -529,7 +535,9 @@ impl Parser<'_> {
                         python_int_parse(s)
                             .ok_or_else(|| format!("invalid literal for int(): '{s}'"))?,
                     ),
-                    Val::Float(f) if f.is_finite() && f.abs() < 9.2e18 => Val::Int(f.trunc() as i64),
+                    Val::Float(f) if f.is_finite() && f.abs() < 9.2e18 => {
+                        Val::Int(f.trunc() as i64)
+                    }
                     other => Val::Int(
                         other
                             .int()
@@ -679,7 +687,11 @@ fn floor_div(a: &Val, b: &Val) -> Result<Val, String> {
             return Err("integer division by zero".to_owned());
         }
         let q = x.checked_div(y).ok_or("integer overflow")?;
-        let q = if (x % y != 0) && ((x < 0) != (y < 0)) { q - 1 } else { q };
+        let q = if (x % y != 0) && ((x < 0) != (y < 0)) {
+            q - 1
+        } else {
+            q
+        };
         return Ok(Val::Int(q));
     }
     let (x, y) = numbers(a, b, "//")?;
@@ -695,14 +707,22 @@ fn modulo(a: &Val, b: &Val) -> Result<Val, String> {
             return Err("integer modulo by zero".to_owned());
         }
         let r = x.checked_rem(y).ok_or("integer overflow")?;
-        return Ok(Val::Int(if r != 0 && ((r < 0) != (y < 0)) { r + y } else { r }));
+        return Ok(Val::Int(if r != 0 && ((r < 0) != (y < 0)) {
+            r + y
+        } else {
+            r
+        }));
     }
     let (x, y) = numbers(a, b, "%")?;
     if y == 0.0 {
         return Err("float modulo".to_owned());
     }
     let r = x % y;
-    Ok(Val::Float(if r != 0.0 && ((r < 0.0) != (y < 0.0)) { r + y } else { r }))
+    Ok(Val::Float(if r != 0.0 && ((r < 0.0) != (y < 0.0)) {
+        r + y
+    } else {
+        r
+    }))
 }
 
 fn power(a: &Val, b: &Val) -> Result<Val, String> {
@@ -788,7 +808,10 @@ mod tests {
         assert_eq!(ev("-7 % 3").as_deref(), Ok("2"));
         assert_eq!(ev("2 ** 10").as_deref(), Ok("1024"));
         assert_eq!(ev("robot == 'tiago'").as_deref(), Ok("True"));
-        assert_eq!(ev("arg('robot') + '_description'").as_deref(), Ok("tiago_description"));
+        assert_eq!(
+            ev("arg('robot') + '_description'").as_deref(),
+            Ok("tiago_description")
+        );
         assert_eq!(ev("flag and not False").as_deref(), Ok("True"));
         assert_eq!(ev("'a' if n > 2 else 'b'").as_deref(), Ok("a"));
         assert_eq!(ev("1 < n < 5").as_deref(), Ok("True"));

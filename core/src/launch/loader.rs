@@ -5,8 +5,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-use roxmltree::{Document, Node};
 use rover_sim::ResourcePaths;
+use roxmltree::{Document, Node};
 
 use super::eval::EvalHost;
 use super::value::{ParamValue, convert_value, parse_bool, parse_yaml};
@@ -43,10 +43,14 @@ pub fn load(path: &Path, options: &LaunchOptions) -> Result<Launch, LaunchError>
         env: Vec::new(),
         pass_all_args: false,
     };
-    loader.file(path, ctx, Location {
-        file: path.to_path_buf(),
-        line: 0,
-    })?;
+    loader.file(
+        path,
+        ctx,
+        Location {
+            file: path.to_path_buf(),
+            line: 0,
+        },
+    )?;
     Ok(loader.out)
 }
 
@@ -131,7 +135,11 @@ impl Ctx {
 
 fn global_ns(ns: &str) -> String {
     let c = canonical_name(ns);
-    let c = if c.starts_with('/') { c } else { format!("/{c}") };
+    let c = if c.starts_with('/') {
+        c
+    } else {
+        format!("/{c}")
+    };
     if c.ends_with('/') { c } else { format!("{c}/") }
 }
 
@@ -208,8 +216,19 @@ fn known_attributes(tag: &str) -> &'static [&'static str] {
         "param" => &["name", "value", "type", "textfile", "binfile", "command"],
         "rosparam" => &["command", "ns", "file", "param", "subst_value"],
         "node" => &[
-            "pkg", "type", "name", "args", "machine", "respawn", "respawn_delay", "required",
-            "ns", "clear_params", "output", "cwd", "launch-prefix",
+            "pkg",
+            "type",
+            "name",
+            "args",
+            "machine",
+            "respawn",
+            "respawn_delay",
+            "required",
+            "ns",
+            "clear_params",
+            "output",
+            "cwd",
+            "launch-prefix",
         ],
         "remap" => &["from", "to"],
         "env" => &["name", "value"],
@@ -250,9 +269,7 @@ impl Loader<'_> {
                 ..Default::default()
             },
         )
-        .map_err(|e| {
-            LaunchError::new(path, e.pos().row, format!("not well-formed XML: {e}"))
-        })?;
+        .map_err(|e| LaunchError::new(path, e.pos().row, format!("not well-formed XML: {e}")))?;
         let root = doc.root_element();
         if root.tag_name().name() != "launch" {
             return Err(LaunchError::new(
@@ -341,7 +358,13 @@ impl Loader<'_> {
         }
     }
 
-    fn resolve(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, text: &str, ctx: &Ctx) -> Result<String, LaunchError> {
+    fn resolve(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        text: &str,
+        ctx: &Ctx,
+    ) -> Result<String, LaunchError> {
         let mut scope = Scope {
             args: &ctx.args,
             file: &ctx.file,
@@ -410,18 +433,28 @@ impl Loader<'_> {
         let unless_value = self.opt(r, tag, "unless", ctx)?;
         let as_bool = |v: &str| {
             parse_bool(v).ok_or_else(|| {
-                r.err(tag, format!("if/unless value \"{v}\": expected true, false, 1 or 0"))
+                r.err(
+                    tag,
+                    format!("if/unless value \"{v}\": expected true, false, 1 or 0"),
+                )
             })
         };
         match (if_value, unless_value) {
-            (Some(_), Some(_)) => Err(r.err(tag, "cannot set both 'if' and 'unless' on the same tag")),
+            (Some(_), Some(_)) => {
+                Err(r.err(tag, "cannot set both 'if' and 'unless' on the same tag"))
+            }
             (Some(v), None) => as_bool(&v),
             (None, Some(v)) => as_bool(&v).map(|b| !b),
             (None, None) => Ok(true),
         }
     }
 
-    fn arg(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, ctx: &mut Ctx) -> Result<(), LaunchError> {
+    fn arg(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        ctx: &mut Ctx,
+    ) -> Result<(), LaunchError> {
         let name = self.req(r, tag, "name", ctx)?;
         let value = self.opt(r, tag, "value", ctx)?;
         let default = self.opt(r, tag, "default", ctx)?;
@@ -465,7 +498,12 @@ impl Loader<'_> {
             let ns = match node_name {
                 Some(name) => global_ns(&ns_join(&ctx.ns, name)),
                 None if tag.attribute("ns").is_some() => ctx.ns.clone(),
-                None => return Err(r.err(tag, "'ns' attribute must be set in order to use 'clear_params'")),
+                None => {
+                    return Err(r.err(
+                        tag,
+                        "'ns' attribute must be set in order to use 'clear_params'",
+                    ));
+                }
             };
             self.out.clear_params.push(ns);
         }
@@ -486,7 +524,12 @@ impl Loader<'_> {
         Ok((from, to))
     }
 
-    fn env(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, ctx: &Ctx) -> Result<(String, String), LaunchError> {
+    fn env(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        ctx: &Ctx,
+    ) -> Result<(String, String), LaunchError> {
         let name = self.req(r, tag, "name", ctx)?;
         let value = self.req(r, tag, "value", ctx)?;
         if name.is_empty() {
@@ -504,7 +547,11 @@ impl Loader<'_> {
         ctx: &Ctx,
         in_node: bool,
     ) -> Result<Option<(String, Param)>, LaunchError> {
-        let ty = tag.attribute("type").unwrap_or("auto").trim().to_ascii_lowercase();
+        let ty = tag
+            .attribute("type")
+            .unwrap_or("auto")
+            .trim()
+            .to_ascii_lowercase();
         let value = self.opt(r, tag, "value", ctx)?;
         let textfile = self.opt(r, tag, "textfile", ctx)?;
         let binfile = self.opt(r, tag, "binfile", ctx)?;
@@ -522,10 +569,16 @@ impl Loader<'_> {
         let name = self.req(r, tag, "name", ctx)?.trim().to_owned();
         let bad = |e: String| r.err(tag, format!("<param name=\"{name}\">: {e}"));
         let (value, source) = if let Some(v) = value {
-            (convert_value(v.trim(), &ty).map_err(bad)?, ParamSource::Value)
+            (
+                convert_value(v.trim(), &ty).map_err(bad)?,
+                ParamSource::Value,
+            )
         } else if let Some(f) = textfile {
             let text = read_text(Path::new(&f)).map_err(bad)?;
-            (convert_value(&text, &ty).map_err(bad)?, ParamSource::TextFile(f.into()))
+            (
+                convert_value(&text, &ty).map_err(bad)?,
+                ParamSource::TextFile(f.into()),
+            )
         } else if let Some(f) = binfile {
             let bytes = read_bytes(Path::new(&f)).map_err(bad)?;
             (ParamValue::Binary(bytes), ParamSource::BinFile(f.into()))
@@ -547,7 +600,13 @@ impl Loader<'_> {
     }
 
     /// Sets a parameter; a mapping becomes one parameter per key.
-    fn set(&mut self, name: String, param: Param, r: &FileReader<'_, '_>, tag: Node<'_, '_>) -> Result<(), LaunchError> {
+    fn set(
+        &mut self,
+        name: String,
+        param: Param,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+    ) -> Result<(), LaunchError> {
         if name.starts_with('~') {
             return Err(r.err(tag, format!("private name \"{name}\" outside a node")));
         }
@@ -564,7 +623,10 @@ impl Loader<'_> {
             return Ok(());
         }
         if name == "/" {
-            return Err(r.err(tag, "cannot set a non-mapping value on the root namespace '/'"));
+            return Err(r.err(
+                tag,
+                "cannot set a non-mapping value on the root namespace '/'",
+            ));
         }
         self.out.params.insert(name, param);
         Ok(())
@@ -596,7 +658,13 @@ impl Loader<'_> {
             };
             let expanded = rover_sim::expand_xacro(&path, &xargs, &self.options.resources)
                 .map_err(|e| format!("xacro: {e}"))?;
-            return Ok((expanded.text, ParamSource::Xacro { file: path, args: xargs }));
+            return Ok((
+                expanded.text,
+                ParamSource::Xacro {
+                    file: path,
+                    args: xargs,
+                },
+            ));
         }
         if !self.options.run_commands {
             return Err(format!("commands are not run here: \"{command}\""));
@@ -618,8 +686,15 @@ impl Loader<'_> {
         Ok((text, ParamSource::Command(words)))
     }
 
-    fn rosparam(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, ctx: &Ctx) -> Result<(), LaunchError> {
-        let command = self.opt(r, tag, "command", ctx)?.unwrap_or_else(|| "load".to_owned());
+    fn rosparam(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        ctx: &Ctx,
+    ) -> Result<(), LaunchError> {
+        let command = self
+            .opt(r, tag, "command", ctx)?
+            .unwrap_or_else(|| "load".to_owned());
         let ns = self.opt(r, tag, "ns", ctx)?.unwrap_or_default();
         let file = self.opt(r, tag, "file", ctx)?;
         let param = self.opt(r, tag, "param", ctx)?.unwrap_or_default();
@@ -646,13 +721,19 @@ impl Loader<'_> {
                     text
                 };
                 let value = parse_yaml(&text).map_err(|e| {
-                    r.err(tag, match &file {
-                        Some(f) => format!("{f}: {e}"),
-                        None => format!("<rosparam>: {e}"),
-                    })
+                    r.err(
+                        tag,
+                        match &file {
+                            Some(f) => format!("{f}: {e}"),
+                            None => format!("<rosparam>: {e}"),
+                        },
+                    )
                 })?;
                 if param.is_empty() && !matches!(value, ParamValue::Map(_)) {
-                    return Err(r.err(tag, "<rosparam> needs a 'param' attribute for a value that is not a mapping"));
+                    return Err(r.err(
+                        tag,
+                        "<rosparam> needs a 'param' attribute for a value that is not a mapping",
+                    ));
                 }
                 let p = Param {
                     value,
@@ -675,14 +756,25 @@ impl Loader<'_> {
                 ));
                 Ok(())
             }
-            other => Err(r.err(tag, format!("<rosparam command=\"{other}\">: expected load, dump or delete"))),
+            other => Err(r.err(
+                tag,
+                format!("<rosparam command=\"{other}\">: expected load, dump or delete"),
+            )),
         }
     }
 
-    fn node(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, ctx: &Ctx) -> Result<(), LaunchError> {
+    fn node(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        ctx: &Ctx,
+    ) -> Result<(), LaunchError> {
         let name = self.req(r, tag, "name", ctx)?;
         if name.is_empty() || name.contains('/') {
-            return Err(r.err(tag, format!("illegal <node> name \"{name}\" (a base name, without '/')")));
+            return Err(r.err(
+                tag,
+                format!("illegal <node> name \"{name}\" (a base name, without '/')"),
+            ));
         }
         let ns = self.opt(r, tag, "ns", ctx)?;
         if ns.as_deref() == Some("") {
@@ -710,9 +802,16 @@ impl Loader<'_> {
                 .parse::<f64>()
                 .ok()
                 .filter(|d| d.is_finite() && *d >= 0.0)
-                .ok_or_else(|| r.err(tag, format!("respawn_delay=\"{v}\": expected seconds (a number >= 0)")))?,
+                .ok_or_else(|| {
+                    r.err(
+                        tag,
+                        format!("respawn_delay=\"{v}\": expected seconds (a number >= 0)"),
+                    )
+                })?,
         };
-        let launch_prefix = self.opt(r, tag, "launch-prefix", ctx)?.filter(|p| !p.is_empty());
+        let launch_prefix = self
+            .opt(r, tag, "launch-prefix", ctx)?
+            .filter(|p| !p.is_empty());
         let cwd = self.opt(r, tag, "cwd", ctx)?;
         let mut node_ctx = child.clone();
         node_ctx.ns = param_ns.clone();
@@ -738,10 +837,10 @@ impl Loader<'_> {
                     let pair = self.env(r, t, ctx)?;
                     node_ctx.env.push(pair);
                 }
-                other => self.out.warnings.push(format!(
-                    "{}: unrecognized <{other}> inside <node>",
-                    r.at(t)
-                )),
+                other => self
+                    .out
+                    .warnings
+                    .push(format!("{}: unrecognized <{other}> inside <node>", r.at(t))),
             }
         }
         for (key, param) in ctx.private.iter().chain(local.iter()) {
@@ -767,7 +866,12 @@ impl Loader<'_> {
         Ok(())
     }
 
-    fn include(&mut self, r: &FileReader<'_, '_>, tag: Node<'_, '_>, ctx: &mut Ctx) -> Result<(), LaunchError> {
+    fn include(
+        &mut self,
+        r: &FileReader<'_, '_>,
+        tag: Node<'_, '_>,
+        ctx: &mut Ctx,
+    ) -> Result<(), LaunchError> {
         let file = self.req(r, tag, "file", ctx)?;
         let pass_all_args = self.flag(r, tag, "pass_all_args", ctx)?;
         let ns = self.opt(r, tag, "ns", ctx)?;
@@ -826,7 +930,11 @@ impl Loader<'_> {
                     tag,
                     format!(
                         "unused args [{}] for include of {} (it declares no such <arg>)",
-                        unused.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
+                        unused
+                            .iter()
+                            .map(|s| s.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
                         path.display()
                     ),
                 ));
@@ -856,7 +964,8 @@ impl Loader<'_> {
                 let package = package_of(path)?;
                 if !matches!(
                     (package.as_str(), file_name.as_str()),
-                    ("gazebo_ros", "empty_world.launch") | ("darknet_ros", "darknet_ros.launch" | "yolo_v3.launch")
+                    ("gazebo_ros", "empty_world.launch")
+                        | ("darknet_ros", "darknet_ros.launch" | "yolo_v3.launch")
                 ) {
                     return None;
                 }
@@ -927,15 +1036,21 @@ impl FileReader<'_, '_> {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let meta =
+        std::fs::metadata(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     if meta.len() > MAX_FILE_BYTES {
-        return Err(format!("{} is larger than {} MiB", path.display(), MAX_FILE_BYTES >> 20));
+        return Err(format!(
+            "{} is larger than {} MiB",
+            path.display(),
+            MAX_FILE_BYTES >> 20
+        ));
     }
     std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
 }
 
 fn read_text(path: &Path) -> Result<String, String> {
-    String::from_utf8(read_bytes(path)?).map_err(|_| format!("{} is not UTF-8 text", path.display()))
+    String::from_utf8(read_bytes(path)?)
+        .map_err(|_| format!("{} is not UTF-8 text", path.display()))
 }
 
 /// xacro's command line: options, the file, and `name:=value` args.
@@ -954,7 +1069,9 @@ fn xacro_command(words: &[String]) -> Result<(PathBuf, BTreeMap<String, String>)
         } else if file.is_none() {
             file = Some(PathBuf::from(w));
         } else {
-            return Err(format!("xacro: a second file \"{w}\" (expected one input file)"));
+            return Err(format!(
+                "xacro: a second file \"{w}\" (expected one input file)"
+            ));
         }
         i += 1;
     }
@@ -963,7 +1080,7 @@ fn xacro_command(words: &[String]) -> Result<(PathBuf, BTreeMap<String, String>)
 }
 
 /// Python's `shlex.split` (POSIX mode): words split on spaces, with '...', "..." and `\`.
-pub(crate) fn shell_split(s: &str) -> Result<Vec<String>, String> {
+pub fn shell_split(s: &str) -> Result<Vec<String>, String> {
     let mut words = Vec::new();
     let mut word = String::new();
     let mut in_word = false;

@@ -23,7 +23,7 @@ mod value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-pub use loader::{find_launch_file, load};
+pub use loader::{find_launch_file, load, shell_split};
 pub use rover::{DetectorRequest, NodeRole, RoverPart, SpawnRequest, WorldRequest, role_of};
 pub use value::{ParamValue, convert_value, parse_bool, parse_yaml};
 
@@ -271,4 +271,88 @@ pub fn canonical_name(name: &str) -> String {
         out.pop();
     }
     out
+}
+
+/// The executable of node type `node_type` in the package folder `package_dir`: a file of that
+/// name, executable, searched a few folders deep (as roslaunch finds a package's scripts), then
+/// in `/usr/lib/PKG` and `/usr/libexec/PKG` (where Debian installs ROS nodes).
+pub fn find_node_executable(
+    package: &str,
+    package_dir: Option<&Path>,
+    node_type: &str,
+) -> Result<PathBuf, String> {
+    use std::os::unix::fs::PermissionsExt;
+    let mut found = Vec::new();
+    let mut dirs: Vec<(PathBuf, usize)> = package_dir
+        .map(|d| vec![(d.to_path_buf(), 0)])
+        .unwrap_or_default();
+    for prefix in ["/usr/lib", "/usr/libexec"] {
+        let d = Path::new(prefix).join(package);
+        if d.is_dir() {
+            dirs.push((d, 5));
+        }
+    }
+    while let Some((dir, depth)) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let name = entry.file_name();
+            let hidden = name.to_string_lossy().starts_with('.');
+            if path.is_dir() && !hidden && depth < 6 {
+                dirs.push((path, depth + 1));
+            } else if path.is_file() && name.to_string_lossy() == node_type {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    let executable =
+        |p: &PathBuf| std::fs::metadata(p).is_ok_and(|m| m.permissions().mode() & 0o111 != 0);
+    if let Some(exe) = found.iter().find(|p| executable(p)) {
+        return Ok(exe.clone());
+    }
+    match found.first() {
+        Some(p) => Err(format!(
+            "{} is not executable (chmod +x {})",
+            p.display(),
+            p.display()
+        )),
+        None => Err(format!(
+            "cannot find node type \"{node_type}\" in package \"{package}\"{}",
+            package_dir
+                .map(|d| format!(" ({})", d.display()))
+                .unwrap_or_else(|| " (the package was not found)".to_owned())
+        )),
+    }
+}
+
+impl LaunchNode {
+    /// The process's command line as roslaunch builds it: `launch-prefix`, the executable,
+    /// `args` split like a shell, the remaps (`from:=to`) and `__name:=NAME`.
+    pub fn command_line(&self, executable: &Path) -> Result<Vec<String>, String> {
+        let mut words = match &self.launch_prefix {
+            Some(prefix) => loader::shell_split(prefix)?,
+            None => Vec::new(),
+        };
+        words.push(executable.to_string_lossy().into_owned());
+        words.extend(loader::shell_split(&self.args)?);
+        for (from, to) in &self.remaps {
+            words.push(format!("{from}:={to}"));
+        }
+        words.push(format!("__name:={}", self.name));
+        Ok(words)
+    }
+
+    /// The environment roslaunch sets for it besides the inherited one: `ROS_MASTER_URI`,
+    /// `ROS_NAMESPACE` (when not at the root) and its `<env>`s.
+    pub fn environment(&self, master_uri: &str) -> Vec<(String, String)> {
+        let mut env = vec![("ROS_MASTER_URI".to_owned(), master_uri.to_owned())];
+        if let Some(ns) = self.ros_namespace() {
+            env.push(("ROS_NAMESPACE".to_owned(), ns));
+        }
+        env.extend(self.env.iter().cloned());
+        env
+    }
 }

@@ -200,9 +200,7 @@ pub fn role_of(node: &LaunchNode) -> NodeRole {
         ("gazebo_ros", "spawn_model") => NodeRole::Spawn,
         ("gazebo_ros", "gzserver" | "gzclient" | "gazebo" | "debug") => NodeRole::Gazebo,
         ("robot_state_publisher", _) => NodeRole::RobotStatePublisher,
-        ("joint_state_publisher" | "joint_state_publisher_gui", _) => {
-            NodeRole::JointStatePublisher
-        }
+        ("joint_state_publisher" | "joint_state_publisher_gui", _) => NodeRole::JointStatePublisher,
         ("controller_manager", "spawner") => NodeRole::ControllerSpawner(words()),
         ("controller_manager", "controller_manager") => {
             let w = words();
@@ -283,7 +281,8 @@ fn spawn_request(node: &LaunchNode) -> Result<SpawnRequest, LaunchError> {
     }
     if req.param.is_none() && req.file.is_none() {
         return Err(err(
-            "spawn_model: expected -param NAME or -file FILE for the robot's description".to_owned(),
+            "spawn_model: expected -param NAME or -file FILE for the robot's description"
+                .to_owned(),
         ));
     }
     Ok(req)
@@ -294,7 +293,10 @@ fn yolo_threshold(text: &str) -> Option<f32> {
     let value = super::parse_yaml(text).ok()?;
     let get = |v: &ParamValue, key: &str| -> Option<ParamValue> {
         match v {
-            ParamValue::Map(entries) => entries.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone()),
+            ParamValue::Map(entries) => entries
+                .iter()
+                .find(|(k, _)| k == key)
+                .map(|(_, v)| v.clone()),
             _ => None,
         }
     };

@@ -27,7 +27,9 @@ pub(crate) fn resolve(text: &str, host: &mut dyn EvalHost) -> Result<String, Str
             let value = match (pass, command) {
                 (Pass::Early, "env") => {
                     let [name] = args else {
-                        return Err(format!("$(env var) must specify one environment variable [{inner}]"));
+                        return Err(format!(
+                            "$(env var) must specify one environment variable [{inner}]"
+                        ));
                     };
                     std::env::var(name).map_err(|_| {
                         format!("environment variable '{name}' is not set (in $({inner}))")
@@ -35,7 +37,9 @@ pub(crate) fn resolve(text: &str, host: &mut dyn EvalHost) -> Result<String, Str
                 }
                 (Pass::Early, "optenv") => {
                     let Some((name, default)) = args.split_first() else {
-                        return Err(format!("$(optenv var) must specify an environment variable [{inner}]"));
+                        return Err(format!(
+                            "$(optenv var) must specify an environment variable [{inner}]"
+                        ));
                     };
                     std::env::var(name).unwrap_or_else(|_| default.join(" "))
                 }
@@ -162,9 +166,15 @@ mod tests {
         assert_eq!(r("plain").as_deref(), Ok("plain"));
         assert_eq!(r("$(arg x)m").as_deref(), Ok("1.5m"));
         assert_eq!(r("$(find $(arg pkg))/urdf").is_err(), true);
-        assert_eq!(r("$(find mine)/urdf/$(arg x)").as_deref(), Ok("/ws/mine/urdf/1.5"));
+        assert_eq!(
+            r("$(find mine)/urdf/$(arg x)").as_deref(),
+            Ok("/ws/mine/urdf/1.5")
+        );
         assert_eq!(r("$(anon talker)").as_deref(), Ok("talker_42"));
-        assert_eq!(r("$(dirname)/a.yaml").as_deref(), Ok("/ws/mine/launch/a.yaml"));
+        assert_eq!(
+            r("$(dirname)/a.yaml").as_deref(),
+            Ok("/ws/mine/launch/a.yaml")
+        );
         assert_eq!(r("$(optenv ROVER_SURELY_UNSET a b)").as_deref(), Ok("a b"));
         assert_eq!(r("$(eval x * 2)").as_deref(), Ok("3.0"));
         assert!(r("$(arg nope)").is_err());

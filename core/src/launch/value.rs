@@ -172,7 +172,11 @@ pub(crate) fn python_float(v: f64) -> String {
     let (mantissa, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
     let exp: i32 = exp.parse().unwrap_or(0);
     if !(-4..16).contains(&exp) {
-        return format!("{mantissa}e{}{:02}", if exp < 0 { '-' } else { '+' }, exp.abs());
+        return format!(
+            "{mantissa}e{}{:02}",
+            if exp < 0 { '-' } else { '+' },
+            exp.abs()
+        );
     }
     let plain = format!("{v}");
     if plain.contains('.') {
@@ -226,13 +230,8 @@ fn base64(bytes: &[u8]) -> String {
 /// YAML text (`<rosparam>`, `type="yaml"`) as a value; an empty document is an empty mapping,
 /// as roslaunch reads it.
 pub fn parse_yaml(text: &str) -> Result<ParamValue, String> {
-    let docs = Yaml::load_from_str(text).map_err(|e| {
-        format!(
-            "not valid YAML (line {}): {}",
-            e.marker().line(),
-            e.info()
-        )
-    })?;
+    let docs = Yaml::load_from_str(text)
+        .map_err(|e| format!("not valid YAML (line {}): {}", e.marker().line(), e.info()))?;
     match docs.first() {
         None => Ok(ParamValue::Map(Vec::new())),
         Some(doc) => from_yaml(doc),
@@ -252,7 +251,9 @@ fn from_yaml(node: &Yaml<'_>) -> Result<ParamValue, String> {
                 let key = match key {
                     Yaml::Value(scalar) => from_scalar(scalar)?.as_text(),
                     Yaml::Representation(text, _, _) => text.to_string(),
-                    other => return Err(format!("a mapping key must be a scalar, found {other:?}")),
+                    other => {
+                        return Err(format!("a mapping key must be a scalar, found {other:?}"));
+                    }
                 };
                 entries.push((key, from_yaml(value)?));
             }
@@ -285,9 +286,15 @@ mod tests {
     fn auto_conversion_follows_roslaunch() {
         assert_eq!(convert_value("3", "auto"), Ok(ParamValue::Int(3)));
         assert_eq!(convert_value("3.5", "auto"), Ok(ParamValue::Double(3.5)));
-        assert_eq!(convert_value("1_000", "auto"), Ok(ParamValue::Str("1_000".into())));
+        assert_eq!(
+            convert_value("1_000", "auto"),
+            Ok(ParamValue::Str("1_000".into()))
+        );
         assert_eq!(convert_value("True", "auto"), Ok(ParamValue::Bool(true)));
-        assert_eq!(convert_value("1.2.3", "auto"), Ok(ParamValue::Str("1.2.3".into())));
+        assert_eq!(
+            convert_value("1.2.3", "auto"),
+            Ok(ParamValue::Str("1.2.3".into()))
+        );
         assert_eq!(convert_value("7", "str"), Ok(ParamValue::Str("7".into())));
         assert_eq!(convert_value("0", "bool"), Ok(ParamValue::Bool(false)));
         assert!(convert_value("maybe", "bool").is_err());
