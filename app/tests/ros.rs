@@ -297,31 +297,9 @@ impl RosGraph {
         Ok(out)
     }
 
-    /// rospy can import darknet_ros_msgs: generated from ../shared/ros with genpy, as the README
-    /// there says.
+    /// rospy can import darknet_ros_msgs: generated from ../shared/ros with genpy.
     fn darknet_msgs(&self) -> Result<PathBuf> {
-        let out = self.dir.path().join("py");
-        let msgs = shared_ros().join("darknet_ros_msgs/msg");
-        let pkg = out.join("darknet_ros_msgs");
-        let gen_args = |c: &mut Command| {
-            c.args(["/usr/lib/genpy/genmsg_py.py", "-p", "darknet_ros_msgs"])
-                .arg(format!("-Idarknet_ros_msgs:{}", msgs.display()))
-                .arg("-Istd_msgs:/usr/share/std_msgs/msg")
-                .arg("-o")
-                .arg(pkg.join("msg"));
-        };
-        let mut files = Command::new(PYTHON);
-        gen_args(&mut files);
-        for entry in std::fs::read_dir(&msgs)? {
-            files.arg(entry?.path());
-        }
-        ensure!(files.status()?.success(), "genmsg_py failed");
-        let mut init = Command::new(PYTHON);
-        gen_args(&mut init);
-        init.arg("--initpy");
-        ensure!(init.status()?.success(), "genmsg_py --initpy failed");
-        std::fs::write(pkg.join("__init__.py"), "")?;
-        Ok(out)
+        rover_tests::ros::darknet_msgs(&shared_ros(), &self.dir.path().join("py"))
     }
 }
 

@@ -9,6 +9,7 @@ use rover_sim::ResourcePaths;
 use roxmltree::{Document, Node};
 
 use super::eval::EvalHost;
+use super::absolute;
 use super::value::{ParamValue, convert_value, parse_bool, parse_yaml};
 use super::{
     Launch, LaunchError, LaunchNode, LaunchOptions, Location, Output, PROVIDED_PACKAGES, Param,
@@ -168,7 +169,7 @@ impl EvalHost for Scope<'_> {
 
     fn find(&mut self, package: &str) -> Result<String, String> {
         match self.resources.find_package(package, self.file) {
-            Ok(dir) => Ok(dir.to_string_lossy().into_owned()),
+            Ok(dir) => Ok(absolute(&dir).to_string_lossy().into_owned()),
             Err(_) if PROVIDED_PACKAGES.contains(&package) => Ok(provided_placeholder(package)),
             Err(e) => Err(format!(
                 "$(find {package}): {e} (add its folder to ROS_PACKAGE_PATH or pass --package-path {package}=DIR)"
@@ -197,8 +198,7 @@ impl EvalHost for Scope<'_> {
     }
 
     fn dirname(&mut self) -> Result<String, String> {
-        let abs = std::path::absolute(self.file).unwrap_or_else(|_| self.file.to_path_buf());
-        Ok(abs
+        Ok(absolute(self.file)
             .parent()
             .map(|p| p.to_string_lossy().into_owned())
             .unwrap_or_default())

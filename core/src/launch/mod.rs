@@ -284,7 +284,7 @@ pub fn find_node_executable(
     use std::os::unix::fs::PermissionsExt;
     let mut found = Vec::new();
     let mut dirs: Vec<(PathBuf, usize)> = package_dir
-        .map(|d| vec![(d.to_path_buf(), 0)])
+        .map(|d| vec![(absolute(d), 0)])
         .unwrap_or_default();
     for prefix in ["/usr/lib", "/usr/libexec"] {
         let d = Path::new(prefix).join(package);
@@ -356,3 +356,22 @@ impl LaunchNode {
         env
     }
 }
+
+/// `path` absolute, with `.` and `..` folded (Python's `os.path.abspath`, as rospack gives a
+/// package's folder).
+pub(crate) fn absolute(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            other => out.push(other),
+        }
+    }
+    out
+}
+
