@@ -86,15 +86,24 @@ impl Workspace {
             Ok(())
         };
         let mrobot = package("mrobot_gazebo")?;
-        std::fs::copy(seeds.join("my_gazebo3.launch"), mrobot.join("launch/my_gazebo3.launch"))?;
-        std::fs::copy(seeds.join("playground.world"), mrobot.join("worlds/playground.world"))?;
+        std::fs::copy(
+            seeds.join("my_gazebo3.launch"),
+            mrobot.join("launch/my_gazebo3.launch"),
+        )?;
+        std::fs::copy(
+            seeds.join("playground.world"),
+            mrobot.join("worlds/playground.world"),
+        )?;
         std::fs::copy(&car, mrobot.join("urdf/my_gazebo_robot_All.urdf.xacro"))?;
         executable(
             &shared_ros().join("seed_nodes/listener_yolo.py"),
             &mrobot.join("scripts/listener_yolo.py"),
         )?;
         let my_robot = package("my_robot")?;
-        std::fs::copy(seeds.join("simulation.launch"), my_robot.join("launch/simulation.launch"))?;
+        std::fs::copy(
+            seeds.join("simulation.launch"),
+            my_robot.join("launch/simulation.launch"),
+        )?;
         std::fs::copy(&car, my_robot.join("urdf/robot.urdf"))?;
         executable(
             &shared_ros().join("teleop_twist_keyboard/teleop_twist_keyboard.py"),
@@ -178,7 +187,10 @@ impl Workspace {
             };
             let text = String::from_utf8_lossy(&cmdline).replace('\0', " ");
             let stat = std::fs::read_to_string(entry.path().join("stat")).unwrap_or_default();
-            let zombie = stat.rsplit(')').next().is_some_and(|s| s.trim_start().starts_with('Z'));
+            let zombie = stat
+                .rsplit(')')
+                .next()
+                .is_some_and(|s| s.trim_start().starts_with('Z'));
             if !zombie && needles.iter().any(|n| text.contains(n.as_str())) {
                 found.push(format!("{}: {text}", entry.file_name().to_string_lossy()));
             }
@@ -299,7 +311,10 @@ fn the_series_my_gazebo3_launch_drives_the_car_toward_the_person() -> Result<()>
         moved >= 0.5,
         "the car moved {moved:.3} m (want >= 0.5 m):\n{said}"
     );
-    ensure!(!ws.master_answers(), "the master rover started still answers");
+    ensure!(
+        !ws.master_answers(),
+        "the master rover started still answers"
+    );
     let left = ws.leftovers();
     ensure!(left.is_empty(), "processes left behind: {left:?}");
     Ok(())
@@ -353,7 +368,17 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
         ensure!(status.success(), "tmux {args:?} failed");
         Ok(())
     };
-    tmux(&["new-session", "-d", "-s", &session, "-x", "120", "-y", "40", &shell])?;
+    tmux(&[
+        "new-session",
+        "-d",
+        "-s",
+        &session,
+        "-x",
+        "120",
+        "-y",
+        "40",
+        &shell,
+    ])?;
     let result = (|| -> Result<()> {
         let start = Instant::now();
         while !std::fs::read_to_string(&log)
@@ -404,7 +429,10 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
     ensure!(moved > 0.3, "drove {moved:.3} m while `i` was held");
     let end = rows.last().context("empty trace")?;
     ensure!(end.cmd_linear_mps == 0.0, "`k` did not stop the command");
-    ensure!(!ws.master_answers(), "the master rover started still answers");
+    ensure!(
+        !ws.master_answers(),
+        "the master rover started still answers"
+    );
     let left = ws.leftovers();
     ensure!(left.is_empty(), "processes left behind: {left:?}");
     Ok(())
@@ -467,10 +495,8 @@ fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
     let mut failures = Vec::new();
     let mut checked = 0;
     for (pkg, file, nodes) in cases {
-        let mut queries: Vec<Vec<String>> = vec![
-            vec!["--dump-params".into()],
-            vec!["--nodes".into()],
-        ];
+        let mut queries: Vec<Vec<String>> =
+            vec![vec!["--dump-params".into()], vec!["--nodes".into()]];
         for node in nodes {
             queries.push(vec!["--args".into(), (*node).into()]);
         }
@@ -484,7 +510,9 @@ fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
                     c.arg("launch");
                     c
                 };
-                c.args(&query).args([pkg, file]).env("ROVER_LAUNCH_SET", "set");
+                c.args(&query)
+                    .args([pkg, file])
+                    .env("ROVER_LAUNCH_SET", "set");
                 ws.env(&mut c, &[&stubs, &check]);
                 let out = run(c, Duration::from_secs(60))?;
                 ensure!(
@@ -579,7 +607,11 @@ fn ctrl_c_stops_every_node_and_the_master_and_loses_nothing() -> Result<()> {
         "stopped {:.1} s after SIGINT",
         stopped.elapsed().as_secs_f64()
     );
-    ensure!(code == Some(130), "exit code {code:?} (want 130):\n{}", said());
+    ensure!(
+        code == Some(130),
+        "exit code {code:?} (want 130):\n{}",
+        said()
+    );
     ensure!(!ws.master_answers(), "the master still answers");
     let left = ws.leftovers();
     ensure!(left.is_empty(), "processes left behind: {left:?}");
@@ -659,7 +691,10 @@ fn bad_launch_files_are_located_errors_and_a_missing_node_one_warning() -> Resul
     let warnings = said
         .matches("node /ghost is not started: cannot find node type \"no_such_node.py\"")
         .count();
-    ensure!(warnings == 1, "{warnings} warnings for the missing node:\n{said}");
+    ensure!(
+        warnings == 1,
+        "{warnings} warnings for the missing node:\n{said}"
+    );
     ensure!(
         said.contains("missing_node.launch:2"),
         "the warning does not say where:\n{said}"

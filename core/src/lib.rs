@@ -19,7 +19,7 @@ mod follower;
 mod headless;
 mod input;
 mod judge;
-pub mod launch;
+mod launch;
 mod look;
 mod observer;
 mod paths;
@@ -52,6 +52,13 @@ pub use headless::{
 };
 pub use input::{Action, InputSource, JointAction, NoInput};
 pub use judge::{ClassTally, LiveJudge, MATCH_IOU, eval_objects};
+pub use launch::{
+    DetectorRequest, Launch, LaunchError, LaunchNode, LaunchOptions, Location as LaunchLocation,
+    NodeRole, Output as NodeOutput, PROVIDED_PACKAGES, Param as LaunchParam, ParamSource,
+    ParamValue, ProvidedInclude, RoverPart, SpawnRequest, WorldRequest, canonical_name,
+    find_launch_file, find_node_executable, load as load_launch, ns_join, provided_placeholder,
+    role_of, shell_split,
+};
 pub use look::{Look, LookConfig};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};

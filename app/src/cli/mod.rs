@@ -33,19 +33,16 @@ use detect::DetectOptions;
 use signals::Interrupted;
 
 /// `rover xacro FILE [name:=value ...]`: the expanded URDF on stdout.
-fn xacro(
-    file: &std::path::Path,
-    args: &[String],
-    package_paths: Vec<(String, std::path::PathBuf)>,
-) -> anyhow::Result<()> {
+fn xacro(args: args::XacroArgs) -> anyhow::Result<()> {
     let mut resources = rover_sim::ResourcePaths::from_env();
-    resources.packages.extend(package_paths);
+    resources.packages.extend(args.package_paths);
     let xacro_args = args
+        .args
         .iter()
         .filter_map(|a| a.split_once(":="))
         .map(|(k, v)| (k.to_owned(), v.to_owned()))
         .collect();
-    let expanded = rover_sim::expand_xacro(file, &xacro_args, &resources)?;
+    let expanded = rover_sim::expand_xacro(&args.file, &xacro_args, &resources)?;
     use std::io::Write as _;
     let mut out = std::io::stdout().lock();
     out.write_all(expanded.text.as_bytes())?;
@@ -137,11 +134,7 @@ pub fn main() -> ExitCode {
             }),
         Some(Command::Eval(args)) => eval::run(args),
         Some(Command::Launch(args)) => launch::run(args),
-        Some(Command::Xacro {
-            file,
-            args,
-            package_paths,
-        }) => xacro(&file, &args, package_paths),
+        Some(Command::Xacro(args)) => xacro(args),
         Some(Command::Dataset(args)) => dataset::run(args),
         Some(Command::Bench {
             kind:

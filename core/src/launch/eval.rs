@@ -474,11 +474,6 @@ impl Parser<'_> {
                 None => Err(format!("{name}() is missing an argument")),
             }
         };
-        let num = |i: usize| -> Result<f64, String> {
-            args.get(i)
-                .and_then(Val::number)
-                .ok_or_else(|| format!("{name}() expects a number"))
-        };
         let count = |n: std::ops::RangeInclusive<usize>| -> Result<(), String> {
             if n.contains(&args.len()) {
                 Ok(())
@@ -528,97 +523,95 @@ impl Parser<'_> {
                 count(0..=1)?;
                 Val::Str(args.first().map(Val::text).unwrap_or_default())
             }
-            "int" => {
-                count(1..=1)?;
-                match &args[0] {
-                    Val::Str(s) => Val::Int(
-                        python_int_parse(s)
-                            .ok_or_else(|| format!("invalid literal for int(): '{s}'"))?,
-                    ),
-                    Val::Float(f) if f.is_finite() && f.abs() < 9.2e18 => {
-                        Val::Int(f.trunc() as i64)
-                    }
-                    other => Val::Int(
-                        other
-                            .int()
-                            .ok_or_else(|| format!("int() of {}", other.type_name()))?,
-                    ),
-                }
-            }
-            "float" => {
-                count(1..=1)?;
-                match &args[0] {
-                    Val::Str(s) => Val::Float(
-                        python_float_parse(s)
-                            .ok_or_else(|| format!("could not convert string to float: '{s}'"))?,
-                    ),
-                    _ => Val::Float(num(0)?),
-                }
-            }
-            "abs" => {
-                count(1..=1)?;
-                match &args[0] {
-                    Val::Int(i) => Val::Int(i.checked_abs().ok_or("integer overflow")?),
-                    _ => Val::Float(num(0)?.abs()),
-                }
-            }
-            "min" | "max" => {
-                if args.is_empty() {
-                    return Err(format!("{name}() needs arguments"));
-                }
-                let mut best = args[0].clone();
-                for a in &args[1..] {
-                    let better = if name == "min" {
-                        compare(a, "<", &best)?
-                    } else {
-                        compare(a, ">", &best)?
-                    };
-                    if better {
-                        best = a.clone();
-                    }
-                }
-                best
-            }
-            "round" => {
-                count(1..=1)?;
-                let v = num(0)?;
-                // Python rounds half to even.
-                let r = v.round_ties_even();
-                if r.is_finite() && r.abs() < 9.2e18 {
-                    Val::Int(r as i64)
-                } else {
-                    return Err("cannot round that number".to_owned());
-                }
-            }
-            "pow" => {
-                count(2..=2)?;
-                power(&args[0], &args[1])?
-            }
-            "atan2" => {
-                count(2..=2)?;
-                Val::Float(num(0)?.atan2(num(1)?))
-            }
-            _ => {
-                count(1..=1)?;
-                let x = num(0)?;
-                Val::Float(match name {
-                    "sqrt" if x < 0.0 => return Err("math domain error".to_owned()),
-                    "sqrt" => x.sqrt(),
-                    "sin" => x.sin(),
-                    "cos" => x.cos(),
-                    "tan" => x.tan(),
-                    "asin" => x.asin(),
-                    "acos" => x.acos(),
-                    "atan" => x.atan(),
-                    "radians" => x.to_radians(),
-                    "degrees" => x.to_degrees(),
-                    "floor" => return Ok(float_to_int(x.floor())?),
-                    "ceil" => return Ok(float_to_int(x.ceil())?),
-                    _ => return Err(format!("{name}() is not supported")),
-                })
-            }
+            _ => builtin(name, args)?,
         })
     }
+}
+
+/// Python's conversions (`int`, `float`), `abs`, `min`, `max`, `round`, `pow` and the `math`
+/// functions.
+fn builtin(name: &str, args: &[Val]) -> Result<Val, String> {
+    let num = |i: usize| -> Result<f64, String> {
+        args.get(i)
+            .and_then(Val::number)
+            .ok_or_else(|| format!("{name}() expects a number"))
+    };
+    let one = || -> Result<&Val, String> {
+        match args {
+            [v] => Ok(v),
+            _ => Err(format!("{name}() takes one argument, {} given", args.len())),
+        }
+    };
+    Ok(match name {
+        "int" => match one()? {
+            Val::Str(s) => Val::Int(
+                python_int_parse(s).ok_or_else(|| format!("invalid literal for int(): '{s}'"))?,
+            ),
+            Val::Float(f) => float_to_int(f.trunc())?,
+            other => Val::Int(
+                other
+                    .int()
+                    .ok_or_else(|| format!("int() of {}", other.type_name()))?,
+            ),
+        },
+        "float" => match one()? {
+            Val::Str(s) => Val::Float(
+                python_float_parse(s)
+                    .ok_or_else(|| format!("could not convert string to float: '{s}'"))?,
+            ),
+            _ => Val::Float(num(0)?),
+        },
+        "abs" => match one()? {
+            Val::Int(i) => Val::Int(i.checked_abs().ok_or("integer overflow")?),
+            _ => Val::Float(num(0)?.abs()),
+        },
+        "min" | "max" => {
+            let (first, rest) = args
+                .split_first()
+                .ok_or_else(|| format!("{name}() needs arguments"))?;
+            let mut best = first.clone();
+            for a in rest {
+                let op = if name == "min" { "<" } else { ">" };
+                if compare(a, op, &best)? {
+                    best = a.clone();
+                }
+            }
+            best
+        }
+        // Python rounds half to even.
+        "round" => float_to_int(one().and_then(|_| num(0))?.round_ties_even())?,
+        "pow" | "atan2" => {
+            let [a, b] = args else {
+                return Err(format!(
+                    "{name}() takes two arguments, {} given",
+                    args.len()
+                ));
+            };
+            if name == "pow" {
+                power(a, b)?
+            } else {
+                Val::Float(num(0)?.atan2(num(1)?))
+            }
+        }
+        _ => {
+            let x = one().and_then(|_| num(0))?;
+            Val::Float(match name {
+                "sqrt" if x < 0.0 => return Err("math domain error".to_owned()),
+                "sqrt" => x.sqrt(),
+                "sin" => x.sin(),
+                "cos" => x.cos(),
+                "tan" => x.tan(),
+                "asin" => x.asin(),
+                "acos" => x.acos(),
+                "atan" => x.atan(),
+                "radians" => x.to_radians(),
+                "degrees" => x.to_degrees(),
+                "floor" => return float_to_int(x.floor()),
+                "ceil" => return float_to_int(x.ceil()),
+                _ => return Err(format!("{name}() is not supported")),
+            })
+        }
+    })
 }
 
 fn float_to_int(f: f64) -> Result<Val, String> {

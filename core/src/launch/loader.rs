@@ -9,12 +9,13 @@ use rover_sim::ResourcePaths;
 use roxmltree::{Document, Node};
 
 use super::eval::EvalHost;
-use super::absolute;
-use super::value::{ParamValue, convert_value, parse_bool, parse_yaml};
-use super::{
+use super::model::{
     Launch, LaunchError, LaunchNode, LaunchOptions, Location, Output, PROVIDED_PACKAGES, Param,
-    ParamSource, ProvidedInclude, canonical_name, ns_join, provided_placeholder, subst,
+    ParamSource, ProvidedInclude, absolute, canonical_name, ns_join, provided_placeholder,
 };
+use super::shell::shell_split;
+use super::subst;
+use super::value::{ParamValue, convert_value, parse_bool, parse_yaml};
 
 /// Deepest chain of includes (a cycle is caught before this).
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -1077,85 +1078,4 @@ fn xacro_command(words: &[String]) -> Result<(PathBuf, BTreeMap<String, String>)
     }
     let file = file.ok_or_else(|| "xacro: no input file".to_owned())?;
     Ok((file, args))
-}
-
-/// Python's `shlex.split` (POSIX mode): words split on spaces, with '...', "..." and `\`.
-pub fn shell_split(s: &str) -> Result<Vec<String>, String> {
-    let mut words = Vec::new();
-    let mut word = String::new();
-    let mut in_word = false;
-    let mut chars = s.chars();
-    while let Some(c) = chars.next() {
-        match c {
-            c if c.is_whitespace() => {
-                if in_word {
-                    words.push(std::mem::take(&mut word));
-                    in_word = false;
-                }
-            }
-            '\'' => {
-                in_word = true;
-                loop {
-                    match chars.next() {
-                        Some('\'') => break,
-                        Some(c) => word.push(c),
-                        None => return Err(format!("no closing quotation in \"{s}\"")),
-                    }
-                }
-            }
-            '"' => {
-                in_word = true;
-                loop {
-                    match chars.next() {
-                        Some('"') => break,
-                        Some('\\') => match chars.next() {
-                            Some(c @ ('"' | '\\' | '$' | '`')) => word.push(c),
-                            Some(c) => {
-                                word.push('\\');
-                                word.push(c);
-                            }
-                            None => return Err(format!("no closing quotation in \"{s}\"")),
-                        },
-                        Some(c) => word.push(c),
-                        None => return Err(format!("no closing quotation in \"{s}\"")),
-                    }
-                }
-            }
-            '\\' => {
-                in_word = true;
-                match chars.next() {
-                    Some(c) => word.push(c),
-                    None => return Err(format!("no escaped character in \"{s}\"")),
-                }
-            }
-            c => {
-                in_word = true;
-                word.push(c);
-            }
-        }
-    }
-    if in_word {
-        words.push(word);
-    }
-    Ok(words)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn shell_words_split_like_shlex() {
-        assert_eq!(
-            shell_split(r#"xacro --inorder '/a b/robot.xacro' x:="1 2" y:=\$z"#),
-            Ok(vec![
-                "xacro".to_owned(),
-                "--inorder".to_owned(),
-                "/a b/robot.xacro".to_owned(),
-                "x:=1 2".to_owned(),
-                "y:=$z".to_owned()
-            ])
-        );
-        assert!(shell_split("'open").is_err());
-    }
 }

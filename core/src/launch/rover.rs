@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use super::{Launch, LaunchError, LaunchNode, Location, ParamSource, ParamValue, parse_bool};
+use super::model::{Launch, LaunchError, LaunchNode, Location, ParamSource};
+use super::value::{ParamValue, parse_bool, parse_yaml};
 
 /// What a launch's `<node>` is to rover.
 #[derive(Debug, Clone, PartialEq)]
@@ -290,7 +291,7 @@ fn spawn_request(node: &LaunchNode) -> Result<SpawnRequest, LaunchError> {
 
 /// darknet_ros' `yolo_model: threshold: value:` from a network config YAML.
 fn yolo_threshold(text: &str) -> Option<f32> {
-    let value = super::parse_yaml(text).ok()?;
+    let value = parse_yaml(text).ok()?;
     let get = |v: &ParamValue, key: &str| -> Option<ParamValue> {
         match v {
             ParamValue::Map(entries) => entries

@@ -165,7 +165,7 @@ mod tests {
         let r = |s: &str| resolve(s, &mut Host);
         assert_eq!(r("plain").as_deref(), Ok("plain"));
         assert_eq!(r("$(arg x)m").as_deref(), Ok("1.5m"));
-        assert_eq!(r("$(find $(arg pkg))/urdf").is_err(), true);
+        assert!(r("$(find $(arg pkg))/urdf").is_err());
         assert_eq!(
             r("$(find mine)/urdf/$(arg x)").as_deref(),
             Ok("/ws/mine/urdf/1.5")

@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use rover_core::launch::{LaunchNode, Output};
+use rover_core::{LaunchNode, NodeOutput as Output};
 
 /// roslaunch's wait after SIGINT before SIGTERM.
 const SIGINT_WAIT: Duration = Duration::from_secs(15);

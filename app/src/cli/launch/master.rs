@@ -6,7 +6,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use rover_core::launch::{Launch, ParamValue};
+use rover_core::{Launch, ParamValue};
 use rover_ros1::{Value, ros_call};
 
 /// How long a call to the master may take.

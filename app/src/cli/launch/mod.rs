@@ -1,7 +1,7 @@
 //! `rover launch`: a catkin package's roslaunch file, run as roslaunch runs it, with rover in
 //! Gazebo's and darknet_ros' place.
 //!
-//! The file is read with roslaunch's rules ([`rover_core::launch`]). What rover is, it does
+//! The file is read with roslaunch's rules ([`rover_core::load_launch`]). What rover is, it does
 //! itself: gazebo_ros' world and `spawn_model`, `robot_state_publisher`,
 //! `joint_state_publisher`, controller spawners and darknet_ros become rover's world, robot,
 //! /tf, /joint_states, controllers and detector, said once at start. The other nodes are
@@ -17,46 +17,15 @@ mod master;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use clap::Args;
-use rover_core::launch::{
-    Launch, LaunchOptions, NodeRole, Output, Param, ParamSource, ParamValue, RoverPart,
-    find_launch_file, find_node_executable, load, ns_join,
+use rover_core::{
+    Launch, LaunchOptions, LaunchParam as Param, NodeOutput as Output, NodeRole, ParamSource,
+    ParamValue, RoverPart, find_launch_file, find_node_executable, load_launch as load, ns_join,
 };
 use rover_sim::ResourcePaths;
 
-use super::args::RunArgs;
+use super::args::{LaunchArgs, RunArgs};
 use children::{Children, NodeProcess};
 use master::Master;
-
-/// `rover launch` arguments: the launch file, roslaunch's query options, and rover's run
-/// options (--headless, --duration, --trace, --record-mcap, ...).
-#[derive(Debug, Args)]
-pub(crate) struct LaunchArgs {
-    /// `PKG FILE.launch` (FILE found in ROS package PKG, as `roslaunch PKG FILE` finds it) or
-    /// `PATH.launch`, then `name:=value` args for the file
-    #[arg(required = true, num_args = 1.., value_name = "PKG FILE | PATH")]
-    pub(crate) launch: Vec<String>,
-
-    /// Print the parameters the launch sets (YAML, as `roslaunch --dump-params`) and exit
-    #[arg(long)]
-    pub(crate) dump_params: bool,
-
-    /// Print the nodes' names (as `roslaunch --nodes`) and exit
-    #[arg(long)]
-    pub(crate) nodes: bool,
-
-    /// Print the command line NODE would be started with, environment first (as
-    /// `roslaunch --args NODE`), and exit
-    #[arg(long = "args", value_name = "NODE")]
-    pub(crate) node_args: Option<String>,
-
-    /// Print the launch files read (as `roslaunch --files`) and exit
-    #[arg(long)]
-    pub(crate) files: bool,
-
-    #[command(flatten)]
-    pub(crate) run: RunArgs,
-}
 
 /// Runs `rover launch`.
 pub(crate) fn run(args: LaunchArgs) -> Result<()> {
