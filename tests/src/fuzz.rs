@@ -883,6 +883,46 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         hang_limit: text_limit,
     });
 
+    // roslaunch files: the series' two and the three that use every construct, in a copy of
+    // their package (includes by $(dirname) and $(find), rosparam files, a xacro command).
+    // Commands other than xacro are not run.
+    let dir = work.join("roslaunch");
+    let package = dir.join("launch_check");
+    copy_dir(&crate::repo("tests/launch_files/launch_check"), &package)?;
+    let mut launch_seeds = files_with(&crate::repo("tests/launch_files/seeds"), "launch");
+    launch_seeds.extend(files_with(&package.join("launch"), "launch"));
+    // The seeds' own packages, with the robots their xacro commands expand.
+    let car = crate::repo("assets/robots/my_robot.urdf");
+    for (name, robot) in [
+        ("mrobot_gazebo", "urdf/my_gazebo_robot_All.urdf.xacro"),
+        ("my_robot", "urdf/robot.urdf"),
+    ] {
+        let path = dir.join(name).join(robot);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)?;
+        }
+        std::fs::copy(&car, &path)?;
+    }
+    let launch_options = rover_core::LaunchOptions {
+        resources: ResourcePaths::from_env()
+            .with_package("launch_check", &package)
+            .with_package("mrobot_gazebo", dir.join("mrobot_gazebo"))
+            .with_package("my_robot", dir.join("my_robot")),
+        rover: true,
+        ..Default::default()
+    };
+    out.push(Target {
+        name: "roslaunch",
+        seeds: read_all(&launch_seeds)?,
+        input_path: package.join("launch/input.launch"),
+        load: Box::new(move |p| {
+            rover_core::load_launch(p, &launch_options)
+                .map_err(|e| e.to_string())
+                .and_then(|l| outcome(rover_core::RoverPart::of(&l)))
+        }),
+        hang_limit: text_limit,
+    });
+
     // ONNX model bytes (the default model; loading a valid one takes seconds in a debug build).
     let model = rover_perception::default_model_path();
     if model.is_file() {

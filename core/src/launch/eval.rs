@@ -457,7 +457,7 @@ impl Parser<'_> {
                 let text = self
                     .host
                     .arg(name)
-                    .map_err(|_| format!("name '{name}' is not defined (no arg of that name)"))?;
+                    .map_err(|e| format!("name '{name}' is not defined: {e}"))?;
                 Val::from_param(convert_value(&text, "auto")?)
             }
         })

@@ -20,6 +20,8 @@ mod model;
 mod rover;
 mod shell;
 mod subst;
+#[cfg(test)]
+mod tests;
 mod value;
 
 pub use loader::{find_launch_file, load};
