@@ -171,6 +171,18 @@ impl Workspace {
         .is_ok()
     }
 
+    /// Nothing of the launch is left: the master rover started does not answer, and no
+    /// process names the workspace or the master's port.
+    fn ensure_clean(&self) -> Result<()> {
+        ensure!(
+            !self.master_answers(),
+            "the master rover started still answers"
+        );
+        let left = self.leftovers();
+        ensure!(left.is_empty(), "processes left behind: {left:?}");
+        Ok(())
+    }
+
     /// Processes still running whose command line names this workspace or its master port.
     fn leftovers(&self) -> Vec<String> {
         let needles = [
@@ -197,6 +209,17 @@ impl Workspace {
         }
         found
     }
+}
+
+/// This test's workspace, one test at a time; `None` (the skip recorded) where ROS or
+/// ../shared is missing.
+fn setup() -> Result<Option<(std::sync::MutexGuard<'static, ()>, Workspace)>> {
+    let one = lock();
+    if let Some(why) = missing() {
+        rover_tests::skip(&why)?;
+        return Ok(None);
+    }
+    Ok(Some((one, Workspace::new()?)))
 }
 
 /// Runs `command` to its end (killed after `timeout`).
@@ -264,11 +287,9 @@ fn moved_m(rows: &[TraceRow]) -> Result<f64> {
 /// the node sees the person and drives the car toward it; everything is gone afterwards.
 #[test]
 fn the_series_my_gazebo3_launch_drives_the_car_toward_the_person() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing() {
-        return rover_tests::skip(&why);
-    }
-    let ws = Workspace::new()?;
+    let Some((_one, ws)) = setup()? else {
+        return Ok(());
+    };
     let trace = ws.path("trace.csv");
     let trace_arg = trace.to_string_lossy();
     let out = run(
@@ -311,24 +332,16 @@ fn the_series_my_gazebo3_launch_drives_the_car_toward_the_person() -> Result<()>
         moved >= 0.5,
         "the car moved {moved:.3} m (want >= 0.5 m):\n{said}"
     );
-    ensure!(
-        !ws.master_answers(),
-        "the master rover started still answers"
-    );
-    let left = ws.leftovers();
-    ensure!(left.is_empty(), "processes left behind: {left:?}");
-    Ok(())
+    ws.ensure_clean()
 }
 
 /// The first tutorial's `simulation.launch`: its teleop.py (teleop_twist_keyboard) reads the
 /// terminal rover runs in (tmux here), and its keys drive the car.
 #[test]
 fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing() {
-        return rover_tests::skip(&why);
-    }
-    let ws = Workspace::new()?;
+    let Some((_one, ws)) = setup()? else {
+        return Ok(());
+    };
     let trace = ws.path("trace.csv");
     let log = ws.path("rover.log");
     let rc = ws.path("rover.rc");
@@ -352,64 +365,29 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
         log.display(),
         rc.display()
     );
-    let socket = ws.path("tmux.sock");
-    let conf = ws.path("tmux.conf");
-    std::fs::write(&conf, "")?;
-    let session = format!("rover-launch-{}", std::process::id());
-    let tmux = |args: &[&str]| -> Result<()> {
-        let status = Command::new("tmux")
-            .arg("-S")
-            .arg(&socket)
-            .arg("-f")
-            .arg(&conf)
-            .args(args)
-            .stderr(Stdio::null())
-            .status()?;
-        ensure!(status.success(), "tmux {args:?} failed");
-        Ok(())
-    };
-    tmux(&[
-        "new-session",
-        "-d",
-        "-s",
-        &session,
-        "-x",
-        "120",
-        "-y",
-        "40",
-        &shell,
-    ])?;
-    let result = (|| -> Result<()> {
-        let start = Instant::now();
-        while !std::fs::read_to_string(&log)
-            .unwrap_or_default()
-            .contains("CTRL-C to quit")
-        {
-            ensure!(
-                start.elapsed() < Duration::from_secs(90),
-                "teleop never printed its help:\n{}",
-                std::fs::read_to_string(&log).unwrap_or_default()
-            );
-            std::thread::sleep(Duration::from_millis(100));
-        }
-        // A held key repeats (teleop stops after its key timeout without one).
-        for _ in 0..15 {
-            tmux(&["send-keys", "-t", &session, "i"])?;
-            std::thread::sleep(Duration::from_millis(200));
-        }
-        tmux(&["send-keys", "-t", &session, "k"])?;
-        while !rc.exists() {
-            ensure!(
-                start.elapsed() < Duration::from_secs(200),
-                "rover launch did not end:\n{}",
-                std::fs::read_to_string(&log).unwrap_or_default()
-            );
-            std::thread::sleep(Duration::from_millis(200));
-        }
-        Ok(())
-    })();
-    let _ = tmux(&["kill-server"]);
-    result?;
+    let tmux = rover_tests::ros::Tmux::start(ws.dir.path(), &shell)?;
+    let start = Instant::now();
+    let said = || std::fs::read_to_string(&log).unwrap_or_default();
+    while !said().contains("CTRL-C to quit") {
+        ensure!(
+            start.elapsed() < Duration::from_secs(90),
+            "teleop never printed its help:\n{}",
+            said()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    // A held key repeats (teleop stops after its key timeout without one).
+    tmux.press("i", 15)?;
+    tmux.press("k", 1)?;
+    while !rc.exists() {
+        ensure!(
+            start.elapsed() < Duration::from_secs(200),
+            "rover launch did not end:\n{}",
+            said()
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    drop(tmux);
     let said = std::fs::read_to_string(&log)?;
     let code = std::fs::read_to_string(&rc)?;
     ensure!(code.trim() == "0", "rover launch exited {code}:\n{said}");
@@ -429,13 +407,7 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
     ensure!(moved > 0.3, "drove {moved:.3} m while `i` was held");
     let end = rows.last().context("empty trace")?;
     ensure!(end.cmd_linear_mps == 0.0, "`k` did not stop the command");
-    ensure!(
-        !ws.master_answers(),
-        "the master rover started still answers"
-    );
-    let left = ws.leftovers();
-    ensure!(left.is_empty(), "processes left behind: {left:?}");
-    Ok(())
+    ws.ensure_clean()
 }
 
 /// Compares two outputs as the compare script's MODE says (yaml: the same parameters; lines:
@@ -472,11 +444,9 @@ sys.exit(1 if diff else 0)
 /// rover reads them too when asked these questions.
 #[test]
 fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing() {
-        return rover_tests::skip(&why);
-    }
-    let ws = Workspace::new()?;
+    let Some((_one, ws)) = setup()? else {
+        return Ok(());
+    };
     let stubs = fixtures().join("stubs");
     let check = fixtures().join("launch_check");
     let compare = ws.path("compare.py");
@@ -553,11 +523,9 @@ fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
 /// 130; no process is left.
 #[test]
 fn ctrl_c_stops_every_node_and_the_master_and_loses_nothing() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing() {
-        return rover_tests::skip(&why);
-    }
-    let ws = Workspace::new()?;
+    let Some((_one, ws)) = setup()? else {
+        return Ok(());
+    };
     let trace = ws.path("trace.csv");
     let mcap = ws.path("run.mcap");
     let log = ws.path("rover.log");
@@ -612,9 +580,7 @@ fn ctrl_c_stops_every_node_and_the_master_and_loses_nothing() -> Result<()> {
         "exit code {code:?} (want 130):\n{}",
         said()
     );
-    ensure!(!ws.master_answers(), "the master still answers");
-    let left = ws.leftovers();
-    ensure!(left.is_empty(), "processes left behind: {left:?}");
+    ws.ensure_clean()?;
     let rows = parse_trace(&std::fs::read_to_string(&trace)?)?;
     let last = rows.last().context("empty trace")?;
     ensure!(
@@ -632,14 +598,14 @@ fn ctrl_c_stops_every_node_and_the_master_and_loses_nothing() -> Result<()> {
 }
 
 /// Bad input says where: a missing package, an undefined arg (file:line), a cyclic include;
-/// a node whose executable is missing is one warning, and the rest of the launch runs.
+/// a node whose executable is missing is one warning, and the rest of the launch runs. A node
+/// that dies is reported and, with `respawn="true"`, started again; a `required="true"` one
+/// that exits stops the launch with an error.
 #[test]
 fn bad_launch_files_are_located_errors_and_a_missing_node_one_warning() -> Result<()> {
-    let _one = lock();
-    if let Some(why) = missing() {
-        return rover_tests::skip(&why);
-    }
-    let ws = Workspace::new()?;
+    let Some((_one, ws)) = setup()? else {
+        return Ok(());
+    };
     let dir = ws.path("bad");
     std::fs::create_dir_all(&dir)?;
     let write = |name: &str, body: &str| -> Result<String> {
@@ -661,7 +627,17 @@ fn bad_launch_files_are_located_errors_and_a_missing_node_one_warning() -> Resul
     )?;
     let missing_node = write(
         "missing_node.launch",
-        "<launch>\n  <node pkg=\"mrobot_gazebo\" type=\"no_such_node.py\" name=\"ghost\"/>\n</launch>\n",
+        "<launch>\n  <node pkg=\"mrobot_gazebo\" type=\"no_such_node.py\" name=\"ghost\"/>\n  <node pkg=\"mrobot_gazebo\" type=\"quitter.sh\" name=\"quitter\" output=\"screen\" respawn=\"true\" respawn_delay=\"0.5\"/>\n</launch>\n",
+    )?;
+    let required = write(
+        "required.launch",
+        "<launch>\n  <node pkg=\"mrobot_gazebo\" type=\"quitter.sh\" name=\"quitter\" required=\"true\"/>\n</launch>\n",
+    )?;
+    let quitter = ws.path("src/mrobot_gazebo/scripts/quitter.sh");
+    std::fs::write(&quitter, "#!/bin/sh\necho bye\nsleep 0.2\nexit 3\n")?;
+    std::fs::set_permissions(
+        &quitter,
+        <std::fs::Permissions as std::os::unix::fs::PermissionsExt>::from_mode(0o755),
     )?;
     let cases: [(Vec<&str>, &str); 3] = [
         (
@@ -683,7 +659,7 @@ fn bad_launch_files_are_located_errors_and_a_missing_node_one_warning() -> Resul
         );
     }
     let out = run(
-        ws.rover(&[missing_node.as_str(), "--headless", "--duration", "1"]),
+        ws.rover(&[missing_node.as_str(), "--headless", "--duration", "3"]),
         Duration::from_secs(120),
     )?;
     let said = text(&out);
@@ -699,5 +675,31 @@ fn bad_launch_files_are_located_errors_and_a_missing_node_one_warning() -> Resul
         said.contains("missing_node.launch:2"),
         "the warning does not say where:\n{said}"
     );
-    Ok(())
+    // The quitter: reported each time it dies, and started again.
+    let byes = said.lines().filter(|l| *l == "[quitter] bye").count();
+    ensure!(
+        byes >= 2
+            && said.contains("[quitter] respawning")
+            && said.contains("[quitter] process has died")
+            && said.contains("exit status: 3"),
+        "the respawned node: {byes} runs:\n{said}"
+    );
+    // A required node that exits ends the launch long before its 60 s, with an error.
+    let out = run(
+        ws.rover(&[required.as_str(), "--headless", "--duration", "60"]),
+        Duration::from_secs(120),
+    )?;
+    let said = text(&out);
+    ensure!(
+        out.status.code() == Some(1)
+            && said.contains("required node /quitter exited")
+            && said.contains("required.launch:2"),
+        "a required node's exit did not stop the launch with an error:\n{said}"
+    );
+    let rows = said
+        .lines()
+        .find_map(|l| l.strip_prefix("rover: world "))
+        .is_some();
+    ensure!(rows, "the run did not end as a run ends:\n{said}");
+    ws.ensure_clean()
 }

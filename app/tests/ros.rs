@@ -379,21 +379,6 @@ fn teleop_twist_keyboard_in_tmux_drives_and_stops_the_car() -> Result<()> {
     }
     let mut graph = RosGraph::start()?;
     graph.spawn_rover(14.0, &["--no-detector"])?;
-    let session = format!("rover-teleop-{}", std::process::id());
-    let tmux_conf = graph.dir.path().join("tmux.conf");
-    std::fs::write(&tmux_conf, "")?;
-    let socket = graph.dir.path().join("tmux.sock");
-    let tmux = |args: &[&str]| -> Result<()> {
-        let status = Command::new("tmux")
-            .arg("-S")
-            .arg(&socket)
-            .arg("-f")
-            .arg(&tmux_conf)
-            .args(args)
-            .status()?;
-        ensure!(status.success(), "tmux {args:?} failed");
-        Ok(())
-    };
     let script = teleop_dir.join("teleop_twist_keyboard.py");
     let shell = format!(
         "PYTHONUNBUFFERED=1 ROS_MASTER_URI={} ROS_IP=127.0.0.1 ROS_HOME={} ROS_PACKAGE_PATH={} {PYTHON} {} > {} 2>&1",
@@ -403,32 +388,16 @@ fn teleop_twist_keyboard_in_tmux_drives_and_stops_the_car() -> Result<()> {
         script.display(),
         graph.log_path("teleop").display()
     );
-    tmux(&[
-        "new-session",
-        "-d",
-        "-s",
-        &session,
-        "-x",
-        "120",
-        "-y",
-        "40",
-        &shell,
-    ])?;
-    let result = (|| -> Result<Vec<TraceRow>> {
-        // teleop waits for rover's /cmd_vel subscription, then reads keys.
-        graph.wait_for(Duration::from_secs(30), "teleop's key help", |g| {
-            g.log("teleop").contains("CTRL-C to quit")
-        })?;
-        // A held key repeats (teleop stops after its 0.5 s key_timeout without one).
-        for _ in 0..15 {
-            tmux(&["send-keys", "-t", &session, "i"])?;
-            std::thread::sleep(Duration::from_millis(200));
-        }
-        tmux(&["send-keys", "-t", &session, "k"])?;
-        graph.wait_rover(Duration::from_secs(120))
-    })();
-    let _ = tmux(&["kill-server"]);
-    let rows = result?;
+    let tmux = rover_tests::ros::Tmux::start(graph.dir.path(), &shell)?;
+    // teleop waits for rover's /cmd_vel subscription, then reads keys.
+    graph.wait_for(Duration::from_secs(30), "teleop's key help", |g| {
+        g.log("teleop").contains("CTRL-C to quit")
+    })?;
+    // A held key repeats (teleop stops after its 0.5 s key_timeout without one).
+    tmux.press("i", 15)?;
+    tmux.press("k", 1)?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    drop(tmux);
     let driving: Vec<&TraceRow> = rows.iter().filter(|r| r.cmd_linear_mps == 0.5).collect();
     let (Some(first), Some(last)) = (driving.first(), driving.last()) else {
         bail!(

@@ -426,6 +426,10 @@ struct Stepped {
     interrupted: bool,
 }
 
+/// A duration that means "until stopped" (Ctrl-C, or the stop flag): 1e9 s of sim time, some
+/// 32 years; progress lines then say so instead of counting toward it.
+pub const UNTIL_STOPPED_S: f64 = 1e9;
+
 /// Steps the session until `duration_s` of sim time or a stop request: script steps and
 /// outside inputs first, then physics; paced to the real-time factor and reporting progress
 /// when the config asks. An observer's failure ends the run with its error.
@@ -468,12 +472,18 @@ fn step_to_end(
             && last_report.elapsed() >= every
         {
             last_report = Instant::now();
-            tracing::info!(
-                "sim time {:.1} / {:.1} s ({:.1}x real time)",
-                session.sim().sim_time_s(),
-                duration_s,
-                session.sim().sim_time_s() / started.elapsed().as_secs_f64()
-            );
+            let rtf = session.sim().sim_time_s() / started.elapsed().as_secs_f64();
+            if duration_s >= UNTIL_STOPPED_S {
+                tracing::info!(
+                    "sim time {:.1} s ({rtf:.1}x real time; until stopped)",
+                    session.sim().sim_time_s()
+                );
+            } else {
+                tracing::info!(
+                    "sim time {:.1} / {duration_s:.1} s ({rtf:.1}x real time)",
+                    session.sim().sim_time_s()
+                );
+            }
         }
     }
     Ok(Stepped {

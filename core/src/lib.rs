@@ -47,8 +47,8 @@ pub use follower::{
     LaserMount, TargetFilter, range_bearing_from,
 };
 pub use headless::{
-    DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary, run_headless, run_headless_driven,
-    run_headless_observed,
+    DEFAULT_DETECT_HZ, Perception, RunConfig, RunSummary, UNTIL_STOPPED_S, run_headless,
+    run_headless_driven, run_headless_observed,
 };
 pub use input::{Action, InputSource, JointAction, NoInput};
 pub use judge::{ClassTally, LiveJudge, MATCH_IOU, eval_objects};

@@ -41,3 +41,69 @@ pub fn free_port() -> Result<u16> {
         .local_addr()?
         .port())
 }
+
+/// A tmux server of a test's own (its socket and an empty config in `dir`) running one
+/// session: a terminal for programs that read keys, such as teleop_twist_keyboard. The
+/// server is killed when dropped.
+pub struct Tmux {
+    socket: PathBuf,
+    conf: PathBuf,
+    session: String,
+}
+
+impl Tmux {
+    /// Starts `shell` in a 120x40 session.
+    pub fn start(dir: &Path, shell: &str) -> Result<Self> {
+        let conf = dir.join("tmux.conf");
+        std::fs::write(&conf, "")?;
+        let tmux = Self {
+            socket: dir.join("tmux.sock"),
+            conf,
+            session: format!("rover-test-{}", std::process::id()),
+        };
+        let session = tmux.session.clone();
+        tmux.run(&[
+            "new-session",
+            "-d",
+            "-s",
+            &session,
+            "-x",
+            "120",
+            "-y",
+            "40",
+            shell,
+        ])?;
+        Ok(tmux)
+    }
+
+    /// Presses `key` in the session (held: `times`, 200 ms apart, as a key repeats).
+    pub fn press(&self, key: &str, times: usize) -> Result<()> {
+        for i in 0..times {
+            if i > 0 {
+                std::thread::sleep(std::time::Duration::from_millis(200));
+            }
+            self.run(&["send-keys", "-t", &self.session, key])?;
+        }
+        Ok(())
+    }
+
+    fn run(&self, args: &[&str]) -> Result<()> {
+        let status = Command::new("tmux")
+            .arg("-S")
+            .arg(&self.socket)
+            .arg("-f")
+            .arg(&self.conf)
+            .args(args)
+            .stderr(std::process::Stdio::null())
+            .status()?;
+        ensure!(status.success(), "tmux {args:?} failed");
+        Ok(())
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        // The server is gone already when its one session ended.
+        let _ = self.run(&["kill-server"]);
+    }
+}

@@ -4,12 +4,16 @@ use std::path::{Path, PathBuf};
 
 use super::{LaunchOptions, NodeRole, ParamSource, ParamValue, RoverPart, load};
 
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).expect("a temp folder");
+        let _ = std::fs::create_dir_all(parent);
     }
-    std::fs::write(&path, text).expect("a temp file");
+    if let Err(e) = std::fs::write(&path, text) {
+        panic!("cannot write {}: {e}", path.display());
+    }
     path
 }
 
@@ -30,8 +34,8 @@ fn error(dir: &Path, text: &str) -> String {
 }
 
 #[test]
-fn include_args_follow_roslaunch_rules() {
-    let dir = tempfile::tempdir().expect("a temp folder");
+fn include_args_follow_roslaunch_rules() -> TestResult {
+    let dir = tempfile::tempdir()?;
     let d = dir.path();
     write(d, "package.xml", "<package><name>pkg</name></package>");
     write(
@@ -44,7 +48,7 @@ fn include_args_follow_roslaunch_rules() {
         "ok.launch",
         "<launch><include file=\"$(find pkg)/inc.launch\" ns=\"n\"><arg name=\"a\" value=\"1\"/></include></launch>",
     );
-    let launch = load(&ok, &options(d, true)).expect("loads");
+    let launch = load(&ok, &options(d, true))?;
     assert_eq!(launch.params["/n/sum"].value, ParamValue::Int(3));
     assert_eq!(launch.files.len(), 2);
 
@@ -83,11 +87,12 @@ fn include_args_follow_roslaunch_rules() {
     assert!(xml.contains("bad.launch:3: not well-formed XML"), "{xml}");
     let root = error(d, "<robot/>");
     assert!(root.contains("expected a <launch> root element"), "{root}");
+    Ok(())
 }
 
 #[test]
-fn a_cyclic_include_is_an_error_where_it_closes() {
-    let dir = tempfile::tempdir().expect("a temp folder");
+fn a_cyclic_include_is_an_error_where_it_closes() -> TestResult {
+    let dir = tempfile::tempdir()?;
     let d = dir.path();
     let a = write(
         d,
@@ -99,16 +104,18 @@ fn a_cyclic_include_is_an_error_where_it_closes() {
         "b.launch",
         "<launch>\n\n<include file=\"$(dirname)/a.launch\"/>\n</launch>",
     );
-    let e = load(&a, &options(d, true))
-        .expect_err("a cycle")
-        .to_string();
+    let Err(e) = load(&a, &options(d, true)) else {
+        return Err("a cycle loaded".into());
+    };
+    let e = e.to_string();
     assert!(e.contains("b.launch:3: cyclic include: "), "{e}");
     assert!(e.contains("a.launch -> ") && e.ends_with("a.launch"), "{e}");
+    Ok(())
 }
 
 #[test]
-fn rover_does_gazebo_spawn_darknet_and_controllers_itself() {
-    let dir = tempfile::tempdir().expect("a temp folder");
+fn rover_does_gazebo_spawn_darknet_and_controllers_itself() -> TestResult {
+    let dir = tempfile::tempdir()?;
     let d = dir.path();
     write(d, "package.xml", "<package><name>pkg</name></package>");
     write(
@@ -146,7 +153,7 @@ fn rover_does_gazebo_spawn_darknet_and_controllers_itself() {
   <node name="mine" pkg="pkg" type="mine.py"/>
 </launch>"#,
     );
-    let launch = load(&path, &options(d, true)).expect("loads");
+    let launch = load(&path, &options(d, true))?;
     let description = &launch.params["/robot_description"];
     match (&description.source, &description.value) {
         (ParamSource::Xacro { file, args }, ParamValue::Str(urdf)) => {
@@ -156,8 +163,8 @@ fn rover_does_gazebo_spawn_darknet_and_controllers_itself() {
         }
         other => panic!("robot_description from {other:?}"),
     }
-    let part = RoverPart::of(&launch).expect("rover's part");
-    let world = part.world.clone().expect("the world");
+    let part = RoverPart::of(&launch)?;
+    let world = part.world.clone().ok_or("no world")?;
     assert!(
         world
             .world_name
@@ -165,7 +172,7 @@ fn rover_does_gazebo_spawn_darknet_and_controllers_itself() {
             .is_some_and(|w| w.ends_with("my.world"))
     );
     assert!(world.paused && !world.gui && world.use_sim_time);
-    let spawn = part.spawn.clone().expect("the spawn");
+    let spawn = part.spawn.clone().ok_or("no spawn")?;
     assert_eq!((spawn.xyz_m, spawn.yaw_rad), ([1.5, -2.0, 0.0], 0.5));
     assert_eq!(spawn.param.as_deref(), Some("robot_description"));
     assert_eq!(part.detector.as_ref().and_then(|d| d.threshold), Some(0.45));
@@ -183,4 +190,5 @@ fn rover_does_gazebo_spawn_darknet_and_controllers_itself() {
             NodeRole::Process
         ]
     );
+    Ok(())
 }

@@ -46,6 +46,8 @@ pub(crate) struct Children {
     procs: Arc<Mutex<Vec<Running>>>,
     stopping: Arc<AtomicBool>,
     supervisor: Option<JoinHandle<()>>,
+    /// Why the launch was stopped by a `required="true"` node, when it was.
+    required_exit: Arc<Mutex<Option<String>>>,
 }
 
 /// Sends SIGINT to a child (as Ctrl-C would).
@@ -77,22 +79,30 @@ impl Children {
         }
         let procs = Arc::new(Mutex::new(procs));
         let stopping = Arc::new(AtomicBool::new(false));
+        let required_exit = Arc::new(Mutex::new(None));
         let supervisor = {
-            let (procs, stopping, log_dir) = (
-                Arc::clone(&procs),
-                Arc::clone(&stopping),
-                log_dir.to_path_buf(),
-            );
+            let watch = Watch {
+                stop,
+                required_exit: Arc::clone(&required_exit),
+                log_dir: log_dir.to_path_buf(),
+            };
+            let (procs, stopping) = (Arc::clone(&procs), Arc::clone(&stopping));
             std::thread::Builder::new()
                 .name("launch-supervisor".into())
-                .spawn(move || supervise(&procs, &stopping, &stop, &log_dir))
+                .spawn(move || supervise(&procs, &stopping, &watch))
                 .ok()
         };
         Self {
             procs,
             stopping,
             supervisor,
+            required_exit,
         }
+    }
+
+    /// Why a `required="true"` node stopped the launch, when one did.
+    pub(crate) fn required_exit(&self) -> Option<String> {
+        self.required_exit.lock().ok().and_then(|r| r.clone())
     }
 
     /// Stops every node (SIGINT, SIGTERM after 15 s, SIGKILL after 2 s more), in reverse
@@ -204,16 +214,19 @@ fn sanitize(name: &str) -> String {
         .collect()
 }
 
-fn supervise(
-    procs: &Mutex<Vec<Running>>,
-    stopping: &AtomicBool,
-    stop: &AtomicBool,
-    log_dir: &Path,
-) {
+/// What the supervisor needs besides the processes.
+struct Watch {
+    /// The run's stop flag (set when a required node exits).
+    stop: Arc<AtomicBool>,
+    required_exit: Arc<Mutex<Option<String>>>,
+    log_dir: PathBuf,
+}
+
+fn supervise(procs: &Mutex<Vec<Running>>, stopping: &AtomicBool, w: &Watch) {
     while !stopping.load(Ordering::SeqCst) {
         if let Ok(mut procs) = procs.lock() {
             for p in procs.iter_mut() {
-                watch(p, stop, log_dir);
+                watch(p, w);
             }
         }
         std::thread::sleep(POLL);
@@ -221,14 +234,15 @@ fn supervise(
 }
 
 /// Reports a node that exited, and starts it again when it should.
-fn watch(p: &mut Running, stop: &AtomicBool, log_dir: &Path) {
+fn watch(p: &mut Running, w: &Watch) {
+    let stop = &w.stop;
     if let Some(at) = p.restart_at
         && Instant::now() >= at
         && !stop.load(Ordering::SeqCst)
     {
         p.restart_at = None;
         say!("[{}] respawning", p.spec.node.name);
-        p.spawn(log_dir);
+        p.spawn(&w.log_dir);
         return;
     }
     let Some(child) = p.child.as_mut() else {
@@ -251,7 +265,15 @@ fn watch(p: &mut Running, stop: &AtomicBool, log_dir: &Path) {
         );
     }
     if node.required {
-        tracing::warn!("[{}] is required: stopping the launch", node.name);
+        let why = format!(
+            "required node {} exited ({status}; {}): the launch stopped",
+            node.full_name(),
+            node.at
+        );
+        tracing::warn!("{why}");
+        if let Ok(mut r) = w.required_exit.lock() {
+            r.get_or_insert(why);
+        }
         stop.store(true, Ordering::SeqCst);
     } else if node.respawn && !stop.load(Ordering::SeqCst) {
         p.restart_at = Some(Instant::now() + Duration::from_secs_f64(node.respawn_delay_s));

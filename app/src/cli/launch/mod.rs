@@ -65,7 +65,10 @@ pub(crate) fn run(args: LaunchArgs) -> Result<()> {
     let result = super::run::run_until(run, stop);
     children.stop();
     master.stop();
-    result
+    match children.required_exit() {
+        Some(why) => Err(anyhow::anyhow!(why)),
+        None => result,
+    }
 }
 
 /// `PKG FILE` or `PATH`, then `name:=value` args.
@@ -182,6 +185,11 @@ fn log_dir() -> PathBuf {
 /// each replaced part of the launch was.
 fn apply(part: &RoverPart, launch: &mut Launch, run: &mut RunArgs, log_dir: &Path) -> Result<()> {
     run.ros.ros = true;
+    if run.duration.is_none() && run.script.is_none() {
+        // As roslaunch: until Ctrl-C (or the window closes).
+        run.duration = Some(rover_core::UNTIL_STOPPED_S);
+        say!("  runs until Ctrl-C (--duration SECS to stop sooner)");
+    }
     apply_world(part, launch, run)?;
     apply_robot(part, launch, run, log_dir)?;
     match &part.detector {
