@@ -55,6 +55,8 @@ with Reader(Path(sys.argv[1])) as reader:
             print('odom %d %d %.9f %.9f %.9f' % (m.header.stamp.sec, m.header.stamp.nanosec,
                                                  p.position.x, p.position.y, yaw))
             assert t == m.header.stamp.sec * 10**9 + m.header.stamp.nanosec
+        elif c.msgtype == 'gazebo_msgs/msg/ModelStates':
+            assert len(m.name) == len(m.pose) == len(m.twist) >= 2, m.name
         elif c.msgtype == 'darknet_ros_msgs/msg/BoundingBoxes':
             for b in m.bounding_boxes:
                 print('box', b.class_id.replace(' ', '_'), b.xmin, b.ymin, b.xmax, b.ymax,
@@ -160,6 +162,7 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
             "/darknet_ros/found_object",
             "darknet_ros_msgs/msg/ObjectCount",
         ),
+        ("/gazebo/model_states", "gazebo_msgs/msg/ModelStates"),
     ];
     for (topic, msgtype) in expected {
         ensure!(

@@ -32,6 +32,10 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation",
     ),
     (
+        "gazebo_msgs/ModelStates",
+        "string[] name\ngeometry_msgs/Pose[] pose\ngeometry_msgs/Twist[] twist",
+    ),
+    (
         "geometry_msgs/PoseWithCovariance",
         "geometry_msgs/Pose pose\nfloat64[36] covariance",
     ),

@@ -121,6 +121,51 @@ impl Decode for Twist {
     }
 }
 
+/// `geometry_msgs/Pose`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Pose {
+    /// Position (m).
+    pub position: Vector3,
+    /// Orientation.
+    pub orientation: Quaternion,
+}
+
+impl Pose {
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.position.encode(out);
+        self.orientation.encode(out);
+    }
+}
+
+/// `gazebo_msgs/ModelStates`: every model's name, world pose and world twist.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ModelStates {
+    /// Model names.
+    pub name: Vec<String>,
+    /// Their poses (world frame).
+    pub pose: Vec<Pose>,
+    /// Their velocities (world frame).
+    pub twist: Vec<Twist>,
+}
+
+impl Message for ModelStates {
+    const TYPE: &'static str = "gazebo_msgs/ModelStates";
+    fn encode(&self, out: &mut Vec<u8>) {
+        wire::len(out, self.name.len());
+        for n in &self.name {
+            wire::string(out, n);
+        }
+        wire::len(out, self.pose.len());
+        for p in &self.pose {
+            p.encode(out);
+        }
+        wire::len(out, self.twist.len());
+        for t in &self.twist {
+            t.encode(out);
+        }
+    }
+}
+
 /// `geometry_msgs/Transform` (with its parent and child frames: `TransformStamped`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TransformStamped {

@@ -53,7 +53,7 @@ pub use model::{
 pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, HOLD_BANDWIDTH_HZ,
-    HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory,
+    HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState, JointTrajectory, ModelState,
     ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions, Simulation, TrajectoryOutcome,
     TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };

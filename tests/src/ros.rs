@@ -12,25 +12,45 @@ pub const PYTHON: &str = "/usr/bin/python3";
 /// `shared_ros/darknet_ros_msgs/msg` (as ../shared/ros/README.md says); returns the folder to
 /// put on PYTHONPATH.
 pub fn darknet_msgs(shared_ros: &Path, out: &Path) -> Result<PathBuf> {
-    let msgs = shared_ros.join("darknet_ros_msgs/msg");
-    let pkg = out.join("darknet_ros_msgs");
+    generate_msgs(
+        "darknet_ros_msgs",
+        &shared_ros.join("darknet_ros_msgs/msg"),
+        &[("std_msgs", Path::new("/usr/share/std_msgs/msg"))],
+        out,
+    )
+}
+
+/// Generates ROS 1 package `package`'s messages for rospy into `out` with genpy, from the
+/// `.msg` files in `msgs`; `deps` are the other packages' `.msg` folders they use. Returns the
+/// folder to put on PYTHONPATH.
+pub fn generate_msgs(
+    package: &str,
+    msgs: &Path,
+    deps: &[(&str, &Path)],
+    out: &Path,
+) -> Result<PathBuf> {
+    let pkg = out.join(package);
     let gen_args = |c: &mut Command| {
-        c.args(["/usr/lib/genpy/genmsg_py.py", "-p", "darknet_ros_msgs"])
-            .arg(format!("-Idarknet_ros_msgs:{}", msgs.display()))
-            .arg("-Istd_msgs:/usr/share/std_msgs/msg")
-            .arg("-o")
-            .arg(pkg.join("msg"));
+        c.args(["/usr/lib/genpy/genmsg_py.py", "-p", package])
+            .arg(format!("-I{package}:{}", msgs.display()));
+        for (dep, dir) in deps {
+            c.arg(format!("-I{dep}:{}", dir.display()));
+        }
+        c.arg("-o").arg(pkg.join("msg"));
     };
     let mut files = Command::new(PYTHON);
     gen_args(&mut files);
-    for entry in std::fs::read_dir(&msgs)? {
+    for entry in std::fs::read_dir(msgs)? {
         files.arg(entry?.path());
     }
-    ensure!(files.status()?.success(), "genmsg_py failed");
+    ensure!(files.status()?.success(), "genmsg_py failed for {package}");
     let mut init = Command::new(PYTHON);
     gen_args(&mut init);
     init.arg("--initpy");
-    ensure!(init.status()?.success(), "genmsg_py --initpy failed");
+    ensure!(
+        init.status()?.success(),
+        "genmsg_py --initpy failed for {package}"
+    );
     std::fs::write(pkg.join("__init__.py"), "")?;
     Ok(out.to_path_buf())
 }

@@ -51,6 +51,9 @@ pub(crate) struct Start {
     pub static_tf: Vec<Transform>,
     /// The camera's calibration, when the robot has a camera.
     pub camera: Option<CameraInfo>,
+    /// The models' names (`/gazebo/model_states`), in the order of
+    /// [`ControlUpdate::models`].
+    pub model_names: Vec<String>,
 }
 
 /// A control update.
@@ -64,6 +67,8 @@ pub(crate) struct ControlUpdate {
     /// One per controller of the plan's `controllers`, in that order: what its trajectory
     /// does (default for controllers that take no trajectory).
     pub runs: Vec<RunSample>,
+    /// Every model's world pose and twist (a recycled buffer).
+    pub models: Vec<rover_sim::ModelState>,
 }
 
 /// A trajectory controller's run at a control update.
@@ -183,6 +188,7 @@ pub(crate) struct BufferPool {
     boxes: Receiver<Vec<BoundingBox>>,
     joints: Receiver<Vec<JointSample>>,
     runs: Receiver<Vec<RunSample>>,
+    models: Receiver<Vec<rover_sim::ModelState>>,
 }
 
 /// The publishing thread's end: what an event still holds after every family saw it.
@@ -192,6 +198,7 @@ pub(crate) struct BufferReturn {
     boxes: SyncSender<Vec<BoundingBox>>,
     joints: SyncSender<Vec<JointSample>>,
     runs: SyncSender<Vec<RunSample>>,
+    models: SyncSender<Vec<rover_sim::ModelState>>,
 }
 
 /// A pool and its return path.
@@ -201,6 +208,7 @@ pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
     let (boxes_back, boxes) = sync_channel(4);
     let (joints_back, joints) = sync_channel(4);
     let (runs_back, runs) = sync_channel(4);
+    let (models_back, models) = sync_channel(4);
     (
         BufferPool {
             pixels,
@@ -208,6 +216,7 @@ pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
             boxes,
             joints,
             runs,
+            models,
         },
         BufferReturn {
             pixels: pixels_back,
@@ -215,6 +224,7 @@ pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
             boxes: boxes_back,
             joints: joints_back,
             runs: runs_back,
+            models: models_back,
         },
     )
 }
@@ -244,6 +254,11 @@ impl BufferPool {
     pub fn take_runs(&self) -> Vec<RunSample> {
         self.runs.try_recv().unwrap_or_default()
     }
+
+    /// A model states buffer (its contents are stale).
+    pub fn take_models(&self) -> Vec<rover_sim::ModelState> {
+        self.models.try_recv().unwrap_or_default()
+    }
 }
 
 impl BufferReturn {
@@ -255,6 +270,7 @@ impl BufferReturn {
             Event::Control(c) => {
                 send(&self.joints, c.joints);
                 send(&self.runs, c.runs);
+                send(&self.models, c.models);
             }
             Event::Image(i) => {
                 send(&self.pixels, i.pixels);

@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -29,6 +29,7 @@ pub(crate) mod ground_truth;
 pub(crate) mod input;
 pub(crate) mod joint_states;
 pub(crate) mod laser;
+pub(crate) mod model_states;
 pub(crate) mod odom;
 pub(crate) mod plan;
 pub(crate) mod status;
@@ -81,6 +82,8 @@ pub(crate) trait Transport {
     fn ground_truth(&mut self) -> Result<Box<dyn darknet::BoxesWire>>;
     /// `/rover/status`.
     fn status(&mut self) -> Result<Box<dyn status::StatusWire>>;
+    /// `/gazebo/model_states`.
+    fn model_states(&mut self) -> Result<Box<dyn model_states::ModelStatesWire>>;
 }
 
 /// The topic families both transports publish, advertised in this order and shown every event
@@ -103,6 +106,7 @@ pub(crate) fn families(
         Box::new(laser::Laser::new(transport.laser(plan)?)),
         Box::new(arm::Arm::new(transport.arm(plan)?)),
         Box::new(status::Status::new(transport.status()?)),
+        Box::new(model_states::ModelStates::new(transport.model_states()?)),
     ];
     if ground_truth {
         families.push(Box::new(ground_truth::GroundTruth::new(
@@ -260,6 +264,7 @@ impl<R: Send + 'static> Observer for Bridge<R> {
         self.send(Event::Start(Start {
             static_tf,
             camera: camera.cloned(),
+            model_names: sim.model_state_names(),
         }));
     }
 
@@ -270,11 +275,14 @@ impl<R: Send + 'static> Observer for Bridge<R> {
             capture::joints(sim, sample, &b.joints, &mut joints);
             let mut runs = b.buffers.take_runs();
             capture::runs(sim, &b.controllers, &mut runs);
+            let mut models = b.buffers.take_models();
+            sim.model_states_into(&mut models);
             b.send(Event::Control(ControlUpdate {
                 sample: *sample,
                 joints,
                 arm: capture::arm(sim, &stats.arm),
                 runs,
+                models,
             }));
         });
     }

@@ -20,6 +20,7 @@ mod convert;
 mod detections;
 mod joint_states;
 mod laser;
+mod model_states;
 mod odom;
 mod status;
 mod tf;
@@ -104,6 +105,10 @@ impl Transport for Ros1<'_> {
 
     fn status(&mut self) -> Result<Box<dyn status_family::StatusWire>> {
         Ok(Box::new(status::Status::advertise(self.node)?))
+    }
+
+    fn model_states(&mut self) -> Result<Box<dyn crate::bridge::model_states::ModelStatesWire>> {
+        Ok(Box::new(model_states::ModelStates::advertise(self.node)?))
     }
 }
 

@@ -164,6 +164,19 @@ pub const OBJECT_COUNT: &str = concat!("std_msgs/Header header\nint8 count\n", h
 /// `std_msgs/msg/String`.
 pub const STRING: &str = "string data\n";
 
+/// `gazebo_msgs/msg/ModelStates`.
+pub const MODEL_STATES: &str = concat!(
+    "string[] name\ngeometry_msgs/Pose[] pose\ngeometry_msgs/Twist[] twist\n",
+    block!(
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n"
+    ),
+    point!(),
+    quaternion!(),
+    block!("geometry_msgs/Twist", twist_fields!()),
+    vector3!()
+);
+
 /// `geometry_msgs/msg/PointStamped`.
 pub const POINT_STAMPED: &str = concat!(
     "std_msgs/Header header\ngeometry_msgs/Point point\n",
@@ -234,6 +247,7 @@ mod tests {
             BOUNDING_BOXES,
             OBJECT_COUNT,
             STRING,
+            MODEL_STATES,
             POINT_STAMPED,
             JOINT_TRAJECTORY,
             FLOAT64_MULTI_ARRAY,

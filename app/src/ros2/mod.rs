@@ -45,6 +45,7 @@ mod input;
 mod joint_states;
 mod laser;
 mod mcap;
+mod model_states;
 mod msgs;
 mod odom;
 mod parameters;
@@ -181,6 +182,10 @@ impl Transport for Sinks<'_> {
 
     fn status(&mut self) -> Result<Box<dyn status_family::StatusWire>> {
         Ok(Box::new(status::Status::create(self)?))
+    }
+
+    fn model_states(&mut self) -> Result<Box<dyn crate::bridge::model_states::ModelStatesWire>> {
+        Ok(Box::new(model_states::ModelStates::create(self)?))
     }
 }
 

@@ -437,6 +437,22 @@ impl RosMessage for ObjectCount {
     const DEFINITION: &'static str = super::definitions::OBJECT_COUNT;
 }
 
+/// `gazebo_msgs/msg/ModelStates`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelStates {
+    /// Model names.
+    pub name: Vec<String>,
+    /// Their poses (world frame).
+    pub pose: Vec<Pose>,
+    /// Their velocities (world frame).
+    pub twist: Vec<Twist>,
+}
+
+impl RosMessage for ModelStates {
+    const DDS_TYPE: &'static str = "gazebo_msgs::msg::dds_::ModelStates_";
+    const DEFINITION: &'static str = super::definitions::MODEL_STATES;
+}
+
 /// `std_msgs/msg/String`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Text {

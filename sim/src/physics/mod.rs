@@ -10,6 +10,7 @@ pub(crate) mod diff_drive;
 pub(crate) mod joints;
 pub(crate) mod placement;
 pub(crate) mod simulation;
+pub(crate) mod states;
 
 pub use actuators::{
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
@@ -23,3 +24,4 @@ pub use diff_drive::{
 };
 pub use placement::PersonLook;
 pub use simulation::{ControlSample, SimOptions, Simulation};
+pub use states::ModelState;

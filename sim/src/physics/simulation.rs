@@ -71,7 +71,7 @@ pub struct Simulation {
     pub(crate) world: World,
     pub(crate) link_body: Vec<RigidBodyHandle>,
     pub(crate) body_from_link: Vec<Pose>,
-    base: RigidBodyHandle,
+    pub(crate) base: RigidBodyHandle,
     /// Driven wheel joints: the left and right ones first (their speeds are the measured
     /// wheel speeds), then a skid steer's rear wheels. Empty when the robot cannot be driven.
     wheels: Vec<WheelJoint>,
