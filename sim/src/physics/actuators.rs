@@ -178,12 +178,27 @@ impl Actuator {
     }
 }
 
+/// A `<mimic>` joint's actuator and the joint it follows: each control update it tracks
+/// `multiplier x leader + offset` (and the leader's speed times the multiplier), as Gazebo's
+/// mimic joint plugins drive a gripper's second finger, with its own motor's effort cap.
+#[derive(Debug, Clone, Copy)]
+struct Follower {
+    /// The mimic joint's actuator.
+    actuator: usize,
+    /// The joint it follows, as built.
+    leader: BuiltJoint,
+    multiplier: f64,
+    offset: f64,
+}
+
 /// The actuators of one robot, run at the control period.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Actuators {
     list: Vec<Actuator>,
     /// Actuator index per joint (joint order).
     by_joint: Vec<Option<usize>>,
+    /// The `<mimic>` joints' actuators, driven from their leaders.
+    followers: Vec<Follower>,
 }
 
 impl Actuators {
@@ -197,7 +212,13 @@ impl Actuators {
             by_joint: vec![None; robot.joints.len()],
             ..Self::default()
         };
-        for id in robot.actuated_joints() {
+        let mimics = robot
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.is_moving() && j.mimic.is_some())
+            .map(|(i, _)| JointId(i));
+        for id in robot.actuated_joints().into_iter().chain(mimics) {
             let Some(built) = joints[id.index()] else {
                 continue;
             };
@@ -234,10 +255,47 @@ impl Actuators {
                 data.set_motor_model(built.axis, MotorModel::ForceBased)
                     .set_motor_max_force(built.axis, effort_max as f32);
             }
+            if let Some(m) = &joint.mimic {
+                let Some(leader) = joints.get(m.joint.index()).copied().flatten() else {
+                    // A leader the scene does not move (fixed): the follower holds.
+                    out.by_joint[id.index()] = Some(out.list.len());
+                    out.list.push(actuator);
+                    continue;
+                };
+                out.followers.push(Follower {
+                    actuator: out.list.len(),
+                    leader,
+                    multiplier: f64::from(m.multiplier),
+                    offset: f64::from(m.offset),
+                });
+            }
             out.by_joint[id.index()] = Some(out.list.len());
             out.list.push(actuator);
         }
         out
+    }
+
+    /// Whether `joint` follows another (`<mimic>`): it takes no commands of its own.
+    fn is_follower(&self, joint: JointId) -> bool {
+        let Some(i) = self.by_joint.get(joint.index()).copied().flatten() else {
+            return false;
+        };
+        self.followers.iter().any(|f| f.actuator == i)
+    }
+
+    /// Points every `<mimic>` joint at its leader's position now.
+    fn follow_leaders(&mut self, physics: &PhysicsWorld) {
+        for f in &self.followers {
+            let q = f.leader.position(&physics.bodies);
+            let v = f.leader.velocity(&physics.bodies);
+            if let Some(a) = self.list.get_mut(f.actuator) {
+                let cap = a.velocity_max.unwrap_or(f64::INFINITY);
+                a.command = JointCommand::Track {
+                    position: a.clamp_position(f.multiplier * q + f.offset),
+                    velocity: (f.multiplier * v).clamp(-cap, cap),
+                };
+            }
+        }
     }
 
     /// The actuator of `joint`, if it has one.
@@ -268,9 +326,20 @@ impl Actuators {
                 "joint \"{name}\": command {command:?} is not finite"
             )));
         }
+        if self.is_follower(joint) {
+            let leader = robot
+                .joint(joint)
+                .mimic
+                .as_ref()
+                .map(|m| robot.joint(m.joint).name.clone())
+                .unwrap_or_default();
+            return Err(SimError::Setup(format!(
+                "joint \"{name}\" mimics \"{leader}\" and follows it: command \"{leader}\" instead"
+            )));
+        }
         let Some(a) = self.of_mut(joint) else {
             return Err(SimError::Setup(format!(
-                "joint \"{name}\" has no actuator (it is fixed, passive, a drive wheel or mimics another joint)"
+                "joint \"{name}\" has no actuator (it is fixed, passive or a drive wheel)"
             )));
         };
         a.command = match command {
@@ -331,6 +400,7 @@ impl Actuators {
     /// One control update of length `dt_s`: moves setpoints, sets the motors.
     pub(crate) fn update(&mut self, physics: &mut PhysicsWorld, dt_s: f64) {
         self.measure_loads(physics);
+        self.follow_leaders(physics);
         for a in &mut self.list {
             if a.inertia <= MIN_INERTIA {
                 // Mass properties are computed by the first physics step.
