@@ -41,6 +41,18 @@ pub struct Vector3 {
     pub z: f64,
 }
 
+impl From<[f64; 3]> for Vector3 {
+    fn from([x, y, z]: [f64; 3]) -> Self {
+        Self { x, y, z }
+    }
+}
+
+impl From<[f64; 4]> for Quaternion {
+    fn from([x, y, z, w]: [f64; 4]) -> Self {
+        Self { x, y, z, w }
+    }
+}
+
 impl Vector3 {
     fn encode(&self, out: &mut Vec<u8>) {
         wire::f64_fixed(out, &[self.x, self.y, self.z]);

@@ -145,6 +145,18 @@ impl<'de> Deserialize<'de> for Covariance {
     }
 }
 
+impl From<[f64; 3]> for Vector3 {
+    fn from([x, y, z]: [f64; 3]) -> Self {
+        Self { x, y, z }
+    }
+}
+
+impl From<[f64; 4]> for Quaternion {
+    fn from([x, y, z, w]: [f64; 4]) -> Self {
+        Self { x, y, z, w }
+    }
+}
+
 /// `geometry_msgs/msg/Pose`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Pose {
