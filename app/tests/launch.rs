@@ -222,6 +222,17 @@ fn setup() -> Result<Option<(std::sync::MutexGuard<'static, ()>, Workspace)>> {
     Ok(Some((one, Workspace::new()?)))
 }
 
+/// A thread reading `pipe` to its end (so a chatty child never blocks on a full pipe).
+fn drain<R: std::io::Read + Send + 'static>(pipe: Option<R>) -> std::thread::JoinHandle<Vec<u8>> {
+    std::thread::spawn(move || {
+        let mut buf = Vec::new();
+        if let Some(mut p) = pipe {
+            let _ = p.read_to_end(&mut buf);
+        }
+        buf
+    })
+}
+
 /// Runs `command` to its end (killed after `timeout`).
 fn run(mut command: Command, timeout: Duration) -> Result<Output> {
     let mut child = command
@@ -229,24 +240,8 @@ fn run(mut command: Command, timeout: Duration) -> Result<Output> {
         .stderr(Stdio::piped())
         .spawn()
         .context("starting the command")?;
-    let (out, err) = (child.stdout.take(), child.stderr.take());
-    let read = |pipe: Option<std::process::ChildStdout>| {
-        std::thread::spawn(move || {
-            let mut buf = Vec::new();
-            if let Some(mut p) = pipe {
-                let _ = std::io::Read::read_to_end(&mut p, &mut buf);
-            }
-            buf
-        })
-    };
-    let stdout = read(out);
-    let stderr = std::thread::spawn(move || {
-        let mut buf = Vec::new();
-        if let Some(mut p) = err {
-            let _ = std::io::Read::read_to_end(&mut p, &mut buf);
-        }
-        buf
-    });
+    let stdout = drain(child.stdout.take());
+    let stderr = drain(child.stderr.take());
     let start = Instant::now();
     let status = loop {
         if let Some(s) = child.try_wait()? {

@@ -11,7 +11,8 @@ use roxmltree::{Document, Node};
 use super::eval::EvalHost;
 use super::model::{
     Launch, LaunchError, LaunchNode, LaunchOptions, Location, Output, PROVIDED_PACKAGES, Param,
-    ParamSource, ProvidedInclude, absolute, canonical_name, ns_join, provided_placeholder,
+    ParamSource, ProvidedInclude, absolute, canonical_name, files_named, ns_join,
+    provided_placeholder,
 };
 use super::shell::shell_split;
 use super::subst;
@@ -59,22 +60,7 @@ pub fn load(path: &Path, options: &LaunchOptions) -> Result<Launch, LaunchError>
 /// The launch file `name` in package folder `package_dir` (searched a few folders deep, as
 /// `roslaunch PKG FILE` finds it).
 pub fn find_launch_file(package_dir: &Path, name: &str) -> Result<PathBuf, String> {
-    let mut found = Vec::new();
-    let mut dirs = vec![(package_dir.to_path_buf(), 0usize)];
-    while let Some((dir, depth)) = dirs.pop() {
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        for entry in entries.flatten() {
-            let path = entry.path();
-            let hidden = entry.file_name().to_string_lossy().starts_with('.');
-            if path.is_dir() && !hidden && depth < 6 {
-                dirs.push((path, depth + 1));
-            } else if path.is_file() && entry.file_name().to_string_lossy() == name {
-                found.push(path);
-            }
-        }
-    }
+    let mut found = files_named(vec![(package_dir.to_path_buf(), 0)], name);
     found.sort();
     match found.len() {
         0 => Err(format!(

@@ -262,31 +262,16 @@ pub fn find_node_executable(
     node_type: &str,
 ) -> Result<PathBuf, String> {
     use std::os::unix::fs::PermissionsExt;
-    let mut found = Vec::new();
-    let mut dirs: Vec<(PathBuf, usize)> = package_dir
+    let mut roots: Vec<(PathBuf, usize)> = package_dir
         .map(|d| vec![(absolute(d), 0)])
         .unwrap_or_default();
     for prefix in ["/usr/lib", "/usr/libexec"] {
         let d = Path::new(prefix).join(package);
         if d.is_dir() {
-            dirs.push((d, 5));
+            roots.push((d, SEARCH_DEPTH - 1));
         }
     }
-    while let Some((dir, depth)) = dirs.pop() {
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        for entry in entries.flatten() {
-            let path = entry.path();
-            let name = entry.file_name();
-            let hidden = name.to_string_lossy().starts_with('.');
-            if path.is_dir() && !hidden && depth < 6 {
-                dirs.push((path, depth + 1));
-            } else if path.is_file() && name.to_string_lossy() == node_type {
-                found.push(path);
-            }
-        }
-    }
+    let mut found = files_named(roots, node_type);
     found.sort();
     let executable =
         |p: &PathBuf| std::fs::metadata(p).is_ok_and(|m| m.permissions().mode() & 0o111 != 0);
@@ -306,6 +291,31 @@ pub fn find_node_executable(
                 .unwrap_or_else(|| " (the package was not found)".to_owned())
         )),
     }
+}
+
+/// How many folders deep a package is searched for a launch file or a node's executable.
+const SEARCH_DEPTH: usize = 6;
+
+/// Files called `name` under `roots` (each with the depth it starts at; hidden folders skipped,
+/// at most [`SEARCH_DEPTH`] deep), as roslaunch finds a package's launch files and scripts.
+pub(crate) fn files_named(mut dirs: Vec<(PathBuf, usize)>, name: &str) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    while let Some((dir, depth)) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let file_name = entry.file_name();
+            let file_name = file_name.to_string_lossy();
+            if path.is_dir() && !file_name.starts_with('.') && depth < SEARCH_DEPTH {
+                dirs.push((path, depth + 1));
+            } else if path.is_file() && file_name == name {
+                found.push(path);
+            }
+        }
+    }
+    found
 }
 
 impl LaunchNode {

@@ -18,7 +18,7 @@ pub(crate) fn resolve(text: &str, host: &mut dyn EvalHost) -> Result<String, Str
     }
     let mut resolved = text.to_owned();
     for pass in [Pass::Early, Pass::Find] {
-        for inner in collect(&resolved.clone(), text)? {
+        for inner in collect(&resolved, text)? {
             let words: Vec<&str> = inner.split(' ').filter(|w| !w.is_empty()).collect();
             let (command, args) = match words.split_first() {
                 Some((c, a)) => (*c, a),

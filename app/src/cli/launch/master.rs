@@ -27,10 +27,7 @@ impl Master {
     /// The master at `ROS_MASTER_URI` (default `http://localhost:11311/`), started when none
     /// answers there.
     pub(crate) fn ensure() -> Result<Self> {
-        let uri = std::env::var("ROS_MASTER_URI")
-            .ok()
-            .filter(|u| !u.is_empty())
-            .unwrap_or_else(|| "http://localhost:11311/".to_owned());
+        let uri = master_uri();
         if answers(&uri) {
             tracing::info!("ROS master at {uri}");
             return Ok(Self { uri, process: None });
@@ -41,11 +38,7 @@ impl Master {
                 "no ROS master answers at ROS_MASTER_URI={uri}, and {host} is not this machine, so rover cannot start one there"
             );
         }
-        let ros_home = std::env::var_os("ROS_HOME")
-            .map(std::path::PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".ros")))
-            .unwrap_or_else(std::env::temp_dir);
-        let _ = std::fs::create_dir_all(&ros_home);
+        let ros_home = ros_home();
         let process = Command::new("rosmaster")
             .args(["--core", "-p", &port.to_string()])
             .env("ROS_HOME", &ros_home)
@@ -143,6 +136,24 @@ impl Drop for Master {
     fn drop(&mut self) {
         self.stop();
     }
+}
+
+/// `ROS_MASTER_URI`, else roslaunch's default `http://localhost:11311/`.
+pub(super) fn master_uri() -> String {
+    std::env::var("ROS_MASTER_URI")
+        .ok()
+        .filter(|u| !u.is_empty())
+        .unwrap_or_else(|| "http://localhost:11311/".to_owned())
+}
+
+/// `ROS_HOME`, else `~/.ros` (created): where the master and the nodes run.
+pub(super) fn ros_home() -> std::path::PathBuf {
+    let home = std::env::var_os("ROS_HOME")
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".ros")))
+        .unwrap_or_else(std::env::temp_dir);
+    let _ = std::fs::create_dir_all(&home);
+    home
 }
 
 fn answers(uri: &str) -> bool {

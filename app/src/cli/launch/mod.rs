@@ -58,6 +58,9 @@ pub(crate) fn run(args: LaunchArgs) -> Result<()> {
     let processes = processes(&launch, &part, &resources, &master.uri);
     master.set_params(&launch)?;
     if processes.iter().any(|p| p.node.output == Output::Log) {
+        if let Err(e) = std::fs::create_dir_all(&log_dir) {
+            tracing::warn!("cannot create {}: {e}", log_dir.display());
+        }
         say!("  logs of output=\"log\" nodes: {}", log_dir.display());
     }
     let stop = super::signals::stop_on_signals()?;
@@ -144,7 +147,7 @@ fn query(args: &LaunchArgs, launch: &Launch, resources: &ResourcePaths) -> Resul
         let exe = find_node_executable(&node.pkg, dir.as_deref(), &node.node_type)
             .map_err(|e| anyhow::anyhow!("{}: {e}", node.at))?;
         let mut words: Vec<String> = node
-            .environment(&master_uri_from_env())
+            .environment(&master::master_uri())
             .into_iter()
             .filter(|(k, v)| std::env::var(k).ok().as_deref() != Some(v.as_str()))
             .map(|(k, v)| format!("{k}=\"{v}\""))
@@ -155,30 +158,17 @@ fn query(args: &LaunchArgs, launch: &Launch, resources: &ResourcePaths) -> Resul
     Ok(())
 }
 
-fn master_uri_from_env() -> String {
-    std::env::var("ROS_MASTER_URI")
-        .ok()
-        .filter(|u| !u.is_empty())
-        .unwrap_or_else(|| "http://localhost:11311/".to_owned())
-}
-
 /// Where `output="log"` nodes write: `ROS_LOG_DIR`, else `ROS_HOME/log`, else `~/.ros/log`,
-/// in a folder of this launch.
+/// in a folder of this launch (created when something is written there).
 fn log_dir() -> PathBuf {
     let base = std::env::var_os("ROS_LOG_DIR")
         .map(PathBuf::from)
-        .or_else(|| std::env::var_os("ROS_HOME").map(|h| Path::new(&h).join("log")))
-        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".ros/log")))
-        .unwrap_or_else(std::env::temp_dir);
+        .unwrap_or_else(|| master::ros_home().join("log"));
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs())
         .unwrap_or(0);
-    let dir = base.join(format!("rover-launch-{secs}-{}", std::process::id()));
-    if let Err(e) = std::fs::create_dir_all(&dir) {
-        tracing::warn!("cannot create {}: {e}", dir.display());
-    }
-    dir
+    base.join(format!("rover-launch-{secs}-{}", std::process::id()))
 }
 
 /// Turns what rover does itself into run options (the user's own options win), saying what
@@ -327,7 +317,9 @@ fn apply_robot(part: &RoverPart, launch: &Launch, run: &mut RunArgs, log_dir: &P
                     &spawn.model
                 }
             ));
-            std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+            std::fs::create_dir_all(log_dir)
+                .and_then(|()| std::fs::write(&path, text))
+                .with_context(|| format!("writing {}", path.display()))?;
             run.world.robot = Some(path);
         }
         _ => bail!(
@@ -346,10 +338,7 @@ fn processes(
     resources: &ResourcePaths,
     master_uri: &str,
 ) -> Vec<NodeProcess> {
-    let ros_home = std::env::var_os("ROS_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".ros")))
-        .unwrap_or_else(std::env::temp_dir);
+    let ros_home = master::ros_home();
     let mut out = Vec::new();
     for (node, role) in launch.nodes.iter().zip(&part.roles) {
         if *role != NodeRole::Process {
@@ -370,7 +359,6 @@ fn processes(
                 .map(Path::to_path_buf)
                 .unwrap_or_else(|| ros_home.clone())
         } else {
-            let _ = std::fs::create_dir_all(&ros_home);
             ros_home.clone()
         };
         say!(
