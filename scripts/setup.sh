@@ -47,6 +47,8 @@ if [ "$purpose" = test ]; then
     python3-rosgraph-msgs python3-roslib python3-genpy python3-trajectory-msgs tmux)
   # roslaunch itself: `rover launch` is checked against its --dump-params, --nodes and --args.
   packages+=(python3-roslaunch)
+  # MoveIt's way in: actionlib's SimpleActionClient, and actionlib_msgs' .msg files for genpy.
+  packages+=(python3-actionlib ros-actionlib-msgs)
   packages+=(slurmctld slurmd slurm-client munge)
 fi
 missing=()

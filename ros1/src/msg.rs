@@ -111,6 +111,71 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "Header header\nHeader image_header\ndarknet_ros_msgs/BoundingBox[] bounding_boxes",
     ),
     ("darknet_ros_msgs/ObjectCount", "Header header\nint8 count"),
+    ("actionlib_msgs/GoalID", "time stamp\nstring id"),
+    (
+        "actionlib_msgs/GoalStatus",
+        "uint8 PENDING=0\nuint8 ACTIVE=1\nuint8 PREEMPTED=2\nuint8 SUCCEEDED=3\nuint8 ABORTED=4\nuint8 REJECTED=5\nuint8 PREEMPTING=6\nuint8 RECALLING=7\nuint8 RECALLED=8\nuint8 LOST=9\nactionlib_msgs/GoalID goal_id\nuint8 status\nstring text",
+    ),
+    (
+        "actionlib_msgs/GoalStatusArray",
+        "Header header\nactionlib_msgs/GoalStatus[] status_list",
+    ),
+    (
+        "control_msgs/JointTolerance",
+        "string name\nfloat64 position\nfloat64 velocity\nfloat64 acceleration",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryGoal",
+        "trajectory_msgs/JointTrajectory trajectory\ncontrol_msgs/JointTolerance[] path_tolerance\ncontrol_msgs/JointTolerance[] goal_tolerance\nduration goal_time_tolerance",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryResult",
+        "int32 SUCCESSFUL=0\nint32 INVALID_GOAL=-1\nint32 INVALID_JOINTS=-2\nint32 OLD_HEADER_TIMESTAMP=-3\nint32 PATH_TOLERANCE_VIOLATED=-4\nint32 GOAL_TOLERANCE_VIOLATED=-5\nint32 error_code\nstring error_string",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryFeedback",
+        "Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint desired\ntrajectory_msgs/JointTrajectoryPoint actual\ntrajectory_msgs/JointTrajectoryPoint error",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryActionGoal",
+        "Header header\nactionlib_msgs/GoalID goal_id\ncontrol_msgs/FollowJointTrajectoryGoal goal",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryActionResult",
+        "Header header\nactionlib_msgs/GoalStatus status\ncontrol_msgs/FollowJointTrajectoryResult result",
+    ),
+    (
+        "control_msgs/FollowJointTrajectoryActionFeedback",
+        "Header header\nactionlib_msgs/GoalStatus status\ncontrol_msgs/FollowJointTrajectoryFeedback feedback",
+    ),
+    (
+        "control_msgs/GripperCommand",
+        "float64 position\nfloat64 max_effort",
+    ),
+    (
+        "control_msgs/GripperCommandGoal",
+        "control_msgs/GripperCommand command",
+    ),
+    (
+        "control_msgs/GripperCommandResult",
+        "float64 position\nfloat64 effort\nbool stalled\nbool reached_goal",
+    ),
+    (
+        "control_msgs/GripperCommandFeedback",
+        "float64 position\nfloat64 effort\nbool stalled\nbool reached_goal",
+    ),
+    (
+        "control_msgs/GripperCommandActionGoal",
+        "Header header\nactionlib_msgs/GoalID goal_id\ncontrol_msgs/GripperCommandGoal goal",
+    ),
+    (
+        "control_msgs/GripperCommandActionResult",
+        "Header header\nactionlib_msgs/GoalStatus status\ncontrol_msgs/GripperCommandResult result",
+    ),
+    (
+        "control_msgs/GripperCommandActionFeedback",
+        "Header header\nactionlib_msgs/GoalStatus status\ncontrol_msgs/GripperCommandFeedback feedback",
+    ),
 ];
 
 const BUILTIN: &[&str] = &[
@@ -252,6 +317,10 @@ pub mod wire {
     }
     /// A u32.
     pub fn u32(out: &mut Vec<u8>, v: u32) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    /// An i32.
+    pub fn i32(out: &mut Vec<u8>, v: i32) {
         out.extend_from_slice(&v.to_le_bytes());
     }
     /// An i64.

@@ -4,6 +4,16 @@
 use crate::error::Result;
 use crate::msg::{Decode, Message, Reader, wire};
 
+mod actions;
+
+pub use actions::{
+    FollowJointTrajectoryActionFeedback, FollowJointTrajectoryActionGoal,
+    FollowJointTrajectoryActionResult, FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal,
+    FollowJointTrajectoryResult, GoalId, GoalStatus, GoalStatusArray, GripperCommand,
+    GripperCommandActionFeedback, GripperCommandActionGoal, GripperCommandActionResult,
+    GripperCommandResult, JointTolerance,
+};
+
 /// `std_msgs/Header`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Header {
@@ -491,14 +501,19 @@ impl Message for JointTrajectory {
 
 impl Decode for JointTrajectory {
     fn decode(bytes: &[u8]) -> Result<Self> {
-        let mut r = Reader::new(bytes);
-        let header = Header::decode(&mut r)?;
+        Self::read(&mut Reader::new(bytes))
+    }
+}
+
+impl JointTrajectory {
+    fn read(r: &mut Reader<'_>) -> Result<Self> {
+        let header = Header::decode(r)?;
         let n = r.len(4)?;
         let joint_names = (0..n).map(|_| r.string()).collect::<Result<_>>()?;
         // Each point is at least its four array lengths and a duration.
         let n = r.len(24)?;
         let points = (0..n)
-            .map(|_| JointTrajectoryPoint::decode(&mut r))
+            .map(|_| JointTrajectoryPoint::decode(r))
             .collect::<Result<_>>()?;
         Ok(Self {
             header,

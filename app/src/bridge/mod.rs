@@ -34,6 +34,7 @@ pub(crate) mod odom;
 pub(crate) mod plan;
 pub(crate) mod status;
 pub(crate) mod tf;
+pub(crate) mod trajectory_goals;
 
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;

@@ -7,10 +7,10 @@ use anyhow::Result;
 use rover_core::{Action, InputSource, JointAction};
 use rover_ros1::msgs;
 use rover_ros1::{Node, Subscriber};
-use rover_sim::TrajectoryPoint;
 
+use super::convert::sim_trajectory;
 use crate::bridge::RosPlan;
-use crate::bridge::input::{poll_in_turn, trajectory};
+use crate::bridge::input::poll_in_turn;
 
 #[derive(Debug)]
 enum Topic {
@@ -44,13 +44,10 @@ impl ControllerCommands {
 
 /// A trajectory message as `controller`'s action.
 fn trajectory_action(controller: &str, msg: msgs::JointTrajectory) -> JointAction {
-    let points = msg.points.into_iter().map(|p| TrajectoryPoint {
-        time_from_start_s: p.time_from_start_s,
-        positions: p.positions,
-        velocities: p.velocities,
-        accelerations: p.accelerations,
-    });
-    trajectory(controller, msg.header.stamp_s, msg.joint_names, points)
+    JointAction::Trajectory {
+        controller: controller.to_owned(),
+        trajectory: Box::new(sim_trajectory(msg)),
+    }
 }
 
 impl InputSource for ControllerCommands {

@@ -5,11 +5,14 @@
 //! `odom.rs`, `tf.rs`, `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the
 //! ground truth), `laser.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
 //! `state` topics, which only ROS 1 carries (their control_msgs layouts differ between ROS 2
-//! distributions); and the input half: `cmd_vel.rs`, `controllers.rs` (the controllers'
-//! `command` topics) and the arm's task (`arm.rs`), as rover input.
+//! distributions); `actions.rs`, actionlib's `follow_joint_trajectory` for each trajectory
+//! controller (what a goal means is the shared bridge's, app/src/bridge/trajectory_goals.rs);
+//! and the input half: `cmd_vel.rs`, `controllers.rs` (the controllers' `command` topics) and
+//! the arm's task (`arm.rs`), as rover input.
 //!
 //! Stamps are sim time; `/robot_description` (and `/use_sim_time`) are parameters.
 
+mod actions;
 mod arm;
 mod camera;
 mod clock;
@@ -119,6 +122,8 @@ pub struct RosInput {
     cmd_vel: RosCmdVel,
     controllers: ControllerCommands,
     arm: arm::ArmTaskInput,
+    /// Trajectories of the goals the action servers accepted (and stops for cancelled ones).
+    actions: std::sync::mpsc::Receiver<Action>,
 }
 
 impl InputSource for RosInput {
@@ -127,6 +132,7 @@ impl InputSource for RosInput {
             .poll()
             .or_else(|| self.controllers.poll())
             .or_else(|| self.arm.poll())
+            .or_else(|| self.actions.try_recv().ok())
     }
 }
 
@@ -149,6 +155,10 @@ impl Bridge<()> {
             crate::bridge::families(&mut Ros1 { node: &node }, &plan, options.ground_truth)?;
         families.push(Box::new(controller_states::ControllerStates::advertise(
             &node, &plan,
+        )?));
+        let (to_session, from_actions) = std::sync::mpsc::channel();
+        families.push(Box::new(actions::TrajectoryActions::serve(
+            &node, &plan, to_session,
         )?));
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
         let controllers = ControllerCommands::subscribe(&node, &plan)?;
@@ -196,6 +206,7 @@ impl Bridge<()> {
                 cmd_vel: cmd,
                 controllers,
                 arm: arm_task,
+                actions: from_actions,
             },
         ))
     }

@@ -1,0 +1,539 @@
+//! A joint trajectory controller's action goals (control_msgs FollowJointTrajectory), as
+//! joint_trajectory_controller handles them, for both transports: which goals are refused and
+//! with which result code, how an accepted goal's trajectory reaches the session, how its run
+//! ends (SUCCEEDED, ABORTED with the tolerance violated, or CANCELED), preemption by a newer
+//! goal or a command on the controller's topic, cancels that stop the joints where they are,
+//! and the feedback's arrays. The transports keep only their wire: ROS 1's actionlib topics
+//! (app/src/ros/actions.rs), ROS 2's action services (app/src/ros2/actions.rs). A goal's id is
+//! the transport's own (actionlib's string, ROS 2's UUID).
+//!
+//! The goal's tolerances and `goal_time_tolerance` are not read: the controller's own, from the
+//! controllers file, apply.
+
+use std::sync::mpsc::Sender;
+
+use rover_core::{Action, JointAction};
+use rover_sim::{JointTrajectory, TrajectoryOutcome};
+
+use super::RosPlan;
+use super::events::{ControlUpdate, JointSample, RunSample};
+
+/// How long a goal may wait for its controller to start it (s of sim time).
+const START_TIMEOUT_S: f64 = 1.0;
+/// Ended goals kept for the status list and for late result requests.
+const ENDED_KEPT: usize = 16;
+
+/// control_msgs' FollowJointTrajectory result codes.
+pub(crate) mod code {
+    /// The trajectory was followed.
+    pub const SUCCESSFUL: i32 = 0;
+    /// The goal is malformed (no points, values that are not finite, short arrays), or the
+    /// controller did not start it.
+    pub const INVALID_GOAL: i32 = -1;
+    /// Its joints are not the controller's.
+    pub const INVALID_JOINTS: i32 = -2;
+    /// A path tolerance was exceeded.
+    pub const PATH_TOLERANCE_VIOLATED: i32 = -4;
+    /// The goal tolerance was not met in time.
+    pub const GOAL_TOLERANCE_VIOLATED: i32 = -5;
+}
+
+/// Where a goal stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum GoalState {
+    /// Its trajectory runs, or is about to.
+    Executing,
+    /// Reached within the tolerances.
+    Succeeded,
+    /// Stopped by a tolerance, or never started.
+    Aborted,
+    /// Cancelled, or preempted by a newer goal or command.
+    Canceled,
+}
+
+/// Why a goal was refused: control_msgs' result code and a reason.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Rejection {
+    /// One of [`code`]'s.
+    pub code: i32,
+    /// For people.
+    pub why: String,
+}
+
+/// One accepted goal.
+#[derive(Debug)]
+pub(crate) struct Goal<Id> {
+    /// The transport's id for it.
+    pub id: Id,
+    /// Where it stands.
+    pub state: GoalState,
+    /// Its result code (see [`code`]) once ended.
+    pub error_code: i32,
+    /// Its result's text.
+    pub error_string: String,
+    /// When it was accepted (sim s).
+    pub accepted_s: f64,
+    /// Its ending was handed to the transport ([`TrajectoryGoals::take_ended`]).
+    reported: bool,
+    /// The controller's run count when it was accepted: its own run is the next.
+    runs_before: u64,
+    /// Its run started.
+    started: bool,
+    /// Its points' times from the start (s), for the feedback's index.
+    point_times_s: Vec<f64>,
+}
+
+impl<Id> Goal<Id> {
+    /// Whether it has ended.
+    pub fn ended(&self) -> bool {
+        self.state != GoalState::Executing
+    }
+
+    fn end(&mut self, state: GoalState, error_code: i32, why: &str) {
+        self.state = state;
+        self.error_code = error_code;
+        why.clone_into(&mut self.error_string);
+    }
+}
+
+/// The feedback's arrays for the executing goal, refilled in place.
+#[derive(Debug, Default)]
+pub(crate) struct FeedbackArrays {
+    /// The actuators' setpoints.
+    pub desired: Vec<f64>,
+    /// The joints' positions.
+    pub actual: Vec<f64>,
+    /// Their velocities.
+    pub actual_velocities: Vec<f64>,
+    /// desired - actual.
+    pub error: Vec<f64>,
+    /// The point the trajectory is heading for.
+    pub index: usize,
+}
+
+/// One trajectory controller's goals.
+#[derive(Debug)]
+pub(crate) struct TrajectoryGoals<Id> {
+    /// The controller's name.
+    pub controller: String,
+    /// The action's name: the controller's namespace, `/follow_joint_trajectory`.
+    pub action: String,
+    /// Its joints' names, in the controller's order.
+    pub joint_names: Vec<String>,
+    /// The goals accepted, the ended ones kept a while.
+    pub goals: Vec<Goal<Id>>,
+    /// The controller's index in the plan (its run sample).
+    index: usize,
+    /// Its joints' indices in the plan.
+    joints: Vec<usize>,
+    /// A goal's state changed since [`Self::take_changed`].
+    changed: bool,
+    /// Why a goal ended when a command on the controller's topic replaced it (the topic as
+    /// the transport names it).
+    preempted_by_topic: String,
+}
+
+impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
+    /// One for each of the plan's trajectory controllers; `command_topic` is the controller's
+    /// trajectory topic as the transport names it (`~/command`, `~/joint_trajectory`).
+    pub fn for_plan(plan: &RosPlan, command_topic: &str) -> Vec<Self> {
+        plan.controllers
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.trajectory)
+            .map(|(index, c)| {
+                let base = c
+                    .command_topic
+                    .strip_suffix("/command")
+                    .unwrap_or(&c.command_topic);
+                Self {
+                    controller: c.name.clone(),
+                    action: format!("{base}/follow_joint_trajectory"),
+                    joint_names: c
+                        .joints
+                        .iter()
+                        .map(|&j| plan.joints[j].name.clone())
+                        .collect(),
+                    goals: Vec::new(),
+                    index,
+                    joints: c.joints.clone(),
+                    changed: false,
+                    preempted_by_topic: format!("preempted by a command on {command_topic}"),
+                }
+            })
+            .collect()
+    }
+
+    /// This controller's run in `update`.
+    pub fn run(&self, update: &ControlUpdate) -> RunSample {
+        update.runs.get(self.index).copied().unwrap_or_default()
+    }
+
+    /// Why joint_trajectory_controller would refuse `t` (with `multi_dof` points too), if it
+    /// would.
+    pub fn check(&self, t: &JointTrajectory, multi_dof: bool) -> Result<(), Rejection> {
+        let reject = |code, why: String| Err(Rejection { code, why });
+        let n = t.joint_names.len();
+        if let Some(name) = t.joint_names.iter().find(|n| !self.joint_names.contains(n)) {
+            return reject(
+                code::INVALID_JOINTS,
+                format!(
+                    "joint {name} is not one of {}'s ({})",
+                    self.controller,
+                    self.joint_names.join(", ")
+                ),
+            );
+        }
+        if let Some(name) = self.joint_names.iter().find(|n| !t.joint_names.contains(n)) {
+            // joint_trajectory_controller's allow_partial_joints_goal is false by default.
+            return reject(
+                code::INVALID_JOINTS,
+                format!("the trajectory does not list joint {name}"),
+            );
+        }
+        if t.points.is_empty() {
+            return reject(code::INVALID_GOAL, "the trajectory has no points".into());
+        }
+        if multi_dof {
+            return reject(
+                code::INVALID_GOAL,
+                "multi-DOF trajectories are not supported".into(),
+            );
+        }
+        for (k, p) in t.points.iter().enumerate() {
+            let arrays = [&p.positions, &p.velocities, &p.accelerations];
+            if p.positions.len() != n || arrays.iter().any(|a| !a.is_empty() && a.len() != n) {
+                return reject(
+                    code::INVALID_GOAL,
+                    format!("point {k} does not have one value per joint ({n})"),
+                );
+            }
+            let finite = arrays.iter().all(|a| a.iter().all(|v| v.is_finite()));
+            if !finite || !p.time_from_start_s.is_finite() {
+                return reject(
+                    code::INVALID_GOAL,
+                    format!("point {k} has a value that is not a finite number"),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Accepts a checked goal: the goal executing is preempted (CANCELED, as
+    /// joint_trajectory_controller does) and the trajectory goes to the session.
+    pub fn accept(
+        &mut self,
+        id: Id,
+        trajectory: JointTrajectory,
+        now_s: f64,
+        run: RunSample,
+        to_session: &Sender<Action>,
+    ) {
+        for g in self.goals.iter_mut().filter(|g| !g.ended()) {
+            g.end(
+                GoalState::Canceled,
+                code::SUCCESSFUL,
+                "preempted by a new goal",
+            );
+        }
+        let point_times_s = trajectory
+            .points
+            .iter()
+            .map(|p| p.time_from_start_s)
+            .collect();
+        let _ = to_session.send(Action::Joint(JointAction::Trajectory {
+            controller: self.controller.clone(),
+            trajectory: Box::new(trajectory),
+        }));
+        self.goals.push(Goal {
+            id,
+            state: GoalState::Executing,
+            error_code: code::SUCCESSFUL,
+            error_string: String::new(),
+            accepted_s: now_s,
+            reported: false,
+            runs_before: run.runs,
+            started: false,
+            point_times_s,
+        });
+        self.changed = true;
+    }
+
+    /// Cancels the executing goals `named` picks; the joints stop where they are. The ids
+    /// cancelled, and whether a named goal had already ended.
+    pub fn cancel(
+        &mut self,
+        named: impl Fn(&Goal<Id>) -> bool,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Id>, bool) {
+        let mut cancelled = Vec::new();
+        let mut ended_before = false;
+        for g in self.goals.iter_mut().filter(|g| named(g)) {
+            if g.ended() {
+                ended_before = true;
+                continue;
+            }
+            g.end(GoalState::Canceled, code::SUCCESSFUL, "cancelled");
+            cancelled.push(g.id.clone());
+        }
+        if !cancelled.is_empty() {
+            // A trajectory without points stops the controller's run and holds the joints
+            // where they are.
+            let _ = to_session.send(Action::Joint(JointAction::Trajectory {
+                controller: self.controller.clone(),
+                trajectory: Box::new(JointTrajectory {
+                    start_s: 0.0,
+                    joint_names: self.joint_names.clone(),
+                    points: Vec::new(),
+                }),
+            }));
+            self.changed = true;
+        }
+        (cancelled, ended_before)
+    }
+
+    /// Follows the executing goal's run: started, then how it ended.
+    pub fn follow(&mut self, run: RunSample, now_s: f64) {
+        let Some(g) = self.goals.iter_mut().find(|g| !g.ended()) else {
+            return;
+        };
+        if !g.started && run.runs > g.runs_before {
+            g.started = true;
+        }
+        if !g.started {
+            if now_s - g.accepted_s > START_TIMEOUT_S {
+                g.end(
+                    GoalState::Aborted,
+                    code::INVALID_GOAL,
+                    "the controller did not start the trajectory (rover's log says why)",
+                );
+                self.changed = true;
+            }
+            return;
+        }
+        if run.runs > g.runs_before + 1 {
+            // Another trajectory (a command on the controller's topic) replaced the goal's, as
+            // joint_trajectory_controller preempts an action goal for a topic command.
+            g.end(
+                GoalState::Canceled,
+                code::SUCCESSFUL,
+                &self.preempted_by_topic,
+            );
+            self.changed = true;
+            return;
+        }
+        if run.active {
+            return;
+        }
+        let (state, code, why) = match run.outcome {
+            Some(TrajectoryOutcome::Reached) | None => {
+                (GoalState::Succeeded, code::SUCCESSFUL, "goal reached")
+            }
+            Some(TrajectoryOutcome::PathToleranceViolated) => (
+                GoalState::Aborted,
+                code::PATH_TOLERANCE_VIOLATED,
+                "PATH_TOLERANCE_VIOLATED",
+            ),
+            Some(TrajectoryOutcome::GoalToleranceViolated) => (
+                GoalState::Aborted,
+                code::GOAL_TOLERANCE_VIOLATED,
+                "GOAL_TOLERANCE_VIOLATED",
+            ),
+            Some(TrajectoryOutcome::Stopped) => (GoalState::Canceled, code::SUCCESSFUL, "stopped"),
+        };
+        g.end(state, code, why);
+        self.changed = true;
+    }
+
+    /// Goals that ended since the last call, each handed out once (for a transport that
+    /// publishes results as they come); ended goals beyond the kept number are forgotten.
+    pub fn take_ended(&mut self, mut each: impl FnMut(&Goal<Id>)) {
+        for g in self.goals.iter_mut().filter(|g| g.ended() && !g.reported) {
+            g.reported = true;
+            each(g);
+        }
+        let ended = self.goals.iter().filter(|g| g.ended()).count();
+        if ended > ENDED_KEPT {
+            let mut extra = ended - ENDED_KEPT;
+            self.goals.retain(|g| {
+                let drop = extra > 0 && g.ended() && g.reported;
+                extra -= usize::from(drop);
+                !drop
+            });
+        }
+    }
+
+    /// Whether a goal's state changed since the last call.
+    pub fn take_changed(&mut self) -> bool {
+        std::mem::take(&mut self.changed)
+    }
+
+    /// The goal with `id`.
+    pub fn goal(&self, id: &Id) -> Option<&Goal<Id>> {
+        self.goals.iter().find(|g| g.id == *id)
+    }
+
+    /// The executing goal's feedback, filled into `out`: the joints' setpoints, positions,
+    /// velocities and the difference; `None` while no started goal executes.
+    pub fn feedback(
+        &self,
+        update: &ControlUpdate,
+        now_s: f64,
+        out: &mut FeedbackArrays,
+    ) -> Option<&Goal<Id>> {
+        let g = self.goals.iter().find(|g| !g.ended() && g.started)?;
+        let samples = || self.joints.iter().filter_map(|&j| update.joints.get(j));
+        let fill = |to: &mut Vec<f64>, f: fn(&JointSample) -> f64| {
+            to.clear();
+            to.extend(samples().map(f));
+        };
+        fill(&mut out.desired, |s| s.setpoint);
+        fill(&mut out.actual, |s| s.position);
+        fill(&mut out.actual_velocities, |s| s.velocity_radps);
+        fill(&mut out.error, |s| s.setpoint - s.position);
+        let elapsed_s = now_s - g.accepted_s;
+        out.index = g
+            .point_times_s
+            .iter()
+            .position(|&t| t >= elapsed_s)
+            .unwrap_or(g.point_times_s.len().saturating_sub(1));
+        Some(g)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rover_sim::TrajectoryPoint;
+
+    fn goals() -> TrajectoryGoals<u32> {
+        TrajectoryGoals {
+            controller: "arm_controller".into(),
+            action: "/arm_controller/follow_joint_trajectory".into(),
+            joint_names: vec!["a".into(), "b".into()],
+            goals: Vec::new(),
+            index: 0,
+            joints: vec![0, 1],
+            changed: false,
+            preempted_by_topic: "preempted by a command on ~/command".into(),
+        }
+    }
+
+    fn trajectory(names: &[&str], positions: Vec<f64>) -> JointTrajectory {
+        JointTrajectory {
+            start_s: 0.0,
+            joint_names: names.iter().map(|n| (*n).to_owned()).collect(),
+            points: vec![TrajectoryPoint {
+                positions,
+                velocities: Vec::new(),
+                accelerations: Vec::new(),
+                time_from_start_s: 1.0,
+            }],
+        }
+    }
+
+    #[test]
+    fn bad_goals_get_control_msgs_codes() {
+        let g = goals();
+        let code = |t: &JointTrajectory| g.check(t, false).err().map(|r| r.code);
+        assert_eq!(code(&trajectory(&["a", "b"], vec![0.1, 0.2])), None);
+        assert_eq!(code(&trajectory(&["b", "a"], vec![0.1, 0.2])), None);
+        assert_eq!(
+            code(&trajectory(&["a", "x"], vec![0.1, 0.2])),
+            Some(code::INVALID_JOINTS)
+        );
+        assert_eq!(
+            code(&trajectory(&["a"], vec![0.1])),
+            Some(code::INVALID_JOINTS)
+        );
+        assert_eq!(
+            code(&trajectory(&["a", "b"], vec![f64::NAN, 0.2])),
+            Some(code::INVALID_GOAL)
+        );
+        assert_eq!(
+            code(&trajectory(&["a", "b"], vec![0.1])),
+            Some(code::INVALID_GOAL)
+        );
+        let mut empty = trajectory(&["a", "b"], Vec::new());
+        empty.points.clear();
+        assert_eq!(code(&empty), Some(code::INVALID_GOAL));
+    }
+
+    #[test]
+    fn a_goal_runs_then_succeeds_and_a_newer_one_preempts() {
+        let (to_session, from) = std::sync::mpsc::channel();
+        let mut g = goals();
+        let idle = RunSample::default();
+        g.accept(
+            1,
+            trajectory(&["a", "b"], vec![0.1, 0.2]),
+            0.0,
+            idle,
+            &to_session,
+        );
+        assert!(from.try_recv().is_ok());
+        let running = RunSample {
+            active: true,
+            runs: 1,
+            outcome: None,
+        };
+        g.follow(running, 0.1);
+        assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Executing));
+        g.accept(
+            2,
+            trajectory(&["a", "b"], vec![0.0, 0.0]),
+            0.2,
+            running,
+            &to_session,
+        );
+        assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Canceled));
+        g.follow(
+            RunSample {
+                active: false,
+                runs: 2,
+                outcome: Some(TrajectoryOutcome::Reached),
+            },
+            1.5,
+        );
+        assert_eq!(g.goal(&2).map(|x| x.state), Some(GoalState::Succeeded));
+        let mut ended = Vec::new();
+        g.take_ended(|x| ended.push(x.id));
+        g.take_ended(|x| ended.push(x.id));
+        assert_eq!(ended, [1, 2]);
+    }
+
+    #[test]
+    fn a_cancel_stops_the_joints_and_a_goal_never_started_aborts() {
+        let (to_session, from) = std::sync::mpsc::channel();
+        let mut g = goals();
+        g.accept(
+            7,
+            trajectory(&["a", "b"], vec![0.1, 0.2]),
+            0.0,
+            RunSample::default(),
+            &to_session,
+        );
+        let _ = from.try_recv();
+        let (cancelled, ended_before) = g.cancel(|x| x.id == 7, &to_session);
+        assert_eq!(cancelled.len(), 1);
+        assert!(!ended_before);
+        match from.try_recv() {
+            Ok(Action::Joint(JointAction::Trajectory { trajectory, .. })) => {
+                assert!(trajectory.points.is_empty());
+            }
+            other => panic!("expected a stop, got {other:?}"),
+        }
+        assert!(g.cancel(|x| x.id == 7, &to_session).1);
+        g.accept(
+            8,
+            trajectory(&["a", "b"], vec![0.1, 0.2]),
+            2.0,
+            RunSample::default(),
+            &to_session,
+        );
+        g.follow(RunSample::default(), 3.5);
+        let goal = g.goal(&8);
+        assert_eq!(goal.map(|x| x.state), Some(GoalState::Aborted));
+        assert_eq!(goal.map(|x| x.error_code), Some(code::INVALID_GOAL));
+    }
+}
