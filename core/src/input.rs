@@ -51,6 +51,15 @@ pub enum JointAction {
         /// The trajectory.
         trajectory: Box<JointTrajectory>,
     },
+    /// A gripper controller's command (control_msgs/GripperCommand).
+    Gripper {
+        /// Controller name.
+        controller: String,
+        /// The finger joint's position (m or rad).
+        position: f64,
+        /// The most effort the fingers may use (N or N m); 0 or less: the joints' limit.
+        max_effort: f64,
+    },
     /// Go to a named pose of the controllers file.
     Pose(String),
     /// The arm's end effector (`--ee-link`) to a point in the arm base's frame (m, REP-103),

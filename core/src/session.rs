@@ -311,6 +311,11 @@ impl Session {
                 controller,
                 trajectory,
             } => self.sim.follow_trajectory(controller, trajectory),
+            JointAction::Gripper {
+                controller,
+                position,
+                max_effort,
+            } => self.sim.command_gripper(controller, *position, *max_effort),
             JointAction::Pose(name) => self.sim.go_to_named_pose(name),
             JointAction::Tool {
                 position_m,

@@ -119,3 +119,181 @@ fn pandas_second_finger_follows_the_first() -> Result<()> {
     );
     Ok(())
 }
+
+/// A gripper built to grasp: a base, a wrist turning the palm, and two fingers that close
+/// toward the palm's middle (the right one mimics the left), with a 5 cm ball resting on the
+/// palm between them.
+const GRASPER: &str = r#"<?xml version="1.0"?>
+<robot name="grasper">
+  <link name="base">
+    <inertial><mass value="5.0"/><inertia ixx="0.05" iyy="0.05" izz="0.05" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.02"/><geometry><box size="0.3 0.3 0.04"/></geometry></collision>
+  </link>
+  <link name="palm">
+    <inertial><mass value="1.0"/><inertia ixx="0.005" iyy="0.005" izz="0.005" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.02"/><geometry><box size="0.1 0.2 0.04"/></geometry></collision>
+  </link>
+  <link name="left_finger">
+    <inertial><mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.03 0.01 0.06"/></geometry></collision>
+  </link>
+  <link name="right_finger">
+    <inertial><mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.03 0.01 0.06"/></geometry></collision>
+  </link>
+  <joint name="wrist_joint" type="revolute">
+    <parent link="base"/><child link="palm"/>
+    <origin xyz="0 0 0.04"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="20" velocity="1"/>
+  </joint>
+  <joint name="left_finger_joint" type="prismatic">
+    <parent link="palm"/><child link="left_finger"/>
+    <origin xyz="0 0.06 0.065"/><axis xyz="0 -1 0"/>
+    <limit lower="0" upper="0.05" effort="20" velocity="0.1"/>
+  </joint>
+  <joint name="right_finger_joint" type="prismatic">
+    <parent link="palm"/><child link="right_finger"/>
+    <origin xyz="0 -0.06 0.065"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.05" effort="20" velocity="0.1"/>
+    <mimic joint="left_finger_joint"/>
+  </joint>
+</robot>
+"#;
+
+const GRASPER_CONTROLLERS: &str = "gripper_controller:
+  type: position_controllers/GripperActionController
+  joint: left_finger_joint
+  goal_tolerance: 0.002
+  stall_timeout: 0.5
+";
+
+/// The grasper, its controllers and a ball on its palm, as a world file in `dir`.
+fn grasper_world(dir: &std::path::Path, controllers: &str) -> Result<std::path::PathBuf> {
+    std::fs::write(dir.join("grasper.urdf"), GRASPER)?;
+    std::fs::write(dir.join("grasper.yaml"), controllers)?;
+    let world = dir.join("grasper.toml");
+    std::fs::write(
+        &world,
+        "name = \"grasper\"\n[robot]\nurdf = \"grasper.urdf\"\ncontrollers = \"grasper.yaml\"\n\n[[sphere]]\nname = \"ball\"\nradius_m = 0.025\nposition_m = [0.0, 0.0, 0.11]\nmass_kg = 0.05\ncolor = \"#d02020\"\n",
+    )?;
+    Ok(world)
+}
+
+fn grasper_sim(world: &std::path::Path) -> Result<rover_sim::Simulation> {
+    let world = rover_sim::World::load(world)?;
+    let urdf = world
+        .robot
+        .urdf
+        .clone()
+        .context("the world names its robot")?;
+    let mut robot = RobotModel::load_with(&urdf, &LoadOptions::default())?;
+    if let Some(c) = &world.robot.controllers {
+        robot.load_controllers(c)?;
+    }
+    Ok(rover_sim::Simulation::new(
+        world,
+        robot,
+        &rover_sim::SimOptions::default(),
+    )?)
+}
+
+/// Runs until the gripper's command ends (at most `limit_s`).
+fn until_done(sim: &mut rover_sim::Simulation, limit_s: f64) -> Result<rover_sim::GripperState> {
+    let end = sim.sim_time_s() + limit_s;
+    loop {
+        sim.step();
+        let state = *sim
+            .gripper_state("gripper_controller")
+            .context("no gripper controller")?;
+        if !state.active || sim.sim_time_s() > end {
+            return Ok(state);
+        }
+    }
+}
+
+/// control_msgs/GripperCommand as gripper_action_controller answers it: closing on nothing
+/// reaches the goal; closing on the ball stalls short of it, pushing with the command's
+/// max_effort, and the ball stays between the fingers; reopening reaches the goal again.
+#[test]
+fn a_gripper_command_reaches_its_goal_or_stalls_on_the_ball() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let mut sim = grasper_sim(&grasper_world(dir.path(), GRASPER_CONTROLLERS)?)?;
+    run(&mut sim, 0.5);
+    sim.command_gripper("gripper_controller", 0.01, 0.0)?;
+    let free = until_done(&mut sim, 5.0)?;
+    println!("free: {free:?}");
+    ensure!(
+        free.reached_goal && !free.stalled && (free.position - 0.01).abs() <= 0.002,
+        "closing 1 cm on nothing: {free:?}"
+    );
+    sim.command_gripper("gripper_controller", 0.05, 5.0)?;
+    let closed = until_done(&mut sim, 5.0)?;
+    run(&mut sim, 0.5);
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let ball = poses.first().context("no ball")?.translation;
+    let effort = sim
+        .gripper_state("gripper_controller")
+        .context("no gripper")?
+        .effort;
+    println!(
+        "on the ball: {closed:?}; ball at {:.4} {:.4} {:.4}; effort after 0.5 s {effort:.3} N",
+        ball.x, ball.y, ball.z
+    );
+    // The fingers' inner faces are 5.5 cm from the middle when open: they touch a 2.5 cm ball
+    // at 3 cm. rapier's contacts are soft (a spring whose stiffness scales with the bodies'
+    // masses, at 30 Hz): 5 N on each side of a 50 g ball sinks each finger ~5 mm into it.
+    ensure!(
+        closed.stalled
+            && !closed.reached_goal
+            && closed.position > 0.029
+            && closed.position < 0.038,
+        "closing on the ball: {closed:?}"
+    );
+    ensure!(
+        effort > 2.5 && effort <= 5.0 + 1e-6,
+        "a stalled gripper keeps squeezing with max_effort 5 N: {effort}"
+    );
+    ensure!(
+        ball.y.abs() < 0.005 && ball.x.abs() < 0.01 && ball.z > 0.05,
+        "the ball left the fingers: {ball:?}"
+    );
+    sim.command_gripper("gripper_controller", 0.0, 0.0)?;
+    let open = until_done(&mut sim, 5.0)?;
+    ensure!(open.reached_goal, "reopening: {open:?}");
+    let refused = sim
+        .command_gripper("gripper_controller", f64::NAN, 1.0)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    ensure!(refused.contains("finite"), "a NaN command: {refused:?}");
+    Ok(())
+}
+
+/// A gripper controller that names an arm joint, a mimic joint or a missing joint is refused
+/// with the file's line and the reason.
+#[test]
+fn a_gripper_naming_a_joint_that_is_not_a_finger_is_refused() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    for (joint, expected) in [
+        (
+            "wrist_joint",
+            "is not a finger joint: joint \"left_finger_joint\" moves beyond it",
+        ),
+        ("right_finger_joint", "mimics another joint"),
+        ("thumb_joint", "has no joint \"thumb_joint\""),
+    ] {
+        let yaml = GRASPER_CONTROLLERS.replace("left_finger_joint", joint);
+        let world = grasper_world(dir.path(), &yaml)?;
+        let error = match grasper_sim(&world) {
+            Ok(_) => String::new(),
+            Err(e) => format!("{e:#}"),
+        };
+        println!("{joint}: {error}");
+        ensure!(
+            error.contains(expected) && error.contains("grasper.yaml:3"),
+            "a gripper on {joint}: {error:?}"
+        );
+    }
+    Ok(())
+}

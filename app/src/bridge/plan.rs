@@ -197,7 +197,14 @@ fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
     config
         .controllers
         .iter()
-        .filter(|c| !matches!(c.kind, ControllerKind::JointState { .. }))
+        // Joint state controllers publish /joint_states; gripper controllers take actions
+        // only (gripper_cmd), no command topic.
+        .filter(|c| {
+            !matches!(
+                c.kind,
+                ControllerKind::JointState { .. } | ControllerKind::Gripper(_)
+            )
+        })
         .map(|c| {
             let ns = if c.namespace.is_empty() {
                 plugin_ns

@@ -13,7 +13,7 @@ use saphyr::{LoadableYamlNode, MarkedYaml, Scalar, YamlData};
 use crate::error::{Result, SimError};
 use crate::model::actuation::Pid;
 use crate::model::controllers::{
-    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose,
+    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, GripperSpec, NamedPose,
     TrajectoryConstraints, TrajectorySpec,
 };
 use crate::model::robot::RobotModel;
@@ -23,7 +23,27 @@ const SUPPORTED: &str = "joint_state_controller/JointStateController, \
 effort_controllers/JointPositionController, position_controllers/JointPositionController, \
 velocity_controllers/JointVelocityController, effort_controllers/JointVelocityController, \
 effort_controllers/JointEffortController, position_controllers/JointTrajectoryController, \
-effort_controllers/JointTrajectoryController, velocity_controllers/JointTrajectoryController";
+effort_controllers/JointTrajectoryController, velocity_controllers/JointTrajectoryController, \
+position_controllers/GripperActionController, effort_controllers/GripperActionController";
+
+/// Whether `link` is `ancestor` or hangs from it.
+fn carries(
+    robot: &RobotModel,
+    ancestor: crate::model::robot::LinkId,
+    link: crate::model::robot::LinkId,
+) -> bool {
+    let mut at = link;
+    for _ in 0..robot.link_ids().count() {
+        if at == ancestor {
+            return true;
+        }
+        match robot.joint_ids().find(|(_, j)| j.child == at) {
+            Some((_, j)) => at = j.parent,
+            None => return false,
+        }
+    }
+    false
+}
 
 /// A YAML node reduced to what a controllers file uses, with its line.
 #[derive(Debug, Clone)]
@@ -35,7 +55,7 @@ struct Node {
 #[derive(Debug, Clone)]
 enum Value {
     Null,
-    Bool,
+    Bool(bool),
     Number(f64),
     Text(String),
     Map(Vec<(String, Node)>),
@@ -64,7 +84,7 @@ impl Node {
     fn describe(&self) -> &'static str {
         match self.value {
             Value::Null => "nothing",
-            Value::Bool => "a boolean",
+            Value::Bool(_) => "a boolean",
             Value::Number(_) => "a number",
             Value::Text(_) => "text",
             Value::Map(_) => "a mapping",
@@ -123,7 +143,7 @@ fn convert(node: &MarkedYaml<'_>, path: &Path) -> Result<Node> {
     let line = u32::try_from(node.span.start.line()).unwrap_or(u32::MAX);
     let value = match &node.data {
         YamlData::Value(Scalar::Null) => Value::Null,
-        YamlData::Value(Scalar::Boolean(_)) => Value::Bool,
+        YamlData::Value(Scalar::Boolean(b)) => Value::Bool(*b),
         YamlData::Value(Scalar::Integer(i)) => Value::Number(*i as f64),
         YamlData::Value(Scalar::FloatingPoint(f)) => Value::Number(f.into_inner()),
         YamlData::Value(Scalar::String(s)) => Value::Text(s.to_string()),
@@ -360,6 +380,10 @@ impl Reader<'_> {
             | "velocity_controllers/JointTrajectoryController" => {
                 ControllerKind::Trajectory(self.trajectory(name, &type_name, node)?)
             }
+            "position_controllers/GripperActionController"
+            | "effort_controllers/GripperActionController" => {
+                ControllerKind::Gripper(self.gripper(name, node)?)
+            }
             other => {
                 return Err(self.error(
                     type_node.line,
@@ -388,6 +412,66 @@ impl Reader<'_> {
             type_name,
             kind,
             line,
+        })
+    }
+
+    /// A gripper action controller: its finger joint must close between limits (prismatic or
+    /// revolute) and move a link nothing else moving hangs from (a finger, not an arm joint).
+    fn gripper(&self, name: &str, node: &Node) -> Result<GripperSpec> {
+        let joint = self.joint_of(node, name)?;
+        let line = node.get("joint").map_or(node.line, |j| j.line);
+        let robot = self.robot;
+        if let Some(id) = robot.joint_id(&joint) {
+            let j = robot.joint(id);
+            if j.position_limits().is_none() {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "controller `{name}`: joint \"{joint}\" has no position limits; a gripper's finger joint is prismatic or revolute with <limit lower upper>"
+                    ),
+                ));
+            }
+            let beyond = robot.joint_ids().find(|(_, other)| {
+                other.is_moving() && other.mimic.is_none() && carries(robot, j.child, other.parent)
+            });
+            if let Some((_, other)) = beyond {
+                return Err(self.error(
+                    line,
+                    format!(
+                        "controller `{name}`: joint \"{joint}\" is not a finger joint: joint \"{}\" moves beyond it; name the joint that moves a finger",
+                        other.name
+                    ),
+                ));
+            }
+        }
+        let number = |key: &str, default: f64| -> Result<f64> {
+            let v = self.optional_number(node, key, default)?;
+            if v < 0.0 {
+                return Err(self.error(node.line, format!("`{key}` must not be negative")));
+            }
+            Ok(v)
+        };
+        let allow_stalling = match node.get("allow_stalling") {
+            None => false,
+            Some(n) => match n.value {
+                Value::Bool(b) => b,
+                _ => {
+                    return Err(self.error(
+                        n.line,
+                        format!(
+                            "`allow_stalling` must be true or false, found {}",
+                            n.describe()
+                        ),
+                    ));
+                }
+            },
+        };
+        Ok(GripperSpec {
+            joint,
+            goal_tolerance: number("goal_tolerance", 0.01)?,
+            stalled_velocity_threshold: number("stalled_velocity_threshold", 0.001)?,
+            stall_timeout_s: number("stall_timeout", 1.0)?,
+            allow_stalling,
         })
     }
 

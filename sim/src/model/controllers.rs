@@ -85,6 +85,10 @@ pub enum ControllerKind {
     /// `position_controllers/JointTrajectoryController` or `effort_controllers/...`: follows
     /// trajectory_msgs/JointTrajectory messages.
     Trajectory(TrajectorySpec),
+    /// `position_controllers/GripperActionController` or `effort_controllers/...`: a gripper's
+    /// finger joint, commanded as control_msgs/GripperCommand (a position and the most effort);
+    /// the joints that `<mimic>` it follow.
+    Gripper(GripperSpec),
 }
 
 impl ControllerKind {
@@ -94,6 +98,7 @@ impl ControllerKind {
             Self::JointState { .. } => &[],
             Self::Joint { joint, .. } => std::slice::from_ref(joint),
             Self::Trajectory(t) => &t.joints,
+            Self::Gripper(g) => std::slice::from_ref(&g.joint),
         }
     }
 }
@@ -140,4 +145,22 @@ pub struct TrajectoryConstraints {
     pub trajectory: Vec<f64>,
     /// `<joint>/goal`: the largest position error at the end, in `joints` order.
     pub goal: Vec<f64>,
+}
+
+/// A gripper action controller (ros_control's gripper_action_controller): one finger joint, the
+/// others mimicking it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GripperSpec {
+    /// `joint`: the finger joint commanded.
+    pub joint: String,
+    /// `goal_tolerance` (m or rad; default 0.01): within it the goal is reached.
+    pub goal_tolerance: f64,
+    /// `stalled_velocity_threshold` (m/s or rad/s; default 0.001): slower than this, the
+    /// fingers are not moving.
+    pub stalled_velocity_threshold: f64,
+    /// `stall_timeout` (s; default 1.0): not moving this long short of the goal is a stall.
+    pub stall_timeout_s: f64,
+    /// `allow_stalling` (default false, as ROS 1's controller): a stall ends the goal
+    /// succeeded rather than aborted (a grasp that closes on an object).
+    pub allow_stalling: bool,
 }

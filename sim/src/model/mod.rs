@@ -25,7 +25,7 @@ pub use classes::{
     is_known_class, label_part_of_model,
 };
 pub use controllers::{
-    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, NamedPose,
+    CommandKind, ControllerConfig, ControllerKind, ControllerSpec, GripperSpec, NamedPose,
     TrajectoryConstraints, TrajectorySpec,
 };
 pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};

@@ -95,6 +95,8 @@ pub(crate) struct Actuator {
     continuous: bool,
     limits: Option<(f64, f64)>,
     effort_max: f64,
+    /// A lower cap a gripper command sets (its `max_effort`); `None`: `effort_max`.
+    effort_cap: Option<f64>,
     velocity_max: Option<f64>,
     command: JointCommand,
     /// User gains (a controllers YAML); `None`: derived from the inertia.
@@ -119,6 +121,12 @@ pub(crate) struct Actuator {
 }
 
 impl Actuator {
+    /// The most effort the motor may use now (N m or N).
+    fn cap(&self) -> f64 {
+        self.effort_cap
+            .map_or(self.effort_max, |c| c.min(self.effort_max))
+    }
+
     fn gains(&self) -> Pid {
         self.pid.unwrap_or_else(|| {
             let omega = 2.0 * std::f64::consts::PI * HOLD_BANDWIDTH_HZ;
@@ -187,6 +195,8 @@ struct Follower {
     actuator: usize,
     /// The joint it follows, as built.
     leader: BuiltJoint,
+    /// That joint's id.
+    leader_id: JointId,
     multiplier: f64,
     offset: f64,
 }
@@ -236,6 +246,7 @@ impl Actuators {
                 continuous: matches!(joint.kind, JointKind::Continuous),
                 limits,
                 effort_max,
+                effort_cap: None,
                 velocity_max: joint.velocity_limit.filter(|v| *v > 0.0).map(f64::from),
                 command: JointCommand::Position(start),
                 pid: None,
@@ -265,6 +276,7 @@ impl Actuators {
                 out.followers.push(Follower {
                     actuator: out.list.len(),
                     leader,
+                    leader_id: m.joint,
                     multiplier: f64::from(m.multiplier),
                     offset: f64::from(m.offset),
                 });
@@ -286,8 +298,22 @@ impl Actuators {
     /// Points every `<mimic>` joint at its leader's position now.
     fn follow_leaders(&mut self, physics: &PhysicsWorld) {
         for f in &self.followers {
-            let q = f.leader.position(&physics.bodies);
-            let v = f.leader.velocity(&physics.bodies);
+            // An actuated leader's setpoint, so that both fingers of a gripper push toward
+            // their own goal with their own effort cap (one motor, coupled fingers, equal
+            // forces); a leader without an actuator is followed where it is.
+            let leader = self
+                .by_joint
+                .get(f.leader_id.index())
+                .copied()
+                .flatten()
+                .and_then(|i| self.list.get(i));
+            let (q, v) = match leader {
+                Some(l) => (l.setpoint, l.setpoint_velocity),
+                None => (
+                    f.leader.position(&physics.bodies),
+                    f.leader.velocity(&physics.bodies),
+                ),
+            };
             if let Some(a) = self.list.get_mut(f.actuator) {
                 let cap = a.velocity_max.unwrap_or(f64::INFINITY);
                 a.command = JointCommand::Track {
@@ -390,6 +416,25 @@ impl Actuators {
         self.of(joint).map_or(0.0, |a| a.measured.1)
     }
 
+    /// Caps the effort of `joint` and of the joints that mimic it (a gripper command's
+    /// `max_effort`); `None` lifts the cap back to the joints' `<limit effort>`.
+    pub(crate) fn set_effort_cap(&mut self, joint: JointId, cap: Option<f64>) {
+        let followers: Vec<usize> = self
+            .followers
+            .iter()
+            .filter(|f| f.leader_id == joint)
+            .map(|f| f.actuator)
+            .collect();
+        if let Some(a) = self.of_mut(joint) {
+            a.effort_cap = cap;
+        }
+        for i in followers {
+            if let Some(a) = self.list.get_mut(i) {
+                a.effort_cap = cap;
+            }
+        }
+    }
+
     /// Gives a joint its own PID gains (an effort_controllers position controller).
     pub(crate) fn set_pid(&mut self, joint: JointId, pid: Pid) {
         if let Some(a) = self.of_mut(joint) {
@@ -423,18 +468,19 @@ impl Actuators {
                         a.advance_setpoint(target, dt_s);
                     }
                     let error = a.error(a.setpoint, q);
+                    let cap = a.cap();
                     let i_cap = if gains.i_clamp > 0.0 {
                         gains.i_clamp
                     } else if a.pid.is_none() {
-                        HOLD_INTEGRAL_HEADROOM * a.effort_max
+                        HOLD_INTEGRAL_HEADROOM * cap
                     } else {
-                        a.effort_max
+                        cap
                     };
                     // ros_control's PID integrates always (bounded by i_clamp); the default hold
                     // only small errors, once the setpoint has arrived and the motor is not
                     // saturated, so a move does not wind it up into an overshoot.
                     let settled = a.setpoint_velocity == 0.0
-                        && a.effort.abs() < a.effort_max
+                        && a.effort.abs() < cap
                         && error.abs() < HOLD_INTEGRAL_BAND;
                     // Kept as an effort, so gains that change with the pose do not rescale it.
                     if a.pid.is_some() || settled {
@@ -446,7 +492,7 @@ impl Actuators {
                         a.integral + if a.pid.is_none() { a.gravity_hold } else { 0.0 };
                     a.effort =
                         (gains.p * error + gains.d * (a.setpoint_velocity - v) + feed_forward)
-                            .clamp(-a.effort_max, a.effort_max);
+                            .clamp(-cap, cap);
                     // The explicit terms shift the implicit PD's target by the error they
                     // stand for.
                     let shift = if gains.p > 0.0 {
@@ -461,7 +507,7 @@ impl Actuators {
                         gains.p as f32,
                         gains.d as f32,
                     )
-                    .set_motor_max_force(axis, a.effort_max as f32);
+                    .set_motor_max_force(axis, cap as f32);
                 }
                 JointCommand::Velocity(target) => {
                     let gain = a.inertia / dt_s.max(1e-3);

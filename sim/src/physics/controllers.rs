@@ -11,7 +11,7 @@
 
 use crate::error::{Result, SimError};
 use crate::model::controllers::{
-    CommandKind, ControllerConfig, ControllerKind, TrajectoryConstraints,
+    CommandKind, ControllerConfig, ControllerKind, GripperSpec, TrajectoryConstraints,
 };
 use crate::model::robot::{JointId, RobotModel};
 use crate::physics::actuators::{Actuators, JointCommand};
@@ -80,6 +80,37 @@ pub struct ControllerCommandState {
     pub command: f64,
 }
 
+/// A gripper controller's command and what came of it, as control_msgs/GripperCommand's
+/// result reports it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GripperState {
+    /// The finger joint.
+    pub joint: Option<JointId>,
+    /// The commanded position (m or rad).
+    pub goal: f64,
+    /// The finger joint's position now.
+    pub position: f64,
+    /// The effort its motor exerts now (N or N m).
+    pub effort: f64,
+    /// A command is being carried out.
+    pub active: bool,
+    /// Commands taken so far.
+    pub runs: u64,
+    /// The last command ended short of its goal with the fingers not moving (closed on
+    /// something).
+    pub stalled: bool,
+    /// The last command ended within `goal_tolerance`.
+    pub reached_goal: bool,
+}
+
+#[derive(Debug, Clone)]
+struct GripperRun {
+    spec: GripperSpec,
+    state: GripperState,
+    /// When the finger last moved faster than `stalled_velocity_threshold` (sim s).
+    last_moved_s: f64,
+}
+
 #[derive(Debug, Clone)]
 enum Running {
     JointState,
@@ -89,6 +120,7 @@ enum Running {
         last: f64,
     },
     Trajectory(Box<TrajectoryRun>),
+    Gripper(Box<GripperRun>),
 }
 
 #[derive(Debug, Clone)]
@@ -173,6 +205,19 @@ impl Controllers {
                         command: *command,
                         last,
                     }
+                }
+                ControllerKind::Gripper(g) => {
+                    let id = id_of(actuators, &g.joint)?;
+                    Running::Gripper(Box::new(GripperRun {
+                        spec: g.clone(),
+                        state: GripperState {
+                            joint: Some(id),
+                            goal: actuators.setpoint(id),
+                            position: actuators.position(id),
+                            ..GripperState::default()
+                        },
+                        last_moved_s: 0.0,
+                    }))
                 }
                 ControllerKind::Trajectory(t) => {
                     let joints = t
@@ -317,10 +362,54 @@ impl Controllers {
         Ok(())
     }
 
+    /// A gripper controller's command (control_msgs/GripperCommand): the finger joint to
+    /// `position`, pushing with at most `max_effort` (0 or less: its `<limit effort>`). A new
+    /// command replaces the one running.
+    pub(crate) fn command_gripper(
+        &mut self,
+        name: &str,
+        (position, max_effort): (f64, f64),
+        robot: &RobotModel,
+        (actuators, now_s): (&mut Actuators, f64),
+    ) -> Result<()> {
+        let i = self.index(name)?;
+        let Running::Gripper(run) = &mut self.list[i] else {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\" is not a gripper controller (GripperActionController)"
+            )));
+        };
+        if !(position.is_finite() && max_effort.is_finite()) {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\": a gripper command needs finite numbers, got position {position}, max_effort {max_effort}"
+            )));
+        }
+        let Some(joint) = run.state.joint else {
+            return Err(SimError::Setup(format!(
+                "controller \"{name}\" has no joint"
+            )));
+        };
+        actuators.set_effort_cap(joint, (max_effort > 0.0).then_some(max_effort));
+        actuators.command(robot, joint, JointCommand::Position(position))?;
+        let s = &mut run.state;
+        s.goal = actuators.target(joint);
+        s.active = true;
+        s.runs += 1;
+        s.stalled = false;
+        s.reached_goal = false;
+        run.last_moved_s = now_s;
+        Ok(())
+    }
+
     /// One control update: samples running trajectories into the actuators' commands, checks
-    /// their tolerances.
+    /// their tolerances; follows the grippers' commands to their goal or a stall.
     pub(crate) fn update(&mut self, robot: &RobotModel, actuators: &mut Actuators, now_s: f64) {
         for (name, running) in self.names.iter().zip(&mut self.list) {
+            if let Running::Gripper(run) = running {
+                if let Some(event) = run.update(name, actuators, now_s) {
+                    self.events.push(event);
+                }
+                continue;
+            }
             let Running::Trajectory(run) = running else {
                 continue;
             };
@@ -351,6 +440,15 @@ impl Controllers {
         }
     }
 
+    /// The state of the gripper controller `name`.
+    pub(crate) fn gripper_state(&self, name: &str) -> Option<&GripperState> {
+        let i = self.index(name).ok()?;
+        match &self.list[i] {
+            Running::Gripper(run) => Some(&run.state),
+            _ => None,
+        }
+    }
+
     /// The joint and last command of the single-joint controller `name`.
     pub(crate) fn command_state(&self, name: &str) -> Option<ControllerCommandState> {
         let i = self.index(name).ok()?;
@@ -359,8 +457,42 @@ impl Controllers {
                 joint: Some(*joint),
                 command: *last,
             }),
-            Running::JointState | Running::Trajectory(_) => None,
+            Running::JointState | Running::Trajectory(_) | Running::Gripper(_) => None,
         }
+    }
+}
+
+impl GripperRun {
+    /// Measures the finger; ends the command at its goal or at a stall (what ended it, for
+    /// the log). The position command stays: a stalled gripper keeps squeezing.
+    fn update(&mut self, name: &str, actuators: &Actuators, now_s: f64) -> Option<String> {
+        let joint = self.state.joint?;
+        let s = &mut self.state;
+        s.position = actuators.position(joint);
+        s.effort = actuators.of(joint).map_or(0.0, |a| a.effort);
+        if !s.active {
+            return None;
+        }
+        if actuators.velocity(joint).abs() > self.spec.stalled_velocity_threshold {
+            self.last_moved_s = now_s;
+        }
+        if (s.goal - s.position).abs() <= self.spec.goal_tolerance {
+            s.active = false;
+            s.reached_goal = true;
+            return Some(format!(
+                "controller {name}: gripper reached {:.4} (goal {:.4})",
+                s.position, s.goal
+            ));
+        }
+        if now_s - self.last_moved_s > self.spec.stall_timeout_s {
+            s.active = false;
+            s.stalled = true;
+            return Some(format!(
+                "controller {name}: gripper stalled at {:.4} (goal {:.4}), pushing with {:.2}",
+                s.position, s.goal, s.effort
+            ));
+        }
+        None
     }
 }
 

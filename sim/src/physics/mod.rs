@@ -16,7 +16,8 @@ pub use actuators::{
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
 };
 pub use controllers::{
-    ControllerCommandState, JointTrajectory, TrajectoryOutcome, TrajectoryPoint, TrajectoryState,
+    ControllerCommandState, GripperState, JointTrajectory, TrajectoryOutcome, TrajectoryPoint,
+    TrajectoryState,
 };
 pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,

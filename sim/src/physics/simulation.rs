@@ -16,7 +16,7 @@ use crate::physics::build::{
     add_world, joint_mass_ratio, person_body_pose,
 };
 use crate::physics::controllers::{
-    ControllerCommandState, Controllers, JointTrajectory, TrajectoryState,
+    ControllerCommandState, Controllers, GripperState, JointTrajectory, TrajectoryState,
 };
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
@@ -423,6 +423,24 @@ impl Simulation {
         let now = self.sim_time_s();
         self.controllers
             .follow(name, trajectory, &self.robot, (&mut self.actuators, now))
+    }
+
+    /// Sends a command to the gripper controller `name` (control_msgs/GripperCommand: the
+    /// finger joint's position, and the most effort, 0 or less for its `<limit effort>`); what
+    /// came of it is [`Simulation::gripper_state`].
+    pub fn command_gripper(&mut self, name: &str, position: f64, max_effort: f64) -> Result<()> {
+        let now = self.sim_time_s();
+        self.controllers.command_gripper(
+            name,
+            (position, max_effort),
+            &self.robot,
+            (&mut self.actuators, now),
+        )
+    }
+
+    /// The state of the gripper controller `name`.
+    pub fn gripper_state(&self, name: &str) -> Option<&GripperState> {
+        self.controllers.gripper_state(name)
     }
 
     /// Moves every joint of the controllers file's pose `name` there (each at its own pace,
