@@ -120,63 +120,18 @@ fn pandas_second_finger_follows_the_first() -> Result<()> {
     Ok(())
 }
 
-/// A gripper built to grasp: a base, a wrist turning the palm, and two fingers that close
-/// toward the palm's middle (the right one mimics the left), with a 5 cm ball resting on the
-/// palm between them.
-const GRASPER: &str = r#"<?xml version="1.0"?>
-<robot name="grasper">
-  <link name="base">
-    <inertial><mass value="5.0"/><inertia ixx="0.05" iyy="0.05" izz="0.05" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.02"/><geometry><box size="0.3 0.3 0.04"/></geometry></collision>
-  </link>
-  <link name="palm">
-    <inertial><mass value="1.0"/><inertia ixx="0.005" iyy="0.005" izz="0.005" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.02"/><geometry><box size="0.1 0.2 0.04"/></geometry></collision>
-  </link>
-  <link name="left_finger">
-    <inertial><mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.03 0.01 0.06"/></geometry></collision>
-  </link>
-  <link name="right_finger">
-    <inertial><mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.03 0.01 0.06"/></geometry></collision>
-  </link>
-  <joint name="wrist_joint" type="revolute">
-    <parent link="base"/><child link="palm"/>
-    <origin xyz="0 0 0.04"/><axis xyz="0 0 1"/>
-    <limit lower="-1" upper="1" effort="20" velocity="1"/>
-  </joint>
-  <joint name="left_finger_joint" type="prismatic">
-    <parent link="palm"/><child link="left_finger"/>
-    <origin xyz="0 0.06 0.065"/><axis xyz="0 -1 0"/>
-    <limit lower="0" upper="0.05" effort="20" velocity="0.1"/>
-  </joint>
-  <joint name="right_finger_joint" type="prismatic">
-    <parent link="palm"/><child link="right_finger"/>
-    <origin xyz="0 -0.06 0.065"/><axis xyz="0 1 0"/>
-    <limit lower="0" upper="0.05" effort="20" velocity="0.1"/>
-    <mimic joint="left_finger_joint"/>
-  </joint>
-</robot>
-"#;
-
-const GRASPER_CONTROLLERS: &str = "gripper_controller:
-  type: position_controllers/GripperActionController
-  joint: left_finger_joint
-  goal_tolerance: 0.002
-  stall_timeout: 0.5
-";
-
-/// The grasper, its controllers and a ball on its palm, as a world file in `dir`.
-fn grasper_world(dir: &std::path::Path, controllers: &str) -> Result<std::path::PathBuf> {
-    std::fs::write(dir.join("grasper.urdf"), GRASPER)?;
-    std::fs::write(dir.join("grasper.yaml"), controllers)?;
-    let world = dir.join("grasper.toml");
-    std::fs::write(
-        &world,
-        "name = \"grasper\"\n[robot]\nurdf = \"grasper.urdf\"\ncontrollers = \"grasper.yaml\"\n\n[[sphere]]\nname = \"ball\"\nradius_m = 0.025\nposition_m = [0.0, 0.0, 0.11]\nmass_kg = 0.05\ncolor = \"#d02020\"\n",
-    )?;
-    Ok(world)
+/// tests/grasper/: a base, a wrist turning the palm, and two fingers that close toward the
+/// palm's middle (the right one mimics the left), with a 5 cm ball resting on the palm between
+/// them; copied into `dir`, the controllers file replaced by `controllers` if given.
+fn grasper_world(dir: &std::path::Path, controllers: Option<&str>) -> Result<std::path::PathBuf> {
+    let from = rover_tests::repo("tests/grasper");
+    for file in ["grasper.urdf", "grasper.yaml", "grasper.toml"] {
+        std::fs::copy(from.join(file), dir.join(file))?;
+    }
+    if let Some(yaml) = controllers {
+        std::fs::write(dir.join("grasper.yaml"), yaml)?;
+    }
+    Ok(dir.join("grasper.toml"))
 }
 
 fn grasper_sim(world: &std::path::Path) -> Result<rover_sim::Simulation> {
@@ -217,7 +172,7 @@ fn until_done(sim: &mut rover_sim::Simulation, limit_s: f64) -> Result<rover_sim
 #[test]
 fn a_gripper_command_reaches_its_goal_or_stalls_on_the_ball() -> Result<()> {
     let dir = tempfile::tempdir()?;
-    let mut sim = grasper_sim(&grasper_world(dir.path(), GRASPER_CONTROLLERS)?)?;
+    let mut sim = grasper_sim(&grasper_world(dir.path(), None)?)?;
     run(&mut sim, 0.5);
     sim.command_gripper("gripper_controller", 0.01, 0.0)?;
     let free = until_done(&mut sim, 5.0)?;
@@ -283,15 +238,16 @@ fn a_gripper_naming_a_joint_that_is_not_a_finger_is_refused() -> Result<()> {
         ("right_finger_joint", "mimics another joint"),
         ("thumb_joint", "has no joint \"thumb_joint\""),
     ] {
-        let yaml = GRASPER_CONTROLLERS.replace("left_finger_joint", joint);
-        let world = grasper_world(dir.path(), &yaml)?;
+        let yaml = std::fs::read_to_string(rover_tests::repo("tests/grasper/grasper.yaml"))?
+            .replace("left_finger_joint", joint);
+        let world = grasper_world(dir.path(), Some(&yaml))?;
         let error = match grasper_sim(&world) {
             Ok(_) => String::new(),
             Err(e) => format!("{e:#}"),
         };
         println!("{joint}: {error}");
         ensure!(
-            error.contains(expected) && error.contains("grasper.yaml:3"),
+            error.contains(expected) && error.contains("grasper.yaml:4"),
             "a gripper on {joint}: {error:?}"
         );
     }

@@ -8,7 +8,9 @@ use rover_sim::{
     Simulation, link_from_optical,
 };
 
-use super::events::{ArmSample, Detections, ImageFrame, JointSample, RunSample, Transform};
+use super::events::{
+    ArmSample, Detections, GripperSample, ImageFrame, JointSample, RunSample, Transform,
+};
 use super::plan::{JointSource, MovingJoint};
 
 /// The image to hand over: `frame` copied into the recycled `pixels`, its depth image (if
@@ -140,15 +142,29 @@ pub(crate) fn joints(
 }
 
 /// Samples each of `controllers` (names) at a control update, into `out`: what its
-/// trajectory does.
+/// trajectory does, or its gripper command.
 pub(crate) fn runs(sim: &Simulation, controllers: &[String], out: &mut Vec<RunSample>) {
     out.clear();
     out.extend(controllers.iter().map(|name| {
+        if let Some(g) = sim.gripper_state(name) {
+            return RunSample {
+                active: g.active,
+                runs: g.runs,
+                outcome: None,
+                gripper: GripperSample {
+                    position: g.position,
+                    effort: g.effort,
+                    stalled: g.stalled,
+                    reached_goal: g.reached_goal,
+                },
+            };
+        }
         sim.trajectory_state(name)
             .map(|s| RunSample {
                 active: s.active,
                 runs: s.runs,
                 outcome: s.outcome,
+                gripper: GripperSample::default(),
             })
             .unwrap_or_default()
     }));

@@ -65,7 +65,8 @@ pub(crate) struct ControlUpdate {
     /// The arm's task.
     pub arm: ArmSample,
     /// One per controller of the plan's `controllers`, in that order: what its trajectory
-    /// does (default for controllers that take no trajectory).
+    /// does (default for controllers that take no trajectory); then one per gripper of the
+    /// plan's `grippers`.
     pub runs: Vec<RunSample>,
     /// Every model's world pose and twist (a recycled buffer).
     pub models: Vec<rover_sim::ModelState>,
@@ -80,6 +81,21 @@ pub(crate) struct RunSample {
     pub runs: u64,
     /// How the last one ended (`None` while it runs).
     pub outcome: Option<rover_sim::TrajectoryOutcome>,
+    /// A gripper's finger and how its last command ended (zeros for other controllers).
+    pub gripper: GripperSample,
+}
+
+/// A gripper controller's finger at a control update (control_msgs/GripperCommand's result).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct GripperSample {
+    /// The finger joint's position (m or rad).
+    pub position: f64,
+    /// Its effort (N or N m).
+    pub effort: f64,
+    /// The last command ended short of its goal, the finger not moving.
+    pub stalled: bool,
+    /// The last command ended at its goal.
+    pub reached_goal: bool,
 }
 
 /// The arm's task at a control update, its points in the robot's base frame.

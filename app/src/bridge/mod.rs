@@ -19,6 +19,7 @@
 //! A new topic: a family file here, its encoder in each transport (a `Transport` method each),
 //! and a line in [`families`]; docs/ARCHITECTURE.md walks through `/rover/status`.
 
+pub(crate) mod action_goals;
 pub(crate) mod arm;
 pub(crate) mod camera;
 pub(crate) mod capture;
@@ -34,7 +35,6 @@ pub(crate) mod odom;
 pub(crate) mod plan;
 pub(crate) mod status;
 pub(crate) mod tf;
-pub(crate) mod trajectory_goals;
 
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
@@ -180,7 +180,12 @@ impl<R: Send + 'static> Bridge<R> {
             thread: Some(thread),
             buffers,
             joints: plan.joints.clone(),
-            controllers: plan.controllers.iter().map(|c| c.name.clone()).collect(),
+            controllers: plan
+                .controllers
+                .iter()
+                .map(|c| c.name.clone())
+                .chain(plan.grippers.iter().map(|(name, _)| name.clone()))
+                .collect(),
             camera_link: robot.cameras.first().map(|c| c.link.clone()),
             backlog,
             now_s: 0.0,

@@ -38,6 +38,9 @@ pub struct RosPlan {
     pub joint_states_hz: Option<f64>,
     /// The controllers file's command topics.
     pub(crate) controllers: Vec<ControllerTopic>,
+    /// The controllers file's gripper controllers: their names and action namespaces
+    /// (`/<namespace>/<controller>/gripper_cmd`).
+    pub(crate) grippers: Vec<(String, String)>,
 }
 
 /// A controller's topics (`/<namespace>/<controller>/command`).
@@ -156,6 +159,7 @@ impl RosPlan {
                 })
             }),
             controllers: Vec::new(),
+            grippers: Vec::new(),
         }
         .with_controllers(robot)
     }
@@ -176,12 +180,40 @@ impl RosPlan {
                 .collect();
         }
         self.controllers = topics;
+        self.grippers = robot
+            .controllers
+            .iter()
+            .flat_map(|config| &config.controllers)
+            .filter(|c| matches!(c.kind, ControllerKind::Gripper(_)))
+            .map(|c| {
+                let ns = namespace_prefix(robot, &c.namespace);
+                (c.name.clone(), format!("{ns}/{}/gripper_cmd", c.name))
+            })
+            .collect();
         self
     }
 }
 
 /// How often a position controller's `state` goes out (Hz).
 const STATE_HZ: f64 = 50.0;
+
+/// `/<namespace>` for a controller written under `namespace` in its file (empty: the
+/// gazebo_ros_control plugin's `robotNamespace`); empty for none.
+fn namespace_prefix(robot: &RobotModel, namespace: &str) -> String {
+    let ns = if namespace.is_empty() {
+        robot
+            .ros_control
+            .as_ref()
+            .map_or("", |r| r.namespace.trim_matches('/'))
+    } else {
+        namespace.trim_matches('/')
+    };
+    if ns.is_empty() {
+        String::new()
+    } else {
+        format!("/{ns}")
+    }
+}
 
 /// The command topics of the robot's controllers: `/<namespace>/<controller>/command`, the
 /// namespace being the one the controllers file puts them under, else the gazebo_ros_control
@@ -190,10 +222,6 @@ fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
     let Some(config) = &robot.controllers else {
         return Vec::new();
     };
-    let plugin_ns = robot
-        .ros_control
-        .as_ref()
-        .map_or("", |r| r.namespace.trim_matches('/'));
     config
         .controllers
         .iter()
@@ -206,16 +234,7 @@ fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
             )
         })
         .map(|c| {
-            let ns = if c.namespace.is_empty() {
-                plugin_ns
-            } else {
-                c.namespace.trim_matches('/')
-            };
-            let prefix = if ns.is_empty() {
-                String::new()
-            } else {
-                format!("/{ns}")
-            };
+            let prefix = namespace_prefix(robot, &c.namespace);
             let (state, pid, state_hz) = match &c.kind {
                 ControllerKind::Trajectory(t) => (true, None, t.state_publish_rate_hz),
                 ControllerKind::Joint {

@@ -3,7 +3,7 @@
 //! `/<ns>/<controller>/follow_joint_trajectory/{goal,cancel,status,feedback,result}`
 //! (control_msgs/FollowJointTrajectoryAction). What a goal means (which are refused and with
 //! which code, how its run ends, preemption, cancels that stop the joints) is the shared
-//! bridge's (app/src/bridge/trajectory_goals.rs); here is actionlib's wire:
+//! bridge's (app/src/bridge/action_goals.rs); here is actionlib's wire:
 //! - a refused goal gets a REJECTED result with its code (INVALID_JOINTS, INVALID_GOAL);
 //! - an accepted one is ACTIVE, then SUCCEEDED, ABORTED (with the tolerance violated) or
 //!   PREEMPTED (cancelled, or replaced by a newer goal or a topic command), with its result;
@@ -28,13 +28,13 @@ use rover_ros1::{Node, Publisher, Subscriber};
 
 use super::convert::{header, seq_of, sim_trajectory};
 use crate::bridge::RosPlan;
+use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState};
 use crate::bridge::events::{ControlUpdate, RunSample, TopicFamily};
-use crate::bridge::trajectory_goals::{FeedbackArrays, Goal, GoalState, TrajectoryGoals};
 
 /// Seconds between status messages (actionlib's 5 Hz).
 const STATUS_PERIOD_S: f64 = 0.2;
 /// Seconds between feedback messages (joint_trajectory_controller's 20 Hz).
-const FEEDBACK_PERIOD_S: f64 = 0.05;
+pub(super) const FEEDBACK_PERIOD_S: f64 = 0.05;
 
 /// A goal's actionlib status.
 fn status_of(state: GoalState) -> u8 {
@@ -47,7 +47,7 @@ fn status_of(state: GoalState) -> u8 {
 }
 
 /// A goal's entry in the status list.
-fn goal_status(g: &Goal<GoalId>) -> GoalStatus {
+pub(super) fn goal_status(g: &Goal<GoalId>) -> GoalStatus {
     GoalStatus {
         goal_id: g.id.clone(),
         status: status_of(g.state),
@@ -57,7 +57,7 @@ fn goal_status(g: &Goal<GoalId>) -> GoalStatus {
 
 /// One controller's action server.
 struct ActionServer {
-    goals: TrajectoryGoals<GoalId>,
+    goals: ActionGoals<GoalId>,
     goal_in: Subscriber<FollowJointTrajectoryActionGoal>,
     cancel_in: Subscriber<GoalId>,
     status: Publisher<GoalStatusArray>,
@@ -84,7 +84,7 @@ impl TrajectoryActions {
     /// `node`; accepted trajectories go to the session through `to_session`.
     pub fn serve(node: &Node, plan: &RosPlan, to_session: Sender<Action>) -> Result<Self> {
         let mut servers = Vec::new();
-        for goals in TrajectoryGoals::for_plan(plan, "~/command") {
+        for goals in ActionGoals::trajectories(plan, "~/command") {
             let topic = |name: &str| format!("{}/{name}", goals.action);
             tracing::info!(
                 "ROS: action {} (control_msgs/FollowJointTrajectoryAction)",
@@ -129,14 +129,7 @@ impl ActionServer {
             self.take_goal(msg, now_s, run, to_session);
         }
         while let Some(cancel) = self.cancel_in.try_recv() {
-            // actionlib's rule: the goal with this id, and every goal stamped at or before a
-            // non-zero stamp; an empty id with a zero stamp is every goal.
-            let named = |g: &Goal<GoalId>| {
-                (cancel.id.is_empty() && cancel.stamp_s == 0.0)
-                    || (!cancel.id.is_empty() && g.id.id == cancel.id)
-                    || (cancel.stamp_s != 0.0 && g.id.stamp_s <= cancel.stamp_s)
-            };
-            self.goals.cancel(named, to_session);
+            self.goals.cancel_trajectory(named_by(&cancel), to_session);
         }
         self.goals.follow(run, now_s);
         let (result, msg) = (&mut self.result, &mut self.result_msg);
@@ -150,16 +143,12 @@ impl ActionServer {
             self.next_feedback_s = now_s + FEEDBACK_PERIOD_S;
             self.publish_feedback(update, now_s);
         }
-        if self.goals.take_changed() || now_s + 1e-9 >= self.next_status_s {
-            self.next_status_s = now_s + STATUS_PERIOD_S;
-            let m = &mut self.status_msg;
-            m.status_list.clear();
-            m.status_list
-                .extend(self.goals.goals.iter().map(goal_status));
-            m.header.seq = seq_of(&self.status);
-            m.header.stamp_s = now_s;
-            self.status.publish(m);
-        }
+        publish_status(
+            &mut self.goals,
+            (&mut self.status, &mut self.status_msg),
+            &mut self.next_status_s,
+            now_s,
+        );
     }
 
     /// Checks a goal: a refused one gets its REJECTED result at once, an accepted one starts.
@@ -170,14 +159,12 @@ impl ActionServer {
         run: RunSample,
         to_session: &Sender<Action>,
     ) {
-        let mut id = msg.goal_id;
-        if id.id.is_empty() {
-            self.unnamed += 1;
-            id.id = format!("rover-{}", self.unnamed);
-        }
+        let id = own_id(msg.goal_id, &mut self.unnamed);
         let trajectory = sim_trajectory(msg.goal.trajectory);
         match self.goals.check(&trajectory, false) {
-            Ok(()) => self.goals.accept(id, trajectory, now_s, run, to_session),
+            Ok(()) => self
+                .goals
+                .accept_trajectory(id, trajectory, (now_s, run), to_session),
             Err(r) => {
                 tracing::warn!(
                     "ROS: {} rejected goal {}: {}",
@@ -230,4 +217,40 @@ fn publish_result(
     msg.header.seq = seq_of(publisher);
     msg.header.stamp_s = now_s;
     publisher.publish(msg);
+}
+
+/// Which goals a `cancel` message names, by actionlib's rule: the goal with its id, and every
+/// goal stamped at or before a non-zero stamp; an empty id with a zero stamp is every goal.
+pub(super) fn named_by(cancel: &GoalId) -> impl Fn(&Goal<GoalId>) -> bool + '_ {
+    move |g| {
+        (cancel.id.is_empty() && cancel.stamp_s == 0.0)
+            || (!cancel.id.is_empty() && g.id.id == cancel.id)
+            || (cancel.stamp_s != 0.0 && g.id.stamp_s <= cancel.stamp_s)
+    }
+}
+
+/// A goal's id, `rover-N` for a goal sent without one.
+pub(super) fn own_id(mut id: GoalId, unnamed: &mut u64) -> GoalId {
+    if id.id.is_empty() {
+        *unnamed += 1;
+        id.id = format!("rover-{unnamed}");
+    }
+    id
+}
+
+/// The `status` topic: at 5 Hz and whenever a goal's state changed.
+pub(super) fn publish_status(
+    goals: &mut ActionGoals<GoalId>,
+    (publisher, msg): (&mut Publisher<GoalStatusArray>, &mut GoalStatusArray),
+    next_s: &mut f64,
+    now_s: f64,
+) {
+    if goals.take_changed() || now_s + 1e-9 >= *next_s {
+        *next_s = now_s + STATUS_PERIOD_S;
+        msg.status_list.clear();
+        msg.status_list.extend(goals.goals.iter().map(goal_status));
+        msg.header.seq = seq_of(publisher);
+        msg.header.stamp_s = now_s;
+        publisher.publish(msg);
+    }
 }

@@ -6,7 +6,8 @@
 //! ground truth), `laser.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
 //! `state` topics, which only ROS 1 carries (their control_msgs layouts differ between ROS 2
 //! distributions); `actions.rs`, actionlib's `follow_joint_trajectory` for each trajectory
-//! controller (what a goal means is the shared bridge's, app/src/bridge/trajectory_goals.rs);
+//! controller, and `gripper.rs`, `gripper_cmd` for each gripper controller (what a goal
+//! means is the shared bridge's, app/src/bridge/action_goals.rs);
 //! and the input half: `cmd_vel.rs`, `controllers.rs` (the controllers' `command` topics) and
 //! the arm's task (`arm.rs`), as rover input.
 //!
@@ -21,6 +22,7 @@ mod controller_states;
 mod controllers;
 mod convert;
 mod detections;
+mod gripper;
 mod joint_states;
 mod laser;
 mod model_states;
@@ -158,7 +160,12 @@ impl Bridge<()> {
         )?));
         let (to_session, from_actions) = std::sync::mpsc::channel();
         families.push(Box::new(actions::TrajectoryActions::serve(
-            &node, &plan, to_session,
+            &node,
+            &plan,
+            to_session.clone(),
+        )?));
+        families.push(Box::new(gripper::GripperActions::serve(
+            &node, &plan, robot, to_session,
         )?));
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
         let controllers = ControllerCommands::subscribe(&node, &plan)?;

@@ -6,7 +6,7 @@
 //!
 //! A topic family on the publishing thread: at every control update it takes the requests
 //! that came and answers them. What a goal means (which are refused, how its run ends,
-//! preemption, cancels) is the shared bridge's (app/src/bridge/trajectory_goals.rs); here is
+//! preemption, cancels) is the shared bridge's (app/src/bridge/action_goals.rs); here is
 //! ROS 2's wire: a refused goal is not accepted (its reason in rover's log), an ended one is
 //! SUCCEEDED, ABORTED or CANCELED in the status list and get_result's reply. Feedback at
 //! 20 Hz (joint_trajectory_controller's `action_monitor_rate`).
@@ -31,8 +31,8 @@ use super::discovery::RosDistro;
 use super::msgs::{Duration, Time};
 use super::services::{RequestHeader, Server};
 use crate::bridge::RosPlan;
+use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState, code};
 use crate::bridge::events::{ControlUpdate, TopicFamily};
-use crate::bridge::trajectory_goals::{FeedbackArrays, Goal, GoalState, TrajectoryGoals, code};
 
 /// Seconds between feedback messages (20 Hz).
 const FEEDBACK_PERIOD_S: f64 = 0.05;
@@ -86,7 +86,7 @@ fn result(g: &Goal<Uuid>) -> FollowJointTrajectoryResult {
 
 /// One controller's action server.
 struct ActionServer {
-    goals: TrajectoryGoals<Uuid>,
+    goals: ActionGoals<Uuid>,
     send_goal: Server<SendGoal>,
     cancel_goal: Server<CancelGoal>,
     get_result: Server<GetResult>,
@@ -117,7 +117,7 @@ impl TrajectoryActions {
         to_session: Sender<Action>,
     ) -> Result<Self> {
         let mut servers = Vec::new();
-        for goals in TrajectoryGoals::for_plan(plan, "~/joint_trajectory") {
+        for goals in ActionGoals::trajectories(plan, "~/joint_trajectory") {
             let internal = format!("{}/_action/", goals.action);
             let dds = format!("rt{internal}");
             tracing::info!(
@@ -232,7 +232,7 @@ impl ActionServer {
             let accepted = match self.goals.check(&trajectory, multi_dof) {
                 Ok(()) => {
                     self.goals
-                        .accept(goal_id, trajectory, now_s, run, to_session);
+                        .accept_trajectory(goal_id, trajectory, (now_s, run), to_session);
                     true
                 }
                 Err(r) => {
@@ -289,7 +289,7 @@ impl ActionServer {
                 g.id == info.goal_id
             }
         };
-        let (cancelled, ended_before) = self.goals.cancel(named, to_session);
+        let (cancelled, ended_before) = self.goals.cancel_trajectory(named, to_session);
         if cancelled.is_empty() {
             let code = if ended_before {
                 CANCEL_ERROR_GOAL_TERMINATED

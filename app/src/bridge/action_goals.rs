@@ -1,14 +1,15 @@
-//! A joint trajectory controller's action goals (control_msgs FollowJointTrajectory), as
-//! joint_trajectory_controller handles them, for both transports: which goals are refused and
-//! with which result code, how an accepted goal's trajectory reaches the session, how its run
-//! ends (SUCCEEDED, ABORTED with the tolerance violated, or CANCELED), preemption by a newer
-//! goal or a command on the controller's topic, cancels that stop the joints where they are,
-//! and the feedback's arrays. The transports keep only their wire: ROS 1's actionlib topics
-//! (app/src/ros/actions.rs), ROS 2's action services (app/src/ros2/actions.rs). A goal's id is
-//! the transport's own (actionlib's string, ROS 2's UUID).
+//! The controllers' action goals as ros_control serves them, for both transports:
+//! control_msgs FollowJointTrajectory as joint_trajectory_controller handles it, and
+//! GripperCommand as gripper_action_controller does. Here: which goals are refused and with
+//! which result code, how an accepted goal reaches the session, how its run ends (SUCCEEDED,
+//! ABORTED with the tolerance violated or the gripper stalled, or CANCELED), preemption by a
+//! newer goal or a command on the controller's topic, cancels that stop the joints where they
+//! are, and the feedback's arrays. The transports keep only their wire: ROS 1's actionlib
+//! topics (app/src/ros/actions.rs), ROS 2's action services (app/src/ros2/actions.rs). A goal's
+//! id is the transport's own (actionlib's string, ROS 2's UUID).
 //!
-//! The goal's tolerances and `goal_time_tolerance` are not read: the controller's own, from the
-//! controllers file, apply.
+//! A trajectory goal's tolerances and `goal_time_tolerance` are not read: the controller's own,
+//! from the controllers file, apply.
 
 use std::sync::mpsc::Sender;
 
@@ -16,7 +17,7 @@ use rover_core::{Action, JointAction};
 use rover_sim::{JointTrajectory, TrajectoryOutcome};
 
 use super::RosPlan;
-use super::events::{ControlUpdate, JointSample, RunSample};
+use super::events::{ControlUpdate, GripperSample, JointSample, RunSample};
 
 /// How long a goal may wait for its controller to start it (s of sim time).
 const START_TIMEOUT_S: f64 = 1.0;
@@ -73,7 +74,9 @@ pub(crate) struct Goal<Id> {
     pub error_string: String,
     /// When it was accepted (sim s).
     pub accepted_s: f64,
-    /// Its ending was handed to the transport ([`TrajectoryGoals::take_ended`]).
+    /// The controller's run when it ended (a gripper's result is read from it).
+    pub last_run: RunSample,
+    /// Its ending was handed to the transport ([`ActionGoals::take_ended`]).
     reported: bool,
     /// The controller's run count when it was accepted: its own run is the next.
     runs_before: u64,
@@ -111,18 +114,30 @@ pub(crate) struct FeedbackArrays {
     pub index: usize,
 }
 
-/// One trajectory controller's goals.
+/// Which action a controller serves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    /// FollowJointTrajectory.
+    Trajectory,
+    /// GripperCommand; a stall ends the goal succeeded with `allow_stalling`, else aborted.
+    Gripper { allow_stalling: bool },
+}
+
+/// One controller's goals.
 #[derive(Debug)]
-pub(crate) struct TrajectoryGoals<Id> {
+pub(crate) struct ActionGoals<Id> {
     /// The controller's name.
     pub controller: String,
-    /// The action's name: the controller's namespace, `/follow_joint_trajectory`.
+    /// The action's name: the controller's namespace, `/follow_joint_trajectory` or
+    /// `/gripper_cmd`.
     pub action: String,
     /// Its joints' names, in the controller's order.
     pub joint_names: Vec<String>,
     /// The goals accepted, the ended ones kept a while.
     pub goals: Vec<Goal<Id>>,
-    /// The controller's index in the plan (its run sample).
+    /// Which action it serves.
+    kind: Kind,
+    /// The controller's index among the update's run samples.
     index: usize,
     /// Its joints' indices in the plan.
     joints: Vec<usize>,
@@ -133,10 +148,10 @@ pub(crate) struct TrajectoryGoals<Id> {
     preempted_by_topic: String,
 }
 
-impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
+impl<Id: Clone + PartialEq> ActionGoals<Id> {
     /// One for each of the plan's trajectory controllers; `command_topic` is the controller's
     /// trajectory topic as the transport names it (`~/command`, `~/joint_trajectory`).
-    pub fn for_plan(plan: &RosPlan, command_topic: &str) -> Vec<Self> {
+    pub fn trajectories(plan: &RosPlan, command_topic: &str) -> Vec<Self> {
         plan.controllers
             .iter()
             .enumerate()
@@ -155,6 +170,7 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
                         .map(|&j| plan.joints[j].name.clone())
                         .collect(),
                     goals: Vec::new(),
+                    kind: Kind::Trajectory,
                     index,
                     joints: c.joints.clone(),
                     changed: false,
@@ -162,6 +178,83 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
                 }
             })
             .collect()
+    }
+
+    /// One for each of the plan's gripper controllers (`robot` says whether a stall succeeds).
+    pub fn grippers(plan: &RosPlan, robot: &rover_sim::RobotModel) -> Vec<Self> {
+        plan.grippers
+            .iter()
+            .enumerate()
+            .map(|(k, (name, action))| {
+                let spec = robot
+                    .controllers
+                    .as_ref()
+                    .and_then(|c| c.controller(name))
+                    .map(|c| &c.kind);
+                let allow_stalling = matches!(
+                    spec,
+                    Some(rover_sim::ControllerKind::Gripper(g)) if g.allow_stalling
+                );
+                Self {
+                    controller: name.clone(),
+                    action: action.clone(),
+                    joint_names: Vec::new(),
+                    goals: Vec::new(),
+                    kind: Kind::Gripper { allow_stalling },
+                    index: plan.controllers.len() + k,
+                    joints: Vec::new(),
+                    changed: false,
+                    preempted_by_topic: String::new(),
+                }
+            })
+            .collect()
+    }
+
+    /// Why gripper_action_controller would refuse a GripperCommand, if it would.
+    pub fn check_gripper(position: f64, max_effort: f64) -> Result<(), Rejection> {
+        if position.is_finite() && max_effort.is_finite() {
+            Ok(())
+        } else {
+            Err(Rejection {
+                code: code::INVALID_GOAL,
+                why: format!(
+                    "position {position} and max_effort {max_effort} must be finite numbers"
+                ),
+            })
+        }
+    }
+
+    /// Accepts a gripper command: the goal executing is preempted, the command goes to the
+    /// session.
+    pub fn accept_gripper(
+        &mut self,
+        id: Id,
+        (position, max_effort): (f64, f64),
+        (now_s, run): (f64, RunSample),
+        to_session: &Sender<Action>,
+    ) {
+        let action = Action::Joint(JointAction::Gripper {
+            controller: self.controller.clone(),
+            position,
+            max_effort,
+        });
+        self.accept(id, action, Vec::new(), (now_s, run), to_session);
+    }
+
+    /// Cancels the executing gripper goals `named` picks; the fingers hold where they are
+    /// (`position`, the finger's now), as gripper_action_controller does.
+    pub fn cancel_gripper(
+        &mut self,
+        named: impl Fn(&Goal<Id>) -> bool,
+        position: f64,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Id>, bool) {
+        let hold = Action::Joint(JointAction::Gripper {
+            controller: self.controller.clone(),
+            position,
+            max_effort: 0.0,
+        });
+        self.cancel(named, hold, to_session)
     }
 
     /// This controller's run in `update`.
@@ -219,14 +312,33 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
         Ok(())
     }
 
-    /// Accepts a checked goal: the goal executing is preempted (CANCELED, as
+    /// Accepts a checked trajectory goal: the goal executing is preempted (CANCELED, as
     /// joint_trajectory_controller does) and the trajectory goes to the session.
-    pub fn accept(
+    pub fn accept_trajectory(
         &mut self,
         id: Id,
         trajectory: JointTrajectory,
-        now_s: f64,
-        run: RunSample,
+        (now_s, run): (f64, RunSample),
+        to_session: &Sender<Action>,
+    ) {
+        let point_times_s = trajectory
+            .points
+            .iter()
+            .map(|p| p.time_from_start_s)
+            .collect();
+        let action = Action::Joint(JointAction::Trajectory {
+            controller: self.controller.clone(),
+            trajectory: Box::new(trajectory),
+        });
+        self.accept(id, action, point_times_s, (now_s, run), to_session);
+    }
+
+    fn accept(
+        &mut self,
+        id: Id,
+        action: Action,
+        point_times_s: Vec<f64>,
+        (now_s, run): (f64, RunSample),
         to_session: &Sender<Action>,
     ) {
         for g in self.goals.iter_mut().filter(|g| !g.ended()) {
@@ -236,21 +348,14 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
                 "preempted by a new goal",
             );
         }
-        let point_times_s = trajectory
-            .points
-            .iter()
-            .map(|p| p.time_from_start_s)
-            .collect();
-        let _ = to_session.send(Action::Joint(JointAction::Trajectory {
-            controller: self.controller.clone(),
-            trajectory: Box::new(trajectory),
-        }));
+        let _ = to_session.send(action);
         self.goals.push(Goal {
             id,
             state: GoalState::Executing,
             error_code: code::SUCCESSFUL,
             error_string: String::new(),
             accepted_s: now_s,
+            last_run: run,
             reported: false,
             runs_before: run.runs,
             started: false,
@@ -259,11 +364,31 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
         self.changed = true;
     }
 
-    /// Cancels the executing goals `named` picks; the joints stop where they are. The ids
-    /// cancelled, and whether a named goal had already ended.
-    pub fn cancel(
+    /// Cancels the executing trajectory goals `named` picks; the joints stop where they are
+    /// (a trajectory without points). The ids cancelled, and whether a named goal had already
+    /// ended.
+    pub fn cancel_trajectory(
         &mut self,
         named: impl Fn(&Goal<Id>) -> bool,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Id>, bool) {
+        let stop = Action::Joint(JointAction::Trajectory {
+            controller: self.controller.clone(),
+            trajectory: Box::new(JointTrajectory {
+                start_s: 0.0,
+                joint_names: self.joint_names.clone(),
+                points: Vec::new(),
+            }),
+        });
+        self.cancel(named, stop, to_session)
+    }
+
+    /// Cancels the executing goals `named` picks and sends `stop` if any was. The ids
+    /// cancelled, and whether a named goal had already ended.
+    fn cancel(
+        &mut self,
+        named: impl Fn(&Goal<Id>) -> bool,
+        stop: Action,
         to_session: &Sender<Action>,
     ) -> (Vec<Id>, bool) {
         let mut cancelled = Vec::new();
@@ -277,16 +402,7 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
             cancelled.push(g.id.clone());
         }
         if !cancelled.is_empty() {
-            // A trajectory without points stops the controller's run and holds the joints
-            // where they are.
-            let _ = to_session.send(Action::Joint(JointAction::Trajectory {
-                controller: self.controller.clone(),
-                trajectory: Box::new(JointTrajectory {
-                    start_s: 0.0,
-                    joint_names: self.joint_names.clone(),
-                    points: Vec::new(),
-                }),
-            }));
+            let _ = to_session.send(stop);
             self.changed = true;
         }
         (cancelled, ended_before)
@@ -325,21 +441,10 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
         if run.active {
             return;
         }
-        let (state, code, why) = match run.outcome {
-            Some(TrajectoryOutcome::Reached) | None => {
-                (GoalState::Succeeded, code::SUCCESSFUL, "goal reached")
-            }
-            Some(TrajectoryOutcome::PathToleranceViolated) => (
-                GoalState::Aborted,
-                code::PATH_TOLERANCE_VIOLATED,
-                "PATH_TOLERANCE_VIOLATED",
-            ),
-            Some(TrajectoryOutcome::GoalToleranceViolated) => (
-                GoalState::Aborted,
-                code::GOAL_TOLERANCE_VIOLATED,
-                "GOAL_TOLERANCE_VIOLATED",
-            ),
-            Some(TrajectoryOutcome::Stopped) => (GoalState::Canceled, code::SUCCESSFUL, "stopped"),
+        g.last_run = run;
+        let (state, code, why) = match self.kind {
+            Kind::Trajectory => trajectory_ending(run),
+            Kind::Gripper { allow_stalling } => gripper_ending(run.gripper, allow_stalling),
         };
         g.end(state, code, why);
         self.changed = true;
@@ -401,17 +506,53 @@ impl<Id: Clone + PartialEq> TrajectoryGoals<Id> {
     }
 }
 
+/// How a trajectory's run ended, as FollowJointTrajectory's result says it.
+fn trajectory_ending(run: RunSample) -> (GoalState, i32, &'static str) {
+    match run.outcome {
+        Some(TrajectoryOutcome::Reached) | None => {
+            (GoalState::Succeeded, code::SUCCESSFUL, "goal reached")
+        }
+        Some(TrajectoryOutcome::PathToleranceViolated) => (
+            GoalState::Aborted,
+            code::PATH_TOLERANCE_VIOLATED,
+            "PATH_TOLERANCE_VIOLATED",
+        ),
+        Some(TrajectoryOutcome::GoalToleranceViolated) => (
+            GoalState::Aborted,
+            code::GOAL_TOLERANCE_VIOLATED,
+            "GOAL_TOLERANCE_VIOLATED",
+        ),
+        Some(TrajectoryOutcome::Stopped) => (GoalState::Canceled, code::SUCCESSFUL, "stopped"),
+    }
+}
+
+/// How a gripper command ended, as gripper_action_controller says it: at its goal, SUCCEEDED;
+/// stalled on something, ABORTED (ROS 1's rule) or SUCCEEDED with `allow_stalling` (ROS 2's
+/// option).
+fn gripper_ending(g: GripperSample, allow_stalling: bool) -> (GoalState, i32, &'static str) {
+    if g.reached_goal {
+        (GoalState::Succeeded, code::SUCCESSFUL, "goal reached")
+    } else if g.stalled && allow_stalling {
+        (GoalState::Succeeded, code::SUCCESSFUL, "stalled (allowed)")
+    } else if g.stalled {
+        (GoalState::Aborted, code::SUCCESSFUL, "stalled")
+    } else {
+        (GoalState::Canceled, code::SUCCESSFUL, "stopped")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use rover_sim::TrajectoryPoint;
 
-    fn goals() -> TrajectoryGoals<u32> {
-        TrajectoryGoals {
+    fn goals() -> ActionGoals<u32> {
+        ActionGoals {
             controller: "arm_controller".into(),
             action: "/arm_controller/follow_joint_trajectory".into(),
             joint_names: vec!["a".into(), "b".into()],
             goals: Vec::new(),
+            kind: Kind::Trajectory,
             index: 0,
             joints: vec![0, 1],
             changed: false,
@@ -464,26 +605,24 @@ mod tests {
         let (to_session, from) = std::sync::mpsc::channel();
         let mut g = goals();
         let idle = RunSample::default();
-        g.accept(
+        g.accept_trajectory(
             1,
             trajectory(&["a", "b"], vec![0.1, 0.2]),
-            0.0,
-            idle,
+            (0.0, idle),
             &to_session,
         );
         assert!(from.try_recv().is_ok());
         let running = RunSample {
             active: true,
             runs: 1,
-            outcome: None,
+            ..RunSample::default()
         };
         g.follow(running, 0.1);
         assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Executing));
-        g.accept(
+        g.accept_trajectory(
             2,
             trajectory(&["a", "b"], vec![0.0, 0.0]),
-            0.2,
-            running,
+            (0.2, running),
             &to_session,
         );
         assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Canceled));
@@ -492,6 +631,7 @@ mod tests {
                 active: false,
                 runs: 2,
                 outcome: Some(TrajectoryOutcome::Reached),
+                ..RunSample::default()
             },
             1.5,
         );
@@ -506,15 +646,14 @@ mod tests {
     fn a_cancel_stops_the_joints_and_a_goal_never_started_aborts() {
         let (to_session, from) = std::sync::mpsc::channel();
         let mut g = goals();
-        g.accept(
+        g.accept_trajectory(
             7,
             trajectory(&["a", "b"], vec![0.1, 0.2]),
-            0.0,
-            RunSample::default(),
+            (0.0, RunSample::default()),
             &to_session,
         );
         let _ = from.try_recv();
-        let (cancelled, ended_before) = g.cancel(|x| x.id == 7, &to_session);
+        let (cancelled, ended_before) = g.cancel_trajectory(|x| x.id == 7, &to_session);
         assert_eq!(cancelled.len(), 1);
         assert!(!ended_before);
         match from.try_recv() {
@@ -523,17 +662,35 @@ mod tests {
             }
             other => panic!("expected a stop, got {other:?}"),
         }
-        assert!(g.cancel(|x| x.id == 7, &to_session).1);
-        g.accept(
+        assert!(g.cancel_trajectory(|x| x.id == 7, &to_session).1);
+        g.accept_trajectory(
             8,
             trajectory(&["a", "b"], vec![0.1, 0.2]),
-            2.0,
-            RunSample::default(),
+            (2.0, RunSample::default()),
             &to_session,
         );
         g.follow(RunSample::default(), 3.5);
         let goal = g.goal(&8);
         assert_eq!(goal.map(|x| x.state), Some(GoalState::Aborted));
         assert_eq!(goal.map(|x| x.error_code), Some(code::INVALID_GOAL));
+    }
+
+    #[test]
+    fn a_gripper_goal_ends_as_its_command_did() {
+        let stalled = GripperSample {
+            position: 0.03,
+            effort: 5.0,
+            stalled: true,
+            reached_goal: false,
+        };
+        assert_eq!(gripper_ending(stalled, false).0, GoalState::Aborted);
+        assert_eq!(gripper_ending(stalled, true).0, GoalState::Succeeded);
+        let reached = GripperSample {
+            reached_goal: true,
+            ..GripperSample::default()
+        };
+        assert_eq!(gripper_ending(reached, false).0, GoalState::Succeeded);
+        assert!(ActionGoals::<u32>::check_gripper(f64::NAN, 1.0).is_err());
+        assert!(ActionGoals::<u32>::check_gripper(0.01, 0.0).is_ok());
     }
 }
