@@ -1278,3 +1278,159 @@ print('statuses %s' % ' '.join('/'.join('%d:%d' % x for x in s) for s in seen))
     );
     Ok(())
 }
+
+/// GripperCommand's messages for a Cyclone DDS peer (with [`ACTION_MESSAGES`]).
+const GRIPPER_MESSAGES: &str = r#"
+@dataclass
+class GripperCommand(IdlStruct, typename="control_msgs::msg::dds_::GripperCommand_"):
+    position: types.float64
+    max_effort: types.float64
+
+@dataclass
+class GC_Goal(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_Goal_"):
+    command: GripperCommand
+
+@dataclass
+class GC_Result(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_Result_"):
+    position: types.float64
+    effort: types.float64
+    stalled: bool
+    reached_goal: bool
+
+@dataclass
+class GC_FeedbackMessage(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_FeedbackMessage_"):
+    goal_id: UUID
+    feedback: GC_Result
+
+@dataclass
+class GC_SendGoal_Request(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_SendGoal_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    goal_id: UUID
+    goal: GC_Goal
+
+@dataclass
+class GC_SendGoal_Response(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_SendGoal_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    accepted: bool
+    stamp: Time
+
+@dataclass
+class GC_GetResult_Request(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_GetResult_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    goal_id: UUID
+
+@dataclass
+class GC_GetResult_Response(IdlStruct, typename="control_msgs::action::dds_::GripperCommand_GetResult_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    status: types.int8
+    result: GC_Result
+"#;
+
+/// MoveIt's gripper on ROS 2: a Cyclone DDS action client on `/gripper_controller/gripper_cmd`
+/// (control_msgs/action/GripperCommand, as ros2_control's gripper_action_controller serves it)
+/// closes the test grasper (tests/grasper) on the ball between its fingers: accepted, feedback
+/// while the fingers move, and get_result says ABORTED with `stalled` (the ball stops them
+/// short of the goal, pushing with the goal's max_effort); a goal with a NaN position is not
+/// accepted; reopening SUCCEEDS with `reached_goal`.
+#[test]
+fn a_cyclone_action_client_closes_the_gripper_on_the_ball() -> Result<()> {
+    let Some(cyclonedds) = cyclonedds() else {
+        return Ok(());
+    };
+    let mut graph = Graph::new(cyclonedds, domain(11))?;
+    let world = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/grasper/grasper.toml");
+    graph.spawn_rover(
+        40.0,
+        &["--world", &world.to_string_lossy(), "--no-detector"],
+    )?;
+    std::thread::sleep(Duration::from_secs(2));
+    let script = format!(
+        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{GRIPPER_MESSAGES}\n{}",
+        r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
+a = '/gripper_controller/gripper_cmd/_action/'
+def service(name, req, resp):
+    return (DataWriter(dp, Topic(dp, 'rq' + a + name + 'Request', req), qos=reliable),
+            DataReader(dp, Topic(dp, 'rr' + a + name + 'Reply', resp), qos=reliable))
+send = service('send_goal', GC_SendGoal_Request, GC_SendGoal_Response)
+result = service('get_result', GC_GetResult_Request, GC_GetResult_Response)
+feedback = DataReader(dp, Topic(dp, 'rt' + a + 'feedback', GC_FeedbackMessage), qos=reliable)
+time.sleep(3)
+seq = [0]
+def goal(label, k, position, effort, wait):
+    seq[0] += 1
+    gid = UUID(uuid=[k] * 16)
+    send[0].write(GC_SendGoal_Request(guid=7, seq=seq[0], goal_id=gid, goal=GC_Goal(command=GripperCommand(position=position, max_effort=effort))))
+    end = time.time() + 3
+    accepted = []
+    while time.time() < end and not accepted:
+        accepted += send[1].take(N=10)
+        time.sleep(0.02)
+    print('%s accepted %s' % (label, [r.accepted for r in accepted]))
+    if not accepted or not accepted[0].accepted:
+        return
+    seq[0] += 1
+    result[0].write(GC_GetResult_Request(guid=7, seq=seq[0], goal_id=gid))
+    end = time.time() + wait
+    got, fb = [], []
+    while time.time() < end and not got:
+        got += result[1].take(N=10)
+        fb += [f for f in feedback.take(N=100) if bytes(f.goal_id.uuid)[0] == k]
+        time.sleep(0.02)
+    for r in got:
+        x = r.result
+        print('%s result %d %.4f %.3f %d %d feedback %d' % (label, r.status, x.position, x.effort, x.stalled, x.reached_goal, len(fb)))
+goal('close', 1, 0.05, 5.0, 10)
+goal('nan', 2, float('nan'), 1.0, 1)
+goal('open', 3, 0.0, 0.0, 10)
+"#
+    );
+    let out = graph.python("gripper.py", &script, Duration::from_secs(60))?;
+    println!("{out}");
+    let log = std::fs::read_to_string(graph.dir.path().join("rover.log"))?;
+    let numbers = |prefix: &str| -> Result<Vec<f64>> {
+        let rest = out
+            .lines()
+            .find_map(|l| l.strip_prefix(prefix))
+            .with_context(|| format!("no \"{prefix}\" line:\n{out}\nrover:\n{log}"))?;
+        Ok(rest.split(' ').filter_map(|w| w.parse().ok()).collect())
+    };
+    ensure!(
+        out.contains("close accepted [True]") && out.contains("nan accepted [False]"),
+        "accepting goals:\n{out}\nrover:\n{log}"
+    );
+    // [status, position, effort, stalled, reached_goal, feedback]; action_msgs: SUCCEEDED 4,
+    // ABORTED 6.
+    let close = numbers("close result ")?;
+    ensure!(
+        close[0] == 6.0
+            && close[1] > 0.029
+            && close[1] < 0.038
+            && close[3] == 1.0
+            && close[4] == 0.0,
+        "closing on the ball: {close:?}"
+    );
+    ensure!(
+        close[2] > 2.5 && close[2] <= 5.0 + 1e-3 && close[5] >= 5.0,
+        "closing on the ball: effort (max 5 N) and feedback: {close:?}"
+    );
+    let open = numbers("open result ")?;
+    ensure!(
+        open[0] == 4.0 && open[1].abs() <= 0.002 && open[4] == 1.0,
+        "reopening: {open:?}"
+    );
+    Ok(())
+}

@@ -1,7 +1,7 @@
-//! The messages of a ROS 2 action as rover serves `control_msgs/action/FollowJointTrajectory`
+//! The messages of the ROS 2 actions rover serves, `control_msgs/action/FollowJointTrajectory`
 //! (Humble's and Jazzy's layout; from Lyrical on the feedback carries two more fields,
-//! `index` and `multi_dof_index`, control_msgs 6), and action_msgs' goal bookkeeping: serde
-//! structs in CDR layout, as `msgs.rs`.
+//! `index` and `multi_dof_index`, control_msgs 6) and `control_msgs/action/GripperCommand`,
+//! and action_msgs' goal bookkeeping: serde structs in CDR layout, as `msgs.rs`.
 
 use serde::ser::SerializeStruct;
 use serde::{Deserialize, Serialize, Serializer};
@@ -232,6 +232,70 @@ impl Serialize for FeedbackMessage {
         s.serialize_field("feedback", &Feedback(self))?;
         s.end()
     }
+}
+
+/// `control_msgs/msg/GripperCommand`: where the fingers should go, and the most effort.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct GripperCommand {
+    /// The finger joint's position (m or rad).
+    pub position: f64,
+    /// The most effort (N or N m); 0 or less: the joint's limit.
+    pub max_effort: f64,
+}
+
+/// `control_msgs/action/GripperCommand`'s goal.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct GripperCommandGoal {
+    /// The command.
+    pub command: GripperCommand,
+}
+
+/// `control_msgs/action/GripperCommand`'s result (and its feedback: the same fields).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct GripperCommandResult {
+    /// Where the finger is.
+    pub position: f64,
+    /// The effort it exerts.
+    pub effort: f64,
+    /// It pushes without moving, short of the goal.
+    pub stalled: bool,
+    /// It reached the goal.
+    pub reached_goal: bool,
+}
+
+/// GripperCommand's SendGoal.
+pub struct GripperSendGoal;
+impl ServiceType for GripperSendGoal {
+    type Request = (Uuid, GripperCommandGoal);
+    type Response = (bool, Time);
+    const REQUEST_TYPE: &'static str =
+        "control_msgs::action::dds_::GripperCommand_SendGoal_Request_";
+    const RESPONSE_TYPE: &'static str =
+        "control_msgs::action::dds_::GripperCommand_SendGoal_Response_";
+}
+
+/// GripperCommand's GetResult.
+pub struct GripperGetResult;
+impl ServiceType for GripperGetResult {
+    type Request = Uuid;
+    type Response = (i8, GripperCommandResult);
+    const REQUEST_TYPE: &'static str =
+        "control_msgs::action::dds_::GripperCommand_GetResult_Request_";
+    const RESPONSE_TYPE: &'static str =
+        "control_msgs::action::dds_::GripperCommand_GetResult_Response_";
+}
+
+/// GripperCommand's feedback topic type name.
+pub const GRIPPER_FEEDBACK_TYPE: &str =
+    "control_msgs::action::dds_::GripperCommand_FeedbackMessage_";
+
+/// `GripperCommand_FeedbackMessage`: the goal's id and the feedback.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct GripperFeedbackMessage {
+    /// Which goal.
+    pub goal_id: Uuid,
+    /// The finger now.
+    pub feedback: GripperCommandResult,
 }
 
 #[cfg(test)]

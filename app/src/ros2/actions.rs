@@ -1,8 +1,11 @@
 //! `follow_joint_trajectory` for each joint trajectory controller, as ros2_control's
 //! joint_trajectory_controller serves it (`/<controller>/follow_joint_trajectory`,
-//! control_msgs/action/FollowJointTrajectory): the send_goal, cancel_goal and get_result
-//! services and the feedback and status topics, as rcl maps an action onto them
-//! (`rq/<action>/_action/send_goalRequest`, `rt/<action>/_action/feedback`, ...).
+//! control_msgs/action/FollowJointTrajectory), and `gripper_cmd` for each gripper controller,
+//! as its gripper_action_controller does (`/<controller>/gripper_cmd`,
+//! control_msgs/action/GripperCommand): the send_goal, cancel_goal and get_result services and
+//! the feedback and status topics, as rcl maps an action onto them
+//! (`rq/<action>/_action/send_goalRequest`, `rt/<action>/_action/feedback`, ...). One server
+//! serves either action ([`ActionType`] says what differs).
 //!
 //! A topic family on the publishing thread: at every control update it takes the requests
 //! that came and answers them. What a goal means (which are refused, how its run ends,
@@ -15,7 +18,7 @@ use std::sync::mpsc::Sender;
 
 use anyhow::{Context, Result};
 use rover_core::Action;
-use rover_sim::{JointTrajectory, TrajectoryPoint};
+use rover_sim::{JointTrajectory, RobotModel, TrajectoryPoint};
 use rustdds::no_key::DataWriter;
 use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, QosPolicies, RTPSEntity, TopicKind};
 use serde::Serialize;
@@ -23,19 +26,209 @@ use serde::Serialize;
 use super::action_msgs::{
     CANCEL_ERROR_GOAL_TERMINATED, CANCEL_ERROR_NONE, CANCEL_ERROR_UNKNOWN_GOAL_ID, CancelGoal,
     FEEDBACK_TYPE, FeedbackMessage, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
-    GetResult, GoalInfo, GoalStatus, GoalStatusArray, STATUS_ABORTED, STATUS_CANCELED,
-    STATUS_EXECUTING, STATUS_SUCCEEDED, STATUS_TYPE, SendGoal, Uuid,
+    GRIPPER_FEEDBACK_TYPE, GetResult, GoalInfo, GoalStatus, GoalStatusArray, GripperCommandGoal,
+    GripperCommandResult, GripperFeedbackMessage, GripperGetResult, GripperSendGoal,
+    STATUS_ABORTED, STATUS_CANCELED, STATUS_EXECUTING, STATUS_SUCCEEDED, STATUS_TYPE, SendGoal,
+    Uuid,
 };
 use super::dds::{default_qos, latched_qos};
 use super::discovery::RosDistro;
-use super::msgs::{Duration, Time};
-use super::services::{RequestHeader, Server};
+use super::msgs::Time;
+use super::services::{RequestHeader, Server, ServiceType};
 use crate::bridge::RosPlan;
-use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState, code};
-use crate::bridge::events::{ControlUpdate, TopicFamily};
+use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, code};
+use crate::bridge::events::{ControlUpdate, GripperSample, RunSample, TopicFamily};
 
 /// Seconds between feedback messages (20 Hz).
 const FEEDBACK_PERIOD_S: f64 = 0.05;
+
+/// What one control_msgs action is on ROS 2's wire, and how its goals go to the shared book.
+trait ActionType {
+    /// Its send_goal service.
+    type SendGoal: ServiceType<Response = (bool, Time)>;
+    /// Its get_result service.
+    type GetResult: ServiceType<Request = Uuid>;
+    /// What the server keeps to publish feedback.
+    type Feedback;
+    /// Its feedback message.
+    type FeedbackMessage: Serialize + Clone;
+    /// The feedback topic's type name.
+    const FEEDBACK_TYPE: &'static str;
+    /// The action's type, for the log.
+    const NAME: &'static str;
+
+    /// The feedback's first state.
+    fn feedback(distro: RosDistro) -> Self::Feedback;
+    /// Checks a send_goal request's goal and, if it is good, accepts it.
+    fn take(
+        goals: &mut ActionGoals<Uuid>,
+        request: <Self::SendGoal as ServiceType>::Request,
+        now: (f64, RunSample),
+        to_session: &Sender<Action>,
+    ) -> Result<(), Rejection>;
+    /// Cancels the goals `named` picks, stopping the joints.
+    fn cancel(
+        goals: &mut ActionGoals<Uuid>,
+        named: impl Fn(&Goal<Uuid>) -> bool,
+        run: RunSample,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Uuid>, bool);
+    /// An ended goal's get_result reply; `None`: a goal the server does not know.
+    fn result(g: Option<&Goal<Uuid>>) -> <Self::GetResult as ServiceType>::Response;
+    /// The executing goal's feedback, if one executes.
+    fn fill<'f>(
+        feedback: &'f mut Self::Feedback,
+        goals: &ActionGoals<Uuid>,
+        update: &ControlUpdate,
+        now_s: f64,
+    ) -> Option<&'f Self::FeedbackMessage>;
+}
+
+/// control_msgs/action/FollowJointTrajectory.
+struct FollowJointTrajectory;
+
+impl ActionType for FollowJointTrajectory {
+    type SendGoal = SendGoal;
+    type GetResult = GetResult;
+    type Feedback = (FeedbackArrays, FeedbackMessage);
+    type FeedbackMessage = FeedbackMessage;
+    const FEEDBACK_TYPE: &'static str = FEEDBACK_TYPE;
+    const NAME: &'static str = "control_msgs/action/FollowJointTrajectory";
+
+    fn feedback(distro: RosDistro) -> Self::Feedback {
+        let msg = FeedbackMessage {
+            with_index: distro >= RosDistro::Lyrical,
+            ..FeedbackMessage::default()
+        };
+        (FeedbackArrays::default(), msg)
+    }
+
+    fn take(
+        goals: &mut ActionGoals<Uuid>,
+        (id, goal): (Uuid, FollowJointTrajectoryGoal),
+        now: (f64, RunSample),
+        to_session: &Sender<Action>,
+    ) -> Result<(), Rejection> {
+        let trajectory = trajectory_of(&goal);
+        let multi_dof = !goal.multi_dof_trajectory.points.is_empty();
+        goals.check(&trajectory, multi_dof)?;
+        goals.accept_trajectory(id, trajectory, now, to_session);
+        Ok(())
+    }
+
+    fn cancel(
+        goals: &mut ActionGoals<Uuid>,
+        named: impl Fn(&Goal<Uuid>) -> bool,
+        _run: RunSample,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Uuid>, bool) {
+        goals.cancel_trajectory(named, to_session)
+    }
+
+    fn result(g: Option<&Goal<Uuid>>) -> (i8, FollowJointTrajectoryResult) {
+        match g {
+            Some(g) => (
+                status_of(g.state),
+                FollowJointTrajectoryResult {
+                    error_code: g.error_code,
+                    error_string: g.error_string.clone(),
+                },
+            ),
+            None => (
+                STATUS_ABORTED,
+                FollowJointTrajectoryResult {
+                    error_code: code::INVALID_GOAL,
+                    error_string: "unknown goal".to_owned(),
+                },
+            ),
+        }
+    }
+
+    fn fill<'f>(
+        (arrays, m): &'f mut Self::Feedback,
+        goals: &ActionGoals<Uuid>,
+        update: &ControlUpdate,
+        now_s: f64,
+    ) -> Option<&'f FeedbackMessage> {
+        let g = goals.feedback(update, now_s, arrays)?;
+        m.goal_id = g.id;
+        m.header.stamp = Time::from_secs(now_s);
+        m.joint_names.clone_from(&goals.joint_names);
+        // The points' arrays are copied in place: no allocation once warm.
+        m.desired.positions.clone_from(&arrays.desired);
+        m.actual.positions.clone_from(&arrays.actual);
+        m.actual.velocities.clone_from(&arrays.actual_velocities);
+        m.error.positions.clone_from(&arrays.error);
+        m.index = i32::try_from(arrays.index).unwrap_or(i32::MAX);
+        Some(m)
+    }
+}
+
+/// control_msgs/action/GripperCommand.
+struct GripperCommand;
+
+/// GripperCommand's result fields from a sample.
+fn gripper_result(g: GripperSample) -> GripperCommandResult {
+    GripperCommandResult {
+        position: g.position,
+        effort: g.effort,
+        stalled: g.stalled,
+        reached_goal: g.reached_goal,
+    }
+}
+
+impl ActionType for GripperCommand {
+    type SendGoal = GripperSendGoal;
+    type GetResult = GripperGetResult;
+    type Feedback = GripperFeedbackMessage;
+    type FeedbackMessage = GripperFeedbackMessage;
+    const FEEDBACK_TYPE: &'static str = GRIPPER_FEEDBACK_TYPE;
+    const NAME: &'static str = "control_msgs/action/GripperCommand";
+
+    fn feedback(_distro: RosDistro) -> Self::Feedback {
+        GripperFeedbackMessage::default()
+    }
+
+    fn take(
+        goals: &mut ActionGoals<Uuid>,
+        (id, goal): (Uuid, GripperCommandGoal),
+        now: (f64, RunSample),
+        to_session: &Sender<Action>,
+    ) -> Result<(), Rejection> {
+        let c = goal.command;
+        ActionGoals::<Uuid>::check_gripper(c.position, c.max_effort)?;
+        goals.accept_gripper(id, (c.position, c.max_effort), now, to_session);
+        Ok(())
+    }
+
+    fn cancel(
+        goals: &mut ActionGoals<Uuid>,
+        named: impl Fn(&Goal<Uuid>) -> bool,
+        run: RunSample,
+        to_session: &Sender<Action>,
+    ) -> (Vec<Uuid>, bool) {
+        goals.cancel_gripper(named, run.gripper.position, to_session)
+    }
+
+    fn result(g: Option<&Goal<Uuid>>) -> (i8, GripperCommandResult) {
+        match g {
+            Some(g) => (status_of(g.state), gripper_result(g.last_run.gripper)),
+            None => (STATUS_ABORTED, GripperCommandResult::default()),
+        }
+    }
+
+    fn fill<'f>(
+        m: &'f mut Self::Feedback,
+        goals: &ActionGoals<Uuid>,
+        update: &ControlUpdate,
+        _now_s: f64,
+    ) -> Option<&'f GripperFeedbackMessage> {
+        let g = goals.goals.iter().find(|g| !g.ended())?;
+        m.goal_id = g.id;
+        m.feedback = gripper_result(goals.run(update).gripper);
+        Some(m)
+    }
+}
 
 /// A writer of `M` on the DDS topic `name` (already mapped: `rt/...`).
 fn writer<M: Serialize>(
@@ -76,165 +269,94 @@ fn goal_info(g: &Goal<Uuid>) -> GoalInfo {
     }
 }
 
-/// A goal's result.
-fn result(g: &Goal<Uuid>) -> FollowJointTrajectoryResult {
-    FollowJointTrajectoryResult {
-        error_code: g.error_code,
-        error_string: g.error_string.clone(),
-    }
-}
-
 /// One controller's action server.
-struct ActionServer {
+struct ActionServer<A: ActionType> {
     goals: ActionGoals<Uuid>,
-    send_goal: Server<SendGoal>,
+    send_goal: Server<A::SendGoal>,
     cancel_goal: Server<CancelGoal>,
-    get_result: Server<GetResult>,
-    feedback: DataWriter<FeedbackMessage, CDRSerializerAdapter<FeedbackMessage>>,
+    get_result: Server<A::GetResult>,
+    feedback: DataWriter<A::FeedbackMessage, CDRSerializerAdapter<A::FeedbackMessage>>,
     status: DataWriter<GoalStatusArray, CDRSerializerAdapter<GoalStatusArray>>,
     /// get_result requests waiting for their goal to end.
     waiting: Vec<(RequestHeader, Uuid)>,
     next_feedback_s: f64,
-    feedback_arrays: FeedbackArrays,
-    feedback_msg: FeedbackMessage,
+    feedback_state: A::Feedback,
 }
 
-/// The action servers of every joint trajectory controller, and the way to the session.
-pub(super) struct TrajectoryActions {
-    servers: Vec<ActionServer>,
-    to_session: Sender<Action>,
+/// The DDS entities an action server is made on.
+struct Dds<'a> {
+    participant: &'a DomainParticipant,
+    subscriber: &'a rustdds::Subscriber,
+    publisher: &'a rustdds::Publisher,
+    distro: RosDistro,
 }
 
-impl TrajectoryActions {
-    /// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers;
-    /// accepted trajectories go to the session through `to_session`.
-    pub fn serve(
-        participant: &DomainParticipant,
-        subscriber: &rustdds::Subscriber,
-        publisher: &rustdds::Publisher,
-        plan: &RosPlan,
-        distro: RosDistro,
-        to_session: Sender<Action>,
-    ) -> Result<Self> {
-        let mut servers = Vec::new();
-        for goals in ActionGoals::trajectories(plan, "~/joint_trajectory") {
-            let internal = format!("{}/_action/", goals.action);
-            let dds = format!("rt{internal}");
-            tracing::info!(
-                "ROS 2: action {} (control_msgs/action/FollowJointTrajectory)",
-                goals.action
-            );
-            servers.push(ActionServer {
-                send_goal: Server::new(
-                    participant,
-                    subscriber,
-                    publisher,
-                    &format!("{internal}send_goal"),
-                )?,
-                cancel_goal: Server::new(
-                    participant,
-                    subscriber,
-                    publisher,
-                    &format!("{internal}cancel_goal"),
-                )?,
-                get_result: Server::new(
-                    participant,
-                    subscriber,
-                    publisher,
-                    &format!("{internal}get_result"),
-                )?,
-                feedback: writer(
-                    participant,
-                    publisher,
-                    &format!("{dds}feedback"),
-                    FEEDBACK_TYPE,
-                    default_qos(),
-                )?,
-                status: writer(
-                    participant,
-                    publisher,
-                    &format!("{dds}status"),
-                    STATUS_TYPE,
-                    latched_qos(),
-                )?,
-                goals,
-                waiting: Vec::new(),
-                next_feedback_s: 0.0,
-                feedback_arrays: FeedbackArrays::default(),
-                feedback_msg: FeedbackMessage {
-                    with_index: distro >= RosDistro::Lyrical,
-                    ..FeedbackMessage::default()
-                },
-            });
-        }
+impl<A: ActionType> ActionServer<A> {
+    fn new(goals: ActionGoals<Uuid>, dds: &Dds<'_>) -> Result<Self> {
+        let internal = format!("{}/_action/", goals.action);
+        let topic = format!("rt{internal}");
+        tracing::info!("ROS 2: action {} ({})", goals.action, A::NAME);
+        let (participant, subscriber, publisher) = (dds.participant, dds.subscriber, dds.publisher);
         Ok(Self {
-            servers,
-            to_session,
+            send_goal: Server::new(
+                participant,
+                subscriber,
+                publisher,
+                &format!("{internal}send_goal"),
+            )?,
+            cancel_goal: Server::new(
+                participant,
+                subscriber,
+                publisher,
+                &format!("{internal}cancel_goal"),
+            )?,
+            get_result: Server::new(
+                participant,
+                subscriber,
+                publisher,
+                &format!("{internal}get_result"),
+            )?,
+            feedback: writer(
+                participant,
+                publisher,
+                &format!("{topic}feedback"),
+                A::FEEDBACK_TYPE,
+                default_qos(),
+            )?,
+            status: writer(
+                participant,
+                publisher,
+                &format!("{topic}status"),
+                STATUS_TYPE,
+                latched_qos(),
+            )?,
+            goals,
+            waiting: Vec::new(),
+            next_feedback_s: 0.0,
+            feedback_state: A::feedback(dds.distro),
         })
     }
 
-    /// The servers' readers and writers, for `ros_discovery_info`.
-    pub fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
-        let mut readers = Vec::new();
-        let mut writers = Vec::new();
-        for s in &self.servers {
-            for (r, w) in [
-                s.send_goal.gids(),
-                s.cancel_goal.gids(),
-                s.get_result.gids(),
-            ] {
-                readers.push(r);
-                writers.push(w);
-            }
-            writers.push(s.feedback.guid());
-            writers.push(s.status.guid());
+    /// Its readers and writers, into `readers` and `writers`.
+    fn gids(&self, readers: &mut Vec<GUID>, writers: &mut Vec<GUID>) {
+        for (r, w) in [
+            self.send_goal.gids(),
+            self.cancel_goal.gids(),
+            self.get_result.gids(),
+        ] {
+            readers.push(r);
+            writers.push(w);
         }
-        (readers, writers)
+        writers.push(self.feedback.guid());
+        writers.push(self.status.guid());
     }
-}
 
-impl TopicFamily for TrajectoryActions {
-    fn control(&mut self, update: &ControlUpdate) {
-        for server in &mut self.servers {
-            server.update(update, &self.to_session);
-        }
-    }
-}
-
-/// A goal as the simulation takes it.
-fn trajectory_of(goal: &FollowJointTrajectoryGoal) -> JointTrajectory {
-    let secs = |d: Duration| f64::from(d.sec) + f64::from(d.nanosec) * 1e-9;
-    let t = &goal.trajectory;
-    let stamp = t.header.stamp;
-    JointTrajectory {
-        start_s: f64::from(stamp.sec) + f64::from(stamp.nanosec) * 1e-9,
-        joint_names: t.joint_names.clone(),
-        points: t
-            .points
-            .iter()
-            .map(|p| TrajectoryPoint {
-                positions: p.positions.clone(),
-                velocities: p.velocities.clone(),
-                accelerations: p.accelerations.clone(),
-                time_from_start_s: secs(p.time_from_start),
-            })
-            .collect(),
-    }
-}
-
-impl ActionServer {
     fn update(&mut self, update: &ControlUpdate, to_session: &Sender<Action>) {
         let now_s = update.sample.sim_time_s;
         let run = self.goals.run(update);
-        while let Some((header, (goal_id, goal))) = self.send_goal.next_request() {
-            let trajectory = trajectory_of(&goal);
-            let multi_dof = !goal.multi_dof_trajectory.points.is_empty();
-            let accepted = match self.goals.check(&trajectory, multi_dof) {
-                Ok(()) => {
-                    self.goals
-                        .accept_trajectory(goal_id, trajectory, (now_s, run), to_session);
-                    true
-                }
+        while let Some((header, request)) = self.send_goal.next_request() {
+            let accepted = match A::take(&mut self.goals, request, (now_s, run), to_session) {
+                Ok(()) => true,
                 Err(r) => {
                     tracing::warn!(
                         "ROS 2: {} rejected a goal: {}",
@@ -248,7 +370,7 @@ impl ActionServer {
                 .reply(header, (accepted, Time::from_secs(now_s)));
         }
         while let Some((header, info)) = self.cancel_goal.next_request() {
-            let reply = self.cancel(info, to_session);
+            let reply = self.cancel(info, run, to_session);
             self.cancel_goal.reply(header, reply);
         }
         self.goals.follow(run, now_s);
@@ -259,7 +381,11 @@ impl ActionServer {
         self.answer_results();
         if now_s + 1e-9 >= self.next_feedback_s {
             self.next_feedback_s = now_s + FEEDBACK_PERIOD_S;
-            self.publish_feedback(update, now_s);
+            if let Some(m) = A::fill(&mut self.feedback_state, &self.goals, update, now_s)
+                && let Err(e) = self.feedback.write(m.clone(), None)
+            {
+                tracing::warn!("ROS 2: {} feedback not sent ({e})", self.goals.controller);
+            }
         }
         if self.goals.take_changed() {
             let status_list = self
@@ -279,7 +405,12 @@ impl ActionServer {
 
     /// Cancels the goals `info` names (a zero id: all accepted up to its stamp, or all with a
     /// zero stamp too); the joints stop where they are.
-    fn cancel(&mut self, info: GoalInfo, to_session: &Sender<Action>) -> (i8, Vec<GoalInfo>) {
+    fn cancel(
+        &mut self,
+        info: GoalInfo,
+        run: RunSample,
+        to_session: &Sender<Action>,
+    ) -> (i8, Vec<GoalInfo>) {
         let all = info.goal_id == Uuid::default();
         let until = f64::from(info.stamp.sec) + f64::from(info.stamp.nanosec) * 1e-9;
         let named = |g: &Goal<Uuid>| {
@@ -289,7 +420,7 @@ impl ActionServer {
                 g.id == info.goal_id
             }
         };
-        let (cancelled, ended_before) = self.goals.cancel_trajectory(named, to_session);
+        let (cancelled, ended_before) = A::cancel(&mut self.goals, named, run, to_session);
         if cancelled.is_empty() {
             let code = if ended_before {
                 CANCEL_ERROR_GOAL_TERMINATED
@@ -306,23 +437,15 @@ impl ActionServer {
         (CANCEL_ERROR_NONE, infos)
     }
 
-    /// Replies to the get_result requests whose goal has ended (an unknown goal: aborted,
-    /// INVALID_GOAL, at once).
+    /// Replies to the get_result requests whose goal has ended (an unknown goal: aborted, at
+    /// once).
     fn answer_results(&mut self) {
         let goals = &self.goals;
         let mut replies = Vec::new();
         self.waiting.retain(|(header, id)| match goals.goal(id) {
             Some(g) if !g.ended() => true,
-            Some(g) => {
-                replies.push((*header, (status_of(g.state), result(g))));
-                false
-            }
-            None => {
-                let result = FollowJointTrajectoryResult {
-                    error_code: code::INVALID_GOAL,
-                    error_string: "unknown goal".to_owned(),
-                };
-                replies.push((*header, (STATUS_ABORTED, result)));
+            found => {
+                replies.push((*header, A::result(found)));
                 false
             }
         });
@@ -330,25 +453,91 @@ impl ActionServer {
             self.get_result.reply(header, reply);
         }
     }
+}
 
-    /// The executing goal's feedback: the joints' setpoints, positions and their difference.
-    fn publish_feedback(&mut self, update: &ControlUpdate, now_s: f64) {
-        let arrays = &mut self.feedback_arrays;
-        let Some(g) = self.goals.feedback(update, now_s, arrays) else {
-            return;
+/// The action servers: every joint trajectory controller's and every gripper controller's,
+/// and the way to the session.
+pub(super) struct ControllerActions {
+    trajectories: Vec<ActionServer<FollowJointTrajectory>>,
+    grippers: Vec<ActionServer<GripperCommand>>,
+    to_session: Sender<Action>,
+}
+
+impl ControllerActions {
+    /// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers and
+    /// `gripper_cmd` for each gripper controller; accepted goals go to the session through
+    /// `to_session`.
+    pub fn serve(
+        (participant, subscriber, publisher): (
+            &DomainParticipant,
+            &rustdds::Subscriber,
+            &rustdds::Publisher,
+        ),
+        (plan, robot): (&RosPlan, &RobotModel),
+        distro: RosDistro,
+        to_session: Sender<Action>,
+    ) -> Result<Self> {
+        let dds = Dds {
+            participant,
+            subscriber,
+            publisher,
+            distro,
         };
-        let m = &mut self.feedback_msg;
-        m.goal_id = g.id;
-        m.header.stamp = Time::from_secs(now_s);
-        m.joint_names.clone_from(&self.goals.joint_names);
-        // The points' arrays are copied in place: no allocation once warm.
-        m.desired.positions.clone_from(&arrays.desired);
-        m.actual.positions.clone_from(&arrays.actual);
-        m.actual.velocities.clone_from(&arrays.actual_velocities);
-        m.error.positions.clone_from(&arrays.error);
-        m.index = i32::try_from(arrays.index).unwrap_or(i32::MAX);
-        if let Err(e) = self.feedback.write(m.clone(), None) {
-            tracing::warn!("ROS 2: {} feedback not sent ({e})", self.goals.controller);
+        Ok(Self {
+            trajectories: ActionGoals::trajectories(plan, "~/joint_trajectory")
+                .into_iter()
+                .map(|g| ActionServer::new(g, &dds))
+                .collect::<Result<_>>()?,
+            grippers: ActionGoals::grippers(plan, robot)
+                .into_iter()
+                .map(|g| ActionServer::new(g, &dds))
+                .collect::<Result<_>>()?,
+            to_session,
+        })
+    }
+
+    /// The servers' readers and writers, for `ros_discovery_info`.
+    pub fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
+        let mut readers = Vec::new();
+        let mut writers = Vec::new();
+        for s in &self.trajectories {
+            s.gids(&mut readers, &mut writers);
         }
+        for s in &self.grippers {
+            s.gids(&mut readers, &mut writers);
+        }
+        (readers, writers)
+    }
+}
+
+impl TopicFamily for ControllerActions {
+    fn control(&mut self, update: &ControlUpdate) {
+        for server in &mut self.trajectories {
+            server.update(update, &self.to_session);
+        }
+        for server in &mut self.grippers {
+            server.update(update, &self.to_session);
+        }
+    }
+}
+
+/// A goal as the simulation takes it.
+fn trajectory_of(goal: &FollowJointTrajectoryGoal) -> JointTrajectory {
+    let secs = |d: super::msgs::Duration| f64::from(d.sec) + f64::from(d.nanosec) * 1e-9;
+    let t = &goal.trajectory;
+    let stamp = t.header.stamp;
+    JointTrajectory {
+        start_s: f64::from(stamp.sec) + f64::from(stamp.nanosec) * 1e-9,
+        joint_names: t.joint_names.clone(),
+        points: t
+            .points
+            .iter()
+            .map(|p| TrajectoryPoint {
+                positions: p.positions.clone(),
+                velocities: p.velocities.clone(),
+                accelerations: p.accelerations.clone(),
+                time_from_start_s: secs(p.time_from_start),
+            })
+            .collect(),
     }
 }

@@ -283,12 +283,12 @@ impl Bridge<Recorded> {
 }
 
 /// What `--ros2` adds on DDS: the participant and its publisher, the input half (topics,
-/// parameter services) and the trajectory controllers' action servers.
+/// parameter services) and the controllers' action servers.
 struct DdsNode {
     participant: DomainParticipant,
     publisher: rustdds::Publisher,
     input: Ros2Input,
-    actions: actions::TrajectoryActions,
+    actions: actions::ControllerActions,
 }
 
 /// What the publishing thread keeps alive until it ends: `ros_discovery_info`'s writer, the
@@ -323,11 +323,9 @@ impl DdsNode {
         let subscriber = participant
             .create_subscriber(&default_qos())
             .context("creating the DDS subscriber")?;
-        let actions = actions::TrajectoryActions::serve(
-            &participant,
-            &subscriber,
-            &publisher,
-            plan,
+        let actions = actions::ControllerActions::serve(
+            (&participant, &subscriber, &publisher),
+            (plan, robot),
             options.distro,
             to_session,
         )?;
@@ -346,7 +344,7 @@ impl DdsNode {
         self,
         options: &Ros2Options,
         writers: Vec<rustdds::GUID>,
-    ) -> Result<(Ros2Input, Held, actions::TrajectoryActions)> {
+    ) -> Result<(Ros2Input, Held, actions::ControllerActions)> {
         let mut d = discovery::Discovery::new(
             &self.participant,
             &self.publisher,
