@@ -251,3 +251,33 @@ fn h_in_the_real_window_brings_the_jogged_arm_home() -> Result<()> {
     );
     Ok(())
 }
+
+/// A camera narrower than the HUD (worlds/arm_car_reach.toml's workspace camera: 320 x 240)
+/// gets a window as wide as the HUD's lines (640 px), the image centred above: the HUD's
+/// lines are whole (text beyond the image's right edge), not cut at 320 px.
+#[test]
+fn a_narrow_camera_gets_a_hud_whose_lines_fit() -> Result<()> {
+    let run = run_window("worlds/arm_car_reach.toml", 3, "sleep 1", None)?;
+    let shot = run.shot.to_rgb8();
+    assert_eq!(
+        (shot.width(), shot.height()),
+        (640, 240 + 112),
+        "{}",
+        run.log
+    );
+    let background = image::Rgb([24u8, 26, 30]);
+    // The HUD strip, right of where a 320 px canvas would have ended.
+    let text_beyond = (240..352)
+        .flat_map(|y| (330..630).map(move |x| (x, y)))
+        .filter(|&(x, y)| *shot.get_pixel(x, y) != background)
+        .count();
+    assert!(
+        text_beyond > 200,
+        "no HUD text right of 330 px ({text_beyond} pixels): lines are cut; log:\n{}",
+        run.log
+    );
+    // The image is centred: background at the left margin, the render in the middle.
+    assert_eq!(*shot.get_pixel(100, 120), background);
+    assert_ne!(*shot.get_pixel(320, 120), background);
+    Ok(())
+}

@@ -17,6 +17,34 @@ const BOX_THICKNESS_PX: u32 = 2;
 /// Characters per HUD line at 640 px.
 const LINE_CHARS: usize = 64;
 
+/// The narrowest canvas: the HUD's lines fit (a narrower camera image is centred above it).
+pub(super) const MIN_WIDTH: usize = LINE_CHARS * CHAR_W as usize;
+
+/// The canvas for a camera image of `camera` (width, height, px): as wide as the image or the
+/// HUD's lines, whichever is wider, and the HUD strip taller.
+pub(super) fn canvas_size(camera: (usize, usize)) -> (usize, usize) {
+    (camera.0.max(MIN_WIDTH), camera.1 + HUD_H)
+}
+
+/// Copies the camera image (`image`, `size` px) into the canvas's top, centred; the margins
+/// beside a narrower image get the background. Whether it fitted.
+fn draw_image(canvas: &mut Canvas<'_>, image: &[u32], size: (usize, usize)) -> Option<usize> {
+    let (w, img_h) = (canvas.width, canvas.height.saturating_sub(HUD_H));
+    let (iw, ih) = size;
+    if iw > w || ih != img_h || image.len() != iw * ih {
+        return None;
+    }
+    let x0 = (w - iw) / 2;
+    if x0 > 0 {
+        canvas.fill(0, 0, w as i64, img_h as i64, BACKGROUND);
+    }
+    for (row, src) in image.chunks_exact(iw).enumerate() {
+        let start = row * w + x0;
+        canvas.pixels[start..start + iw].copy_from_slice(src);
+    }
+    Some(x0)
+}
+
 /// What the HUD shows.
 pub(super) struct HudState<'a> {
     /// The newest camera image, packed.
@@ -41,17 +69,21 @@ pub(super) struct HudState<'a> {
 /// Composes camera image, boxes and HUD into `canvas`.
 pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
     let (w, h) = (canvas.width, canvas.height);
-    let img_h = h - HUD_H;
-    let (iw, ih) = hud.image_size;
-    if iw == w && ih == img_h && hud.image.len() == iw * ih {
-        canvas.pixels[..w * img_h].copy_from_slice(hud.image);
-        canvas.fill(0, img_h as i64, w as i64, HUD_H as i64, BACKGROUND);
-    } else {
-        canvas.fill(0, 0, w as i64, h as i64, BACKGROUND);
-        canvas.text(20, 20, "waiting for the camera...", [200, 200, 200]);
-    }
+    let img_h = h.saturating_sub(HUD_H);
+    let (iw, _) = hud.image_size;
+    let image_x = match draw_image(canvas, hud.image, hud.image_size) {
+        Some(x0) => {
+            canvas.fill(0, img_h as i64, w as i64, HUD_H as i64, BACKGROUND);
+            Some(x0 as i64)
+        }
+        None => {
+            canvas.fill(0, 0, w as i64, h as i64, BACKGROUND);
+            canvas.text(20, 20, "waiting for the camera...", [200, 200, 200]);
+            None
+        }
+    };
     let session = hud.session;
-    if let Some(boxes) = session.last_boxes() {
+    if let (Some(x0), Some(boxes)) = (image_x, session.last_boxes()) {
         for b in &boxes.bounding_boxes {
             let color = if b.class == session.follower().config().target_class {
                 [255, 70, 70]
@@ -59,17 +91,17 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
                 [80, 200, 255]
             };
             // The ROS detection image's and `rover detect`'s outline, on the camera image.
-            let outline = box_outline(w as u32, img_h as u32, b, BOX_THICKNESS_PX);
+            let outline = box_outline(iw as u32, img_h as u32, b, BOX_THICKNESS_PX);
             for r in outline.into_iter().flatten() {
-                let (x, y) = (i64::from(r.x0), i64::from(r.y0));
+                let (x, y) = (x0 + i64::from(r.x0), i64::from(r.y0));
                 let (rw, rh) = (i64::from(r.x1 - r.x0), i64::from(r.y1 - r.y0));
                 canvas.fill(x, y, rw, rh, color);
             }
             let label = format!("{} {:.2}", b.class, b.probability);
             let lw = label.len() as i64 * CHAR_W + 4;
             let ly = (b.ymin - 20).max(0);
-            canvas.fill(b.xmin, ly, lw, 20, color);
-            canvas.text(b.xmin + 2, ly, &label, [0, 0, 0]);
+            canvas.fill(x0 + b.xmin, ly, lw, 20, color);
+            canvas.text(x0 + b.xmin + 2, ly, &label, [0, 0, 0]);
         }
     }
     let stats = session.stats();
@@ -216,6 +248,38 @@ impl std::fmt::Display for GoalText {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A camera narrower than the HUD (worlds/arm_car_reach.toml renders 320 px) gets a canvas
+    /// the HUD's lines fit, the image centred with background beside it.
+    #[test]
+    fn a_narrow_camera_image_is_centred_above_a_hud_that_fits() {
+        assert_eq!(canvas_size((320, 240)), (MIN_WIDTH, 240 + HUD_H));
+        assert_eq!(canvas_size((1280, 720)), (1280, 720 + HUD_H));
+        // The HUD's longest fixed line.
+        let keys = "i , j l u o m . drive   k stop   q/z speed   f follow";
+        assert!(keys.len() as i64 * CHAR_W + 8 <= MIN_WIDTH as i64);
+        let (w, h) = canvas_size((320, 240));
+        let mut pixels = vec![0u32; w * h];
+        let mut canvas = Canvas {
+            pixels: &mut pixels,
+            width: w,
+            height: h,
+        };
+        let image = vec![0x00ff_0000u32; 320 * 240];
+        assert_eq!(draw_image(&mut canvas, &image, (320, 240)), Some(160));
+        let bg = super::super::canvas::pack(BACKGROUND);
+        assert_eq!(pixels[10 * w + 159], bg);
+        assert_eq!(pixels[10 * w + 160], 0x00ff_0000);
+        assert_eq!(pixels[239 * w + 479], 0x00ff_0000);
+        assert_eq!(pixels[239 * w + 480], bg);
+        // An image of another size than the canvas expects is not drawn.
+        let mut canvas = Canvas {
+            pixels: &mut pixels,
+            width: w,
+            height: h,
+        };
+        assert_eq!(draw_image(&mut canvas, &image, (320, 200)), None);
+    }
 
     #[test]
     fn the_truth_line_counts_what_was_found_missed_and_false() {

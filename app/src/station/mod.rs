@@ -472,7 +472,7 @@ pub fn run(
     let (w, h) = session
         .camera_info()
         .map_or((640, 480), |i| (i.width as usize, i.height as usize));
-    let canvas_size = (w, h + hud::HUD_H);
+    let canvas_size = hud::canvas_size((w, h));
     let pads = match Gamepads::new() {
         Ok(p) => Some(p),
         Err(e) => {
