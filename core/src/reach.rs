@@ -4,9 +4,11 @@
 //! object's true pose.
 //!
 //! Each detector message:
-//! 1. every box of the class, confident enough, becomes a point in the arm's base frame: its
-//!    centre pixel's ray, at the median depth of the box's central part (a box's edges hold
-//!    background);
+//! 1. every box of the class, confident enough, becomes a point in the arm's base frame: the
+//!    object's centre, estimated along its centre pixel's ray. The median depth of the box's
+//!    central part (a box's edges hold background) is the surface the camera sees; the centre
+//!    lies one radius beyond it, the radius from the box's size at that depth (exact for a
+//!    sphere; for other shapes, an object as deep as it is wide);
 //! 2. the point nearest the one reached for last (within [`ReachConfig::gate_m`]) is kept, so
 //!    a second object does not take over; after [`ReachConfig::forget_after_s`] without it,
 //!    the most confident box will do;
@@ -33,7 +35,7 @@ pub struct ReachConfig {
     pub class: String,
     /// Minimum detection probability.
     pub min_probability: f64,
-    /// How far short of the object's seen surface the tool stops (m).
+    /// How far short of the object's (estimated) centre the tool stops (m).
     pub standoff_m: f64,
     /// The object must move this far (m) before the goal is planned again.
     pub replan_m: f64,
@@ -346,9 +348,13 @@ pub fn pregrasp(object_m: Vector3<f64>, standoff_m: f64) -> Vector3<f64> {
     object_m - standoff_m * approach
 }
 
-/// A box's object point in the arm's base frame: the ray through its centre pixel at the
-/// median depth of its central part (half its width and height around the centre); `None`
-/// when that part holds no depth within `max_range_m`.
+/// A box's object point in the arm's base frame: the object's centre, on the ray through the
+/// box's centre pixel. The median depth of the box's central part (half its width and height
+/// around the centre) is the surface the camera sees there; the centre lies one radius further
+/// along the ray. The radius is the one whose silhouette fills the box: a sphere of radius `r`
+/// whose centre is `d` away subtends `asin(r / d)`, and the box's larger side gives that angle
+/// (the smaller may be cut by the image's edge or an occluder). `None` when the central part
+/// holds no depth within `max_range_m`.
 pub fn object_point(
     b: &BoundingBox,
     view: &DepthView<'_>,
@@ -387,8 +393,20 @@ pub fn object_point(
     let z = f64::from(samples[n / 2]);
     let u = (b.xmin + b.xmax) as f64 / 2.0;
     let v = (b.ymin + b.ymax) as f64 / 2.0;
-    let optical = Point3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
-    Some((view.base_from_optical * optical).coords)
+    let surface = Vector3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
+    let radius = radius_seen((xmax - xmin) as f64 / fx, (ymax - ymin) as f64 / fy, surface.norm());
+    let centre = surface + surface.normalize() * radius;
+    Some((view.base_from_optical * Point3::from(centre)).coords)
+}
+
+/// The radius (m) of a sphere whose silhouette spans `width` by `height` (the box's sides over
+/// the focal length: tangents of the full angle, near the image centre) and whose nearest
+/// point is `surface_m` away: with half-angle `a`, `sin a = r / (surface_m + r)`, so
+/// `r = surface_m sin a / (1 - sin a)`.
+fn radius_seen(width: f64, height: f64, surface_m: f64) -> f64 {
+    let half_angle = (width.max(height) / 2.0).atan();
+    let s = half_angle.sin().min(0.9);
+    surface_m * s / (1.0 - s)
 }
 
 #[cfg(test)]
@@ -439,11 +457,29 @@ mod tests {
             4.0,
         );
         let p = p.unwrap_or_else(Vector3::zeros);
-        assert!((p - Vector3::new(1.0, -0.5, 0.5)).norm() < 1e-9, "{p:?}");
+        // The surface at 1 m along the ray through (30, 15), then one radius on: the 14 px box
+        // spans 0.7 rad-tangents, a sphere of r = d sin(a) / (1 - sin(a)) with a = atan(0.35).
+        let surface: Vector3<f64> = Vector3::new(1.0, -0.5, 0.5);
+        let sin_a = 0.35f64.atan().sin();
+        let r = surface.xy().norm() * sin_a / (1.0 - sin_a);
+        let along: Vector3<f64> = Vector3::new(1.0, -0.5, 0.0).normalize();
+        let want = surface + along * r;
+        assert!((p - want).norm() < 1e-9, "{p:?}, want {want:?}");
         // Nothing within range: no point.
         assert!(object_point(&ball_box(23, 8, 37, 22), &view, [20.0; 4], 0.5).is_none());
         // A box off the image is clamped to it, not read out of bounds.
         let _ = object_point(&ball_box(-50, -50, 500, 500), &view, [20.0; 4], 4.0);
+    }
+
+    /// A sphere seen straight on: the estimate puts the centre where it is.
+    #[test]
+    fn a_spheres_centre_is_one_radius_beyond_its_surface() {
+        // A 6 cm ball 0.5 m ahead (its surface at 0.44 m), fx = 300: its silhouette's half
+        // angle is asin(0.06 / 0.5), tangent 0.1209, so the box is 72.5 px wide.
+        let r = 0.06f64;
+        let tan = (r / 0.5).asin().tan();
+        let radius = radius_seen(2.0 * tan, 2.0 * tan, 0.44);
+        assert!((radius - r).abs() < 1e-9, "{radius}");
     }
 
     #[test]

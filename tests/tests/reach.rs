@@ -10,6 +10,8 @@ use rover_sim::{JointCommand, Pose, SimOptions, World};
 
 /// The ball's radius (m) and where it rests at first (centre, world frame).
 const BALL_RADIUS_M: f64 = 0.06;
+/// How far short of the ball's centre TIAGo's tool stops (m).
+const TIAGO_STANDOFF_M: f64 = 0.16;
 const BALL_AT: [f64; 3] = [0.75, -0.25, 0.76];
 
 /// A stand 0.7 m high and a red ball on it (a red sphere is what YOLO calls "sports ball").
@@ -54,6 +56,12 @@ fn session(seed: u64) -> Result<Option<Session>> {
         arm: ArmConfig {
             base_link: Some("torso_lift_link".into()),
             ee_link: Some("arm_tool_link".into()),
+            // TIAGo's wrist is wider than the arm car's hand: it stops 10 cm short of the
+            // ball's surface, 16 cm from its centre.
+            reach: rover_core::ReachConfig {
+                standoff_m: TIAGO_STANDOFF_M,
+                ..rover_core::ReachConfig::default()
+            },
             ..ArmConfig::default()
         },
         ..SessionOptions::default()
@@ -117,20 +125,20 @@ fn run_for(session: &mut Session, seconds: f64, run: &mut Run) -> Result<()> {
     Ok(())
 }
 
-/// Where the tool should end: 10 cm short of the ball's surface point the camera sees at the
-/// box centre (on the line from the camera to the ball's centre), horizontally along the line
-/// from the arm's base (torso_lift_link) — computed here from the ball's true pose.
+/// Where the tool should end: [`TIAGO_STANDOFF_M`] short of the ball's centre, horizontally
+/// along the line from the arm's base (torso_lift_link) — computed here from the ball's true
+/// pose.
 fn pregrasp_truth(session: &Session) -> Result<[f64; 3]> {
-    pregrasp_truth_of(session, "torso_lift_link", 1, BALL_RADIUS_M)
+    pregrasp_truth_of(session, "torso_lift_link", 1, TIAGO_STANDOFF_M)
 }
 
-/// [`pregrasp_truth`] for world object `ball` of radius `radius_m`, the arm working from
-/// link `base_link`.
+/// [`pregrasp_truth`] for world object `ball`, the arm working from link `base_link`, the tool
+/// stopping `standoff_m` short of the centre.
 fn pregrasp_truth_of(
     session: &Session,
     base_link: &str,
     ball: usize,
-    radius_m: f64,
+    standoff_m: f64,
 ) -> Result<[f64; 3]> {
     let sim = session.sim();
     let link = |name: &str| {
@@ -139,22 +147,22 @@ fn pregrasp_truth_of(
             .map(|id| sim.world_from_link(id))
             .ok_or_else(|| anyhow::anyhow!("no link {name}"))
     };
-    let camera_link = sim
-        .robot()
-        .cameras
-        .first()
-        .map(|c| c.link.clone())
-        .unwrap_or_default();
-    let camera = link(&camera_link)?;
     let base = link(base_link)?;
     let centre = object(session, ball).translation;
-    let toward_camera = (camera.translation - centre).normalize();
-    let surface = centre + toward_camera * radius_m as f32;
-    let mut horizontal = base.inverse().transform_point(surface);
+    let mut horizontal = base.inverse().transform_point(centre);
     horizontal.z = 0.0;
     let approach = base.rotation * horizontal.normalize();
-    let p = surface - approach * 0.1;
+    let p = centre - approach * standoff_m as f32;
     Ok([f64::from(p.x), f64::from(p.y), f64::from(p.z)])
+}
+
+/// How far reach's estimate of the ball's centre (from its box and the depth image) is from
+/// the true centre (m).
+fn centre_error(session: &Session, ball: usize) -> f64 {
+    let c = object(session, ball).translation;
+    session.stats().arm.object_world_m.map_or(f64::INFINITY, |p| {
+        distance(p, [f64::from(c.x), f64::from(c.y), f64::from(c.z)])
+    })
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -178,7 +186,14 @@ fn tiago_reaches_short_of_the_ball_the_detector_sees() -> Result<()> {
     run_for(&mut session, 10.0, &mut run)?;
     let goal = pregrasp_truth(&session)?;
     let status = session.stats().arm;
-    println!("status at 10 s: {status:?}; pre-grasp from the truth {goal:.3?}");
+    let centre_error_m = centre_error(&session, 1);
+    println!(
+        "status at 10 s: {status:?}; pre-grasp from the truth {goal:.3?}; the ball's centre estimated {centre_error_m:.4} m off"
+    );
+    assert!(
+        centre_error_m < 0.02,
+        "the ball's centre estimated {centre_error_m:.4} m from the truth"
+    );
     let centre = ball(&session).translation;
     let centre = [
         f64::from(centre.x),
@@ -311,8 +326,8 @@ fn the_arm_car_reaches_for_the_ball_in_its_example_world() -> Result<()> {
     session.input(Action::ToggleReach, &mut NoObserver);
     let start_s = session.sim().sim_time_s();
     run_for(&mut session, 10.0, &mut run)?;
-    let radius_m = 0.06;
-    let goal = pregrasp_truth_of(&session, "base_link", 1, radius_m)?;
+    let goal = pregrasp_truth_of(&session, "base_link", 1, 0.1)?;
+    let centre_error_m = centre_error(&session, 1);
     let status = session.stats().arm;
     let end = status.tool_world_m.unwrap_or([f64::NAN; 3]);
     let arrived = run
@@ -322,8 +337,12 @@ fn the_arm_car_reaches_for_the_ball_in_its_example_world() -> Result<()> {
         .map(|(t, _, _)| t - start_s);
     let moved = (object(&session, 1).translation - ball_at_start).length();
     println!(
-        "arm car: {status:?}; pre-grasp from the truth {goal:.3?}; within 5 cm after {arrived:?} s; {:.3} m at 10 s; the ball moved {moved:.4} m",
+        "arm car: {status:?}; pre-grasp from the truth {goal:.3?}; within 5 cm after {arrived:?} s; {:.3} m at 10 s; the ball moved {moved:.4} m; the centre estimated {centre_error_m:.4} m off",
         distance(end, goal)
+    );
+    assert!(
+        centre_error_m < 0.02,
+        "the ball's centre estimated {centre_error_m:.4} m from the truth"
     );
     assert!(distance(end, goal) <= 0.05, "tool {end:?}, goal {goal:?}");
     assert!(moved < 1e-3, "the ball was touched");

@@ -463,7 +463,8 @@ pub(crate) struct ArmArgs {
     #[arg(long, default_value = "sports ball", value_name = "CLASS")]
     pub(crate) arm_class: String,
 
-    /// Arm: how far short of the object's seen surface the tool stops (m)
+    /// Arm: how far short of the object's centre (estimated from its box and the depth image)
+    /// the tool stops (m)
     #[arg(long, default_value_t = 0.10, value_name = "M")]
     pub(crate) reach_standoff: f64,
 }
