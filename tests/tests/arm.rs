@@ -118,8 +118,26 @@ fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
         .to_degrees();
     let driving = worst_error(&sim, &HOME)?;
     let base_m = sim.world_from_base().translation;
+    // Then brake to a stop: the turn counts in total, braking included.
+    sim.set_cmd_vel(Twist {
+        linear_mps: 0.0,
+        angular_radps: 0.0,
+    })?;
+    let mut turns = Vec::new();
+    for _ in 0..20 {
+        run_for(&mut sim, 0.1);
+        let t = (yaw0.inverse() * sim.world_from_base().rotation)
+            .to_euler(glam::EulerRot::ZYX)
+            .0
+            .to_degrees();
+        turns.push(format!("{t:.2}"));
+    }
+    let total_deg = (yaw0.inverse() * sim.world_from_base().rotation)
+        .to_euler(glam::EulerRot::ZYX)
+        .0
+        .to_degrees();
     println!(
-        "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {base_m:?}"
+        "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {base_m:?}; braking: {turns:?}, total {total_deg:.2} deg"
     );
     assert!(at_2s.1 < 0.01, "by 2 s: {at_2s:?}");
     assert!(held.1 < 0.01, "while held: {held:?}");
