@@ -394,7 +394,11 @@ pub fn object_point(
     let u = (b.xmin + b.xmax) as f64 / 2.0;
     let v = (b.ymin + b.ymax) as f64 / 2.0;
     let surface = Vector3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
-    let radius = radius_seen((xmax - xmin) as f64 / fx, (ymax - ymin) as f64 / fy, surface.norm());
+    let radius = radius_seen(
+        (xmax - xmin) as f64 / fx,
+        (ymax - ymin) as f64 / fy,
+        surface.norm(),
+    );
     let centre = surface + surface.normalize() * radius;
     Some((view.base_from_optical * Point3::from(centre)).coords)
 }

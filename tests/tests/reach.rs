@@ -160,9 +160,13 @@ fn pregrasp_truth_of(
 /// the true centre (m).
 fn centre_error(session: &Session, ball: usize) -> f64 {
     let c = object(session, ball).translation;
-    session.stats().arm.object_world_m.map_or(f64::INFINITY, |p| {
-        distance(p, [f64::from(c.x), f64::from(c.y), f64::from(c.z)])
-    })
+    session
+        .stats()
+        .arm
+        .object_world_m
+        .map_or(f64::INFINITY, |p| {
+            distance(p, [f64::from(c.x), f64::from(c.y), f64::from(c.z)])
+        })
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -66,6 +66,33 @@ pub(super) struct HudState<'a> {
     pub truth: Option<&'a str>,
 }
 
+/// The newest detections' outlines and labels on the camera image, whose left edge is at
+/// `x0` on the canvas and whose size is `image` (px).
+fn draw_boxes(canvas: &mut Canvas<'_>, session: &Session, x0: i64, image: (usize, usize)) {
+    let Some(boxes) = session.last_boxes() else {
+        return;
+    };
+    for b in &boxes.bounding_boxes {
+        let color = if b.class == session.follower().config().target_class {
+            [255, 70, 70]
+        } else {
+            [80, 200, 255]
+        };
+        // The ROS detection image's and `rover detect`'s outline, on the camera image.
+        let outline = box_outline(image.0 as u32, image.1 as u32, b, BOX_THICKNESS_PX);
+        for r in outline.into_iter().flatten() {
+            let (x, y) = (x0 + i64::from(r.x0), i64::from(r.y0));
+            let (rw, rh) = (i64::from(r.x1 - r.x0), i64::from(r.y1 - r.y0));
+            canvas.fill(x, y, rw, rh, color);
+        }
+        let label = format!("{} {:.2}", b.class, b.probability);
+        let lw = label.len() as i64 * CHAR_W + 4;
+        let ly = (b.ymin - 20).max(0);
+        canvas.fill(x0 + b.xmin, ly, lw, 20, color);
+        canvas.text(x0 + b.xmin + 2, ly, &label, [0, 0, 0]);
+    }
+}
+
 /// Composes camera image, boxes and HUD into `canvas`.
 pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
     let (w, h) = (canvas.width, canvas.height);
@@ -83,26 +110,8 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
         }
     };
     let session = hud.session;
-    if let (Some(x0), Some(boxes)) = (image_x, session.last_boxes()) {
-        for b in &boxes.bounding_boxes {
-            let color = if b.class == session.follower().config().target_class {
-                [255, 70, 70]
-            } else {
-                [80, 200, 255]
-            };
-            // The ROS detection image's and `rover detect`'s outline, on the camera image.
-            let outline = box_outline(iw as u32, img_h as u32, b, BOX_THICKNESS_PX);
-            for r in outline.into_iter().flatten() {
-                let (x, y) = (x0 + i64::from(r.x0), i64::from(r.y0));
-                let (rw, rh) = (i64::from(r.x1 - r.x0), i64::from(r.y1 - r.y0));
-                canvas.fill(x, y, rw, rh, color);
-            }
-            let label = format!("{} {:.2}", b.class, b.probability);
-            let lw = label.len() as i64 * CHAR_W + 4;
-            let ly = (b.ymin - 20).max(0);
-            canvas.fill(x0 + b.xmin, ly, lw, 20, color);
-            canvas.text(x0 + b.xmin + 2, ly, &label, [0, 0, 0]);
-        }
+    if let Some(x0) = image_x {
+        draw_boxes(canvas, session, x0, (iw, img_h));
     }
     let stats = session.stats();
     let teleop = session.pilot().teleop();
