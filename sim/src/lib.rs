@@ -40,9 +40,9 @@ pub use model::actor;
 pub use model::human;
 pub use model::{
     COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
-    ControllerKind, ControllerSpec, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DepthOutput,
-    DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GripperSpec, Ground,
-    HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId,
+    ControllerKind, ControllerSpec, DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION,
+    DepthOutput, DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GripperSpec,
+    Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId,
     JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig, Link, LinkId,
     MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model,
     ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel,

@@ -228,6 +228,11 @@ fn world_unknown_keys_and_bad_values_name_the_key_path() {
     );
     let e = err("[physics]\nstep_hz = \"fast\"\n");
     assert!(e.starts_with("w.toml:2: at `physics.step_hz`"), "{e}");
+    let e = err("[physics]\ncontact_hz = 0.0\n");
+    assert!(
+        e.contains("at `physics.contact_hz`: expected a contact stiffness of 1..=1000 Hz"),
+        "{e}"
+    );
     let e = err("[[person]]\nposition_m = [4.0, 0.0]\nheight_m = 7.0\n");
     assert!(
         e.contains("at `person[0].height_m`: expected a height between 0.5 and 2.5 m"),

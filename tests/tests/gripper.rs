@@ -253,3 +253,74 @@ fn a_gripper_naming_a_joint_that_is_not_a_finger_is_refused() -> Result<()> {
     }
     Ok(())
 }
+
+/// The ball's centre in the palm's frame (m).
+fn ball_in_palm(sim: &rover_sim::Simulation) -> Result<glam::Vec3> {
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let ball = poses.first().context("no ball")?.translation;
+    let palm = sim.robot().link_id("palm").context("no palm")?;
+    Ok(sim.world_from_link(palm).inverse().transform_point(ball))
+}
+
+/// Holding by friction: the lifter (tests/grasper/lifter.urdf) lowers its fingers around a
+/// 5 cm ball lying on the ground, closes on it with 10 N, lifts it 25 cm, turns it 1 rad, then
+/// drops and raises it 10 cm twice at the lift's full speed: the ball moves less than 1 cm in
+/// the palm's frame throughout, and falls when the fingers open.
+#[test]
+fn a_ball_held_by_friction_stays_in_the_fingers_while_lifted_and_turned() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let from = rover_tests::repo("tests/grasper");
+    for file in ["lifter.urdf", "lifter.toml", "grasper.yaml"] {
+        std::fs::copy(from.join(file), dir.path().join(file))?;
+    }
+    let mut sim = grasper_sim(&dir.path().join("lifter.toml"))?;
+    run(&mut sim, 0.5);
+    sim.command_joint("lift_joint", JointCommand::Position(-0.055))?;
+    run(&mut sim, 1.5);
+    sim.command_gripper("gripper_controller", 0.05, 10.0)?;
+    let grasp = until_done(&mut sim, 5.0)?;
+    ensure!(
+        grasp.stalled,
+        "the fingers did not close on the ball: {grasp:?}"
+    );
+    run(&mut sim, 0.3);
+    let held_at = ball_in_palm(&sim)?;
+    let mut worst = 0.0f32;
+    let mut moves = |sim: &mut rover_sim::Simulation, joint: &str, q: f64, s: f64| -> Result<()> {
+        sim.command_joint(joint, JointCommand::Position(q))?;
+        let end = sim.sim_time_s() + s;
+        while sim.sim_time_s() < end {
+            sim.step();
+            worst = worst.max((ball_in_palm(sim)? - held_at).length());
+        }
+        Ok(())
+    };
+    moves(&mut sim, "lift_joint", 0.2, 1.5)?;
+    moves(&mut sim, "wrist_joint", 1.0, 1.5)?;
+    for _ in 0..2 {
+        moves(&mut sim, "lift_joint", 0.1, 0.6)?;
+        moves(&mut sim, "lift_joint", 0.2, 0.6)?;
+    }
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let lifted_z = poses.first().context("no ball")?.translation.z;
+    println!(
+        "grasp {grasp:?}; the ball moved at most {:.2} mm in the palm's frame; lifted to z {lifted_z:.3} m",
+        worst * 1000.0
+    );
+    ensure!(
+        worst < 0.01,
+        "the held ball slipped {worst:.4} m in the fingers"
+    );
+    ensure!(lifted_z > 0.2, "the ball was not lifted: z {lifted_z}");
+    sim.command_gripper("gripper_controller", 0.0, 0.0)?;
+    run(&mut sim, 2.0);
+    sim.object_poses_into(&mut poses);
+    let dropped_z = poses.first().context("no ball")?.translation.z;
+    ensure!(
+        dropped_z < 0.05,
+        "opened, the ball did not fall: z {dropped_z}"
+    );
+    Ok(())
+}

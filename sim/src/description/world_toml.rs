@@ -14,7 +14,8 @@ use crate::model::drive::DriveSpec;
 use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World, check_step_hz,
+    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World,
+    check_step_hz,
 };
 
 impl World {
@@ -121,6 +122,7 @@ struct RawPhysics {
     gravity_mps2: [f64; 3],
     solver_iterations: usize,
     joints: JointSolver,
+    contact_hz: f64,
 }
 
 impl Default for RawPhysics {
@@ -130,6 +132,7 @@ impl Default for RawPhysics {
             gravity_mps2: [0.0, 0.0, -9.81],
             solver_iterations: 4,
             joints: JointSolver::default(),
+            contact_hz: DEFAULT_CONTACT_HZ,
         }
     }
 }
@@ -141,6 +144,7 @@ impl From<RawPhysics> for Physics {
             gravity_mps2: p.gravity_mps2,
             solver_iterations: p.solver_iterations,
             joints: p.joints,
+            contact_hz: p.contact_hz,
         }
     }
 }
@@ -445,6 +449,17 @@ impl RawWorld {
             return Err(c.fail("physics.step_hz", message));
         }
         c.finite("physics.gravity_mps2", &self.physics.gravity_mps2)?;
+        if !(self.physics.contact_hz.is_finite()
+            && (1.0..=1000.0).contains(&self.physics.contact_hz))
+        {
+            return Err(c.fail(
+                "physics.contact_hz",
+                format!(
+                    "expected a contact stiffness of 1..=1000 Hz (default {DEFAULT_CONTACT_HZ}), found {}",
+                    self.physics.contact_hz
+                ),
+            ));
+        }
         if !(1..=100).contains(&self.physics.solver_iterations) {
             return Err(c.fail(
                 "physics.solver_iterations",

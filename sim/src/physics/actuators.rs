@@ -39,6 +39,10 @@ const MIN_INERTIA: f64 = 1e-9;
 /// The share of the velocity limit a position move plans for (the loop's tracking error
 /// takes the rest).
 const PROFILE_VELOCITY_SHARE: f64 = 0.9;
+/// How far a `<mimic>` joint may be from where its leader puts it when pushing with its full
+/// effort (m or rad): the coupling's stiffness.
+const MIMIC_HOLD_ERROR: f64 = 0.001;
+
 /// The share of the effort left over from carrying the load that a position move plans to
 /// accelerate and brake with (the loop's corrections take the rest).
 const PROFILE_EFFORT_SHARE: f64 = 0.3;
@@ -97,6 +101,9 @@ pub(crate) struct Actuator {
     effort_max: f64,
     /// A lower cap a gripper command sets (its `max_effort`); `None`: `effort_max`.
     effort_cap: Option<f64>,
+    /// A `<mimic>` joint: held to its leader stiffly (its full effort within
+    /// [`MIMIC_HOLD_ERROR`]), as a coupling.
+    coupling: bool,
     velocity_max: Option<f64>,
     command: JointCommand,
     /// User gains (a controllers YAML); `None`: derived from the inertia.
@@ -130,7 +137,10 @@ impl Actuator {
     fn gains(&self) -> Pid {
         self.pid.unwrap_or_else(|| {
             let omega = 2.0 * std::f64::consts::PI * HOLD_BANDWIDTH_HZ;
-            let p = (self.inertia * omega * omega).max(self.friction / HOLD_FRICTION_ERROR);
+            let mut p = (self.inertia * omega * omega).max(self.friction / HOLD_FRICTION_ERROR);
+            if self.coupling {
+                p = p.max(self.cap() / MIMIC_HOLD_ERROR);
+            }
             Pid {
                 p,
                 i: p / HOLD_INTEGRAL_S,
@@ -195,8 +205,6 @@ struct Follower {
     actuator: usize,
     /// The joint it follows, as built.
     leader: BuiltJoint,
-    /// That joint's id.
-    leader_id: JointId,
     multiplier: f64,
     offset: f64,
 }
@@ -247,6 +255,7 @@ impl Actuators {
                 limits,
                 effort_max,
                 effort_cap: None,
+                coupling: joint.mimic.is_some(),
                 velocity_max: joint.velocity_limit.filter(|v| *v > 0.0).map(f64::from),
                 command: JointCommand::Position(start),
                 pid: None,
@@ -276,7 +285,6 @@ impl Actuators {
                 out.followers.push(Follower {
                     actuator: out.list.len(),
                     leader,
-                    leader_id: m.joint,
                     multiplier: f64::from(m.multiplier),
                     offset: f64::from(m.offset),
                 });
@@ -298,22 +306,8 @@ impl Actuators {
     /// Points every `<mimic>` joint at its leader's position now.
     fn follow_leaders(&mut self, physics: &PhysicsWorld) {
         for f in &self.followers {
-            // An actuated leader's setpoint, so that both fingers of a gripper push toward
-            // their own goal with their own effort cap (one motor, coupled fingers, equal
-            // forces); a leader without an actuator is followed where it is.
-            let leader = self
-                .by_joint
-                .get(f.leader_id.index())
-                .copied()
-                .flatten()
-                .and_then(|i| self.list.get(i));
-            let (q, v) = match leader {
-                Some(l) => (l.setpoint, l.setpoint_velocity),
-                None => (
-                    f.leader.position(&physics.bodies),
-                    f.leader.velocity(&physics.bodies),
-                ),
-            };
+            let q = f.leader.position(&physics.bodies);
+            let v = f.leader.velocity(&physics.bodies);
             if let Some(a) = self.list.get_mut(f.actuator) {
                 let cap = a.velocity_max.unwrap_or(f64::INFINITY);
                 a.command = JointCommand::Track {
@@ -416,22 +410,13 @@ impl Actuators {
         self.of(joint).map_or(0.0, |a| a.measured.1)
     }
 
-    /// Caps the effort of `joint` and of the joints that mimic it (a gripper command's
-    /// `max_effort`); `None` lifts the cap back to the joints' `<limit effort>`.
+    /// Caps the effort of `joint` (a gripper command's `max_effort`); `None` lifts the cap
+    /// back to its `<limit effort>`. The joints that mimic it keep their own limit: they are a
+    /// coupling, holding their finger where the leader's puts it, so the leader's cap is the
+    /// squeeze.
     pub(crate) fn set_effort_cap(&mut self, joint: JointId, cap: Option<f64>) {
-        let followers: Vec<usize> = self
-            .followers
-            .iter()
-            .filter(|f| f.leader_id == joint)
-            .map(|f| f.actuator)
-            .collect();
         if let Some(a) = self.of_mut(joint) {
             a.effort_cap = cap;
-        }
-        for i in followers {
-            if let Some(a) = self.list.get_mut(i) {
-                a.effort_cap = cap;
-            }
         }
     }
 

@@ -107,9 +107,14 @@ pub struct GripperState {
 struct GripperRun {
     spec: GripperSpec,
     state: GripperState,
-    /// When the finger last moved faster than `stalled_velocity_threshold` (sim s).
-    last_moved_s: f64,
+    /// Where the finger was when it last moved (m or rad), and when (sim s).
+    last_moved: (f64, f64),
 }
+
+/// The least band (m or rad) a finger must leave to count as moving: the fingers of a closed
+/// gripper jitter by ~0.5 mm in rapier's contacts, which an instantaneous speed would read as
+/// moving.
+const STALL_BAND_MIN: f64 = 0.001;
 
 #[derive(Debug, Clone)]
 enum Running {
@@ -216,7 +221,7 @@ impl Controllers {
                             position: actuators.position(id),
                             ..GripperState::default()
                         },
-                        last_moved_s: 0.0,
+                        last_moved: (0.0, 0.0),
                     }))
                 }
                 ControllerKind::Trajectory(t) => {
@@ -396,7 +401,7 @@ impl Controllers {
         s.runs += 1;
         s.stalled = false;
         s.reached_goal = false;
-        run.last_moved_s = now_s;
+        run.last_moved = (actuators.position(joint), now_s);
         Ok(())
     }
 
@@ -473,8 +478,13 @@ impl GripperRun {
         if !s.active {
             return None;
         }
-        if actuators.velocity(joint).abs() > self.spec.stalled_velocity_threshold {
-            self.last_moved_s = now_s;
+        // Moving: out of the band the threshold speed covers in `stall_timeout` since it last
+        // moved (gripper_action_controller reads the instantaneous speed; rover the distance,
+        // which the fingers' jitter on a held object does not reset).
+        let band =
+            (self.spec.stalled_velocity_threshold * self.spec.stall_timeout_s).max(STALL_BAND_MIN);
+        if (s.position - self.last_moved.0).abs() > band {
+            self.last_moved = (s.position, now_s);
         }
         if (s.goal - s.position).abs() <= self.spec.goal_tolerance {
             s.active = false;
@@ -484,7 +494,7 @@ impl GripperRun {
                 s.position, s.goal
             ));
         }
-        if now_s - self.last_moved_s > self.spec.stall_timeout_s {
+        if now_s - self.last_moved.1 > self.spec.stall_timeout_s {
             s.active = false;
             s.stalled = true;
             return Some(format!(
