@@ -41,14 +41,14 @@ pub use model::human;
 pub use model::{
     COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
     ControllerKind, ControllerSpec, DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION,
-    DepthOutput, DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GripperSpec,
-    Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId,
-    JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig, Link, LinkId,
-    MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model,
-    ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, RobotModel,
-    RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun, TrajectoryConstraints,
-    TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz, class_of_model,
-    is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
+    DepthOutput, DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GraspMode,
+    GripperSpec, Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial,
+    Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
+    Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
+    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
+    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun,
+    TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz,
+    class_of_model, is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
 };
 pub use noise::SplitMix64;
 pub use physics::{

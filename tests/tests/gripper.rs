@@ -263,28 +263,33 @@ fn ball_in_palm(sim: &rover_sim::Simulation) -> Result<glam::Vec3> {
     Ok(sim.world_from_link(palm).inverse().transform_point(ball))
 }
 
-/// Holding by friction: the lifter (tests/grasper/lifter.urdf) lowers its fingers around a
-/// 5 cm ball lying on the ground, closes on it with 10 N, lifts it 25 cm, turns it 1 rad, then
-/// drops and raises it 10 cm twice at the lift's full speed: the ball moves less than 1 cm in
-/// the palm's frame throughout, and falls when the fingers open.
-#[test]
-fn a_ball_held_by_friction_stays_in_the_fingers_while_lifted_and_turned() -> Result<()> {
+/// How far the held ball moves in the palm's frame while the lifter lifts it 25 cm, turns it
+/// 1 rad and drops and raises it 10 cm twice at full speed (m); whether it fell when the
+/// fingers opened; what the grasp assist held, if anything. `grasp` is the world's `[robot]
+/// grasp` line.
+fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
     let dir = tempfile::tempdir()?;
     let from = rover_tests::repo("tests/grasper");
-    for file in ["lifter.urdf", "lifter.toml", "grasper.yaml"] {
+    for file in ["lifter.urdf", "grasper.yaml"] {
         std::fs::copy(from.join(file), dir.path().join(file))?;
     }
+    let world = std::fs::read_to_string(from.join("lifter.toml"))?.replace(
+        "controllers = \"grasper.yaml\"\n",
+        &format!("controllers = \"grasper.yaml\"\n{grasp}\n"),
+    );
+    std::fs::write(dir.path().join("lifter.toml"), world)?;
     let mut sim = grasper_sim(&dir.path().join("lifter.toml"))?;
     run(&mut sim, 0.5);
     sim.command_joint("lift_joint", JointCommand::Position(-0.055))?;
     run(&mut sim, 1.5);
     sim.command_gripper("gripper_controller", 0.05, 10.0)?;
-    let grasp = until_done(&mut sim, 5.0)?;
+    let grasp_state = until_done(&mut sim, 5.0)?;
     ensure!(
-        grasp.stalled,
-        "the fingers did not close on the ball: {grasp:?}"
+        grasp_state.stalled,
+        "the fingers did not close on the ball: {grasp_state:?}"
     );
-    run(&mut sim, 0.3);
+    run(&mut sim, 1.2);
+    let held = sim.grasp_assist_holds();
     let held_at = ball_in_palm(&sim)?;
     let mut worst = 0.0f32;
     let mut moves = |sim: &mut rover_sim::Simulation, joint: &str, q: f64, s: f64| -> Result<()> {
@@ -305,22 +310,72 @@ fn a_ball_held_by_friction_stays_in_the_fingers_while_lifted_and_turned() -> Res
     let mut poses = Vec::new();
     sim.object_poses_into(&mut poses);
     let lifted_z = poses.first().context("no ball")?.translation.z;
-    println!(
-        "grasp {grasp:?}; the ball moved at most {:.2} mm in the palm's frame; lifted to z {lifted_z:.3} m",
-        worst * 1000.0
-    );
-    ensure!(
-        worst < 0.01,
-        "the held ball slipped {worst:.4} m in the fingers"
-    );
     ensure!(lifted_z > 0.2, "the ball was not lifted: z {lifted_z}");
     sim.command_gripper("gripper_controller", 0.0, 0.0)?;
     run(&mut sim, 2.0);
     sim.object_poses_into(&mut poses);
-    let dropped_z = poses.first().context("no ball")?.translation.z;
+    let fell = poses.first().context("no ball")?.translation.z < 0.05;
+    println!(
+        "{grasp:?}: grasp {grasp_state:?}; the assist held {held:?}; the ball moved at most {:.2} mm in the palm's frame; lifted to z {lifted_z:.3} m; fell when opened: {fell}; the assist holds {:?} after",
+        worst * 1000.0,
+        sim.grasp_assist_holds()
+    );
     ensure!(
-        dropped_z < 0.05,
-        "opened, the ball did not fall: z {dropped_z}"
+        sim.grasp_assist_holds().is_none(),
+        "the assist did not let go when the fingers opened"
+    );
+    Ok((worst, fell, held))
+}
+
+/// Holding, both ways: the lifter (tests/grasper/lifter.urdf) lowers its fingers around a 5 cm
+/// ball lying on the ground, closes on it with 10 N, lifts it 25 cm, turns it 1 rad, then drops
+/// and raises it 10 cm twice at the lift's full speed. By friction (the default) and with the
+/// grasp assist (gazebo_grasp_fix's rule: the ball fixed to the palm once gripped), the ball
+/// moves less than 1 cm in the palm's frame, and falls when the fingers open.
+#[test]
+fn a_held_ball_stays_in_the_fingers_while_lifted_and_turned_by_friction_or_assist() -> Result<()> {
+    let (friction_slip, friction_fell, friction_held) = lift_and_shake("")?;
+    ensure!(friction_held.is_none(), "no assist was asked for");
+    let (assist_slip, assist_fell, assist_held) = lift_and_shake("grasp = \"assist\"")?;
+    ensure!(
+        assist_held == Some(0),
+        "the assist did not hold the ball: {assist_held:?}"
+    );
+    for (mode, slip, fell) in [
+        ("friction", friction_slip, friction_fell),
+        ("assist", assist_slip, assist_fell),
+    ] {
+        ensure!(
+            slip < 0.01,
+            "{mode}: the held ball slipped {slip:.4} m in the fingers"
+        );
+        ensure!(fell, "{mode}: opened, the ball did not fall");
+    }
+    Ok(())
+}
+
+/// `grasp = "assist"` on a robot without a gripper controller is refused, saying what it needs.
+#[test]
+fn the_grasp_assist_without_a_gripper_controller_is_refused() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let world = grasper_world(
+        dir.path(),
+        Some(
+            "wrist_controller:\n  type: position_controllers/JointPositionController\n  joint: wrist_joint\n",
+        ),
+    )?;
+    let text = std::fs::read_to_string(&world)?.replace(
+        "controllers = \"grasper.yaml\"\n",
+        "controllers = \"grasper.yaml\"\ngrasp = \"assist\"\n",
+    );
+    std::fs::write(&world, text)?;
+    let error = match grasper_sim(&world) {
+        Ok(_) => String::new(),
+        Err(e) => format!("{e:#}"),
+    };
+    ensure!(
+        error.contains("grasp = \"assist\" needs a gripper controller"),
+        "{error:?}"
     );
     Ok(())
 }

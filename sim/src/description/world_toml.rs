@@ -14,8 +14,8 @@ use crate::model::drive::DriveSpec;
 use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, Ground, JointSolver, Object, Physics, RobotSpawn, World,
-    check_step_hz,
+    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, GraspMode, Ground, JointSolver, Object, Physics,
+    RobotSpawn, World, check_step_hz,
 };
 
 impl World {
@@ -113,6 +113,8 @@ struct RawRobot {
     arm_group: Option<String>,
     arm_base: Option<String>,
     ee_link: Option<String>,
+    #[serde(default)]
+    grasp: GraspMode,
 }
 
 #[derive(Debug, Deserialize)]
@@ -442,6 +444,7 @@ impl RawWorld {
             arm_group: raw_robot.arm_group,
             arm_base: raw_robot.arm_base,
             ee_link: raw_robot.ee_link,
+            grasp: raw_robot.grasp,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

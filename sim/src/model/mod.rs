@@ -43,6 +43,6 @@ pub use sensors::{
     PixelFormat,
 };
 pub use world::{
-    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, Ground, JointSolver, Model,
-    ModelLink, Object, Physics, RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
+    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,
+    Model, ModelLink, Object, Physics, RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
 };

@@ -68,6 +68,21 @@ pub struct RobotSpawn {
     pub arm_base: Option<String>,
     /// `ee_link`: the arm's end effector, which reaches.
     pub ee_link: Option<String>,
+    /// `grasp`: how the gripper holds what it closes on.
+    pub grasp: GraspMode,
+}
+
+/// How a gripper holds what it closes on (`[robot] grasp`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GraspMode {
+    /// By friction: the fingers squeeze with their capped motor force (the default: nothing
+    /// but physics; slip is measured, not hidden).
+    #[default]
+    Friction,
+    /// gazebo_grasp_fix's rule: an object two fingers push on from opposing sides for about a
+    /// second is fixed to the palm until the fingers open.
+    Assist,
 }
 
 /// Physics settings (`[physics]`).

@@ -431,6 +431,11 @@ impl Controllers {
         }
     }
 
+    /// Records something that happened (a grasp attached or let go), for the same log.
+    pub(crate) fn note(&mut self, event: String) {
+        self.events.push(event);
+    }
+
     /// Takes what happened since the last call (trajectory outcomes), oldest first.
     pub(crate) fn drain_events(&mut self) -> std::vec::Drain<'_, String> {
         self.events.drain(..)

@@ -7,6 +7,7 @@ pub(crate) mod actuators;
 pub(crate) mod build;
 pub(crate) mod controllers;
 pub(crate) mod diff_drive;
+pub(crate) mod grasp;
 pub(crate) mod joints;
 pub(crate) mod placement;
 pub(crate) mod simulation;

@@ -84,6 +84,8 @@ pub struct Simulation {
     pub(crate) people: Vec<RigidBodyHandle>,
     /// Bodies of the world objects, in world order.
     pub(crate) objects: Vec<RigidBodyHandle>,
+    /// The grasp assist, with `[robot] grasp = "assist"`.
+    grasp: Option<crate::physics::grasp::GraspAssist>,
     /// Counts placements ([`Simulation::layout_version`]).
     pub(crate) layout: u64,
     /// Relative poses of placed things, kept until the next step.
@@ -205,6 +207,16 @@ impl Simulation {
                 .unwrap_or_default(),
         );
         let encoder = EncoderOdometry::new(start, &drive_config);
+        let grasp = match world.robot.grasp {
+            crate::model::world::GraspMode::Friction => None,
+            crate::model::world::GraspMode::Assist => {
+                Some(crate::physics::grasp::GraspAssist::new(
+                    &robot,
+                    &robot_bodies.link_body,
+                    objects.len(),
+                )?)
+            }
+        };
         Ok(Self {
             physics,
             link_body: robot_bodies.link_body,
@@ -218,6 +230,7 @@ impl Simulation {
             seed: options.seed,
             people,
             objects,
+            grasp,
             layout: 0,
             placement: PlacementCache::default(),
             model_links,
@@ -272,6 +285,12 @@ impl Simulation {
         }
         self.actuators.apply_efforts(&mut self.physics, self.dt_s);
         self.physics.step();
+        if let Some(grasp) = &mut self.grasp
+            && let Some(event) = grasp.update(&mut self.physics, &self.objects, now)
+        {
+            tracing::info!("{event}");
+            self.controllers.note(event);
+        }
         self.placement.clear();
         self.step_index += 1;
         let measured = self.wheel_speeds_radps();
@@ -440,6 +459,11 @@ impl Simulation {
             &self.robot,
             (&mut self.actuators, now),
         )
+    }
+
+    /// The world object the grasp assist holds (`[robot] grasp = "assist"`), by its index.
+    pub fn grasp_assist_holds(&self) -> Option<usize> {
+        self.grasp.as_ref().and_then(|g| g.held())
     }
 
     /// The state of the gripper controller `name`.
