@@ -1480,24 +1480,8 @@ time.sleep(2.5)
 later = [latest.get(n, float('nan')) for n in names]
 print('D state %d moved_after %.4f from_goal %.4f' % (client.get_state(), max(abs(a - b) for a, b in zip(at_cancel, later)), max(abs(a - b) for a, b in zip(later, first))))
 "#;
-    let path = graph.dir.path().join("fjt.py");
-    std::fs::write(&path, script)?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&path).env("PYTHONPATH", &py);
-    let out = graph.run(c, Duration::from_secs(90))?;
-    println!("{out}");
-    let log = graph.log("rover");
-    let line = |label: &str| -> Result<Vec<f64>> {
-        let l = out
-            .lines()
-            .find(|l| l.starts_with(&format!("{label} state")))
-            .with_context(|| format!("no result for goal {label}:\n{out}\nrover:\n{log}"))?;
-        Ok(l.split(' ').filter_map(|w| w.parse().ok()).collect())
-    };
-    ensure!(
-        out.contains("server True"),
-        "no action server:\n{out}\n{log}"
-    );
+    let (out, log) = run_action_client(&graph, "fjt.py", script, &py)?;
+    let line = |label: &str| goal_line(&out, &log, label);
     // actionlib_msgs/GoalStatus: PREEMPTED 2, SUCCEEDED 3, REJECTED 5.
     let a = line("A")?;
     ensure!(
@@ -1580,24 +1564,8 @@ send('B', 0.05, 5.0)
 send('C', float('nan'), 1.0)
 send('D', 0.0, 0.0)
 "#;
-    let path = graph.dir.path().join("gripper.py");
-    std::fs::write(&path, script)?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&path).env("PYTHONPATH", &py);
-    let out = graph.run(c, Duration::from_secs(90))?;
-    println!("{out}");
-    let log = graph.log("rover");
-    let line = |label: &str| -> Result<Vec<f64>> {
-        let l = out
-            .lines()
-            .find(|l| l.starts_with(&format!("{label} state")))
-            .with_context(|| format!("no result for goal {label}:\n{out}\nrover:\n{log}"))?;
-        Ok(l.split(' ').filter_map(|w| w.parse().ok()).collect())
-    };
-    ensure!(
-        out.contains("server True"),
-        "no action server:\n{out}\n{log}"
-    );
+    let (out, log) = run_action_client(&graph, "gripper.py", script, &py)?;
+    let line = |label: &str| goal_line(&out, &log, label);
     // [state, position, effort, stalled, reached, feedback]; GoalStatus: SUCCEEDED 3,
     // ABORTED 4, REJECTED 5.
     let a = line("A")?;
@@ -1638,4 +1606,35 @@ fn control_msgs(graph: &RosGraph) -> Result<PathBuf> {
         ],
         &graph.dir.path().join("control_py"),
     )
+}
+
+/// Runs the actionlib client `script` (as `name`, with `py` on PYTHONPATH) against the graph;
+/// its output and rover's log. The client must have found the server (`server True`).
+fn run_action_client(
+    graph: &RosGraph,
+    name: &str,
+    script: &str,
+    py: &Path,
+) -> Result<(String, String)> {
+    let path = graph.dir.path().join(name);
+    std::fs::write(&path, script)?;
+    let mut c = graph.command(PYTHON);
+    c.arg(&path).env("PYTHONPATH", py);
+    let out = graph.run(c, Duration::from_secs(90))?;
+    println!("{out}");
+    let log = graph.log("rover");
+    ensure!(
+        out.contains("server True"),
+        "no action server:\n{out}\n{log}"
+    );
+    Ok((out, log))
+}
+
+/// The numbers on the client's `LABEL state ...` line for goal `label`.
+fn goal_line(out: &str, log: &str, label: &str) -> Result<Vec<f64>> {
+    let l = out
+        .lines()
+        .find(|l| l.starts_with(&format!("{label} state")))
+        .with_context(|| format!("no result for goal {label}:\n{out}\nrover:\n{log}"))?;
+    Ok(l.split(' ').filter_map(|w| w.parse().ok()).collect())
 }

@@ -159,12 +159,12 @@ impl Bridge<()> {
             &node, &plan,
         )?));
         let (to_session, from_actions) = std::sync::mpsc::channel();
-        families.push(Box::new(actions::TrajectoryActions::serve(
+        families.push(Box::new(actions::trajectory_actions(
             &node,
             &plan,
             to_session.clone(),
         )?));
-        families.push(Box::new(gripper::GripperActions::serve(
+        families.push(Box::new(gripper::gripper_actions(
             &node, &plan, robot, to_session,
         )?));
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
