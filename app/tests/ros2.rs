@@ -1116,23 +1116,9 @@ fn an_action_client_moves_tiagos_arm_and_a_cancel_stops_it() -> Result<()> {
     }
     std::thread::sleep(Duration::from_secs(2));
     let script = format!(
-        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{}",
+        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{ACTION_CLIENT}\n{}",
         r#"
-import os, time
-from cyclonedds.domain import DomainParticipant
-from cyclonedds.topic import Topic
-from cyclonedds.pub import DataWriter
-from cyclonedds.sub import DataReader
-from cyclonedds.qos import Qos, Policy
-from cyclonedds.util import duration
-
-dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
-reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
-latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
 a = '/arm_controller/follow_joint_trajectory/_action/'
-def service(name, req, resp):
-    return (DataWriter(dp, Topic(dp, 'rq' + a + name + 'Request', req), qos=reliable),
-            DataReader(dp, Topic(dp, 'rr' + a + name + 'Reply', resp), qos=reliable))
 send = service('send_goal', FJT_SendGoal_Request, FJT_SendGoal_Response)
 cancel = service('cancel_goal', CancelGoal_Request, CancelGoal_Response)
 result = service('get_result', FJT_GetResult_Request, FJT_GetResult_Response)
@@ -1279,6 +1265,26 @@ print('statuses %s' % ' '.join('/'.join('%d:%d' % x for x in s) for s in seen))
     Ok(())
 }
 
+/// A Cyclone DDS action client's set-up: the participant, reliable and latched QoS, and
+/// `service(name, request, response)`, the writer and reader of action `a`'s service `name`
+/// (the script sets `a`, the action's `/<name>/_action/` prefix).
+const ACTION_CLIENT: &str = r#"
+import os, time
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.qos import Qos, Policy
+from cyclonedds.util import duration
+
+dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
+latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+def service(name, req, resp):
+    return (DataWriter(dp, Topic(dp, 'rq' + a + name + 'Request', req), qos=reliable),
+            DataReader(dp, Topic(dp, 'rr' + a + name + 'Reply', resp), qos=reliable))
+"#;
+
 /// GripperCommand's messages for a Cyclone DDS peer (with [`ACTION_MESSAGES`]).
 const GRIPPER_MESSAGES: &str = r#"
 @dataclass
@@ -1349,22 +1355,9 @@ fn a_cyclone_action_client_closes_the_gripper_on_the_ball() -> Result<()> {
     )?;
     std::thread::sleep(Duration::from_secs(2));
     let script = format!(
-        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{GRIPPER_MESSAGES}\n{}",
+        "{CONTROL_MESSAGES}\n{ACTION_MESSAGES}\n{GRIPPER_MESSAGES}\n{ACTION_CLIENT}\n{}",
         r#"
-import os, time
-from cyclonedds.domain import DomainParticipant
-from cyclonedds.topic import Topic
-from cyclonedds.pub import DataWriter
-from cyclonedds.sub import DataReader
-from cyclonedds.qos import Qos, Policy
-from cyclonedds.util import duration
-
-dp = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
-reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
 a = '/gripper_controller/gripper_cmd/_action/'
-def service(name, req, resp):
-    return (DataWriter(dp, Topic(dp, 'rq' + a + name + 'Request', req), qos=reliable),
-            DataReader(dp, Topic(dp, 'rr' + a + name + 'Reply', resp), qos=reliable))
 send = service('send_goal', GC_SendGoal_Request, GC_SendGoal_Response)
 result = service('get_result', GC_GetResult_Request, GC_GetResult_Response)
 feedback = DataReader(dp, Topic(dp, 'rt' + a + 'feedback', GC_FeedbackMessage), qos=reliable)

@@ -72,17 +72,23 @@ pub(super) trait Stamped: Message + Default {
     fn header(&mut self) -> &mut Header;
 }
 
-impl Stamped for FollowJointTrajectoryActionResult {
-    fn header(&mut self) -> &mut Header {
-        &mut self.header
-    }
+/// [`Stamped`] for action messages whose header is their `header` field.
+macro_rules! stamped {
+    ($($t:ty),*) => {$(
+        impl Stamped for $t {
+            fn header(&mut self) -> &mut Header {
+                &mut self.header
+            }
+        }
+    )*};
 }
 
-impl Stamped for FollowJointTrajectoryActionFeedback {
-    fn header(&mut self) -> &mut Header {
-        &mut self.header
-    }
-}
+stamped!(
+    FollowJointTrajectoryActionResult,
+    FollowJointTrajectoryActionFeedback,
+    rover_ros1::msgs::GripperCommandActionResult,
+    rover_ros1::msgs::GripperCommandActionFeedback
+);
 
 /// Publishes `msg` numbered and stamped `now_s`.
 fn publish<M: Stamped>(publisher: &mut Publisher<M>, msg: &mut M, now_s: f64) {

@@ -15,10 +15,10 @@ use rover_core::Action;
 use rover_ros1::Node;
 use rover_ros1::msgs::{
     GoalId, GripperCommandActionFeedback, GripperCommandActionGoal, GripperCommandActionResult,
-    GripperCommandResult, Header,
+    GripperCommandResult,
 };
 
-use super::actions::{ActionFamily, ActionServer, Actionlib, Stamped, goal_status, rejected};
+use super::actions::{ActionFamily, ActionServer, Actionlib, goal_status, rejected};
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::ActionGoals;
 use crate::bridge::events::{ControlUpdate, GripperSample};
@@ -30,18 +30,6 @@ fn result_of(g: GripperSample) -> GripperCommandResult {
         effort: g.effort,
         stalled: g.stalled,
         reached_goal: g.reached_goal,
-    }
-}
-
-impl Stamped for GripperCommandActionResult {
-    fn header(&mut self) -> &mut Header {
-        &mut self.header
-    }
-}
-
-impl Stamped for GripperCommandActionFeedback {
-    fn header(&mut self) -> &mut Header {
-        &mut self.header
     }
 }
 
