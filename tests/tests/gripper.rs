@@ -301,12 +301,19 @@ fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
         }
         Ok(())
     };
+    let (wall, sim_start_s) = (std::time::Instant::now(), sim.sim_time_s());
     moves(&mut sim, "lift_joint", 0.2, 1.5)?;
     moves(&mut sim, "wrist_joint", 1.0, 1.5)?;
     for _ in 0..2 {
         moves(&mut sim, "lift_joint", 0.1, 0.6)?;
         moves(&mut sim, "lift_joint", 0.2, 0.6)?;
     }
+    // For the record only (no test depends on the machine's speed).
+    println!(
+        "{grasp:?}: {:.1} s of sim time holding the ball in {:.3} s of wall time",
+        sim.sim_time_s() - sim_start_s,
+        wall.elapsed().as_secs_f64()
+    );
     let mut poses = Vec::new();
     sim.object_poses_into(&mut poses);
     let lifted_z = poses.first().context("no ball")?.translation.z;
