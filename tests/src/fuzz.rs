@@ -640,7 +640,12 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     let no_resources = ResourcePaths::from_env();
     out.push(Target {
         name: "world_toml",
-        seeds: read_all(&files_with(&crate::repo("worlds"), "toml"))?,
+        seeds: read_all(
+            &files_with(&crate::repo("worlds"), "toml")
+                .into_iter()
+                .chain(files_with(&crate::repo("tests/grasper"), "toml"))
+                .collect::<Vec<_>>(),
+        )?,
         input_path: dir.join("world.toml"),
         load: Box::new({
             let car = car.clone();
@@ -663,6 +668,40 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             robot.load_controllers(p).map_err(|e| e.to_string())?;
             let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
             simulate(p, world, robot)
+        }),
+        hang_limit: text_limit,
+    });
+
+    // A gripper controller (gripper_action_controller's parameters), on the test grasper.
+    let dir = work.join("gripper");
+    std::fs::create_dir_all(&dir)?;
+    let grasper = rover_sim::RobotModel::load(&crate::repo("tests/grasper/grasper.urdf"))?;
+    out.push(Target {
+        name: "gripper_yaml",
+        seeds: read_all(&[crate::repo("tests/grasper/grasper.yaml")])?,
+        input_path: dir.join("controllers.yaml"),
+        load: Box::new(move |p| {
+            let mut robot = grasper.clone();
+            robot.load_controllers(p).map_err(|e| e.to_string())?;
+            // The gripper, if the file still has one, is commanded closed and stepped.
+            let gripper = robot
+                .controllers
+                .iter()
+                .flat_map(|c| &c.controllers)
+                .find(|c| matches!(c.kind, rover_sim::ControllerKind::Gripper(_)))
+                .map(|c| c.name.clone());
+            let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
+            let mut sim =
+                rover_sim::Simulation::new(world, robot, &rover_sim::SimOptions::default())
+                    .map_err(|e| format!("{}: {e}", p.display()))?;
+            if let Some(name) = gripper {
+                sim.command_gripper(&name, 0.05, 5.0)
+                    .map_err(|e| e.to_string())?;
+            }
+            for _ in 0..20 {
+                sim.step();
+            }
+            Ok(())
         }),
         hang_limit: text_limit,
     });
