@@ -210,20 +210,6 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
             .collect()
     }
 
-    /// Why gripper_action_controller would refuse a GripperCommand, if it would.
-    pub fn check_gripper(position: f64, max_effort: f64) -> Result<(), Rejection> {
-        if position.is_finite() && max_effort.is_finite() {
-            Ok(())
-        } else {
-            Err(Rejection {
-                code: code::INVALID_GOAL,
-                why: format!(
-                    "position {position} and max_effort {max_effort} must be finite numbers"
-                ),
-            })
-        }
-    }
-
     /// Accepts a gripper command: the goal executing is preempted, the command goes to the
     /// session.
     pub fn accept_gripper(
@@ -506,6 +492,18 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
     }
 }
 
+/// Why gripper_action_controller would refuse a GripperCommand, if it would.
+pub(crate) fn check_gripper(position: f64, max_effort: f64) -> Result<(), Rejection> {
+    if position.is_finite() && max_effort.is_finite() {
+        Ok(())
+    } else {
+        Err(Rejection {
+            code: code::INVALID_GOAL,
+            why: format!("position {position} and max_effort {max_effort} must be finite numbers"),
+        })
+    }
+}
+
 /// How a trajectory's run ended, as FollowJointTrajectory's result says it.
 fn trajectory_ending(run: RunSample) -> (GoalState, i32, &'static str) {
     match run.outcome {
@@ -690,7 +688,7 @@ mod tests {
             ..GripperSample::default()
         };
         assert_eq!(gripper_ending(reached, false).0, GoalState::Succeeded);
-        assert!(ActionGoals::<u32>::check_gripper(f64::NAN, 1.0).is_err());
-        assert!(ActionGoals::<u32>::check_gripper(0.01, 0.0).is_ok());
+        assert!(check_gripper(f64::NAN, 1.0).is_err());
+        assert!(check_gripper(0.01, 0.0).is_ok());
     }
 }

@@ -14,13 +14,13 @@ use anyhow::Result;
 use rover_core::Action;
 use rover_ros1::Node;
 use rover_ros1::msgs::{
-    GoalId, GripperCommandActionFeedback, GripperCommandActionGoal, GripperCommandActionResult,
+    GripperCommandActionFeedback, GripperCommandActionGoal, GripperCommandActionResult,
     GripperCommandResult,
 };
 
 use super::actions::{ActionFamily, ActionServer, Actionlib, goal_status, rejected};
 use crate::bridge::RosPlan;
-use crate::bridge::action_goals::ActionGoals;
+use crate::bridge::action_goals::{ActionGoals, check_gripper};
 use crate::bridge::events::{ControlUpdate, GripperSample};
 
 /// GripperCommand's result (and feedback) fields from a sample.
@@ -67,7 +67,7 @@ impl ActionServer for GripperServer {
         let run = self.io.goals.run(update);
         while let Some((id, msg)) = self.io.next_goal(|m| m.goal_id.clone()) {
             let c = msg.command;
-            match ActionGoals::<GoalId>::check_gripper(c.position, c.max_effort) {
+            match check_gripper(c.position, c.max_effort) {
                 Ok(()) => self.io.goals.accept_gripper(
                     id,
                     (c.position, c.max_effort),

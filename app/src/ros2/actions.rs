@@ -36,7 +36,9 @@ use super::discovery::RosDistro;
 use super::msgs::Time;
 use super::services::{RequestHeader, Server, ServiceType};
 use crate::bridge::RosPlan;
-use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, code};
+use crate::bridge::action_goals::{
+    ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
+};
 use crate::bridge::events::{ControlUpdate, GripperSample, RunSample, TopicFamily};
 
 /// Seconds between feedback messages (20 Hz).
@@ -196,7 +198,7 @@ impl ActionType for GripperCommand {
         to_session: &Sender<Action>,
     ) -> Result<(), Rejection> {
         let c = goal.command;
-        ActionGoals::<Uuid>::check_gripper(c.position, c.max_effort)?;
+        check_gripper(c.position, c.max_effort)?;
         goals.accept_gripper(id, (c.position, c.max_effort), now, to_session);
         Ok(())
     }

@@ -36,7 +36,16 @@ fn draw_image(canvas: &mut Canvas<'_>, image: &[u32], size: (usize, usize)) -> O
     }
     let x0 = (w - iw) / 2;
     if x0 > 0 {
-        canvas.fill(0, 0, w as i64, img_h as i64, BACKGROUND);
+        // The margins beside the image.
+        canvas.fill(0, 0, x0 as i64, img_h as i64, BACKGROUND);
+        let right = x0 + iw;
+        canvas.fill(
+            right as i64,
+            0,
+            (w - right) as i64,
+            img_h as i64,
+            BACKGROUND,
+        );
     }
     for (row, src) in image.chunks_exact(iw).enumerate() {
         let start = row * w + x0;

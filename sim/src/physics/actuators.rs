@@ -138,7 +138,9 @@ impl Actuator {
         self.pid.unwrap_or_else(|| {
             let omega = 2.0 * std::f64::consts::PI * HOLD_BANDWIDTH_HZ;
             let mut p = (self.inertia * omega * omega).max(self.friction / HOLD_FRICTION_ERROR);
-            if self.coupling {
+            // A joint without an effort limit (`effort_max` is f32::MAX) keeps the default
+            // hold: no finite stiffness puts an unlimited effort within the error.
+            if self.coupling && self.effort_max < f64::from(f32::MAX) {
                 p = p.max(self.cap() / MIMIC_HOLD_ERROR);
             }
             Pid {

@@ -157,10 +157,10 @@ impl Simulation {
         physics.gravity = Vec3::new(g[0] as f32, g[1] as f32, g[2] as f32);
         physics.integration_parameters.dt = dt_s as f32;
         physics.integration_parameters.num_solver_iterations = world.physics.solver_iterations;
-        if world.physics.contact_hz != crate::model::world::DEFAULT_CONTACT_HZ {
-            let soft = &mut physics.integration_parameters.contact_softness;
-            soft.natural_frequency = world.physics.contact_hz as f32;
-        }
+        physics
+            .integration_parameters
+            .contact_softness
+            .natural_frequency = world.physics.contact_hz as f32;
 
         let WorldBodies {
             ground,
