@@ -46,6 +46,7 @@ pub use model::{
     Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
     Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
     Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
+    PlanError, PlannerOptions, TimedPath, plan_path,
     RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun,
     TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz,
     class_of_model, is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
@@ -54,7 +55,8 @@ pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, GripperState,
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
-    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions,
+    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, PlanningScene,
+    SceneContact, SimOptions,
     Simulation, TrajectoryOutcome, TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds,
     wrap_angle,
 };

@@ -84,6 +84,8 @@ pub struct ChainJoint {
     pub upper: f64,
     /// Whether it slides (prismatic) rather than turns.
     pub prismatic: bool,
+    /// Its `<limit velocity>` (rad/s or m/s), when given.
+    pub velocity_limit: Option<f64>,
     /// Unit axis in the joint's own frame.
     axis: Vector3<f64>,
 }
@@ -219,6 +221,10 @@ impl KinematicChain {
                 lower,
                 upper,
                 prismatic,
+                velocity_limit: j
+                    .velocity_limit
+                    .map(f64::from)
+                    .filter(|v| v.is_finite() && *v > 0.0),
                 axis: axis.try_normalize(1e-9).unwrap_or_else(Vector3::z),
             });
         }
@@ -384,6 +390,9 @@ pub struct IkTarget {
     pub position_m: Vector3<f64>,
     /// The tip's orientation, when it matters.
     pub orientation: Option<UnitQuaternion<f64>>,
+    /// Where the tip's z axis should point (a unit vector, base frame) when only that matters
+    /// (a gripper's approach: the turn about it is free); ignored when `orientation` is given.
+    pub approach: Option<Vector3<f64>>,
 }
 
 impl IkTarget {
@@ -392,6 +401,17 @@ impl IkTarget {
         Self {
             position_m,
             orientation: None,
+            approach: None,
+        }
+    }
+
+    /// A point with the tip's z axis along `direction` (base frame; any length but zero): a
+    /// gripper coming in along `direction`, its turn about it free.
+    pub fn approach(position_m: Vector3<f64>, direction: Vector3<f64>) -> Self {
+        Self {
+            position_m,
+            orientation: None,
+            approach: direction.try_normalize(1e-12),
         }
     }
 
@@ -400,6 +420,7 @@ impl IkTarget {
         Self {
             position_m: base_from_tip.translation.vector,
             orientation: Some(base_from_tip.rotation),
+            approach: None,
         }
     }
 }
@@ -553,18 +574,29 @@ impl IkSolver {
     /// Errors of the tip at `self.q` (the weighted 6-vector, position m, orientation rad),
     /// filling the Jacobian (orientation rows weighted the same).
     fn errors(&mut self, target: &IkTarget) -> (Vector6<f64>, f64, f64) {
-        let weight = target
-            .orientation
-            .map_or(0.0, |_| self.options.orientation_weight_m);
+        let approach = target.approach.filter(|_| target.orientation.is_none());
+        let weight = if target.orientation.is_some() || approach.is_some() {
+            self.options.orientation_weight_m
+        } else {
+            0.0
+        };
         let frames = &mut self.frames;
         let tip = self
             .chain
             .walk(&self.q, |i, origin, axis| frames[i] = (origin, axis));
         let p_tip = tip.translation.vector;
+        let tip_z = tip.rotation * Vector3::z();
         for (i, joint) in self.chain.joints.iter().enumerate() {
             let (origin, axis) = self.frames[i];
             let (linear, angular) = if joint.prismatic {
                 (axis, Vector3::zeros())
+            } else if approach.is_some() {
+                // A turn about the tip's own z leaves its direction as it is: only the rest
+                // of the joint's turn counts.
+                (
+                    axis.cross(&(p_tip - origin)),
+                    (axis - tip_z * tip_z.dot(&axis)) * weight,
+                )
             } else {
                 (axis.cross(&(p_tip - origin)), axis * weight)
             };
@@ -573,9 +605,16 @@ impl IkSolver {
             column.fixed_rows_mut::<3>(3).copy_from(&angular);
         }
         let position = target.position_m - p_tip;
-        let rotation = target.orientation.map_or(Vector3::zeros(), |r| {
-            (r * tip.rotation.inverse()).scaled_axis()
-        });
+        let rotation = match (target.orientation, approach) {
+            (Some(r), _) => (r * tip.rotation.inverse()).scaled_axis(),
+            (None, Some(d)) => UnitQuaternion::rotation_between(&tip_z, &d)
+                .map_or_else(
+                    // Opposite: half a turn about any axis across the tip's z.
+                    || tip.rotation * Vector3::x() * std::f64::consts::PI,
+                    |r| r.scaled_axis(),
+                ),
+            (None, None) => Vector3::zeros(),
+        };
         let mut error = Vector6::zeros();
         error.fixed_rows_mut::<3>(0).copy_from(&position);
         error.fixed_rows_mut::<3>(3).copy_from(&(rotation * weight));

@@ -10,6 +10,7 @@ pub(crate) mod diff_drive;
 pub(crate) mod grasp;
 pub(crate) mod joints;
 pub(crate) mod placement;
+pub(crate) mod scene;
 pub(crate) mod simulation;
 pub(crate) mod states;
 
@@ -25,5 +26,6 @@ pub use diff_drive::{
     WheelSpeeds, wrap_angle,
 };
 pub use placement::PersonLook;
+pub use scene::{PlanningScene, SceneContact};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use states::ModelState;

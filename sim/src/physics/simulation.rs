@@ -93,7 +93,7 @@ pub struct Simulation {
     /// Bodies of the SDF models' links, in model then link order.
     pub(crate) model_links: Vec<RigidBodyHandle>,
     /// The ground's body (not an obstacle for clearance figures).
-    ground: RigidBodyHandle,
+    pub(crate) ground: RigidBodyHandle,
     /// Every moving joint as built (joint order; `None` for fixed ones).
     joints: Vec<Option<BuiltJoint>>,
     /// The actuated joints' motors, run every `control_steps` physics steps.

@@ -1,0 +1,343 @@
+//! The planning scene: what an arm's motion planner checks a configuration against, as MoveIt
+//! checks one against its planning scene. The arm's links (every link one of its chain's joints
+//! moves) at the configuration, by forward kinematics over the robot's tree, against:
+//! - the world's colliders where they are now (the ground, boxes, spheres, models, people):
+//!   the geometry Gazebo's planning-scene plugins hand MoveIt;
+//! - the robot's links the chain does not move (the chassis, a mast), except the ones a chain
+//!   link touches with every joint at zero (neighbours by construction, as MoveIt's setup
+//!   assistant's "adjacent" and "default" pairs);
+//! - an object held in the hand, carried with its link ([`PlanningScene::attach_sphere`]).
+//!
+//! A pair closer than the margin is a collision. The chain's own links are not checked against
+//! each other (a five-joint arm cannot fold onto itself; a longer arm's SRDF pairs are left for
+//! later).
+
+use rapier3d::parry::query;
+use glam::Quat;
+use rapier3d::prelude::*;
+
+use crate::error::Result;
+use crate::geometry::Pose;
+use crate::model::kinematics::KinematicChain;
+use crate::model::robot::{JointId, JointKind, LinkId, RobotModel};
+use crate::physics::build::{ROBOT_GROUP, collider_shape};
+use crate::physics::simulation::Simulation;
+
+/// What a configuration hits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneContact {
+    /// The arm's link (or `held object`).
+    pub link: String,
+    /// What it comes within the margin of: a world object's name, `ground`, a model link
+    /// (`model::link`), a person or one of the robot's other links.
+    pub obstacle: String,
+    /// Their distance (m; 0 when they overlap).
+    pub distance_m: f32,
+}
+
+/// One obstacle, fixed where it was when the scene was taken.
+#[derive(Clone)]
+struct Obstacle {
+    world_from_shape: Pose,
+    shape: SharedShape,
+    name: String,
+    /// The world object's index, for an object.
+    object: Option<usize>,
+    aabb: rapier3d::parry::bounding_volume::Aabb,
+}
+
+/// The scene for one chain.
+#[derive(Clone)]
+pub struct PlanningScene {
+    robot: RobotModel,
+    /// The robot's joints parents first.
+    order: Vec<JointId>,
+    /// Every joint's position (robot joint order), the chain's replaced per check.
+    q_all: Vec<f64>,
+    chain_joints: Vec<JointId>,
+    world_from_root: Pose,
+    /// The links the chain moves, with their shapes (link frame).
+    moving: Vec<(LinkId, Vec<(Pose, SharedShape)>)>,
+    obstacles: Vec<Obstacle>,
+    /// A held object: its link, where it is on the link, its shape.
+    attached: Option<(LinkId, Pose, SharedShape)>,
+    /// Objects left out (the one about to be grasped, the one held).
+    ignored: Vec<usize>,
+    margin_m: f32,
+    root_from_link: Vec<Pose>,
+}
+
+impl std::fmt::Debug for PlanningScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlanningScene")
+            .field("moving_links", &self.moving.len())
+            .field("obstacles", &self.obstacles.len())
+            .field("margin_m", &self.margin_m)
+            .finish_non_exhaustive()
+    }
+}
+
+impl PlanningScene {
+    /// The margin (m): closer than this is a collision.
+    pub fn margin_m(&self) -> f32 {
+        self.margin_m
+    }
+
+    /// Leaves world object `index` out of the checks (the object a grasp is about to touch),
+    /// or takes it back in (`ignore` false).
+    pub fn ignore_object(&mut self, index: usize, ignore: bool) {
+        self.ignored.retain(|&i| i != index);
+        if ignore {
+            self.ignored.push(index);
+        }
+    }
+
+    /// The world object nearest `world_point_m` within `within_m` of its surface, by index
+    /// (the object a perceived point belongs to).
+    pub fn object_near(&self, world_point_m: [f64; 3], within_m: f32) -> Option<usize> {
+        let [x, y, z] = world_point_m.map(|v| v as f32);
+        let point = Vec3::new(x, y, z);
+        self.obstacles
+            .iter()
+            .filter_map(|o| {
+                let d = o
+                    .shape
+                    .distance_to_point(&o.world_from_shape, point, true);
+                (d <= within_m).then_some((o.object?, d))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// Carries a sphere of `radius_m` with `link` at `link_from_centre` (a held object), or
+    /// nothing (`None`).
+    pub fn attach_sphere(&mut self, held: Option<(LinkId, Pose, f32)>) {
+        self.attached = held.map(|(link, pose, r)| (link, pose, SharedShape::ball(r)));
+    }
+
+    /// The first thing the chain's links (or the held object) come within the margin of at
+    /// `q` (the chain's joint positions), if any.
+    pub fn collision(&mut self, q: &[f64]) -> Option<SceneContact> {
+        self.forward(q);
+        for (link, shapes) in &self.moving {
+            let world_from_link = self.world_from_root * self.root_from_link[link.index()];
+            for (link_from_shape, shape) in shapes {
+                let name = || self.robot.links[link.index()].name.clone();
+                if let Some(hit) = self.first_hit(&(world_from_link * *link_from_shape), shape, name)
+                {
+                    return Some(hit);
+                }
+            }
+        }
+        if let Some((link, pose, shape)) = &self.attached {
+            let world = self.world_from_root * self.root_from_link[link.index()] * *pose;
+            return self.first_hit(&world, shape, || "held object".to_owned());
+        }
+        None
+    }
+
+    /// The nearest obstacle within the margin of one shape.
+    fn first_hit(
+        &self,
+        world_from_shape: &Pose,
+        shape: &SharedShape,
+        link: impl Fn() -> String,
+    ) -> Option<SceneContact> {
+        let aabb = shape.compute_aabb(world_from_shape).loosened(self.margin_m);
+        for o in &self.obstacles {
+            if o.object.is_some_and(|i| self.ignored.contains(&i))
+                || !aabb.intersects(&o.aabb)
+            {
+                continue;
+            }
+            let Ok(d) = query::distance(world_from_shape, &**shape, &o.world_from_shape, &*o.shape)
+            else {
+                continue;
+            };
+            if d.distance < self.margin_m {
+                return Some(SceneContact {
+                    link: link(),
+                    obstacle: o.name.clone(),
+                    distance_m: d.distance,
+                });
+            }
+        }
+        None
+    }
+
+    /// Every link's pose in the root frame with the chain at `q`.
+    fn forward(&mut self, q: &[f64]) {
+        for (id, v) in self.chain_joints.iter().zip(q) {
+            if let Some(slot) = self.q_all.get_mut(id.index()) {
+                *slot = *v;
+            }
+        }
+        // Mimic joints follow their leaders.
+        for (i, joint) in self.robot.joints.iter().enumerate() {
+            if let Some(m) = &joint.mimic {
+                let leader = self.q_all.get(m.joint.index()).copied().unwrap_or(0.0);
+                self.q_all[i] = f64::from(m.multiplier) * leader + f64::from(m.offset);
+            }
+        }
+        root_from_links_at(&self.robot, &self.order, &self.q_all, &mut self.root_from_link);
+    }
+}
+
+/// Every link's pose in the root frame with the joints at `q_all` (robot joint order),
+/// visiting joints in `order` (parents first) into `out`.
+fn root_from_links_at(robot: &RobotModel, order: &[JointId], q_all: &[f64], out: &mut Vec<Pose>) {
+    out.clear();
+    out.resize(robot.links.len(), Pose::IDENTITY);
+    for id in order {
+        let joint = &robot.joints[id.index()];
+        let q = q_all.get(id.index()).copied().unwrap_or(0.0) as f32;
+        let motion = match joint.kind {
+            JointKind::Fixed => Pose::IDENTITY,
+            JointKind::Prismatic { .. } => Pose::from_translation(joint.axis * q),
+            _ => Pose::from_rotation(Quat::from_axis_angle(joint.axis, q)),
+        };
+        out[joint.child.index()] = out[joint.parent.index()] * joint.parent_from_child * motion;
+    }
+}
+
+/// The robot's joints, parents first.
+fn joint_order(robot: &RobotModel) -> Vec<JointId> {
+    let mut placed = vec![false; robot.links.len()];
+    placed[robot.root.index()] = true;
+    let mut order = Vec::with_capacity(robot.joints.len());
+    let mut progress = true;
+    while progress {
+        progress = false;
+        for (id, joint) in robot.joint_ids() {
+            if placed[joint.parent.index()] && !placed[joint.child.index()] {
+                placed[joint.child.index()] = true;
+                order.push(id);
+                progress = true;
+            }
+        }
+    }
+    order
+}
+
+impl Simulation {
+    /// The planning scene for `chain` (a chain of this robot) as things are now, closer than
+    /// `margin_m` counting as a collision. Errors: a collision mesh that cannot be read.
+    pub fn planning_scene(&self, chain: &KinematicChain, margin_m: f32) -> Result<PlanningScene> {
+        let robot = &self.robot;
+        let order = joint_order(robot);
+        let chain_joints: Vec<JointId> = chain.joints().iter().map(|j| j.id).collect();
+        // The links the chain moves: below its first joint.
+        let mut moved = vec![false; robot.links.len()];
+        for id in &order {
+            let joint = &robot.joints[id.index()];
+            if chain_joints.first() == Some(id) || moved[joint.parent.index()] {
+                moved[joint.child.index()] = true;
+            }
+        }
+        let mut shapes: Vec<Vec<(Pose, SharedShape)>> = vec![Vec::new(); robot.links.len()];
+        for (i, link) in robot.links.iter().enumerate() {
+            for c in &link.collisions {
+                let (shape, fix) = collider_shape(&c.shape, &robot.source, &link.name, false)?;
+                shapes[i].push((c.link_from_shape * fix, shape));
+            }
+        }
+        let q_all: Vec<f64> = robot
+            .joint_ids()
+            .map(|(id, _)| self.joint_state(id).map_or(0.0, |s| s.position))
+            .collect();
+        let world_from_root = self.world_from_link(robot.root);
+        let mut obstacles = self.world_obstacles();
+        // The robot's other links, where they are now, but not those a chain link touches
+        // with every joint at zero.
+        let mut at_zero = Vec::new();
+        root_from_links_at(robot, &order, &vec![0.0; robot.joints.len()], &mut at_zero);
+        let touching_at_zero = |fixed: usize| {
+            shapes[fixed].iter().any(|(pf, sf)| {
+                (0..robot.links.len()).filter(|&m| moved[m]).any(|m| {
+                    shapes[m].iter().any(|(pm, sm)| {
+                        query::distance(&(at_zero[fixed] * *pf), &**sf, &(at_zero[m] * *pm), &**sm)
+                            .is_ok_and(|d| d.distance < margin_m)
+                    })
+                })
+            })
+        };
+        for (i, link) in robot.links.iter().enumerate() {
+            if moved[i] || shapes[i].is_empty() || touching_at_zero(i) {
+                continue;
+            }
+            let world_from_link = self.world_from_link(LinkId(i));
+            for (pose, shape) in &shapes[i] {
+                let world_from_shape = world_from_link * *pose;
+                obstacles.push(Obstacle {
+                    aabb: shape.compute_aabb(&world_from_shape),
+                    world_from_shape,
+                    shape: shape.clone(),
+                    name: format!("{} (the robot's)", link.name),
+                    object: None,
+                });
+            }
+        }
+        let moving = (0..robot.links.len())
+            .filter(|&i| moved[i] && !shapes[i].is_empty())
+            .map(|i| (LinkId(i), shapes[i].clone()))
+            .collect();
+        Ok(PlanningScene {
+            robot: robot.clone(),
+            order,
+            q_all,
+            chain_joints,
+            world_from_root,
+            moving,
+            obstacles,
+            attached: None,
+            ignored: Vec::new(),
+            margin_m,
+            root_from_link: Vec::new(),
+        })
+    }
+
+    /// Every collider not the robot's, where it is now, named.
+    fn world_obstacles(&self) -> Vec<Obstacle> {
+        let name_of = |body: Option<RigidBodyHandle>| -> (String, Option<usize>) {
+            let Some(body) = body else {
+                return ("ground".to_owned(), None);
+            };
+            if body == self.ground {
+                return ("ground".to_owned(), None);
+            }
+            if let Some(i) = self.objects.iter().position(|b| *b == body) {
+                let name = self.world.objects.get(i).map_or_else(
+                    || format!("object {i}"),
+                    |o| {
+                        if o.name.is_empty() {
+                            format!("object {i}")
+                        } else {
+                            o.name.clone()
+                        }
+                    },
+                );
+                return (name, Some(i));
+            }
+            if let Some(i) = self.people.iter().position(|b| *b == body) {
+                return (format!("person {i}"), None);
+            }
+            ("a model".to_owned(), None)
+        };
+        self.physics
+            .colliders
+            .iter()
+            .filter(|(_, c)| !c.collision_groups().memberships.contains(ROBOT_GROUP))
+            .map(|(_, c)| {
+                let (name, object) = name_of(c.parent());
+                let world_from_shape = *c.position();
+                Obstacle {
+                    aabb: c.shape().compute_aabb(&world_from_shape),
+                    world_from_shape,
+                    shape: c.shared_shape().clone(),
+                    name,
+                    object,
+                }
+            })
+            .collect()
+    }
+}
