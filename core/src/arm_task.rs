@@ -12,6 +12,7 @@ use rover_sim::{
 };
 
 use crate::look::{Look, LookConfig};
+use crate::pick::{Pick, PickConfig, PickState};
 use crate::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
 
 /// How many recent images are kept for detections still to come.
@@ -37,6 +38,8 @@ pub struct ArmConfig {
     pub look: LookConfig,
     /// Reach settings (its class is the one reached for).
     pub reach: ReachConfig,
+    /// Pick-and-place settings (its class is the one picked).
+    pub pick: PickConfig,
 }
 
 /// What the arm is doing on its own.
@@ -49,15 +52,18 @@ pub enum ArmMode {
     Look,
     /// Reaching for the class.
     Reach,
+    /// Picking the class up and putting it on the place.
+    Pick,
 }
 
 impl ArmMode {
-    /// `off`, `look` or `reach`.
+    /// `off`, `look`, `reach` or `pick`.
     pub fn as_str(self) -> &'static str {
         match self {
             ArmMode::Off => "off",
             ArmMode::Look => "look",
             ArmMode::Reach => "reach",
+            ArmMode::Pick => "pick",
         }
     }
 }
@@ -69,6 +75,8 @@ pub struct ArmStatus {
     pub mode: ArmMode,
     /// What the reach is doing (meaningful in [`ArmMode::Reach`]).
     pub reach: ReachState,
+    /// What the pick is doing (meaningful in [`ArmMode::Pick`]).
+    pub pick: PickState,
     /// The object point reached for, world frame (m).
     pub object_world_m: Option<[f64; 3]>,
     /// The pre-grasp goal, world frame (m).
@@ -88,6 +96,10 @@ impl Default for ArmConfig {
             look: LookConfig {
                 class: reach.class.clone(),
                 ..LookConfig::default()
+            },
+            pick: PickConfig {
+                class: reach.class.clone(),
+                ..PickConfig::default()
             },
             reach,
         }
@@ -156,6 +168,7 @@ pub(crate) struct ArmTask {
     camera_link: LinkId,
     look: Result<Look, String>,
     reach: Result<Reach, String>,
+    pick: Result<Pick, String>,
     /// The end effector moved to points (scripts, Cartesian jogging).
     tool: Result<IkSolver, String>,
     /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
@@ -200,6 +213,16 @@ impl ArmTask {
                 Reach::new(robot, c, base_name, ee, config.reach.clone()).map_err(|e| e.to_string())
             }
         };
+        let pick = match (camera, ee_link) {
+            (Some(c), Some(ee)) if c.depth.is_some() => {
+                Pick::new(sim, c, base_name, ee, config.pick.clone())
+            }
+            _ => Err(reach
+                .as_ref()
+                .err()
+                .cloned()
+                .unwrap_or_else(|| "no depth camera or end effector".to_owned())),
+        };
         let tool = ee_link
             .ok_or_else(|| {
                 "no end effector given (--ee-link LINK, or ee_link in the world's [robot])"
@@ -223,6 +246,7 @@ impl ArmTask {
             camera_link,
             look,
             reach,
+            pick,
             tool,
             look_while_reaching,
             frames: Vec::new(),
@@ -316,12 +340,18 @@ impl ArmTask {
             ArmMode::Reach => {
                 self.reach.as_ref().map_err(|e| format!("no reach: {e}"))?;
             }
+            ArmMode::Pick => {
+                self.pick.as_ref().map_err(|e| format!("no pick: {e}"))?;
+            }
             ArmMode::Off => {}
         }
         // Whatever was going on stops where it is.
         self.hold(sim);
         if let Ok(reach) = self.reach.as_mut() {
             reach.reset();
+        }
+        if let Ok(pick) = self.pick.as_mut() {
+            pick.reset();
         }
         self.mode = next;
         self.status = ArmStatus {
@@ -391,6 +421,17 @@ impl ArmTask {
                 command(sim, look.joints(), &targets);
             }
         }
+        if self.mode == ArmMode::Pick
+            && let Ok(pick) = self.pick.as_mut()
+        {
+            let view = DepthView {
+                depth_m: &record.depth_m,
+                width: record.width,
+                height: record.height,
+                base_from_optical: record.base_from_optical,
+            };
+            pick.observe(boxes, &view, sim);
+        }
         if self.mode == ArmMode::Reach
             && let Ok(reach) = self.reach.as_mut()
         {
@@ -411,8 +452,12 @@ impl ArmTask {
         Ok(())
     }
 
-    /// After a control update: the reach's arrival and the status's world points.
-    pub(crate) fn update(&mut self, sim: &Simulation) -> Result<(), KinematicsError> {
+    /// After a control update: the pick's steps, the reach's arrival and the status's world
+    /// points.
+    pub(crate) fn update(&mut self, sim: &mut Simulation) -> Result<(), KinematicsError> {
+        if self.mode == ArmMode::Pick {
+            return self.update_pick(sim);
+        }
         if self.mode != ArmMode::Reach {
             return Ok(());
         }
@@ -433,8 +478,53 @@ impl ArmTask {
             object_world_m: reach.object_m().map(world),
             goal_world_m: reach.goal_m().map(world),
             tool_world_m: Some(world(tool)),
+            ..ArmStatus::default()
         };
         Ok(())
+    }
+
+    /// The pick's step and status.
+    fn update_pick(&mut self, sim: &mut Simulation) -> Result<(), KinematicsError> {
+        let Ok(pick) = self.pick.as_mut() else {
+            return Ok(());
+        };
+        pick.update(sim);
+        joint_positions(sim, &mut self.q);
+        chain_positions(pick.joints(), &self.q, &mut self.chain_q);
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base_link));
+        let world = |p: Vector3<f64>| {
+            let w = world_from_base * nalgebra::Point3::from(p);
+            [w.x, w.y, w.z]
+        };
+        let tool = self
+            .tool
+            .as_ref()
+            .ok()
+            .map(|t| t.chain().base_from_tip(&self.chain_q))
+            .transpose()?
+            .map(|p| world(p.translation.vector));
+        self.status = ArmStatus {
+            mode: self.mode,
+            pick: pick.state(),
+            object_world_m: pick.object().map(|(p, _)| world(p)),
+            tool_world_m: tool,
+            ..ArmStatus::default()
+        };
+        Ok(())
+    }
+
+    /// What the pick has to say since the last call: (warning, text).
+    pub(crate) fn drain_said(&mut self, mut f: impl FnMut(bool, String)) {
+        if let Ok(pick) = self.pick.as_mut() {
+            for (warn, text) in pick.drain_said() {
+                f(warn, text);
+            }
+        }
+    }
+
+    /// The pick controller, when the robot has one.
+    pub(crate) fn pick(&self) -> Option<&Pick> {
+        self.pick.as_ref().ok()
     }
 
     /// Tells the tasks' joints to stay where they are.
@@ -444,6 +534,7 @@ impl ArmTask {
             ArmMode::Off => return,
             ArmMode::Look => self.look.as_ref().map(|l| l.joints()).unwrap_or_default(),
             ArmMode::Reach => self.reach.as_ref().map(|r| r.joints()).unwrap_or_default(),
+            ArmMode::Pick => self.pick.as_ref().map(|p| p.joints()).unwrap_or_default(),
         };
         chain_positions(joints, &self.q, &mut self.chain_q);
         command(sim, joints, &self.chain_q);

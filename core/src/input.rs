@@ -20,7 +20,10 @@ pub enum Action {
     /// Switch the arm's reach on or off (the tool goes to a pre-grasp point short of the
     /// class's object; the camera looks at it when its chain is not the arm's).
     ToggleReach,
-    /// Set the arm's task (off, look, reach): what ROS's `/rover/arm/task` asks for.
+    /// Switch the arm's pick and place on or off (the gripper picks the class's object up and
+    /// puts it on the place).
+    TogglePick,
+    /// Set the arm's task (off, look, reach, pick): what ROS's `/rover/arm/task` asks for.
     Arm(crate::arm_task::ArmMode),
     /// Move the robot's joints (the arm); the base's mode does not change.
     Joint(JointAction),

@@ -24,6 +24,7 @@ mod look;
 mod observer;
 mod paths;
 mod people_sweep;
+mod pick;
 mod pilot;
 mod reach;
 mod run_files;
@@ -65,8 +66,11 @@ pub use paths::{bundled_path, default_robot_path};
 pub use people_sweep::{
     SWEEP_DISTANCES_M, SWEEP_HEADINGS_DEG, SWEEP_POSTURES, SweepPosture, SweepView, sweep,
 };
+pub use pick::{Pick, PickConfig, PickState};
 pub use pilot::{Mode, Pilot};
-pub use reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep, object_point, pregrasp};
+pub use reach::{
+    DepthView, Reach, ReachConfig, ReachState, ReachStep, object_estimate, object_point, pregrasp,
+};
 pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use scenario::{
     Scenario, ScenarioCheck, ScenarioCriteria, ScenarioMetrics, ScenarioOptions, ScenarioResult,

@@ -69,7 +69,11 @@ impl Pilot {
                 Some(Twist::ZERO)
             }
             // The arm moves in either mode; the base is not touched.
-            Action::Joint(_) | Action::ToggleLook | Action::ToggleReach | Action::Arm(_) => None,
+            Action::Joint(_)
+            | Action::ToggleLook
+            | Action::ToggleReach
+            | Action::TogglePick
+            | Action::Arm(_) => None,
         }
     }
 }

@@ -358,9 +358,19 @@ pub fn pregrasp(object_m: Vector3<f64>, standoff_m: f64) -> Vector3<f64> {
 pub fn object_point(
     b: &BoundingBox,
     view: &DepthView<'_>,
-    [fx, fy, cx, cy]: [f64; 4],
+    intrinsics: [f64; 4],
     max_range_m: f64,
 ) -> Option<Vector3<f64>> {
+    object_estimate(b, view, intrinsics, max_range_m).map(|(centre, _)| centre)
+}
+
+/// [`object_point`] with the radius it used (m).
+pub fn object_estimate(
+    b: &BoundingBox,
+    view: &DepthView<'_>,
+    [fx, fy, cx, cy]: [f64; 4],
+    max_range_m: f64,
+) -> Option<(Vector3<f64>, f64)> {
     let (w, h) = (i64::from(view.width), i64::from(view.height));
     let (xmin, xmax, ymin, ymax) = (b.xmin, b.xmax, b.ymin, b.ymax);
     let (qx, qy) = ((xmax - xmin) / 4, (ymax - ymin) / 4);
@@ -400,7 +410,7 @@ pub fn object_point(
         surface.norm(),
     );
     let centre = surface + surface.normalize() * radius;
-    Some((view.base_from_optical * Point3::from(centre)).coords)
+    Some(((view.base_from_optical * Point3::from(centre)).coords, radius))
 }
 
 /// The radius (m) of a sphere whose silhouette spans `width` by `height` (the box's sides over

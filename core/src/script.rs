@@ -185,9 +185,10 @@ impl Script {
                         "follow" => Action::ToggleFollow,
                         "look" => Action::ToggleLook,
                         "reach" => Action::ToggleReach,
+                        "pick" => Action::TogglePick,
                         other => {
                             return bail(format!(
-                                "toggle \"{other}\" is unknown; expected \"follow\", \"look\" or \"reach\""
+                                "toggle \"{other}\" is unknown; expected \"follow\", \"look\", \"reach\" or \"pick\""
                             ));
                         }
                     },
@@ -235,7 +236,10 @@ impl ScriptPlayer {
         self.script.steps.iter().any(|s| {
             matches!(
                 s.action,
-                Action::ToggleFollow | Action::ToggleLook | Action::ToggleReach
+                Action::ToggleFollow
+                    | Action::ToggleLook
+                    | Action::ToggleReach
+                    | Action::TogglePick
             )
         })
     }

@@ -211,6 +211,11 @@ impl Session {
         self.arm.reach()
     }
 
+    /// The arm's pick controller, when the robot has one (an end effector, a depth camera).
+    pub fn pick(&self) -> Option<&crate::pick::Pick> {
+        self.arm.pick()
+    }
+
     /// Moves world object `index` (world order) to `position_m` (its centre) with heading
     /// `yaw_rad`, at rest: a scene change from outside the loop (a test, a scripted event).
     pub fn place_object(&mut self, index: usize, position_m: [f64; 3], yaw_rad: f64) -> Result<()> {
@@ -262,6 +267,7 @@ impl Session {
             }
             Action::ToggleLook => Some(self.arm.toggled(ArmMode::Look)),
             Action::ToggleReach => Some(self.arm.toggled(ArmMode::Reach)),
+            Action::TogglePick => Some(self.arm.toggled(ArmMode::Pick)),
             Action::Arm(mode) => Some(mode),
             _ => None,
         };
@@ -405,7 +411,16 @@ impl Session {
                 .filter(|_| following)
                 .map(|t| t.position_at(sample.sim_time_s));
             self.stats.follow_goal_m = self.follower.goal_m().filter(|_| following);
-            self.arm.update(&self.sim).map_err(arm_error)?;
+            self.arm.update(&mut self.sim).map_err(arm_error)?;
+            let now = sample.sim_time_s;
+            self.arm.drain_said(|warn, text| {
+                let level = if warn {
+                    EventLevel::Warn
+                } else {
+                    EventLevel::Info
+                };
+                emit(observer, now, level, &text);
+            });
             let before = self.stats.arm;
             self.stats.arm = self.arm.status();
             if before.mode == ArmMode::Reach
@@ -420,6 +435,21 @@ impl Session {
                         "reach: {} -> {}",
                         before.reach.as_str(),
                         self.stats.arm.reach.as_str()
+                    ),
+                );
+            }
+            if before.mode == ArmMode::Pick
+                && self.stats.arm.mode == ArmMode::Pick
+                && before.pick != self.stats.arm.pick
+            {
+                emit(
+                    observer,
+                    sample.sim_time_s,
+                    EventLevel::Info,
+                    &format!(
+                        "pick: {} -> {}",
+                        before.pick.as_str(),
+                        self.stats.arm.pick.as_str()
                     ),
                 );
             }

@@ -15,6 +15,7 @@ pub(crate) fn arm_task(word: &str) -> Option<Action> {
         "off" => Some(Action::Arm(ArmMode::Off)),
         "look" => Some(Action::Arm(ArmMode::Look)),
         "reach" => Some(Action::Arm(ArmMode::Reach)),
+        "pick" => Some(Action::Arm(ArmMode::Pick)),
         other => {
             tracing::warn!("{TASK_TOPIC}: \"{other}\" is not a task; expected off, look or reach");
             None

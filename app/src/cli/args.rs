@@ -434,8 +434,8 @@ impl FollowArgs {
     }
 }
 
-/// The arm's look and reach (docs/ARM.md): switched on by `toggle = "look"` / `"reach"` in a
-/// script, the station's keys, or ROS.
+/// The arm's look, reach and pick (docs/ARM.md): switched on by `toggle = "look"` / `"reach"` /
+/// `"pick"` in a script, the station's keys, or ROS.
 #[derive(Debug, Args)]
 pub(crate) struct ArmArgs {
     /// Arm: the end effector that reaches (e.g. TIAGo's arm_tool_link) [default: the world's
@@ -467,6 +467,11 @@ pub(crate) struct ArmArgs {
     /// the tool stops (m)
     #[arg(long, default_value_t = 0.10, value_name = "M")]
     pub(crate) reach_standoff: f64,
+
+    /// Pick: the world object pick puts what it picked on or in, by name (e.g. worlds/
+    /// arm_car_pick.toml's `bin`) [default: the world's [robot] place]
+    #[arg(long, value_name = "NAME")]
+    pub(crate) place: Option<String>,
 }
 
 impl ArmArgs {
@@ -489,6 +494,11 @@ impl ArmArgs {
                 class: self.arm_class.clone(),
                 standoff_m: self.reach_standoff,
                 ..rover_core::ReachConfig::default()
+            },
+            pick: rover_core::PickConfig {
+                class: self.arm_class.clone(),
+                place: self.place.clone(),
+                ..rover_core::PickConfig::default()
             },
         })
     }

@@ -132,5 +132,6 @@ pub fn task_line(status: &rover_core::ArmStatus) -> Option<String> {
                 status.reach.as_str()
             ))
         }
+        ArmMode::Pick => Some(format!("arm PICK {}   r stops", status.pick.as_str())),
     }
 }

@@ -117,6 +117,7 @@ impl KeyTeleop {
         match name {
             "f" => Some(KeyCommand::Input(Action::ToggleFollow)),
             "g" => Some(KeyCommand::Input(Action::ToggleReach)),
+            "r" => Some(KeyCommand::Input(Action::TogglePick)),
             "v" => Some(KeyCommand::Input(Action::ToggleLook)),
             "p" => Some(KeyCommand::TogglePause),
             "n" => Some(KeyCommand::StepOnce),
@@ -255,6 +256,10 @@ mod tests {
         assert_eq!(
             k.key("v", true, MANUAL),
             Some(KeyCommand::Input(Action::ToggleLook))
+        );
+        assert_eq!(
+            k.key("r", true, MANUAL),
+            Some(KeyCommand::Input(Action::TogglePick))
         );
         assert_eq!(k.key("0", true, MANUAL), Some(KeyCommand::SelectToolAxis));
         assert_eq!(k.key("3", true, MANUAL), Some(KeyCommand::SelectJoint(2)));

@@ -115,6 +115,7 @@ struct RawRobot {
     ee_link: Option<String>,
     #[serde(default)]
     grasp: GraspMode,
+    place: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -445,6 +446,7 @@ impl RawWorld {
             arm_base: raw_robot.arm_base,
             ee_link: raw_robot.ee_link,
             grasp: raw_robot.grasp,
+            place: raw_robot.place,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

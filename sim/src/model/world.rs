@@ -70,6 +70,8 @@ pub struct RobotSpawn {
     pub ee_link: Option<String>,
     /// `grasp`: how the gripper holds what it closes on.
     pub grasp: GraspMode,
+    /// `place`: the world object pick puts what it picked on (or in), by name.
+    pub place: Option<String>,
 }
 
 /// How a gripper holds what it closes on (`[robot] grasp`).

@@ -422,6 +422,18 @@ impl Actuators {
         }
     }
 
+    /// Starts `joint`'s setpoint afresh where the joint is, at rest, its integral emptied: a
+    /// new gripper command moves from where the fingers are, not from where the last
+    /// command's setpoint ran ahead to (a finger stalled on an object has its setpoint at the
+    /// closed end, and opening would first have to wind it back).
+    pub(crate) fn restart_setpoint(&mut self, joint: JointId) {
+        if let Some(a) = self.of_mut(joint) {
+            a.setpoint = a.measured.0;
+            a.setpoint_velocity = 0.0;
+            a.integral = 0.0;
+        }
+    }
+
     /// Gives a joint its own PID gains (an effort_controllers position controller).
     pub(crate) fn set_pid(&mut self, joint: JointId, pid: Pid) {
         if let Some(a) = self.of_mut(joint) {

@@ -394,6 +394,7 @@ impl Controllers {
             )));
         };
         actuators.set_effort_cap(joint, (max_effort > 0.0).then_some(max_effort));
+        actuators.restart_setpoint(joint);
         actuators.command(robot, joint, JointCommand::Position(position))?;
         let s = &mut run.state;
         s.goal = actuators.target(joint);

@@ -35,6 +35,20 @@ pub struct SceneContact {
     pub distance_m: f32,
 }
 
+impl std::fmt::Display for SceneContact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.distance_m > 0.0 {
+            write!(
+                f,
+                "{} within {:.3} m of {}",
+                self.link, self.distance_m, self.obstacle
+            )
+        } else {
+            write!(f, "{} hits {}", self.link, self.obstacle)
+        }
+    }
+}
+
 /// One obstacle, fixed where it was when the scene was taken.
 #[derive(Clone)]
 struct Obstacle {
@@ -107,6 +121,14 @@ impl PlanningScene {
             })
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(i, _)| i)
+    }
+
+    /// Sets a joint outside the chain (a finger: the gripper open or closed) for the checks
+    /// that follow; a joint of the chain is set by each check.
+    pub fn set_joint(&mut self, joint: JointId, position: f64) {
+        if let Some(q) = self.q_all.get_mut(joint.index()) {
+            *q = position;
+        }
     }
 
     /// Carries a sphere of `radius_m` with `link` at `link_from_centre` (a held object), or
@@ -296,32 +318,68 @@ impl Simulation {
         })
     }
 
+    /// What world object `index` touches now (a contact with force in it): the robot's links
+    /// by name (links welded into one body by the first of them), `ground`, other objects by
+    /// name, people and models. Empty for an index out of range.
+    pub fn object_contacts(&self, index: usize) -> Vec<String> {
+        let Some(body) = self.objects.get(index) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        let Some(rb) = self.physics.bodies.get(*body) else {
+            return out;
+        };
+        for collider in rb.colliders() {
+            for pair in self.physics.narrow_phase.contact_pairs_with(*collider) {
+                if !pair.has_any_active_contact() || pair.total_impulse_magnitude() <= 0.0 {
+                    continue;
+                }
+                let other = if pair.collider1 == *collider {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                let parent = self.physics.colliders.get(other).and_then(|c| c.parent());
+                let name = match parent {
+                    Some(b) => match self.link_body.iter().position(|l| *l == b) {
+                        Some(link) => self.robot.links[link].name.clone(),
+                        None => self.body_name(b),
+                    },
+                    None => "ground".to_owned(),
+                };
+                if !out.contains(&name) {
+                    out.push(name);
+                }
+            }
+        }
+        out
+    }
+
+    /// The name of a body that is not the robot's.
+    fn body_name(&self, body: RigidBodyHandle) -> String {
+        if body == self.ground {
+            return "ground".to_owned();
+        }
+        if let Some(i) = self.objects.iter().position(|b| *b == body) {
+            return match self.world.objects.get(i) {
+                Some(o) if !o.name.is_empty() => o.name.clone(),
+                _ => format!("object {i}"),
+            };
+        }
+        if let Some(i) = self.people.iter().position(|b| *b == body) {
+            return format!("person {i}");
+        }
+        "a model".to_owned()
+    }
+
     /// Every collider not the robot's, where it is now, named.
     fn world_obstacles(&self) -> Vec<Obstacle> {
         let name_of = |body: Option<RigidBodyHandle>| -> (String, Option<usize>) {
             let Some(body) = body else {
                 return ("ground".to_owned(), None);
             };
-            if body == self.ground {
-                return ("ground".to_owned(), None);
-            }
-            if let Some(i) = self.objects.iter().position(|b| *b == body) {
-                let name = self.world.objects.get(i).map_or_else(
-                    || format!("object {i}"),
-                    |o| {
-                        if o.name.is_empty() {
-                            format!("object {i}")
-                        } else {
-                            o.name.clone()
-                        }
-                    },
-                );
-                return (name, Some(i));
-            }
-            if let Some(i) = self.people.iter().position(|b| *b == body) {
-                return (format!("person {i}"), None);
-            }
-            ("a model".to_owned(), None)
+            let object = self.objects.iter().position(|b| *b == body);
+            (self.body_name(body), object)
         };
         self.physics
             .colliders

@@ -1,0 +1,227 @@
+//! Pick and place with the real renderer, physics and detector: the arm car
+//! (worlds/arm_car_pick.toml, its two-finger gripper) sees the ball through its mast's depth
+//! camera, plans round the table and the bin, grasps the ball, and drops it into the bin.
+
+use anyhow::Result;
+use rover_core::{Action, DetectorMode, EventLevel, PickState, Session, SessionOptions};
+use rover_sim::{Pose, SimOptions};
+
+/// The ball's index among the world's objects (worlds/arm_car_pick.toml).
+const BALL: usize = 6;
+/// The bin's inside (world frame): x and y ranges (m), and its floor's top (m).
+const BIN_X: (f64, f64) = (0.195, 0.305);
+const BIN_Y: (f64, f64) = (-0.205, -0.095);
+const BIN_FLOOR_Z: f64 = 0.104;
+
+/// Events said, printed as they come.
+#[derive(Default)]
+struct Said(Vec<(f64, EventLevel, String)>);
+
+impl rover_core::Observer for Said {
+    fn event(&mut self, t: f64, level: EventLevel, text: &str) {
+        println!("  {t:7.3} {level:?} {text}");
+        self.0.push((t, level, text.to_owned()));
+    }
+
+    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
+        if std::env::var_os("PICK_DEBUG").is_some() {
+            for b in &boxes.bounding_boxes {
+                println!(
+                    "  box {} {:.2} [{}, {}, {}, {}]",
+                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
+                );
+            }
+        }
+    }
+}
+
+/// The pick world as shipped, detecting at 5 Hz of sim time in lockstep.
+fn session(seed: u64) -> Result<Session> {
+    let config = rover_core::RunConfig {
+        world: Some(rover_tests::repo("worlds/arm_car_pick.toml")),
+        ..rover_core::RunConfig::default()
+    };
+    let (world, robot) = config.load_world_and_robot()?;
+    let options = SessionOptions {
+        sim: SimOptions {
+            seed,
+            ..SimOptions::default()
+        },
+        camera: true,
+        every_frame: false,
+        detector: DetectorMode::Lockstep { rate_hz: 5.0 },
+        ..SessionOptions::default()
+    };
+    Ok(Session::new(world, robot, &options, &mut Said::default())?)
+}
+
+fn object(session: &Session, index: usize) -> Pose {
+    let mut poses = Vec::new();
+    session.sim().object_poses_into(&mut poses);
+    poses.get(index).copied().unwrap_or(Pose::IDENTITY)
+}
+
+/// How one pick went.
+#[derive(Debug)]
+struct Outcome {
+    state: PickState,
+    /// Sim seconds from the toggle to done (or the end).
+    took_s: f64,
+    /// The ball's centre at the end (world, m).
+    ball_m: [f64; 3],
+    planning_s: Option<f64>,
+    /// How far the ball moved in the tool's frame while lifted and carried (m).
+    slip_m: f32,
+    /// What but the fingers and the table touched the ball before the grasp.
+    touched: Vec<String>,
+}
+
+impl Outcome {
+    fn in_bin(&self) -> bool {
+        let [x, y, z] = self.ball_m;
+        (BIN_X.0..=BIN_X.1).contains(&x)
+            && (BIN_Y.0..=BIN_Y.1).contains(&y)
+            && z > BIN_FLOOR_Z
+            && z < BIN_FLOOR_Z + 0.05
+    }
+}
+
+/// Switches pick on after `settle_s`, runs until it is done or failed (then 1 s more for the
+/// ball to land) or `limit_s` has passed.
+fn pick(session: &mut Session, settle_s: f64, limit_s: f64, said: &mut Said) -> Result<Outcome> {
+    let end = session.sim().sim_time_s() + settle_s;
+    while session.sim().sim_time_s() < end {
+        session.step(said)?;
+    }
+    session.input(Action::TogglePick, said);
+    let start = session.sim().sim_time_s();
+    let mut finished: Option<f64> = None;
+    let tool = session
+        .sim()
+        .robot()
+        .link_id("tool_link")
+        .ok_or_else(|| anyhow::anyhow!("no tool_link"))?;
+    let finger = session
+        .sim()
+        .robot()
+        .joint_id("left_finger_joint")
+        .ok_or_else(|| anyhow::anyhow!("no left_finger_joint"))?;
+    let mut held_from: Option<glam::Vec3> = None;
+    let mut slip_m = 0.0f32;
+    let mut touched: Vec<String> = Vec::new();
+    loop {
+        session.step(said)?;
+        let now = session.sim().sim_time_s();
+        let state = session.stats().arm.pick;
+        if matches!(
+            state,
+            PickState::Seeking | PickState::Approaching | PickState::Grasping
+        ) {
+            for link in session.sim().object_contacts(BALL) {
+                if link != "table" && !link.ends_with("_finger_link") && !touched.contains(&link)
+                {
+                    touched.push(link);
+                }
+            }
+        }
+        if matches!(state, PickState::Lifting | PickState::Carrying) {
+            let sim = session.sim();
+            let in_tool = sim
+                .world_from_link(tool)
+                .inverse()
+                .transform_point(object(session, BALL).translation);
+            let from = *held_from.get_or_insert(in_tool);
+            slip_m = slip_m.max((in_tool - from).length());
+            if std::env::var_os("PICK_DEBUG").is_some() && session.sim().step_index() % 40 == 0 {
+                let right = sim
+                    .robot()
+                    .joint_id("right_finger_joint")
+                    .and_then(|j| sim.joint_state(j));
+                println!(
+                    "  {now:.2} {state:?} ball in tool {in_tool:.4?} finger {:?} right {right:?}",
+                    sim.joint_state(finger)
+                );
+            }
+        }
+        if finished.is_none() && matches!(state, PickState::Done | PickState::Failed) {
+            finished = Some(now);
+        }
+        if finished.is_some_and(|f| now > f + 1.0) || now - start > limit_s {
+            break;
+        }
+    }
+    let t = object(session, BALL).translation;
+    Ok(Outcome {
+        state: session.stats().arm.pick,
+        took_s: finished.unwrap_or(session.sim().sim_time_s()) - start,
+        ball_m: [f64::from(t.x), f64::from(t.y), f64::from(t.z)],
+        planning_s: session.pick().and_then(|p| p.planning_s()),
+        slip_m,
+        touched,
+    })
+}
+
+/// The shipped world: the ball ends in the bin, the pick done in under 30 s of sim time, and
+/// nothing but the fingers touched the ball before the grasp.
+#[test]
+fn the_arm_car_picks_the_ball_and_drops_it_in_the_bin() -> Result<()> {
+    let mut said = Said::default();
+    let mut session = session(0)?;
+    let outcome = pick(&mut session, 1.0, 40.0, &mut said)?;
+    println!("{outcome:?}");
+    assert_eq!(outcome.state, PickState::Done, "{:?}", said.0.last());
+    assert!(outcome.took_s < 30.0, "{outcome:?}");
+    assert!(outcome.in_bin(), "{outcome:?}");
+    assert!(outcome.touched.is_empty(), "{outcome:?}");
+    Ok(())
+}
+
+/// Where trial `seed` puts the ball on the table (world frame, its centre): x 0.23-0.30 m,
+/// y 0.05-0.13 m: left of the bin, within the arm's reach, and where the mast's camera sees
+/// all of it and YOLO (yolov12n) calls it a sports ball at 0.44-0.82. Nearer the middle the
+/// car's own front camera hides the ball's lower half (the depth under its box is then the
+/// front camera's), and beside it YOLO calls the ball an apple.
+fn ball_place(seed: u64) -> [f64; 3] {
+    let mut rng = rover_sim::SplitMix64(0x5eed_0000 + seed);
+    [0.23 + 0.07 * rng.unit(), 0.05 + 0.08 * rng.unit(), 0.1335]
+}
+
+/// The measure: the ball at 20 seeded random places on the table; at least 19 of 20
+/// picks end with the ball in the bin within 30 s of sim time, nothing but the fingers
+/// touching it before the grasp. Prints each trial, the planning time's median and slowest.
+#[test]
+fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
+    let mut results = Vec::new();
+    let only: Option<u64> = std::env::var("PICK_TRIAL").ok().and_then(|t| t.parse().ok());
+    for seed in (0..20).filter(|s| only.is_none_or(|o| o == *s)) {
+        let mut said = Said::default();
+        let mut session = session(seed)?;
+        let at = ball_place(seed);
+        session.place_object(BALL, at, 0.0)?;
+        let outcome = pick(&mut session, 1.0, 35.0, &mut said)?;
+        let ok = outcome.state == PickState::Done
+            && outcome.took_s < 30.0
+            && outcome.in_bin()
+            && outcome.touched.is_empty();
+        println!("trial {seed:2}: ball at {at:.3?}: {ok} {outcome:?}");
+        if !ok {
+            for (t, level, text) in said.0.iter().filter(|(_, l, _)| *l == EventLevel::Warn) {
+                println!("    {t:.2} {level:?} {text}");
+            }
+        }
+        results.push((ok, outcome));
+    }
+    let successes = results.iter().filter(|(ok, _)| *ok).count();
+    let mut planning: Vec<f64> = results.iter().filter_map(|(_, o)| o.planning_s).collect();
+    planning.sort_by(f64::total_cmp);
+    let took: Vec<f64> = results.iter().map(|(_, o)| o.took_s).collect();
+    println!(
+        "{successes}/20 in the bin; planning median {:.4} s, slowest {:.4} s ({} planned); sim seconds per pick: {took:.1?}",
+        planning.get(planning.len() / 2).copied().unwrap_or(f64::NAN),
+        planning.last().copied().unwrap_or(f64::NAN),
+        planning.len()
+    );
+    assert!(successes >= 19, "{successes}/20");
+    Ok(())
+}
+
