@@ -29,9 +29,9 @@ use std::collections::VecDeque;
 use nalgebra::{Point3, Vector3};
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraInfo, ChainJoint, ControllerKind, GraspMode, IkOptions, IkSolver,
-    IkTarget, JointCommand, JointId, KinematicChain, LinkId, PlannerOptions, PlanningScene, Pose,
-    Shape, Simulation, TimedPath, isometry_from_pose, plan_path,
+    CameraConfig, CameraInfo, ChainJoint, ControllerKind, GraspMode, IkOptions, IkSolver, IkTarget,
+    JointCommand, JointId, KinematicChain, LinkId, PlannerOptions, PlanningScene, Pose, Shape,
+    Simulation, TimedPath, isometry_from_pose, plan_path,
 };
 
 use crate::reach::{DepthView, object_estimate};
@@ -147,6 +147,17 @@ enum Step {
     Gripper { position: f64, grip: bool },
     /// Wait (s); with the grasp assist, until it holds (or the time is up).
     Wait { s: f64, until_held: bool },
+}
+
+/// The joint-space paths of a grasp.
+#[derive(Debug)]
+struct Grasp {
+    /// From the start to the pre-grasp.
+    to_pre: Vec<Vec<f64>>,
+    /// Straight in, from the pre-grasp to the grasp.
+    descent: Vec<Vec<f64>>,
+    /// Straight up with the object.
+    lift: Vec<Vec<f64>>,
 }
 
 /// The gripper the pick uses.
@@ -353,7 +364,13 @@ impl Pick {
         let finished = match &step {
             Step::Move(path) => {
                 path.sample(t, &mut self.q, &mut self.v);
-                for ((joint, q), v) in self.solver.chain().joints().iter().zip(&self.q).zip(&self.v)
+                for ((joint, q), v) in self
+                    .solver
+                    .chain()
+                    .joints()
+                    .iter()
+                    .zip(&self.q)
+                    .zip(&self.v)
                 {
                     let command = JointCommand::Track {
                         position: *q,
@@ -397,8 +414,8 @@ impl Pick {
             self.said.push((
                 false,
                 format!(
-                    "pick: {}: the tool stopped {off:.3} m from its goal; q {:?} goal {:?}",
-                    self.state.as_str(), self.q, self.joints().iter().map(|j| sim.joint_state(j.id).map(|s| s.effort)).collect::<Vec<_>>()
+                    "pick: {}: the tool stopped {off:.3} m from its goal (the joints cannot hold it there)",
+                    self.state.as_str()
                 ),
             ));
         }
@@ -416,11 +433,15 @@ impl Pick {
                 .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position)),
         );
         let chain = self.solver.chain();
-        let (at, want) = (chain.base_from_tip(&self.q).ok()?, chain.base_from_tip(goal).ok()?);
+        let (at, want) = (
+            chain.base_from_tip(&self.q).ok()?,
+            chain.base_from_tip(goal).ok()?,
+        );
         Some((at.translation.vector - want.translation.vector).norm())
     }
 
-    /// The whole plan for an object at `centre` (base frame) of `radius`.
+    /// The whole plan for an object at `centre` (base frame) of `radius`: the grasp, then the
+    /// place (or, with no place, holding it up).
     fn plan(
         &mut self,
         sim: &Simulation,
@@ -428,97 +449,31 @@ impl Pick {
         radius: f64,
     ) -> Result<VecDeque<(Step, PickState)>, String> {
         let g = self.gripper.clone()?;
-        let c = self.config.clone();
         let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
         let mut scene = sim
-            .planning_scene(self.solver.chain(), c.margin_m as f32)
+            .planning_scene(self.solver.chain(), self.config.margin_m as f32)
             .map_err(|e| e.to_string())?;
-        let world = |p: Vector3<f64>| {
-            let w = world_from_base * Point3::from(p);
-            [w.x, w.y, w.z]
-        };
-        let target = scene.object_near(world(centre), radius as f32 + 0.02);
-        let place_top = self.place_top(sim)?;
+        let w = world_from_base * Point3::from(centre);
+        let target = scene.object_near([w.x, w.y, w.z], radius as f32 + 0.02);
+        let place = self.place_top(sim)?.map(|top| {
+            let over = world_from_base.inverse()
+                * Point3::new(top[0], top[1], top[2] + self.config.drop_height_m + radius);
+            over.coords
+        });
         let q0: Vec<f64> = self
             .joints()
             .iter()
             .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
             .collect();
-        let speed = |w: Vec<Vec<f64>>, stop: bool, joints: &[ChainJoint]| {
-            TimedPath::new(w, joints, c.speed_scale, RAMP_S, stop)
-        };
-        let joints = self.joints().to_vec();
-
-        // The grasp, fingers open, the object left out (the fingers go round it).
-        scene.set_joint(g.joint, g.open);
-        if let Some(t) = target {
-            scene.ignore_object(t, true);
-        }
-        let (grasp_q, _, descent) = self
-            .reachable(&mut scene, centre, &q0, "the grasp", Some(c.approach_m))
-            .map_err(|why| format!("cannot grasp the {}: {why}", c.class))?;
-        let pre_q = descent.last().cloned().unwrap_or_else(|| grasp_q.clone());
-        // To the pre-grasp with the object in the scene.
-        if let Some(t) = target {
-            scene.ignore_object(t, false);
-        }
-        let to_pre = plan_path(&joints, &q0, &pre_q, &c.planner, |q| {
-            scene.collision(q).map(|h| h.to_string())
-        })
-        .map_err(|e| format!("to the pre-grasp: {e}"))?;
-        // Holding it: the object on the tool, the fingers on it.
-        if let Some(t) = target {
-            scene.ignore_object(t, true);
-        }
-        scene.set_joint(g.joint, (radius).clamp(g.closed.min(g.open), g.closed.max(g.open)));
-        // Straight up off what it rests on: the arm is checked, the object (touching its
-        // support, as far as the estimate knows) only from the lift's top.
-        // The hand may turn on the way up (a held object turns with it).
-        let lift = self.line_at_least(
-            &mut scene,
-            &grasp_q,
-            (centre, centre + Vector3::z() * c.lift_m),
-            None,
-            0.5,
-        )?;
-        let lift_q = lift.last().cloned().unwrap_or_else(|| grasp_q.clone());
-        scene.attach_sphere(Some((self.tool, Pose::IDENTITY, radius as f32)));
-        let base_from_world = world_from_base.inverse();
-        let over = base_from_world
-            * Point3::new(
-                place_top[0],
-                place_top[1],
-                place_top[2] + c.drop_height_m + radius,
-            );
-        let (place_q, _, _) = self
-            .reachable(&mut scene, over.coords, &lift_q, "the place", None)
-            .map_err(|why| format!("cannot reach over the place: {why}"))?;
-        let carry = plan_path(&joints, &lift_q, &place_q, &c.planner, |q| {
-            scene.collision(q).map(|h| h.to_string())
-        })
-        .map_err(|e| format!("carrying: {e}"))?;
-        // Let go; back up and home, the gripper open.
-        scene.attach_sphere(None);
-        scene.set_joint(g.joint, g.open);
-        let retreat_from = self.solver.chain().base_from_tip(&place_q).map_err(|e| e.to_string())?;
-        let from = retreat_from.translation.vector;
-        let retreat = self.line_at_least(
-            &mut scene,
-            &place_q,
-            (from, from + Vector3::z() * RETREAT_M),
-            None,
-            0.0,
-        )?;
-        let retreat_q = retreat.last().cloned().unwrap_or_else(|| place_q.clone());
-        let home = plan_path(&joints, &retreat_q, &q0, &c.planner, |q| {
-            scene.collision(q).map(|h| h.to_string())
-        })
-        .map_err(|e| format!("going home: {e}"))?;
-
-        let mut descent = descent;
-        descent.reverse();
+        let grasp = self.plan_grasp(&mut scene, (centre, radius), target, &g, &q0)?;
         let assist = sim.world().robot.grasp == GraspMode::Assist;
-        Ok(VecDeque::from([
+        let joints = self.joints().to_vec();
+        let speed_scale = self.config.speed_scale;
+        let timed = |w: Vec<Vec<f64>>, stop: bool| {
+            Step::Move(TimedPath::new(w, &joints, speed_scale, RAMP_S, stop))
+        };
+        let lift_q = grasp.lift.last().cloned().unwrap_or_default();
+        let mut steps = VecDeque::from([
             (
                 Step::Gripper {
                     position: g.open,
@@ -526,8 +481,8 @@ impl Pick {
                 },
                 PickState::Approaching,
             ),
-            (Step::Move(speed(to_pre, true, &joints)), PickState::Approaching),
-            (Step::Move(speed(descent, false, &joints)), PickState::Approaching),
+            (timed(grasp.to_pre, true), PickState::Approaching),
+            (timed(grasp.descent, false), PickState::Approaching),
             (
                 Step::Gripper {
                     position: g.closed,
@@ -542,8 +497,45 @@ impl Pick {
                 },
                 PickState::Grasping,
             ),
-            (Step::Move(speed(lift, false, &joints)), PickState::Lifting),
-            (Step::Move(speed(carry, true, &joints)), PickState::Carrying),
+            (timed(grasp.lift, false), PickState::Lifting),
+        ]);
+        let Some(over) = place else {
+            // No place: it stays in the hand, held up.
+            return Ok(steps);
+        };
+        // Carrying: the object on the tool.
+        scene.attach_sphere(Some((self.tool, Pose::IDENTITY, radius as f32)));
+        let (place_q, _, _) = self
+            .reachable(&mut scene, over, &lift_q, "the place", None)
+            .map_err(|why| format!("cannot reach over the place: {why}"))?;
+        let carry = plan_path(&joints, &lift_q, &place_q, &self.config.planner, |q| {
+            scene.collision(q).map(|h| h.to_string())
+        })
+        .map_err(|e| format!("carrying: {e}"))?;
+        // Let go; back up and home, the gripper open.
+        scene.attach_sphere(None);
+        scene.set_joint(g.joint, g.open);
+        let from = self
+            .solver
+            .chain()
+            .base_from_tip(&place_q)
+            .map_err(|e| e.to_string())?
+            .translation
+            .vector;
+        let retreat = self.line_at_least(
+            &mut scene,
+            &place_q,
+            (from, from + Vector3::z() * RETREAT_M),
+            None,
+            0.0,
+        )?;
+        let retreat_q = retreat.last().cloned().unwrap_or_else(|| place_q.clone());
+        let home = plan_path(&joints, &retreat_q, &q0, &self.config.planner, |q| {
+            scene.collision(q).map(|h| h.to_string())
+        })
+        .map_err(|e| format!("going home: {e}"))?;
+        steps.extend([
+            (timed(carry, true), PickState::Carrying),
             (
                 Step::Gripper {
                     position: g.open,
@@ -558,9 +550,61 @@ impl Pick {
                 },
                 PickState::Releasing,
             ),
-            (Step::Move(speed(retreat, false, &joints)), PickState::Retreating),
-            (Step::Move(speed(home, true, &joints)), PickState::Retreating),
-        ]))
+            (timed(retreat, false), PickState::Retreating),
+            (timed(home, true), PickState::Retreating),
+        ]);
+        Ok(steps)
+    }
+
+    /// The way to the object and up with it, from `q0`: the path to the pre-grasp (the object
+    /// in the scene), the straight way in and the lift (the object left out, the fingers on
+    /// it).
+    fn plan_grasp(
+        &mut self,
+        scene: &mut PlanningScene,
+        (centre, radius): (Vector3<f64>, f64),
+        target: Option<usize>,
+        g: &Gripper,
+        q0: &[f64],
+    ) -> Result<Grasp, String> {
+        let c = self.config.clone();
+        scene.set_joint(g.joint, g.open);
+        if let Some(t) = target {
+            scene.ignore_object(t, true);
+        }
+        let (grasp_q, _, mut descent) = self
+            .reachable(scene, centre, q0, "the grasp", Some(c.approach_m))
+            .map_err(|why| format!("cannot grasp the {}: {why}", c.class))?;
+        let pre_q = descent.last().cloned().unwrap_or_else(|| grasp_q.clone());
+        descent.reverse();
+        if let Some(t) = target {
+            scene.ignore_object(t, false);
+        }
+        let joints = self.joints().to_vec();
+        let to_pre = plan_path(&joints, q0, &pre_q, &c.planner, |q| {
+            scene.collision(q).map(|h| h.to_string())
+        })
+        .map_err(|e| format!("to the pre-grasp: {e}"))?;
+        if let Some(t) = target {
+            scene.ignore_object(t, true);
+        }
+        let (lo, hi) = (g.closed.min(g.open), g.closed.max(g.open));
+        scene.set_joint(g.joint, radius.clamp(lo, hi));
+        // Straight up off what it rests on; the hand may turn on the way (the object turns
+        // with it). The arm is checked, the object (touching its support, as far as the
+        // estimate knows) only from the lift's top.
+        let lift = self.line_at_least(
+            scene,
+            &grasp_q,
+            (centre, centre + Vector3::z() * c.lift_m),
+            None,
+            0.5,
+        )?;
+        Ok(Grasp {
+            to_pre,
+            descent,
+            lift,
+        })
     }
 
     /// Joint positions putting the tool at `point` (base frame) coming in along the first of
@@ -599,7 +643,13 @@ impl Pick {
             // The straight way in, `back_m` long, must be there too.
             let back = match back_m {
                 Some(back_m) => {
-                    match self.line(scene, &solution.q, point, point - approach * back_m, Some(approach)) {
+                    match self.line(
+                        scene,
+                        &solution.q,
+                        point,
+                        point - approach * back_m,
+                        Some(approach),
+                    ) {
                         Ok(line) => line,
                         Err(e) => {
                             why.push(format!("{pitch_deg:.0} deg down: {e}"));
@@ -648,12 +698,11 @@ impl Pick {
                 .solver
                 .solve(&target, &last)
                 .map_err(|e| e.to_string())?;
-            let jump = s
-                .q
-                .iter()
-                .zip(&last)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
+            let jump =
+                s.q.iter()
+                    .zip(&last)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
             let done = (k - 1) as f64 / n as f64;
             let blocked = !ik_close(s.position_error_m, s.orientation_error_rad)
                 || jump > MAX_LINE_JUMP_RAD
@@ -661,8 +710,7 @@ impl Pick {
             if blocked && done >= share && k > 1 {
                 break;
             }
-            if !ik_close(s.position_error_m, s.orientation_error_rad) || jump > MAX_LINE_JUMP_RAD
-            {
+            if !ik_close(s.position_error_m, s.orientation_error_rad) || jump > MAX_LINE_JUMP_RAD {
                 return Err(format!(
                     "no straight move from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}) m: IK {:.3} m off, a {jump:.2} rad jump",
                     from.x, from.y, from.z, to.x, to.y, to.z, s.position_error_m
@@ -676,17 +724,19 @@ impl Pick {
         Ok(waypoints)
     }
 
-    /// The top centre of the place (world frame).
-    fn place_top(&self, sim: &Simulation) -> Result<[f64; 3], String> {
+    /// The top centre of the place (world frame): the configured place, else the world's
+    /// `[robot] place`, else none (the object is held up). An error for a name the world
+    /// lacks.
+    fn place_top(&self, sim: &Simulation) -> Result<Option<[f64; 3]>, String> {
         let world = sim.world();
-        let name = self
+        let Some(name) = self
             .config
             .place
             .clone()
             .or_else(|| world.robot.place.clone())
-            .ok_or_else(|| {
-                "no place given (--place NAME, or place in the world's [robot])".to_owned()
-            })?;
+        else {
+            return Ok(None);
+        };
         let index = world
             .objects
             .iter()
@@ -716,11 +766,11 @@ impl Pick {
             Shape::Mesh { .. } => 0.0,
         };
         let t = pose.translation;
-        Ok([
+        Ok(Some([
             f64::from(t.x),
             f64::from(t.y),
             f64::from(t.z + half_height),
-        ])
+        ]))
     }
 }
 

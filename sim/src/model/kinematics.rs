@@ -607,12 +607,11 @@ impl IkSolver {
         let position = target.position_m - p_tip;
         let rotation = match (target.orientation, approach) {
             (Some(r), _) => (r * tip.rotation.inverse()).scaled_axis(),
-            (None, Some(d)) => UnitQuaternion::rotation_between(&tip_z, &d)
-                .map_or_else(
-                    // Opposite: half a turn about any axis across the tip's z.
-                    || tip.rotation * Vector3::x() * std::f64::consts::PI,
-                    |r| r.scaled_axis(),
-                ),
+            (None, Some(d)) => UnitQuaternion::rotation_between(&tip_z, &d).map_or_else(
+                // Opposite: half a turn about any axis across the tip's z.
+                || tip.rotation * Vector3::x() * std::f64::consts::PI,
+                |r| r.scaled_axis(),
+            ),
             (None, None) => Vector3::zeros(),
         };
         let mut error = Vector6::zeros();

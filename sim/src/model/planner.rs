@@ -440,8 +440,11 @@ mod tests {
             .collect();
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("chain.urdf");
-        std::fs::write(&path, format!("<robot name=\"chain\">{links}{joints}</robot>"))
-            .expect("write");
+        std::fs::write(
+            &path,
+            format!("<robot name=\"chain\">{links}{joints}</robot>"),
+        )
+        .expect("write");
         let robot = crate::model::robot::RobotModel::load(&path).expect("chain loads");
         KinematicChain::new(&robot, "l0", &format!("l{n}"))
             .expect("chain")
@@ -454,12 +457,17 @@ mod tests {
     #[test]
     fn rrt_connect_goes_round_a_wall_and_repeats_itself() {
         let j = joints(2);
-        let wall = |q: &[f64]| {
-            (q[0] > 0.5 && q[0] < 0.7 && q[1] < 1.5).then(|| "the wall".to_owned())
-        };
+        let wall =
+            |q: &[f64]| (q[0] > 0.5 && q[0] < 0.7 && q[1] < 1.5).then(|| "the wall".to_owned());
         let plan = || {
-            plan_path(&j, &[0.0, 0.0], &[1.2, 0.0], &PlannerOptions::default(), wall)
-                .expect("a path")
+            plan_path(
+                &j,
+                &[0.0, 0.0],
+                &[1.2, 0.0],
+                &PlannerOptions::default(),
+                wall,
+            )
+            .expect("a path")
         };
         let path = plan();
         assert!(path.len() >= 3, "{path:?}");
@@ -469,7 +477,13 @@ mod tests {
         }
         assert_eq!(path, plan());
         assert!(matches!(
-            plan_path(&j, &[0.6, 0.0], &[1.2, 0.0], &PlannerOptions::default(), wall),
+            plan_path(
+                &j,
+                &[0.6, 0.0],
+                &[1.2, 0.0],
+                &PlannerOptions::default(),
+                wall
+            ),
             Err(PlanError::StartInCollision(_))
         ));
         let boxed = |q: &[f64]| (q[0] > 0.5).then(|| "everything".to_owned());
@@ -499,7 +513,10 @@ mod tests {
                 path.sample(t, &mut q, &mut v);
                 assert!(v.iter().all(|v| v.abs() <= 0.5 + 1e-9), "{t}: {v:?}");
                 for (a, b) in q.iter().zip(&last) {
-                    assert!((a - b).abs() <= 0.5 * 0.01 + 1e-9, "{t}: {q:?} after {last:?}");
+                    assert!(
+                        (a - b).abs() <= 0.5 * 0.01 + 1e-9,
+                        "{t}: {q:?} after {last:?}"
+                    );
                 }
                 last.clone_from(&q);
                 t += 0.01;

@@ -309,7 +309,12 @@ impl Actuators {
     fn follow_leaders(&mut self, physics: &PhysicsWorld) {
         for f in &self.followers {
             let q = f.leader.position(&physics.bodies);
-            let v = f.leader.velocity(&physics.bodies);
+            // A multibody's link bodies do not carry its joints' speeds (they are recomputed
+            // from its own coordinates), so there the follower tracks the position alone.
+            let v = match f.leader.handle {
+                JointRef::Impulse(_) => f.leader.velocity(&physics.bodies),
+                JointRef::Multibody(_) => 0.0,
+            };
             if let Some(a) = self.list.get_mut(f.actuator) {
                 let cap = a.velocity_max.unwrap_or(f64::INFINITY);
                 a.command = JointCommand::Track {

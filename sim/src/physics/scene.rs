@@ -12,8 +12,8 @@
 //! each other (a five-joint arm cannot fold onto itself; a longer arm's SRDF pairs are left for
 //! later).
 
-use rapier3d::parry::query;
 use glam::Quat;
+use rapier3d::parry::query;
 use rapier3d::prelude::*;
 
 use crate::error::Result;
@@ -114,9 +114,7 @@ impl PlanningScene {
         self.obstacles
             .iter()
             .filter_map(|o| {
-                let d = o
-                    .shape
-                    .distance_to_point(&o.world_from_shape, point, true);
+                let d = o.shape.distance_to_point(&o.world_from_shape, point, true);
                 (d <= within_m).then_some((o.object?, d))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -145,7 +143,8 @@ impl PlanningScene {
             let world_from_link = self.world_from_root * self.root_from_link[link.index()];
             for (link_from_shape, shape) in shapes {
                 let name = || self.robot.links[link.index()].name.clone();
-                if let Some(hit) = self.first_hit(&(world_from_link * *link_from_shape), shape, name)
+                if let Some(hit) =
+                    self.first_hit(&(world_from_link * *link_from_shape), shape, name)
                 {
                     return Some(hit);
                 }
@@ -167,9 +166,7 @@ impl PlanningScene {
     ) -> Option<SceneContact> {
         let aabb = shape.compute_aabb(world_from_shape).loosened(self.margin_m);
         for o in &self.obstacles {
-            if o.object.is_some_and(|i| self.ignored.contains(&i))
-                || !aabb.intersects(&o.aabb)
-            {
+            if o.object.is_some_and(|i| self.ignored.contains(&i)) || !aabb.intersects(&o.aabb) {
                 continue;
             }
             let Ok(d) = query::distance(world_from_shape, &**shape, &o.world_from_shape, &*o.shape)
@@ -201,7 +198,12 @@ impl PlanningScene {
                 self.q_all[i] = f64::from(m.multiplier) * leader + f64::from(m.offset);
             }
         }
-        root_from_links_at(&self.robot, &self.order, &self.q_all, &mut self.root_from_link);
+        root_from_links_at(
+            &self.robot,
+            &self.order,
+            &self.q_all,
+            &mut self.root_from_link,
+        );
     }
 }
 
