@@ -149,6 +149,9 @@ enum Step {
     Wait { s: f64, until_held: bool },
 }
 
+/// Joint-space waypoints (the chain's joints each).
+type Waypoints = Vec<Vec<f64>>;
+
 /// The joint-space paths of a grasp.
 #[derive(Debug)]
 struct Grasp {
@@ -505,7 +508,7 @@ impl Pick {
         };
         // Carrying: the object on the tool.
         scene.attach_sphere(Some((self.tool, Pose::IDENTITY, radius as f32)));
-        let (place_q, _, _) = self
+        let (place_q, _) = self
             .reachable(&mut scene, over, &lift_q, "the place", None)
             .map_err(|why| format!("cannot reach over the place: {why}"))?;
         let carry = plan_path(&joints, &lift_q, &place_q, &self.config.planner, |q| {
@@ -572,7 +575,7 @@ impl Pick {
         if let Some(t) = target {
             scene.ignore_object(t, true);
         }
-        let (grasp_q, _, mut descent) = self
+        let (grasp_q, mut descent) = self
             .reachable(scene, centre, q0, "the grasp", Some(c.approach_m))
             .map_err(|why| format!("cannot grasp the {}: {why}", c.class))?;
         let pre_q = descent.last().cloned().unwrap_or_else(|| grasp_q.clone());
@@ -608,8 +611,8 @@ impl Pick {
     }
 
     /// Joint positions putting the tool at `point` (base frame) coming in along the first of
-    /// the approach pitches IK reaches there without a collision, and that direction; else
-    /// why not (the last reason).
+    /// the approach pitches IK reaches there without a collision (with `back_m`, the straight
+    /// way back out along it free too, returned), else why not at each pitch.
     fn reachable(
         &mut self,
         scene: &mut PlanningScene,
@@ -617,7 +620,7 @@ impl Pick {
         seed: &[f64],
         what: &str,
         back_m: Option<f64>,
-    ) -> Result<(Vec<f64>, Vector3<f64>, Vec<Vec<f64>>), String> {
+    ) -> Result<(Vec<f64>, Waypoints), String> {
         let horizontal = Vector3::new(point.x, point.y, 0.0)
             .try_normalize(1e-9)
             .unwrap_or_else(Vector3::x);
@@ -659,7 +662,7 @@ impl Pick {
                 }
                 None => Vec::new(),
             };
-            return Ok((solution.q, approach, back));
+            return Ok((solution.q, back));
         }
         Err(format!("{what}, coming in {}", why.join("; ")))
     }

@@ -110,11 +110,6 @@ fn pick(session: &mut Session, settle_s: f64, limit_s: f64, said: &mut Said) -> 
         .robot()
         .link_id("tool_link")
         .ok_or_else(|| anyhow::anyhow!("no tool_link"))?;
-    let finger = session
-        .sim()
-        .robot()
-        .joint_id("left_finger_joint")
-        .ok_or_else(|| anyhow::anyhow!("no left_finger_joint"))?;
     let mut held_from: Option<glam::Vec3> = None;
     let mut slip_m = 0.0f32;
     let mut touched: Vec<String> = Vec::new();
@@ -131,15 +126,6 @@ fn pick(session: &mut Session, settle_s: f64, limit_s: f64, said: &mut Said) -> 
                 }
             }
         }
-        if std::env::var_os("PICK_DEBUG").is_some()
-            && state == PickState::Grasping
-            && session.sim().step_index() % 10 == 0
-        {
-            println!(
-                "  {now:.2} grasping: finger {:?}",
-                session.sim().joint_state(finger)
-            );
-        }
         if matches!(state, PickState::Lifting | PickState::Carrying) {
             let sim = session.sim();
             let in_tool = sim
@@ -148,16 +134,6 @@ fn pick(session: &mut Session, settle_s: f64, limit_s: f64, said: &mut Said) -> 
                 .transform_point(object(session, BALL).translation);
             let from = *held_from.get_or_insert(in_tool);
             slip_m = slip_m.max((in_tool - from).length());
-            if std::env::var_os("PICK_DEBUG").is_some() && session.sim().step_index() % 40 == 0 {
-                let right = sim
-                    .robot()
-                    .joint_id("right_finger_joint")
-                    .and_then(|j| sim.joint_state(j));
-                println!(
-                    "  {now:.2} {state:?} ball in tool {in_tool:.4?} finger {:?} right {right:?}",
-                    sim.joint_state(finger)
-                );
-            }
         }
         if finished.is_none() && matches!(state, PickState::Done | PickState::Failed) {
             finished = Some(now);
