@@ -15,6 +15,9 @@ use crate::look::{Look, LookConfig};
 use crate::pick::{Pick, PickConfig, PickState};
 use crate::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
 
+/// A tool point whose arm comes this close (m) to anything is refused (touching counts).
+const TOOL_CONTACT_M: f32 = 0.001;
+
 /// How many recent images are kept for detections still to come.
 const FRAMES: usize = 8;
 
@@ -171,6 +174,8 @@ pub(crate) struct ArmTask {
     pick: Result<Pick, String>,
     /// The end effector moved to points (scripts, Cartesian jogging).
     tool: Result<IkSolver, String>,
+    /// The planning scene a tool point is checked in (built at the first point).
+    tool_scene: Option<rover_sim::PlanningScene>,
     /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
     look_while_reaching: bool,
     frames: Vec<FrameRecord>,
@@ -248,6 +253,7 @@ impl ArmTask {
             reach,
             pick,
             tool,
+            tool_scene: None,
             look_while_reaching,
             frames: Vec::new(),
             q: Vec::with_capacity(robot.joints.len()),
@@ -310,6 +316,26 @@ impl ArmTask {
                 goal.z,
                 solver.chain().base_name(),
                 solution.position_error_m
+            ));
+        }
+        // A point inside something: the arm would have to go through it.
+        let scene = match &mut self.tool_scene {
+            Some(scene) => {
+                sim.refresh_planning_scene(scene);
+                scene
+            }
+            None => self.tool_scene.insert(
+                sim.planning_scene(solver.chain(), TOOL_CONTACT_M)
+                    .map_err(|e| e.to_string())?,
+            ),
+        };
+        if let Some(hit) = scene.collision(&solution.q) {
+            return Err(format!(
+                "tool: ({:.3}, {:.3}, {:.3}) m in {} is refused: there, {hit}",
+                goal.x,
+                goal.y,
+                goal.z,
+                solver.chain().base_name()
             ));
         }
         command(sim, solver.chain().joints(), &solution.q);

@@ -190,6 +190,9 @@ pub struct Pick {
     object: Option<(Vector3<f64>, f64)>,
     /// Wall-clock seconds the last plan took.
     planning_s: Option<f64>,
+    /// Waypoints of the last plan's joint-space paths: to the pre-grasp, the carry, home
+    /// (2: a straight joint move; more: it goes round something).
+    path_points: Option<[usize; 3]>,
     q: Vec<f64>,
     v: Vec<f64>,
     /// What to say next (a warning when `true`).
@@ -229,6 +232,7 @@ impl Pick {
             running: None,
             object: None,
             planning_s: None,
+            path_points: None,
             q: Vec::new(),
             v: Vec::new(),
             said: Vec::new(),
@@ -255,6 +259,12 @@ impl Pick {
         self.planning_s
     }
 
+    /// Waypoints of the last plan's joint-space paths (to the pre-grasp, the carry, home; 0
+    /// for a leg without one): 2 is a straight joint move, more goes round something.
+    pub fn path_points(&self) -> Option<[usize; 3]> {
+        self.path_points
+    }
+
     /// Starts afresh.
     pub fn reset(&mut self) {
         self.sightings.clear();
@@ -263,6 +273,7 @@ impl Pick {
         self.running = None;
         self.object = None;
         self.planning_s = None;
+        self.path_points = None;
     }
 
     /// What it has to say since the last call: (warning, text).
@@ -476,6 +487,7 @@ impl Pick {
             Step::Move(TimedPath::new(w, &joints, speed_scale, RAMP_S, stop))
         };
         let lift_q = grasp.lift.last().cloned().unwrap_or_default();
+        self.path_points = Some([grasp.to_pre.len(), 0, 0]);
         let mut steps = VecDeque::from([
             (
                 Step::Gripper {
@@ -537,6 +549,11 @@ impl Pick {
             scene.collision(q).map(|h| h.to_string())
         })
         .map_err(|e| format!("going home: {e}"))?;
+        self.path_points = Some([
+            self.path_points.map_or(0, |p| p[0]),
+            carry.len(),
+            home.len(),
+        ]);
         steps.extend([
             (timed(carry, true), PickState::Carrying),
             (

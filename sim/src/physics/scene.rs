@@ -57,6 +57,8 @@ struct Obstacle {
     name: String,
     /// The world object's index, for an object.
     object: Option<usize>,
+    /// One of the robot's own links.
+    robot: bool,
     aabb: rapier3d::parry::bounding_volume::Aabb,
 }
 
@@ -70,8 +72,11 @@ pub struct PlanningScene {
     q_all: Vec<f64>,
     chain_joints: Vec<JointId>,
     world_from_root: Pose,
-    /// The links the chain moves, with their shapes (link frame).
-    moving: Vec<(LinkId, Vec<(Pose, SharedShape)>)>,
+    /// The links the chain moves, whether they are checked against the robot's other links,
+    /// and their shapes (link frame).
+    moving: Vec<(LinkId, bool, Vec<(Pose, SharedShape)>)>,
+    /// The robot's links the chain does not move that count as obstacles, with their shapes.
+    fixed_links: Vec<(LinkId, Pose, SharedShape)>,
     obstacles: Vec<Obstacle>,
     /// A held object: its link, where it is on the link, its shape.
     attached: Option<(LinkId, Pose, SharedShape)>,
@@ -139,20 +144,19 @@ impl PlanningScene {
     /// `q` (the chain's joint positions), if any.
     pub fn collision(&mut self, q: &[f64]) -> Option<SceneContact> {
         self.forward(q);
-        for (link, shapes) in &self.moving {
+        for (link, self_check, shapes) in &self.moving {
             let world_from_link = self.world_from_root * self.root_from_link[link.index()];
             for (link_from_shape, shape) in shapes {
                 let name = || self.robot.links[link.index()].name.clone();
-                if let Some(hit) =
-                    self.first_hit(&(world_from_link * *link_from_shape), shape, name)
-                {
+                let at = world_from_link * *link_from_shape;
+                if let Some(hit) = self.first_hit(&at, shape, *self_check, name) {
                     return Some(hit);
                 }
             }
         }
         if let Some((link, pose, shape)) = &self.attached {
             let world = self.world_from_root * self.root_from_link[link.index()] * *pose;
-            return self.first_hit(&world, shape, || "held object".to_owned());
+            return self.first_hit(&world, shape, true, || "held object".to_owned());
         }
         None
     }
@@ -162,11 +166,15 @@ impl PlanningScene {
         &self,
         world_from_shape: &Pose,
         shape: &SharedShape,
+        self_check: bool,
         link: impl Fn() -> String,
     ) -> Option<SceneContact> {
         let aabb = shape.compute_aabb(world_from_shape).loosened(self.margin_m);
         for o in &self.obstacles {
-            if o.object.is_some_and(|i| self.ignored.contains(&i)) || !aabb.intersects(&o.aabb) {
+            if o.object.is_some_and(|i| self.ignored.contains(&i))
+                || (o.robot && !self_check)
+                || !aabb.intersects(&o.aabb)
+            {
                 continue;
             }
             let Ok(d) = query::distance(world_from_shape, &**shape, &o.world_from_shape, &*o.shape)
@@ -252,10 +260,16 @@ impl Simulation {
         let chain_joints: Vec<JointId> = chain.joints().iter().map(|j| j.id).collect();
         // The links the chain moves: below its first joint.
         let mut moved = vec![false; robot.links.len()];
+        // The links only the first joint moves (the arm's first link, welded to it) turn in
+        // place beside the robot's body they are mounted on: they are not checked against it.
+        let mut first_only = vec![false; robot.links.len()];
         for id in &order {
             let joint = &robot.joints[id.index()];
-            if chain_joints.first() == Some(id) || moved[joint.parent.index()] {
+            let parent = joint.parent.index();
+            if chain_joints.first() == Some(id) || moved[parent] {
                 moved[joint.child.index()] = true;
+                first_only[joint.child.index()] = chain_joints.first() == Some(id)
+                    || (first_only[parent] && joint.kind == JointKind::Fixed);
             }
         }
         let mut shapes: Vec<Vec<(Pose, SharedShape)>> = vec![Vec::new(); robot.links.len()];
@@ -265,12 +279,6 @@ impl Simulation {
                 shapes[i].push((c.link_from_shape * fix, shape));
             }
         }
-        let q_all: Vec<f64> = robot
-            .joint_ids()
-            .map(|(id, _)| self.joint_state(id).map_or(0.0, |s| s.position))
-            .collect();
-        let world_from_root = self.world_from_link(robot.root);
-        let mut obstacles = self.world_obstacles();
         // The robot's other links, where they are now, but not those a chain link touches
         // with every joint at zero.
         let mut at_zero = Vec::new();
@@ -285,39 +293,60 @@ impl Simulation {
                 })
             })
         };
-        for (i, link) in robot.links.iter().enumerate() {
-            if moved[i] || shapes[i].is_empty() || touching_at_zero(i) {
-                continue;
-            }
-            let world_from_link = self.world_from_link(LinkId(i));
-            for (pose, shape) in &shapes[i] {
-                let world_from_shape = world_from_link * *pose;
-                obstacles.push(Obstacle {
-                    aabb: shape.compute_aabb(&world_from_shape),
-                    world_from_shape,
-                    shape: shape.clone(),
-                    name: format!("{} (the robot's)", link.name),
-                    object: None,
-                });
-            }
-        }
+        let fixed_links: Vec<(LinkId, Pose, SharedShape)> = (0..robot.links.len())
+            .filter(|&i| !moved[i] && !shapes[i].is_empty() && !touching_at_zero(i))
+            .flat_map(|i| {
+                shapes[i]
+                    .iter()
+                    .map(move |(pose, shape)| (LinkId(i), *pose, shape.clone()))
+            })
+            .collect();
         let moving = (0..robot.links.len())
             .filter(|&i| moved[i] && !shapes[i].is_empty())
-            .map(|i| (LinkId(i), shapes[i].clone()))
+            .map(|i| (LinkId(i), !first_only[i], shapes[i].clone()))
             .collect();
-        Ok(PlanningScene {
+        let mut scene = PlanningScene {
             robot: robot.clone(),
             order,
-            q_all,
+            q_all: Vec::new(),
             chain_joints,
-            world_from_root,
+            world_from_root: Pose::IDENTITY,
             moving,
-            obstacles,
+            fixed_links,
+            obstacles: Vec::new(),
             attached: None,
             ignored: Vec::new(),
             margin_m,
             root_from_link: Vec::new(),
-        })
+        };
+        self.refresh_planning_scene(&mut scene);
+        Ok(scene)
+    }
+
+    /// Brings `scene` (this robot's) up to now: the joints' positions, where the robot is,
+    /// where the world's things are; nothing ignored or attached.
+    pub fn refresh_planning_scene(&self, scene: &mut PlanningScene) {
+        scene.q_all.clear();
+        scene.q_all.extend(
+            self.robot
+                .joint_ids()
+                .map(|(id, _)| self.joint_state(id).map_or(0.0, |s| s.position)),
+        );
+        scene.world_from_root = self.world_from_link(self.robot.root);
+        scene.obstacles = self.world_obstacles();
+        for (link, pose, shape) in &scene.fixed_links {
+            let world_from_shape = self.world_from_link(*link) * *pose;
+            scene.obstacles.push(Obstacle {
+                aabb: shape.compute_aabb(&world_from_shape),
+                world_from_shape,
+                shape: shape.clone(),
+                name: format!("{} (the robot's)", self.robot.links[link.index()].name),
+                object: None,
+                robot: true,
+            });
+        }
+        scene.ignored.clear();
+        scene.attached = None;
     }
 
     /// What world object `index` touches now (a contact with force in it): the robot's links
@@ -396,6 +425,7 @@ impl Simulation {
                     shape: c.shared_shape().clone(),
                     name,
                     object,
+                    robot: false,
                 }
             })
             .collect()
