@@ -1150,6 +1150,13 @@ pub(crate) struct PhysicsBenchArgs {
     /// Also measure at these step rates (Hz), e.g. --rates 250,500,1000
     #[arg(long, value_delimiter = ',', value_name = "HZ,...")]
     pub(crate) rates: Vec<f64>,
+
+    /// Hold this world object in the gripper while driving (before the clock starts: the
+    /// gripper opens, the object is put at the end effector, the gripper closes on it);
+    /// needs a gripper controller and the world's [robot] ee_link. Says whether it was still
+    /// held at the end. E.g. `--world worlds/arm_car_pick.toml --spawn -3,-3 --hold ball`
+    #[arg(long, value_name = "NAME")]
+    pub(crate) hold: Option<String>,
 }
 
 /// `NAME:=VALUE` (xacro's own spelling; `NAME=VALUE` is accepted too).

@@ -21,6 +21,8 @@ pub struct PhysicsBench {
     pub sim_s: f64,
     /// Wall seconds it took (best of the repeats).
     pub wall_s: f64,
+    /// With an object held: how far it ended from the end effector (m).
+    pub held_off_m: Option<f64>,
 }
 
 impl PhysicsBench {
@@ -40,8 +42,8 @@ impl PhysicsBench {
 pub fn physics(
     config: &RunConfig,
     step_hz: Option<f64>,
-    sim_s: f64,
-    repeats: u32,
+    (sim_s, repeats): (f64, u32),
+    hold: Option<&str>,
 ) -> Result<PhysicsBench> {
     let (world, robot) = config.load_world_and_robot()?;
     let options = SimOptions {
@@ -50,15 +52,18 @@ pub fn physics(
     };
     let mut best = f64::INFINITY;
     let mut rate = 0.0;
+    let mut held_off_m = None;
     for _ in 0..repeats.max(1) {
         let mut sim = Simulation::new(world.clone(), robot.clone(), &options)?;
         rate = 1.0 / sim.dt_s();
+        let held = hold.map(|name| grasp(&mut sim, name)).transpose()?;
+        let first = sim.step_index();
         let steps = (sim_s / sim.dt_s()).round() as u64;
         let started = Instant::now();
         let mut turning_left = true;
         sim.set_cmd_vel(Twist::new(0.5, 0.6))?;
-        while sim.step_index() < steps {
-            if sim.step_index() % (4 * rate as u64) == 0 {
+        while sim.step_index() - first < steps {
+            if (sim.step_index() - first) % (4 * rate as u64) == 0 {
                 let turn = if turning_left { 0.6 } else { -0.6 };
                 sim.set_cmd_vel(Twist::new(0.5, turn))?;
                 turning_left = !turning_left;
@@ -66,12 +71,81 @@ pub fn physics(
             sim.step();
         }
         best = best.min(started.elapsed().as_secs_f64());
+        if let Some((object, tool)) = held {
+            held_off_m = Some(object_to_link_m(&sim, object, tool));
+        }
     }
     Ok(PhysicsBench {
         step_hz: rate,
         sim_s,
         wall_s: best,
+        held_off_m,
     })
+}
+
+/// Puts world object `name` in the robot's gripper, untimed: the first gripper controller
+/// opens, the object goes to the end effector (the world's `[robot] ee_link`), the gripper
+/// closes on it with 5 N and settles. Returns the object's index and the end effector.
+fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::LinkId)> {
+    let object = sim
+        .world()
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or_else(|| anyhow::anyhow!("--hold {name}: the world has no object \"{name}\""))?;
+    let ee = sim.world().robot.ee_link.clone().ok_or_else(|| {
+        anyhow::anyhow!("--hold needs the world's [robot] ee_link (where the object is held)")
+    })?;
+    let tool = sim
+        .robot()
+        .link_id(&ee)
+        .ok_or_else(|| anyhow::anyhow!("--hold: the robot has no link \"{ee}\" (ee_link)"))?;
+    let (controller, joint) = sim
+        .robot()
+        .controllers
+        .as_ref()
+        .and_then(|c| {
+            c.controllers.iter().find_map(|s| match &s.kind {
+                rover_sim::ControllerKind::Gripper(g) => Some((s.name.clone(), g.joint.clone())),
+                _ => None,
+            })
+        })
+        .ok_or_else(|| anyhow::anyhow!("--hold needs a gripper controller"))?;
+    let open = sim
+        .robot()
+        .joint_id(&joint)
+        .and_then(|j| sim.robot().joint(j).position_limits())
+        .map_or(0.0, |(_, hi)| f64::from(hi));
+    sim.command_gripper(&controller, open, 0.0)?;
+    let settle = |sim: &mut Simulation, s: f64| {
+        let end = sim.sim_time_s() + s;
+        while sim.sim_time_s() < end {
+            sim.step();
+        }
+    };
+    settle(sim, 1.0);
+    let at = sim.world_from_link(tool).translation;
+    let at = [f64::from(at.x), f64::from(at.y), f64::from(at.z)];
+    sim.place_object(object, at, 0.0)?;
+    sim.command_gripper(&controller, 0.0, 5.0)?;
+    settle(sim, 1.5);
+    let off = object_to_link_m(sim, object, tool);
+    anyhow::ensure!(
+        off < 0.02,
+        "--hold {name}: the gripper did not take it ({off:.3} m from {ee} after closing)"
+    );
+    Ok((object, tool))
+}
+
+/// An object this close to the end effector (m) is still in the hand.
+const HELD_WITHIN_M: f64 = 0.05;
+
+/// How far world object `object` is from link `link` (m).
+fn object_to_link_m(sim: &Simulation, object: usize, link: rover_sim::LinkId) -> f64 {
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let o = poses.get(object).map(|p| p.translation).unwrap_or_default();
+    f64::from((o - sim.world_from_link(link).translation).length())
 }
 
 /// Result of the detector benchmark.
@@ -489,12 +563,8 @@ pub fn record(
     })
 }
 
-pub(crate) fn bench_cmd(
-    world: WorldArgs,
-    sim_seconds: f64,
-    repeats: u32,
-    rates: Vec<f64>,
-) -> Result<()> {
+pub(crate) fn bench_cmd(world: WorldArgs, args: super::args::PhysicsBenchArgs) -> Result<()> {
+    let (sim_seconds, repeats, rates) = (args.sim_seconds, args.repeats, args.rates);
     anyhow::ensure!(
         sim_seconds.is_finite() && sim_seconds > 0.0,
         "--sim-seconds must be positive, found {sim_seconds}"
@@ -511,7 +581,12 @@ pub(crate) fn bench_cmd(
         "real-time x"
     );
     for step_hz in plan {
-        let b = physics(&config, step_hz, sim_seconds, repeats)?;
+        let b = physics(
+            &config,
+            step_hz,
+            (sim_seconds, repeats),
+            args.hold.as_deref(),
+        )?;
         say!(
             "{:>10.0} {:>12.3} {:>12.1} {:>14.0}",
             b.step_hz,
@@ -519,6 +594,14 @@ pub(crate) fn bench_cmd(
             b.us_per_step(),
             b.real_time_factor()
         );
+        if let (Some(name), Some(off)) = (&args.hold, b.held_off_m) {
+            let verdict = if off < HELD_WITHIN_M {
+                "still in the hand"
+            } else {
+                "dropped"
+            };
+            say!("  {name}: {verdict}, {off:.3} m from the end effector at the end");
+        }
     }
     Ok(())
 }

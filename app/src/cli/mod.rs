@@ -116,7 +116,7 @@ pub fn main() -> ExitCode {
         | Some(Command::Bench {
             kind: Some(BenchKind::Physics { world, physics }),
             ..
-        }) => bench::bench_cmd(world, physics.sim_seconds, physics.repeats, physics.rates),
+        }) => bench::bench_cmd(world, physics),
         Some(Command::Detect {
             images,
             detector,

@@ -49,6 +49,9 @@ impl std::fmt::Display for SceneContact {
     }
 }
 
+/// A link's collision shapes, each with its pose in the link's frame.
+type LinkShapes = Vec<(Pose, SharedShape)>;
+
 /// One obstacle, fixed where it was when the scene was taken.
 #[derive(Clone)]
 struct Obstacle {
@@ -74,7 +77,7 @@ pub struct PlanningScene {
     world_from_root: Pose,
     /// The links the chain moves, whether they are checked against the robot's other links,
     /// and their shapes (link frame).
-    moving: Vec<(LinkId, bool, Vec<(Pose, SharedShape)>)>,
+    moving: Vec<(LinkId, bool, LinkShapes)>,
     /// The robot's links the chain does not move that count as obstacles, with their shapes.
     fixed_links: Vec<(LinkId, Pose, SharedShape)>,
     obstacles: Vec<Obstacle>,
@@ -272,7 +275,7 @@ impl Simulation {
                     || (first_only[parent] && joint.kind == JointKind::Fixed);
             }
         }
-        let mut shapes: Vec<Vec<(Pose, SharedShape)>> = vec![Vec::new(); robot.links.len()];
+        let mut shapes: Vec<LinkShapes> = vec![Vec::new(); robot.links.len()];
         for (i, link) in robot.links.iter().enumerate() {
             for c in &link.collisions {
                 let (shape, fix) = collider_shape(&c.shape, &robot.source, &link.name, false)?;
