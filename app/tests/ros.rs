@@ -1228,7 +1228,13 @@ print('\n'.join(lines))
                     "t" => 't',
                     _ => return None,
                 };
-                let n = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok());
+                // Every number is printed with 9 decimals: a shorter one is a line the
+                // captured output cut off.
+                let n = |i: usize| {
+                    f.get(i)
+                        .filter(|v| v.rsplit_once('.').is_some_and(|(_, d)| d.len() == 9))
+                        .and_then(|v| v.parse::<f64>().ok())
+                };
                 let stamp = f.get(1)?.parse::<i64>().ok()? * 1_000_000_000
                     + f.get(2)?.parse::<i64>().ok()?;
                 Some((kind, stamp, n(3)?, [n(4)?, n(5)?, n(6)?, n(7)?]))

@@ -303,7 +303,7 @@ mod tests {
         assert!(err("steps = [ { at = 1.0, cmd_vel = [nan, 0.0] } ]").contains("finite"));
         assert!(
             err("steps = [ { at = 1.0, toggle = \"dance\" } ]")
-                .contains("expected \"follow\", \"look\" or \"reach\"")
+                .contains("expected \"follow\", \"look\", \"reach\" or \"pick\"")
         );
         let both = err("steps = [ { at = 1.0, joint = \"a\", position = 1.0, velocity = 2.0 } ]");
         assert!(both.contains("exactly one of `position`"), "{both}");

@@ -1,10 +1,11 @@
-//! The arm's look and reach out: `/rover/arm/state` (std_msgs/String, latched, on every
-//! change: `off`, `look`, or `reach <state>`), `/rover/arm/object` and `/rover/arm/goal`
-//! (geometry_msgs/PointStamped in the robot's base frame, every control update while reach
-//! has them: the object point it reaches for and the pre-grasp point the tool is sent to).
+//! The arm's look, reach and pick out: `/rover/arm/state` (std_msgs/String, latched, on
+//! every change: `off`, `look`, `reach <state>` or `pick <state>`), `/rover/arm/object` and
+//! `/rover/arm/goal` (geometry_msgs/PointStamped in the robot's base frame, every control
+//! update while reach or pick has them: the object point it goes for and reach's pre-grasp
+//! point).
 //! The task comes in on `/rover/arm/task` (input.rs).
 
-use rover_core::{ArmMode, ReachState};
+use rover_core::{ArmMode, PickState, ReachState};
 
 use super::events::{ArmSample, ControlUpdate, TopicFamily};
 
@@ -36,7 +37,7 @@ pub(crate) trait ArmWire: Send {
 pub(crate) struct Arm {
     wire: Box<dyn ArmWire>,
     text: String,
-    last: Option<(ArmMode, ReachState)>,
+    last: Option<(ArmMode, ReachState, PickState)>,
 }
 
 impl Arm {
@@ -55,21 +56,27 @@ impl TopicFamily for Arm {
         let ArmSample {
             mode,
             reach,
+            pick,
             object_base_m,
             goal_base_m,
         } = update.arm;
         let t = update.sample.sim_time_s;
-        if self.last != Some((mode, reach)) {
-            self.last = Some((mode, reach));
+        if self.last != Some((mode, reach, pick)) {
+            self.last = Some((mode, reach, pick));
             self.text.clear();
             self.text.push_str(mode.as_str());
-            if mode == ArmMode::Reach {
+            let state = match mode {
+                ArmMode::Reach => Some(reach.as_str()),
+                ArmMode::Pick => Some(pick.as_str()),
+                ArmMode::Off | ArmMode::Look => None,
+            };
+            if let Some(state) = state {
                 self.text.push(' ');
-                self.text.push_str(reach.as_str());
+                self.text.push_str(state);
             }
             self.wire.state(t, &self.text);
         }
-        if mode == ArmMode::Reach {
+        if matches!(mode, ArmMode::Reach | ArmMode::Pick) {
             for (which, p) in [
                 (ArmPoint::Object, object_base_m),
                 (ArmPoint::Goal, goal_base_m),

@@ -189,6 +189,7 @@ pub(crate) fn arm(sim: &Simulation, arm: &rover_core::ArmStatus) -> ArmSample {
     ArmSample {
         mode: arm.mode,
         reach: arm.reach,
+        pick: arm.pick,
         object_base_m: to_base(arm.object_world_m),
         goal_base_m: to_base(arm.goal_world_m),
     }

@@ -105,6 +105,8 @@ pub(crate) struct ArmSample {
     pub mode: rover_core::ArmMode,
     /// What reach is doing.
     pub reach: rover_core::ReachState,
+    /// What pick is doing.
+    pub pick: rover_core::PickState,
     /// The object point reach goes for (m, base frame).
     pub object_base_m: Option<[f64; 3]>,
     /// The pre-grasp goal (m, base frame).

@@ -8,8 +8,8 @@ use rover_sim::{JointTrajectory, TrajectoryPoint};
 /// The arm's task topic.
 pub(crate) const TASK_TOPIC: &str = "/rover/arm/task";
 
-/// The action a task word asks for (`off`, `look` or `reach`); anything else is a warning and
-/// no action.
+/// The action a task word asks for (`off`, `look`, `reach` or `pick`); anything else is a
+/// warning and no action.
 pub(crate) fn arm_task(word: &str) -> Option<Action> {
     match word.trim() {
         "off" => Some(Action::Arm(ArmMode::Off)),
@@ -67,6 +67,7 @@ mod tests {
     fn task_words_are_trimmed_and_others_refused() {
         assert_eq!(arm_task(" look\n"), Some(Action::Arm(ArmMode::Look)));
         assert_eq!(arm_task("reach"), Some(Action::Arm(ArmMode::Reach)));
+        assert_eq!(arm_task("pick"), Some(Action::Arm(ArmMode::Pick)));
         assert_eq!(arm_task("grab"), None);
     }
 

@@ -63,8 +63,10 @@ fn teleop_name(name: &str, wasd: bool) -> Option<&'static str> {
         (_, "f") => "f",
         (_, "p") => "p",
         (_, "n") => "n",
-        // The arm's: pick a joint, jog it, home; reach (grab) and look (view) on / off.
+        // The arm's: pick a joint, jog it, home; reach (grab), pick and place (retrieve)
+        // and look (view) on / off.
         (_, "g") => "g",
+        (_, "r") => "r",
         (_, "v") => "v",
         (_, "[") => "[",
         (_, "]") => "]",
