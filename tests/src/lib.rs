@@ -160,6 +160,23 @@ pub fn tiago() -> anyhow::Result<Option<RobotModel>> {
     Ok(Some(robot))
 }
 
+/// Session options for the arm's perception tests: seed `seed`, the drive's command timeout
+/// off (a teleop key or script step holds until the next), the camera rendered, the detector
+/// in lockstep at 5 Hz of sim time.
+pub fn lockstep_options(seed: u64) -> rover_core::SessionOptions {
+    rover_core::SessionOptions {
+        sim: rover_sim::SimOptions {
+            seed,
+            cmd_timeout_s: Some(0.0),
+            ..rover_sim::SimOptions::default()
+        },
+        camera: true,
+        every_frame: false,
+        detector: rover_core::DetectorMode::Lockstep { rate_hz: 5.0 },
+        ..rover_core::SessionOptions::default()
+    }
+}
+
 /// TIAGo's wheels, driven like gazebo_ros_diff_drive (sizes from the URDF).
 pub fn tiago_drive() -> rover_sim::DriveSpec {
     rover_sim::DriveSpec {

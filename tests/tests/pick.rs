@@ -3,8 +3,8 @@
 //! camera, plans round the table and the bin, grasps the ball, and drops it into the bin.
 
 use anyhow::Result;
-use rover_core::{Action, DetectorMode, EventLevel, PickState, Session, SessionOptions};
-use rover_sim::{Pose, SimOptions};
+use rover_core::{Action, EventLevel, PickState, Session};
+use rover_sim::Pose;
 
 /// The ball's index among the world's objects (worlds/arm_car_pick.toml).
 const BALL: usize = 6;
@@ -49,17 +49,7 @@ fn session_with(seed: u64, change: impl FnOnce(&mut rover_sim::World)) -> Result
     };
     let (mut world, robot) = config.load_world_and_robot()?;
     change(&mut world);
-    let options = SessionOptions {
-        sim: SimOptions {
-            seed,
-            cmd_timeout_s: Some(0.0),
-            ..SimOptions::default()
-        },
-        camera: true,
-        every_frame: false,
-        detector: DetectorMode::Lockstep { rate_hz: 5.0 },
-        ..SessionOptions::default()
-    };
+    let options = rover_tests::lockstep_options(seed);
     Ok(Session::new(world, robot, &options, &mut Said::default())?)
 }
 

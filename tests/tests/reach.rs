@@ -6,7 +6,7 @@ use anyhow::Result;
 use rover_core::{
     Action, ArmConfig, DetectorMode, JointAction, NoObserver, ReachState, Session, SessionOptions,
 };
-use rover_sim::{JointCommand, Pose, SimOptions, World};
+use rover_sim::{JointCommand, Pose, World};
 
 /// The ball's radius (m) and where it rests at first (centre, world frame).
 const BALL_RADIUS_M: f64 = 0.06;
@@ -45,14 +45,6 @@ fn session(seed: u64) -> Result<Option<Session>> {
         return Ok(None);
     };
     let options = SessionOptions {
-        sim: SimOptions {
-            seed,
-            cmd_timeout_s: Some(0.0),
-            ..SimOptions::default()
-        },
-        camera: true,
-        every_frame: false,
-        detector: DetectorMode::Lockstep { rate_hz: 5.0 },
         arm: ArmConfig {
             base_link: Some("torso_lift_link".into()),
             ee_link: Some("arm_tool_link".into()),
@@ -64,7 +56,7 @@ fn session(seed: u64) -> Result<Option<Session>> {
             },
             ..ArmConfig::default()
         },
-        ..SessionOptions::default()
+        ..rover_tests::lockstep_options(seed)
     };
     let mut session = Session::new(world()?, robot, &options, &mut NoObserver)?;
     for (joint, q) in START {
