@@ -29,9 +29,9 @@ use std::collections::VecDeque;
 use nalgebra::{Point3, Vector3};
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraInfo, ChainJoint, ControllerKind, GraspMode, IkOptions, IkSolver, IkTarget,
-    JointCommand, JointId, KinematicChain, LinkId, PlannerOptions, PlanningScene, Pose, Shape,
-    Simulation, TimedPath, isometry_from_pose, plan_path,
+    CameraConfig, CameraInfo, ChainJoint, GraspMode, IkOptions, IkSolver, IkTarget, JointCommand,
+    JointId, KinematicChain, LinkId, PlannerOptions, PlanningScene, Pose, Shape, Simulation,
+    TimedPath, isometry_from_pose, plan_path,
 };
 
 use crate::reach::{DepthView, object_estimate};
@@ -824,12 +824,8 @@ fn find_gripper(sim: &Simulation) -> Result<Gripper, String> {
     let spec = robot
         .controllers
         .as_ref()
-        .and_then(|c| {
-            c.controllers.iter().find_map(|s| match &s.kind {
-                ControllerKind::Gripper(g) => Some((s.name.clone(), g.joint.clone())),
-                _ => None,
-            })
-        })
+        .and_then(|c| c.first_gripper())
+        .map(|(name, g)| (name.to_owned(), g.joint.clone()))
         .ok_or_else(|| {
             "the robot has no gripper controller (a GripperActionController in its controllers file)"
                 .to_owned()

@@ -104,12 +104,8 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::LinkId)>
         .robot()
         .controllers
         .as_ref()
-        .and_then(|c| {
-            c.controllers.iter().find_map(|s| match &s.kind {
-                rover_sim::ControllerKind::Gripper(g) => Some((s.name.clone(), g.joint.clone())),
-                _ => None,
-            })
-        })
+        .and_then(|c| c.first_gripper())
+        .map(|(name, g)| (name.to_owned(), g.joint.clone()))
         .ok_or_else(|| anyhow::anyhow!("--hold needs a gripper controller"))?;
     let open = sim
         .robot()

@@ -29,6 +29,15 @@ impl ControllerConfig {
         self.controllers.iter().find(|c| c.name == name)
     }
 
+    /// The first gripper controller (file order): its name and settings. The grasp assist,
+    /// pick and `rover bench physics --hold` use it.
+    pub fn first_gripper(&self) -> Option<(&str, &GripperSpec)> {
+        self.controllers.iter().find_map(|c| match &c.kind {
+            ControllerKind::Gripper(g) => Some((c.name.as_str(), g)),
+            _ => None,
+        })
+    }
+
     /// The pose named `name`.
     pub fn named_pose(&self, name: &str) -> Option<&NamedPose> {
         self.named_poses.iter().find(|p| p.name == name)

@@ -15,7 +15,6 @@ use rapier3d::prelude::*;
 
 use crate::error::{Result, SimError};
 use crate::geometry::Pose;
-use crate::model::controllers::ControllerKind;
 use crate::model::robot::RobotModel;
 
 /// How often grips are checked (Hz; gazebo_grasp_fix's `update_rate`).
@@ -61,12 +60,9 @@ impl GraspAssist {
     ) -> Result<Self> {
         let finger = robot
             .controllers
-            .iter()
-            .flat_map(|c| &c.controllers)
-            .find_map(|c| match &c.kind {
-                ControllerKind::Gripper(g) => Some(g.joint.clone()),
-                _ => None,
-            })
+            .as_ref()
+            .and_then(|c| c.first_gripper())
+            .map(|(_, g)| g.joint.clone())
             .ok_or_else(|| {
                 SimError::Setup(format!(
                     "grasp = \"assist\" needs a gripper controller (position_controllers/GripperActionController) in \"{}\"'s controllers file",
