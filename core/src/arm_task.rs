@@ -218,9 +218,12 @@ impl ArmTask {
                 Reach::new(robot, c, base_name, ee, config.reach.clone()).map_err(|e| e.to_string())
             }
         };
+        // A named object is taken by its known pose: no camera needed.
+        let by_name = config.pick.object.is_some() || spawn.pick.is_some();
         let pick = match (camera, ee_link) {
+            (_, Some(ee)) if by_name => Pick::new(sim, camera, base_name, ee, config.pick.clone()),
             (Some(c), Some(ee)) if c.depth.is_some() => {
-                Pick::new(sim, c, base_name, ee, config.pick.clone())
+                Pick::new(sim, Some(c), base_name, ee, config.pick.clone())
             }
             _ => Err(reach
                 .as_ref()

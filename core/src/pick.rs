@@ -26,11 +26,11 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use rover_perception::BoundingBoxes;
 use rover_sim::{
     CameraConfig, CameraInfo, ChainJoint, GraspMode, IkOptions, IkSolver, IkTarget, JointCommand,
-    JointId, KinematicChain, LinkId, PlannerOptions, PlanningScene, Pose, Shape, Simulation,
+    JointId, KinematicChain, LinkId, Place, PlannerOptions, PlanningScene, Pose, Shape, Simulation,
     TimedPath, isometry_from_pose, plan_path,
 };
 
@@ -63,8 +63,13 @@ pub struct PickConfig {
     pub margin_m: f64,
     /// Depth beyond this (m) is not trusted.
     pub max_range_m: f64,
-    /// The world object to put it on (by name); `None`: the world's `[robot] place`.
-    pub place: Option<String>,
+    /// Where to put it (a world object it is dropped on or in, or a point it is set down
+    /// at); `None`: the world's `[robot] place`.
+    pub place: Option<Place>,
+    /// A world object to take by its known pose, no camera needed (as a MoveIt pick node is
+    /// given a collision object); `None`: the world's `[robot] pick`, else what the detector
+    /// sees of [`Self::class`].
+    pub object: Option<String>,
     /// Planner settings.
     pub planner: PlannerOptions,
 }
@@ -86,6 +91,7 @@ impl Default for PickConfig {
             margin_m: 0.01,
             max_range_m: 4.0,
             place: None,
+            object: None,
             planner: PlannerOptions::default(),
         }
     }
@@ -161,6 +167,8 @@ struct Grasp {
     descent: Vec<Vec<f64>>,
     /// Straight up with the object.
     lift: Vec<Vec<f64>>,
+    /// How the hand holds it.
+    way: Way,
 }
 
 /// The gripper the pick uses.
@@ -170,6 +178,60 @@ struct Gripper {
     joint: JointId,
     open: f64,
     closed: f64,
+    /// The direction the finger joint moves, in the tool's frame (unit): the fingers close
+    /// across it.
+    across_tool: Vector3<f64>,
+}
+
+/// What is picked, as the plan needs it (arm base frame, m).
+#[derive(Debug, Clone, Copy)]
+struct Target {
+    /// Its centre.
+    centre: Vector3<f64>,
+    /// From its centre down to what it rests on.
+    half_height_m: f64,
+    /// A sphere round it: the hand carries it as this.
+    bound_m: f64,
+    /// A box: its orientation (base frame) and half sizes along its axes; the fingers close
+    /// across its x or y faces. `None`: round (any turn of the hand will do).
+    cuboid: Option<(UnitQuaternion<f64>, [f64; 3])>,
+}
+
+impl Target {
+    /// A ball (or anything round) of `radius_m` at `centre`.
+    fn round(centre: Vector3<f64>, radius_m: f64) -> Self {
+        Self {
+            centre,
+            half_height_m: radius_m,
+            bound_m: radius_m,
+            cuboid: None,
+        }
+    }
+}
+
+/// One way of taking hold: the tool's z along `along` (the way in), its turn about it fixed
+/// by `turn` or free.
+#[derive(Debug, Clone)]
+struct Way {
+    /// How a refusal names it.
+    label: String,
+    /// The tool's z axis (base frame, unit).
+    along: Vector3<f64>,
+    /// The tool's whole orientation (base frame), when its turn matters (across a box's
+    /// faces).
+    turn: Option<UnitQuaternion<f64>>,
+    /// Each finger's position closed on the object (m from the middle).
+    grip_m: f64,
+}
+
+impl Way {
+    /// The IK target for the tool at `point`.
+    fn target(&self, point: Vector3<f64>) -> IkTarget {
+        match self.turn {
+            Some(turn) => IkTarget::pose(&Isometry3::from_parts(Translation3::from(point), turn)),
+            None => IkTarget::approach(point, self.along),
+        }
+    }
 }
 
 /// The pick controller for one arm.
@@ -201,10 +263,11 @@ pub struct Pick {
 
 impl Pick {
     /// A pick for the chain from `base_link` to `tool_link` of `sim`'s robot, seeing through
-    /// `camera`, with the robot's first gripper controller.
+    /// `camera` (none: it can only take a named object, [`PickConfig::object`]), with the
+    /// robot's first gripper controller.
     pub fn new(
         sim: &Simulation,
-        camera: &CameraConfig,
+        camera: Option<&CameraConfig>,
         base_link: &str,
         tool_link: &str,
         config: PickConfig,
@@ -218,14 +281,17 @@ impl Pick {
             ..IkOptions::default()
         };
         let solver = IkSolver::new(chain, options).map_err(|e| e.to_string())?;
-        let info = CameraInfo::from_config(camera);
+        let intrinsics = camera.map_or([0.0; 4], |camera| {
+            let info = CameraInfo::from_config(camera);
+            [info.k[0], info.k[4], info.k[2], info.k[5]]
+        });
         Ok(Self {
             config,
             solver,
             base,
             tool,
-            gripper: find_gripper(sim),
-            intrinsics: [info.k[0], info.k[4], info.k[2], info.k[5]],
+            gripper: find_gripper(sim, tool),
+            intrinsics,
             sightings: Vec::new(),
             state: PickState::Seeking,
             steps: VecDeque::new(),
@@ -312,9 +378,16 @@ impl Pick {
         let n = self.sightings.len() as f64;
         let centre = self.sightings.iter().map(|(p, _)| p).sum::<Vector3<f64>>() / n;
         let radius = self.sightings.iter().map(|(_, r)| r).sum::<f64>() / n;
-        self.object = Some((centre, radius));
+        let what = format!("the {}", self.config.class);
+        self.plan_for(sim, &what, Target::round(centre, radius));
+    }
+
+    /// Plans the whole pick of `target` (called `what`), and starts it or says why not.
+    fn plan_for(&mut self, sim: &Simulation, what: &str, target: Target) {
+        let centre = target.centre;
+        self.object = Some((centre, target.bound_m));
         let started = std::time::Instant::now();
-        let planned = self.plan(sim, centre, radius);
+        let planned = self.plan(sim, what, target);
         self.planning_s = Some(started.elapsed().as_secs_f64());
         match planned {
             Ok(steps) => {
@@ -323,18 +396,76 @@ impl Pick {
                 self.said.push((
                     false,
                     format!(
-                        "pick: {} at ({:.3}, {:.3}, {:.3}) m, radius {:.3} m; planned in {:.3} s",
-                        self.config.class,
+                        "pick: {what} at ({:.3}, {:.3}, {:.3}) m, {:.3} m across; planned in {:.3} s",
                         centre.x,
                         centre.y,
                         centre.z,
-                        radius,
+                        2.0 * target.bound_m,
                         self.planning_s.unwrap_or_default()
                     ),
                 ));
             }
             Err(why) => self.fail(why),
         }
+    }
+
+    /// The world object to take by its known pose, if one is named (here or in the world's
+    /// `[robot] pick`).
+    pub fn known_object(&self, sim: &Simulation) -> Option<String> {
+        self.config
+            .object
+            .clone()
+            .or_else(|| sim.world().robot.pick.clone())
+    }
+
+    /// Takes the named world object by its pose now (arm base frame): a box by its faces, a
+    /// sphere or anything else as round.
+    fn seek_known(&mut self, sim: &Simulation, name: &str) {
+        let world = sim.world();
+        let Some(index) = world.objects.iter().position(|o| o.name == name) else {
+            let why = format!(
+                "no world object \"{name}\" to pick; the world's objects: {}",
+                object_names(sim)
+            );
+            return self.fail(why);
+        };
+        let mut poses = Vec::new();
+        sim.object_poses_into(&mut poses);
+        let pose = poses.get(index).copied().unwrap_or(Pose::IDENTITY);
+        let base_from_object = isometry_from_pose(&sim.world_from_link(self.base)).inverse()
+            * isometry_from_pose(&pose);
+        let centre = base_from_object.translation.vector;
+        let r = base_from_object.rotation;
+        let target = match world.objects[index].shape {
+            Shape::Box { size_m } => {
+                let half = [size_m.x, size_m.y, size_m.z].map(|v| f64::from(v) / 2.0);
+                Target {
+                    centre,
+                    half_height_m: half[2],
+                    bound_m: half.iter().map(|h| h * h).sum::<f64>().sqrt(),
+                    cuboid: Some((r, half)),
+                }
+            }
+            Shape::Sphere { radius_m } => Target::round(centre, f64::from(radius_m)),
+            Shape::Cylinder {
+                radius_m, length_m, ..
+            } => Target {
+                half_height_m: f64::from(length_m) / 2.0,
+                ..Target::round(centre, f64::from(radius_m))
+            },
+            Shape::Capsule {
+                radius_m, length_m, ..
+            } => Target {
+                half_height_m: f64::from(radius_m + length_m / 2.0),
+                ..Target::round(centre, f64::from(radius_m))
+            },
+            Shape::Mesh { .. } => {
+                return self.fail(format!(
+                    "\"{name}\" is a mesh: pick takes boxes, spheres, cylinders and capsules by name"
+                ));
+            }
+        };
+        self.plan_for(sim, &format!("\"{name}\""), target);
     }
 
     fn fail(&mut self, why: String) {
@@ -347,6 +478,11 @@ impl Pick {
     /// After a control update: runs the plan's steps (joint setpoints and gripper commands to
     /// `sim`).
     pub fn update(&mut self, sim: &mut Simulation) {
+        if self.state == PickState::Seeking
+            && let Some(name) = self.known_object(sim)
+        {
+            self.seek_known(sim, &name);
+        }
         let now = sim.sim_time_s();
         if self.running.is_none() {
             let Some((step, state)) = self.steps.pop_front() else {
@@ -459,27 +595,28 @@ impl Pick {
     fn plan(
         &mut self,
         sim: &Simulation,
-        centre: Vector3<f64>,
-        radius: f64,
+        what: &str,
+        target: Target,
     ) -> Result<VecDeque<(Step, PickState)>, String> {
         let g = self.gripper.clone()?;
         let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
         let mut scene = sim
             .planning_scene(self.solver.chain(), self.config.margin_m as f32)
             .map_err(|e| e.to_string())?;
-        let w = world_from_base * Point3::from(centre);
-        let target = scene.object_near([w.x, w.y, w.z], radius as f32 + 0.02);
-        let place = self.place_top(sim)?.map(|top| {
+        let w = world_from_base * Point3::from(target.centre);
+        let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
+        // Over the place: where the carry ends, and how far it then goes straight down.
+        let place = self.place_under(sim)?.map(|(under, drop_m, lower_m)| {
             let over = world_from_base.inverse()
-                * Point3::new(top[0], top[1], top[2] + self.config.drop_height_m + radius);
-            over.coords
+                * Point3::new(under[0], under[1], under[2] + drop_m + target.half_height_m);
+            (over.coords, lower_m)
         });
         let q0: Vec<f64> = self
             .joints()
             .iter()
             .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
             .collect();
-        let grasp = self.plan_grasp(&mut scene, (centre, radius), target, &g, &q0)?;
+        let grasp = self.plan_grasp(&mut scene, what, target, object, &g, &q0)?;
         let assist = sim.world().robot.grasp == GraspMode::Assist;
         let joints = self.joints().to_vec();
         let speed_scale = self.config.speed_scale;
@@ -514,37 +651,64 @@ impl Pick {
             ),
             (timed(grasp.lift, false), PickState::Lifting),
         ]);
-        let Some(over) = place else {
+        let Some((over, lower_m)) = place else {
             // No place: it stays in the hand, held up.
             return Ok(steps);
         };
-        // Carrying: the object on the tool.
-        scene.attach_sphere(Some((self.tool, Pose::IDENTITY, radius as f32)));
-        let (place_q, _) = self
-            .reachable(&mut scene, over, &lift_q, "the place", None)
+        // Carrying: the object on the tool, as the hand holds it.
+        match (target.cuboid, grasp.way.turn) {
+            (Some((r, half)), Some(turn)) => {
+                let q = (turn.inverse() * r).into_inner();
+                let tool_from_box =
+                    glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32);
+                scene.attach_box(
+                    self.tool,
+                    Pose::from_rotation(tool_from_box),
+                    half.map(|h| h as f32),
+                );
+            }
+            _ => scene.attach_sphere(Some((self.tool, Pose::IDENTITY, target.bound_m as f32))),
+        }
+        let ways = self.ways_round(over, g.open);
+        let (place_q, _, way) = self
+            .reachable(&mut scene, over, &lift_q, "the place", None, &ways)
             .map_err(|why| format!("cannot reach over the place: {why}"))?;
         let carry = plan_path(&joints, &lift_q, &place_q, &self.config.planner, |q| {
             scene.collision(q).map(|h| h.to_string())
         })
         .map_err(|e| format!("carrying: {e}"))?;
-        // Let go; back up and home, the gripper open.
+        // Set down: straight down onto the surface, the object (about to touch it) left out.
         scene.attach_sphere(None);
+        let set_down = if lower_m > 0.0 {
+            self.line_at_least(
+                &mut scene,
+                &place_q,
+                (over, over - Vector3::z() * lower_m),
+                Some(&ways[way]),
+                1.0,
+            )
+            .map_err(|e| format!("setting it down: {e}"))?
+        } else {
+            Vec::new()
+        };
+        let release_q = set_down.last().cloned().unwrap_or_else(|| place_q.clone());
+        // Let go; back up and home, the gripper open.
         scene.set_joint(g.joint, g.open);
         let from = self
             .solver
             .chain()
-            .base_from_tip(&place_q)
+            .base_from_tip(&release_q)
             .map_err(|e| e.to_string())?
             .translation
             .vector;
         let retreat = self.line_at_least(
             &mut scene,
-            &place_q,
-            (from, from + Vector3::z() * RETREAT_M),
+            &release_q,
+            (from, from + Vector3::z() * RETREAT_M.max(lower_m)),
             None,
             0.0,
         )?;
-        let retreat_q = retreat.last().cloned().unwrap_or_else(|| place_q.clone());
+        let retreat_q = retreat.last().cloned().unwrap_or_else(|| release_q.clone());
         let home = plan_path(&joints, &retreat_q, &q0, &self.config.planner, |q| {
             scene.collision(q).map(|h| h.to_string())
         })
@@ -554,8 +718,11 @@ impl Pick {
             carry.len(),
             home.len(),
         ]);
+        steps.push_back((timed(carry, true), PickState::Carrying));
+        if set_down.len() > 1 {
+            steps.push_back((timed(set_down, false), PickState::Releasing));
+        }
         steps.extend([
-            (timed(carry, true), PickState::Carrying),
             (
                 Step::Gripper {
                     position: g.open,
@@ -582,19 +749,34 @@ impl Pick {
     fn plan_grasp(
         &mut self,
         scene: &mut PlanningScene,
-        (centre, radius): (Vector3<f64>, f64),
+        what: &str,
+        object: Target,
         target: Option<usize>,
         g: &Gripper,
         q0: &[f64],
     ) -> Result<Grasp, String> {
         let c = self.config.clone();
+        let centre = object.centre;
         scene.set_joint(g.joint, g.open);
         if let Some(t) = target {
             scene.ignore_object(t, true);
         }
-        let (grasp_q, mut descent) = self
-            .reachable(scene, centre, q0, "the grasp", Some(c.approach_m))
-            .map_err(|why| format!("cannot grasp the {}: {why}", c.class))?;
+        let ways = match object.cuboid {
+            Some((r, half)) => self.ways_across(
+                [(r * Vector3::x(), half[0]), (r * Vector3::y(), half[1])],
+                g,
+            ),
+            None => self.ways_round(centre, object.bound_m),
+        };
+        if ways.is_empty() {
+            return Err(format!(
+                "cannot grasp {what}: it is wider than the open gripper ({:.3} m) every way",
+                2.0 * g.open.abs().max(g.closed.abs())
+            ));
+        }
+        let (grasp_q, mut descent, way) = self
+            .reachable(scene, centre, q0, "the grasp", Some(c.approach_m), &ways)
+            .map_err(|why| format!("cannot grasp {what}: {why}"))?;
         let pre_q = descent.last().cloned().unwrap_or_else(|| grasp_q.clone());
         descent.reverse();
         if let Some(t) = target {
@@ -609,7 +791,7 @@ impl Pick {
             scene.ignore_object(t, true);
         }
         let (lo, hi) = (g.closed.min(g.open), g.closed.max(g.open));
-        scene.set_joint(g.joint, radius.clamp(lo, hi));
+        scene.set_joint(g.joint, ways[way].grip_m.clamp(lo, hi));
         // Straight up off what it rests on; the hand may turn on the way (the object turns
         // with it). The arm is checked, the object (touching its support, as far as the
         // estimate knows) only from the lift's top.
@@ -624,12 +806,64 @@ impl Pick {
             to_pre,
             descent,
             lift,
+            way: ways[way].clone(),
         })
     }
 
-    /// Joint positions putting the tool at `point` (base frame) coming in along the first of
-    /// the approach pitches IK reaches there without a collision (with `back_m`, the straight
-    /// way back out along it free too, returned), else why not at each pitch.
+    /// The ways to take hold of something round at `point` (base frame): coming in along
+    /// [`PickConfig::approach_pitches_deg`] below horizontal, away from the arm's base, the
+    /// turn about the way in free; the fingers close to `grip_m`.
+    fn ways_round(&self, point: Vector3<f64>, grip_m: f64) -> Vec<Way> {
+        let horizontal = Vector3::new(point.x, point.y, 0.0)
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::x);
+        (self.config.approach_pitches_deg.iter())
+            .map(|pitch_deg| {
+                let pitch = pitch_deg.to_radians();
+                Way {
+                    label: format!("{pitch_deg:.0} deg down"),
+                    along: horizontal * pitch.cos() - Vector3::z() * pitch.sin(),
+                    turn: None,
+                    grip_m,
+                }
+            })
+            .collect()
+    }
+
+    /// The ways to take hold of a box from above: the fingers across one pair of its faces
+    /// (the narrower first), either way round; only faces the open gripper fits round (with
+    /// 5 mm to spare on each side).
+    fn ways_across(&self, mut faces: [(Vector3<f64>, f64); 2], g: &Gripper) -> Vec<Way> {
+        faces.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let down = -Vector3::z();
+        let open = g.open.abs().max(g.closed.abs());
+        let mut ways = Vec::new();
+        for (k, (axis, half)) in faces.iter().enumerate() {
+            let across = (axis - down * axis.dot(&down)).try_normalize(1e-6);
+            let Some(across) = across.filter(|_| *half + 0.005 <= open) else {
+                continue;
+            };
+            for sign in [1.0, -1.0] {
+                if let Some(turn) = turn_taking(g.across_tool, across * sign, down) {
+                    ways.push(Way {
+                        label: format!(
+                            "from above across its {} faces{}",
+                            ["narrow", "wide"][k],
+                            if sign < 0.0 { ", turned round" } else { "" }
+                        ),
+                        along: down,
+                        turn: Some(turn),
+                        grip_m: *half,
+                    });
+                }
+            }
+        }
+        ways
+    }
+
+    /// Joint positions putting the tool at `point` (base frame) the first of `ways` IK
+    /// reaches there without a collision (with `back_m`, the straight way back out along it
+    /// free too, returned), and which way; else why not each way.
     fn reachable(
         &mut self,
         scene: &mut PlanningScene,
@@ -637,75 +871,55 @@ impl Pick {
         seed: &[f64],
         what: &str,
         back_m: Option<f64>,
-    ) -> Result<(Vec<f64>, Waypoints), String> {
-        let horizontal = Vector3::new(point.x, point.y, 0.0)
-            .try_normalize(1e-9)
-            .unwrap_or_else(Vector3::x);
+        ways: &[Way],
+    ) -> Result<(Vec<f64>, Waypoints, usize), String> {
         let mut why: Vec<String> = Vec::new();
-        for pitch_deg in self.config.approach_pitches_deg.clone() {
-            let pitch = pitch_deg.to_radians();
-            let approach = horizontal * pitch.cos() - Vector3::z() * pitch.sin();
+        for (k, way) in ways.iter().enumerate() {
+            let label = &way.label;
             let solution = self
                 .solver
-                .solve(&IkTarget::approach(point, approach), seed)
+                .solve(&way.target(point), seed)
                 .map_err(|e| e.to_string())?;
             if !ik_close(solution.position_error_m, solution.orientation_error_rad) {
                 why.push(format!(
-                    "{pitch_deg:.0} deg down: out of reach by {:.3} m",
+                    "{label}: out of reach by {:.3} m",
                     solution.position_error_m
                 ));
                 continue;
             }
             if let Some(hit) = scene.collision(&solution.q) {
-                why.push(format!("{pitch_deg:.0} deg down: {hit}"));
+                why.push(format!("{label}: {hit}"));
                 continue;
             }
             // The straight way in, `back_m` long, must be there too.
             let back = match back_m {
                 Some(back_m) => {
-                    match self.line(
-                        scene,
-                        &solution.q,
-                        point,
-                        point - approach * back_m,
-                        Some(approach),
-                    ) {
+                    let to = point - way.along * back_m;
+                    match self.line_at_least(scene, &solution.q, (point, to), Some(way), 1.0) {
                         Ok(line) => line,
                         Err(e) => {
-                            why.push(format!("{pitch_deg:.0} deg down: {e}"));
+                            why.push(format!("{label}: {e}"));
                             continue;
                         }
                     }
                 }
                 None => Vec::new(),
             };
-            return Ok((solution.q, back));
+            return Ok((solution.q, back, k));
         }
         Err(format!("{what}, coming in {}", why.join("; ")))
     }
 
-    /// A straight line of the tool from `from` (at `from_q`) to `to` (base frame), its z along
-    /// `approach` when given: joint waypoints every centimetre, each by IK from the last, each
-    /// free.
-    fn line(
-        &mut self,
-        scene: &mut PlanningScene,
-        from_q: &[f64],
-        from: Vector3<f64>,
-        to: Vector3<f64>,
-        approach: Option<Vector3<f64>>,
-    ) -> Result<Vec<Vec<f64>>, String> {
-        self.line_at_least(scene, from_q, (from, to), approach, 1.0)
-    }
-
-    /// [`Self::line`] that may stop short where IK or the scene ends it, once `share` of the
-    /// way is done (a lift or a retreat at the edge of the arm's reach).
+    /// A straight line of the tool from `from` (at `from_q`) to `to` (base frame), held to
+    /// `way`'s direction when given: joint waypoints every centimetre, each by IK from the
+    /// last, each free. It may stop short where IK or the scene ends it once `share` of the way
+    /// is done (a lift or a retreat at the edge of the arm's reach).
     fn line_at_least(
         &mut self,
         scene: &mut PlanningScene,
         from_q: &[f64],
         (from, to): (Vector3<f64>, Vector3<f64>),
-        approach: Option<Vector3<f64>>,
+        way: Option<&Way>,
         share: f64,
     ) -> Result<Vec<Vec<f64>>, String> {
         let n = ((to - from).norm() / LINE_STEP_M).ceil().max(1.0) as usize;
@@ -713,7 +927,7 @@ impl Pick {
         for k in 1..=n {
             let p = from + (to - from) * (k as f64 / n as f64);
             let last = waypoints.last().cloned().unwrap_or_default();
-            let target = approach.map_or(IkTarget::point(p), |d| IkTarget::approach(p, d));
+            let target = way.map_or(IkTarget::point(p), |w| w.target(p));
             let s = self
                 .solver
                 .solve(&target, &last)
@@ -744,33 +958,35 @@ impl Pick {
         Ok(waypoints)
     }
 
-    /// The top centre of the place (world frame): the configured place, else the world's
-    /// `[robot] place`, else none (the object is held up). An error for a name the world
-    /// lacks.
-    fn place_top(&self, sim: &Simulation) -> Result<Option<[f64; 3]>, String> {
+    /// Where the object's bottom goes (world frame), how high above that the carry ends, and
+    /// how far the hand then goes straight down before letting go (m): over a world object's
+    /// top centre, [`PickConfig::drop_height_m`] and no further (dropped into a bin, onto a
+    /// tray); at a point, [`PickConfig::approach_m`], then down to [`SET_DOWN_M`] above it (set
+    /// down, as MoveIt's place approaches). From the configured place, else the world's
+    /// `[robot] place`; none: the object is held up. An error for an object the world lacks.
+    fn place_under(&self, sim: &Simulation) -> Result<Option<([f64; 3], f64, f64)>, String> {
         let world = sim.world();
-        let Some(name) = self
+        let name = match self
             .config
             .place
             .clone()
             .or_else(|| world.robot.place.clone())
-        else {
-            return Ok(None);
+        {
+            None => return Ok(None),
+            Some(Place::Point(p)) => {
+                let above = self.config.approach_m.max(SET_DOWN_M);
+                return Ok(Some((p, above, above - SET_DOWN_M)));
+            }
+            Some(Place::Object(name)) => name,
         };
         let index = world
             .objects
             .iter()
             .position(|o| o.name == name)
             .ok_or_else(|| {
-                let names: Vec<&str> = world
-                    .objects
-                    .iter()
-                    .map(|o| o.name.as_str())
-                    .filter(|n| !n.is_empty())
-                    .collect();
                 format!(
                     "no world object \"{name}\" to place on; the world's objects: {}",
-                    names.join(", ")
+                    object_names(sim)
                 )
             })?;
         let mut poses = Vec::new();
@@ -786,13 +1002,43 @@ impl Pick {
             Shape::Mesh { .. } => 0.0,
         };
         let t = pose.translation;
-        Ok(Some([
-            f64::from(t.x),
-            f64::from(t.y),
-            f64::from(t.z + half_height),
-        ]))
+        Ok(Some((
+            [f64::from(t.x), f64::from(t.y), f64::from(t.z + half_height)],
+            self.config.drop_height_m,
+            0.0,
+        )))
     }
 }
+
+/// The world's named objects, comma-separated (for errors).
+fn object_names(sim: &Simulation) -> String {
+    let names: Vec<&str> = (sim.world().objects.iter())
+        .map(|o| o.name.as_str())
+        .filter(|n| !n.is_empty())
+        .collect();
+    names.join(", ")
+}
+
+/// The tool's orientation (base frame) whose z is `along` and whose finger direction
+/// (`across_tool`, in the tool's frame) is `across`; `None` when either pair is parallel.
+fn turn_taking(
+    across_tool: Vector3<f64>,
+    across: Vector3<f64>,
+    along: Vector3<f64>,
+) -> Option<UnitQuaternion<f64>> {
+    let frame = |x: Vector3<f64>, z: Vector3<f64>| -> Option<Matrix3<f64>> {
+        let z = z.try_normalize(1e-9)?;
+        let x = (x - z * x.dot(&z)).try_normalize(1e-6)?;
+        Some(Matrix3::from_columns(&[x, z.cross(&x), z]))
+    };
+    let in_tool = frame(across_tool, Vector3::z())?;
+    let in_base = frame(across, along)?;
+    let rotation = Rotation3::from_matrix_unchecked(in_base * in_tool.transpose());
+    Some(UnitQuaternion::from_rotation_matrix(&rotation))
+}
+
+/// How far above a place point the object's bottom is let go (m): set down, not dropped.
+const SET_DOWN_M: f64 = 0.005;
 
 /// Seconds after a path's end before the next step (the joints settle on their setpoints).
 const SETTLE_S: f64 = 0.3;
@@ -818,8 +1064,9 @@ fn ik_close(position_m: f64, orientation_rad: f64) -> bool {
 }
 
 /// The robot's first gripper controller: its name, finger joint and limits (open at the upper
-/// limit, as Franka's and the arm car's fingers are).
-fn find_gripper(sim: &Simulation) -> Result<Gripper, String> {
+/// limit, as Franka's and the arm car's fingers are), and the way its finger moves seen from
+/// `tool` (rigidly on the finger joint's parent, as a tool point on a hand is).
+fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
     let robot = sim.robot();
     let spec = robot
         .controllers
@@ -838,10 +1085,16 @@ fn find_gripper(sim: &Simulation) -> Result<Gripper, String> {
         .position_limits()
         .map(|(lo, hi)| (f64::from(lo), f64::from(hi)))
         .ok_or_else(|| format!("finger joint \"{}\" has no limits", spec.1))?;
+    let finger = robot.joint(joint);
+    let world_from = |link| isometry_from_pose(&sim.world_from_link(link));
+    let axis = finger.parent_from_child.rotation * finger.axis;
+    let across_tool = (world_from(tool).rotation.inverse() * world_from(finger.parent).rotation)
+        * Vector3::new(f64::from(axis.x), f64::from(axis.y), f64::from(axis.z));
     Ok(Gripper {
         controller: spec.0,
         joint,
         open,
         closed,
+        across_tool,
     })
 }

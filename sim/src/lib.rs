@@ -45,7 +45,7 @@ pub use model::{
     GripperSpec, Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial,
     Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
     Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
-    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat,
+    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, Place,
     PlanError, PlannerOptions, RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE,
     TextureImage, TexturedRun, TimedPath, TrajectoryConstraints, TrajectorySpec, Transmission,
     Visual, Walk, World, check_step_hz, class_of_model, is_known_class, isometry_from_pose,

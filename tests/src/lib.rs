@@ -146,6 +146,25 @@ pub fn example_robot_data(file: &str) -> Option<PathBuf> {
     )
 }
 
+/// `example-robot-data`'s package folder (its `share/example-robot-data`, what
+/// `package://example-robot-data` and `$(find example-robot-data)` name); `None`, after
+/// recording the skip, when set-up has not fetched it.
+pub fn example_robot_data_package() -> Option<PathBuf> {
+    let wheel = pypi("example-robot-data", "6.0.0")?;
+    Some(wheel.join("cmeel.prefix/share/example-robot-data"))
+}
+
+/// Robot loading options that find `example-robot-data` where set-up put it (`None`, after
+/// recording the skip, when it has not).
+pub fn example_robot_data_options() -> Option<rover_sim::LoadOptions> {
+    let package = example_robot_data_package()?;
+    let mut options = rover_sim::LoadOptions::default();
+    options.resources = options
+        .resources
+        .with_package("example-robot-data", package);
+    Some(options)
+}
+
 /// PAL's TIAGo without its hand, in `example-robot-data`.
 pub const TIAGO_NO_HAND: &str = "tiago_description/robots/tiago_no_hand.urdf";
 
@@ -185,6 +204,7 @@ pub fn tiago_drive() -> rover_sim::DriveSpec {
         wheel_separation_m: None,
         wheel_diameter_m: None,
         wheel_torque_nm: None,
+        wheel_acceleration_mps2: None,
     }
 }
 

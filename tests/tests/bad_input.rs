@@ -270,7 +270,16 @@ fn the_bundled_worlds_load() -> anyhow::Result<()> {
                 .urdf
                 .clone()
                 .unwrap_or_else(|| repo("assets/robots/my_robot.urdf"));
-            RobotModel::load(&urdf)?;
+            // The panda's world finds the arm in PyPI's example-robot-data.
+            let options = if path.ends_with("panda_pick.toml") {
+                let Some(options) = rover_tests::example_robot_data_options() else {
+                    continue;
+                };
+                options
+            } else {
+                rover_sim::LoadOptions::default()
+            };
+            RobotModel::load_with(&urdf, &options)?;
         }
     }
     let playground = World::load(&repo("worlds/playground.toml"))?;

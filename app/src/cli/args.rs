@@ -468,10 +468,38 @@ pub(crate) struct ArmArgs {
     #[arg(long, default_value_t = 0.10, value_name = "M")]
     pub(crate) reach_standoff: f64,
 
-    /// Pick: the world object pick puts what it picked on or in, by name (e.g. worlds/
-    /// arm_car_pick.toml's `bin`) [default: the world's [robot] place]
-    #[arg(long, value_name = "NAME")]
+    /// Pick: where pick puts what it picked: a world object's name (e.g. worlds/
+    /// arm_car_pick.toml's `bin`; dropped on or in it) or a point X,Y,Z in the world frame (m;
+    /// set down there) [default: the world's [robot] place]
+    #[arg(long, value_name = "NAME|X,Y,Z", allow_hyphen_values = true)]
     pub(crate) place: Option<String>,
+
+    /// Pick: take this world object by its known pose (as a MoveIt node adds the object to
+    /// its planning scene), no camera or detector needed [default: the world's [robot] pick,
+    /// else what the detector sees of --arm-class]
+    #[arg(long, value_name = "NAME")]
+    pub(crate) pick_object: Option<String>,
+}
+
+/// `--place`: three comma-separated finite numbers are a point, anything else an object's name.
+fn parse_place(text: &str) -> anyhow::Result<rover_sim::Place> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() == 3 && parts.iter().all(|p| p.parse::<f64>().is_ok()) {
+        let mut point = [0.0; 3];
+        for (v, p) in point.iter_mut().zip(&parts) {
+            *v = p.parse::<f64>()?;
+        }
+        anyhow::ensure!(
+            point.iter().all(|v| v.is_finite()),
+            "--place {text}: a point must be three finite numbers X,Y,Z (m)"
+        );
+        return Ok(rover_sim::Place::Point(point));
+    }
+    anyhow::ensure!(
+        !text.trim().is_empty(),
+        "--place: expected a world object's name or a point X,Y,Z (m), found nothing"
+    );
+    Ok(rover_sim::Place::Object(text.to_owned()))
 }
 
 impl ArmArgs {
@@ -497,7 +525,8 @@ impl ArmArgs {
             },
             pick: rover_core::PickConfig {
                 class: self.arm_class.clone(),
-                place: self.place.clone(),
+                place: self.place.as_deref().map(parse_place).transpose()?,
+                object: self.pick_object.clone(),
                 ..rover_core::PickConfig::default()
             },
         })
@@ -1182,6 +1211,7 @@ fn parse_drive(s: &str) -> Result<rover_sim::DriveSpec, String> {
             wheel_separation_m: None,
             wheel_diameter_m: None,
             wheel_torque_nm: None,
+            wheel_acceleration_mps2: None,
         }),
         _ => Err(format!("expected LEFT_JOINT,RIGHT_JOINT, found \"{s}\"")),
     }

@@ -466,12 +466,25 @@ impl Reader<'_> {
                 }
             },
         };
+        let gains = match node.get("gains") {
+            None => None,
+            Some(g) => {
+                let Some(pid) = g.get(&joint) else {
+                    return Err(self.error(
+                        g.line,
+                        format!("`gains` has no entry for joint \"{joint}\""),
+                    ));
+                };
+                Some(self.pid(pid, &format!("gains/{joint}"))?)
+            }
+        };
         Ok(GripperSpec {
             joint,
             goal_tolerance: number("goal_tolerance", 0.01)?,
             stalled_velocity_threshold: number("stalled_velocity_threshold", 0.001)?,
             stall_timeout_s: number("stall_timeout", 1.0)?,
             allow_stalling,
+            gains,
         })
     }
 

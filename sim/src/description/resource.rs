@@ -116,8 +116,13 @@ impl ResourcePaths {
         }
         for root in &self.package_search {
             searched.push(root.clone());
+            // A package by its package.xml's name, or a share/NAME folder by its own (as
+            // above): a pip-installed example-robot-data's `cmeel.prefix/share` on the path
+            // finds `example-robot-data`.
             if let Some(found) = find_below(root, SEARCH_DEPTH, &|dir| {
                 package_name(dir).as_deref() == Some(name)
+                    || (dir.file_name().is_some_and(|n| n == name)
+                        && dir.join("package.xml").is_file())
             }) {
                 return Ok(found);
             }

@@ -14,7 +14,7 @@ use crate::model::drive::DriveSpec;
 use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
-    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, GraspMode, Ground, JointSolver, Object, Physics,
+    DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, GraspMode, Ground, JointSolver, Object, Physics, Place,
     RobotSpawn, World, check_step_hz,
 };
 
@@ -115,7 +115,16 @@ struct RawRobot {
     ee_link: Option<String>,
     #[serde(default)]
     grasp: GraspMode,
-    place: Option<String>,
+    place: Option<RawPlace>,
+    pick: Option<String>,
+}
+
+/// `place = "NAME"` or `place = [x, y, z]`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum RawPlace {
+    Object(String),
+    Point([f64; 3]),
 }
 
 #[derive(Debug, Deserialize)]
@@ -446,7 +455,15 @@ impl RawWorld {
             arm_base: raw_robot.arm_base,
             ee_link: raw_robot.ee_link,
             grasp: raw_robot.grasp,
-            place: raw_robot.place,
+            place: match raw_robot.place {
+                None => None,
+                Some(RawPlace::Object(name)) => Some(Place::Object(name)),
+                Some(RawPlace::Point(p)) => {
+                    c.coordinates("robot.place", &p)?;
+                    Some(Place::Point(p))
+                }
+            },
+            pick: raw_robot.pick,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

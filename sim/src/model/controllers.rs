@@ -172,4 +172,7 @@ pub struct GripperSpec {
     /// `allow_stalling` (default false, as ROS 1's controller): a stall ends the goal
     /// succeeded rather than aborted (a grasp that closes on an object).
     pub allow_stalling: bool,
+    /// `gains/<joint>` (the effort variant's position loop, its output capped by the goal's
+    /// `max_effort`); `None`: rover's hold gains.
+    pub gains: Option<Pid>,
 }

@@ -106,4 +106,9 @@ pub struct DriveSpec {
     /// Motor torque limit (N m); default gazebo_ros_diff_drive's 5.
     #[serde(default)]
     pub wheel_torque_nm: Option<f64>,
+    /// Ramp on the commanded wheel rim speed (m/s^2), gazebo_ros_diff_drive's
+    /// `wheelAcceleration` (a diff_drive_controller's `linear/x/max_acceleration` does the
+    /// same for straight driving); default 0, unlimited.
+    #[serde(default)]
+    pub wheel_acceleration_mps2: Option<f64>,
 }

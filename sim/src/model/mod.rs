@@ -46,5 +46,5 @@ pub use sensors::{
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,
-    Model, ModelLink, Object, Physics, RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
+    Model, ModelLink, Object, Physics, Place, RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
 };

@@ -287,6 +287,14 @@ impl RobotModel {
         if let Some(t) = spec.wheel_torque_nm {
             config.wheel_torque_nm = t;
         }
+        if let Some(a) = spec.wheel_acceleration_mps2 {
+            if !(a.is_finite() && a >= 0.0) {
+                return Err(setup(format!(
+                    "wheel_acceleration_mps2 is {a}; expected 0 (unlimited) or a positive number of m/s^2"
+                )));
+            }
+            config.wheel_acceleration_mps2 = a;
+        }
         tracing::info!(
             "{}: driving joints \"{}\" and \"{}\" (wheel separation {separation:.3} m, diameter {diameter:.3} m)",
             self.name,

@@ -70,8 +70,32 @@ pub struct RobotSpawn {
     pub ee_link: Option<String>,
     /// `grasp`: how the gripper holds what it closes on.
     pub grasp: GraspMode,
-    /// `place`: the world object pick puts what it picked on (or in), by name.
-    pub place: Option<String>,
+    /// `place`: where pick puts what it picked: a world object (dropped on or in it) or a
+    /// point (set down there).
+    pub place: Option<Place>,
+    /// `pick`: the world object pick takes by its known pose (as a MoveIt pick node is given a
+    /// collision object), with no camera; `None`: the object of the class the detector sees.
+    pub pick: Option<String>,
+}
+
+/// Where pick puts what it picked (`[robot] place`, `--place`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Place {
+    /// A world object by name (`place = "bin"`): the object is let go a little above its top
+    /// (a bin's floor, a tray).
+    Object(String),
+    /// A point in the world frame (`place = [x, y, z]`, m): the object's bottom centre is set
+    /// down there.
+    Point([f64; 3]),
+}
+
+impl std::fmt::Display for Place {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Object(name) => write!(f, "\"{name}\""),
+            Self::Point([x, y, z]) => write!(f, "({x:.3}, {y:.3}, {z:.3}) m"),
+        }
+    }
 }
 
 /// How a gripper holds what it closes on (`[robot] grasp`).

@@ -42,6 +42,9 @@ const PROFILE_VELOCITY_SHARE: f64 = 0.9;
 /// How far a `<mimic>` joint may be from where its leader puts it when pushing with its full
 /// effort (m or rad): the coupling's stiffness.
 const MIMIC_HOLD_ERROR: f64 = 0.001;
+/// A `<mimic>` joint's effort cap while its leader's is lowered (a gripper's squeeze), as a
+/// multiple of the leader's.
+const MIMIC_CAP_RATIO: f64 = 2.0;
 
 /// The share of the effort left over from carrying the load that a position move plans to
 /// accelerate and brake with (the loop's corrections take the rest).
@@ -418,12 +421,23 @@ impl Actuators {
     }
 
     /// Caps the effort of `joint` (a gripper command's `max_effort`); `None` lifts the cap
-    /// back to its `<limit effort>`. The joints that mimic it keep their own limit: they are a
-    /// coupling, holding their finger where the leader's puts it, so the leader's cap is the
-    /// squeeze.
+    /// back to its `<limit effort>`. The joints that mimic it are a coupling, holding their
+    /// finger where the leader's puts it, so the leader's cap is the squeeze; theirs becomes
+    /// [`MIMIC_CAP_RATIO`] times it (and their stiffness with it, [`MIMIC_HOLD_ERROR`]): enough
+    /// to hold the grip centred, not a 100 N spring on a 15 g finger kicking what it holds
+    /// whenever the leader moves between two control updates.
     pub(crate) fn set_effort_cap(&mut self, joint: JointId, cap: Option<f64>) {
-        if let Some(a) = self.of_mut(joint) {
-            a.effort_cap = cap;
+        let Some(i) = self.by_joint.get(joint.index()).copied().flatten() else {
+            return;
+        };
+        self.list[i].effort_cap = cap;
+        let leader = self.list[i].built.handle;
+        for f in &self.followers {
+            if f.leader.handle == leader
+                && let Some(a) = self.list.get_mut(f.actuator)
+            {
+                a.effort_cap = cap.map(|c| c * MIMIC_CAP_RATIO);
+            }
         }
     }
 

@@ -213,6 +213,9 @@ impl Controllers {
                 }
                 ControllerKind::Gripper(g) => {
                     let id = id_of(actuators, &g.joint)?;
+                    if let Some(pid) = &g.gains {
+                        actuators.set_pid(id, *pid);
+                    }
                     Running::Gripper(Box::new(GripperRun {
                         spec: g.clone(),
                         state: GripperState {

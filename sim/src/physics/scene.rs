@@ -143,6 +143,13 @@ impl PlanningScene {
         self.attached = held.map(|(link, pose, r)| (link, pose, SharedShape::ball(r)));
     }
 
+    /// Carries a box of half sizes `half_m` with `link`, its centre and axes at
+    /// `link_from_box` (a held box, turned as the hand holds it).
+    pub fn attach_box(&mut self, link: LinkId, link_from_box: Pose, half_m: [f32; 3]) {
+        let [x, y, z] = half_m;
+        self.attached = Some((link, link_from_box, SharedShape::cuboid(x, y, z)));
+    }
+
     /// The first thing the chain's links (or the held object) come within the margin of at
     /// `q` (the chain's joint positions), if any.
     pub fn collision(&mut self, q: &[f64]) -> Option<SceneContact> {
