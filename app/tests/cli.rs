@@ -117,6 +117,14 @@ fn bad_input_exits_with_a_located_error() -> Result<()> {
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
 
+    let out = rover(&["--headless", "--place", "0.5,0.2,inf"], dir.path())?;
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("--place 0.5,0.2,inf: a point must be three finite numbers"),
+        "{}",
+        text(&out.stderr)
+    );
+
     let out = rover(&["--headless", "--script", "missing.toml"], dir.path())?;
     assert_eq!(out.status.code(), Some(1));
     assert!(

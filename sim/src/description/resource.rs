@@ -318,6 +318,18 @@ mod tests {
             via_env.find_package("other_pkg", Path::new("/"))?,
             ws.join("other")
         );
+        // A pip-installed share/NAME folder whose package.xml names it otherwise
+        // (example-robot-data's says example_robot_descriptions), found through the path.
+        let share = tmp.path().join("site/cmeel.prefix/share");
+        package(&share.join("example-robot-data"), "example_robot_descriptions")?;
+        let pip = ResourcePaths {
+            package_search: vec![share.clone()],
+            ..Default::default()
+        };
+        assert_eq!(
+            pip.find_package("example-robot-data", Path::new("/"))?,
+            share.join("example-robot-data")
+        );
         let explicit = ResourcePaths::default().with_package("x", "/somewhere");
         assert_eq!(
             explicit.find_package("x", &near)?,

@@ -121,7 +121,10 @@ struct RawRobot {
 
 /// `place = "NAME"` or `place = [x, y, z]`.
 #[derive(Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a world object's name (\"bin\") or a point [x, y, z] in metres"
+)]
 enum RawPlace {
     Object(String),
     Point([f64; 3]),
