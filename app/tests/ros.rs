@@ -1032,6 +1032,65 @@ fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Resul
     Ok(())
 }
 
+/// Pick over ROS: a rospy node publishes `pick` on `/rover/arm/task` in worlds/arm_car_pick.toml
+/// and reads the latched `/rover/arm/state` go through the pick's states in order (`pick
+/// approaching` ... `pick done`), and `/rover/arm/object` (a PointStamped in base_link) is on
+/// the ball the mast's camera sees, on the table in front of the car.
+#[test]
+fn a_rospy_node_has_the_arm_car_pick_the_ball_and_reads_its_states() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let mut graph = RosGraph::start()?;
+    let world = repo().join("worlds/arm_car_pick.toml");
+    graph.spawn_rover(45.0, &["--world", &world.to_string_lossy()])?;
+    let out = graph.run_python(
+        "pick.py",
+        "import rospy\nfrom std_msgs.msg import String\nfrom geometry_msgs.msg import PointStamped\nrospy.init_node('pick_check')\nstates = []\nrospy.Subscriber('/rover/arm/state', String, lambda m: states.append(m.data))\ntask = rospy.Publisher('/rover/arm/task', String, queue_size=1, latch=True)\nrospy.sleep(2.0)\ntask.publish(String('pick'))\nend = rospy.Time.now() + rospy.Duration(35)\nwhile not ({'pick done', 'pick failed'} & set(states)) and rospy.Time.now() < end:\n    rospy.sleep(0.1)\nprint('states ' + ','.join(s.replace(' ', '_') for s in states))\no = rospy.wait_for_message('/rover/arm/object', PointStamped, timeout=10)\nprint('object %s %.4f %.4f %.4f' % (o.header.frame_id, o.point.x, o.point.y, o.point.z))\n",
+        Duration::from_secs(70),
+    )?;
+    println!("{out}");
+    let states: Vec<&str> = out
+        .lines()
+        .find_map(|l| l.strip_prefix("states "))
+        .map(|l| l.split(',').collect())
+        .unwrap_or_default();
+    let order = [
+        "pick_approaching",
+        "pick_grasping",
+        "pick_lifting",
+        "pick_carrying",
+        "pick_releasing",
+        "pick_retreating",
+        "pick_done",
+    ];
+    let seen: Vec<&str> = states
+        .iter()
+        .copied()
+        .filter(|s| order.contains(s))
+        .collect();
+    ensure!(
+        seen == order,
+        "/rover/arm/state went {states:?}, not through {order:?}:\n{out}"
+    );
+    let object: Vec<&str> = out
+        .lines()
+        .find_map(|l| l.strip_prefix("object "))
+        .map(|l| l.split(' ').collect())
+        .unwrap_or_default();
+    ensure!(object.len() == 4, "no /rover/arm/object:\n{out}");
+    ensure!(object[0] == "base_link", "object frame {}", object[0]);
+    let (x, y, z): (f64, f64, f64) = (object[1].parse()?, object[2].parse()?, object[3].parse()?);
+    // The ball's centre: (0.27, 0.08) on the table, 0.05 m above base_link.
+    ensure!(
+        (x - 0.27).abs() < 0.03 && (y - 0.08).abs() < 0.03 && (z - 0.05).abs() < 0.03,
+        "object ({x}, {y}, {z}) is not the ball"
+    );
+    graph.wait_rover(Duration::from_secs(120))?;
+    Ok(())
+}
+
 /// A ROS master for a run with both bridges: the tests' lock, the graph, and the PYTHONPATH of
 /// a Cyclone DDS peer (cyclonedds and examples/ros2's `rover_msgs`). `None` with the skip
 /// recorded (a failure in strict mode) when ROS or the cyclonedds wheel is missing.

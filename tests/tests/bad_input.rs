@@ -235,7 +235,9 @@ fn world_unknown_keys_and_bad_values_name_the_key_path() {
     );
     let e = err("[robot]\nplace = [0.5, 0.2, 1e12]\n");
     assert!(e.contains("at `robot.place`"), "{e}");
-    let e = err("[robot.drive]\nleft_joint = \"l\"\nright_joint = \"r\"\nwheel_acceleration_mps2 = \"fast\"\n");
+    let e = err(
+        "[robot.drive]\nleft_joint = \"l\"\nright_joint = \"r\"\nwheel_acceleration_mps2 = \"fast\"\n",
+    );
     assert!(e.contains("wheel_acceleration_mps2"), "{e}");
     let e = err("[physics]\ncontact_hz = 0.0\n");
     assert!(

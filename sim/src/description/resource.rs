@@ -321,7 +321,10 @@ mod tests {
         // A pip-installed share/NAME folder whose package.xml names it otherwise
         // (example-robot-data's says example_robot_descriptions), found through the path.
         let share = tmp.path().join("site/cmeel.prefix/share");
-        package(&share.join("example-robot-data"), "example_robot_descriptions")?;
+        package(
+            &share.join("example-robot-data"),
+            "example_robot_descriptions",
+        )?;
         let pip = ResourcePaths {
             package_search: vec![share.clone()],
             ..Default::default()
