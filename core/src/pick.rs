@@ -405,7 +405,10 @@ impl Pick {
                     ),
                 ));
             }
-            Err(why) => self.fail(why),
+            Err(why) => self.fail(format!(
+                "{what} at ({:.3}, {:.3}, {:.3}) m: {why}",
+                centre.x, centre.y, centre.z
+            )),
         }
     }
 

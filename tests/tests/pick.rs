@@ -285,6 +285,17 @@ fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Re
             {
                 session.step(&mut said)?;
                 worst = worst.max((ball_in_tool(&session)? - start).length());
+                if std::env::var_os("PICK_DEBUG_HOLD").is_some()
+                    && session.sim().step_index() % 10 == 0
+                {
+                    println!(
+                        "    {:.2} ball {:.4?} fingers {:.4?} x {:.3}",
+                        session.sim().sim_time_s(),
+                        ball_in_tool(&session)?,
+                        fingers(&session),
+                        session.sim().ground_truth().x_m
+                    );
+                }
             }
             println!(
                 "  after {key:?}: the ball moved at most {worst:.4} m; now at {:.4?} in the tool (from {start:.4?}); fingers {:.4?}",
