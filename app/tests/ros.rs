@@ -1015,14 +1015,8 @@ fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Resul
         states.split(',').any(|s| s == "reach_arrived"),
         "no `reach arrived` on /rover/arm/state:\n{out}"
     );
-    let goal: Vec<&str> = out
-        .lines()
-        .find_map(|l| l.strip_prefix("goal "))
-        .map(|l| l.split(' ').collect())
-        .unwrap_or_default();
-    ensure!(goal.len() == 4, "no /rover/arm/goal:\n{out}");
-    ensure!(goal[0] == "base_footprint", "goal frame {}", goal[0]);
-    let (x, y, z): (f64, f64, f64) = (goal[1].parse()?, goal[2].parse()?, goal[3].parse()?);
+    let (frame, [x, y, z]) = stamped_point(&out, "goal")?;
+    ensure!(frame == "base_footprint", "goal frame {frame}");
     // The ball's near surface is about 0.69 m ahead; 10 cm short of it, at its height.
     ensure!(
         (0.5..0.68).contains(&x) && (-0.3..-0.1).contains(&y) && (0.7..0.85).contains(&z),
@@ -1030,6 +1024,20 @@ fn a_rospy_node_switches_tiagos_reach_on_and_reads_its_state_and_goal() -> Resul
     );
     graph.wait_rover(Duration::from_secs(120))?;
     Ok(())
+}
+
+/// The PointStamped a rospy check printed as `NAME FRAME X Y Z`: its frame and point.
+fn stamped_point(out: &str, name: &str) -> Result<(String, [f64; 3])> {
+    let fields: Vec<&str> = out
+        .lines()
+        .find_map(|l| l.strip_prefix(name)?.strip_prefix(' '))
+        .map(|l| l.split(' ').collect())
+        .unwrap_or_default();
+    ensure!(fields.len() == 4, "no {name} point in:\n{out}");
+    Ok((
+        fields[0].to_owned(),
+        [fields[1].parse()?, fields[2].parse()?, fields[3].parse()?],
+    ))
 }
 
 /// Pick over ROS: a rospy node publishes `pick` on `/rover/arm/task` in worlds/arm_car_pick.toml
@@ -1074,14 +1082,8 @@ fn a_rospy_node_has_the_arm_car_pick_the_ball_and_reads_its_states() -> Result<(
         seen == order,
         "/rover/arm/state went {states:?}, not through {order:?}:\n{out}"
     );
-    let object: Vec<&str> = out
-        .lines()
-        .find_map(|l| l.strip_prefix("object "))
-        .map(|l| l.split(' ').collect())
-        .unwrap_or_default();
-    ensure!(object.len() == 4, "no /rover/arm/object:\n{out}");
-    ensure!(object[0] == "base_link", "object frame {}", object[0]);
-    let (x, y, z): (f64, f64, f64) = (object[1].parse()?, object[2].parse()?, object[3].parse()?);
+    let (frame, [x, y, z]) = stamped_point(&out, "object")?;
+    ensure!(frame == "base_link", "object frame {frame}");
     // The ball's centre: (0.27, 0.08) on the table, 0.05 m above base_link.
     ensure!(
         (x - 0.27).abs() < 0.03 && (y - 0.08).abs() < 0.03 && (z - 0.05).abs() < 0.03,

@@ -593,8 +593,8 @@ impl Pick {
         Some((at.translation.vector - want.translation.vector).norm())
     }
 
-    /// The whole plan for an object at `centre` (base frame) of `radius`: the grasp, then the
-    /// place (or, with no place, holding it up).
+    /// The whole plan for `target` (called `what`): the grasp, then the place (or, with no
+    /// place, holding it up).
     fn plan(
         &mut self,
         sim: &Simulation,
@@ -658,8 +658,29 @@ impl Pick {
             // No place: it stays in the hand, held up.
             return Ok(steps);
         };
+        let held = (target, grasp.way);
+        steps.extend(self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m))?);
+        Ok(steps)
+    }
+
+    /// From the lift (`lift_q`) with the object `held` as the hand took it: the carry to over
+    /// the place (`over`, base frame), the straight way down `lower_m` (none for a drop), the
+    /// release, the retreat and the way home (`home_q`).
+    fn plan_place(
+        &mut self,
+        scene: &mut PlanningScene,
+        (target, way_held): (Target, Way),
+        g: &Gripper,
+        (lift_q, home_q): (&[f64], &[f64]),
+        (over, lower_m): (Vector3<f64>, f64),
+    ) -> Result<Vec<(Step, PickState)>, String> {
+        let joints = self.joints().to_vec();
+        let speed_scale = self.config.speed_scale;
+        let timed = |w: Vec<Vec<f64>>, stop: bool| {
+            Step::Move(TimedPath::new(w, &joints, speed_scale, RAMP_S, stop))
+        };
         // Carrying: the object on the tool, as the hand holds it.
-        match (target.cuboid, grasp.way.turn) {
+        match (target.cuboid, way_held.turn) {
             (Some((r, half)), Some(turn)) => {
                 let q = (turn.inverse() * r).into_inner();
                 let tool_from_box =
@@ -674,9 +695,9 @@ impl Pick {
         }
         let ways = self.ways_round(over, g.open);
         let (place_q, _, way) = self
-            .reachable(&mut scene, over, &lift_q, "the place", None, &ways)
+            .reachable(scene, over, lift_q, "the place", None, &ways)
             .map_err(|why| format!("cannot reach over the place: {why}"))?;
-        let carry = plan_path(&joints, &lift_q, &place_q, &self.config.planner, |q| {
+        let carry = plan_path(&joints, lift_q, &place_q, &self.config.planner, |q| {
             scene.collision(q).map(|h| h.to_string())
         })
         .map_err(|e| format!("carrying: {e}"))?;
@@ -684,7 +705,7 @@ impl Pick {
         scene.attach_sphere(None);
         let set_down = if lower_m > 0.0 {
             self.line_at_least(
-                &mut scene,
+                scene,
                 &place_q,
                 (over, over - Vector3::z() * lower_m),
                 Some(&ways[way]),
@@ -705,14 +726,14 @@ impl Pick {
             .translation
             .vector;
         let retreat = self.line_at_least(
-            &mut scene,
+            scene,
             &release_q,
             (from, from + Vector3::z() * RETREAT_M.max(lower_m)),
             None,
             0.0,
         )?;
         let retreat_q = retreat.last().cloned().unwrap_or_else(|| release_q.clone());
-        let home = plan_path(&joints, &retreat_q, &q0, &self.config.planner, |q| {
+        let home = plan_path(&joints, &retreat_q, home_q, &self.config.planner, |q| {
             scene.collision(q).map(|h| h.to_string())
         })
         .map_err(|e| format!("going home: {e}"))?;
@@ -721,9 +742,9 @@ impl Pick {
             carry.len(),
             home.len(),
         ]);
-        steps.push_back((timed(carry, true), PickState::Carrying));
+        let mut steps = vec![(timed(carry, true), PickState::Carrying)];
         if set_down.len() > 1 {
-            steps.push_back((timed(set_down, false), PickState::Releasing));
+            steps.push((timed(set_down, false), PickState::Releasing));
         }
         steps.extend([
             (
