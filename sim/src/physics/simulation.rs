@@ -132,7 +132,9 @@ impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
         let drivable = robot.diff_drive.is_some();
-        if !drivable {
+        // A robot bolted to the world (a `world` root link: an arm on a table) is not meant to
+        // drive; anything else without a drive is told why cmd_vel does nothing.
+        if !drivable && !robot.is_anchored() {
             tracing::warn!(
                 "{}: robot \"{}\" cannot be driven: it has no libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin and the world gives no [robot.drive]; it is simulated and shown, commands are ignored",
                 robot.source.display(),
