@@ -18,12 +18,14 @@ const SEARCH_DEPTH: usize = 4;
 
 /// A URI or package that could not be found, with every place that was searched.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{what} not found; searched: {}", searched_list(.searched))]
+#[error("{what} not found; searched: {}{hint}", searched_list(.searched))]
 pub struct NotFound {
     /// What was looked for (`package "foo"`, `package://foo/bar.stl`).
     pub what: String,
     /// Folders and files searched, in order.
     pub searched: Vec<PathBuf>,
+    /// What to do about it (starting with "; "), or empty.
+    pub hint: String,
 }
 
 fn searched_list(searched: &[PathBuf]) -> String {
@@ -127,9 +129,17 @@ impl ResourcePaths {
                 return Ok(found);
             }
         }
+        let hint = if self.package_search.is_empty() {
+            format!(
+                "; ROS_PACKAGE_PATH is not set: set it to a folder the package is in (a pip install's site-packages/cmeel.prefix/share, a catkin workspace's src), or pass --package-path {name}=DIR"
+            )
+        } else {
+            String::new()
+        };
         Err(NotFound {
             what: format!("ROS package \"{name}\""),
             searched,
+            hint,
         })
     }
 
@@ -144,9 +154,15 @@ impl ResourcePaths {
             }
             searched.push(root.clone());
         }
+        let hint = if self.model_search.is_empty() {
+            "; GAZEBO_MODEL_PATH is not set: set it to the folder holding the model, or pass --model-path DIR".to_owned()
+        } else {
+            String::new()
+        };
         Err(NotFound {
             what: format!("Gazebo model \"{name}\" (model://{name})"),
             searched,
+            hint,
         })
     }
 
@@ -205,6 +221,7 @@ impl ResourcePaths {
                 Err(NotFound {
                     what: format!("file {uri}"),
                     searched: vec![p],
+                    hint: String::new(),
                 })
             };
         };
@@ -215,6 +232,7 @@ impl ResourcePaths {
             Err(NotFound {
                 what: format!("file {uri}"),
                 searched: vec![p],
+                hint: String::new(),
             })
         }
     }
@@ -308,6 +326,11 @@ mod tests {
             .err()
             .ok_or("found a package that does not exist")?;
         assert!(err.to_string().contains("ROS package \"nope\" not found"));
+        assert!(
+            err.to_string()
+                .contains("ROS_PACKAGE_PATH is not set: set it to a folder the package is in"),
+            "{err}"
+        );
         assert!(err.searched.contains(&absolute(&near)));
 
         let via_env = ResourcePaths {
