@@ -183,6 +183,13 @@ struct Gripper {
     across_tool: Vector3<f64>,
 }
 
+impl Gripper {
+    /// Each finger's furthest from the middle (m or rad): half the widest the hand opens.
+    fn widest_m(&self) -> f64 {
+        self.open.abs().max(self.closed.abs())
+    }
+}
+
 /// What is picked, as the plan needs it (arm base frame, m).
 #[derive(Debug, Clone, Copy)]
 struct Target {
@@ -350,7 +357,8 @@ impl Pick {
     /// A detector message with the depth image it came from: while seeking, a sighting; once
     /// the sightings agree, the plan.
     pub fn observe(&mut self, boxes: &BoundingBoxes, view: &DepthView<'_>, sim: &Simulation) {
-        if self.state != PickState::Seeking {
+        // A named object is taken by its pose ([`Self::update`]), not by what is seen.
+        if self.state != PickState::Seeking || self.known_object(sim).is_some() {
             return;
         }
         let c = &self.config;
@@ -414,59 +422,42 @@ impl Pick {
 
     /// The world object to take by its known pose, if one is named (here or in the world's
     /// `[robot] pick`).
-    pub fn known_object(&self, sim: &Simulation) -> Option<String> {
-        self.config
-            .object
-            .clone()
-            .or_else(|| sim.world().robot.pick.clone())
+    pub fn known_object<'a>(&'a self, sim: &'a Simulation) -> Option<&'a str> {
+        (self.config.object.as_deref()).or(sim.world().robot.pick.as_deref())
     }
 
     /// Takes the named world object by its pose now (arm base frame): a box by its faces, a
     /// sphere or anything else as round.
     fn seek_known(&mut self, sim: &Simulation, name: &str) {
-        let world = sim.world();
-        let Some(index) = world.objects.iter().position(|o| o.name == name) else {
-            let why = format!(
-                "no world object \"{name}\" to pick; the world's objects: {}",
-                object_names(sim)
-            );
-            return self.fail(why);
+        let (shape, pose) = match world_object(sim, name, "to pick") {
+            Ok(found) => found,
+            Err(why) => return self.fail(why),
         };
-        let mut poses = Vec::new();
-        sim.object_poses_into(&mut poses);
-        let pose = poses.get(index).copied().unwrap_or(Pose::IDENTITY);
         let base_from_object = isometry_from_pose(&sim.world_from_link(self.base)).inverse()
             * isometry_from_pose(&pose);
         let centre = base_from_object.translation.vector;
-        let r = base_from_object.rotation;
-        let target = match world.objects[index].shape {
+        let Some(half_height_m) = shape.half_height_m().map(f64::from) else {
+            return self.fail(format!(
+                "\"{name}\" is a mesh: pick takes boxes, spheres, cylinders and capsules by name"
+            ));
+        };
+        let target = match shape {
             Shape::Box { size_m } => {
                 let half = [size_m.x, size_m.y, size_m.z].map(|v| f64::from(v) / 2.0);
                 Target {
                     centre,
-                    half_height_m: half[2],
+                    half_height_m,
                     bound_m: half.iter().map(|h| h * h).sum::<f64>().sqrt(),
-                    cuboid: Some((r, half)),
+                    cuboid: Some((base_from_object.rotation, half)),
                 }
             }
-            Shape::Sphere { radius_m } => Target::round(centre, f64::from(radius_m)),
-            Shape::Cylinder {
-                radius_m, length_m, ..
-            } => Target {
-                half_height_m: f64::from(length_m) / 2.0,
-                ..Target::round(centre, f64::from(radius_m))
+            Shape::Sphere { radius_m }
+            | Shape::Cylinder { radius_m, .. }
+            | Shape::Capsule { radius_m, .. } => Target {
+                half_height_m,
+                ..Target::round(centre, f64::from(*radius_m))
             },
-            Shape::Capsule {
-                radius_m, length_m, ..
-            } => Target {
-                half_height_m: f64::from(radius_m + length_m / 2.0),
-                ..Target::round(centre, f64::from(radius_m))
-            },
-            Shape::Mesh { .. } => {
-                return self.fail(format!(
-                    "\"{name}\" is a mesh: pick takes boxes, spheres, cylinders and capsules by name"
-                ));
-            }
+            Shape::Mesh { .. } => return,
         };
         self.plan_for(sim, &format!("\"{name}\""), target);
     }
@@ -482,7 +473,7 @@ impl Pick {
     /// `sim`).
     pub fn update(&mut self, sim: &mut Simulation) {
         if self.state == PickState::Seeking
-            && let Some(name) = self.known_object(sim)
+            && let Some(name) = self.known_object(sim).map(str::to_owned)
         {
             self.seek_known(sim, &name);
         }
@@ -795,7 +786,7 @@ impl Pick {
         if ways.is_empty() {
             return Err(format!(
                 "cannot grasp {what}: it is wider than the open gripper ({:.3} m) every way",
-                2.0 * g.open.abs().max(g.closed.abs())
+                2.0 * g.widest_m()
             ));
         }
         let (grasp_q, mut descent, way) = self
@@ -860,7 +851,7 @@ impl Pick {
     fn ways_across(&self, mut faces: [(Vector3<f64>, f64); 2], g: &Gripper) -> Vec<Way> {
         faces.sort_by(|a, b| a.1.total_cmp(&b.1));
         let down = -Vector3::z();
-        let open = g.open.abs().max(g.closed.abs());
+        let open = g.widest_m();
         let mut ways = Vec::new();
         for (k, (axis, half)) in faces.iter().enumerate() {
             let across = (axis - down * axis.dot(&down)).try_normalize(1e-6);
@@ -1003,35 +994,37 @@ impl Pick {
             }
             Some(Place::Object(name)) => name,
         };
-        let index = world
-            .objects
-            .iter()
-            .position(|o| o.name == name)
-            .ok_or_else(|| {
-                format!(
-                    "no world object \"{name}\" to place on; the world's objects: {}",
-                    object_names(sim)
-                )
-            })?;
-        let mut poses = Vec::new();
-        sim.object_poses_into(&mut poses);
-        let pose = poses.get(index).copied().unwrap_or(Pose::IDENTITY);
-        let half_height = match world.objects[index].shape {
-            Shape::Box { size_m } => size_m.z / 2.0,
-            Shape::Sphere { radius_m } => radius_m,
-            Shape::Cylinder { length_m, .. } => length_m / 2.0,
-            Shape::Capsule {
-                radius_m, length_m, ..
-            } => radius_m + length_m / 2.0,
-            Shape::Mesh { .. } => 0.0,
-        };
+        let (shape, pose) = world_object(sim, &name, "to place on")?;
         let t = pose.translation;
+        let top = t.z + shape.half_height_m().unwrap_or(0.0);
         Ok(Some((
-            [f64::from(t.x), f64::from(t.y), f64::from(t.z + half_height)],
+            [f64::from(t.x), f64::from(t.y), f64::from(top)],
             self.config.drop_height_m,
             0.0,
         )))
     }
+}
+
+/// World object `name`'s shape and pose now; else an error saying what it was wanted for
+/// (`"to pick"`) and listing the world's objects.
+fn world_object<'w>(
+    sim: &'w Simulation,
+    name: &str,
+    wanted: &str,
+) -> Result<(&'w Shape, Pose), String> {
+    let world = sim.world();
+    let index = (world.objects.iter())
+        .position(|o| o.name == name)
+        .ok_or_else(|| {
+            format!(
+                "no world object \"{name}\" {wanted}; the world's objects: {}",
+                object_names(sim)
+            )
+        })?;
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let pose = poses.get(index).copied().unwrap_or(Pose::IDENTITY);
+    Ok((&world.objects[index].shape, pose))
 }
 
 /// The world's named objects, comma-separated (for errors).

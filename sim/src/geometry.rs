@@ -91,6 +91,20 @@ pub enum Shape {
     },
 }
 
+impl Shape {
+    /// Half its extent along its own z (m): how far its centre is above what it stands on,
+    /// upright. `None` for a mesh.
+    pub fn half_height_m(&self) -> Option<f32> {
+        match self {
+            Shape::Box { size_m } => Some(size_m.z / 2.0),
+            Shape::Cylinder { length_m, .. } => Some(length_m / 2.0),
+            Shape::Sphere { radius_m } => Some(*radius_m),
+            Shape::Capsule { radius_m, length_m } => Some(radius_m + length_m / 2.0),
+            Shape::Mesh { .. } => None,
+        }
+    }
+}
+
 /// Linear RGBA colour, components in 0..=1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rgba(pub [f32; 4]);

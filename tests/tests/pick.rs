@@ -501,30 +501,6 @@ fn the_panda_picks_a_cube_and_sets_it_down_20_cm_away() -> Result<()> {
         session.step(&mut said)?;
         let now = session.sim().sim_time_s();
         let state = session.stats().arm.pick;
-        if std::env::var("PICK_DEBUG").is_ok_and(|every| {
-            every
-                .parse::<u64>()
-                .is_ok_and(|n| session.sim().step_index() % n.max(1) == 0)
-        }) {
-            let sim = session.sim();
-            let tcp = sim
-                .robot()
-                .link_id("panda_hand_tcp")
-                .map(|l| sim.world_from_link(l));
-            let finger = ["panda_finger_joint1", "panda_finger_joint2"].map(|n| {
-                sim.robot()
-                    .joint_id(n)
-                    .and_then(|j| sim.joint_state(j))
-                    .map(|s| (s.position, s.effort))
-            });
-            println!(
-                "  {now:.2} {state:?} tcp {:?} cube {:?} finger {:?} touches {:?}",
-                tcp.map(|p| (p.translation, p.rotation)),
-                object(&session, CUBE),
-                finger,
-                sim.object_contacts(CUBE)
-            );
-        }
         if finished.is_none() && matches!(state, PickState::Done | PickState::Failed) {
             finished = Some(now);
         }

@@ -483,17 +483,15 @@ pub(crate) struct ArmArgs {
 
 /// `--place`: three comma-separated finite numbers are a point, anything else an object's name.
 fn parse_place(text: &str) -> anyhow::Result<rover_sim::Place> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    if parts.len() == 3 && parts.iter().all(|p| p.parse::<f64>().is_ok()) {
-        let mut point = [0.0; 3];
-        for (v, p) in point.iter_mut().zip(&parts) {
-            *v = p.parse::<f64>()?;
-        }
+    let numbers: Result<Vec<f64>, _> = text.split(',').map(|p| p.trim().parse::<f64>()).collect();
+    if let Ok(point) = numbers
+        && let [x, y, z] = point[..]
+    {
         anyhow::ensure!(
             point.iter().all(|v| v.is_finite()),
             "--place {text}: a point must be three finite numbers X,Y,Z (m)"
         );
-        return Ok(rover_sim::Place::Point(point));
+        return Ok(rover_sim::Place::Point([x, y, z]));
     }
     anyhow::ensure!(
         !text.trim().is_empty(),

@@ -291,6 +291,17 @@ impl Reader<'_> {
     }
 
     /// `{p, i, d, i_clamp}` (control_toolbox's names; `i_clamp_max` is taken for `i_clamp`).
+    /// `gains/<joint>`: the entry of a `gains` map for `joint`, which must be there.
+    fn joint_gains(&self, gains: &Node, joint: &str) -> Result<Pid> {
+        let Some(pid) = gains.get(joint) else {
+            return Err(self.error(
+                gains.line,
+                format!("`gains` has no entry for joint \"{joint}\""),
+            ));
+        };
+        self.pid(pid, &format!("gains/{joint}"))
+    }
+
     fn pid(&self, node: &Node, what: &str) -> Result<Pid> {
         if !node.is_map() {
             return Err(self.error(
@@ -468,15 +479,7 @@ impl Reader<'_> {
         };
         let gains = match node.get("gains") {
             None => None,
-            Some(g) => {
-                let Some(pid) = g.get(&joint) else {
-                    return Err(self.error(
-                        g.line,
-                        format!("`gains` has no entry for joint \"{joint}\""),
-                    ));
-                };
-                Some(self.pid(pid, &format!("gains/{joint}"))?)
-            }
+            Some(g) => Some(self.joint_gains(g, &joint)?),
         };
         Ok(GripperSpec {
             joint,
@@ -527,13 +530,7 @@ impl Reader<'_> {
             };
             let mut out = Vec::with_capacity(joints.len());
             for joint in &joints {
-                let Some(j) = g.get(joint) else {
-                    return Err(self.error(
-                        g.line,
-                        format!("`gains` has no entry for joint \"{joint}\""),
-                    ));
-                };
-                out.push(self.pid(j, &format!("gains/{joint}"))?);
+                out.push(self.joint_gains(g, joint)?);
             }
             Some(out)
         };

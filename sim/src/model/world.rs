@@ -89,15 +89,6 @@ pub enum Place {
     Point([f64; 3]),
 }
 
-impl std::fmt::Display for Place {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Object(name) => write!(f, "\"{name}\""),
-            Self::Point([x, y, z]) => write!(f, "({x:.3}, {y:.3}, {z:.3}) m"),
-        }
-    }
-}
-
 /// How a gripper holds what it closes on (`[robot] grasp`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]

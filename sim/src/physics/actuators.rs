@@ -330,16 +330,17 @@ impl Actuators {
 
     /// The actuator of `joint`, if it has one.
     pub(crate) fn of(&self, joint: JointId) -> Option<&Actuator> {
-        self.by_joint
-            .get(joint.index())
-            .copied()
-            .flatten()
-            .map(|i| &self.list[i])
+        self.index(joint).map(|i| &self.list[i])
     }
 
     fn of_mut(&mut self, joint: JointId) -> Option<&mut Actuator> {
-        let i = self.by_joint.get(joint.index()).copied().flatten()?;
+        let i = self.index(joint)?;
         self.list.get_mut(i)
+    }
+
+    /// Where `joint`'s actuator is in the list, if it has one.
+    fn index(&self, joint: JointId) -> Option<usize> {
+        self.by_joint.get(joint.index()).copied().flatten()
     }
 
     /// Sets a joint's command. Non-finite values and joints without an actuator are errors;
@@ -427,7 +428,7 @@ impl Actuators {
     /// to hold the grip centred, not a 100 N spring on a 15 g finger kicking what it holds
     /// whenever the leader moves between two control updates.
     pub(crate) fn set_effort_cap(&mut self, joint: JointId, cap: Option<f64>) {
-        let Some(i) = self.by_joint.get(joint.index()).copied().flatten() else {
+        let Some(i) = self.index(joint) else {
             return;
         };
         self.list[i].effort_cap = cap;
