@@ -159,6 +159,10 @@ struct FrameRecord {
     height: u32,
     /// The optical frame in the arm's base frame.
     base_from_optical: nalgebra::Isometry3<f64>,
+    /// The arm's base in the world when the image was taken.
+    world_from_base: nalgebra::Isometry3<f64>,
+    /// When the image was taken (s of sim time).
+    sim_time_s: f64,
     /// Every joint's position (robot joint order; 0 for joints that do not move).
     q: Vec<f64>,
 }
@@ -395,6 +399,8 @@ impl ArmTask {
                     width: 0,
                     height: 0,
                     base_from_optical: nalgebra::Isometry3::identity(),
+                    world_from_base: nalgebra::Isometry3::identity(),
+                    sim_time_s: 0.0,
                     q: Vec::new(),
                 };
                 FRAMES
@@ -422,6 +428,8 @@ impl ArmTask {
             sim.world_from_link(self.base_link).inverse() * sim.world_from_link(self.camera_link);
         slot.base_from_optical =
             isometry_from_pose(&(base_from_camera * Pose::from_rotation(link_from_optical())));
+        slot.world_from_base = isometry_from_pose(&sim.world_from_link(self.base_link));
+        slot.sim_time_s = sim.sim_time_s();
         joint_positions(sim, &mut slot.q);
     }
 
@@ -459,7 +467,12 @@ impl ArmTask {
                 height: record.height,
                 base_from_optical: record.base_from_optical,
             };
-            pick.observe(boxes, &view, sim);
+            pick.observe(
+                boxes,
+                &view,
+                (&record.world_from_base, record.sim_time_s),
+                sim,
+            );
         }
         if self.mode == ArmMode::Reach
             && let Ok(reach) = self.reach.as_mut()
@@ -548,6 +561,21 @@ impl ArmTask {
             for (warn, text) in pick.drain_said() {
                 f(warn, text);
             }
+        }
+    }
+
+    /// What the pick tells the base this control update (`fetch`), while pick is on.
+    pub(crate) fn base_command(&self) -> Option<rover_sim::Twist> {
+        if self.mode != ArmMode::Pick {
+            return None;
+        }
+        self.pick.as_ref().ok().and_then(Pick::base_command)
+    }
+
+    /// Stops a fetch's pick, saying `why`.
+    pub(crate) fn stop_fetch(&mut self, why: &str) {
+        if let Ok(pick) = self.pick.as_mut() {
+            pick.stop(why);
         }
     }
 

@@ -24,6 +24,8 @@
 //!    (closing all the way means it missed), the arm lifts, carries, the gripper opens over the
 //!    place, and the arm retreats and goes back to where it started.
 
+mod fetch;
+
 use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -31,7 +33,7 @@ use rover_perception::BoundingBoxes;
 use rover_sim::{
     CameraConfig, CameraInfo, ChainJoint, GraspMode, IkOptions, IkSolver, IkTarget, JointCommand,
     JointId, KinematicChain, LinkId, Place, PlannerOptions, PlanningScene, Pose, Shape, Simulation,
-    TimedPath, isometry_from_pose, plan_path,
+    TimedPath, Twist, isometry_from_pose, plan_path,
 };
 
 use crate::reach::{DepthView, object_estimate};
@@ -70,6 +72,10 @@ pub struct PickConfig {
     /// given a collision object); `None`: the world's `[robot] pick`, else what the detector
     /// sees of [`Self::class`].
     pub object: Option<String>,
+    /// Where (m, x forward and y left in the arm's base frame) the object should be when the
+    /// car stops to pick it; set, the pick drives the base to within reach of the object and
+    /// then to the place. `None`: the world's `[robot] fetch`, else the base is not moved.
+    pub fetch_at: Option<[f64; 2]>,
     /// Planner settings.
     pub planner: PlannerOptions,
 }
@@ -92,6 +98,7 @@ impl Default for PickConfig {
             max_range_m: 4.0,
             place: None,
             object: None,
+            fetch_at: None,
             planner: PlannerOptions::default(),
         }
     }
@@ -119,6 +126,10 @@ pub enum PickState {
     Done,
     /// Refused or failed (the reason was said).
     Failed,
+    /// Driving the base to within reach of the object (`fetch`).
+    Fetching,
+    /// Driving the base, the object in the hand, to the place (`fetch`).
+    Delivering,
 }
 
 impl PickState {
@@ -134,10 +145,12 @@ impl PickState {
             Self::Retreating => "retreating",
             Self::Done => "done",
             Self::Failed => "failed",
+            Self::Fetching => "fetching",
+            Self::Delivering => "delivering",
         }
     }
 
-    /// 0 seeking ... 8 failed (for plots).
+    /// 0 seeking ... 8 failed, 9 fetching, 10 delivering (for plots).
     pub fn index(self) -> usize {
         self as usize
     }
@@ -266,6 +279,16 @@ pub struct Pick {
     v: Vec<f64>,
     /// What to say next (a warning when `true`).
     said: Vec<(bool, String)>,
+    /// The base's go-to-point controller (`fetch`).
+    drive: fetch::DriveTo,
+    /// Where the base is driving to, while it is.
+    leg: Option<fetch::Leg>,
+    /// What the base is told this control update (`fetch`: zero while the arm works).
+    base_cmd: Option<Twist>,
+    /// No sighting from an image taken before this (s of sim time): the base was moving.
+    settle_until_s: f64,
+    /// The object in the hand, to be placed once the base is at the place (`fetch`).
+    held: Option<fetch::Held>,
 }
 
 impl Pick {
@@ -309,6 +332,11 @@ impl Pick {
             q: Vec::new(),
             v: Vec::new(),
             said: Vec::new(),
+            drive: fetch::DriveTo::default(),
+            leg: None,
+            base_cmd: None,
+            settle_until_s: 0.0,
+            held: None,
         })
     }
 
@@ -347,6 +375,11 @@ impl Pick {
         self.object = None;
         self.planning_s = None;
         self.path_points = None;
+        self.drive.reset();
+        self.leg = None;
+        self.base_cmd = None;
+        self.settle_until_s = 0.0;
+        self.held = None;
     }
 
     /// What it has to say since the last call: (warning, text).
@@ -354,11 +387,23 @@ impl Pick {
         self.said.drain(..)
     }
 
-    /// A detector message with the depth image it came from: while seeking, a sighting; once
-    /// the sightings agree, the plan.
-    pub fn observe(&mut self, boxes: &BoundingBoxes, view: &DepthView<'_>, sim: &Simulation) {
+    /// A detector message with the depth image it came from, taken at `captured_s` (sim time)
+    /// with the arm's base at `world_from_base`: while seeking, a sighting; once the sightings
+    /// agree, the plan. With `fetch`, a sighting out of reach sends the base to it, and each
+    /// sighting on the way corrects where it goes.
+    pub fn observe(
+        &mut self,
+        boxes: &BoundingBoxes,
+        view: &DepthView<'_>,
+        (world_from_base, captured_s): (&Isometry3<f64>, f64),
+        sim: &Simulation,
+    ) {
         // A named object is taken by its pose ([`Self::update`]), not by what is seen.
-        if self.state != PickState::Seeking || self.known_object(sim).is_some() {
+        let fetching = self.state == PickState::Fetching;
+        if !(self.state == PickState::Seeking || fetching) || self.known_object(sim).is_some() {
+            return;
+        }
+        if captured_s < self.settle_until_s {
             return;
         }
         let c = &self.config;
@@ -372,6 +417,10 @@ impl Pick {
             self.sightings.clear();
             return;
         };
+        if self.fetch_towards(sim, seen.0, world_from_base) {
+            return;
+        }
+        let c = &self.config;
         if self
             .sightings
             .first()
@@ -433,9 +482,12 @@ impl Pick {
             Ok(found) => found,
             Err(why) => return self.fail(why),
         };
-        let base_from_object = isometry_from_pose(&sim.world_from_link(self.base)).inverse()
-            * isometry_from_pose(&pose);
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        let base_from_object = world_from_base.inverse() * isometry_from_pose(&pose);
         let centre = base_from_object.translation.vector;
+        if self.fetch_towards(sim, centre, &world_from_base) {
+            return;
+        }
         let Some(half_height_m) = shape.half_height_m().map(f64::from) else {
             return self.fail(format!(
                 "\"{name}\" is a mesh: pick takes boxes, spheres, cylinders and capsules by name"
@@ -462,6 +514,16 @@ impl Pick {
         self.plan_for(sim, &format!("\"{name}\""), target);
     }
 
+    /// Stops where it is (the arm holds), saying `why`.
+    pub fn stop(&mut self, why: &str) {
+        self.leg = None;
+        self.base_cmd = None;
+        self.state = PickState::Failed;
+        self.steps.clear();
+        self.running = None;
+        self.said.push((true, why.to_owned()));
+    }
+
     fn fail(&mut self, why: String) {
         self.state = PickState::Failed;
         self.steps.clear();
@@ -472,18 +534,39 @@ impl Pick {
     /// After a control update: runs the plan's steps (joint setpoints and gripper commands to
     /// `sim`).
     pub fn update(&mut self, sim: &mut Simulation) {
+        let now = sim.sim_time_s();
+        self.base_cmd = None;
+        self.drive_base(sim, now);
         if self.state == PickState::Seeking
+            && now >= self.settle_until_s
             && let Some(name) = self.known_object(sim).map(str::to_owned)
         {
             self.seek_known(sim, &name);
         }
-        let now = sim.sim_time_s();
+        self.run_steps(sim, now);
+        if self.fetch_at(sim).is_some()
+            && !matches!(self.state, PickState::Done | PickState::Failed)
+        {
+            // A fetch owns the base: it stands still while the arm works.
+            self.base_cmd.get_or_insert(Twist::ZERO);
+        }
+    }
+
+    /// What the base is told this control update: `Some` while a fetch drives it (zero while
+    /// the arm works), `None` when the pick leaves the base alone.
+    pub fn base_command(&self) -> Option<Twist> {
+        self.base_cmd
+    }
+
+    /// Runs the plan's steps.
+    fn run_steps(&mut self, sim: &mut Simulation, now: f64) {
         if self.running.is_none() {
             let Some((step, state)) = self.steps.pop_front() else {
                 if !matches!(
                     self.state,
-                    PickState::Seeking | PickState::Done | PickState::Failed
-                ) {
+                    PickState::Seeking | PickState::Done | PickState::Failed | PickState::Fetching
+                ) && !self.deliver(sim, now)
+                {
                     self.state = PickState::Done;
                     self.said.push((false, "pick: done".to_owned()));
                 }
@@ -600,7 +683,8 @@ impl Pick {
         let w = world_from_base * Point3::from(target.centre);
         let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
         // Over the place: where the carry ends, and how far it then goes straight down.
-        let place = self.place_under(sim)?.map(|(under, drop_m, lower_m)| {
+        let place_under = self.place_under(sim)?;
+        let place = place_under.map(|(under, drop_m, lower_m)| {
             let over = world_from_base.inverse()
                 * Point3::new(under[0], under[1], under[2] + drop_m + target.half_height_m);
             (over.coords, lower_m)
@@ -649,6 +733,18 @@ impl Pick {
             // No place: it stays in the hand, held up.
             return Ok(steps);
         };
+        if let Some(place) = place_under
+            && self.fetch_at(sim).is_some()
+        {
+            // Fetching: it is held up while the base drives to the place ([`Self::deliver`]).
+            self.held = Some(fetch::Held {
+                target,
+                way: grasp.way,
+                home_q: q0,
+                place,
+            });
+            return Ok(steps);
+        }
         let held = (target, grasp.way);
         steps.extend(self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m))?);
         Ok(steps)

@@ -92,6 +92,8 @@ pub struct Session {
     labels: Vec<String>,
     every_frame: bool,
     pilot: Pilot,
+    /// Whether a fetch commanded the base last control update.
+    fetch_drove: bool,
     follower: Follower,
     arm: ArmTask,
     stats: LoopStats,
@@ -183,6 +185,7 @@ impl Session {
             labels,
             every_frame: options.every_frame,
             pilot: Pilot::default(),
+            fetch_drove: false,
             stats,
             last_boxes: None,
             detections_done: 0,
@@ -283,6 +286,11 @@ impl Session {
         let before = self.pilot.mode();
         let cmd = self.pilot.apply(&action);
         let after = self.pilot.mode();
+        if cmd.is_some() && self.arm.base_command().is_some() {
+            // A person (or a ROS node) driving takes the base back from a fetch.
+            self.arm
+                .stop_fetch("pick: stopped: the base was driven by another input");
+        }
         if before != after {
             self.follower.reset();
             let text = match after {
@@ -412,6 +420,7 @@ impl Session {
                 .map(|t| t.position_at(sample.sim_time_s));
             self.stats.follow_goal_m = self.follower.goal_m().filter(|_| following);
             self.arm.update(&mut self.sim).map_err(arm_error)?;
+            self.fetch_drive()?;
             let now = sample.sim_time_s;
             self.arm.drain_said(|warn, text| {
                 let level = if warn {
@@ -456,6 +465,19 @@ impl Session {
             observer.control(&self.sim, sample, &self.stats);
         }
         Ok(sample)
+    }
+
+    /// A fetch's base command (pick driving the base) goes to the drive; a stop once it lets
+    /// go. The follower keeps the base while it drives.
+    fn fetch_drive(&mut self) -> Result<()> {
+        let cmd = self.arm.base_command();
+        match cmd {
+            Some(cmd) if self.pilot.mode() == Mode::Manual => self.sim.set_cmd_vel(cmd)?,
+            None if self.fetch_drove => self.sim.set_cmd_vel(rover_sim::Twist::ZERO)?,
+            _ => {}
+        }
+        self.fetch_drove = cmd.is_some();
+        Ok(())
     }
 
     fn camera_and_detection(&mut self, observer: &mut dyn Observer) -> Result<()> {

@@ -117,6 +117,7 @@ struct RawRobot {
     grasp: GraspMode,
     place: Option<RawPlace>,
     pick: Option<String>,
+    fetch: Option<[f64; 2]>,
 }
 
 /// `place = "NAME"` or `place = [x, y, z]`.
@@ -467,6 +468,13 @@ impl RawWorld {
                 }
             },
             pick: raw_robot.pick,
+            fetch: match raw_robot.fetch {
+                Some(at) => {
+                    c.coordinates("robot.fetch", &at)?;
+                    Some(at)
+                }
+                None => None,
+            },
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

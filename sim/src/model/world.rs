@@ -76,6 +76,10 @@ pub struct RobotSpawn {
     /// `pick`: the world object pick takes by its known pose (as a MoveIt pick node is given a
     /// collision object), with no camera; `None`: the object of the class the detector sees.
     pub pick: Option<String>,
+    /// `fetch`: where (m, x forward and y left in the arm's base frame) the object should be
+    /// when the car stops to pick it; set, the pick drives the car: to within reach of what it
+    /// sees, then to a world object place. `None`: the pick never moves the base.
+    pub fetch: Option<[f64; 2]>,
 }
 
 /// Where pick puts what it picked (`[robot] place`, `--place`).
