@@ -125,6 +125,14 @@ fn bad_input_exits_with_a_located_error() -> Result<()> {
         text(&out.stderr)
     );
 
+    let out = rover(&["--headless", "--fetch", "0.27"], dir.path())?;
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("--fetch 0.27: expected X,Y"),
+        "{}",
+        text(&out.stderr)
+    );
+
     let out = rover(&["--headless", "--script", "missing.toml"], dir.path())?;
     assert_eq!(out.status.code(), Some(1));
     assert!(

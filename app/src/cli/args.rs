@@ -479,6 +479,24 @@ pub(crate) struct ArmArgs {
     /// else what the detector sees of --arm-class]
     #[arg(long, value_name = "NAME")]
     pub(crate) pick_object: Option<String>,
+
+    /// Pick: fetch: the car drives to within reach of the object (until it is at X,Y, m, x
+    /// forward and y left in the arm's base frame: where the arm takes it best), picks it,
+    /// backs off and drives to the --place, and puts it there (e.g. worlds/
+    /// arm_car_fetch.toml) [default: the world's [robot] fetch, else the base stays put]
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
+    pub(crate) fetch: Option<String>,
+}
+
+/// `--fetch X,Y`: two finite numbers (m).
+fn parse_fetch(text: &str) -> anyhow::Result<[f64; 2]> {
+    let numbers: Result<Vec<f64>, _> = text.split(',').map(|p| p.trim().parse::<f64>()).collect();
+    match numbers.as_deref() {
+        Ok(&[x, y]) if x.is_finite() && y.is_finite() => Ok([x, y]),
+        _ => anyhow::bail!(
+            "--fetch {text}: expected X,Y: where the object should be when the car stops to pick it (two finite numbers, m, in the arm's base frame)"
+        ),
+    }
 }
 
 /// `--place`: three comma-separated finite numbers are a point, anything else an object's name.
@@ -525,6 +543,7 @@ impl ArmArgs {
                 class: self.arm_class.clone(),
                 place: self.place.as_deref().map(parse_place).transpose()?,
                 object: self.pick_object.clone(),
+                fetch_at: self.fetch.as_deref().map(parse_fetch).transpose()?,
                 ..rover_core::PickConfig::default()
             },
         })
