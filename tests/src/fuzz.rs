@@ -536,7 +536,10 @@ fn load_world_and_simulate(
     resources: &rover_sim::ResourcePaths,
     robot: &rover_sim::RobotModel,
 ) -> Result<(), String> {
-    let world = rover_sim::World::load_with(path, resources).map_err(|e| e.to_string())?;
+    let mut world = rover_sim::World::load_with(path, resources).map_err(|e| e.to_string())?;
+    // The tutorial car has no gripper to assist (a world's own robot has one: grasp.rs
+    // refuses the assist without it, tested in gripper.rs).
+    world.robot.grasp = rover_sim::GraspMode::Friction;
     simulate(path, world, robot.clone())
 }
 

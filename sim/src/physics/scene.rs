@@ -396,6 +396,34 @@ impl Simulation {
         out
     }
 
+    /// The force (N) the ground pushes on link `link`'s body with, in the last step (the sum
+    /// of its contacts' impulses over the step; links welded into one body share it). 0 for a
+    /// link not on the ground.
+    pub fn ground_force_n(&self, link: crate::LinkId) -> f32 {
+        let Some(body) = self.link_body.get(link.index()) else {
+            return 0.0;
+        };
+        let Some(rb) = self.physics.bodies.get(*body) else {
+            return 0.0;
+        };
+        let dt = self.physics.integration_parameters.dt.max(f32::EPSILON);
+        let mut impulse = 0.0;
+        for collider in rb.colliders() {
+            for pair in self.physics.narrow_phase.contact_pairs_with(*collider) {
+                let other = if pair.collider1 == *collider {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                let parent = self.physics.colliders.get(other).and_then(|c| c.parent());
+                if parent.is_none() || parent == Some(self.ground) {
+                    impulse += pair.total_impulse_magnitude();
+                }
+            }
+        }
+        impulse / dt
+    }
+
     /// The name of a body that is not the robot's.
     fn body_name(&self, body: RigidBodyHandle) -> String {
         if body == self.ground {
