@@ -85,6 +85,24 @@ fn run_for(sim: &mut Simulation, seconds: f64) {
     }
 }
 
+/// What the ground pushes up on TIAGo's base body (its four casters, welded to it) and on each
+/// wheel, averaged over `seconds` (N).
+fn ground_loads_n(sim: &mut Simulation, seconds: f64) -> Result<[f32; 3]> {
+    let links =
+        ["base_link", "wheel_left_link", "wheel_right_link"].map(|n| sim.robot().link_id(n));
+    let mut sum = [0.0f32; 3];
+    let mut n = 0.0f32;
+    let end = sim.sim_time_s() + seconds;
+    while sim.sim_time_s() < end {
+        sim.step();
+        for (s, link) in sum.iter_mut().zip(&links) {
+            *s += link.map_or(0.0, |l| sim.ground_force_n(l));
+        }
+        n += 1.0;
+    }
+    Ok(sum.map(|s| s / n.max(1.0)))
+}
+
 /// TIAGo told to go to its home pose, after `seconds`.
 fn tiago_sent_home(seconds: f64) -> Result<Option<Simulation>> {
     let Some(mut sim) = tiago(JointSolver::default())? else {
@@ -106,12 +124,14 @@ fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
     };
     let at_2s = worst_error(&sim, &HOME)?;
     let held = worst_error_over(&mut sim, &HOME, 10.0)?;
+    let resting_n = ground_loads_n(&mut sim, 0.5)?;
     let yaw0 = sim.world_from_base().rotation;
     sim.set_cmd_vel(Twist {
         linear_mps: 0.3,
         angular_radps: 0.0,
     })?;
-    run_for(&mut sim, 3.5);
+    run_for(&mut sim, 3.0);
+    let driving_n = ground_loads_n(&mut sim, 0.5)?;
     let turn_deg = (yaw0.inverse() * sim.world_from_base().rotation)
         .to_euler(glam::EulerRot::ZYX)
         .0
@@ -137,7 +157,7 @@ fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
         .0
         .to_degrees();
     println!(
-        "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {base_m:?}; braking: {turns:?}, total {total_deg:.2} deg"
+        "worst at 2 s {at_2s:?}, worst while held {held:?}, base turned {turn_deg:.2} deg, worst after driving {driving:?}, base at {base_m:?}; braking: {turns:?}, total {total_deg:.2} deg; ground loads (N: casters, left wheel, right wheel) resting {resting_n:.0?}, driving {driving_n:.0?}"
     );
     assert!(at_2s.1 < 0.01, "by 2 s: {at_2s:?}");
     assert!(held.1 < 0.01, "while held: {held:?}");

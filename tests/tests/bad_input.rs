@@ -238,7 +238,10 @@ fn world_unknown_keys_and_bad_values_name_the_key_path() {
     let e = err("[robot]\nfetch = [0.27]\n");
     assert!(e.starts_with("w.toml:2: at `robot.fetch`"), "{e}");
     let e = err("[robot]\nfetch = [0.27, 1e12]\n");
-    assert!(e.contains("at `robot.fetch`") && e.contains("out of range"), "{e}");
+    assert!(
+        e.contains("at `robot.fetch`") && e.contains("out of range"),
+        "{e}"
+    );
     let e = err(
         "[robot.drive]\nleft_joint = \"l\"\nright_joint = \"r\"\nwheel_acceleration_mps2 = \"fast\"\n",
     );

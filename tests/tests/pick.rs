@@ -203,7 +203,12 @@ fn the_arm_car_fetches_the_ball_from_a_table_into_a_bin_1_m_away() -> Result<()>
     let took_s = finished.unwrap_or_default();
     let ball = object(&session, BALL).translation;
     println!("fetched in {took_s:.1} s of sim time; the ball at {ball:.3?}");
-    assert_eq!(session.stats().arm.pick, PickState::Done, "{:?}", said.0.last());
+    assert_eq!(
+        session.stats().arm.pick,
+        PickState::Done,
+        "{:?}",
+        said.0.last()
+    );
     let texts: Vec<&str> = said.0.iter().map(|(_, _, t)| t.as_str()).collect();
     for step in [
         "pick: seeking -> fetching",
@@ -217,7 +222,10 @@ fn the_arm_car_fetches_the_ball_from_a_table_into_a_bin_1_m_away() -> Result<()>
         ball.x.abs() < 0.055 && (ball.y + 1.0).abs() < 0.055 && ball.z > 0.004 && ball.z < 0.054,
         "the ball is not in the bin: {ball:?}"
     );
-    assert!(bumped.is_empty(), "the car touched the table or the bin: {bumped:?}");
+    assert!(
+        bumped.is_empty(),
+        "the car touched the table or the bin: {bumped:?}"
+    );
     Ok(())
 }
 

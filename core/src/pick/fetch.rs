@@ -220,8 +220,8 @@ impl Pick {
             scene.ignore_object(i, true);
         }
         let ([x, y, z], drop_m, lower_m) = held.place;
-        let over = world_from_base.inverse()
-            * Point3::new(x, y, z + drop_m + held.target.half_height_m);
+        let over =
+            world_from_base.inverse() * Point3::new(x, y, z + drop_m + held.target.half_height_m);
         self.plan_place(
             &mut scene,
             (held.target, held.way),
@@ -269,10 +269,7 @@ impl DriveTo {
         let dt = self.last_s.map_or(0.0, |t| (now_s - t).max(0.0));
         self.last_s = Some(now_s);
         let step = MAX_ACCEL_MPS2 * dt;
-        self.last = Twist::new(
-            (self.last.linear_mps - step).max(-MAX_BACK_MPS),
-            0.0,
-        );
+        self.last = Twist::new((self.last.linear_mps - step).max(-MAX_BACK_MPS), 0.0);
         self.last
     }
 
@@ -351,6 +348,9 @@ mod tests {
         let (first, _) = drive.command(0.0, Vector2::new(2.0, 0.0), Vector2::new(0.3, 0.0));
         assert_eq!(first, Twist::ZERO);
         let (next, _) = drive.command(0.1, Vector2::new(2.0, 0.0), Vector2::new(0.3, 0.0));
-        assert!((next.linear_mps - MAX_ACCEL_MPS2 * 0.1).abs() < 1e-9, "{next:?}");
+        assert!(
+            (next.linear_mps - MAX_ACCEL_MPS2 * 0.1).abs() < 1e-9,
+            "{next:?}"
+        );
     }
 }
