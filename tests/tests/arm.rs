@@ -116,7 +116,8 @@ fn tiago_sent_home(seconds: f64) -> Result<Option<Simulation>> {
 }
 
 /// Hold: the home pose is reached within 0.01 rad by 2 s and held for 10 s; then driving
-/// 0.3 m/s for 3.5 s turns the base less than 1 degree.
+/// 0.3 m/s for 3.5 s and braking to a stop turns the base less than 1 degree in all, the
+/// wheels carrying the base (not its casters).
 #[test]
 fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
     let Some(mut sim) = tiago_sent_home(2.0)? else {
@@ -163,6 +164,16 @@ fn tiago_holds_a_commanded_pose_and_drives_straight() -> Result<()> {
     assert!(held.1 < 0.01, "while held: {held:?}");
     assert!(driving.1 < 0.01, "while driving: {driving:?}");
     assert!(turn_deg.abs() < 1.0, "the base turned {turn_deg} degrees");
+    // The measure: braking included. The casters' `<kp>` lets them give way, so the
+    // wheels carry the base (and can brake it) as in Gazebo.
+    assert!(
+        total_deg.abs() < 1.0,
+        "driving and braking turned the base {total_deg} degrees"
+    );
+    assert!(
+        resting_n[1] > resting_n[0] && resting_n[2] > resting_n[0],
+        "the casters carry more than each wheel: {resting_n:?}"
+    );
     assert!(base_m.x > 0.8, "drove to {base_m:?}");
     Ok(())
 }

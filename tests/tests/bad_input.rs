@@ -79,6 +79,27 @@ fn the_bundled_robot_loads_with_its_plugins() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `<kp>` (ODE's contact stiffness) is read per link; one that is not a positive number is
+/// left out with a warning, the robot still loads (a soft-contact tuning is no reason to refuse
+/// a robot).
+#[test]
+fn contact_stiffness_is_read_and_a_bad_one_is_left_out() -> anyhow::Result<()> {
+    let kp = |text: &str| -> anyhow::Result<Option<f32>> {
+        let robot = RobotModel::from_str(text, Path::new("kp.urdf"))?;
+        let caster = robot
+            .link_id("caster_link")
+            .ok_or_else(|| anyhow::anyhow!("no caster_link"))?;
+        Ok(robot.link(caster).contact_kp_n_per_m)
+    };
+    let text = robot_text();
+    assert_eq!(kp(&text)?, None);
+    let soft = text.replace("<mu1>0.0</mu1>", "<mu1>0.0</mu1><kp>1000000.0</kp>");
+    assert_eq!(kp(&soft)?, Some(1e6));
+    let bad = text.replace("<mu1>0.0</mu1>", "<mu1>0.0</mu1><kp>soft</kp>");
+    assert_eq!(kp(&bad)?, None);
+    Ok(())
+}
+
 #[test]
 fn plugin_naming_a_missing_joint_lists_the_joints_that_exist() {
     let text = robot_text().replace(

@@ -27,6 +27,8 @@ pub(crate) struct Extensions {
     pub lasers: Vec<LaserConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
+    /// Link name -> contact stiffness `<kp>` (N/m).
+    pub contact_kp: BTreeMap<String, f32>,
     /// Sensors and plugins rover does not simulate, for one summary line.
     pub ignored: Vec<String>,
 }
@@ -192,6 +194,17 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         "<gazebo reference>",
                         "friction coefficient",
                     )?)
+                }
+                "kp" => {
+                    if let Some(link) = reference {
+                        // A soft-contact tuning, not worth refusing a robot over: warned.
+                        match ctx.positive(child, "<gazebo reference>", "contact stiffness, N/m") {
+                            Ok(kp) => {
+                                ext.contact_kp.insert(link.to_owned(), kp as f32);
+                            }
+                            Err(e) => tracing::warn!("{e}; ignored"),
+                        }
+                    }
                 }
                 "mu2" => {
                     mu[1] = Some(ctx.non_negative(

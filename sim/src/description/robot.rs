@@ -123,6 +123,11 @@ impl RobotModel {
         let root = find_root(&links, &joints, path, &lines)?;
 
         let extensions = gazebo::parse(&doc, path)?;
+        for (reference, kp) in &extensions.contact_kp {
+            if let Some(&i) = link_index.get(reference) {
+                links[i].contact_kp_n_per_m = Some(*kp);
+            }
+        }
         for (reference, friction) in &extensions.friction {
             match link_index.get(reference) {
                 Some(&i) => links[i].friction = Some(*friction),
@@ -483,6 +488,7 @@ fn convert_link(
         visuals,
         collisions,
         friction: None,
+        contact_kp_n_per_m: None,
     })
 }
 

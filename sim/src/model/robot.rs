@@ -74,6 +74,10 @@ pub struct Link {
     pub collisions: Vec<Collision>,
     /// Friction coefficient from `<gazebo reference="link"><mu1>`/`<mu2>` (the smaller one).
     pub friction: Option<f32>,
+    /// Contact stiffness (N/m) from `<gazebo reference="link"><kp>`: its contacts give way by
+    /// the robot's weight over this before they push (ODE's soft contact, where the stiffer
+    /// contacts beside it carry the load); `None`: as hard as rapier holds contacts.
+    pub contact_kp_n_per_m: Option<f32>,
 }
 
 /// Kind of a URDF joint that rover simulates.

@@ -12,6 +12,7 @@ use crate::model::person::Person;
 use crate::model::robot::{JointKind, RobotModel};
 use crate::model::world::JointSolver;
 use crate::model::world::World;
+use crate::physics::contact_springs::ContactSprings;
 use crate::physics::joints::{BuiltJoint, add_joints};
 
 /// Collision group of the robot's own colliders (the robot does not collide with itself,
@@ -144,6 +145,8 @@ pub(crate) struct RobotBodies {
     pub(crate) joints: Vec<Option<BuiltJoint>>,
     /// Mass of each link's rigid body (kg).
     pub(crate) link_mass_kg: Vec<f32>,
+    /// Contacts that give way (`<kp>` links' colliders).
+    pub(crate) springs: ContactSprings,
 }
 
 /// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
@@ -229,16 +232,31 @@ pub(crate) fn add_robot(
         |root| world_from_root * root_from_links[root],
     );
     let robot_groups = InteractionGroups::new(ROBOT_GROUP, !ROBOT_GROUP, InteractionTestMode::And);
+    let mass_kg: f32 = (robot.links.iter())
+        .filter_map(|l| l.inertial.as_ref())
+        .map(|i| i.mass_kg)
+        .sum();
+    let weight_n = mass_kg * world.physics.gravity_mps2[2].abs() as f32;
+    let mut springs = ContactSprings::default();
     for (i, shape, link_from_shape) in shapes {
-        physics.insert_collider(
+        let kp = robot.links[i].contact_kp_n_per_m;
+        let collider = physics.insert_collider(
             ColliderBuilder::new(shape)
                 .position(body_from_link[i] * link_from_shape)
                 .density(0.0)
                 .friction(robot.links[i].friction.unwrap_or(1.0))
                 .friction_combine_rule(CoefficientCombineRule::Min)
-                .collision_groups(robot_groups),
+                .collision_groups(robot_groups)
+                .active_hooks(if kp.is_some() {
+                    ActiveHooks::MODIFY_SOLVER_CONTACTS
+                } else {
+                    ActiveHooks::empty()
+                }),
             Some(link_body[i]),
         );
+        if let Some(kp) = kp {
+            springs.insert(collider, kp, weight_n);
+        }
     }
     let joints = add_joints(physics, robot, &link_body, &body_from_link, solver);
     Ok(RobotBodies {
@@ -246,6 +264,7 @@ pub(crate) fn add_robot(
         link_mass_kg,
         body_from_link,
         joints,
+        springs,
     })
 }
 

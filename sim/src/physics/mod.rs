@@ -5,6 +5,7 @@
 
 pub(crate) mod actuators;
 pub(crate) mod build;
+pub(crate) mod contact_springs;
 pub(crate) mod controllers;
 pub(crate) mod diff_drive;
 pub(crate) mod grasp;

@@ -86,6 +86,8 @@ pub struct Simulation {
     pub(crate) objects: Vec<RigidBodyHandle>,
     /// The grasp assist, with `[robot] grasp = "assist"`.
     grasp: Option<crate::physics::grasp::GraspAssist>,
+    /// Contacts of `<kp>` links, which give way (rapier's contact hook).
+    springs: crate::physics::contact_springs::ContactSprings,
     /// Counts placements ([`Simulation::layout_version`]).
     pub(crate) layout: u64,
     /// Relative poses of placed things, kept until the next step.
@@ -221,6 +223,7 @@ impl Simulation {
         };
         Ok(Self {
             physics,
+            springs: robot_bodies.springs,
             link_body: robot_bodies.link_body,
             body_from_link: robot_bodies.body_from_link,
             base,
@@ -286,7 +289,11 @@ impl Simulation {
             self.actuators.update(&mut self.physics, period_s);
         }
         self.actuators.apply_efforts(&mut self.physics, self.dt_s);
-        self.physics.step();
+        if self.springs.is_empty() {
+            self.physics.step();
+        } else {
+            self.physics.step_with_events(&self.springs, &());
+        }
         if let Some(grasp) = &mut self.grasp
             && let Some(event) = grasp.update(&mut self.physics, &self.objects, now)
         {
