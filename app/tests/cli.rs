@@ -23,6 +23,15 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// `rover ARGS` in `cwd` exits 1, its stderr saying `expected`.
+fn assert_refused(args: &[&str], cwd: &Path, expected: &str) -> Result<()> {
+    let out = rover(args, cwd)?;
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(expected), "{stderr}");
+    Ok(())
+}
+
 /// `rover ... | head`: a reader that stops reading is no reason to panic. The run finishes
 /// (its trace is written) and exits 0; it used to die with "failed printing to stdout".
 #[test]
@@ -117,21 +126,16 @@ fn bad_input_exits_with_a_located_error() -> Result<()> {
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
 
-    let out = rover(&["--headless", "--place", "0.5,0.2,inf"], dir.path())?;
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        text(&out.stderr).contains("--place 0.5,0.2,inf: a point must be three finite numbers"),
-        "{}",
-        text(&out.stderr)
-    );
-
-    let out = rover(&["--headless", "--fetch", "0.27"], dir.path())?;
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        text(&out.stderr).contains("--fetch 0.27: expected X,Y"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(
+        &["--headless", "--place", "0.5,0.2,inf"],
+        dir.path(),
+        "--place 0.5,0.2,inf: a point must be three finite numbers",
+    )?;
+    assert_refused(
+        &["--headless", "--fetch", "0.27"],
+        dir.path(),
+        "--fetch 0.27: expected X,Y",
+    )?;
 
     let out = rover(&["--headless", "--script", "missing.toml"], dir.path())?;
     assert_eq!(out.status.code(), Some(1));

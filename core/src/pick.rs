@@ -671,6 +671,20 @@ impl Pick {
         Some((at.translation.vector - want.translation.vector).norm())
     }
 
+    /// What every plan starts from: the gripper, where the arm's base is, and the planning
+    /// scene as the world is now.
+    fn planning_start(
+        &self,
+        sim: &Simulation,
+    ) -> Result<(Gripper, Isometry3<f64>, PlanningScene), String> {
+        let g = self.gripper.clone()?;
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        let scene = sim
+            .planning_scene(self.solver.chain(), self.config.margin_m as f32)
+            .map_err(|e| e.to_string())?;
+        Ok((g, world_from_base, scene))
+    }
+
     /// The whole plan for `target` (called `what`): the grasp, then the place (or, with no
     /// place, holding it up).
     fn plan(
@@ -679,11 +693,7 @@ impl Pick {
         what: &str,
         target: Target,
     ) -> Result<VecDeque<(Step, PickState)>, String> {
-        let g = self.gripper.clone()?;
-        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
-        let mut scene = sim
-            .planning_scene(self.solver.chain(), self.config.margin_m as f32)
-            .map_err(|e| e.to_string())?;
+        let (g, world_from_base, mut scene) = self.planning_start(sim)?;
         let w = world_from_base * Point3::from(target.centre);
         let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
         // Over the place: where the carry ends, and how far it then goes straight down.
@@ -1279,11 +1289,7 @@ impl Pick {
         sim: &Simulation,
         held: Held,
     ) -> Result<Vec<(Step, PickState)>, String> {
-        let g = self.gripper.clone()?;
-        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
-        let mut scene = sim
-            .planning_scene(self.solver.chain(), self.config.margin_m as f32)
-            .map_err(|e| e.to_string())?;
+        let (g, world_from_base, mut scene) = self.planning_start(sim)?;
         let q: Vec<f64> = (self.joints().iter())
             .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
             .collect();
