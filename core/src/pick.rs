@@ -518,20 +518,17 @@ impl Pick {
         self.plan_for(sim, &format!("\"{name}\""), target);
     }
 
-    /// Stops where it is (the arm holds), saying `why`.
+    /// Stops where it is (the arm holds, the base is left alone), saying `why`.
     pub fn stop(&mut self, why: &str) {
-        self.leg = None;
-        self.base_cmd = None;
-        self.state = PickState::Failed;
-        self.steps.clear();
-        self.running = None;
-        self.said.push((true, why.to_owned()));
+        self.fail(why.to_owned());
     }
 
     fn fail(&mut self, why: String) {
         self.state = PickState::Failed;
         self.steps.clear();
         self.running = None;
+        self.leg = None;
+        self.base_cmd = None;
         self.said.push((true, format!("pick: {why}")));
     }
 
@@ -671,6 +668,13 @@ impl Pick {
         Some((at.translation.vector - want.translation.vector).norm())
     }
 
+    /// The chain's joint positions now.
+    fn chain_q(&self, sim: &Simulation) -> Vec<f64> {
+        (self.joints().iter())
+            .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
+            .collect()
+    }
+
     /// What every plan starts from: the gripper, where the arm's base is, and the planning
     /// scene as the world is now.
     fn planning_start(
@@ -698,16 +702,8 @@ impl Pick {
         let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
         // Over the place: where the carry ends, and how far it then goes straight down.
         let place_under = self.place_under(sim)?;
-        let place = place_under.map(|(under, drop_m, lower_m)| {
-            let over = world_from_base.inverse()
-                * Point3::new(under[0], under[1], under[2] + drop_m + target.half_height_m);
-            (over.coords, lower_m)
-        });
-        let q0: Vec<f64> = self
-            .joints()
-            .iter()
-            .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
-            .collect();
+        let place = place_under.map(|p| over_place(&world_from_base, p, target.half_height_m));
+        let q0 = self.chain_q(sim);
         let grasp = self.plan_grasp(&mut scene, what, target, object, &g, &q0)?;
         let assist = sim.world().robot.grasp == GraspMode::Assist;
         let joints = self.joints().to_vec();
@@ -1290,9 +1286,7 @@ impl Pick {
         held: Held,
     ) -> Result<Vec<(Step, PickState)>, String> {
         let (g, world_from_base, mut scene) = self.planning_start(sim)?;
-        let q: Vec<f64> = (self.joints().iter())
-            .map(|j| sim.joint_state(j.id).map_or(0.0, |s| s.position))
-            .collect();
+        let q = self.chain_q(sim);
         // The object in the hand is carried, not avoided.
         let tool = self
             .solver
@@ -1306,17 +1300,27 @@ impl Pick {
         ) {
             scene.ignore_object(i, true);
         }
-        let ([x, y, z], drop_m, lower_m) = held.place;
-        let over =
-            world_from_base.inverse() * Point3::new(x, y, z + drop_m + held.target.half_height_m);
+        let over = over_place(&world_from_base, held.place, held.target.half_height_m);
         self.plan_place(
             &mut scene,
             (held.target, held.way),
             &g,
             (&q, &held.home_q),
-            (over.coords, lower_m),
+            over,
         )
     }
+}
+
+/// Where the carry ends over a place ([`Pick::place_under`]: the point under the object, how
+/// high above it the carry ends, how far the hand then goes down), in the arm's base frame for
+/// an object `half_height_m` tall above its centre, and how far it goes down.
+fn over_place(
+    world_from_base: &Isometry3<f64>,
+    ([x, y, z], above_m, lower_m): ([f64; 3], f64, f64),
+    half_height_m: f64,
+) -> (Vector3<f64>, f64) {
+    let over = world_from_base.inverse() * Point3::new(x, y, z + above_m + half_height_m);
+    (over.coords, lower_m)
 }
 
 /// World object `name`'s shape and pose now; else an error saying what it was wanted for

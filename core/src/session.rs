@@ -287,9 +287,11 @@ impl Session {
         let cmd = self.pilot.apply(&action);
         let after = self.pilot.mode();
         if cmd.is_some() && self.arm.base_command().is_some() {
-            // A person (or a ROS node) driving takes the base back from a fetch.
+            // A person (or a ROS node) driving takes the base back from a fetch: their command
+            // stands (no stop follows it).
             self.arm
-                .stop_fetch("pick: stopped: the base was driven by another input");
+                .stop_fetch("stopped: the base was driven by another input");
+            self.fetch_drove = false;
         }
         if before != after {
             self.follower.reset();
@@ -473,7 +475,9 @@ impl Session {
         let cmd = self.arm.base_command();
         match cmd {
             Some(cmd) if self.pilot.mode() == Mode::Manual => self.sim.set_cmd_vel(cmd)?,
-            None if self.fetch_drove => self.sim.set_cmd_vel(rover_sim::Twist::ZERO)?,
+            None if self.fetch_drove && self.pilot.mode() == Mode::Manual => {
+                self.sim.set_cmd_vel(rover_sim::Twist::ZERO)?;
+            }
             _ => {}
         }
         self.fetch_drove = cmd.is_some();

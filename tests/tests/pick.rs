@@ -229,6 +229,50 @@ fn the_arm_car_fetches_the_ball_from_a_table_into_a_bin_1_m_away() -> Result<()>
     Ok(())
 }
 
+/// A key pressed while a fetch drives takes the base back: the pick stops, saying so, and the
+/// key's command drives the car (no stop from the fetch comes after it).
+#[test]
+fn a_key_takes_the_base_back_from_a_fetch() -> Result<()> {
+    use rover_core::KeyAction;
+    let mut said = Said::default();
+    let mut session = session_in("worlds/arm_car_fetch.toml", 0, |_| {})?;
+    session.input(Action::TogglePick, &mut said);
+    let run = |session: &mut Session, seconds: f64, said: &mut Said| -> Result<()> {
+        let end = session.sim().sim_time_s() + seconds;
+        while session.sim().sim_time_s() < end {
+            session.step(said)?;
+        }
+        Ok(())
+    };
+    run(&mut session, 2.0, &mut said)?;
+    assert_eq!(
+        session.stats().arm.pick,
+        PickState::Fetching,
+        "{:?}",
+        said.0
+    );
+    assert!(
+        session.sim().odometry().linear_mps > 0.1,
+        "the fetch is not driving"
+    );
+    session.input(Action::Key(KeyAction::Move { x: -1.0, th: 0.0 }), &mut said);
+    run(&mut session, 1.0, &mut said)?;
+    assert_eq!(session.stats().arm.pick, PickState::Failed);
+    assert!(
+        said.0
+            .iter()
+            .any(|(_, _, t)| t == "pick: stopped: the base was driven by another input"),
+        "{:?}",
+        said.0
+    );
+    let backing = session.sim().odometry().linear_mps;
+    assert!(
+        backing < -0.3,
+        "the key's command did not hold: {backing} m/s"
+    );
+    Ok(())
+}
+
 /// Where trial `seed` puts the ball on the table (world frame, its centre): x 0.23-0.29 m,
 /// y 0.05-0.125 m: left of the bin, within the arm's reach, and where the mast's camera sees
 /// all of it and YOLO (yolov12n) calls it a sports ball at 0.44-0.82. Nearer the middle the

@@ -375,13 +375,7 @@ impl Simulation {
                 if !pair.has_any_active_contact() || pair.total_impulse_magnitude() <= 0.0 {
                     continue;
                 }
-                let other = if pair.collider1 == *collider {
-                    pair.collider2
-                } else {
-                    pair.collider1
-                };
-                let parent = self.physics.colliders.get(other).and_then(|c| c.parent());
-                let name = match parent {
+                let name = match self.other_body(pair, *collider) {
                     Some(b) => match self.link_body.iter().position(|l| *l == b) {
                         Some(link) => self.robot.links[link].name.clone(),
                         None => self.body_name(b),
@@ -396,9 +390,9 @@ impl Simulation {
         out
     }
 
-    /// The force (N) the ground pushes on link `link`'s body with, in the last step (the sum
-    /// of its contacts' impulses over the step; links welded into one body share it). 0 for a
-    /// link not on the ground.
+    /// The force (N) the ground (or a collider on no body) pushes on link `link`'s body with,
+    /// in the last step (the sum of those contacts' impulses over the step; links welded into
+    /// one body share it). 0 for a link not on the ground.
     pub fn ground_force_n(&self, link: crate::LinkId) -> f32 {
         let Some(body) = self.link_body.get(link.index()) else {
             return 0.0;
@@ -410,18 +404,23 @@ impl Simulation {
         let mut impulse = 0.0;
         for collider in rb.colliders() {
             for pair in self.physics.narrow_phase.contact_pairs_with(*collider) {
-                let other = if pair.collider1 == *collider {
-                    pair.collider2
-                } else {
-                    pair.collider1
-                };
-                let parent = self.physics.colliders.get(other).and_then(|c| c.parent());
+                let parent = self.other_body(pair, *collider);
                 if parent.is_none() || parent == Some(self.ground) {
                     impulse += pair.total_impulse_magnitude();
                 }
             }
         }
         impulse / dt
+    }
+
+    /// The body of the collider `pair` pairs with `collider` (`None`: a collider on no body).
+    fn other_body(&self, pair: &ContactPair, collider: ColliderHandle) -> Option<RigidBodyHandle> {
+        let other = if pair.collider1 == collider {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        self.physics.colliders.get(other).and_then(|c| c.parent())
     }
 
     /// The name of a body that is not the robot's.
