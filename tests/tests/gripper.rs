@@ -263,11 +263,13 @@ fn ball_in_palm(sim: &rover_sim::Simulation) -> Result<glam::Vec3> {
     Ok(sim.world_from_link(palm).inverse().transform_point(ball))
 }
 
-/// How far the held ball moves in the palm's frame while the lifter lifts it 25 cm, turns it
-/// 1 rad and drops and raises it 10 cm twice at full speed (m); whether it fell when the
-/// fingers opened; what the grasp assist held, if anything. `grasp` is the world's `[robot]
-/// grasp` line.
-fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
+/// The lifter (tests/grasper/lifter.urdf) lowered round the ball on the ground and closed on
+/// it with `squeeze_n` (the GripperCommand's max_effort); `grasp` is the world's `[robot]
+/// grasp` line. The simulation and how the close ended.
+fn lifter_grasp(
+    grasp: &str,
+    squeeze_n: f64,
+) -> Result<(rover_sim::Simulation, rover_sim::GripperState)> {
     let dir = tempfile::tempdir()?;
     let from = rover_tests::repo("tests/grasper");
     for file in ["lifter.urdf", "grasper.yaml"] {
@@ -282,8 +284,17 @@ fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
     run(&mut sim, 0.5);
     sim.command_joint("lift_joint", JointCommand::Position(-0.055))?;
     run(&mut sim, 1.5);
-    sim.command_gripper("gripper_controller", 0.05, 10.0)?;
+    sim.command_gripper("gripper_controller", 0.05, squeeze_n)?;
     let grasp_state = until_done(&mut sim, 5.0)?;
+    Ok((sim, grasp_state))
+}
+
+/// How far the held ball moves in the palm's frame while the lifter lifts it 25 cm, turns it
+/// 1 rad and drops and raises it 10 cm twice at full speed (m); whether it fell when the
+/// fingers opened; what the grasp assist held, if anything. `grasp` is the world's `[robot]
+/// grasp` line.
+fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
+    let (mut sim, grasp_state) = lifter_grasp(grasp, 10.0)?;
     ensure!(
         grasp_state.stalled,
         "the fingers did not close on the ball: {grasp_state:?}"
@@ -383,6 +394,37 @@ fn the_grasp_assist_without_a_gripper_controller_is_refused() -> Result<()> {
     ensure!(
         error.contains("grasp = \"assist\" needs a gripper controller"),
         "{error:?}"
+    );
+    Ok(())
+}
+
+/// Friction holds what Coulomb's bound holds and no more (the finger pads' friction anchors,
+/// sim/src/physics/grip_friction.rs, included): closed on the 50 g ball with 0.05 N, two pads
+/// at mu 1 grip it with at most 0.1 N of friction against its 0.49 N weight, and when the
+/// lifter rises 25 cm the ball stays on the ground; closed with 10 N it rises with them.
+#[test]
+fn a_ball_squeezed_too_weakly_for_its_weight_slides_out_of_the_fingers() -> Result<()> {
+    let mut lifted = Vec::new();
+    for squeeze_n in [0.05, 10.0] {
+        let (mut sim, closed) = lifter_grasp("", squeeze_n)?;
+        run(&mut sim, 1.2);
+        sim.command_joint("lift_joint", JointCommand::Position(0.2))?;
+        run(&mut sim, 1.5);
+        let mut poses = Vec::new();
+        sim.object_poses_into(&mut poses);
+        let z = poses.first().context("no ball")?.translation.z;
+        println!("squeezed with {squeeze_n} N ({closed:?}): the ball is at z {z:.3} m");
+        lifted.push(z);
+    }
+    ensure!(
+        lifted[0] < 0.05,
+        "a 0.05 N squeeze lifted the ball to z {} m",
+        lifted[0]
+    );
+    ensure!(
+        lifted[1] > 0.2,
+        "a 10 N squeeze did not lift the ball: z {} m",
+        lifted[1]
     );
     Ok(())
 }

@@ -342,9 +342,9 @@ fn ball_in_tool(session: &Session) -> Result<glam::Vec3> {
 
 /// Holding: with no place the pick lifts the ball and keeps it. Then the car drives 2 m at
 /// 0.5 m/s, turns 90 degrees at 1 rad/s and brakes to a stop (teleop's `,`, `j`, `k`): the
-/// ball moves less than 1 cm in the tool's frame from where it sat when the car set off with
-/// the grasp assist; by friction (the default) the figure is printed (see below). It backs away, as
-/// the table is in front of it.
+/// ball moves less than 1 cm in the tool's frame from where it sat when the car set off, held
+/// by friction (the default; the pads' friction anchors keep it from creeping, without them it
+/// slid 2 cm) and by the grasp assist. It backs away, as the table is in front of it.
 #[test]
 fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Result<()> {
     use rover_core::KeyAction;
@@ -427,16 +427,10 @@ fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Re
             outcome.slip_m,
             session.sim().grasp_assist_holds()
         );
-        // By friction the ball slides ~2 cm along the pads when the car sets off and turns
-        // (the fingers squeeze it with 5 N, centred; at 10 N the multibody mimic finger
-        // yields and the grip goes off-centre). The figure is printed; the issue stays open
-        // on it.
-        if mode == rover_sim::GraspMode::Assist {
-            assert!(
-                worst < 0.01,
-                "{mode:?}: the ball moved {worst} m in the hand"
-            );
-        }
+        assert!(
+            worst < 0.01,
+            "{mode:?}: the ball moved {worst} m in the hand"
+        );
         assert!(x0 - pose.x_m > 1.8, "{mode:?}: drove {} m", x0 - pose.x_m);
     }
     Ok(())

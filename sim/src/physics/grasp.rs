@@ -58,30 +58,12 @@ impl GraspAssist {
         link_body: &[RigidBodyHandle],
         objects: usize,
     ) -> Result<Self> {
-        let finger = robot
-            .controllers
-            .as_ref()
-            .and_then(|c| c.first_gripper())
-            .map(|(_, g)| g.joint.clone())
-            .ok_or_else(|| {
-                SimError::Setup(format!(
-                    "grasp = \"assist\" needs a gripper controller (position_controllers/GripperActionController) in \"{}\"'s controllers file",
-                    robot.name
-                ))
-            })?;
-        let id = robot
-            .joint_id(&finger)
-            .ok_or_else(|| SimError::Setup(format!("no joint \"{finger}\"")))?;
-        let leader = robot.joint(id);
-        let body = |link: crate::model::robot::LinkId| link_body.get(link.index()).copied();
-        let palm = body(leader.parent)
-            .ok_or_else(|| SimError::Setup(format!("joint \"{finger}\"'s palm has no body")))?;
-        let fingers: Vec<RigidBodyHandle> = robot
-            .joint_ids()
-            .filter(|(other, j)| *other == id || j.mimic.as_ref().is_some_and(|m| m.joint == id))
-            .filter_map(|(_, j)| body(j.child))
-            .filter(|b| *b != palm)
-            .collect();
+        let (palm, fingers) = gripper_bodies(robot, link_body)?.ok_or_else(|| {
+            SimError::Setup(format!(
+                "grasp = \"assist\" needs a gripper controller (position_controllers/GripperActionController) in \"{}\"'s controllers file",
+                robot.name
+            ))
+        })?;
         Ok(Self {
             palm,
             fingers,
@@ -210,4 +192,35 @@ impl GraspAssist {
         });
         Some(format!("grasp assist: holding object {k}"))
     }
+}
+
+/// The robot's first gripper controller's palm (its finger joint's parent link's body) and
+/// fingers (the bodies of that joint's child link and of those of the joints that mimic it);
+/// `None` without a gripper controller.
+pub(crate) fn gripper_bodies(
+    robot: &RobotModel,
+    link_body: &[RigidBodyHandle],
+) -> Result<Option<(RigidBodyHandle, Vec<RigidBodyHandle>)>> {
+    let Some(finger) = robot
+        .controllers
+        .as_ref()
+        .and_then(|c| c.first_gripper())
+        .map(|(_, g)| g.joint.clone())
+    else {
+        return Ok(None);
+    };
+    let id = robot
+        .joint_id(&finger)
+        .ok_or_else(|| SimError::Setup(format!("no joint \"{finger}\"")))?;
+    let leader = robot.joint(id);
+    let body = |link: crate::model::robot::LinkId| link_body.get(link.index()).copied();
+    let palm = body(leader.parent)
+        .ok_or_else(|| SimError::Setup(format!("joint \"{finger}\"'s palm has no body")))?;
+    let fingers: Vec<RigidBodyHandle> = robot
+        .joint_ids()
+        .filter(|(other, j)| *other == id || j.mimic.as_ref().is_some_and(|m| m.joint == id))
+        .filter_map(|(_, j)| body(j.child))
+        .filter(|b| *b != palm)
+        .collect();
+    Ok(Some((palm, fingers)))
 }

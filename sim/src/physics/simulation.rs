@@ -21,6 +21,7 @@ use crate::physics::controllers::{
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
+use crate::physics::grip_friction::{ContactHooks, FrictionAnchors};
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
 
 /// Options that are not part of the world or robot files.
@@ -88,6 +89,8 @@ pub struct Simulation {
     grasp: Option<crate::physics::grasp::GraspAssist>,
     /// Contacts of `<kp>` links, which give way (rapier's contact hook).
     springs: crate::physics::contact_springs::ContactSprings,
+    /// Static friction on the gripper's finger pads.
+    anchors: FrictionAnchors,
     /// Counts placements ([`Simulation::layout_version`]).
     pub(crate) layout: u64,
     /// Relative poses of placed things, kept until the next step.
@@ -221,8 +224,13 @@ impl Simulation {
                 )?)
             }
         };
+        let fingers = crate::physics::grasp::gripper_bodies(&robot, &robot_bodies.link_body)?
+            .map(|(_, fingers)| fingers)
+            .unwrap_or_default();
+        let anchors = FrictionAnchors::new(&mut physics, &fingers);
         Ok(Self {
             physics,
+            anchors,
             springs: robot_bodies.springs,
             link_body: robot_bodies.link_body,
             body_from_link: robot_bodies.body_from_link,
@@ -289,10 +297,17 @@ impl Simulation {
             self.actuators.update(&mut self.physics, period_s);
         }
         self.actuators.apply_efforts(&mut self.physics, self.dt_s);
-        if self.springs.is_empty() {
+        if self.springs.is_empty() && self.anchors.is_empty() {
             self.physics.step();
         } else {
-            self.physics.step_with_events(&self.springs, &());
+            let hooks = ContactHooks {
+                springs: &self.springs,
+                anchors: &self.anchors,
+            };
+            self.physics.step_with_events(&hooks, &());
+        }
+        if !self.anchors.is_empty() {
+            self.anchors.update(&self.physics, &self.objects);
         }
         if let Some(grasp) = &mut self.grasp
             && let Some(event) = grasp.update(&mut self.physics, &self.objects, now)
