@@ -37,8 +37,10 @@ impl PhysicsBench {
     }
 }
 
-/// Steps the world's physics with the robot driving a figure of eight (forward at 0.5 m/s,
-/// turning left then right every 4 s) for `sim_s` seconds, `repeats` times; keeps the fastest.
+/// Steps the world's physics with the robot driving a figure of eight (forward at
+/// [`EIGHT_SPEED_MPS`], a full circle left at [`EIGHT_TURN_RADPS`], then one right) for `sim_s`
+/// seconds, `repeats` times; keeps the fastest. The eight closes, so the robot stays within
+/// 3.5 m of where it started however long it runs (a 20 m ground holds it).
 pub fn physics(
     config: &RunConfig,
     step_hz: Option<f64>,
@@ -61,11 +63,15 @@ pub fn physics(
         let steps = (sim_s / sim.dt_s()).round() as u64;
         let started = Instant::now();
         let mut turning_left = true;
-        sim.set_cmd_vel(Twist::new(0.5, 0.6))?;
+        let lobe_steps = (std::f64::consts::TAU / EIGHT_TURN_RADPS * rate).round() as u64;
         while sim.step_index() - first < steps {
-            if (sim.step_index() - first) % (4 * rate as u64) == 0 {
-                let turn = if turning_left { 0.6 } else { -0.6 };
-                sim.set_cmd_vel(Twist::new(0.5, turn))?;
+            if (sim.step_index() - first).is_multiple_of(lobe_steps.max(1)) {
+                let turn = if turning_left {
+                    EIGHT_TURN_RADPS
+                } else {
+                    -EIGHT_TURN_RADPS
+                };
+                sim.set_cmd_vel(Twist::new(EIGHT_SPEED_MPS, turn))?;
                 turning_left = !turning_left;
             }
             sim.step();
@@ -82,6 +88,11 @@ pub fn physics(
         held_off_m,
     })
 }
+
+/// The physics benchmark's driving speed (m/s).
+const EIGHT_SPEED_MPS: f64 = 0.5;
+/// The physics benchmark's turn rate (rad/s): circles of 0.83 m radius.
+const EIGHT_TURN_RADPS: f64 = 0.6;
 
 /// Puts world object `name` in the robot's gripper, untimed: the first gripper controller
 /// opens, the object goes to the end effector (the world's `[robot] ee_link`), the gripper
