@@ -46,6 +46,8 @@ pub(crate) struct FrictionAnchors {
     pads: Vec<ColliderHandle>,
     /// The anchored contacts, by rapier's collider pair.
     anchors: HashMap<(ColliderHandle, ColliderHandle), Anchor>,
+    /// The anchors being gathered by an update (kept to reuse its memory).
+    next: HashMap<(ColliderHandle, ColliderHandle), Anchor>,
     /// The velocity of collider2's surface relative to collider1's the next step's friction
     /// asks for, per pair (world frame, m/s).
     corrections: HashMap<(ColliderHandle, ColliderHandle), Vec3>,
@@ -80,8 +82,7 @@ impl FrictionAnchors {
     /// stuck, anchors new contacts, drops those that ended, and sets the next step's
     /// corrections.
     pub(crate) fn update(&mut self, physics: &PhysicsWorld, objects: &[RigidBodyHandle]) {
-        let mut kept: HashMap<(ColliderHandle, ColliderHandle), Anchor> =
-            HashMap::with_capacity(self.anchors.len());
+        self.next.clear();
         self.corrections.clear();
         for pad in &self.pads {
             for pair in physics.narrow_phase.contact_pairs_with(*pad) {
@@ -108,12 +109,12 @@ impl FrictionAnchors {
                     .filter(|a| touch.slip(a).length() <= SLIPPED_M)
                     .unwrap_or_else(|| touch.anchor());
                 let slip = touch.slip(&anchor);
-                kept.insert(key, anchor);
+                self.next.insert(key, anchor);
                 let correction = (-slip / ANCHOR_TIME_S).clamp_length_max(MAX_CORRECTION_MPS);
                 self.corrections.insert(key, correction);
             }
         }
-        self.anchors = kept;
+        std::mem::swap(&mut self.anchors, &mut self.next);
     }
 }
 
