@@ -150,6 +150,10 @@ impl RunConfig {
     pub fn load_world_and_robot(&self) -> Result<(World, RobotModel)> {
         let world_path = self.world.clone().unwrap_or_else(paths::default_world);
         let mut world = World::load_with(&world_path, &self.resource_paths())?;
+        // `--srdf` stands for the world's: the planner reads its collision pairs from there.
+        if let Some(srdf) = &self.arm.srdf {
+            world.robot.srdf = Some(srdf.clone());
+        }
         if let Some([x, y, yaw_deg]) = self.spawn {
             world.robot.position_m = [x, y];
             world.robot.yaw_rad = yaw_deg.to_radians();

@@ -2,7 +2,7 @@
 //! (`tiago_no_hand.urdf`) and Universal Robots' UR5, both from PyPI `example-robot-data`
 //! 6.0.0, fetched into the cache at test time (skipped, with the reason, when unavailable).
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use rover_sim::{
     JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel, SimOptions,
     Simulation, Twist, World,
@@ -602,6 +602,11 @@ fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
     );
     let chain = KinematicChain::new(&robot, &group.base_link, &group.tip_link)?;
     assert_eq!(chain.joints().len(), 7);
+    // Its <disable_collisions>: 35 pairs, every link the URDF's.
+    let (pairs, unknown) = rover_sim::load_disabled_collisions(&srdf, &robot)?;
+    let id = |name: &str| robot.link_id(name).context(name.to_owned());
+    assert_eq!((pairs.len(), unknown.len()), (35, 0), "{unknown:?}");
+    assert!(pairs.contains(&(id("panda_hand")?, id("panda_leftfinger")?)));
     let err = load_arm_group(&srdf, &robot, Some("legs"))
         .err()
         .map(|e| e.to_string())

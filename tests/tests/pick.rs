@@ -643,3 +643,86 @@ fn the_panda_picks_a_cube_and_sets_it_down_20_cm_away() -> Result<()> {
     );
     Ok(())
 }
+
+/// The planner checks the arm against itself, as MoveIt does. Straight up the arm car's arm is
+/// clear; folded (elbow 2.4 rad, wrist pitch 1.8 rad) its fingers come back down through its
+/// shoulder and the planning scene names the pair. An SRDF (`[robot] srdf`) whose
+/// `<disable_collisions>` lists the shoulder's and upper arm's pairs with the links beyond the
+/// elbow takes them out of the checks; a `<disable_collisions>` without `link2` is refused naming the file
+/// and line; pairs naming links the robot does not have are left out.
+#[test]
+fn the_planning_scene_checks_the_arm_against_itself_and_reads_the_srdfs_pairs() -> Result<()> {
+    let config = rover_core::RunConfig {
+        world: Some(rover_tests::repo("worlds/arm_car_pick.toml")),
+        ..rover_core::RunConfig::default()
+    };
+    let (world, robot) = config.load_world_and_robot()?;
+    let chain = rover_sim::KinematicChain::new(&robot, "base_link", "tool_link")?;
+    let folded = [0.0, 0.0, 2.4, 1.8, 0.0];
+    let hit = |world: rover_sim::World| -> Result<[Option<rover_sim::SceneContact>; 2]> {
+        let sim =
+            rover_sim::Simulation::new(world, robot.clone(), &rover_sim::SimOptions::default())?;
+        let mut scene = sim.planning_scene(&chain, 0.01)?;
+        Ok([scene.collision(&[0.0; 5]), scene.collision(&folded)])
+    };
+    let [straight, bent] = hit(world.clone())?;
+    println!("straight up: {straight:?}; folded: {bent:?}");
+    assert_eq!(straight, None);
+    let bent = bent.ok_or_else(|| anyhow::anyhow!("the folded arm hits nothing"))?;
+    let (near, far) = (
+        ["shoulder_link", "upper_arm_link"],
+        [
+            "forearm_link",
+            "wrist_link",
+            "hand_link",
+            "left_finger_link",
+            "right_finger_link",
+        ],
+    );
+    let robots = |l: &str| format!("{l} (the robot's)");
+    let disabled = |c: &rover_sim::SceneContact| {
+        near.iter().any(|n| {
+            far.iter().any(|f| {
+                (c.link == *n && c.obstacle == robots(f))
+                    || (c.link == *f && c.obstacle == robots(n))
+            })
+        })
+    };
+    assert!(disabled(&bent), "{bent}");
+    let dir = tempfile::tempdir()?;
+    let pairs: String = near
+        .iter()
+        .flat_map(|n| far.iter().map(move |f| (n, f)))
+        .map(|(n, f)| {
+            format!("  <disable_collisions link1=\"{n}\" link2=\"{f}\" reason=\"Never\"/>\n")
+        })
+        .collect();
+    let srdf = dir.path().join("arm_car.srdf");
+    std::fs::write(
+        &srdf,
+        format!(
+            "<robot name=\"my_robot\">\n{pairs}  <disable_collisions link1=\"gripper_palm\" link2=\"upper_arm_link\" reason=\"Never\"/>\n</robot>\n"
+        ),
+    )?;
+    let mut with_srdf = world.clone();
+    with_srdf.robot.srdf = Some(srdf.clone());
+    let [_, bent] = hit(with_srdf)?;
+    println!("folded, with the SRDF's pairs: {bent:?}");
+    assert!(bent.as_ref().is_none_or(|c| !disabled(c)), "{bent:?}");
+    std::fs::write(
+        &srdf,
+        "<robot name=\"my_robot\">\n  <disable_collisions link1=\"hand_link\" reason=\"Never\"/>\n</robot>\n",
+    )?;
+    let mut bad = world;
+    bad.robot.srdf = Some(srdf);
+    let err = rover_sim::Simulation::new(bad, robot.clone(), &rover_sim::SimOptions::default())
+        .err()
+        .ok_or_else(|| anyhow::anyhow!("a <disable_collisions> without link2 was taken"))?
+        .to_string();
+    println!("{err}");
+    assert!(
+        err.contains("arm_car.srdf:2") && err.contains("link2"),
+        "{err}"
+    );
+    Ok(())
+}

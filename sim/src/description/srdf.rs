@@ -2,8 +2,9 @@
 //! reach (`--srdf FILE --arm-group NAME`). Read: `<group>` with a `<chain base_link tip_link>`,
 //! or `<joint name>`s (the chain from the first joint's parent to the last's child), or
 //! `<group name>`s (their joints together); `<end_effector parent_link parent_group>` names the
-//! tool when there is one. Collision pairs, virtual joints and group states are not needed
-//! here and are skipped.
+//! tool when there is one. `<disable_collisions link1 link2>` pairs are read for the planning
+//! scene's self-collision checks ([`load_disabled_collisions`]). Virtual joints and group
+//! states are not needed here and are skipped.
 
 use std::path::Path;
 
@@ -11,7 +12,7 @@ use roxmltree::Node;
 
 use crate::description::xml::{children, line_of, parse_xml};
 use crate::error::{Result, SimError};
-use crate::model::{JointKind, RobotModel};
+use crate::model::{JointKind, LinkId, RobotModel};
 
 /// A planning group resolved to the links of its serial chain.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -100,6 +101,84 @@ pub fn parse_arm_group(
         base_link,
         tip_link,
     })
+}
+
+/// The link pairs an SRDF's `<disable_collisions link1 link2 reason>` lines say never collide
+/// (or always touch): the planner does not check them against each other. Pairs naming a link
+/// the robot does not have are left out (an SRDF written for a fuller variant of the robot),
+/// their names returned as the second list. A file that is not an SRDF, or a line without
+/// both links, is an error naming the file and line.
+pub fn load_disabled_collisions(
+    path: &Path,
+    robot: &RobotModel,
+) -> Result<(Vec<(LinkId, LinkId)>, Vec<String>)> {
+    let text = crate::io::read_text(path)?;
+    parse_disabled_collisions(&text, path, robot)
+}
+
+/// The link pairs the world's SRDF (`[robot] srdf`) says never collide, if it names one; links
+/// the robot does not have are left out, saying so.
+pub(crate) fn srdf_disabled_collisions(
+    world: &crate::model::world::World,
+    robot: &RobotModel,
+) -> Result<Vec<(LinkId, LinkId)>> {
+    let Some(path) = &world.robot.srdf else {
+        return Ok(Vec::new());
+    };
+    let (pairs, unknown) = load_disabled_collisions(path, robot)?;
+    if !unknown.is_empty() {
+        tracing::warn!(
+            "{}: <disable_collisions> pairs naming links robot \"{}\" does not have are left out: {}",
+            path.display(),
+            robot.name,
+            unknown.join(", ")
+        );
+    }
+    Ok(pairs)
+}
+
+/// As [`load_disabled_collisions`], from text; `path` is used in messages.
+pub fn parse_disabled_collisions(
+    text: &str,
+    path: &Path,
+    robot: &RobotModel,
+) -> Result<(Vec<(LinkId, LinkId)>, Vec<String>)> {
+    let doc = parse_xml(text, path)?;
+    let root = doc.root_element();
+    let fail = |node: Node<'_, '_>, message: String| {
+        SimError::invalid(path, Some(line_of(&doc, node)), message)
+    };
+    if !root.has_tag_name("robot") {
+        return Err(fail(
+            root,
+            format!(
+                "expected an SRDF <robot>, found <{}>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    let (mut pairs, mut unknown) = (Vec::new(), Vec::new());
+    for node in children(root, "disable_collisions") {
+        let link = |attr: &str| {
+            node.attribute(attr).ok_or_else(|| {
+                fail(
+                    node,
+                    format!("<disable_collisions> needs {attr}=\"...\" (a link name)"),
+                )
+            })
+        };
+        let (a, b) = (link("link1")?, link("link2")?);
+        match (robot.link_id(a), robot.link_id(b)) {
+            (Some(a), Some(b)) => pairs.push((a, b)),
+            (first, _) => {
+                let missing = if first.is_none() { a } else { b };
+                if !unknown.iter().any(|u| u == missing) {
+                    unknown.push(missing.to_owned());
+                }
+            }
+        }
+    }
+    Ok((pairs, unknown))
 }
 
 /// The base and last link of `group`'s chain (a subgroup's joints count as the group's).

@@ -60,7 +60,8 @@ pub struct RobotSpawn {
     /// (default: the first).
     pub camera: Option<String>,
     /// `srdf`: a MoveIt SRDF for the robot (resolved against the world file's folder): its
-    /// planning group gives the arm's base and end effector.
+    /// planning group gives the arm's base and end effector, its `<disable_collisions>` the
+    /// link pairs the planner does not check against each other.
     pub srdf: Option<PathBuf>,
     /// `arm_group`: which SRDF group is the arm (default: `arm`, else the only group).
     pub arm_group: Option<String>,

@@ -20,7 +20,11 @@ use std::collections::HashMap;
 use glam::Vec3;
 use rapier3d::prelude::*;
 
+use crate::error::Result;
 use crate::geometry::Pose;
+use crate::model::robot::RobotModel;
+use crate::model::world::GraspMode;
+use crate::physics::grasp::{GraspAssist, gripper_bodies};
 
 use crate::physics::contact_springs::ContactSprings;
 
@@ -116,6 +120,25 @@ impl FrictionAnchors {
         }
         std::mem::swap(&mut self.anchors, &mut self.next);
     }
+}
+
+/// How the robot's first gripper holds: the grasp assist (with `grasp = "assist"`) and the
+/// friction anchors of its finger pads (none without a gripper controller). `objects`: how
+/// many world objects there are.
+pub(crate) fn grip(
+    robot: &RobotModel,
+    (link_body, objects): (&[RigidBodyHandle], usize),
+    mode: GraspMode,
+    physics: &mut PhysicsWorld,
+) -> Result<(Option<GraspAssist>, FrictionAnchors)> {
+    let assist = match mode {
+        GraspMode::Friction => None,
+        GraspMode::Assist => Some(GraspAssist::new(robot, link_body, objects)?),
+    };
+    let fingers = gripper_bodies(robot, link_body)?
+        .map(|(_, fingers)| fingers)
+        .unwrap_or_default();
+    Ok((assist, FrictionAnchors::new(physics, &fingers)))
 }
 
 /// A contact pair now: its two bodies' poses, the mean contact point on each surface and the

@@ -6,11 +6,14 @@
 //! - the robot's links the chain does not move (the chassis, a mast), except the ones a chain
 //!   link touches with every joint at zero (neighbours by construction, as MoveIt's setup
 //!   assistant's "adjacent" and "default" pairs);
-//! - an object held in the hand, carried with its link ([`PlanningScene::attach_sphere`]).
+//! - an object held in the hand, carried with its link ([`PlanningScene::attach_sphere`]);
+//! - the arm's own links against each other (overlapping, no margin), as MoveIt checks
+//!   self-collision: every pair but neighbours (links one joint apart, or welded by fixed
+//!   joints), pairs that touch with every joint at zero (the setup assistant's "adjacent" and
+//!   "default" pairs) and the pairs the world's SRDF (`[robot] srdf`) lists in
+//!   `<disable_collisions>`.
 //!
-//! A pair closer than the margin is a collision. The chain's own links are not checked against
-//! each other (a five-joint arm cannot fold onto itself; a longer arm's SRDF pairs are left for
-//! later).
+//! Against the world and the robot's other links, a pair closer than the margin is a collision.
 
 use glam::Quat;
 use rapier3d::parry::query;
@@ -78,6 +81,8 @@ pub struct PlanningScene {
     /// The links the chain moves, whether they are checked against the robot's other links,
     /// and their shapes (link frame).
     moving: Vec<(LinkId, bool, LinkShapes)>,
+    /// The pairs of [`Self::moving`] (indices) checked against each other.
+    self_pairs: Vec<(usize, usize)>,
     /// The robot's links the chain does not move that count as obstacles, with their shapes.
     fixed_links: Vec<(LinkId, Pose, SharedShape)>,
     obstacles: Vec<Obstacle>,
@@ -166,7 +171,44 @@ impl PlanningScene {
         }
         if let Some((link, pose, shape)) = &self.attached {
             let world = self.world_from_root * self.root_from_link[link.index()] * *pose;
-            return self.first_hit(&world, shape, true, || "held object".to_owned());
+            if let Some(hit) = self.first_hit(&world, shape, true, || "held object".to_owned()) {
+                return Some(hit);
+            }
+        }
+        self.self_collision()
+    }
+
+    /// The first pair of the arm's own links that overlap, at the pose [`Self::forward`] last
+    /// computed. No margin, as MoveIt pads no link by default: a moving link's shape is its
+    /// collision mesh's convex hull, larger than the link where it is concave.
+    fn self_collision(&self) -> Option<SceneContact> {
+        for &(a, b) in &self.self_pairs {
+            let ((link_a, _, shapes_a), (link_b, _, shapes_b)) = (&self.moving[a], &self.moving[b]);
+            let (root_from_a, root_from_b) = (
+                self.root_from_link[link_a.index()],
+                self.root_from_link[link_b.index()],
+            );
+            for (pose_a, shape_a) in shapes_a {
+                for (pose_b, shape_b) in shapes_b {
+                    let (at_a, at_b) = (root_from_a * *pose_a, root_from_b * *pose_b);
+                    if !shape_a
+                        .compute_aabb(&at_a)
+                        .intersects(&shape_b.compute_aabb(&at_b))
+                    {
+                        continue;
+                    }
+                    if query::intersection_test(&at_a, &**shape_a, &at_b, &**shape_b)
+                        .is_ok_and(|i| i.intersecting)
+                    {
+                        let name = |l: &LinkId| self.robot.links[l.index()].name.clone();
+                        return Some(SceneContact {
+                            link: name(link_a),
+                            obstacle: format!("{} (the robot's)", name(link_b)),
+                            distance_m: 0.0,
+                        });
+                    }
+                }
+            }
         }
         None
     }
@@ -223,6 +265,54 @@ impl PlanningScene {
             &mut self.root_from_link,
         );
     }
+}
+
+/// The pairs of `moving` (the chain's links with their shapes) a configuration is checked
+/// for: all but neighbours (one moving joint apart, or welded by fixed joints), pairs within
+/// `margin_m` of each other with every joint at zero (`at_zero`: the links' poses then) and
+/// the `disabled` pairs (an SRDF's).
+fn self_pairs(
+    robot: &RobotModel,
+    moving: &[(LinkId, bool, LinkShapes)],
+    at_zero: &[Pose],
+    (disabled, margin_m): (&[(LinkId, LinkId)], f32),
+) -> Vec<(usize, usize)> {
+    // Each link's rigid group: the topmost link it is welded to by fixed joints.
+    let mut group: Vec<usize> = (0..robot.links.len()).collect();
+    for id in joint_order(robot) {
+        let joint = robot.joint(id);
+        if joint.kind == JointKind::Fixed {
+            group[joint.child.index()] = group[joint.parent.index()];
+        }
+    }
+    let neighbours = |a: LinkId, b: LinkId| {
+        let (ga, gb) = (group[a.index()], group[b.index()]);
+        ga == gb
+            || robot.joints.iter().any(|j| {
+                let (p, c) = (group[j.parent.index()], group[j.child.index()]);
+                (p == ga && c == gb) || (p == gb && c == ga)
+            })
+    };
+    let touch_at_zero = |a: &(LinkId, bool, LinkShapes), b: &(LinkId, bool, LinkShapes)| {
+        a.2.iter().any(|(pa, sa)| {
+            b.2.iter().any(|(pb, sb)| {
+                let (at_a, at_b) = (at_zero[a.0.index()] * *pa, at_zero[b.0.index()] * *pb);
+                query::distance(&at_a, &**sa, &at_b, &**sb).is_ok_and(|d| d.distance < margin_m)
+            })
+        })
+    };
+    let mut out = Vec::new();
+    for (i, a) in moving.iter().enumerate() {
+        for (j, b) in moving.iter().enumerate().skip(i + 1) {
+            let listed = disabled
+                .iter()
+                .any(|&(x, y)| (x == a.0 && y == b.0) || (x == b.0 && y == a.0));
+            if !listed && !neighbours(a.0, b.0) && !touch_at_zero(a, b) {
+                out.push((i, j));
+            }
+        }
+    }
+    out
 }
 
 /// Every link's pose in the root frame with the joints at `q_all` (robot joint order),
@@ -311,10 +401,11 @@ impl Simulation {
                     .map(move |(pose, shape)| (LinkId(i), *pose, shape.clone()))
             })
             .collect();
-        let moving = (0..robot.links.len())
+        let moving: Vec<(LinkId, bool, LinkShapes)> = (0..robot.links.len())
             .filter(|&i| moved[i] && !shapes[i].is_empty())
             .map(|i| (LinkId(i), !first_only[i], shapes[i].clone()))
             .collect();
+        let self_pairs = self_pairs(robot, &moving, &at_zero, (&self.srdf_disabled, margin_m));
         let mut scene = PlanningScene {
             robot: robot.clone(),
             order,
@@ -322,6 +413,7 @@ impl Simulation {
             chain_joints,
             world_from_root: Pose::IDENTITY,
             moving,
+            self_pairs,
             fixed_links,
             obstacles: Vec::new(),
             attached: None,

@@ -91,6 +91,9 @@ pub struct Simulation {
     springs: crate::physics::contact_springs::ContactSprings,
     /// Static friction on the gripper's finger pads.
     anchors: FrictionAnchors,
+    /// Link pairs the world's SRDF (`[robot] srdf`) says never collide: the planning scene
+    /// does not check them against each other.
+    pub(crate) srdf_disabled: Vec<(LinkId, LinkId)>,
     /// Counts placements ([`Simulation::layout_version`]).
     pub(crate) layout: u64,
     /// Relative poses of placed things, kept until the next step.
@@ -214,20 +217,12 @@ impl Simulation {
                 .unwrap_or_default(),
         );
         let encoder = EncoderOdometry::new(start, &drive_config);
-        let grasp = match world.robot.grasp {
-            crate::model::world::GraspMode::Friction => None,
-            crate::model::world::GraspMode::Assist => {
-                Some(crate::physics::grasp::GraspAssist::new(
-                    &robot,
-                    &robot_bodies.link_body,
-                    objects.len(),
-                )?)
-            }
-        };
-        let fingers = crate::physics::grasp::gripper_bodies(&robot, &robot_bodies.link_body)?
-            .map(|(_, fingers)| fingers)
-            .unwrap_or_default();
-        let anchors = FrictionAnchors::new(&mut physics, &fingers);
+        let (grasp, anchors) = crate::physics::grip_friction::grip(
+            &robot,
+            (&robot_bodies.link_body, objects.len()),
+            world.robot.grasp,
+            &mut physics,
+        )?;
         Ok(Self {
             physics,
             anchors,
@@ -252,6 +247,7 @@ impl Simulation {
             actuators,
             controllers,
             control_steps,
+            srdf_disabled: crate::description::srdf::srdf_disabled_collisions(&world, &robot)?,
             robot,
             world,
         })
