@@ -27,10 +27,10 @@ mod render;
 mod sensors;
 
 pub use description::{
-    ArmGroup, Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh, TriMeshPart, WorldFile,
-    expand_xacro, load_arm_group, load_controllers, load_disabled_collisions, load_mesh,
-    load_texture, load_toml, parse_arm_group, parse_controllers, parse_disabled_collisions,
-    parse_toml, uses_xacro,
+    ArmGroup, DisabledCollisions, Expanded, LoadOptions, NotFound, ResourcePaths, TriMesh,
+    TriMeshPart, WorldFile, expand_xacro, load_arm_group, load_controllers,
+    load_disabled_collisions, load_mesh, load_texture, load_toml, parse_arm_group,
+    parse_controllers, parse_disabled_collisions, parse_toml, uses_xacro,
 };
 pub use error::{Location, Result, SimError};
 pub use geometry::{Pose, Rgba, Shape, pose_from_position_yaw, pose_from_xyz_rpy, yaw_of};

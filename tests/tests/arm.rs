@@ -603,7 +603,10 @@ fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
     let chain = KinematicChain::new(&robot, &group.base_link, &group.tip_link)?;
     assert_eq!(chain.joints().len(), 7);
     // Its <disable_collisions>: 35 pairs, every link the URDF's.
-    let (pairs, unknown) = rover_sim::load_disabled_collisions(&srdf, &robot)?;
+    let rover_sim::DisabledCollisions {
+        pairs,
+        unknown_links: unknown,
+    } = rover_sim::load_disabled_collisions(&srdf, &robot)?;
     let id = |name: &str| robot.link_id(name).context(name.to_owned());
     assert_eq!((pairs.len(), unknown.len()), (35, 0), "{unknown:?}");
     assert!(pairs.contains(&(id("panda_hand")?, id("panda_leftfinger")?)));

@@ -29,7 +29,8 @@ pub use mesh_file::{load_mesh, load_texture};
 pub use resource::{NotFound, ResourcePaths};
 pub use robot::LoadOptions;
 pub use srdf::{
-    ArmGroup, load_arm_group, load_disabled_collisions, parse_arm_group, parse_disabled_collisions,
+    ArmGroup, DisabledCollisions, load_arm_group, load_disabled_collisions, parse_arm_group,
+    parse_disabled_collisions,
 };
 pub use toml::{load_toml, parse_toml};
 pub use trimesh::{TriMesh, TriMeshPart};

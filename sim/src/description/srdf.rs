@@ -40,19 +40,10 @@ pub fn parse_arm_group(
     name: Option<&str>,
 ) -> Result<ArmGroup> {
     let doc = parse_xml(text, path)?;
-    let root = doc.root_element();
+    let root = srdf_root(&doc, path)?;
     let fail = |node: Node<'_, '_>, message: String| {
         SimError::invalid(path, Some(line_of(&doc, node)), message)
     };
-    if !root.has_tag_name("robot") {
-        return Err(fail(
-            root,
-            format!(
-                "expected an SRDF <robot>, found <{}>",
-                root.tag_name().name()
-            ),
-        ));
-    }
     let groups: Vec<Node<'_, '_>> = children(root, "group").collect();
     let names: Vec<&str> = groups.iter().filter_map(|g| g.attribute("name")).collect();
     let known = || {
@@ -103,15 +94,21 @@ pub fn parse_arm_group(
     })
 }
 
+/// An SRDF's `<disable_collisions>` pairs, as [`load_disabled_collisions`] reads them.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct DisabledCollisions {
+    /// The link pairs the planner does not check against each other.
+    pub pairs: Vec<(LinkId, LinkId)>,
+    /// Links named in pairs that the robot does not have (those pairs are left out).
+    pub unknown_links: Vec<String>,
+}
+
 /// The link pairs an SRDF's `<disable_collisions link1 link2 reason>` lines say never collide
 /// (or always touch): the planner does not check them against each other. Pairs naming a link
 /// the robot does not have are left out (an SRDF written for a fuller variant of the robot),
-/// their names returned as the second list. A file that is not an SRDF, or a line without
+/// their names kept in [`DisabledCollisions::unknown_links`]. A file that is not an SRDF, or a line without
 /// both links, is an error naming the file and line.
-pub fn load_disabled_collisions(
-    path: &Path,
-    robot: &RobotModel,
-) -> Result<(Vec<(LinkId, LinkId)>, Vec<String>)> {
+pub fn load_disabled_collisions(path: &Path, robot: &RobotModel) -> Result<DisabledCollisions> {
     let text = crate::io::read_text(path)?;
     parse_disabled_collisions(&text, path, robot)
 }
@@ -125,7 +122,10 @@ pub(crate) fn srdf_disabled_collisions(
     let Some(path) = &world.robot.srdf else {
         return Ok(Vec::new());
     };
-    let (pairs, unknown) = load_disabled_collisions(path, robot)?;
+    let DisabledCollisions {
+        pairs,
+        unknown_links: unknown,
+    } = load_disabled_collisions(path, robot)?;
     if !unknown.is_empty() {
         tracing::warn!(
             "{}: <disable_collisions> pairs naming links robot \"{}\" does not have are left out: {}",
@@ -142,21 +142,12 @@ pub fn parse_disabled_collisions(
     text: &str,
     path: &Path,
     robot: &RobotModel,
-) -> Result<(Vec<(LinkId, LinkId)>, Vec<String>)> {
+) -> Result<DisabledCollisions> {
     let doc = parse_xml(text, path)?;
-    let root = doc.root_element();
+    let root = srdf_root(&doc, path)?;
     let fail = |node: Node<'_, '_>, message: String| {
         SimError::invalid(path, Some(line_of(&doc, node)), message)
     };
-    if !root.has_tag_name("robot") {
-        return Err(fail(
-            root,
-            format!(
-                "expected an SRDF <robot>, found <{}>",
-                root.tag_name().name()
-            ),
-        ));
-    }
     let (mut pairs, mut unknown) = (Vec::new(), Vec::new());
     for node in children(root, "disable_collisions") {
         let link = |attr: &str| {
@@ -178,7 +169,29 @@ pub fn parse_disabled_collisions(
             }
         }
     }
-    Ok((pairs, unknown))
+    Ok(DisabledCollisions {
+        pairs,
+        unknown_links: unknown,
+    })
+}
+
+/// The document's `<robot>` element; anything else is an error at its line.
+fn srdf_root<'a, 'input>(
+    doc: &'a roxmltree::Document<'input>,
+    path: &Path,
+) -> Result<Node<'a, 'input>> {
+    let root = doc.root_element();
+    if !root.has_tag_name("robot") {
+        return Err(SimError::invalid(
+            path,
+            Some(line_of(doc, root)),
+            format!(
+                "expected an SRDF <robot>, found <{}>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    Ok(root)
 }
 
 /// The base and last link of `group`'s chain (a subgroup's joints count as the group's).
