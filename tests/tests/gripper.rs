@@ -407,6 +407,11 @@ fn a_ball_squeezed_too_weakly_for_its_weight_slides_out_of_the_fingers() -> Resu
     let mut lifted = Vec::new();
     for squeeze_n in [0.05, 10.0] {
         let (mut sim, closed) = lifter_grasp("", squeeze_n)?;
+        // The fingers are on the ball either way: what differs is the squeeze.
+        ensure!(
+            closed.stalled,
+            "{squeeze_n} N: the fingers did not close on the ball: {closed:?}"
+        );
         run(&mut sim, 1.2);
         sim.command_joint("lift_joint", JointCommand::Position(0.2))?;
         run(&mut sim, 1.5);

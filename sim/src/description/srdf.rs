@@ -106,8 +106,8 @@ pub struct DisabledCollisions {
 /// The link pairs an SRDF's `<disable_collisions link1 link2 reason>` lines say never collide
 /// (or always touch): the planner does not check them against each other. Pairs naming a link
 /// the robot does not have are left out (an SRDF written for a fuller variant of the robot),
-/// their names kept in [`DisabledCollisions::unknown_links`]. A file that is not an SRDF, or a line without
-/// both links, is an error naming the file and line.
+/// their names kept in [`DisabledCollisions::unknown_links`]. A file that is not an SRDF, or a
+/// line without both links, is an error naming the file and line.
 pub fn load_disabled_collisions(path: &Path, robot: &RobotModel) -> Result<DisabledCollisions> {
     let text = crate::io::read_text(path)?;
     parse_disabled_collisions(&text, path, robot)

@@ -149,6 +149,20 @@ pub(crate) struct RobotBodies {
     pub(crate) springs: ContactSprings,
 }
 
+/// The body of the collider that `pair` pairs with `collider` (`None`: a collider on no body).
+pub(crate) fn other_body(
+    physics: &PhysicsWorld,
+    pair: &ContactPair,
+    collider: ColliderHandle,
+) -> Option<RigidBodyHandle> {
+    let other = if pair.collider1 == collider {
+        pair.collider2
+    } else {
+        pair.collider1
+    };
+    physics.colliders.get(other).and_then(|c| c.parent())
+}
+
 /// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
 /// Meshes of static bodies keep their triangles (a concave arch stays passable); moving ones
 /// become their convex hull. `source` and `link` name the owner in messages.

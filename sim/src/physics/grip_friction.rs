@@ -24,6 +24,7 @@ use crate::error::Result;
 use crate::geometry::Pose;
 use crate::model::robot::RobotModel;
 use crate::model::world::GraspMode;
+use crate::physics::build::other_body;
 use crate::physics::grasp::{GraspAssist, gripper_bodies};
 
 use crate::physics::contact_springs::ContactSprings;
@@ -36,11 +37,13 @@ pub const MAX_CORRECTION_MPS: f32 = 0.05;
 pub const SLIPPED_M: f32 = 0.005;
 
 /// One anchored contact: where it touched on each body when it stuck, in that body's frame
-/// (collider1's and collider2's bodies, m).
+/// (collider1's and collider2's bodies, m), and the velocity of collider2's surface relative to
+/// collider1's the next step's friction asks for (world frame, m/s).
 #[derive(Debug, Clone, Copy)]
 struct Anchor {
     on1: Vec3,
     on2: Vec3,
+    correction_mps: Vec3,
 }
 
 /// The anchors of one gripper's finger pads.
@@ -52,9 +55,6 @@ pub(crate) struct FrictionAnchors {
     anchors: HashMap<(ColliderHandle, ColliderHandle), Anchor>,
     /// The anchors being gathered by an update (kept to reuse its memory).
     next: HashMap<(ColliderHandle, ColliderHandle), Anchor>,
-    /// The velocity of collider2's surface relative to collider1's the next step's friction
-    /// asks for, per pair (world frame, m/s).
-    corrections: HashMap<(ColliderHandle, ColliderHandle), Vec3>,
 }
 
 impl FrictionAnchors {
@@ -87,35 +87,27 @@ impl FrictionAnchors {
     /// corrections.
     pub(crate) fn update(&mut self, physics: &PhysicsWorld, objects: &[RigidBodyHandle]) {
         self.next.clear();
-        self.corrections.clear();
         for pad in &self.pads {
             for pair in physics.narrow_phase.contact_pairs_with(*pad) {
                 if !pair.has_any_active_contact() {
                     continue;
                 }
-                let other = if pair.collider1 == *pad {
-                    pair.collider2
-                } else {
-                    pair.collider1
-                };
-                let other_body = physics.colliders.get(other).and_then(|c| c.parent());
-                if !other_body.is_some_and(|b| objects.contains(&b)) {
+                if !other_body(physics, pair, *pad).is_some_and(|b| objects.contains(&b)) {
                     continue;
                 }
                 let key = (pair.collider1, pair.collider2);
                 let Some(touch) = Touch::of(physics, pair) else {
                     continue;
                 };
-                let anchor = self
+                let mut anchor = self
                     .anchors
                     .get(&key)
                     .copied()
                     .filter(|a| touch.slip(a).length() <= SLIPPED_M)
                     .unwrap_or_else(|| touch.anchor());
-                let slip = touch.slip(&anchor);
+                anchor.correction_mps =
+                    (-touch.slip(&anchor) / ANCHOR_TIME_S).clamp_length_max(MAX_CORRECTION_MPS);
                 self.next.insert(key, anchor);
-                let correction = (-slip / ANCHOR_TIME_S).clamp_length_max(MAX_CORRECTION_MPS);
-                self.corrections.insert(key, correction);
             }
         }
         std::mem::swap(&mut self.anchors, &mut self.next);
@@ -184,6 +176,7 @@ impl Touch {
         Anchor {
             on1: self.pose1.inverse() * self.at1,
             on2: self.pose2.inverse() * self.at2,
+            correction_mps: Vec3::ZERO,
         }
     }
 
@@ -208,9 +201,9 @@ impl PhysicsHooks for ContactHooks<'_> {
         self.springs.modify_solver_contacts(context);
         let Some(correction) = self
             .anchors
-            .corrections
+            .anchors
             .get(&(context.collider1, context.collider2))
-            .copied()
+            .map(|a| a.correction_mps)
         else {
             return;
         };

@@ -23,7 +23,7 @@ use crate::error::Result;
 use crate::geometry::Pose;
 use crate::model::kinematics::KinematicChain;
 use crate::model::robot::{JointId, JointKind, LinkId, RobotModel};
-use crate::physics::build::{ROBOT_GROUP, collider_shape};
+use crate::physics::build::{ROBOT_GROUP, collider_shape, other_body};
 use crate::physics::simulation::Simulation;
 
 /// What a configuration hits.
@@ -189,12 +189,11 @@ impl PlanningScene {
                 self.root_from_link[link_b.index()],
             );
             for (pose_a, shape_a) in shapes_a {
+                let at_a = root_from_a * *pose_a;
+                let aabb_a = shape_a.compute_aabb(&at_a);
                 for (pose_b, shape_b) in shapes_b {
-                    let (at_a, at_b) = (root_from_a * *pose_a, root_from_b * *pose_b);
-                    if !shape_a
-                        .compute_aabb(&at_a)
-                        .intersects(&shape_b.compute_aabb(&at_b))
-                    {
+                    let at_b = root_from_b * *pose_b;
+                    if !aabb_a.intersects(&shape_b.compute_aabb(&at_b)) {
                         continue;
                     }
                     if query::intersection_test(&at_a, &**shape_a, &at_b, &**shape_b)
@@ -467,7 +466,7 @@ impl Simulation {
                 if !pair.has_any_active_contact() || pair.total_impulse_magnitude() <= 0.0 {
                     continue;
                 }
-                let name = match self.other_body(pair, *collider) {
+                let name = match other_body(&self.physics, pair, *collider) {
                     Some(b) => match self.link_body.iter().position(|l| *l == b) {
                         Some(link) => self.robot.links[link].name.clone(),
                         None => self.body_name(b),
@@ -496,23 +495,13 @@ impl Simulation {
         let mut impulse = 0.0;
         for collider in rb.colliders() {
             for pair in self.physics.narrow_phase.contact_pairs_with(*collider) {
-                let parent = self.other_body(pair, *collider);
+                let parent = other_body(&self.physics, pair, *collider);
                 if parent.is_none() || parent == Some(self.ground) {
                     impulse += pair.total_impulse_magnitude();
                 }
             }
         }
         impulse / dt
-    }
-
-    /// The body of the collider `pair` pairs with `collider` (`None`: a collider on no body).
-    fn other_body(&self, pair: &ContactPair, collider: ColliderHandle) -> Option<RigidBodyHandle> {
-        let other = if pair.collider1 == collider {
-            pair.collider2
-        } else {
-            pair.collider1
-        };
-        self.physics.colliders.get(other).and_then(|c| c.parent())
     }
 
     /// The name of a body that is not the robot's.
