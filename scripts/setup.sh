@@ -115,6 +115,9 @@ if [ "$purpose" = test ]; then
   # what is already there needs no network. What could not be had is said here, and the tests
   # that need it are listed as skipped (failures under CI=true or ./test --strict).
   python3 "$root/scripts/test_data.py" "$cache" || true
+  # Real ROS 2 peers: rclpy (Jazzy, Kilted) on Fast DDS and the interface packages PyPI lacks,
+  # built once into rover's cache (scripts/ros2/peers.py says what and how long it took).
+  python3 "$root/scripts/ros2/peers.py" "$cache" || true
   if [ ! -d "$root/scripts/webview/node_modules/playwright-core" ]; then
     say "installing playwright-core (npm) for the web viewer test"
     (cd "$root/scripts/webview" && npm ci --no-audit --no-fund --silent)
