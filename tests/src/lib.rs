@@ -3,6 +3,7 @@
 pub mod architecture;
 pub mod fuzz;
 pub mod golden;
+pub mod rclpy;
 pub mod ros;
 pub mod skip;
 pub mod sweep;

@@ -34,7 +34,7 @@ use super::action_msgs::{
 use super::dds::{default_qos, latched_qos};
 use super::discovery::RosDistro;
 use super::msgs::Time;
-use super::services::{RequestHeader, Server, ServiceType};
+use super::services::{RequestId, Server, ServiceType};
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{
     ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
@@ -280,7 +280,7 @@ struct ActionServer<A: ActionType> {
     feedback: DataWriter<A::FeedbackMessage, CDRSerializerAdapter<A::FeedbackMessage>>,
     status: DataWriter<GoalStatusArray, CDRSerializerAdapter<GoalStatusArray>>,
     /// get_result requests waiting for their goal to end.
-    waiting: Vec<(RequestHeader, Uuid)>,
+    waiting: Vec<(RequestId, Uuid)>,
     next_feedback_s: f64,
     feedback_state: A::Feedback,
 }

@@ -1,6 +1,6 @@
 //! The node's parameters, read-only, through ROS 2's parameter services as rclcpp serves them
 //! (`/<node>/get_parameters`, `list_parameters`, `get_parameter_types`, `describe_parameters`,
-//! `set_parameters`), so `ros2 param get /rover use_sim_time` and `ros2 param list /rover`
+//! `set_parameters`, `set_parameters_atomically`), so `ros2 param get /rover use_sim_time` and `ros2 param list /rover`
 //! answer. rover's parameters: `use_sim_time` (true: every stamp rover publishes is sim time,
 //! on `/clock`) and `robot_description` (the URDF, as robot_state_publisher's). Setting one
 //! is refused with a reason: they describe the run, they do not steer it.
@@ -127,6 +127,18 @@ impl ServiceType for SetParameters {
     const RESPONSE_TYPE: &'static str = "rcl_interfaces::srv::dds_::SetParameters_Response_";
 }
 
+/// `rcl_interfaces/srv/SetParametersAtomically`: all or none (rclpy's parameter client waits
+/// for it with the others).
+pub struct SetParametersAtomically;
+impl ServiceType for SetParametersAtomically {
+    type Request = Vec<Parameter>;
+    type Response = SetParametersResult;
+    const REQUEST_TYPE: &'static str =
+        "rcl_interfaces::srv::dds_::SetParametersAtomically_Request_";
+    const RESPONSE_TYPE: &'static str =
+        "rcl_interfaces::srv::dds_::SetParametersAtomically_Response_";
+}
+
 /// The node's parameters and their services.
 pub struct Parameters {
     values: Vec<(&'static str, ParameterValue, &'static str)>,
@@ -135,6 +147,7 @@ pub struct Parameters {
     list: Server<ListParameters>,
     describe: Server<DescribeParameters>,
     set: Server<SetParameters>,
+    set_atomically: Server<SetParametersAtomically>,
 }
 
 impl Parameters {
@@ -185,6 +198,12 @@ impl Parameters {
                 &name("describe_parameters"),
             )?,
             set: Server::new(participant, subscriber, publisher, &name("set_parameters"))?,
+            set_atomically: Server::new(
+                participant,
+                subscriber,
+                publisher,
+                &name("set_parameters_atomically"),
+            )?,
         })
     }
 
@@ -226,18 +245,24 @@ impl Parameters {
                 })
                 .collect()
         });
-        self.set.serve(|parameters| {
+        let refusal = |p: &Parameter| SetParametersResult {
+            successful: false,
+            reason: if find(&p.name).is_some() {
+                format!("{} is read-only: it describes the run", p.name)
+            } else {
+                format!("rover has no parameter {}", p.name)
+            },
+        };
+        self.set
+            .serve(|parameters| parameters.iter().map(refusal).collect());
+        self.set_atomically.serve(|parameters| {
             parameters
-                .iter()
-                .map(|p| SetParametersResult {
+                .first()
+                .map(refusal)
+                .unwrap_or_else(|| SetParametersResult {
                     successful: false,
-                    reason: if find(&p.name).is_some() {
-                        format!("{} is read-only: it describes the run", p.name)
-                    } else {
-                        format!("rover has no parameter {}", p.name)
-                    },
+                    reason: "no parameters given".to_owned(),
                 })
-                .collect()
         });
     }
 
@@ -249,6 +274,7 @@ impl Parameters {
             self.list.gids(),
             self.describe.gids(),
             self.set.gids(),
+            self.set_atomically.gids(),
         ]
         .into_iter()
         .unzip()

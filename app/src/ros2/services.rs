@@ -1,17 +1,30 @@
-//! ROS 2 services over DDS, as rmw_cyclonedds_cpp carries them: a service `/a/b` is a request
-//! topic `rq/a/bRequest` (type `pkg::srv::dds_::Name_Request_`) and a reply topic
-//! `rr/a/bReply` (`pkg::srv::dds_::Name_Response_`), reliable, volatile, keep last 10 (rmw's
-//! services QoS). Every request starts with a header, the client's id and the request's
-//! number (`uint64 guid; int64 seq`); the reply carries the same header back, which is how
-//! the client matches it.
+//! ROS 2 services over DDS. A service `/a/b` is a request topic `rq/a/bRequest` (type
+//! `pkg::srv::dds_::Name_Request_`) and a reply topic `rr/a/bReply`
+//! (`pkg::srv::dds_::Name_Response_`), reliable, volatile, keep last 10 (rmw's services QoS).
+//! How a reply finds its request depends on the client's RMW, and rover reads each request the
+//! way its client wrote it:
 //!
-//! rmw_fastrtps_cpp (Fast DDS) carries the request's id in the RTPS sample identity instead
-//! of the payload; rover answers rmw_cyclonedds_cpp's clients (and plain Cyclone DDS peers) only.
+//! - **rmw_fastrtps_cpp** (Fast DDS, ROS 2's default RMW): the payload is the request's fields
+//!   alone; the request's id is its RTPS sample identity (the client's writer GUID and the
+//!   sample's sequence number), and the client names its reply reader in the inline QoS
+//!   `PID_RELATED_SAMPLE_IDENTITY`. The reply carries the request's sample identity back as its
+//!   related sample identity, which is how the client matches it.
+//! - **rmw_cyclonedds_cpp** (and plain Cyclone DDS peers): every request starts with a header,
+//!   the client's id and the request's number (`uint64 guid; int64 seq`), and the reply carries
+//!   the same header back in its payload.
+//!
+//! A request with a related sample identity is Fast DDS's; one without is Cyclone's. A request
+//! that does not decode the way its mapping says is one warning per client (naming the mapping
+//! and what was wrong) and no reply; the next request is read as usual.
+
+use std::collections::HashSet;
 
 use anyhow::{Context, Result};
-use rustdds::no_key::{DataReader, DataWriter};
+use rustdds::no_key::{DataReader, DataWriter, Decode, DefaultDecoder, DeserializerAdapter};
+use rustdds::serialization::deserialize_from_cdr_with_rep_id;
 use rustdds::{
-    CDRDeserializerAdapter, CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind,
+    CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, RepresentationIdentifier,
+    SampleIdentity, TopicKind, WriteOptionsBuilder,
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -27,13 +40,22 @@ pub struct RequestHeader {
     pub seq: i64,
 }
 
-/// A request or reply: the header, then the message's fields.
+/// A request or reply in Cyclone's mapping: the header, then the message's fields.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct WithHeader<T> {
     /// Which request.
     pub header: RequestHeader,
     /// The message.
     pub body: T,
+}
+
+/// Which request a reply answers, in the mapping its client used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RequestId {
+    /// Cyclone's: the header from the request's payload, written back in the reply's.
+    Cyclone(RequestHeader),
+    /// Fast DDS's: the request's sample identity, written back as the reply's related one.
+    FastDds(SampleIdentity),
 }
 
 /// A service type: its request and response messages and their DDS type names.
@@ -48,22 +70,81 @@ pub trait ServiceType {
     const RESPONSE_TYPE: &'static str;
 }
 
-type Request<S> = WithHeader<<S as ServiceType>::Request>;
-type Reply<S> = WithHeader<<S as ServiceType>::Response>;
-
-/// One service's server: takes requests when polled, answers each at once.
-pub struct Server<S: ServiceType> {
-    name: String,
-    requests: DataReader<Request<S>, CDRDeserializerAdapter<Request<S>>>,
-    replies: DataWriter<Reply<S>, CDRSerializerAdapter<Reply<S>>>,
-    warned: bool,
+/// A request as it came: its serialized payload and its encoding, decoded once its mapping is
+/// known (the sample's inline QoS says which).
+pub struct RawRequest {
+    bytes: Vec<u8>,
+    encoding: RepresentationIdentifier,
 }
 
-impl<S: ServiceType> Server<S>
-where
-    Request<S>: DeserializeOwned,
-    Reply<S>: Serialize,
-{
+/// Keeps a request's bytes for [`Server::next_request`] to decode.
+pub struct RawAdapter;
+
+/// The encodings rover's CDR decoder reads (XCDR1, either byte order).
+const RAW_ENCODINGS: [RepresentationIdentifier; 4] = [
+    RepresentationIdentifier::CDR_LE,
+    RepresentationIdentifier::CDR_BE,
+    RepresentationIdentifier::PL_CDR_LE,
+    RepresentationIdentifier::PL_CDR_BE,
+];
+
+impl DeserializerAdapter<RawRequest> for RawAdapter {
+    type Error = std::convert::Infallible;
+    type Decoded = RawRequest;
+
+    fn supported_encodings() -> &'static [RepresentationIdentifier] {
+        &RAW_ENCODINGS
+    }
+
+    fn transform_decoded(decoded: RawRequest) -> RawRequest {
+        decoded
+    }
+}
+
+/// [`RawAdapter`]'s decoder: a copy of the bytes.
+#[derive(Clone, Copy)]
+pub struct RawDecoder;
+
+impl Decode<'_, RawRequest> for RawDecoder {
+    type Error = std::convert::Infallible;
+
+    fn decode_bytes(
+        self,
+        input_bytes: &[u8],
+        encoding: RepresentationIdentifier,
+    ) -> Result<RawRequest, Self::Error> {
+        Ok(RawRequest {
+            bytes: input_bytes.to_vec(),
+            encoding,
+        })
+    }
+}
+
+impl DefaultDecoder<RawRequest> for RawAdapter {
+    type Decoder = RawDecoder;
+    const DECODER: RawDecoder = RawDecoder;
+}
+
+/// A reply as its client's mapping writes it: with Cyclone's header, or the fields alone.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum Reply<T> {
+    /// Cyclone's mapping.
+    WithHeader(WithHeader<T>),
+    /// Fast DDS's mapping (the id travels in the inline QoS).
+    Bare(T),
+}
+
+/// One service's server: takes requests when polled, answers each at once or later.
+pub struct Server<S: ServiceType> {
+    name: String,
+    requests: DataReader<RawRequest, RawAdapter>,
+    replies: DataWriter<Reply<S::Response>, CDRSerializerAdapter<Reply<S::Response>>>,
+    /// The clients (request writers) already warned about.
+    warned: HashSet<GUID>,
+}
+
+impl<S: ServiceType> Server<S> {
     /// Serves the service `ros_name` (`/rover/get_parameters`).
     pub fn new(
         participant: &DomainParticipant,
@@ -92,55 +173,153 @@ where
         Ok(Self {
             name: ros_name.to_owned(),
             requests: subscriber
-                .create_datareader_no_key(&request_topic, Some(qos.clone()))
+                .create_datareader_no_key::<RawRequest, RawAdapter>(
+                    &request_topic,
+                    Some(qos.clone()),
+                )
                 .with_context(|| format!("creating the request reader of {ros_name}"))?,
             replies: publisher
                 .create_datawriter_no_key(&reply_topic, Some(qos))
                 .with_context(|| format!("creating the reply writer of {ros_name}"))?,
-            warned: false,
+            warned: HashSet::new(),
         })
     }
 
-    /// The next request that came, if one did (with its header, for the reply). A request
-    /// that does not decode is one warning per service.
-    pub fn next_request(&mut self) -> Option<(RequestHeader, S::Request)> {
-        match self.requests.take_next_sample() {
-            Ok(Some(sample)) => {
-                let request = sample.into_value();
-                Some((request.header, request.body))
-            }
-            Ok(None) => None,
-            Err(e) => {
-                // A peer's garbage or a wrong type: said once; the next poll goes on.
-                self.warn(&format!("a request could not be read ({e})"));
-                None
+    /// The next request that came and decodes, if one did, with its id for the reply. A
+    /// request that does not decode is one warning per client; the ones after it are read.
+    pub fn next_request(&mut self) -> Option<(RequestId, S::Request)> {
+        loop {
+            let sample = match self.requests.take_next_sample() {
+                Ok(Some(sample)) => sample,
+                Ok(None) => return None,
+                Err(e) => {
+                    // Not tied to a client (the reader's own error): said once per service.
+                    self.warn(
+                        GUID::GUID_UNKNOWN,
+                        &format!("a request could not be read ({e})"),
+                    );
+                    return None;
+                }
+            };
+            let info = sample.sample_info();
+            let client = info.writer_guid();
+            let fast_dds = info.related_sample_identity().is_some();
+            let identity = info.sample_identity();
+            let raw = sample.value();
+            match decode_request::<S::Request>(raw, fast_dds, identity) {
+                Ok(request) => return Some(request),
+                Err(what) => self.warn(client, &what),
             }
         }
     }
 
-    /// Answers the request `header` names (now or later) with `body`.
-    pub fn reply(&mut self, header: RequestHeader, body: S::Response) {
-        if let Err(e) = self.replies.write(WithHeader { header, body }, None) {
-            self.warn(&format!("a reply could not be sent ({e})"));
+    /// Answers the request `id` names (now or later) with `body`, in its client's mapping.
+    pub fn reply(&mut self, id: RequestId, body: S::Response) {
+        let written = match id {
+            RequestId::Cyclone(header) => self
+                .replies
+                .write(Reply::WithHeader(WithHeader { header, body }), None)
+                .map(|_| ()),
+            RequestId::FastDds(identity) => {
+                let bytes = fast_dds_reply_bytes(&body);
+                if bytes > MAX_FAST_DDS_REPLY_BYTES {
+                    self.warn(
+                        identity.writer_guid,
+                        &format!(
+                            "a {bytes}-byte reply to a Fast DDS client is not sent: RustDDS 0.15.1 \
+                             writes a sample that needs fragments (over about \
+                             {MAX_FAST_DDS_REPLY_BYTES} bytes) with a related sample identity \
+                             malformed (a stray byte before the inline QoS; docs/ROS2.md)"
+                        ),
+                    );
+                    return;
+                }
+                let options = WriteOptionsBuilder::new()
+                    .related_sample_identity(identity)
+                    .build();
+                self.replies
+                    .write_with_options(Reply::Bare(body), options)
+                    .map(|_| ())
+            }
+        };
+        if let Err(e) = written {
+            self.warn(
+                GUID::GUID_UNKNOWN,
+                &format!("a reply could not be sent ({e})"),
+            );
         }
     }
 
     /// Answers every request that came, with `answer`.
     pub fn serve(&mut self, mut answer: impl FnMut(S::Request) -> S::Response) {
-        while let Some((header, request)) = self.next_request() {
+        while let Some((id, request)) = self.next_request() {
             let body = answer(request);
-            self.reply(header, body);
+            self.reply(id, body);
         }
     }
 
-    fn warn(&mut self, what: &str) {
-        if !std::mem::replace(&mut self.warned, true) {
-            tracing::warn!("ROS 2 service {}: {what}; ignored", self.name);
+    fn warn(&mut self, client: GUID, what: &str) {
+        if self.warned.insert(client) {
+            if client == GUID::GUID_UNKNOWN {
+                tracing::warn!("ROS 2 service {}: {what}; ignored", self.name);
+            } else {
+                tracing::warn!(
+                    "ROS 2 service {}: {what} (client {:?}; said once per client); ignored",
+                    self.name,
+                    client.prefix
+                );
+            }
         }
     }
 
     /// The request reader's and reply writer's GUIDs, for `ros_discovery_info`.
     pub fn gids(&self) -> (GUID, GUID) {
         (self.requests.guid(), self.replies.guid())
+    }
+}
+
+/// The largest reply rover sends in Fast DDS's mapping: one that fits a single RTPS DATA
+/// submessage on any IPv4 path (RustDDS packs up to the path's MTU, at least 1,280 bytes, less
+/// headers and the inline QoS). A larger one would go out as DATA_FRAGs, which RustDDS 0.15.1
+/// writes with a speedy `Option` tag byte before the inline QoS when a related sample identity
+/// is set (`DataFrag::write_to`): Fast DDS cannot read them, and a debug build's assertion on
+/// the submessage length stops the participant's event loop.
+pub const MAX_FAST_DDS_REPLY_BYTES: usize = 1024;
+
+/// How many bytes `body` takes in CDR (little endian, with the 4-byte encapsulation header).
+fn fast_dds_reply_bytes<T: Serialize>(body: &T) -> usize {
+    rustdds::serialization::to_vec::<T, byteorder::LittleEndian>(body)
+        .map_or(usize::MAX, |v| v.len() + 4)
+}
+
+/// A request's fields and id, read the way its mapping says (`fast_dds`: the sample carried a
+/// related sample identity); what was wrong, in words, when it does not decode.
+fn decode_request<T: DeserializeOwned>(
+    raw: &RawRequest,
+    fast_dds: bool,
+    identity: SampleIdentity,
+) -> Result<(RequestId, T), String> {
+    if fast_dds {
+        let (body, _) =
+            deserialize_from_cdr_with_rep_id::<T>(&raw.bytes, raw.encoding).map_err(|e| {
+                format!(
+                    "a request in Fast DDS's mapping (the id in the sample identity) did not \
+                     decode: {e} ({} bytes)",
+                    raw.bytes.len()
+                )
+            })?;
+        Ok((RequestId::FastDds(identity), body))
+    } else {
+        let (request, _) =
+            deserialize_from_cdr_with_rep_id::<WithHeader<T>>(&raw.bytes, raw.encoding).map_err(
+                |e| {
+                    format!(
+                        "a request in Cyclone DDS's mapping (a 16-byte header, no related sample \
+                         identity) did not decode: {e} ({} bytes)",
+                        raw.bytes.len()
+                    )
+                },
+            )?;
+        Ok((RequestId::Cyclone(request.header), request.body))
     }
 }

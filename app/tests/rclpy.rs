@@ -1,0 +1,511 @@
+//! `rover --ros2` against real ROS 2 nodes: rclpy on rmw_fastrtps_cpp (Fast DDS, ROS 2's
+//! default RMW), Jazzy (Fast DDS 2.14, 16-byte Gids) and Kilted (Fast DDS 3.2), from PyPI's
+//! wheels, with control_msgs, darknet_ros_msgs, tf2_msgs and gazebo_msgs built from their
+//! definitions by set-up (`scripts/ros2/peers.py`; the helper is `rover_tests::rclpy`). The
+//! peer is `app/tests/rclpy/peer.py`: a plain rclpy node, as a user's would be, that prints
+//! what it found as JSON; the assertions are here.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, ensure};
+use rover_core::parse_trace;
+use rover_tests::rclpy::{Rclpy, rclpy};
+use serde_json::Value;
+
+/// The distributions tested, each with its own rover (`--ros-distro`: the Gid size).
+const DISTROS: [&str; 2] = ["jazzy", "kilted"];
+
+fn repo(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative)
+}
+
+/// A DDS domain of this test's own (ROS 2 allows 0..=232; the Cyclone tests use 10..210).
+fn domain(salt: u16) -> u16 {
+    ((std::process::id() as u16).wrapping_add(salt.wrapping_mul(17))) % 200 + 10
+}
+
+/// One rover and rclpy peers in one DDS domain; logs in `dir`.
+struct Session {
+    dir: tempfile::TempDir,
+    rclpy: Rclpy,
+    domain: u16,
+    rover: Option<Child>,
+    background: Vec<Child>,
+}
+
+impl Session {
+    /// `rover --headless --ros2 --ros-distro DISTRO` for `duration_s` of sim time at real
+    /// time, with `extra` arguments.
+    fn start(rclpy: Rclpy, salt: u16, duration_s: f64, extra: &[&str]) -> Result<Self> {
+        let dir = tempfile::tempdir()?;
+        let domain = domain(salt);
+        let log = std::fs::File::create(dir.path().join("rover.log"))?;
+        let rover = Command::new(env!("CARGO_BIN_EXE_rover"))
+            .args([
+                "--headless",
+                "--ros2",
+                "--rtf",
+                "1",
+                "--ros-distro",
+                &rclpy.distro,
+            ])
+            .arg("--duration")
+            .arg(duration_s.to_string())
+            .arg("--trace")
+            .arg(dir.path().join("trace.csv"))
+            .args(extra)
+            .env("ROS_DOMAIN_ID", domain.to_string())
+            .env("RUST_LOG", "info")
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .context("starting rover")?;
+        Ok(Self {
+            dir,
+            rclpy,
+            domain,
+            rover: Some(rover),
+            background: Vec::new(),
+        })
+    }
+
+    fn rover_log(&self) -> String {
+        std::fs::read_to_string(self.dir.path().join("rover.log")).unwrap_or_default()
+    }
+
+    /// Runs the Python file `script` with `args` under rclpy, stopped after `timeout`; its
+    /// output (stdout and stderr, also kept as `<label>.log`).
+    fn run(&self, label: &str, script: &Path, args: &[&str], timeout: Duration) -> Result<String> {
+        let path = self.dir.path().join(format!("{label}.log"));
+        let log = std::fs::File::create(&path)?;
+        let mut child = self
+            .rclpy
+            .python(self.domain)
+            .arg(script)
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .with_context(|| format!("starting rclpy {}", self.rclpy.distro))?;
+        let start = Instant::now();
+        while child.try_wait()?.is_none() {
+            if start.elapsed() > timeout {
+                let _ = child.kill();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = child.wait();
+        Ok(std::fs::read_to_string(&path)?)
+    }
+
+    /// Starts the peer's `check` in the background (stopped when the session ends).
+    fn background(&mut self, check: &str) -> Result<()> {
+        let log = std::fs::File::create(self.dir.path().join(format!("{check}.log")))?;
+        let child = self
+            .rclpy
+            .python(self.domain)
+            .arg(repo("app/tests/rclpy/peer.py"))
+            .arg(check)
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()?;
+        self.background.push(child);
+        Ok(())
+    }
+
+    /// The peer's checks, as the JSON object it printed last.
+    fn peer(&self, checks: &[&str], timeout: Duration) -> Result<Value> {
+        let out = self.run(
+            &checks.join("_"),
+            &repo("app/tests/rclpy/peer.py"),
+            checks,
+            timeout,
+        )?;
+        let last = out
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .with_context(|| {
+                format!(
+                    "rclpy {} printed no findings:\n{out}\nrover:\n{}",
+                    self.rclpy.distro,
+                    self.rover_log()
+                )
+            })?;
+        let found: Value = serde_json::from_str(last)?;
+        println!("rclpy {}: {found}", self.rclpy.distro);
+        ensure!(
+            found["rmw"] == "rmw_fastrtps_cpp",
+            "the peer ran on {} (want rmw_fastrtps_cpp)",
+            found["rmw"]
+        );
+        Ok(found)
+    }
+
+    /// Waits for rover to end; its exit must be clean.
+    fn wait(&mut self, timeout: Duration) -> Result<()> {
+        let Some(mut child) = self.rover.take() else {
+            return Ok(());
+        };
+        let start = Instant::now();
+        loop {
+            if let Some(status) = child.try_wait()? {
+                ensure!(
+                    status.success(),
+                    "rover failed ({status}):\n{}",
+                    self.rover_log()
+                );
+                return Ok(());
+            }
+            if start.elapsed() > timeout {
+                let _ = child.kill();
+                anyhow::bail!("rover did not finish in {timeout:?}");
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        for mut child in self
+            .rover
+            .take()
+            .into_iter()
+            .chain(self.background.drain(..))
+        {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Each distribution's rclpy, or `None` when a set-up is missing (the skip recorded).
+fn distros() -> Option<Vec<Rclpy>> {
+    DISTROS.iter().map(|d| rclpy(d)).collect()
+}
+
+/// `ros2 node list` and `ros2 param` as rclpy does them, on Fast DDS: `/rover` is in
+/// `get_node_names_and_namespaces()`; `AsyncParameterClient` finds all six parameter services,
+/// lists rover's parameters, gets `use_sim_time` (true), their types, describes `use_sim_time`
+/// (read only), and setting it is refused with the reason. Every reply must find its request
+/// through Fast DDS's sample identity (rover read Cyclone's header only). `robot_description`
+/// is not answered on Fast DDS, and rover says why (RustDDS's fragments; docs/ROS2.md).
+#[test]
+fn rclpy_on_fast_dds_finds_node_rover_and_reads_its_parameters() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(rclpy, 1 + k as u16, 40.0, &["--no-detector"])?;
+        let found = session.peer(&["graph", "params"], Duration::from_secs(90))?;
+        let log = session.rover_log();
+        let graph = &found["graph"];
+        ensure!(
+            graph["nodes"]
+                .as_array()
+                .is_some_and(|n| n.iter().any(|n| n[0] == "rover" && n[1] == "/")),
+            "{distro}: /rover is not in the node list: {graph}\nrover:\n{log}"
+        );
+        let p = &found["params"];
+        ensure!(
+            p["ready"] == true,
+            "{distro}: no parameter services: {p}\n{log}"
+        );
+        ensure!(
+            p["list"] == serde_json::json!(["robot_description", "use_sim_time"]),
+            "{distro}: list: {p}\n{log}"
+        );
+        // rcl_interfaces' ParameterType: 1 bool, 4 string.
+        ensure!(
+            p["use_sim_time"] == serde_json::json!([1, true]),
+            "{distro}: {p}"
+        );
+        // robot_description's reply (the URDF, 6 kB) would need DATA_FRAGs, which RustDDS
+        // 0.15.1 writes malformed with a related sample identity: rover says so instead of
+        // sending it (docs/ROS2.md). If it ever arrives, it must be the URDF.
+        let description = &p["robot_description"];
+        if description.is_null() {
+            ensure!(
+                log.contains("reply to a Fast DDS client is not sent"),
+                "{distro}: robot_description was not answered and rover did not say why:\n{log}"
+            );
+        } else {
+            ensure!(
+                description[0] == 4
+                    && description[1].as_u64().is_some_and(|n| n > 1000)
+                    && description[2]
+                        .as_str()
+                        .is_some_and(|s| s.starts_with("<?xml") || s.starts_with("<robot")),
+                "{distro}: robot_description: {description}"
+            );
+        }
+        ensure!(
+            p["types"] == serde_json::json!([1, 4]),
+            "{distro}: types: {p}"
+        );
+        ensure!(
+            p["describe"]["name"] == "use_sim_time" && p["describe"]["read_only"] == true,
+            "{distro}: describe: {p}"
+        );
+        let reason = p["set"]["reason"].as_str().unwrap_or_default();
+        ensure!(
+            p["set"]["successful"] == false && !reason.is_empty(),
+            "{distro}: set must be refused with a reason: {p}"
+        );
+        ensure!(
+            !log.contains("could not be read") && !log.contains("did not decode"),
+            "{distro}: rover could not read a request:\n{log}"
+        );
+        session.wait(Duration::from_secs(90))?;
+    }
+    Ok(())
+}
+
+/// MoveIt's way in, from rclpy: an `ActionClient` with the control_msgs set-up built sends
+/// TIAGo's arm (example-robot-data) a two-point FollowJointTrajectory goal: accepted, feedback
+/// for the 7 arm joints, SUCCEEDED (4) with error code 0. A goal for a joint the controller
+/// lacks ends with INVALID_JOINTS (-2). A goal cancelled 1 s in is CANCELED (5), and the arm
+/// then moves no more than 0.01 rad.
+#[test]
+fn an_rclpy_action_client_follows_trajectories_and_cancels_on_tiago() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    let Some(urdf) = rover_tests::example_robot_data(rover_tests::TIAGO_NO_HAND) else {
+        return Ok(());
+    };
+    let controllers = repo("assets/controllers/tiago_no_hand.yaml");
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(
+            rclpy,
+            11 + k as u16,
+            60.0,
+            &[
+                "--no-detector",
+                "--robot",
+                &urdf.to_string_lossy(),
+                "--drive",
+                "wheel_left_joint,wheel_right_joint",
+                "--controllers",
+                &controllers.to_string_lossy(),
+            ],
+        )?;
+        let found = session.peer(&["trajectory"], Duration::from_secs(120))?;
+        let log = session.rover_log();
+        let t = &found["trajectory"];
+        ensure!(
+            t["server"] == true,
+            "{distro}: no action server: {t}\n{log}"
+        );
+        let home = &t["to_home"];
+        ensure!(
+            home["accepted"] == true && home["status"] == 4 && home["error_code"] == 0,
+            "{distro}: the goal did not succeed: {home}\n{log}"
+        );
+        ensure!(
+            home["feedback"].as_u64().is_some_and(|n| n >= 20)
+                && home["feedback_names"]
+                    .as_array()
+                    .is_some_and(|n| n.len() == 7),
+            "{distro}: feedback: {home}"
+        );
+        let unknown = &t["unknown_joint"];
+        ensure!(
+            unknown["error_code"] == -2 || unknown["accepted"] == false,
+            "{distro}: an unknown joint: {unknown}"
+        );
+        let cancelled = &t["cancelled"];
+        ensure!(
+            cancelled["accepted"] == true && cancelled["status"] == 5,
+            "{distro}: the cancel: {cancelled}\n{log}"
+        );
+        let at = cancelled["at_cancel"]
+            .as_array()
+            .context("no pose at the cancel")?;
+        let after = cancelled["after_cancel"]
+            .as_array()
+            .context("no pose after it")?;
+        let moved = at
+            .iter()
+            .zip(after)
+            .map(|(a, b)| (a.as_f64().unwrap_or(f64::NAN) - b.as_f64().unwrap_or(f64::NAN)).abs())
+            .fold(0.0, f64::max);
+        println!("{distro}: the arm moved {moved:.4} rad in the 2 s after the cancel");
+        // The cancel reply comes after the cancel is done; the pose was read when it came.
+        ensure!(
+            moved <= 0.01,
+            "{distro}: the arm moved {moved} rad after the cancel"
+        );
+        session.wait(Duration::from_secs(120))?;
+    }
+    Ok(())
+}
+
+/// MoveIt's gripper, from rclpy: a GripperCommand `ActionClient` closes the test grasper on
+/// its ball (tests/grasper): ABORTED (6) with `stalled`, the fingers held apart by the ball
+/// (docs/ARM.md); reopening SUCCEEDS (4) with `reached_goal`.
+#[test]
+fn an_rclpy_gripper_command_closes_on_the_ball() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    let world = repo("tests/grasper/grasper.toml");
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(
+            rclpy,
+            21 + k as u16,
+            40.0,
+            &["--world", &world.to_string_lossy(), "--no-detector"],
+        )?;
+        let found = session.peer(&["gripper"], Duration::from_secs(90))?;
+        let g = &found["gripper"];
+        let close = &g["close"];
+        let position = close["position"].as_f64().unwrap_or(f64::NAN);
+        ensure!(
+            close["status"] == 6
+                && close["stalled"] == true
+                && close["reached_goal"] == false
+                && (0.029..0.038).contains(&position),
+            "{distro}: closing on the ball: {g}\n{}",
+            session.rover_log()
+        );
+        let open = &g["open"];
+        ensure!(
+            open["status"] == 4 && open["reached_goal"] == true,
+            "{distro}: reopening: {g}"
+        );
+        session.wait(Duration::from_secs(90))?;
+    }
+    Ok(())
+}
+
+/// Each topic of docs/ROS2.md's table for the tutorial car with a laser reaches an rclpy
+/// subscription of its real type and documented QoS (sensor data best effort; /tf_static,
+/// /robot_description and the detection image transient local, subscribed after rover
+/// started): a table of topic, type, QoS and messages received in 10 s.
+#[test]
+fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    let robot = repo("assets/robots/my_robot_laser.urdf.xacro");
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(
+            rclpy,
+            31 + k as u16,
+            30.0,
+            &["--robot", &robot.to_string_lossy()],
+        )?;
+        let found = session.peer(&["topics"], Duration::from_secs(90))?;
+        let table = found["topics"]["table"].as_array().context("no table")?;
+        println!("{distro}: | topic | type | QoS | messages in 10 s |");
+        let mut silent = Vec::new();
+        for row in table {
+            println!(
+                "{distro}: | {} | {} | {} | {} |",
+                row[0], row[1], row[2], row[3]
+            );
+            if row[3].as_u64().unwrap_or(0) == 0 {
+                silent.push(row[0].to_string());
+            }
+        }
+        ensure!(
+            silent.is_empty(),
+            "{distro}: nothing on {silent:?}: {found}\nrover:\n{}",
+            session.rover_log()
+        );
+        let sample = &found["topics"]["sample"];
+        ensure!(
+            sample["/odom"] == serde_json::json!(["odom", "base_link"]),
+            "{distro}: odom frames: {sample}"
+        );
+        ensure!(
+            sample["/camera/image_raw"][3].as_u64()
+                == sample["/camera/image_raw"][0]
+                    .as_u64()
+                    .zip(sample["/camera/image_raw"][1].as_u64())
+                    .map(|(w, h)| w * h * 3),
+            "{distro}: the image's data is not width x height x 3: {sample}"
+        );
+        session.wait(Duration::from_secs(90))?;
+    }
+    Ok(())
+}
+
+/// The tutorial's listener_yolo as a real rclpy node (examples/ros2/listener_yolo_rclpy.py,
+/// with the darknet_ros_msgs set-up built): it prints `person` and its 0.1 m/s on /cmd_vel
+/// moves the car >= 0.5 m toward the person.
+#[test]
+fn the_rclpy_listener_yolo_drives_the_car_toward_the_person() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(rclpy, 41 + k as u16, 16.0, &[])?;
+        let said = session.run(
+            "listener",
+            &repo("examples/ros2/listener_yolo_rclpy.py"),
+            &[],
+            Duration::from_secs(18),
+        )?;
+        session.wait(Duration::from_secs(60))?;
+        let rows = parse_trace(&std::fs::read_to_string(
+            session.dir.path().join("trace.csv"),
+        )?)?;
+        let people = said.lines().filter(|l| l.trim() == "person").count();
+        let first = rows.first().context("an empty trace")?;
+        let last = rows.last().context("an empty trace")?;
+        let moved_m = last.x_m - first.x_m;
+        println!(
+            "{distro}: the listener saw `person` {people} times; the car moved {moved_m:.3} m"
+        );
+        ensure!(people > 0, "{distro}: the listener said:\n{said}");
+        ensure!(
+            moved_m >= 0.5,
+            "{distro}: the car moved {moved_m:.3} m (want >= 0.5)"
+        );
+    }
+    Ok(())
+}
+
+/// Large best-effort samples: rover's 640x480 rgb8 camera reaches a best-effort rclpy
+/// subscription (raw, no Python deserialization) at least as often as an rclpy publisher's
+/// identical images at the same 30 Hz reach the same subscription, counted side by side for
+/// 10 s (rover without its detector, so both publishers have the CPU they need).
+#[test]
+fn rovers_images_reach_rclpy_at_least_as_often_as_an_rclpy_publishers() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(rclpy, 51 + k as u16, 25.0, &["--no-detector"])?;
+        session.background("publish_images")?;
+        let found = session.peer(&["camera_rate"], Duration::from_secs(60))?;
+        let counts = &found["camera_rate"];
+        let rover = counts["/camera/image_raw"].as_u64().unwrap_or(0);
+        let peer = counts["/peer/image_raw"].as_u64().unwrap_or(0);
+        println!("{distro}: images in 10 s: rover {rover}, an rclpy publisher {peer} (30 Hz each)");
+        ensure!(
+            rover >= peer && rover > 0,
+            "{distro}: rover's images arrived {rover} times, the rclpy publisher's {peer} times\n{}",
+            session.rover_log()
+        );
+        session.wait(Duration::from_secs(60))?;
+    }
+    Ok(())
+}
