@@ -327,7 +327,8 @@ fn run_inner(
     let saves_frames = files.frames.is_some();
     let options = SessionOptions {
         sim: config.options.clone(),
-        camera: perceive || saves_frames,
+        // The observers (ROS, a recorder) get the camera with the detector off too.
+        camera: perceive || saves_frames || observer_wants_camera,
         every_frame: observer_wants_camera || saves_frames,
         detector: detector_mode(config, perceive, limits.detect_hz),
         detector_config: config.detector.clone(),

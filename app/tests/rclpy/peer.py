@@ -245,7 +245,7 @@ def camera_rate(node):
 
 
 def publish_images(node):
-    """640x480 rgb8 images, as rover's camera sends them, at 30 Hz for 30 s on /peer/image_raw
+    """640x480 rgb8 images, as rover's camera sends them, at 30 Hz for 40 s on /peer/image_raw
     (best effort, SensorDataQoS)."""
     from sensor_msgs.msg import Image
 
@@ -255,7 +255,7 @@ def publish_images(node):
     image.width, image.height, image.encoding, image.step = 640, 480, "rgb8", 640 * 3
     image.data = bytes(640 * 480 * 3)
     sent, start = 0, time.monotonic()
-    while time.monotonic() - start < 30.0:
+    while time.monotonic() - start < 40.0:
         publisher.publish(image)
         sent += 1
         next_at = start + sent / 30.0
