@@ -106,15 +106,7 @@ impl Session {
             .stderr(log)
             .spawn()
             .with_context(|| format!("starting rclpy {}", self.rclpy.distro))?;
-        let start = Instant::now();
-        while child.try_wait()?.is_none() {
-            if start.elapsed() > timeout {
-                let _ = child.kill();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = child.wait();
+        rover_tests::wait_or_kill(&mut child, timeout)?;
         Ok(std::fs::read_to_string(&path)?)
     }
 

@@ -278,15 +278,7 @@ impl RosGraph {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()?;
-        let start = Instant::now();
-        while child.try_wait()?.is_none() {
-            if start.elapsed() > timeout {
-                let _ = child.kill();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = child.wait();
+        rover_tests::wait_or_kill(&mut child, timeout)?;
         let mut out = String::new();
         if let Some(mut o) = child.stdout.take() {
             o.read_to_string(&mut out)?;

@@ -116,15 +116,7 @@ impl Graph {
             .stdout(log.try_clone()?)
             .stderr(log)
             .spawn()?;
-        let start = Instant::now();
-        while child.try_wait()?.is_none() {
-            if start.elapsed() > timeout {
-                let _ = child.kill();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = child.wait();
+        rover_tests::wait_or_kill(&mut child, timeout)?;
         Ok(std::fs::read_to_string(&log_path)?)
     }
 
@@ -786,11 +778,11 @@ fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Re
             .skip(3)
             .map(str::parse)
             .collect::<Result<_, _>>()?;
-        // The car: cmd_vel and the arm's task in, and the requests of the 5 parameter services;
+        // The car: cmd_vel and the arm's task in, and the requests of the 6 parameter services;
         // out at least clock, odom, tf, tf_static, joint_states, robot_description, image and
-        // camera_info, darknet_ros's three, and the 5 services' replies.
+        // camera_info, darknet_ros's three, and the 6 services' replies.
         ensure!(
-            counts.len() == 2 && counts[0] == 7 && counts[1] >= 16,
+            counts.len() == 2 && counts[0] == 8 && counts[1] >= 17,
             "{gid_bytes}-byte Gids: readers, writers {counts:?}:\n{out}"
         );
         ensure!(
@@ -889,8 +881,9 @@ class SetParameters_Response_(IdlStruct, typename="rcl_interfaces::srv::dds_::Se
 /// `ros2 param get /rover use_sim_time` as a Cyclone DDS client does it: a request on
 /// `rq/rover/get_parametersRequest` comes back on `rr/rover/get_parametersReply` with the
 /// client's header, `use_sim_time` a bool that is true, `robot_description` the URDF (as
-/// `/robot_description` carries it), an unknown name not set; `list_parameters` names both; `set_parameters` is
-/// refused with a reason.
+/// `/robot_description` carries it), an unknown name not set; `list_parameters` names both;
+/// `set_parameters` is refused with a reason. Five truncated requests from another client are
+/// one warning naming the mapping, and the requests after them are answered.
 #[test]
 fn a_cyclone_client_reads_use_sim_time_through_the_parameter_service() -> Result<()> {
     let Some(cyclonedds) = cyclonedds() else {
@@ -923,7 +916,17 @@ description = DataReader(dp, Topic(dp, 'rt/robot_description', String_), qos=lat
 get = client('get_parameters', GetParameters_Request_, GetParameters_Response_)
 lst = client('list_parameters', ListParameters_Request_, ListParameters_Response_)
 st = client('set_parameters', SetParameters_Request_, SetParameters_Response_)
+# A truncated request (the header's first 8 bytes only) from another client, five times: one
+# warning, no reply, and the requests after it are answered.
+@dataclass
+class Truncated(IdlStruct, typename="rcl_interfaces::srv::dds_::GetParameters_Request_"):
+    guid: types.uint64
+other = DomainParticipant(int(os.environ['ROS_DOMAIN_ID']))
+bad = DataWriter(other, Topic(other, 'rq/rover/get_parametersRequest', Truncated), qos=qos)
 time.sleep(3)
+for i in range(5):
+    bad.write(Truncated(guid=i))
+time.sleep(0.5)
 get[0].write(GetParameters_Request_(guid=0x1234, seq=7, names=['use_sim_time', 'robot_description', 'nope']))
 lst[0].write(ListParameters_Request_(guid=0x1234, seq=8, prefixes=[], depth=0))
 value = ParameterValue(type=1, bool_value=False, integer_value=0, double_value=0.0, string_value='', byte_array_value=[], bool_array_value=[], integer_array_value=[], double_array_value=[], string_array_value=[])
@@ -970,6 +973,16 @@ if s:
             .iter()
             .any(|l| l.starts_with("set 9 False use_sim_time is read-only")),
         "set_parameters was not refused:\n{out}"
+    );
+    let log = std::fs::read_to_string(graph.dir.path().join("rover.log"))?;
+    let warnings: Vec<&str> = log
+        .lines()
+        .filter(|l| l.contains("did not decode"))
+        .collect();
+    ensure!(
+        warnings.len() == 1 && warnings[0].contains("Cyclone DDS's mapping"),
+        "five truncated requests from one client must be one warning naming the mapping: \
+         {warnings:?}\n{log}"
     );
     Ok(())
 }

@@ -214,7 +214,7 @@ pub(crate) struct RosArgs {
     /// With --ros2: the ROS 2 distribution the peers run, for what differs on the wire
     /// (`ros_discovery_info`'s ids: 24 bytes on Humble, 16 from Iron on). Default:
     /// `ROS_DISTRO` when it names one of these, else lyrical (the newest LTS)
-    #[arg(long, value_enum, value_name = "DISTRO")]
+    #[arg(long, value_name = "DISTRO", value_parser = ros_distro_parser())]
     pub(crate) ros_distro: Option<crate::ros2::RosDistro>,
 
     /// With --ros: also set /use_sim_time so ROS nodes follow rover's /clock
@@ -1350,4 +1350,14 @@ pub(crate) struct XacroArgs {
     /// Where ROS package NAME is, for $(find NAME) (repeatable)
     #[arg(long = "package-path", value_name = "NAME=DIR", value_parser = parse_package_path)]
     pub(crate) package_paths: Vec<(String, PathBuf)>,
+}
+
+/// `--ros-distro`: one of the distributions rover-ros2 knows, listed in `--help` and in the
+/// error for any other name.
+fn ros_distro_parser() -> impl clap::builder::TypedValueParser<Value = crate::ros2::RosDistro> {
+    use crate::ros2::RosDistro;
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(RosDistro::ALL.map(RosDistro::as_str)).try_map(
+        |name| RosDistro::from_name(&name).ok_or_else(|| format!("no ROS 2 distribution {name}")),
+    )
 }

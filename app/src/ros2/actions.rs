@@ -23,7 +23,12 @@ use rustdds::no_key::DataWriter;
 use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, QosPolicies, RTPSEntity, TopicKind};
 use serde::Serialize;
 
-use super::action_msgs::{
+use crate::bridge::RosPlan;
+use crate::bridge::action_goals::{
+    ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
+};
+use crate::bridge::events::{ControlUpdate, GripperSample, RunSample, TopicFamily};
+use rover_ros2::action_msgs::{
     CANCEL_ERROR_GOAL_TERMINATED, CANCEL_ERROR_NONE, CANCEL_ERROR_UNKNOWN_GOAL_ID, CancelGoal,
     FEEDBACK_TYPE, FeedbackMessage, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
     GRIPPER_FEEDBACK_TYPE, GetResult, GoalInfo, GoalStatus, GoalStatusArray, GripperCommandGoal,
@@ -31,15 +36,10 @@ use super::action_msgs::{
     STATUS_ABORTED, STATUS_CANCELED, STATUS_EXECUTING, STATUS_SUCCEEDED, STATUS_TYPE, SendGoal,
     Uuid,
 };
-use super::dds::{default_qos, latched_qos};
-use super::discovery::RosDistro;
-use super::msgs::Time;
-use super::services::{RequestId, Server, ServiceType};
-use crate::bridge::RosPlan;
-use crate::bridge::action_goals::{
-    ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
-};
-use crate::bridge::events::{ControlUpdate, GripperSample, RunSample, TopicFamily};
+use rover_ros2::dds::{default_qos, latched_qos};
+use rover_ros2::discovery::RosDistro;
+use rover_ros2::msgs::Time;
+use rover_ros2::services::{RequestId, Server, ServiceType};
 
 /// Seconds between feedback messages (20 Hz).
 const FEEDBACK_PERIOD_S: f64 = 0.05;
@@ -525,7 +525,7 @@ impl TopicFamily for ControllerActions {
 
 /// A goal as the simulation takes it.
 fn trajectory_of(goal: &FollowJointTrajectoryGoal) -> JointTrajectory {
-    let secs = |d: super::msgs::Duration| f64::from(d.sec) + f64::from(d.nanosec) * 1e-9;
+    let secs = |d: rover_ros2::msgs::Duration| f64::from(d.sec) + f64::from(d.nanosec) * 1e-9;
     let t = &goal.trajectory;
     let stamp = t.header.stamp;
     JointTrajectory {

@@ -3,11 +3,11 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, header, latched_qos};
 use crate::bridge::RosPlan;
 use crate::bridge::arm::{ArmPoint, ArmWire, GOAL_TOPIC, OBJECT_TOPIC, STATE_TOPIC};
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Time};
 
 /// The arm's topics.
 pub(super) struct Arm {

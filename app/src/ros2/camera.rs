@@ -4,12 +4,12 @@
 use anyhow::Result;
 use rover_sim::CameraInfo;
 
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, header, sensor_qos};
 use crate::bridge::RosPlan;
 use crate::bridge::camera::{CameraWire, Channel, Channels};
 use crate::bridge::copy_fields;
 use crate::bridge::events::ImageFrame;
+use rover_ros2::msgs::{self, Time};
 
 /// One image topic and its camera_info topic.
 struct ImageTopics {

@@ -3,14 +3,14 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, header, latched_qos};
 use crate::bridge::copy_fields;
 use crate::bridge::darknet::{
     BOUNDING_BOXES_TOPIC, BoxesWire, DETECTION_IMAGE_TOPIC, DarknetWire, FOUND_OBJECT_TOPIC,
 };
 use crate::bridge::events::Detections;
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Time};
 
 /// A BoundingBoxes topic.
 pub(super) struct Boxes {

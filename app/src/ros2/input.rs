@@ -15,11 +15,11 @@ use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;
 
-use super::dds::{dds_topic, default_qos};
-use super::msgs::{self, RosMessage};
-use super::parameters::Parameters;
 use crate::bridge::RosPlan;
 use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn, trajectory};
+use rover_ros2::dds::{dds_topic, default_qos};
+use rover_ros2::msgs::{self, RosMessage};
+use rover_ros2::parameters::Parameters;
 
 /// A reader of `M` on one topic that warns once about samples it cannot read.
 struct Reader<M: RosMessage + DeserializeOwned> {

@@ -2,11 +2,11 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Header, Time};
 use super::sinks::{Out, Sinks};
 use crate::bridge::RosPlan;
 use crate::bridge::joint_states::{JointArrays, JointStatesWire};
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Header, Time};
 
 /// `/joint_states`.
 pub(super) struct JointStates {

@@ -4,10 +4,10 @@
 use anyhow::Result;
 use rover_sim::LaserScan;
 
-use super::msgs::{self, Header, Lent, Time};
 use super::sinks::{Out, Sinks, sensor_qos};
 use crate::bridge::RosPlan;
 use crate::bridge::laser::ScanWire;
+use rover_ros2::msgs::{self, Header, Lent, Time};
 
 /// The scan topic (none when the robot has no laser).
 pub(super) struct Laser {

@@ -1,7 +1,7 @@
 //! `--record-mcap FILE`: what the ROS 2 bridge publishes, written as ROS 2 writes a bag — an
 //! MCAP file (the `mcap` crate, Foxglove's own) with one channel per topic, CDR messages
 //! (`cdr`, little-endian with its 4-byte encapsulation header, as on the wire) and `ros2msg`
-//! schemas carrying each type's definition ([`super::definitions`]). Log and publish times are
+//! schemas carrying each type's definition ([`rover_ros2::definitions`]). Log and publish times are
 //! the messages' sim-time stamps in nanoseconds. Chunks are LZ4-compressed: cheap on the CPU
 //! the loop needs, and read by every MCAP reader.
 
@@ -14,8 +14,8 @@ use anyhow::{Context, Result};
 use byteorder::LittleEndian;
 use mcap::records::MessageHeader;
 
-use super::definitions::ros_type_name;
-use super::msgs::{RosMessage, Time};
+use rover_ros2::definitions::ros_type_name;
+use rover_ros2::msgs::{RosMessage, Time};
 
 /// CDR little-endian's encapsulation header (representation id 0x0001, options 0).
 const CDR_LE_HEADER: [u8; 4] = [0, 1, 0, 0];

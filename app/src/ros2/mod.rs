@@ -5,7 +5,8 @@
 //!
 //! It is the shared bridge (app/src/bridge/: the plan, the observer, the publishing thread,
 //! the topic families) on this wire: here are the encoders, one file per topic family, each
-//! implementing its family's wire trait with ROS 2's messages (`msgs.rs`) on the topic's sinks
+//! implementing its family's wire trait with ROS 2's messages (the `rover-ros2` crate's `msgs`)
+//! on the topic's sinks
 //! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
 //! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
 //! `laser.rs`, `arm.rs`, `status.rs`; `/robot_description` is written once, at the start
@@ -22,34 +23,28 @@
 //! without; recording never drops an event (the loop waits for the disk), DDS alone drops what
 //! its thread cannot keep up with.
 //!
-//! `ros_discovery_info` names rover's node and its readers and writers, so `ros2 node list`
-//! finds it (`discovery.rs`); the node's parameters are read through rclcpp's parameter
-//! services (`parameters.rs`, on `services.rs`: rmw_cyclonedds_cpp's request/reply mapping);
-//! each trajectory controller serves `follow_joint_trajectory` (`actions.rs`).
+//! The wire itself is the `rover-ros2` crate: `ros_discovery_info` names rover's node and its
+//! readers and writers, so `ros2 node list` finds it (`discovery`); the node's parameters are
+//! read through rclcpp's parameter services (`parameters`, on `services`: Fast DDS's and
+//! Cyclone DDS's request/reply mappings, chosen per request). Here, each trajectory
+//! controller and gripper serves its action (`actions.rs`) from the bridge's goals.
 //!
 //! Why RustDDS and not ros2-client (the ROS 2 client library on top of it): ros2-client picks
 //! the distribution, and with it the size of `ros_discovery_info`'s ids, with a cargo feature,
 //! where rover picks it per run (`--ros-distro`); and the bridge needs topics, writers and
 //! readers with chosen QoS, which RustDDS offers directly (docs/ROS2.md).
 
-mod action_msgs;
 mod actions;
 mod arm;
 mod camera;
 mod clock;
-mod dds;
-mod definitions;
 mod detections;
-mod discovery;
 mod input;
 mod joint_states;
 mod laser;
 mod mcap;
 mod model_states;
-mod msgs;
 mod odom;
-mod parameters;
-mod services;
 mod sinks;
 mod status;
 mod tf;
@@ -67,11 +62,12 @@ use crate::bridge::{darknet, joint_states as joint_states_family, laser as laser
 use crate::bridge::{odom as odom_family, status as status_family, tf as tf_family};
 use sinks::{Sinks, latched_qos};
 
-pub use dds::dds_topic;
-use dds::default_qos;
-pub use discovery::RosDistro;
 pub use input::Ros2Input;
 pub use mcap::McapSummary;
+pub use rover_ros2::dds::dds_topic;
+use rover_ros2::dds::default_qos;
+pub use rover_ros2::discovery::RosDistro;
+use rover_ros2::{discovery, msgs};
 
 /// Where robot_state_publisher keeps the URDF in ROS 2.
 const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";

@@ -2,12 +2,12 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks};
 use crate::bridge::model_states::{
     MODEL_STATES_TOPIC, ModelPose, ModelStatesWire, fill_model_states,
 };
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Time};
 
 /// `/gazebo/model_states`, its message refilled in place.
 pub(super) struct ModelStates {

@@ -3,11 +3,11 @@
 use anyhow::Result;
 use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
 
-use super::dds::default_qos;
-use super::msgs::{self, Covariance, Time};
 use super::sinks::{Out, Sinks, header};
 use crate::bridge::RosPlan;
 use crate::bridge::odom::{OdomSample, OdomWire};
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Covariance, Time};
 
 /// The odometry topic.
 pub(super) struct Odom {

@@ -6,10 +6,10 @@ use std::sync::{Arc, Mutex, PoisonError};
 use anyhow::Result;
 use rustdds::{DomainParticipant, GUID, QosPolicies, RTPSEntity};
 
-use super::dds::{Writer, writer};
-pub(super) use super::dds::{latched_qos, sensor_qos};
 use super::mcap::McapRecorder;
-use super::msgs::{self, Header, Lent, RosMessage, Time};
+use rover_ros2::dds::{Writer, writer};
+pub(super) use rover_ros2::dds::{latched_qos, sensor_qos};
+use rover_ros2::msgs::{self, Header, Lent, RosMessage, Time};
 
 /// The MCAP file, shared by every topic's channel on the publishing thread.
 pub(super) type Recorder = Arc<Mutex<McapRecorder>>;

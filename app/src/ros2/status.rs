@@ -2,10 +2,10 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks};
 use crate::bridge::status::{STATUS_TOPIC, StatusWire};
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Time};
 
 /// `/rover/status`.
 pub(super) struct Status {

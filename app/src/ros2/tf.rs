@@ -3,11 +3,11 @@
 
 use anyhow::Result;
 
-use super::dds::default_qos;
-use super::msgs::{self, Time};
 use super::sinks::{Out, Sinks, latched_qos};
 use crate::bridge::events::Transform;
 use crate::bridge::tf::TfWire;
+use rover_ros2::dds::default_qos;
+use rover_ros2::msgs::{self, Time};
 
 /// `/tf` and `/tf_static`.
 pub(super) struct Tf {

@@ -95,7 +95,7 @@ pub struct Twist {
 
 impl RosMessage for Twist {
     const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Twist_";
-    const DEFINITION: &'static str = super::definitions::TWIST;
+    const DEFINITION: &'static str = crate::definitions::TWIST;
 }
 
 /// A 6x6 row-major covariance: `float64[36]`, written without a length as CDR fixed arrays are
@@ -199,7 +199,7 @@ pub struct Odometry {
 
 impl RosMessage for Odometry {
     const DDS_TYPE: &'static str = "nav_msgs::msg::dds_::Odometry_";
-    const DEFINITION: &'static str = super::definitions::ODOMETRY;
+    const DEFINITION: &'static str = crate::definitions::ODOMETRY;
 }
 
 /// `rosgraph_msgs/msg/Clock`.
@@ -211,7 +211,7 @@ pub struct Clock {
 
 impl RosMessage for Clock {
     const DDS_TYPE: &'static str = "rosgraph_msgs::msg::dds_::Clock_";
-    const DEFINITION: &'static str = super::definitions::CLOCK;
+    const DEFINITION: &'static str = crate::definitions::CLOCK;
 }
 
 /// `geometry_msgs/msg/Transform`.
@@ -243,7 +243,7 @@ pub struct TfMessage {
 
 impl RosMessage for TfMessage {
     const DDS_TYPE: &'static str = "tf2_msgs::msg::dds_::TFMessage_";
-    const DEFINITION: &'static str = super::definitions::TF_MESSAGE;
+    const DEFINITION: &'static str = crate::definitions::TF_MESSAGE;
 }
 
 /// `sensor_msgs/msg/JointState`.
@@ -263,7 +263,7 @@ pub struct JointState {
 
 impl RosMessage for JointState {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::JointState_";
-    const DEFINITION: &'static str = super::definitions::JOINT_STATE;
+    const DEFINITION: &'static str = crate::definitions::JOINT_STATE;
 }
 
 /// A buffer lent to a message: the writer serializes the message and drops it, and the bridge
@@ -319,7 +319,7 @@ pub struct Image {
 
 impl RosMessage for Image {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Image_";
-    const DEFINITION: &'static str = super::definitions::IMAGE;
+    const DEFINITION: &'static str = crate::definitions::IMAGE;
 }
 
 /// `sensor_msgs/msg/RegionOfInterest`.
@@ -366,7 +366,7 @@ pub struct CameraInfo {
 
 impl RosMessage for CameraInfo {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::CameraInfo_";
-    const DEFINITION: &'static str = super::definitions::CAMERA_INFO;
+    const DEFINITION: &'static str = crate::definitions::CAMERA_INFO;
 }
 
 /// `sensor_msgs/msg/LaserScan`.
@@ -396,7 +396,7 @@ pub struct LaserScan {
 
 impl RosMessage for LaserScan {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::LaserScan_";
-    const DEFINITION: &'static str = super::definitions::LASER_SCAN;
+    const DEFINITION: &'static str = crate::definitions::LASER_SCAN;
 }
 
 /// `darknet_ros_msgs/msg/BoundingBox` as darknet_ros's ROS 2 branch (`foxy`) declares it: ROS 1's
@@ -432,7 +432,7 @@ pub struct BoundingBoxes {
 
 impl RosMessage for BoundingBoxes {
     const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::BoundingBoxes_";
-    const DEFINITION: &'static str = super::definitions::BOUNDING_BOXES;
+    const DEFINITION: &'static str = crate::definitions::BOUNDING_BOXES;
 }
 
 /// `darknet_ros_msgs/msg/ObjectCount`: how many boxes one image gave.
@@ -446,7 +446,7 @@ pub struct ObjectCount {
 
 impl RosMessage for ObjectCount {
     const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::ObjectCount_";
-    const DEFINITION: &'static str = super::definitions::OBJECT_COUNT;
+    const DEFINITION: &'static str = crate::definitions::OBJECT_COUNT;
 }
 
 /// `gazebo_msgs/msg/ModelStates`.
@@ -462,7 +462,7 @@ pub struct ModelStates {
 
 impl RosMessage for ModelStates {
     const DDS_TYPE: &'static str = "gazebo_msgs::msg::dds_::ModelStates_";
-    const DEFINITION: &'static str = super::definitions::MODEL_STATES;
+    const DEFINITION: &'static str = crate::definitions::MODEL_STATES;
 }
 
 /// `std_msgs/msg/String`.
@@ -474,7 +474,7 @@ pub struct Text {
 
 impl RosMessage for Text {
     const DDS_TYPE: &'static str = "std_msgs::msg::dds_::String_";
-    const DEFINITION: &'static str = super::definitions::STRING;
+    const DEFINITION: &'static str = crate::definitions::STRING;
 }
 
 /// `geometry_msgs/msg/PointStamped`.
@@ -488,7 +488,7 @@ pub struct PointStamped {
 
 impl RosMessage for PointStamped {
     const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::PointStamped_";
-    const DEFINITION: &'static str = super::definitions::POINT_STAMPED;
+    const DEFINITION: &'static str = crate::definitions::POINT_STAMPED;
 }
 
 /// `builtin_interfaces/msg/Duration`.
@@ -529,7 +529,7 @@ pub struct JointTrajectory {
 
 impl RosMessage for JointTrajectory {
     const DDS_TYPE: &'static str = "trajectory_msgs::msg::dds_::JointTrajectory_";
-    const DEFINITION: &'static str = super::definitions::JOINT_TRAJECTORY;
+    const DEFINITION: &'static str = crate::definitions::JOINT_TRAJECTORY;
 }
 
 /// `std_msgs/msg/MultiArrayDimension`.
@@ -564,7 +564,7 @@ pub struct Float64MultiArray {
 
 impl RosMessage for Float64MultiArray {
     const DDS_TYPE: &'static str = "std_msgs::msg::dds_::Float64MultiArray_";
-    const DEFINITION: &'static str = super::definitions::FLOAT64_MULTI_ARRAY;
+    const DEFINITION: &'static str = crate::definitions::FLOAT64_MULTI_ARRAY;
 }
 
 #[cfg(test)]

@@ -5,11 +5,11 @@
 //! on `/clock`) and `robot_description` (the URDF, as robot_state_publisher's). Setting one
 //! is refused with a reason: they describe the run, they do not steer it.
 
-use anyhow::Result;
+use crate::error::Result;
 use rustdds::{DomainParticipant, GUID};
 use serde::{Deserialize, Serialize};
 
-use super::services::{Server, ServiceType};
+use crate::services::{Server, ServiceType};
 
 /// `rcl_interfaces/msg/ParameterType`'s values rover uses.
 const PARAMETER_NOT_SET: u8 = 0;

@@ -19,7 +19,7 @@
 
 use std::collections::HashSet;
 
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use rustdds::no_key::{DataReader, DataWriter, Decode, DefaultDecoder, DeserializerAdapter};
 use rustdds::serialization::deserialize_from_cdr_with_rep_id;
 use rustdds::{
@@ -29,7 +29,7 @@ use rustdds::{
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use super::dds::default_qos;
+use crate::dds::default_qos;
 
 /// rmw_cyclonedds_cpp's request header: which client, which of its requests.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

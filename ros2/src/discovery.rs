@@ -10,11 +10,11 @@
 //! distribution uses: 24 bytes up to Humble, 16 from Iron on. A peer of another size reads the
 //! message wrongly, so the distribution is chosen (`--ros-distro`).
 
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use rustdds::no_key::DataWriter;
 use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 
-use super::dds::latched_qos;
+use crate::dds::latched_qos;
 use serde::ser::SerializeTuple;
 use serde::{Serialize, Serializer};
 
@@ -24,7 +24,7 @@ pub const DISCOVERY_TOPIC: &str = "ros_discovery_info";
 const DISCOVERY_TYPE: &str = "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_";
 
 /// A ROS 2 distribution, for what differs on the wire between them (the size of a `Gid`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum RosDistro {
     /// Humble Hawksbill (LTS, 2022): 24-byte Gids.
     Humble,
@@ -40,6 +40,15 @@ pub enum RosDistro {
 }
 
 impl RosDistro {
+    /// Every distribution rover knows, oldest first.
+    pub const ALL: [Self; 5] = [
+        Self::Humble,
+        Self::Iron,
+        Self::Jazzy,
+        Self::Kilted,
+        Self::Lyrical,
+    ];
+
     /// Bytes in a `rmw_dds_common/msg/Gid`.
     pub fn gid_len(self) -> usize {
         if self == Self::Humble { 24 } else { 16 }
@@ -59,15 +68,7 @@ impl RosDistro {
     /// The distribution a `ROS_DISTRO` value names; `None` for anything else (a ROS 1
     /// distribution such as `noetic`, or one rover does not know).
     pub fn from_name(name: &str) -> Option<Self> {
-        [
-            Self::Humble,
-            Self::Iron,
-            Self::Jazzy,
-            Self::Kilted,
-            Self::Lyrical,
-        ]
-        .into_iter()
-        .find(|d| d.as_str() == name.trim())
+        Self::ALL.into_iter().find(|d| d.as_str() == name.trim())
     }
 }
 

@@ -1,12 +1,12 @@
 //! DDS helpers shared by the bridge's halves: ROS names as DDS topics, rclcpp's default QoS,
 //! and typed writers.
 
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use rustdds::no_key::DataWriter;
 use rustdds::policy::{Durability, History, Reliability};
 use rustdds::{CDRSerializerAdapter, DomainParticipant, QosPolicies, QosPolicyBuilder, TopicKind};
 
-use super::msgs::RosMessage;
+use crate::msgs::RosMessage;
 
 /// A ROS name as its DDS topic: `/odom` -> `rt/odom`, `/a/b` -> `rt/a/b`.
 pub fn dds_topic(ros_name: &str) -> String {
@@ -30,25 +30,26 @@ fn qos(reliable: bool, durability: Durability, depth: i32) -> QosPolicies {
 }
 
 /// rclcpp's default QoS: reliable, volatile, keep last 10.
-pub(super) fn default_qos() -> QosPolicies {
+pub fn default_qos() -> QosPolicies {
     qos(true, Durability::Volatile, 10)
 }
 
 /// What a late joiner must still get: reliable, transient local, keep last 1 (tf2's static
 /// broadcaster, robot_state_publisher's description, rmw's `ros_discovery_info`).
-pub(super) fn latched_qos() -> QosPolicies {
+pub fn latched_qos() -> QosPolicies {
     qos(true, Durability::TransientLocal, 1)
 }
 
 /// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).
-pub(super) fn sensor_qos() -> QosPolicies {
+pub fn sensor_qos() -> QosPolicies {
     qos(false, Durability::Volatile, 5)
 }
 
-pub(super) type Writer<M> = DataWriter<M, CDRSerializerAdapter<M>>;
+/// A DDS writer of the message `M`, CDR little-endian.
+pub type Writer<M> = DataWriter<M, CDRSerializerAdapter<M>>;
 
 /// A writer of `M` on the ROS topic `ros_name`.
-pub(super) fn writer<M: RosMessage>(
+pub fn writer<M: RosMessage>(
     participant: &DomainParticipant,
     publisher: &rustdds::Publisher,
     ros_name: &str,

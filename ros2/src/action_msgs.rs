@@ -6,10 +6,10 @@
 use serde::ser::SerializeStruct;
 use serde::{Deserialize, Serialize, Serializer};
 
-use super::msgs::{
+use crate::msgs::{
     Duration, Header, JointTrajectory, JointTrajectoryPoint, Time, Transform, Twist,
 };
-use super::services::ServiceType;
+use crate::services::ServiceType;
 
 /// `unique_identifier_msgs/msg/UUID`: a goal's id.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
