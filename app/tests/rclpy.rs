@@ -288,6 +288,57 @@ fn rclpy_on_fast_dds_finds_node_rover_and_reads_its_parameters() -> Result<()> {
     Ok(())
 }
 
+/// `/parameter_events` as every rclcpp and rclpy node has it: an rclpy node listening before
+/// rover starts hears rover declare its two parameters (string, bool), from node `/rover`,
+/// once, nothing changed or deleted.
+#[test]
+fn an_rclpy_node_hears_rover_declare_its_parameters_on_parameter_events() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let salt = 61 + k as u16;
+        let dir = tempfile::tempdir()?;
+        let log_path = dir.path().join("parameter_events.log");
+        let log = std::fs::File::create(&log_path)?;
+        let mut listener = rclpy
+            .python(domain(salt))
+            .arg(repo("app/tests/rclpy/peer.py"))
+            .arg("parameter_events")
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()?;
+        // rclpy's node is up and subscribed before rover declares anything.
+        std::thread::sleep(Duration::from_secs(4));
+        let mut session = Session::start(rclpy, salt, 10.0, &["--no-detector"])?;
+        rover_tests::wait_or_kill(&mut listener, Duration::from_secs(40))?;
+        let out = std::fs::read_to_string(&log_path)?;
+        let last = out
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .with_context(|| format!("{distro}: the listener printed nothing:\n{out}"))?;
+        let found: Value = serde_json::from_str(last)?;
+        println!("rclpy {distro}: {found}");
+        let events = found["parameter_events"]["events"]
+            .as_array()
+            .context("no events")?;
+        ensure!(
+            events.len() == 1
+                && events[0]["new"]
+                    == serde_json::json!([["robot_description", 4], ["use_sim_time", 1]])
+                && events[0]["changed"] == 0
+                && events[0]["deleted"] == 0,
+            "{distro}: rover's parameter events: {found}\n{}",
+            session.rover_log()
+        );
+        session.wait(Duration::from_secs(60))?;
+    }
+    Ok(())
+}
+
 /// MoveIt's way in, from rclpy: an `ActionClient` with the control_msgs set-up built sends
 /// TIAGo's arm (example-robot-data) a two-point FollowJointTrajectory goal: accepted, feedback
 /// for the 7 arm joints, SUCCEEDED (4) with error code 0. A goal for a joint the controller

@@ -40,6 +40,11 @@ pub fn latched_qos() -> QosPolicies {
     qos(true, Durability::TransientLocal, 1)
 }
 
+/// rclcpp's ParameterEventsQoS: reliable, volatile, keep last 1000.
+pub fn parameter_events_qos() -> QosPolicies {
+    qos(true, Durability::Volatile, 1000)
+}
+
 /// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).
 pub fn sensor_qos() -> QosPolicies {
     qos(false, Durability::Volatile, 5)

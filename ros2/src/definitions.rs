@@ -216,6 +216,26 @@ pub fn ros_type_name(dds_type: &str) -> String {
         .replace("::", "/")
 }
 
+/// `rcl_interfaces/msg/ParameterEvent`: a node's parameters as they appear, change or go.
+pub const PARAMETER_EVENT: &str = concat!(
+    "builtin_interfaces/Time stamp\nstring node\nParameter[] new_parameters\n",
+    "Parameter[] changed_parameters\nParameter[] deleted_parameters\n",
+    time!(),
+    block!(
+        "rcl_interfaces/Parameter",
+        "string name\nParameterValue value\n"
+    ),
+    block!(
+        "rcl_interfaces/ParameterValue",
+        concat!(
+            "uint8 type\nbool bool_value\nint64 integer_value\nfloat64 double_value\n",
+            "string string_value\nbyte[] byte_array_value\nbool[] bool_array_value\n",
+            "int64[] integer_array_value\nfloat64[] double_array_value\n",
+            "string[] string_array_value\n"
+        )
+    )
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;

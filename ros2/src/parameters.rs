@@ -1,12 +1,18 @@
 //! The node's parameters, read-only, through ROS 2's parameter services as rclcpp serves them
 //! (`/<node>/get_parameters`, `list_parameters`, `get_parameter_types`, `describe_parameters`,
-//! `set_parameters`, `set_parameters_atomically`), so `ros2 param get /rover use_sim_time` and `ros2 param list /rover`
-//! answer. rover's parameters: `use_sim_time` (true: every stamp rover publishes is sim time,
+//! `set_parameters`, `set_parameters_atomically`), so `ros2 param get /rover use_sim_time` and
+//! `ros2 param list /rover` answer; and declared on `/parameter_events` as rclcpp declares a
+//! node's parameters, to each subscriber when it matches (a subscriber that started first
+//! hears them, which a write at the start would miss before discovery). rover's parameters: `use_sim_time` (true: every stamp rover publishes is sim time,
 //! on `/clock`) and `robot_description` (the URDF, as robot_state_publisher's). Setting one
 //! is refused with a reason: they describe the run, they do not steer it.
 
+use crate::dds::{Writer, parameter_events_qos, writer};
 use crate::error::Result;
-use rustdds::{DomainParticipant, GUID};
+use crate::msgs::{RosMessage, Time};
+use rustdds::{
+    DataWriterStatus, DomainParticipant, GUID, RTPSEntity, StatusEvented, WriteOptionsBuilder,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::services::{Server, ServiceType};
@@ -139,6 +145,30 @@ impl ServiceType for SetParametersAtomically {
         "rcl_interfaces::srv::dds_::SetParametersAtomically_Response_";
 }
 
+/// `rcl_interfaces/msg/ParameterEvent`, on `/parameter_events`: what every rclcpp and rclpy
+/// node publishes when its parameters are declared, changed or deleted.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ParameterEvent {
+    /// When.
+    pub stamp: Time,
+    /// The node's full name (`/rover`).
+    pub node: String,
+    /// Parameters declared.
+    pub new_parameters: Vec<Parameter>,
+    /// Parameters changed.
+    pub changed_parameters: Vec<Parameter>,
+    /// Parameters deleted.
+    pub deleted_parameters: Vec<Parameter>,
+}
+
+impl RosMessage for ParameterEvent {
+    const DDS_TYPE: &'static str = "rcl_interfaces::msg::dds_::ParameterEvent_";
+    const DEFINITION: &'static str = crate::definitions::PARAMETER_EVENT;
+}
+
+/// The topic of every node's parameter events.
+pub const PARAMETER_EVENTS_TOPIC: &str = "/parameter_events";
+
 /// The node's parameters and their services.
 pub struct Parameters {
     values: Vec<(&'static str, ParameterValue, &'static str)>,
@@ -148,6 +178,8 @@ pub struct Parameters {
     describe: Server<DescribeParameters>,
     set: Server<SetParameters>,
     set_atomically: Server<SetParametersAtomically>,
+    events: Writer<ParameterEvent>,
+    declaration: ParameterEvent,
 }
 
 impl Parameters {
@@ -181,7 +213,27 @@ impl Parameters {
                 "the robot's URDF, as robot_state_publisher has it",
             ),
         ];
+        let events = writer::<ParameterEvent>(
+            participant,
+            publisher,
+            PARAMETER_EVENTS_TOPIC,
+            &parameter_events_qos(),
+        )?;
+        let declaration = ParameterEvent {
+            stamp: Time::default(),
+            node: node.to_owned(),
+            new_parameters: values
+                .iter()
+                .map(|(name, value, _)| Parameter {
+                    name: (*name).to_owned(),
+                    value: value.clone(),
+                })
+                .collect(),
+            ..ParameterEvent::default()
+        };
         Ok(Self {
+            events,
+            declaration,
             values,
             get: Server::new(participant, subscriber, publisher, &name("get_parameters"))?,
             types: Server::new(
@@ -207,8 +259,24 @@ impl Parameters {
         })
     }
 
-    /// Answers the requests that came.
+    /// Answers the requests that came, and declares the parameters to each new subscriber of
+    /// `/parameter_events`.
     pub fn poll(&mut self) {
+        while let Some(status) = self.events.try_recv_status() {
+            if let DataWriterStatus::PublicationMatched {
+                current, reader, ..
+            } = status
+                && current.count_change() > 0
+            {
+                let only_it = WriteOptionsBuilder::new().to_single_reader(reader).build();
+                if let Err(e) = self
+                    .events
+                    .write_with_options(self.declaration.clone(), only_it)
+                {
+                    tracing::warn!("ROS 2: {PARAMETER_EVENTS_TOPIC} could not be written ({e})");
+                }
+            }
+        }
         let values = &self.values;
         let find = |name: &str| values.iter().find(|v| v.0 == name);
         self.get.serve(|names| {
@@ -266,9 +334,9 @@ impl Parameters {
         });
     }
 
-    /// The services' readers and writers, for `ros_discovery_info`.
+    /// The services' readers and writers and the events' writer, for `ros_discovery_info`.
     pub fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
-        [
+        let (readers, mut writers): (Vec<GUID>, Vec<GUID>) = [
             self.get.gids(),
             self.types.gids(),
             self.list.gids(),
@@ -277,6 +345,8 @@ impl Parameters {
             self.set_atomically.gids(),
         ]
         .into_iter()
-        .unzip()
+        .unzip();
+        writers.push(self.events.guid());
+        (readers, writers)
     }
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A real rclpy node (rmw_fastrtps_cpp) that checks `rover --ros2` as ROS 2's own tools would.
 
-    python3 peer.py CHECK...     (CHECK: graph, params, topics, trajectory, gripper,
+    python3 peer.py CHECK...     (CHECK: graph, params, parameter_events, topics, trajectory, gripper,
                                   camera_rate, publish_images)
 
 Run by app/tests/rclpy.rs with a distribution's venv and the interface packages set-up built
@@ -72,6 +72,24 @@ def params(node):
         r = set_.results[0]
         out["set"] = {"successful": r.successful, "reason": r.reason}
     return out
+
+
+def parameter_events(node):
+    """Listens on /parameter_events (started before rover) for rover's declaration."""
+    from rcl_interfaces.msg import ParameterEvent
+
+    events = []
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    node.create_subscription(ParameterEvent, "/parameter_events",
+                             lambda e: events.append(e) if e.node == "/rover" else None, qos)
+    end = time.monotonic() + 30
+    while time.monotonic() < end and not events:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    spin_for(node, 2.0)  # no second declaration to this node
+    return {"events": [{"node": e.node,
+                        "new": sorted((p.name, p.value.type) for p in e.new_parameters),
+                        "changed": len(e.changed_parameters),
+                        "deleted": len(e.deleted_parameters)} for e in events]}
 
 
 def topics(node):
@@ -269,7 +287,8 @@ def main():
     node = Node("rover_test_peer")
     from rclpy.utilities import get_rmw_implementation_identifier
     out = {"rmw": get_rmw_implementation_identifier()}
-    checks = {"graph": graph, "params": params, "topics": topics, "trajectory": trajectory,
+    checks = {"graph": graph, "params": params, "parameter_events": parameter_events,
+              "topics": topics, "trajectory": trajectory,
               "gripper": gripper, "camera_rate": camera_rate, "publish_images": publish_images}
     for check in sys.argv[1:]:
         out[check] = checks[check](node)
