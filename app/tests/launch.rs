@@ -373,11 +373,7 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
     }
     // A held key repeats (teleop stops after its key timeout without one).
     tmux.press("i", 15)?;
-    // A person lifts the finger before pressing `k`. teleop_twist_keyboard loses a key that
-    // comes while its publish thread is still sending the previous one (`update` notifies a
-    // condition nobody waits on yet), so `k` typed within a millisecond of the last `i` can be
-    // lost and the car keeps going: the gap a key repeat leaves avoids that race.
-    std::thread::sleep(Duration::from_millis(200));
+    // `press` leaves a key-repeat gap before `k` (teleop_twist_keyboard's race: Tmux::press).
     tmux.press("k", 1)?;
     while !rc.exists() {
         ensure!(

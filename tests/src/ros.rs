@@ -96,12 +96,14 @@ impl Tmux {
         Ok(tmux)
     }
 
-    /// Presses `key` in the session (held: `times`, 200 ms apart, as a key repeats).
+    /// Presses `key` in the session `times` (held: 200 ms apart, as a key repeats), each press
+    /// a key-repeat gap after the one before, whichever key that was: teleop_twist_keyboard
+    /// loses a key that comes while its publish thread is still sending the previous one
+    /// (`update` notifies a condition nobody waits on yet), so a `k` typed within a millisecond
+    /// of the last `i` could be lost and the car keep going.
     pub fn press(&self, key: &str, times: usize) -> Result<()> {
-        for i in 0..times {
-            if i > 0 {
-                std::thread::sleep(std::time::Duration::from_millis(200));
-            }
+        for _ in 0..times {
+            std::thread::sleep(std::time::Duration::from_millis(200));
             self.run(&["send-keys", "-t", &self.session, key])?;
         }
         Ok(())
