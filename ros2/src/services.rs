@@ -72,13 +72,13 @@ pub trait ServiceType {
 
 /// A request as it came: its serialized payload and its encoding, decoded once its mapping is
 /// known (the sample's inline QoS says which).
-pub struct RawRequest {
+struct RawRequest {
     bytes: Vec<u8>,
     encoding: RepresentationIdentifier,
 }
 
 /// Keeps a request's bytes for [`Server::next_request`] to decode.
-pub struct RawAdapter;
+struct RawAdapter;
 
 /// The encodings rover's CDR decoder reads (XCDR1, either byte order).
 const RAW_ENCODINGS: [RepresentationIdentifier; 4] = [
@@ -103,7 +103,7 @@ impl DeserializerAdapter<RawRequest> for RawAdapter {
 
 /// [`RawAdapter`]'s decoder: a copy of the bytes.
 #[derive(Clone, Copy)]
-pub struct RawDecoder;
+struct RawDecoder;
 
 impl Decode<'_, RawRequest> for RawDecoder {
     type Error = std::convert::Infallible;
@@ -128,7 +128,7 @@ impl DefaultDecoder<RawRequest> for RawAdapter {
 /// A reply as its client's mapping writes it: with Cyclone's header, or the fields alone.
 #[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
-pub enum Reply<T> {
+enum Reply<T> {
     /// Cyclone's mapping.
     WithHeader(WithHeader<T>),
     /// Fast DDS's mapping (the id travels in the inline QoS).

@@ -287,22 +287,20 @@ pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<Stri
     Ok(out)
 }
 
-/// Waits for `child` to end, killing it once `timeout` has passed; then reaps it. `true` when
-/// it ended by itself. (The peers of the ROS tests run until they are done or stopped.)
+/// Waits for `child` to end, killing it once `timeout` has passed; then reaps it. (The peers
+/// of the ROS tests run until they are done or stopped.)
 pub fn wait_or_kill(
     child: &mut std::process::Child,
     timeout: std::time::Duration,
-) -> std::io::Result<bool> {
+) -> std::io::Result<()> {
     let start = std::time::Instant::now();
-    let mut ended = true;
     while child.try_wait()?.is_none() {
         if start.elapsed() > timeout {
             let _ = child.kill();
-            ended = false;
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     let _ = child.wait();
-    Ok(ended)
+    Ok(())
 }
