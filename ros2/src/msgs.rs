@@ -278,6 +278,11 @@ impl<T> Lent<T> {
         Self(std::sync::Arc::new(buffer))
     }
 
+    /// What is lent.
+    pub fn as_slice(&self) -> &[T] {
+        &self.0
+    }
+
     /// The buffer, once no message holds it any more.
     pub fn take_back(self) -> Option<Vec<T>> {
         std::sync::Arc::try_unwrap(self.0).ok()

@@ -4,9 +4,11 @@
 use std::sync::{Arc, Mutex, PoisonError};
 
 use anyhow::Result;
+use rustdds::policy::Reliability;
 use rustdds::{DomainParticipant, GUID, QosPolicies, RTPSEntity};
 
 use super::mcap::McapRecorder;
+use rover_ros2::bulk::BulkWriter;
 use rover_ros2::dds::{Writer, writer};
 pub(super) use rover_ros2::dds::{latched_qos, sensor_qos};
 use rover_ros2::msgs::{self, Header, Lent, RosMessage, Time};
@@ -22,10 +24,17 @@ pub(super) fn header(frame_id: &str) -> Header {
     }
 }
 
+/// A topic's DDS writer: RustDDS's, or for best-effort topics (whose samples may be large)
+/// the one that sends 64 KB fragments (rover_ros2::bulk).
+enum Dds<M: RosMessage> {
+    Plain(Writer<M>),
+    Bulk(BulkWriter<M>),
+}
+
 /// One topic: where its messages go.
 pub(super) struct Out<M: RosMessage> {
     ros_name: String,
-    dds: Option<Writer<M>>,
+    dds: Option<Dds<M>>,
     mcap: Option<(Recorder, u16)>,
     /// A DDS write failed (said once).
     warned: bool,
@@ -40,8 +49,12 @@ impl<M: RosMessage + Clone> Out<M> {
                 .unwrap_or_else(PoisonError::into_inner)
                 .write(*channel, stamp, msg);
         }
-        if let Some(w) = &self.dds
-            && let Err(e) = w.write(msg.clone(), None)
+        let written = match &mut self.dds {
+            Some(Dds::Plain(w)) => w.write(msg.clone(), None).map_err(|e| e.to_string()),
+            Some(Dds::Bulk(w)) => w.write(msg).map_err(|e| e.to_string()),
+            None => Ok(()),
+        };
+        if let Err(e) = written
             && !std::mem::replace(&mut self.warned, true)
         {
             tracing::warn!(
@@ -97,7 +110,11 @@ impl Sinks<'_> {
             Some((participant, publisher)) => {
                 let w = writer(participant, publisher, ros_name, qos)?;
                 self.writers.push(w.guid());
-                Some(w)
+                if qos.reliability() == Some(Reliability::BestEffort) {
+                    Some(Dds::Bulk(BulkWriter::new(participant, w, ros_name)?))
+                } else {
+                    Some(Dds::Plain(w))
+                }
             }
             None => None,
         };

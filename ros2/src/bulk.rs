@@ -1,0 +1,361 @@
+//! Large best-effort samples (images, point clouds) sent in 64,000-byte fragments, as Fast DDS
+//! and Cyclone DDS send theirs, instead of RustDDS's.
+//!
+//! Why rover writes these datagrams itself: RustDDS 0.15.1 cuts every fragmented sample into
+//! 256-byte fragments (a constant of the crate) packed into datagrams of the MTU of the
+//! interface whose subnet holds the reader's address — 1,400 bytes here, though a reader on the
+//! same machine is reached through the loopback device. A 640x480 rgb8 image is then ~700
+//! datagrams and 3,600 fragments; a Fast DDS subscriber at the OS's default receive buffer
+//! (208 KiB) lost three images in four of them (docs/ROS2.md, "Large samples"), where the
+//! same image as 15 datagrams of 64,000-byte fragments is what Fast DDS's own writers send.
+//!
+//! RustDDS still owns the writer: it announces it (SEDP), matches readers by topic and QoS and
+//! reports each match. For each matched reader whose UDP address discovery gives, this module
+//! writes the RTPS message itself (header, INFO_DST, INFO_TS, then one DATA, or one DATA_FRAG
+//! per datagram; RTPS 2.5 sections 8.3.7 and 9.4.5) from its own socket, with the writer's GUID
+//! and its own sequence numbers; a reader with no UDP address (a shared-memory or multicast
+//! only peer) gets the sample from RustDDS, to that reader alone.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use byteorder::LittleEndian;
+use rustdds::{
+    DataWriterStatus, DomainParticipant, GUID, RTPSEntity, StatusEvented, WriteOptionsBuilder,
+};
+
+use crate::dds::Writer;
+use crate::error::{Context, Result};
+use crate::msgs::RosMessage;
+
+/// Serialized-payload bytes per fragment. A datagram of these (84 bytes of RTPS headers
+/// added) fills a 16 KiB kernel buffer: the receiver's socket holds ~12 of them in the OS's
+/// default 208 KiB, where 64 KB datagrams take 128 KiB each and only one or two fit.
+pub const FRAGMENT_BYTES: usize = 15_900;
+
+/// The pace of a sample's datagrams, bytes per second: a 640x480 rgb8 image goes out in
+/// ~15 ms, so the receiver drains its socket while the image arrives instead of after a burst
+/// larger than its buffer.
+pub const PACE_BYTES_PER_S: f64 = 60e6;
+
+/// How often a matched reader whose address is not yet known is looked up again.
+const LOOKUP_EVERY: Duration = Duration::from_secs(1);
+
+/// RTPS submessage ids (RTPS 2.5, 9.4.5.1.1).
+const INFO_TS: u8 = 0x09;
+const INFO_DST: u8 = 0x0e;
+const DATA: u8 = 0x15;
+const DATA_FRAG: u8 = 0x16;
+/// Submessage flags: E (little-endian), and DATA's D (data present).
+const FLAG_LITTLE_ENDIAN: u8 = 0x01;
+const FLAG_DATA: u8 = 0x04;
+/// The CDR little-endian encapsulation (RTPS 2.5, 10.2) that starts each serialized payload.
+const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
+
+/// One matched reader: where its datagrams go (`None`: not known yet, RustDDS sends to it).
+#[derive(Debug)]
+struct Reader {
+    guid: GUID,
+    to: Option<SocketAddr>,
+}
+
+/// One sample for the sending thread: its writer's GUID bytes, serialized payload, sequence number, source time
+/// and readers (GUID bytes, address).
+#[derive(Default)]
+struct Job {
+    writer: [u8; 16],
+    payload: Vec<u8>,
+    sequence: i64,
+    stamp: (u32, u32),
+    readers: Vec<([u8; 16], SocketAddr)>,
+}
+
+/// What the publishing side hands the sending thread: the newest job (an older one not yet
+/// started is dropped, as best effort allows), spare jobs to reuse, and whether to stop.
+#[derive(Default)]
+struct Handoff {
+    next: Option<Job>,
+    spare: Vec<Job>,
+    stop: bool,
+}
+
+/// The hand-off and its signal.
+#[derive(Default)]
+struct Shared {
+    handoff: Mutex<Handoff>,
+    ready: Condvar,
+}
+
+impl Shared {
+    fn lock(&self) -> MutexGuard<'_, Handoff> {
+        self.handoff.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// A best-effort writer of `M` whose samples travel in [`FRAGMENT_BYTES`] fragments, paced at
+/// [`PACE_BYTES_PER_S`] by a thread of their own (the newest sample wins).
+pub struct BulkWriter<M: RosMessage> {
+    writer: Writer<M>,
+    participant: DomainParticipant,
+    readers: Vec<Reader>,
+    /// The last sequence number used, on either path (so a reader moved from RustDDS's path to
+    /// this one never sees a number go back).
+    sequence: i64,
+    last_lookup: Option<Instant>,
+    shared: Arc<Shared>,
+    sender: Option<JoinHandle<()>>,
+    /// A send or write failed (said once).
+    warned: bool,
+}
+
+impl<M: RosMessage> BulkWriter<M> {
+    /// Wraps RustDDS's `writer` (best effort, created on `participant`); `name` names the
+    /// sending thread.
+    pub fn new(participant: &DomainParticipant, writer: Writer<M>, name: &str) -> Result<Self> {
+        let socket = UdpSocket::bind(("0.0.0.0", 0)).context("opening a UDP socket")?;
+        let shared = Arc::new(Shared::default());
+        let sender = {
+            let shared = Arc::clone(&shared);
+            std::thread::Builder::new()
+                .name(format!("dds {name}"))
+                .spawn(move || send_jobs(&shared, &socket))
+                .context("starting a sending thread")?
+        };
+        Ok(Self {
+            writer,
+            participant: participant.clone(),
+            readers: Vec::new(),
+            sequence: 0,
+            last_lookup: None,
+            shared,
+            sender: Some(sender),
+            warned: false,
+        })
+    }
+
+    /// The writer's GUID (what discovery announces).
+    pub fn guid(&self) -> GUID {
+        self.writer.guid()
+    }
+
+    /// The readers matched now, and how many of them this writer sends to itself (the others,
+    /// whose UDP address is not known, get RustDDS's datagrams).
+    pub fn matched(&mut self) -> (usize, usize) {
+        self.follow_matches();
+        let direct = self.readers.iter().filter(|r| r.to.is_some()).count();
+        (self.readers.len(), direct)
+    }
+
+    /// Takes RustDDS's matches and unmatches.
+    fn follow_matches(&mut self) {
+        while let Some(status) = self.writer.try_recv_status() {
+            if let DataWriterStatus::PublicationMatched {
+                current, reader, ..
+            } = status
+            {
+                self.readers.retain(|r| r.guid != reader);
+                if current.count_change() > 0 {
+                    self.readers.push(Reader {
+                        guid: reader,
+                        to: None,
+                    });
+                    self.last_lookup = None;
+                }
+            }
+        }
+    }
+
+    /// Finds the UDP address of each matched reader that has none yet.
+    fn look_up(&mut self) {
+        self.last_lookup = Some(Instant::now());
+        let discovered = self.participant.discovered_readers();
+        for reader in self.readers.iter_mut().filter(|r| r.to.is_none()) {
+            reader.to = discovered
+                .iter()
+                .find(|d| d.reader_proxy.remote_reader_guid == reader.guid)
+                .and_then(|d| {
+                    d.reader_proxy
+                        .unicast_locator_list
+                        .iter()
+                        .filter(|l| l.is_udp())
+                        .map(|l| SocketAddr::from(*l))
+                        .find(SocketAddr::is_ipv4)
+                });
+            if let Some(to) = reader.to {
+                tracing::debug!("ROS 2: reader {:?} at {to}", reader.guid);
+            }
+        }
+    }
+}
+
+impl<M: RosMessage + Clone> BulkWriter<M> {
+    /// Writes `msg` to every matched reader: an error if it cannot be serialized; a failed
+    /// write is one warning per writer.
+    pub fn write(&mut self, msg: &M) -> Result<()> {
+        self.follow_matches();
+        if self.readers.iter().any(|r| r.to.is_none())
+            && self.last_lookup.is_none_or(|t| t.elapsed() >= LOOKUP_EVERY)
+        {
+            self.look_up();
+        }
+        self.sequence += 1;
+        if self.readers.iter().any(|r| r.to.is_some()) {
+            let mut job = self.shared.lock().spare.pop().unwrap_or_default();
+            job.payload.clear();
+            job.payload.extend_from_slice(&CDR_LE);
+            rustdds::cdr_encoding::to_writer::<M, LittleEndian, _>(&mut job.payload, msg)
+                .context("serializing a sample")?;
+            job.writer = self.writer.guid().to_bytes();
+            job.sequence = self.sequence;
+            job.stamp = rtps_time(SystemTime::now());
+            job.readers.clear();
+            job.readers.extend(
+                self.readers
+                    .iter()
+                    .filter_map(|r| Some((r.guid.to_bytes(), r.to?))),
+            );
+            let mut handoff = self.shared.lock();
+            if let Some(old) = handoff.next.replace(job) {
+                handoff.spare.push(old);
+            }
+            drop(handoff);
+            self.shared.ready.notify_one();
+        }
+        for reader in self.readers.iter().filter(|r| r.to.is_none()) {
+            let only_it = WriteOptionsBuilder::new()
+                .to_single_reader(reader.guid)
+                .build();
+            if let Err(e) = self.writer.write_with_options(msg.clone(), only_it)
+                && !std::mem::replace(&mut self.warned, true)
+            {
+                tracing::warn!("ROS 2: a sample could not be written ({e})");
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<M: RosMessage> Drop for BulkWriter<M> {
+    fn drop(&mut self) {
+        self.shared.lock().stop = true;
+        self.shared.ready.notify_one();
+        if let Some(sender) = self.sender.take() {
+            let _ = sender.join();
+        }
+    }
+}
+
+/// The sending thread: each newest job, paced, until told to stop (what is queued is sent).
+fn send_jobs(shared: &Shared, socket: &UdpSocket) {
+    let mut datagram = Vec::with_capacity(FRAGMENT_BYTES + 128);
+    let mut warned = false;
+    loop {
+        let job = {
+            let mut handoff = shared.lock();
+            loop {
+                if let Some(job) = handoff.next.take() {
+                    break job;
+                }
+                if handoff.stop {
+                    return;
+                }
+                handoff = shared
+                    .ready
+                    .wait(handoff)
+                    .unwrap_or_else(PoisonError::into_inner);
+            }
+        };
+        if let Err(e) = send(&job, socket, &mut datagram)
+            && !std::mem::replace(&mut warned, true)
+        {
+            tracing::warn!("ROS 2: a sample could not be sent ({e}); the run goes on");
+        }
+        shared.lock().spare.push(job);
+    }
+}
+/// Sends `job`'s sample to each of its readers: one DATA when it fits a fragment, else one
+/// DATA_FRAG per fragment, each in its own datagram, fragment by fragment to every reader,
+/// paced at [`PACE_BYTES_PER_S`] to each.
+fn send(job: &Job, socket: &UdpSocket, d: &mut Vec<u8>) -> std::io::Result<()> {
+    let sample_bytes = job.payload.len();
+    let fragments = sample_bytes.div_ceil(FRAGMENT_BYTES).max(1);
+    let started = Instant::now();
+    let mut sent_bytes = 0usize;
+    for fragment in 0..fragments {
+        let start = fragment * FRAGMENT_BYTES;
+        let end = (start + FRAGMENT_BYTES).min(sample_bytes);
+        for (reader, to) in &job.readers {
+            message(d, job, *reader, (fragment, fragments), (start, end));
+            socket.send_to(d, to)?;
+        }
+        // Each reader's socket drains on its own: the pace is per reader.
+        sent_bytes += d.len();
+        // Ahead of the pace: wait until the bytes sent so far are due.
+        let due = Duration::from_secs_f64(sent_bytes as f64 / PACE_BYTES_PER_S);
+        if let Some(ahead) = due.checked_sub(started.elapsed())
+            && fragment + 1 < fragments
+        {
+            std::thread::sleep(ahead);
+        }
+    }
+    Ok(())
+}
+
+/// Writes into `d` the RTPS message that carries bytes `start..end` of `job`'s payload, the
+/// fragment `fragment` of `fragments` (0-based), to `reader`.
+fn message(
+    d: &mut Vec<u8>,
+    job: &Job,
+    reader: [u8; 16],
+    (fragment, fragments): (usize, usize),
+    (start, end): (usize, usize),
+) {
+    let writer = &job.writer;
+    d.clear();
+    // Header: protocol, version 2.4, vendor (RustDDS's), the writer's GUID prefix.
+    d.extend_from_slice(b"RTPS");
+    d.extend_from_slice(&[2, 4, 0x01, 0x12]);
+    d.extend_from_slice(&writer[..12]);
+    submessage_header(d, INFO_DST, FLAG_LITTLE_ENDIAN, 12);
+    d.extend_from_slice(&reader[..12]);
+    submessage_header(d, INFO_TS, FLAG_LITTLE_ENDIAN, 8);
+    d.extend_from_slice(&job.stamp.0.to_le_bytes());
+    d.extend_from_slice(&job.stamp.1.to_le_bytes());
+    if fragments == 1 {
+        // extra flags, octets to inline QoS (none follows)
+        submessage_header(d, DATA, FLAG_LITTLE_ENDIAN | FLAG_DATA, 20 + (end - start));
+        d.extend_from_slice(&0u16.to_le_bytes());
+        d.extend_from_slice(&16u16.to_le_bytes());
+    } else {
+        submessage_header(d, DATA_FRAG, FLAG_LITTLE_ENDIAN, 32 + (end - start));
+        d.extend_from_slice(&0u16.to_le_bytes());
+        d.extend_from_slice(&28u16.to_le_bytes());
+    }
+    d.extend_from_slice(&reader[12..]);
+    d.extend_from_slice(&writer[12..]);
+    d.extend_from_slice(&((job.sequence >> 32) as i32).to_le_bytes());
+    d.extend_from_slice(&(job.sequence as u32).to_le_bytes());
+    if fragments > 1 {
+        d.extend_from_slice(&(fragment as u32 + 1).to_le_bytes()); // 1-based
+        d.extend_from_slice(&1u16.to_le_bytes()); // fragments in this submessage
+        d.extend_from_slice(&(FRAGMENT_BYTES as u16).to_le_bytes());
+        d.extend_from_slice(&(job.payload.len() as u32).to_le_bytes());
+    }
+    d.extend_from_slice(&job.payload[start..end]);
+}
+
+/// Appends a submessage header: `id`, `flags`, and the length of what follows it.
+fn submessage_header(d: &mut Vec<u8>, id: u8, flags: u8, length: usize) {
+    d.push(id);
+    d.push(flags);
+    d.extend_from_slice(&(length as u16).to_le_bytes());
+}
+
+/// `t` as RTPS's Time_t: seconds since the Unix epoch and fractions of 2^-32 s.
+fn rtps_time(t: SystemTime) -> (u32, u32) {
+    let since = t.duration_since(UNIX_EPOCH).unwrap_or_default();
+    let fraction = (u64::from(since.subsec_nanos()) << 32) / 1_000_000_000;
+    (since.as_secs() as u32, fraction as u32)
+}

@@ -1,0 +1,119 @@
+//! rover_ros2::bulk against a real RTPS reader: a RustDDS participant subscribing best effort
+//! reassembles what the bulk writer sends from its own socket — a 640x480 rgb8 image in
+//! fragments and a small image in one DATA — byte for byte, in order.
+
+use std::time::{Duration, Instant};
+
+use anyhow::{Result, ensure};
+use rover_ros2::bulk::{BulkWriter, FRAGMENT_BYTES};
+use rover_ros2::dds::{dds_topic, sensor_qos, writer};
+use rover_ros2::msgs::{Header, Image, Lent, RosMessage, Time};
+use rustdds::no_key::DataReader;
+use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
+use serde::Deserialize;
+
+/// sensor_msgs/msg/Image as a reader decodes it.
+#[derive(Debug, Deserialize)]
+struct ReadImage {
+    header: Header,
+    height: u32,
+    width: u32,
+    encoding: String,
+    is_bigendian: u8,
+    step: u32,
+    data: Vec<u8>,
+}
+
+fn image(seconds: i32, (width, height): (u32, u32)) -> Image {
+    let data: Vec<u8> = (0..width * height * 3)
+        .map(|k| (k.wrapping_mul(31) ^ (k >> 7)) as u8 ^ seconds as u8)
+        .collect();
+    Image {
+        header: Header {
+            stamp: Time {
+                sec: seconds,
+                nanosec: 250,
+            },
+            frame_id: "camera_link_optical".into(),
+        },
+        height,
+        width,
+        encoding: "rgb8".into(),
+        is_bigendian: 0,
+        step: width * 3,
+        data: Lent::new(data),
+    }
+}
+
+fn same(read: &ReadImage, sent: &Image) -> bool {
+    read.header == sent.header
+        && (read.height, read.width, read.step, read.is_bigendian)
+            == (sent.height, sent.width, sent.step, sent.is_bigendian)
+        && read.encoding == sent.encoding
+        && read.data == *sent.data.as_slice()
+}
+
+#[test]
+fn a_rustdds_reader_reassembles_the_bulk_writers_images() -> Result<()> {
+    let domain = 100 + (std::process::id() % 100) as u16;
+    let ros_name = "/camera/image_raw";
+    let qos = sensor_qos();
+
+    let sending = DomainParticipant::new(domain)?;
+    let publisher = sending.create_publisher(&qos)?;
+    let w = writer::<Image>(&sending, &publisher, ros_name, &qos)?;
+    let mut bulk = BulkWriter::new(&sending, w, ros_name)?;
+
+    let receiving = DomainParticipant::new(domain)?;
+    let topic = receiving.create_topic(
+        dds_topic(ros_name),
+        Image::DDS_TYPE.to_owned(),
+        &qos,
+        TopicKind::NoKey,
+    )?;
+    let subscriber = receiving.create_subscriber(&qos)?;
+    let mut reader: DataReader<ReadImage, CDRDeserializerAdapter<ReadImage>> =
+        subscriber.create_datareader_no_key(&topic, Some(qos.clone()))?;
+
+    // Discovery: the writer must know the reader and its UDP address.
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let small = image(1, (8, 4));
+    while bulk.matched() != (1, 1) {
+        ensure!(
+            Instant::now() < deadline,
+            "no reader matched: {:?}",
+            bulk.matched()
+        );
+        bulk.write(&small)?;
+        std::thread::sleep(Duration::from_millis(100));
+    }
+
+    let large = image(2, (640, 480));
+    ensure!(large.data.as_slice().len() > 50 * FRAGMENT_BYTES);
+    // Best effort may lose a sample: each is written until it is read (a bound, not a timing).
+    for sent in [&large, &small, &image(3, (640, 480))] {
+        let deadline = Instant::now() + Duration::from_secs(20);
+        'sample: loop {
+            ensure!(
+                Instant::now() < deadline,
+                "{}x{} never arrived",
+                sent.width,
+                sent.height
+            );
+            bulk.write(sent)?;
+            std::thread::sleep(Duration::from_millis(200));
+            while let Ok(Some(sample)) = reader.take_next_sample() {
+                let read = sample.value();
+                if same(read, sent) {
+                    break 'sample;
+                }
+                ensure!(
+                    read.header.stamp.sec <= sent.header.stamp.sec,
+                    "an image from the future: {:?}",
+                    read.header
+                );
+            }
+        }
+    }
+    Ok(())
+}
