@@ -316,11 +316,99 @@ fn an_rclpy_node_hears_rover_declare_its_parameters_on_parameter_events() -> Res
     Ok(())
 }
 
+/// What the peer's FollowJointTrajectory check found, asserted: the goal to its end accepted,
+/// feedback for `joints` joints, SUCCEEDED (4) with error code 0; a goal for a joint the
+/// controller lacks accepted and ABORTED (6) with INVALID_JOINTS (-2) and the joint named; a
+/// goal cancelled 1 s in CANCELED (5), the arm then moving no more than 0.01 rad.
+fn assert_trajectories(distro: &str, t: &Value, joints: usize, log: &str) -> Result<()> {
+    ensure!(
+        t["server"] == true,
+        "{distro}: no action server: {t}\n{log}"
+    );
+    let reached = &t["to_goal"];
+    ensure!(
+        reached["accepted"] == true && reached["status"] == 4 && reached["error_code"] == 0,
+        "{distro}: the goal did not succeed: {reached}\n{log}"
+    );
+    ensure!(
+        reached["feedback"].as_u64().is_some_and(|n| n >= 20)
+            && reached["feedback_names"]
+                .as_array()
+                .is_some_and(|n| n.len() == joints),
+        "{distro}: feedback: {reached}"
+    );
+    let unknown = &t["unknown_joint"];
+    ensure!(
+        unknown["accepted"] == true
+            && unknown["status"] == 6
+            && unknown["error_code"] == -2
+            && unknown["error_string"]
+                .as_str()
+                .is_some_and(|s| s.contains("no_such_joint")),
+        "{distro}: an unknown joint: {unknown}"
+    );
+    let cancelled = &t["cancelled"];
+    ensure!(
+        cancelled["accepted"] == true && cancelled["status"] == 5,
+        "{distro}: the cancel: {cancelled}\n{log}"
+    );
+    let at = cancelled["at_cancel"]
+        .as_array()
+        .context("no pose at the cancel")?;
+    let after = cancelled["after_cancel"]
+        .as_array()
+        .context("no pose after it")?;
+    let moved = at
+        .iter()
+        .zip(after)
+        .map(|(a, b)| (a.as_f64().unwrap_or(f64::NAN) - b.as_f64().unwrap_or(f64::NAN)).abs())
+        .fold(0.0, f64::max);
+    println!("{distro}: the arm moved {moved:.4} rad in the 2 s after the cancel");
+    // The cancel reply comes after the cancel is done; the pose was read when it came.
+    ensure!(
+        moved <= 0.01,
+        "{distro}: the arm moved {moved} rad after the cancel"
+    );
+    Ok(())
+}
+
 /// MoveIt's way in, from rclpy: an `ActionClient` with the control_msgs set-up built sends
-/// TIAGo's arm (example-robot-data) a two-point FollowJointTrajectory goal: accepted, feedback
-/// for the 7 arm joints, SUCCEEDED (4) with error code 0. A goal for a joint the controller
-/// lacks ends with INVALID_JOINTS (-2). A goal cancelled 1 s in is CANCELED (5), and the arm
-/// then moves no more than 0.01 rad.
+/// the arm car's arm (assets/controllers/my_robot_arm_trajectory.yaml: an
+/// effort_controllers/JointTrajectoryController under /arm, multibody joints as the arm car's
+/// pick worlds have them) a two-point FollowJointTrajectory goal, a goal naming a joint it
+/// lacks, and a goal it cancels 1 s in ([`assert_trajectories`]).
+#[test]
+fn an_rclpy_action_client_follows_trajectories_and_cancels_on_the_arm_car() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    let robot = repo("assets/robots/my_robot_arm.urdf.xacro");
+    let controllers = repo("assets/controllers/my_robot_arm_trajectory.yaml");
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(
+            rclpy,
+            71 + k as u16,
+            50.0,
+            &[
+                "--no-detector",
+                "--robot",
+                &robot.to_string_lossy(),
+                "--controllers",
+                &controllers.to_string_lossy(),
+                "--joints",
+                "multibody",
+            ],
+        )?;
+        let found = session.peer(&["arm_car_trajectory"], Duration::from_secs(120))?;
+        let log = session.rover_log();
+        assert_trajectories(&distro, &found["arm_car_trajectory"], 5, &log)?;
+        session.wait(Duration::from_secs(120))?;
+    }
+    Ok(())
+}
+
+/// The same on TIAGo's arm (example-robot-data; position_controllers, 7 joints).
 #[test]
 fn an_rclpy_action_client_follows_trajectories_and_cancels_on_tiago() -> Result<()> {
     let Some(distros) = distros() else {
@@ -348,50 +436,7 @@ fn an_rclpy_action_client_follows_trajectories_and_cancels_on_tiago() -> Result<
         )?;
         let found = session.peer(&["trajectory"], Duration::from_secs(120))?;
         let log = session.rover_log();
-        let t = &found["trajectory"];
-        ensure!(
-            t["server"] == true,
-            "{distro}: no action server: {t}\n{log}"
-        );
-        let home = &t["to_home"];
-        ensure!(
-            home["accepted"] == true && home["status"] == 4 && home["error_code"] == 0,
-            "{distro}: the goal did not succeed: {home}\n{log}"
-        );
-        ensure!(
-            home["feedback"].as_u64().is_some_and(|n| n >= 20)
-                && home["feedback_names"]
-                    .as_array()
-                    .is_some_and(|n| n.len() == 7),
-            "{distro}: feedback: {home}"
-        );
-        let unknown = &t["unknown_joint"];
-        ensure!(
-            unknown["accepted"] == false,
-            "{distro}: an unknown joint: {unknown}"
-        );
-        let cancelled = &t["cancelled"];
-        ensure!(
-            cancelled["accepted"] == true && cancelled["status"] == 5,
-            "{distro}: the cancel: {cancelled}\n{log}"
-        );
-        let at = cancelled["at_cancel"]
-            .as_array()
-            .context("no pose at the cancel")?;
-        let after = cancelled["after_cancel"]
-            .as_array()
-            .context("no pose after it")?;
-        let moved = at
-            .iter()
-            .zip(after)
-            .map(|(a, b)| (a.as_f64().unwrap_or(f64::NAN) - b.as_f64().unwrap_or(f64::NAN)).abs())
-            .fold(0.0, f64::max);
-        println!("{distro}: the arm moved {moved:.4} rad in the 2 s after the cancel");
-        // The cancel reply comes after the cancel is done; the pose was read when it came.
-        ensure!(
-            moved <= 0.01,
-            "{distro}: the arm moved {moved} rad after the cancel"
-        );
+        assert_trajectories(&distro, &found["trajectory"], 7, &log)?;
         session.wait(Duration::from_secs(120))?;
     }
     Ok(())

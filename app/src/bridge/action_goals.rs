@@ -350,6 +350,25 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
         self.changed = true;
     }
 
+    /// Books a goal refused for `rejection` as accepted and ended at once, ABORTED with its
+    /// code (ROS 2's FollowJointTrajectory: a result is the only place for the code); the goal
+    /// executing goes on.
+    pub fn refuse(&mut self, id: Id, rejection: Rejection, (now_s, run): (f64, RunSample)) {
+        self.goals.push(Goal {
+            id,
+            state: GoalState::Aborted,
+            error_code: rejection.code,
+            error_string: rejection.why,
+            accepted_s: now_s,
+            last_run: run,
+            reported: false,
+            runs_before: run.runs,
+            started: false,
+            point_times_s: Vec::new(),
+        });
+        self.changed = true;
+    }
+
     /// Cancels the executing trajectory goals `named` picks; the joints stop where they are
     /// (a trajectory without points). The ids cancelled, and whether a named goal had already
     /// ended.
@@ -596,6 +615,43 @@ mod tests {
         let mut empty = trajectory(&["a", "b"], Vec::new());
         empty.points.clear();
         assert_eq!(code(&empty), Some(code::INVALID_GOAL));
+    }
+
+    #[test]
+    fn a_refused_goal_ends_aborted_with_its_code_and_the_running_one_goes_on() {
+        let (to_session, from) = std::sync::mpsc::channel();
+        let mut g = goals();
+        let idle = RunSample::default();
+        g.accept_trajectory(
+            1,
+            trajectory(&["a", "b"], vec![0.1, 0.2]),
+            (0.0, idle),
+            &to_session,
+        );
+        assert!(from.try_recv().is_ok());
+        let bad = trajectory(&["a", "x"], vec![0.1, 0.2]);
+        let Err(why) = g.check(&bad, false) else {
+            panic!("an unknown joint passed the check");
+        };
+        g.take_changed();
+        g.refuse(2, why, (0.5, idle));
+        assert!(g.take_changed());
+        let refused = g
+            .goal(&2)
+            .map(|x| (x.state, x.error_code, x.error_string.clone()));
+        assert_eq!(
+            refused,
+            Some((
+                GoalState::Aborted,
+                code::INVALID_JOINTS,
+                "joint x is not one of arm_controller's (a, b)".to_owned()
+            ))
+        );
+        assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Executing));
+        assert!(
+            from.try_recv().is_err(),
+            "a refused goal reached the session"
+        );
     }
 
     #[test]

@@ -10,9 +10,12 @@
 //! A topic family on the publishing thread: at every control update it takes the requests
 //! that came and answers them. What a goal means (which are refused, how its run ends,
 //! preemption, cancels) is the shared bridge's (app/src/bridge/action_goals.rs); here is
-//! ROS 2's wire: a refused goal is not accepted (its reason in rover's log), an ended one is
-//! SUCCEEDED, ABORTED or CANCELED in the status list and get_result's reply. Feedback at
-//! 20 Hz (joint_trajectory_controller's `action_monitor_rate`).
+//! ROS 2's wire: a refused trajectory goal is accepted and ends ABORTED with its control_msgs
+//! code and reason (INVALID_JOINTS, INVALID_GOAL; ros2_controllers' JTC rejects it, and a
+//! rejected goal has no result to say why), a refused gripper goal is not accepted (its reason
+//! in rover's log); an ended one is SUCCEEDED, ABORTED or CANCELED in the status list and
+//! get_result's reply. Feedback at 20 Hz (joint_trajectory_controller's
+//! `action_monitor_rate`).
 
 use std::sync::mpsc::Sender;
 
@@ -58,16 +61,19 @@ trait ActionType {
     const FEEDBACK_TYPE: &'static str;
     /// The action's type, for the log.
     const NAME: &'static str;
+    /// A refused goal is accepted and ends ABORTED with its code in the result (`true`: the
+    /// result has an error code), or is not accepted.
+    const REFUSED_ABORTS: bool;
 
     /// The feedback's first state.
     fn feedback(distro: RosDistro) -> Self::Feedback;
-    /// Checks a send_goal request's goal and, if it is good, accepts it.
+    /// Checks a send_goal request's goal and, if it is good, accepts it; else its id and why.
     fn take(
         goals: &mut ActionGoals<Uuid>,
         request: <Self::SendGoal as ServiceType>::Request,
         now: (f64, RunSample),
         to_session: &Sender<Action>,
-    ) -> Result<(), Rejection>;
+    ) -> Result<(), (Uuid, Rejection)>;
     /// Cancels the goals `named` picks, stopping the joints.
     fn cancel(
         goals: &mut ActionGoals<Uuid>,
@@ -96,6 +102,7 @@ impl ActionType for FollowJointTrajectory {
     type FeedbackMessage = FeedbackMessage;
     const FEEDBACK_TYPE: &'static str = FEEDBACK_TYPE;
     const NAME: &'static str = "control_msgs/action/FollowJointTrajectory";
+    const REFUSED_ABORTS: bool = true;
 
     fn feedback(distro: RosDistro) -> Self::Feedback {
         let msg = FeedbackMessage {
@@ -110,10 +117,10 @@ impl ActionType for FollowJointTrajectory {
         (id, goal): (Uuid, FollowJointTrajectoryGoal),
         now: (f64, RunSample),
         to_session: &Sender<Action>,
-    ) -> Result<(), Rejection> {
+    ) -> Result<(), (Uuid, Rejection)> {
         let trajectory = trajectory_of(&goal);
         let multi_dof = !goal.multi_dof_trajectory.points.is_empty();
-        goals.check(&trajectory, multi_dof)?;
+        goals.check(&trajectory, multi_dof).map_err(|r| (id, r))?;
         goals.accept_trajectory(id, trajectory, now, to_session);
         Ok(())
     }
@@ -186,6 +193,7 @@ impl ActionType for GripperCommand {
     type FeedbackMessage = GripperFeedbackMessage;
     const FEEDBACK_TYPE: &'static str = GRIPPER_FEEDBACK_TYPE;
     const NAME: &'static str = "control_msgs/action/GripperCommand";
+    const REFUSED_ABORTS: bool = false;
 
     fn feedback(_distro: RosDistro) -> Self::Feedback {
         GripperFeedbackMessage::default()
@@ -196,9 +204,9 @@ impl ActionType for GripperCommand {
         (id, goal): (Uuid, GripperCommandGoal),
         now: (f64, RunSample),
         to_session: &Sender<Action>,
-    ) -> Result<(), Rejection> {
+    ) -> Result<(), (Uuid, Rejection)> {
         let c = goal.command;
-        check_gripper(c.position, c.max_effort)?;
+        check_gripper(c.position, c.max_effort).map_err(|r| (id, r))?;
         goals.accept_gripper(id, (c.position, c.max_effort), now, to_session);
         Ok(())
     }
@@ -359,7 +367,17 @@ impl<A: ActionType> ActionServer<A> {
         while let Some((header, request)) = self.send_goal.next_request() {
             let accepted = match A::take(&mut self.goals, request, (now_s, run), to_session) {
                 Ok(()) => true,
-                Err(r) => {
+                Err((id, r)) if A::REFUSED_ABORTS => {
+                    tracing::warn!(
+                        "ROS 2: {} aborted a goal (error code {}): {}",
+                        self.goals.controller,
+                        r.code,
+                        r.why
+                    );
+                    self.goals.refuse(id, r, (now_s, run));
+                    true
+                }
+                Err((_, r)) => {
                     tracing::warn!(
                         "ROS 2: {} rejected a goal: {}",
                         self.goals.controller,

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """A real rclpy node (rmw_fastrtps_cpp) that checks `rover --ros2` as ROS 2's own tools would.
 
-    python3 peer.py CHECK...     (CHECK: graph, params, parameter_events, topics, trajectory, gripper,
-                                  camera_rate, publish_images)
+    python3 peer.py CHECK...     (CHECK: graph, params, parameter_events, topics, trajectory,
+                                  arm_car_trajectory, gripper, camera_rate, publish_images)
 
 Run by app/tests/rclpy.rs with a distribution's venv and the interface packages set-up built
 (scripts/ros2/peers.py). The checks run in order, one node; their findings are printed as one
@@ -163,16 +163,17 @@ def _joints(node):
     return latest
 
 
-def trajectory(node):
-    """FollowJointTrajectory on TIAGo's arm: a goal to the end, an unknown joint, a cancel."""
+def _trajectory(node, action, names, to_goal, cancelled):
+    """FollowJointTrajectory on `action` over the joints `names`: `to_goal` (points: positions
+    and whole seconds from the start) to its end, an unknown joint, and `cancelled` cancelled
+    1 s in."""
     from builtin_interfaces.msg import Duration
     from control_msgs.action import FollowJointTrajectory
     from trajectory_msgs.msg import JointTrajectoryPoint
 
     joints = _joints(node)
-    client = ActionClient(node, FollowJointTrajectory, "/arm_controller/follow_joint_trajectory")
+    client = ActionClient(node, FollowJointTrajectory, action)
     out = {"server": client.wait_for_server(timeout_sec=20.0)}
-    names = ["arm_%d_joint" % i for i in range(1, 8)]
 
     def goal(points, joint_names=names):
         g = FollowJointTrajectory.Goal()
@@ -206,16 +207,35 @@ def trajectory(node):
         if feedback:
             f = feedback[len(feedback) // 2].feedback
             entry["feedback_names"] = list(f.joint_names)
+        entry["at_end"] = [joints.get(n, math.nan) for n in names]
         if cancel_after_s is not None:
             spin_for(node, 2.0)
             entry["after_cancel"] = [joints.get(n, math.nan) for n in names]
 
-    run("to_home", goal([([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 2),
-                         ([0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0], 4)]))
+    run("to_goal", goal(to_goal))
     run("unknown_joint", goal([([0.1], 2)], joint_names=["no_such_joint"]))
-    run("cancelled", goal([([1.2, -0.5, -0.2, 1.0, -1.0, 0.5, 0.0], 6)]), cancel_after_s=1.0)
+    run("cancelled", goal(cancelled), cancel_after_s=1.0)
     out["final"] = [joints.get(n, math.nan) for n in names]
     return out
+
+
+def trajectory(node):
+    """FollowJointTrajectory on TIAGo's arm (assets/controllers/tiago_no_hand.yaml)."""
+    return _trajectory(node, "/arm_controller/follow_joint_trajectory",
+                       ["arm_%d_joint" % i for i in range(1, 8)],
+                       [([0.2, -1.0, -0.2, 1.5, -1.0, 0.5, 0.0], 2),
+                        ([0.2, -1.34, -0.2, 1.94, -1.57, 1.37, 0.0], 4)],
+                       [([1.2, -0.5, -0.2, 1.0, -1.0, 0.5, 0.0], 6)])
+
+
+def arm_car_trajectory(node):
+    """FollowJointTrajectory on the arm car's arm, under /arm
+    (assets/controllers/my_robot_arm_trajectory.yaml)."""
+    return _trajectory(node, "/arm/arm_controller/follow_joint_trajectory",
+                       ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+                        "wrist_pitch_joint", "wrist_roll_joint"],
+                       [([0.3, 0.4, 0.5, 0.2, 0.0], 2), ([0.0, 0.7, 0.9, 0.4, 0.0], 4)],
+                       [([0.8, 0.2, 0.3, 0.0, 0.5], 5)])
 
 
 def gripper(node):
@@ -289,7 +309,8 @@ def main():
     out = {"rmw": get_rmw_implementation_identifier()}
     checks = {"graph": graph, "params": params, "parameter_events": parameter_events,
               "topics": topics, "trajectory": trajectory,
-              "gripper": gripper, "camera_rate": camera_rate, "publish_images": publish_images}
+              "arm_car_trajectory": arm_car_trajectory, "gripper": gripper,
+              "camera_rate": camera_rate, "publish_images": publish_images}
     for check in sys.argv[1:]:
         out[check] = checks[check](node)
     print(json.dumps(out), flush=True)
