@@ -192,7 +192,8 @@ fn distros() -> Option<Vec<Rclpy>> {
 /// lists rover's parameters, gets `use_sim_time` (true), their types, describes `use_sim_time`
 /// (read only), and setting it is refused with the reason. Every reply must find its request
 /// through Fast DDS's sample identity (rover read Cyclone's header only). `robot_description`
-/// is not answered on Fast DDS, and rover says why (RustDDS's fragments; docs/ROS2.md).
+/// (the car's URDF, 6 kB: one DATA sent by rover itself) is the URDF `/robot_description`
+/// carries.
 #[test]
 fn rclpy_on_fast_dds_finds_node_rover_and_reads_its_parameters() -> Result<()> {
     let Some(distros) = distros() else {
@@ -224,25 +225,9 @@ fn rclpy_on_fast_dds_finds_node_rover_and_reads_its_parameters() -> Result<()> {
             p["use_sim_time"] == serde_json::json!([1, true]),
             "{distro}: {p}"
         );
-        // robot_description's reply (the URDF, 6 kB) would need DATA_FRAGs, which RustDDS
-        // 0.15.1 writes malformed with a related sample identity: rover says so instead of
-        // sending it (docs/ROS2.md). If it ever arrives, it must be the URDF.
-        let description = &p["robot_description"];
-        if description.is_null() {
-            ensure!(
-                log.contains("reply to a Fast DDS client is not sent"),
-                "{distro}: robot_description was not answered and rover did not say why:\n{log}"
-            );
-        } else {
-            ensure!(
-                description[0] == 4
-                    && description[1].as_u64().is_some_and(|n| n > 1000)
-                    && description[2]
-                        .as_str()
-                        .is_some_and(|s| s.starts_with("<?xml") || s.starts_with("<robot")),
-                "{distro}: robot_description: {description}"
-            );
-        }
+        // robot_description: the URDF, too large for one RTPS DATA of RustDDS's; rover sends
+        // it itself (ros2/src/services.rs, LargeReplies), equal to /robot_description's.
+        assert_robot_description(&distro, p, None, &log)?;
         ensure!(
             p["types"] == serde_json::json!([1, 4]),
             "{distro}: types: {p}"
@@ -313,6 +298,32 @@ fn an_rclpy_node_hears_rover_declare_its_parameters_on_parameter_events() -> Res
         );
         session.wait(Duration::from_secs(60))?;
     }
+    Ok(())
+}
+
+/// The peer's `robot_description` from the parameter client: a string, equal to what
+/// `/robot_description` carries, `length` characters long when given.
+fn assert_robot_description(
+    distro: &str,
+    params: &Value,
+    length: Option<u64>,
+    log: &str,
+) -> Result<()> {
+    let description = &params["robot_description"];
+    ensure!(
+        description[0] == 4
+            && description[1]
+                .as_u64()
+                .is_some_and(|n| n > 1000 && length.is_none_or(|l| n == l))
+            && params["robot_description_is_the_topics"] == true,
+        "{distro}: robot_description through the parameter client: {description}, the \
+         topic's: {} (want {length:?} characters)\n{log}",
+        params["robot_description_is_the_topics"]
+    );
+    ensure!(
+        !log.contains("not sent"),
+        "{distro}: rover did not send a reply:\n{log}"
+    );
     Ok(())
 }
 
@@ -408,7 +419,8 @@ fn an_rclpy_action_client_follows_trajectories_and_cancels_on_the_arm_car() -> R
     Ok(())
 }
 
-/// The same on TIAGo's arm (example-robot-data; position_controllers, 7 joints).
+/// The same on TIAGo's arm (example-robot-data; position_controllers, 7 joints); and
+/// TIAGo's `robot_description` through the parameter client, a reply in DATA_FRAGs.
 #[test]
 fn an_rclpy_action_client_follows_trajectories_and_cancels_on_tiago() -> Result<()> {
     let Some(distros) = distros() else {
@@ -434,9 +446,11 @@ fn an_rclpy_action_client_follows_trajectories_and_cancels_on_tiago() -> Result<
                 &controllers.to_string_lossy(),
             ],
         )?;
-        let found = session.peer(&["trajectory"], Duration::from_secs(120))?;
+        let found = session.peer(&["trajectory", "params"], Duration::from_secs(120))?;
         let log = session.rover_log();
         assert_trajectories(&distro, &found["trajectory"], 7, &log)?;
+        // TIAGo's URDF as rover describes it: 47,578 characters, in DATA_FRAGs of rover's.
+        assert_robot_description(&distro, &found["params"], Some(47_578), &log)?;
         session.wait(Duration::from_secs(120))?;
     }
     Ok(())

@@ -48,28 +48,86 @@ const INFO_TS: u8 = 0x09;
 const INFO_DST: u8 = 0x0e;
 const DATA: u8 = 0x15;
 const DATA_FRAG: u8 = 0x16;
-/// Submessage flags: E (little-endian), and DATA's D (data present).
+/// Submessage flags: E (little-endian), Q (inline QoS follows), and DATA's D (data present).
 const FLAG_LITTLE_ENDIAN: u8 = 0x01;
+const FLAG_INLINE_QOS: u8 = 0x02;
 const FLAG_DATA: u8 = 0x04;
 /// The CDR little-endian encapsulation (RTPS 2.5, 10.2) that starts each serialized payload.
-const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
+pub(crate) const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
 
-/// One matched reader: where its datagrams go (`None`: not known yet, RustDDS sends to it).
+/// One matched reader: where its datagrams go (`None`: not known yet).
 #[derive(Debug)]
-struct Reader {
-    guid: GUID,
-    to: Option<SocketAddr>,
+pub(crate) struct Reader {
+    pub guid: GUID,
+    pub to: Option<SocketAddr>,
 }
 
-/// One sample for the sending thread: its writer's GUID bytes, serialized payload, sequence number, source time
-/// and readers (GUID bytes, address).
+/// The readers RustDDS matched to a writer, with their UDP addresses as discovery gives them.
+#[derive(Debug, Default)]
+pub(crate) struct Matched {
+    pub readers: Vec<Reader>,
+    last_lookup: Option<Instant>,
+}
+
+impl Matched {
+    /// Takes the writer's match and unmatch statuses.
+    pub fn follow(&mut self, statuses: impl Iterator<Item = DataWriterStatus>) {
+        for status in statuses {
+            if let DataWriterStatus::PublicationMatched {
+                current, reader, ..
+            } = status
+            {
+                self.readers.retain(|r| r.guid != reader);
+                if current.count_change() > 0 {
+                    self.readers.push(Reader {
+                        guid: reader,
+                        to: None,
+                    });
+                    self.last_lookup = None;
+                }
+            }
+        }
+    }
+
+    /// Looks up the readers with no address yet, at most every [`LOOKUP_EVERY`].
+    pub fn look_up(&mut self, participant: &DomainParticipant) {
+        if !self.readers.iter().any(|r| r.to.is_none())
+            || self.last_lookup.is_some_and(|t| t.elapsed() < LOOKUP_EVERY)
+        {
+            return;
+        }
+        self.last_lookup = Some(Instant::now());
+        let discovered = participant.discovered_readers();
+        for reader in self.readers.iter_mut().filter(|r| r.to.is_none()) {
+            reader.to = discovered
+                .iter()
+                .find(|d| d.reader_proxy.remote_reader_guid == reader.guid)
+                .and_then(|d| {
+                    d.reader_proxy
+                        .unicast_locator_list
+                        .iter()
+                        .filter(|l| l.is_udp())
+                        .map(|l| SocketAddr::from(*l))
+                        .find(SocketAddr::is_ipv4)
+                });
+            if let Some(to) = reader.to {
+                tracing::debug!("ROS 2: reader {:?} at {to}", reader.guid);
+            }
+        }
+    }
+}
+
+/// One sample to send: its writer's GUID, serialized payload (CDR encapsulation first),
+/// sequence number, source time, inline QoS (a serialized parameter list with its sentinel;
+/// empty: none) and readers (GUID, address).
 #[derive(Default)]
-struct Job {
-    writer: [u8; 16],
-    payload: Vec<u8>,
-    sequence: i64,
-    stamp: (u32, u32),
-    readers: Vec<([u8; 16], SocketAddr)>,
+pub(crate) struct Job {
+    pub writer: [u8; 16],
+    pub payload: Vec<u8>,
+    pub sequence: i64,
+    pub stamp: (u32, u32),
+    pub inline_qos: Vec<u8>,
+    pub readers: Vec<([u8; 16], SocketAddr)>,
 }
 
 /// What the publishing side hands the sending thread: the newest job (an older one not yet
@@ -99,11 +157,10 @@ impl Shared {
 pub struct BulkWriter<M: RosMessage> {
     writer: Writer<M>,
     participant: DomainParticipant,
-    readers: Vec<Reader>,
+    matched: Matched,
     /// The last sequence number used, on either path (so a reader moved from RustDDS's path to
     /// this one never sees a number go back).
     sequence: i64,
-    last_lookup: Option<Instant>,
     shared: Arc<Shared>,
     sender: Option<JoinHandle<()>>,
     /// A send or write failed (said once).
@@ -126,9 +183,8 @@ impl<M: RosMessage> BulkWriter<M> {
         Ok(Self {
             writer,
             participant: participant.clone(),
-            readers: Vec::new(),
+            matched: Matched::default(),
             sequence: 0,
-            last_lookup: None,
             shared,
             sender: Some(sender),
             warned: false,
@@ -144,49 +200,16 @@ impl<M: RosMessage> BulkWriter<M> {
     /// whose UDP address is not known, get RustDDS's datagrams).
     pub fn matched(&mut self) -> (usize, usize) {
         self.follow_matches();
-        let direct = self.readers.iter().filter(|r| r.to.is_some()).count();
-        (self.readers.len(), direct)
+        let readers = &self.matched.readers;
+        let direct = readers.iter().filter(|r| r.to.is_some()).count();
+        (readers.len(), direct)
     }
 
     /// Takes RustDDS's matches and unmatches.
     fn follow_matches(&mut self) {
-        while let Some(status) = self.writer.try_recv_status() {
-            if let DataWriterStatus::PublicationMatched {
-                current, reader, ..
-            } = status
-            {
-                self.readers.retain(|r| r.guid != reader);
-                if current.count_change() > 0 {
-                    self.readers.push(Reader {
-                        guid: reader,
-                        to: None,
-                    });
-                    self.last_lookup = None;
-                }
-            }
-        }
-    }
-
-    /// Finds the UDP address of each matched reader that has none yet.
-    fn look_up(&mut self) {
-        self.last_lookup = Some(Instant::now());
-        let discovered = self.participant.discovered_readers();
-        for reader in self.readers.iter_mut().filter(|r| r.to.is_none()) {
-            reader.to = discovered
-                .iter()
-                .find(|d| d.reader_proxy.remote_reader_guid == reader.guid)
-                .and_then(|d| {
-                    d.reader_proxy
-                        .unicast_locator_list
-                        .iter()
-                        .filter(|l| l.is_udp())
-                        .map(|l| SocketAddr::from(*l))
-                        .find(SocketAddr::is_ipv4)
-                });
-            if let Some(to) = reader.to {
-                tracing::debug!("ROS 2: reader {:?} at {to}", reader.guid);
-            }
-        }
+        let writer = &self.writer;
+        self.matched
+            .follow(std::iter::from_fn(|| writer.try_recv_status()));
     }
 }
 
@@ -195,13 +218,10 @@ impl<M: RosMessage + Clone> BulkWriter<M> {
     /// write is one warning per writer.
     pub fn write(&mut self, msg: &M) -> Result<()> {
         self.follow_matches();
-        if self.readers.iter().any(|r| r.to.is_none())
-            && self.last_lookup.is_none_or(|t| t.elapsed() >= LOOKUP_EVERY)
-        {
-            self.look_up();
-        }
+        self.matched.look_up(&self.participant);
         self.sequence += 1;
-        if self.readers.iter().any(|r| r.to.is_some()) {
+        let readers = &self.matched.readers;
+        if readers.iter().any(|r| r.to.is_some()) {
             let mut job = self.shared.lock().spare.pop().unwrap_or_default();
             job.payload.clear();
             job.payload.extend_from_slice(&CDR_LE);
@@ -210,9 +230,10 @@ impl<M: RosMessage + Clone> BulkWriter<M> {
             job.writer = self.writer.guid().to_bytes();
             job.sequence = self.sequence;
             job.stamp = rtps_time(SystemTime::now());
+            job.inline_qos.clear();
             job.readers.clear();
             job.readers.extend(
-                self.readers
+                readers
                     .iter()
                     .filter_map(|r| Some((r.guid.to_bytes(), r.to?))),
             );
@@ -223,7 +244,7 @@ impl<M: RosMessage + Clone> BulkWriter<M> {
             drop(handoff);
             self.shared.ready.notify_one();
         }
-        for reader in self.readers.iter().filter(|r| r.to.is_none()) {
+        for reader in readers.iter().filter(|r| r.to.is_none()) {
             let only_it = WriteOptionsBuilder::new()
                 .to_single_reader(reader.guid)
                 .build();
@@ -267,7 +288,7 @@ fn send_jobs(shared: &Shared, socket: &UdpSocket) {
                     .unwrap_or_else(PoisonError::into_inner);
             }
         };
-        if let Err(e) = send(&job, socket, &mut datagram)
+        if let Err(e) = send(&job, socket, &mut datagram, Some(PACE_BYTES_PER_S))
             && !std::mem::replace(&mut warned, true)
         {
             tracing::warn!("ROS 2: a sample could not be sent ({e}); the run goes on");
@@ -277,8 +298,13 @@ fn send_jobs(shared: &Shared, socket: &UdpSocket) {
 }
 /// Sends `job`'s sample to each of its readers: one DATA when it fits a fragment, else one
 /// DATA_FRAG per fragment, each in its own datagram, fragment by fragment to every reader,
-/// paced at [`PACE_BYTES_PER_S`] to each.
-fn send(job: &Job, socket: &UdpSocket, d: &mut Vec<u8>) -> std::io::Result<()> {
+/// paced at `pace_bytes_per_s` to each (`None`: at once).
+pub(crate) fn send(
+    job: &Job,
+    socket: &UdpSocket,
+    d: &mut Vec<u8>,
+    pace_bytes_per_s: Option<f64>,
+) -> std::io::Result<()> {
     let sample_bytes = job.payload.len();
     let fragments = sample_bytes.div_ceil(FRAGMENT_BYTES).max(1);
     let started = Instant::now();
@@ -293,9 +319,10 @@ fn send(job: &Job, socket: &UdpSocket, d: &mut Vec<u8>) -> std::io::Result<()> {
         // Each reader's socket drains on its own: the pace is per reader.
         sent_bytes += d.len();
         // Ahead of the pace: wait until the bytes sent so far are due.
-        let due = Duration::from_secs_f64(sent_bytes as f64 / PACE_BYTES_PER_S);
-        if let Some(ahead) = due.checked_sub(started.elapsed())
+        if let Some(pace) = pace_bytes_per_s
             && fragment + 1 < fragments
+            && let Some(ahead) =
+                Duration::from_secs_f64(sent_bytes as f64 / pace).checked_sub(started.elapsed())
         {
             std::thread::sleep(ahead);
         }
@@ -323,13 +350,16 @@ fn message(
     submessage_header(d, INFO_TS, FLAG_LITTLE_ENDIAN, 8);
     d.extend_from_slice(&job.stamp.0.to_le_bytes());
     d.extend_from_slice(&job.stamp.1.to_le_bytes());
+    let qos = &job.inline_qos;
+    let q = if qos.is_empty() { 0 } else { FLAG_INLINE_QOS };
     if fragments == 1 {
-        // extra flags, octets to inline QoS (none follows)
-        submessage_header(d, DATA, FLAG_LITTLE_ENDIAN | FLAG_DATA, 20 + (end - start));
-        d.extend_from_slice(&0u16.to_le_bytes());
-        d.extend_from_slice(&16u16.to_le_bytes());
+        let length = 20 + qos.len() + (end - start);
+        submessage_header(d, DATA, FLAG_LITTLE_ENDIAN | FLAG_DATA | q, length);
+        d.extend_from_slice(&0u16.to_le_bytes()); // extra flags
+        d.extend_from_slice(&16u16.to_le_bytes()); // octets from here to the inline QoS
     } else {
-        submessage_header(d, DATA_FRAG, FLAG_LITTLE_ENDIAN, 32 + (end - start));
+        let length = 32 + qos.len() + (end - start);
+        submessage_header(d, DATA_FRAG, FLAG_LITTLE_ENDIAN | q, length);
         d.extend_from_slice(&0u16.to_le_bytes());
         d.extend_from_slice(&28u16.to_le_bytes());
     }
@@ -343,6 +373,7 @@ fn message(
         d.extend_from_slice(&(FRAGMENT_BYTES as u16).to_le_bytes());
         d.extend_from_slice(&(job.payload.len() as u32).to_le_bytes());
     }
+    d.extend_from_slice(qos);
     d.extend_from_slice(&job.payload[start..end]);
 }
 
@@ -354,7 +385,7 @@ fn submessage_header(d: &mut Vec<u8>, id: u8, flags: u8, length: usize) {
 }
 
 /// `t` as RTPS's Time_t: seconds since the Unix epoch and fractions of 2^-32 s.
-fn rtps_time(t: SystemTime) -> (u32, u32) {
+pub(crate) fn rtps_time(t: SystemTime) -> (u32, u32) {
     let since = t.duration_since(UNIX_EPOCH).unwrap_or_default();
     let fraction = (u64::from(since.subsec_nanos()) << 32) / 1_000_000_000;
     (since.as_secs() as u32, fraction as u32)

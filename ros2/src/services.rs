@@ -18,17 +18,20 @@
 //! and what was wrong) and no reply; the next request is read as usual.
 
 use std::collections::HashSet;
+use std::net::UdpSocket;
+use std::time::SystemTime;
 
 use crate::error::{Context, Result};
 use rustdds::no_key::{DataReader, DataWriter, Decode, DefaultDecoder, DeserializerAdapter};
 use rustdds::serialization::deserialize_from_cdr_with_rep_id;
 use rustdds::{
     CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, RepresentationIdentifier,
-    SampleIdentity, TopicKind, WriteOptionsBuilder,
+    SampleIdentity, StatusEvented, TopicKind, WriteOptionsBuilder,
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use crate::bulk::{self, CDR_LE, Job, Matched, rtps_time};
 use crate::dds::default_qos;
 
 /// rmw_cyclonedds_cpp's request header: which client, which of its requests.
@@ -133,6 +136,8 @@ enum Reply<T> {
     WithHeader(WithHeader<T>),
     /// Fast DDS's mapping (the id travels in the inline QoS).
     Bare(T),
+    /// No fields: what RustDDS writes in place of a large reply rover sent itself.
+    Placeholder,
 }
 
 /// One service's server: takes requests when polled, answers each at once or later.
@@ -140,6 +145,11 @@ pub struct Server<S: ServiceType> {
     name: String,
     requests: DataReader<RawRequest, RawAdapter>,
     replies: DataWriter<Reply<S::Response>, CDRSerializerAdapter<Reply<S::Response>>>,
+    /// The sequence number of the reply writer's last sample (RustDDS numbers each admitted
+    /// write, from 1).
+    last_sequence: i64,
+    /// Fast DDS replies too large for one RTPS DATA of RustDDS's.
+    large: LargeReplies,
     /// The clients (request writers) already warned about.
     warned: HashSet<GUID>,
 }
@@ -181,6 +191,14 @@ impl<S: ServiceType> Server<S> {
             replies: publisher
                 .create_datawriter_no_key(&reply_topic, Some(qos))
                 .with_context(|| format!("creating the reply writer of {ros_name}"))?,
+            last_sequence: 0,
+            large: LargeReplies {
+                participant: participant.clone(),
+                matched: Matched::default(),
+                socket: UdpSocket::bind(("0.0.0.0", 0)).context("opening a UDP socket")?,
+                job: Job::default(),
+                datagram: Vec::new(),
+            },
             warned: HashSet::new(),
         })
     }
@@ -216,37 +234,66 @@ impl<S: ServiceType> Server<S> {
     /// Answers the request `id` names (now or later) with `body`, in its client's mapping.
     pub fn reply(&mut self, id: RequestId, body: S::Response) {
         let written = match id {
-            RequestId::Cyclone(header) => self
-                .replies
-                .write(Reply::WithHeader(WithHeader { header, body }), None)
-                .map(|_| ()),
+            RequestId::Cyclone(header) => self.replies.write_with_options(
+                Reply::WithHeader(WithHeader { header, body }),
+                WriteOptionsBuilder::new().build(),
+            ),
             RequestId::FastDds(identity) => {
-                let bytes = fast_dds_reply_bytes(&body);
-                if bytes > MAX_FAST_DDS_REPLY_BYTES {
-                    self.warn(
-                        identity.writer_guid,
-                        &format!(
-                            "a {bytes}-byte reply to a Fast DDS client is not sent: RustDDS 0.15.1 \
-                             writes a sample that needs fragments (over about \
-                             {MAX_FAST_DDS_REPLY_BYTES} bytes) with a related sample identity \
-                             malformed (a stray byte before the inline QoS; docs/ROS2.md)"
-                        ),
-                    );
+                if fast_dds_reply_bytes(&body) > MAX_FAST_DDS_REPLY_BYTES {
+                    self.reply_large(identity, &body);
                     return;
                 }
                 let options = WriteOptionsBuilder::new()
                     .related_sample_identity(identity)
                     .build();
-                self.replies
-                    .write_with_options(Reply::Bare(body), options)
-                    .map(|_| ())
+                self.replies.write_with_options(Reply::Bare(body), options)
             }
         };
-        if let Err(e) = written {
-            self.warn(
+        match written {
+            Ok(written) => self.last_sequence = i64::from(written.sequence_number),
+            Err(e) => self.warn(
                 GUID::GUID_UNKNOWN,
                 &format!("a reply could not be sent ({e})"),
-            );
+            ),
+        }
+    }
+
+    /// A Fast DDS reply too large for one DATA: sent by rover as the reply writer's next
+    /// sample ([`LargeReplies`]), then that sample number given to RustDDS with an empty
+    /// placeholder for the client's reader alone, which it already holds and drops, so
+    /// RustDDS's reliable bookkeeping and the reader's agree.
+    fn reply_large(&mut self, identity: SampleIdentity, body: &S::Response) {
+        let writer = &self.replies;
+        self.large
+            .matched
+            .follow(std::iter::from_fn(|| writer.try_recv_status()));
+        let sequence = self.last_sequence + 1;
+        let sent = self
+            .large
+            .send(self.replies.guid(), sequence, identity, body);
+        let reader = match sent {
+            Ok(reader) => reader,
+            Err(what) => return self.warn(identity.writer_guid, &what),
+        };
+        let only_it = WriteOptionsBuilder::new().to_single_reader(reader).build();
+        match self.replies.write_with_options(Reply::Placeholder, only_it) {
+            Ok(written) => {
+                self.last_sequence = i64::from(written.sequence_number);
+                if self.last_sequence != sequence {
+                    self.warn(
+                        GUID::GUID_UNKNOWN,
+                        &format!(
+                            "a large reply went out as sample {sequence}, but RustDDS numbered \
+                             it {}",
+                            self.last_sequence
+                        ),
+                    );
+                }
+            }
+            Err(e) => self.warn(
+                GUID::GUID_UNKNOWN,
+                &format!("a reply's placeholder could not be written ({e})"),
+            ),
         }
     }
 
@@ -278,13 +325,91 @@ impl<S: ServiceType> Server<S> {
     }
 }
 
-/// The largest reply rover sends in Fast DDS's mapping: one that fits a single RTPS DATA
+/// The largest reply RustDDS sends in Fast DDS's mapping: one that fits a single RTPS DATA
 /// submessage on any IPv4 path (RustDDS packs up to the path's MTU, at least 1,280 bytes, less
 /// headers and the inline QoS). A larger one would go out as DATA_FRAGs, which RustDDS 0.15.1
 /// writes with a speedy `Option` tag byte before the inline QoS when a related sample identity
 /// is set (`DataFrag::write_to`): Fast DDS cannot read them, and a debug build's assertion on
-/// the submessage length stops the participant's event loop.
+/// the submessage length stops the participant's event loop. Larger replies go through
+/// [`LargeReplies`].
 pub const MAX_FAST_DDS_REPLY_BYTES: usize = 1024;
+
+/// RTPS parameter ids of a related sample identity: the standard one and Fast DDS's own (which
+/// RustDDS also writes both of).
+const PID_RELATED_SAMPLE_IDENTITY: [u16; 2] = [0x0083, 0x800f];
+/// The parameter list's end.
+const PID_SENTINEL: u16 = 0x0001;
+
+/// Fast DDS replies larger than [`MAX_FAST_DDS_REPLY_BYTES`] (`robot_description` through
+/// `get_parameters`), sent by rover itself as `rover_ros2::bulk` sends images: the reply
+/// writer's next sample, from rover's own socket, to the client's reply reader (the reader of
+/// the client's participant matched to the reply writer), with the related sample identity in
+/// each submessage's inline QoS. Over one machine's loopback the few datagrams of a reply
+/// arrive; one lost on a network is not repaired (RustDDS holds only the placeholder) and the
+/// client's call times out.
+struct LargeReplies {
+    participant: DomainParticipant,
+    matched: Matched,
+    socket: UdpSocket,
+    job: Job,
+    datagram: Vec<u8>,
+}
+
+impl LargeReplies {
+    /// Sends `body` as sample `sequence` of the writer `writer`, the reply to the request
+    /// `identity` names; the client's reader it went to, or what went wrong, in words.
+    fn send<R: Serialize>(
+        &mut self,
+        writer: GUID,
+        sequence: i64,
+        identity: SampleIdentity,
+        body: &R,
+    ) -> Result<GUID, String> {
+        self.matched.look_up(&self.participant);
+        let client = identity.writer_guid.prefix;
+        let Some((reader, to)) = self
+            .matched
+            .readers
+            .iter()
+            .filter(|r| r.guid.prefix == client)
+            .find_map(|r| Some((r.guid, r.to?)))
+        else {
+            return Err(
+                "a large reply to a Fast DDS client is not sent: its reply reader is not \
+                 matched, or has no UDP address"
+                    .to_owned(),
+            );
+        };
+        let job = &mut self.job;
+        job.readers.clear();
+        job.readers.push((reader.to_bytes(), to));
+        job.writer = writer.to_bytes();
+        job.sequence = sequence;
+        job.stamp = rtps_time(SystemTime::now());
+        job.payload.clear();
+        job.payload.extend_from_slice(&CDR_LE);
+        rustdds::cdr_encoding::to_writer::<R, byteorder::LittleEndian, _>(&mut job.payload, body)
+            .map_err(|e| format!("a reply could not be serialized ({e})"))?;
+        job.inline_qos.clear();
+        let request = i64::from(identity.sequence_number);
+        for pid in PID_RELATED_SAMPLE_IDENTITY {
+            job.inline_qos.extend_from_slice(&pid.to_le_bytes());
+            job.inline_qos.extend_from_slice(&24u16.to_le_bytes());
+            job.inline_qos
+                .extend_from_slice(&identity.writer_guid.to_bytes());
+            job.inline_qos
+                .extend_from_slice(&((request >> 32) as i32).to_le_bytes());
+            job.inline_qos
+                .extend_from_slice(&(request as u32).to_le_bytes());
+        }
+        job.inline_qos
+            .extend_from_slice(&PID_SENTINEL.to_le_bytes());
+        job.inline_qos.extend_from_slice(&0u16.to_le_bytes());
+        bulk::send(job, &self.socket, &mut self.datagram, None)
+            .map_err(|e| format!("a large reply could not be sent ({e})"))?;
+        Ok(reader)
+    }
+}
 
 /// How many bytes `body` takes in CDR (little endian, with the 4-byte encapsulation header).
 fn fast_dds_reply_bytes<T: Serialize>(body: &T) -> usize {

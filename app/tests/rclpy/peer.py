@@ -54,12 +54,24 @@ def params(node):
     got = spin_until(node, client.get_parameters(["use_sim_time"]), 10)
     if got:
         out["use_sim_time"] = [got.values[0].type, got.values[0].bool_value]
-    # Apart: its reply (the URDF) needs fragments, which RustDDS cannot send to Fast DDS.
-    got = spin_until(node, client.get_parameters(["robot_description"]), 5)
+    # The URDF: larger than one RTPS DATA (rover sends it in its own datagrams); compared
+    # with /robot_description (transient local, through RustDDS's writer).
+    from std_msgs.msg import String
+    published = []
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    node.create_subscription(String, "/robot_description",
+                             lambda m: published.append(m.data), latched)
+    got = spin_until(node, client.get_parameters(["robot_description"]), 10)
+    end = time.monotonic() + 10
+    while time.monotonic() < end and not published:
+        rclpy.spin_once(node, timeout_sec=0.1)
     if got:
         value = got.values[0]
         out["robot_description"] = [value.type, len(value.string_value),
                                     value.string_value.lstrip()[:60]]
+        out["robot_description_is_the_topics"] = bool(published) and \
+            value.string_value == published[0]
     types = spin_until(node, client.get_parameter_types(["use_sim_time", "robot_description"]), 10)
     out["types"] = list(types.types) if types else None
     described = spin_until(node, client.describe_parameters(["use_sim_time"]), 10)
