@@ -40,30 +40,15 @@ impl Header {
     }
 }
 
-/// `geometry_msgs/Vector3` and `Point`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Vector3 {
-    /// x.
-    pub x: f64,
-    /// y.
-    pub y: f64,
-    /// z.
-    pub z: f64,
+pub use rover_msgs::{Pose, Quaternion, Twist, Vector3};
+
+/// The geometry types' fields in ROS 1's serialization (they are written in `rover-msgs`).
+trait Geometry: Sized {
+    fn encode(&self, out: &mut Vec<u8>);
+    fn decode(r: &mut Reader<'_>) -> Result<Self>;
 }
 
-impl From<[f64; 3]> for Vector3 {
-    fn from([x, y, z]: [f64; 3]) -> Self {
-        Self { x, y, z }
-    }
-}
-
-impl From<[f64; 4]> for Quaternion {
-    fn from([x, y, z, w]: [f64; 4]) -> Self {
-        Self { x, y, z, w }
-    }
-}
-
-impl Vector3 {
+impl Geometry for Vector3 {
     fn encode(&self, out: &mut Vec<u8>) {
         wire::f64_fixed(out, &[self.x, self.y, self.z]);
     }
@@ -76,60 +61,38 @@ impl Vector3 {
     }
 }
 
-/// `geometry_msgs/Quaternion`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quaternion {
-    /// x.
-    pub x: f64,
-    /// y.
-    pub y: f64,
-    /// z.
-    pub z: f64,
-    /// w.
-    pub w: f64,
-}
-
-impl Default for Quaternion {
-    fn default() -> Self {
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            w: 1.0,
-        }
-    }
-}
-
-impl Quaternion {
-    /// A rotation about z by `yaw_rad`.
-    pub fn from_yaw(yaw_rad: f64) -> Self {
-        let (s, c) = (yaw_rad / 2.0).sin_cos();
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: s,
-            w: c,
-        }
-    }
+impl Geometry for Quaternion {
     fn encode(&self, out: &mut Vec<u8>) {
         wire::f64_fixed(out, &[self.x, self.y, self.z, self.w]);
     }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            x: r.f64()?,
+            y: r.f64()?,
+            z: r.f64()?,
+            w: r.f64()?,
+        })
+    }
 }
 
-/// `geometry_msgs/Twist`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Twist {
-    /// Linear velocity (m/s).
-    pub linear: Vector3,
-    /// Angular velocity (rad/s).
-    pub angular: Vector3,
+impl Geometry for Pose {
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.position.encode(out);
+        self.orientation.encode(out);
+    }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            position: Vector3::decode(r)?,
+            orientation: Quaternion::decode(r)?,
+        })
+    }
 }
 
 impl Message for Twist {
     const TYPE: &'static str = "geometry_msgs/Twist";
     fn encode(&self, out: &mut Vec<u8>) {
-        self.linear.encode(out);
-        self.angular.encode(out);
+        Geometry::encode(&self.linear, out);
+        Geometry::encode(&self.angular, out);
     }
 }
 
@@ -140,22 +103,6 @@ impl Decode for Twist {
             linear: Vector3::decode(&mut r)?,
             angular: Vector3::decode(&mut r)?,
         })
-    }
-}
-
-/// `geometry_msgs/Pose`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Pose {
-    /// Position (m).
-    pub position: Vector3,
-    /// Orientation.
-    pub orientation: Quaternion,
-}
-
-impl Pose {
-    fn encode(&self, out: &mut Vec<u8>) {
-        self.position.encode(out);
-        self.orientation.encode(out);
     }
 }
 
@@ -829,6 +776,23 @@ mod tests {
         assert_eq!(bytes.len(), 48);
         assert_eq!(Twist::decode(&bytes)?, t);
         assert!(Twist::decode(&bytes[..47]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn a_pose_is_seven_float64s_position_first() -> Result<()> {
+        let pose = Pose {
+            position: [1.0, -2.0, 0.5].into(),
+            orientation: Quaternion::from_yaw(0.3),
+        };
+        let mut bytes = Vec::new();
+        Geometry::encode(&pose, &mut bytes);
+        assert_eq!(bytes.len(), 56);
+        assert_eq!(bytes[..8], 1.0f64.to_le_bytes());
+        assert_eq!(bytes[48..], pose.orientation.w.to_le_bytes());
+        let mut r = Reader::new(&bytes);
+        assert_eq!(<Pose as Geometry>::decode(&mut r)?, pose);
+        assert!(<Pose as Geometry>::decode(&mut Reader::new(&bytes[..55])).is_err());
         Ok(())
     }
 

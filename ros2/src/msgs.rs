@@ -49,49 +49,7 @@ pub struct Header {
     pub frame_id: String,
 }
 
-/// `geometry_msgs/msg/Vector3` and `Point`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Vector3 {
-    /// x.
-    pub x: f64,
-    /// y.
-    pub y: f64,
-    /// z.
-    pub z: f64,
-}
-
-/// `geometry_msgs/msg/Quaternion`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Quaternion {
-    /// x.
-    pub x: f64,
-    /// y.
-    pub y: f64,
-    /// z.
-    pub z: f64,
-    /// w.
-    pub w: f64,
-}
-
-impl Default for Quaternion {
-    fn default() -> Self {
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            w: 1.0,
-        }
-    }
-}
-
-/// `geometry_msgs/msg/Twist`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Twist {
-    /// Linear velocity (m/s).
-    pub linear: Vector3,
-    /// Angular velocity (rad/s).
-    pub angular: Vector3,
-}
+pub use rover_msgs::{Pose, Quaternion, Twist, Vector3};
 
 impl RosMessage for Twist {
     const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Twist_";
@@ -143,27 +101,6 @@ impl<'de> Deserialize<'de> for Covariance {
         }
         d.deserialize_tuple(36, Visit)
     }
-}
-
-impl From<[f64; 3]> for Vector3 {
-    fn from([x, y, z]: [f64; 3]) -> Self {
-        Self { x, y, z }
-    }
-}
-
-impl From<[f64; 4]> for Quaternion {
-    fn from([x, y, z, w]: [f64; 4]) -> Self {
-        Self { x, y, z, w }
-    }
-}
-
-/// `geometry_msgs/msg/Pose`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Pose {
-    /// Position (m).
-    pub position: Vector3,
-    /// Orientation.
-    pub orientation: Quaternion,
 }
 
 /// `geometry_msgs/msg/PoseWithCovariance`.

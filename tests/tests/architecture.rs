@@ -6,7 +6,16 @@ use rover_tests::architecture::CrateSources;
 use rover_tests::repo;
 
 /// Crates whose files must not import each other in a circle.
-const CRATES: [&str; 7] = ["sim", "perception", "core", "ros1", "ros2", "app", "tests"];
+const CRATES: [&str; 8] = [
+    "sim",
+    "perception",
+    "core",
+    "msgs",
+    "ros1",
+    "ros2",
+    "app",
+    "tests",
+];
 
 /// Longest function allowed outside tests (lines from `fn` to its closing brace).
 const MAX_FUNCTION_LINES: usize = 120;
@@ -20,9 +29,11 @@ fn no_crate_has_an_import_circle_between_its_files() -> anyhow::Result<()> {
     let mut circles = Vec::new();
     for krate in CRATES {
         let sources = sources(krate)?;
+        // rover-msgs is one file (lib.rs); every other crate has several.
+        let least = if krate == "msgs" { 1 } else { 2 };
         assert!(
-            sources.files.len() > 1,
-            "{krate}: expected several source files, found {}",
+            sources.files.len() >= least,
+            "{krate}: expected at least {least} source files, found {}",
             sources.files.len()
         );
         if let Some(cycle) = sources.find_cycle() {
@@ -151,6 +162,7 @@ const PUBLIC_MODULES: &[(&str, &[&str])] = &[
     ("sim", &[]),
     ("perception", &[]),
     ("core", &[]),
+    ("msgs", &[]),
     ("ros1", &["msgs"]),
     // ROS 2's wire: namespaces as a ROS 2 stack has them (messages, discovery, services,
     // parameters, actions), none re-exported at the root.
@@ -158,6 +170,7 @@ const PUBLIC_MODULES: &[(&str, &[&str])] = &[
         "ros2",
         &[
             "action_msgs",
+            "bulk",
             "dds",
             "definitions",
             "discovery",
