@@ -1,11 +1,13 @@
 //! The ROS message types rover's two wires share field for field: geometry_msgs' `Vector3`
-//! (also `Point`), `Quaternion`, `Pose` and `Twist` are defined alike in ROS 1 and ROS 2, so
-//! they are written once, here. How each travels is its wire's: `rover-ros1` encodes them in
+//! (also `Point`), `Quaternion`, `Pose` and `Twist`, and the messages whose fields are alike
+//! in ROS 1 and ROS 2 but for their header (`JointState<H>`, `LaserScan<H, R>`,
+//! `BoundingBoxes<H>`, ...: each wire names them with its own `Header`), are written once,
+//! here. How each travels is its wire's: `rover-ros1` encodes them in
 //! ROS 1's serialization (`Message`), `rover-ros2` in CDR through serde (`RosMessage`); both
 //! crates re-export them in their `msgs`.
 //!
 //! The messages whose fields differ between ROS 1 and ROS 2 (std_msgs/Header's `seq`, Time's
-//! layout, darknet_ros's `Class`) stay in each wire's crate.
+//! layout, Odometry's and TF's shapes in rover's ROS 1 encoder) stay in each wire's crate.
 
 use serde::{Deserialize, Serialize};
 
@@ -85,6 +87,201 @@ pub struct Twist {
     pub linear: Vector3,
     /// Angular velocity (rad/s).
     pub angular: Vector3,
+}
+
+/// `sensor_msgs/JointState`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointState<H> {
+    /// Stamp (the frame is empty).
+    pub header: H,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Positions (rad or m).
+    pub position: Vec<f64>,
+    /// Velocities (rad/s or m/s).
+    pub velocity: Vec<f64>,
+    /// Efforts (N m or N).
+    pub effort: Vec<f64>,
+}
+
+/// `sensor_msgs/LaserScan`, with the wire's header `H` and its buffer of ranges `R`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LaserScan<H, R> {
+    /// Stamp and the scanner's frame.
+    pub header: H,
+    /// First ray's angle (rad).
+    pub angle_min: f32,
+    /// Last ray's angle (rad).
+    pub angle_max: f32,
+    /// Between rays (rad).
+    pub angle_increment: f32,
+    /// Between rays (s).
+    pub time_increment: f32,
+    /// Between scans (s).
+    pub scan_time: f32,
+    /// Shortest range (m).
+    pub range_min: f32,
+    /// Longest range (m).
+    pub range_max: f32,
+    /// Ranges (m); infinity where a ray hits nothing.
+    pub ranges: R,
+    /// Intensities (empty: rover's laser measures none).
+    pub intensities: Vec<f32>,
+}
+
+/// `darknet_ros_msgs/BoundingBox`, in ROS 2's field order (ROS 1's wire writes `Class`
+/// first, under its own name).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBox {
+    /// Confidence, 0..1.
+    pub probability: f64,
+    /// Left edge (px).
+    pub xmin: i64,
+    /// Top edge (px).
+    pub ymin: i64,
+    /// Right edge (px).
+    pub xmax: i64,
+    /// Bottom edge (px).
+    pub ymax: i64,
+    /// Class index.
+    pub id: i16,
+    /// Class name (ROS 1's `Class`).
+    pub class_id: String,
+}
+
+/// `darknet_ros_msgs/BoundingBoxes`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBoxes<H> {
+    /// When published.
+    pub header: H,
+    /// The detected image's header.
+    pub image_header: H,
+    /// The boxes, highest probability first.
+    pub bounding_boxes: Vec<BoundingBox>,
+}
+
+/// `darknet_ros_msgs/ObjectCount`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ObjectCount<H> {
+    /// When published.
+    pub header: H,
+    /// Boxes.
+    pub count: i8,
+}
+
+/// `geometry_msgs/PointStamped`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PointStamped<H> {
+    /// Stamp and frame.
+    pub header: H,
+    /// The point (m).
+    pub point: Vector3,
+}
+
+/// `gazebo_msgs/ModelStates`: every model's name, world pose and world twist.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelStates {
+    /// Model names.
+    pub name: Vec<String>,
+    /// Their poses in the world.
+    pub pose: Vec<Pose>,
+    /// Their twists in the world.
+    pub twist: Vec<Twist>,
+}
+
+/// `std_msgs/String`: a line of text.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Text {
+    /// The text.
+    pub data: String,
+}
+
+/// `sensor_msgs/Image`, with the wire's header `H` and its pixel buffer `B`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Image<H, B> {
+    /// Stamp and optical frame.
+    pub header: H,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `rgb8`, `32FC1`, ...
+    pub encoding: String,
+    /// 0: little-endian.
+    pub is_bigendian: u8,
+    /// Bytes per row.
+    pub step: u32,
+    /// Pixels, rows top to bottom.
+    pub data: B,
+}
+
+/// `sensor_msgs/RegionOfInterest` (all zero: the full image).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct RegionOfInterest {
+    /// Left (px).
+    pub x_offset: u32,
+    /// Top (px).
+    pub y_offset: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Width (px).
+    pub width: u32,
+    /// Whether to rectify.
+    pub do_rectify: bool,
+}
+
+/// `sensor_msgs/CameraInfo`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CameraInfo<H> {
+    /// Stamp and optical frame.
+    pub header: H,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `plumb_bob`.
+    pub distortion_model: String,
+    /// Distortion coefficients.
+    pub d: Vec<f64>,
+    /// Intrinsics, row-major 3x3.
+    pub k: [f64; 9],
+    /// Rectification, row-major 3x3.
+    pub r: [f64; 9],
+    /// Projection, row-major 3x4.
+    pub p: [f64; 12],
+    /// Horizontal binning (0 or 1: none).
+    pub binning_x: u32,
+    /// Vertical binning.
+    pub binning_y: u32,
+    /// Region of interest.
+    pub roi: RegionOfInterest,
+}
+
+/// Names, in a wire's `msgs` module, the messages above that carry a header, with the wire's
+/// header type, pixel buffer and range buffer: `wire_messages!(Header, Vec<u8>, Vec<f32>)`
+/// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `BoundingBoxes`, `ObjectCount`
+/// and `PointStamped` there.
+#[macro_export]
+macro_rules! wire_messages {
+    ($header:ty, $pixels:ty, $ranges:ty) => {
+        /// `sensor_msgs/Image`.
+        pub type Image = $crate::Image<$header, $pixels>;
+        /// `sensor_msgs/CameraInfo`.
+        pub type CameraInfo = $crate::CameraInfo<$header>;
+        /// `sensor_msgs/JointState`.
+        pub type JointState = $crate::JointState<$header>;
+        /// `sensor_msgs/LaserScan`.
+        pub type LaserScan = $crate::LaserScan<$header, $ranges>;
+        /// `darknet_ros_msgs/BoundingBoxes`.
+        pub type BoundingBoxes = $crate::BoundingBoxes<$header>;
+        /// `darknet_ros_msgs/ObjectCount`.
+        pub type ObjectCount = $crate::ObjectCount<$header>;
+        /// `geometry_msgs/PointStamped`.
+        pub type PointStamped = $crate::PointStamped<$header>;
+        pub use $crate::{
+            BoundingBox, ModelStates, Pose, Quaternion, RegionOfInterest, Text, Twist, Vector3,
+        };
+    };
 }
 
 #[cfg(test)]

@@ -40,7 +40,7 @@ impl Header {
     }
 }
 
-pub use rover_msgs::{Pose, Quaternion, Twist, Vector3};
+rover_msgs::wire_messages!(Header, Vec<u8>, Vec<f32>);
 
 /// The geometry types' fields in ROS 1's serialization (they are written in `rover-msgs`).
 trait Geometry: Sized {
@@ -104,17 +104,6 @@ impl Decode for Twist {
             angular: Vector3::decode(&mut r)?,
         })
     }
-}
-
-/// `gazebo_msgs/ModelStates`: every model's name, world pose and world twist.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ModelStates {
-    /// Model names.
-    pub name: Vec<String>,
-    /// Their poses (world frame).
-    pub pose: Vec<Pose>,
-    /// Their velocities (world frame).
-    pub twist: Vec<Twist>,
 }
 
 impl Message for ModelStates {
@@ -209,23 +198,6 @@ impl Message for Odometry {
     }
 }
 
-/// `sensor_msgs/Image`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Image {
-    /// Camera optical frame and stamp.
-    pub header: Header,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `rgb8`, `bgr8`, `mono8`.
-    pub encoding: String,
-    /// Bytes per row.
-    pub step: u32,
-    /// Pixels, rows top to bottom.
-    pub data: Vec<u8>,
-}
-
 impl Message for Image {
     const TYPE: &'static str = "sensor_msgs/Image";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -233,31 +205,10 @@ impl Message for Image {
         wire::u32(out, self.height);
         wire::u32(out, self.width);
         wire::string(out, &self.encoding);
-        wire::u8(out, 0);
+        wire::u8(out, self.is_bigendian);
         wire::u32(out, self.step);
         wire::bytes(out, &self.data);
     }
-}
-
-/// `sensor_msgs/CameraInfo` (no binning, full-frame ROI).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct CameraInfo {
-    /// Camera optical frame and stamp.
-    pub header: Header,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `plumb_bob`.
-    pub distortion_model: String,
-    /// Distortion coefficients.
-    pub d: Vec<f64>,
-    /// Intrinsics, row-major 3x3.
-    pub k: [f64; 9],
-    /// Rectification, row-major 3x3.
-    pub r: [f64; 9],
-    /// Projection, row-major 3x4.
-    pub p: [f64; 12],
 }
 
 impl Message for CameraInfo {
@@ -271,13 +222,13 @@ impl Message for CameraInfo {
         wire::f64_fixed(out, &self.k);
         wire::f64_fixed(out, &self.r);
         wire::f64_fixed(out, &self.p);
-        wire::u32(out, 0);
-        wire::u32(out, 0);
-        // roi: x_offset, y_offset, height, width, do_rectify (all zero = full image)
-        for _ in 0..4 {
-            wire::u32(out, 0);
+        wire::u32(out, self.binning_x);
+        wire::u32(out, self.binning_y);
+        let roi = &self.roi;
+        for v in [roi.x_offset, roi.y_offset, roi.height, roi.width] {
+            wire::u32(out, v);
         }
-        wire::u8(out, 0);
+        wire::u8(out, u8::from(roi.do_rectify));
     }
 }
 
@@ -293,21 +244,6 @@ impl Message for Clock {
     fn encode(&self, out: &mut Vec<u8>) {
         wire::time(out, self.clock_s);
     }
-}
-
-/// `sensor_msgs/JointState`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct JointState {
-    /// Stamp (frame empty).
-    pub header: Header,
-    /// Joint names.
-    pub name: Vec<String>,
-    /// Positions (rad).
-    pub position: Vec<f64>,
-    /// Velocities (rad/s).
-    pub velocity: Vec<f64>,
-    /// Efforts (N m); may be empty.
-    pub effort: Vec<f64>,
 }
 
 impl Message for JointState {
@@ -346,13 +282,6 @@ impl Decode for Float64 {
     }
 }
 
-/// `std_msgs/String`: a line of text (rover's arm task in and state out).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Text {
-    /// The text.
-    pub data: String,
-}
-
 impl Message for Text {
     const TYPE: &'static str = "std_msgs/String";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -366,15 +295,6 @@ impl Decode for Text {
             data: Reader::new(bytes).string()?,
         })
     }
-}
-
-/// `geometry_msgs/PointStamped`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PointStamped {
-    /// Stamp and frame.
-    pub header: Header,
-    /// The point (m).
-    pub point: Vector3,
 }
 
 impl Message for PointStamped {
@@ -551,29 +471,6 @@ impl Message for JointTrajectoryControllerState {
     }
 }
 
-/// `sensor_msgs/LaserScan` (no intensities).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LaserScan {
-    /// Laser frame and stamp.
-    pub header: Header,
-    /// First ray's angle (rad).
-    pub angle_min: f32,
-    /// Last ray's angle (rad).
-    pub angle_max: f32,
-    /// Between rays (rad).
-    pub angle_increment: f32,
-    /// Between measurements (s).
-    pub time_increment: f32,
-    /// Between scans (s).
-    pub scan_time: f32,
-    /// Minimum range (m).
-    pub range_min: f32,
-    /// Maximum range (m).
-    pub range_max: f32,
-    /// Ranges (m; +-inf out of range, REP-117).
-    pub ranges: Vec<f32>,
-}
-
 impl Message for LaserScan {
     const TYPE: &'static str = "sensor_msgs/LaserScan";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -590,38 +487,8 @@ impl Message for LaserScan {
             wire::f32(out, v);
         }
         wire::f32_array(out, &self.ranges);
-        wire::f32_array(out, &[]);
+        wire::f32_array(out, &self.intensities);
     }
-}
-
-/// `darknet_ros_msgs/BoundingBox`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct BoundingBox {
-    /// Confidence, 0..1.
-    pub probability: f64,
-    /// Left (px).
-    pub xmin: i64,
-    /// Top (px).
-    pub ymin: i64,
-    /// Right (px).
-    pub xmax: i64,
-    /// Bottom (px).
-    pub ymax: i64,
-    /// Class index.
-    pub id: i16,
-    /// Class name.
-    pub class: String,
-}
-
-/// `darknet_ros_msgs/BoundingBoxes`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct BoundingBoxes {
-    /// When the boxes were published.
-    pub header: Header,
-    /// The image they came from.
-    pub image_header: Header,
-    /// The boxes.
-    pub bounding_boxes: Vec<BoundingBox>,
 }
 
 impl Message for BoundingBoxes {
@@ -637,18 +504,9 @@ impl Message for BoundingBoxes {
             wire::i64(out, b.xmax);
             wire::i64(out, b.ymax);
             wire::i16(out, b.id);
-            wire::string(out, &b.class);
+            wire::string(out, &b.class_id);
         }
     }
-}
-
-/// `darknet_ros_msgs/ObjectCount`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ObjectCount {
-    /// Stamp.
-    pub header: Header,
-    /// Objects found.
-    pub count: i8,
 }
 
 impl Message for ObjectCount {

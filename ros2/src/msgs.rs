@@ -49,7 +49,7 @@ pub struct Header {
     pub frame_id: String,
 }
 
-pub use rover_msgs::{Pose, Quaternion, Twist, Vector3};
+rover_msgs::wire_messages!(Header, Lent<u8>, Lent<f32>);
 
 impl RosMessage for Twist {
     const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Twist_";
@@ -183,21 +183,6 @@ impl RosMessage for TfMessage {
     const DEFINITION: &'static str = crate::definitions::TF_MESSAGE;
 }
 
-/// `sensor_msgs/msg/JointState`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct JointState {
-    /// Stamp.
-    pub header: Header,
-    /// Joint names.
-    pub name: Vec<String>,
-    /// Positions (rad or m).
-    pub position: Vec<f64>,
-    /// Velocities.
-    pub velocity: Vec<f64>,
-    /// Efforts.
-    pub effort: Vec<f64>,
-}
-
 impl RosMessage for JointState {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::JointState_";
     const DEFINITION: &'static str = crate::definitions::JOINT_STATE;
@@ -240,70 +225,9 @@ impl Serialize for Lent<f32> {
     }
 }
 
-/// `sensor_msgs/msg/Image`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct Image {
-    /// Stamp and optical frame.
-    pub header: Header,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `rgb8`, `32FC1`, ...
-    pub encoding: String,
-    /// 0: little-endian.
-    pub is_bigendian: u8,
-    /// Bytes per row.
-    pub step: u32,
-    /// Pixels, rows top to bottom.
-    pub data: Lent<u8>,
-}
-
 impl RosMessage for Image {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Image_";
     const DEFINITION: &'static str = crate::definitions::IMAGE;
-}
-
-/// `sensor_msgs/msg/RegionOfInterest`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct RegionOfInterest {
-    /// Left (px).
-    pub x_offset: u32,
-    /// Top (px).
-    pub y_offset: u32,
-    /// Height (px).
-    pub height: u32,
-    /// Width (px).
-    pub width: u32,
-    /// Whether to rectify.
-    pub do_rectify: bool,
-}
-
-/// `sensor_msgs/msg/CameraInfo` (ROS 2 names its matrices in lower case).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CameraInfo {
-    /// Stamp and optical frame.
-    pub header: Header,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `plumb_bob`.
-    pub distortion_model: String,
-    /// Distortion coefficients.
-    pub d: Vec<f64>,
-    /// Intrinsics, row-major 3x3.
-    pub k: [f64; 9],
-    /// Rectification, row-major 3x3.
-    pub r: [f64; 9],
-    /// Projection, row-major 3x4.
-    pub p: [f64; 12],
-    /// Binning.
-    pub binning_x: u32,
-    /// Binning.
-    pub binning_y: u32,
-    /// Region of interest.
-    pub roi: RegionOfInterest,
 }
 
 impl RosMessage for CameraInfo {
@@ -311,65 +235,9 @@ impl RosMessage for CameraInfo {
     const DEFINITION: &'static str = crate::definitions::CAMERA_INFO;
 }
 
-/// `sensor_msgs/msg/LaserScan`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct LaserScan {
-    /// Stamp and the scanner's frame.
-    pub header: Header,
-    /// First ray's angle (rad).
-    pub angle_min: f32,
-    /// Last ray's angle (rad).
-    pub angle_max: f32,
-    /// Between rays (rad).
-    pub angle_increment: f32,
-    /// Between rays (s).
-    pub time_increment: f32,
-    /// Between scans (s).
-    pub scan_time: f32,
-    /// Shortest range (m).
-    pub range_min: f32,
-    /// Longest range (m).
-    pub range_max: f32,
-    /// Ranges (m).
-    pub ranges: Lent<f32>,
-    /// Intensities.
-    pub intensities: Vec<f32>,
-}
-
 impl RosMessage for LaserScan {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::LaserScan_";
     const DEFINITION: &'static str = crate::definitions::LASER_SCAN;
-}
-
-/// `darknet_ros_msgs/msg/BoundingBox` as darknet_ros's ROS 2 branch (`foxy`) declares it: ROS 1's
-/// `Class` became `class_id` (ROS 2 field names are lower case) and moved last.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct BoundingBox {
-    /// Confidence, 0..1.
-    pub probability: f64,
-    /// Left edge (px).
-    pub xmin: i64,
-    /// Top edge (px).
-    pub ymin: i64,
-    /// Right edge (px).
-    pub xmax: i64,
-    /// Bottom edge (px).
-    pub ymax: i64,
-    /// Class index.
-    pub id: i16,
-    /// Class name.
-    pub class_id: String,
-}
-
-/// `darknet_ros_msgs/msg/BoundingBoxes`: the boxes of one image.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct BoundingBoxes {
-    /// When the boxes were published.
-    pub header: Header,
-    /// The detected image's header.
-    pub image_header: Header,
-    /// The boxes, highest probability first.
-    pub bounding_boxes: Vec<BoundingBox>,
 }
 
 impl RosMessage for BoundingBoxes {
@@ -377,29 +245,9 @@ impl RosMessage for BoundingBoxes {
     const DEFINITION: &'static str = crate::definitions::BOUNDING_BOXES;
 }
 
-/// `darknet_ros_msgs/msg/ObjectCount`: how many boxes one image gave.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct ObjectCount {
-    /// Stamp.
-    pub header: Header,
-    /// Boxes.
-    pub count: i8,
-}
-
 impl RosMessage for ObjectCount {
     const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::ObjectCount_";
     const DEFINITION: &'static str = crate::definitions::OBJECT_COUNT;
-}
-
-/// `gazebo_msgs/msg/ModelStates`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct ModelStates {
-    /// Model names.
-    pub name: Vec<String>,
-    /// Their poses (world frame).
-    pub pose: Vec<Pose>,
-    /// Their velocities (world frame).
-    pub twist: Vec<Twist>,
 }
 
 impl RosMessage for ModelStates {
@@ -407,25 +255,9 @@ impl RosMessage for ModelStates {
     const DEFINITION: &'static str = crate::definitions::MODEL_STATES;
 }
 
-/// `std_msgs/msg/String`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Text {
-    /// The text.
-    pub data: String,
-}
-
 impl RosMessage for Text {
     const DDS_TYPE: &'static str = "std_msgs::msg::dds_::String_";
     const DEFINITION: &'static str = crate::definitions::STRING;
-}
-
-/// `geometry_msgs/msg/PointStamped`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct PointStamped {
-    /// Stamp and frame.
-    pub header: Header,
-    /// The point (m).
-    pub point: Vector3,
 }
 
 impl RosMessage for PointStamped {

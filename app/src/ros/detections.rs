@@ -44,7 +44,7 @@ impl BoxesWire for Boxes {
             .resize_with(boxes.boxes.len(), msgs::BoundingBox::default);
         for (m, b) in out.bounding_boxes.iter_mut().zip(&boxes.boxes) {
             copy_fields!(m, b; probability, xmin, ymin, xmax, ymax, id);
-            m.class.clone_from(&b.class);
+            m.class_id.clone_from(&b.class);
         }
         self.publisher.publish(out);
     }
