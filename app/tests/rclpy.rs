@@ -544,6 +544,18 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
                     .map(|(w, h)| w * h * 3),
             "{distro}: the image's data is not width x height x 3: {sample}"
         );
+        // rover's log on /rosout (transient local: the lines before the peer came too):
+        // the line naming its DDS domain, at INFO, from rover's source.
+        let log_lines = sample["/rosout"].as_array().context("no /rosout sample")?;
+        ensure!(
+            log_lines.iter().any(|l| l[0] == 20
+                && l[1]
+                    .as_str()
+                    .is_some_and(|m| m.starts_with("ROS 2: node rover"))
+                && l[2].as_str().is_some_and(|f| f.ends_with(".rs"))
+                && l[3].as_u64().is_some_and(|n| n > 0)),
+            "{distro}: rover's lines on /rosout: {log_lines:?}"
+        );
         session.wait(Duration::from_secs(90))?;
     }
     Ok(())

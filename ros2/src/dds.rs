@@ -3,7 +3,7 @@
 
 use crate::error::{Context, Result};
 use rustdds::no_key::DataWriter;
-use rustdds::policy::{Durability, History, Reliability};
+use rustdds::policy::{Durability, History, Lifespan, Reliability};
 use rustdds::{CDRSerializerAdapter, DomainParticipant, QosPolicies, QosPolicyBuilder, TopicKind};
 
 use crate::msgs::RosMessage;
@@ -43,6 +43,21 @@ pub fn latched_qos() -> QosPolicies {
 /// rclcpp's ParameterEventsQoS: reliable, volatile, keep last 1000.
 pub fn parameter_events_qos() -> QosPolicies {
     qos(true, Durability::Volatile, 1000)
+}
+
+/// rcl's `/rosout` QoS: reliable, transient local, keep last 1000, each line kept 10 s (a
+/// late rqt_console gets the recent lines).
+pub fn rosout_qos() -> QosPolicies {
+    QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::from_millis(100),
+        })
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1000 })
+        .lifespan(Lifespan {
+            duration: rustdds::Duration::from_secs(10),
+        })
+        .build()
 }
 
 /// rclcpp's SensorDataQoS: best effort, volatile, keep last 5 (images, scans).

@@ -236,6 +236,14 @@ pub const PARAMETER_EVENT: &str = concat!(
     )
 );
 
+/// `rcl_interfaces/msg/Log`: a node's log line, on `/rosout`.
+pub const LOG: &str = concat!(
+    "byte DEBUG=10\nbyte INFO=20\nbyte WARN=30\nbyte ERROR=40\nbyte FATAL=50\n",
+    "builtin_interfaces/Time stamp\nuint8 level\nstring name\nstring msg\nstring file\n",
+    "string function\nuint32 line\n",
+    time!()
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -271,6 +279,7 @@ mod tests {
             POINT_STAMPED,
             JOINT_TRAJECTORY,
             FLOAT64_MULTI_ARRAY,
+            LOG,
         ] {
             let defined: Vec<&str> = def
                 .lines()

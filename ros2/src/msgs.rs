@@ -265,6 +265,44 @@ impl RosMessage for PointStamped {
     const DEFINITION: &'static str = crate::definitions::POINT_STAMPED;
 }
 
+/// `rcl_interfaces/msg/Log`: one line of a node's log, as every rclcpp and rclpy node
+/// publishes it on `/rosout`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Log {
+    /// When it was logged (wall clock, as rcl stamps it).
+    pub stamp: Time,
+    /// [`Log::DEBUG`] .. [`Log::FATAL`].
+    pub level: u8,
+    /// The logger: the node's name (`rover`).
+    pub name: String,
+    /// The text.
+    pub msg: String,
+    /// The source file that logged it.
+    pub file: String,
+    /// The function (rover: its module) that logged it.
+    pub function: String,
+    /// The line that logged it.
+    pub line: u32,
+}
+
+impl Log {
+    /// Debug (and tracing's trace).
+    pub const DEBUG: u8 = 10;
+    /// Info.
+    pub const INFO: u8 = 20;
+    /// Warning.
+    pub const WARN: u8 = 30;
+    /// Error.
+    pub const ERROR: u8 = 40;
+    /// Fatal (rover logs none).
+    pub const FATAL: u8 = 50;
+}
+
+impl RosMessage for Log {
+    const DDS_TYPE: &'static str = "rcl_interfaces::msg::dds_::Log_";
+    const DEFINITION: &'static str = crate::definitions::LOG;
+}
+
 /// `builtin_interfaces/msg/Duration`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Duration {

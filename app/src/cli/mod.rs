@@ -52,16 +52,23 @@ fn xacro(args: args::XacroArgs) -> anyhow::Result<()> {
 
 /// Parses the command line, runs it and turns errors into `rover: error: ...` and exit code 1.
 pub fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
+    use tracing_subscriber::layer::SubscriberExt as _;
+    use tracing_subscriber::util::SubscriberInitExt as _;
+    // The log on stderr, and the same lines on /rosout while a --ros2 bridge listens.
+    tracing_subscriber::registry()
+        .with(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
                 tracing_subscriber::EnvFilter::new(
                     "info,tract_onnx=error,tract_hir=error,tract_core=error,rustdds=warn",
                 )
             }),
         )
-        .with_writer(std::io::stderr)
-        .with_target(false)
+        .with(
+            tracing_subscriber::fmt::layer()
+                .with_writer(std::io::stderr)
+                .with_target(false),
+        )
+        .with(crate::ros2::rosout_layer())
         .init();
     let cli = Cli::parse();
     let result = match cli.command {

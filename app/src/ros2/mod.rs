@@ -9,8 +9,8 @@
 //! on the topic's sinks
 //! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
 //! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
-//! `laser.rs`, `arm.rs`, `status.rs`; `/robot_description` is written once, at the start
-//! (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
+//! `laser.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
+//! is written once, at the start (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
 //! `rt/cmd_vel`, the controllers' commands and `/rover/arm/task` into rover input like a key
 //! press. Stamps are sim time; `/clock` carries it.
 //!
@@ -45,6 +45,7 @@ mod laser;
 mod mcap;
 mod model_states;
 mod odom;
+mod rosout;
 mod sinks;
 mod status;
 mod tf;
@@ -64,6 +65,7 @@ use sinks::{Sinks, latched_qos};
 
 pub use input::Ros2Input;
 pub use mcap::McapSummary;
+pub use rosout::layer as rosout_layer;
 pub use rover_ros2::dds::dds_topic;
 use rover_ros2::dds::default_qos;
 pub use rover_ros2::discovery::RosDistro;
@@ -228,8 +230,9 @@ impl Bridge<Recorded> {
         drop(sinks);
         let (input, held) = match dds {
             Some(node) => {
-                let (input, held, actions) = node.announce(options, writers)?;
+                let (input, held, actions, rosout) = node.announce(options, writers)?;
                 families.push(Box::new(actions));
+                families.push(Box::new(rosout));
                 (Some(input), Some(held))
             }
             None => (None, None),
@@ -279,12 +282,14 @@ impl Bridge<Recorded> {
 }
 
 /// What `--ros2` adds on DDS: the participant and its publisher, the input half (topics,
-/// parameter services) and the controllers' action servers.
+/// parameter services), the controllers' action servers and `/rosout` (with its writer's
+/// GUID).
 struct DdsNode {
     participant: DomainParticipant,
     publisher: rustdds::Publisher,
     input: Ros2Input,
     actions: actions::ControllerActions,
+    rosout: (rosout::Rosout, rustdds::GUID),
 }
 
 /// What the publishing thread keeps alive until it ends: `ros_discovery_info`'s writer, the
@@ -325,22 +330,24 @@ impl DdsNode {
             options.distro,
             to_session,
         )?;
+        let rosout = rosout::Rosout::create(&participant, &publisher, &node)?;
         Ok(Self {
             participant,
             publisher,
             input,
             actions,
+            rosout,
         })
     }
 
     /// Publishes `ros_discovery_info` for the node: the input's and the actions' readers and
-    /// writers, and the topics' `writers`. What the bridge runs with: the input, what its
-    /// thread holds, and the action servers (a topic family).
+    /// writers, `/rosout`'s and the topics' `writers`. What the bridge runs with: the input,
+    /// what its thread holds, the action servers and `/rosout` (topic families).
     fn announce(
         self,
         options: &Ros2Options,
         writers: Vec<rustdds::GUID>,
-    ) -> Result<(Ros2Input, Held, actions::ControllerActions)> {
+    ) -> Result<(Ros2Input, Held, actions::ControllerActions, rosout::Rosout)> {
         let mut d = discovery::Discovery::new(
             &self.participant,
             &self.publisher,
@@ -352,11 +359,14 @@ impl DdsNode {
         readers.extend(action_readers);
         all_writers.extend(action_writers);
         all_writers.extend(writers);
+        let (rosout, rosout_writer) = self.rosout;
+        all_writers.push(rosout_writer);
         d.add(&readers, &all_writers)?;
         Ok((
             self.input,
             (d, self.publisher, self.participant),
             self.actions,
+            rosout,
         ))
     }
 }

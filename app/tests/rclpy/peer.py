@@ -109,6 +109,7 @@ def topics(node):
     from darknet_ros_msgs.msg import BoundingBoxes, ObjectCount
     from gazebo_msgs.msg import ModelStates
     from nav_msgs.msg import Odometry
+    from rcl_interfaces.msg import Log
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import CameraInfo, Image, JointState, LaserScan
     from std_msgs.msg import String
@@ -117,6 +118,8 @@ def topics(node):
     reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    rosout = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
     table = [
         ("/clock", Clock, reliable, "reliable"),
         ("/odom", Odometry, reliable, "reliable"),
@@ -132,11 +135,16 @@ def topics(node):
         ("/gazebo/model_states", ModelStates, reliable, "reliable"),
         ("/rover/status", String, reliable, "reliable"),
         ("/scan", LaserScan, qos_profile_sensor_data, "best effort"),
+        ("/rosout", Log, rosout, "reliable, transient local"),
     ]
-    counts, last = {}, {}
+    counts, last, rover_log = {}, {}, []
 
     def keep(name):
         def callback(message):
+            if name == "/rosout":
+                if message.name != "rover":
+                    return  # other nodes' lines (this one's)
+                rover_log.append([message.level, message.msg, message.file, message.line])
             counts[name] = counts.get(name, 0) + 1
             last[name] = message
         return callback
@@ -160,6 +168,7 @@ def topics(node):
         sample["/tf_static"] = len(last["/tf_static"].transforms)
     if "/scan" in last:
         sample["/scan"] = len(last["/scan"].ranges)
+    sample["/rosout"] = rover_log[:20]
     return {"table": [[n, k.__module__.split(".")[0] + "/msg/" + k.__name__, q, counts.get(n, 0)]
                       for n, k, _, q in table], "sample": sample}
 
