@@ -1558,7 +1558,7 @@ print('D state %d moved_after %.4f from_goal %.4f' % (client.get_state(), max(ab
     let b = line("B")?;
     ensure!(b[0] == 5.0 && b[1] == -2.0, "goal B (unknown joint): {b:?}");
     ensure!(
-        out.contains("wrist_roll is not one of arm_controller's"),
+        out.contains("arm_controller: joint \"wrist_roll\" is not one of its joints"),
         "{out}"
     );
     let c = line("C")?;

@@ -129,8 +129,8 @@ pub struct LaserScan<H, R> {
     pub intensities: Vec<f32>,
 }
 
-/// `darknet_ros_msgs/BoundingBox`, in ROS 2's field order (ROS 1's wire writes `Class`
-/// first, under its own name).
+/// `darknet_ros_msgs/BoundingBox` (ROS 1 names the class `Class`, ROS 2 `class_id`; both
+/// write it last).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct BoundingBox {
     /// Confidence, 0..1.

@@ -1,16 +1,18 @@
-//! Large best-effort samples (images, point clouds) sent in 64,000-byte fragments, as Fast DDS
-//! and Cyclone DDS send theirs, instead of RustDDS's.
+//! Large best-effort samples (images, point clouds) sent in fragments of [`FRAGMENT_BYTES`],
+//! paced, instead of RustDDS's.
 //!
 //! Why rover writes these datagrams itself: RustDDS 0.15.1 cuts every fragmented sample into
 //! 256-byte fragments (a constant of the crate) packed into datagrams of the MTU of the
 //! interface whose subnet holds the reader's address — 1,400 bytes here, though a reader on the
 //! same machine is reached through the loopback device. A 640x480 rgb8 image is then ~700
 //! datagrams and 3,600 fragments; a Fast DDS subscriber at the OS's default receive buffer
-//! (208 KiB) lost three images in four of them (docs/ROS2.md, "Large samples"), where the
-//! same image as 15 datagrams of 64,000-byte fragments is what Fast DDS's own writers send.
+//! (208 KiB) lost three images in four of them (docs/ROS2.md, "Large samples"), where Fast
+//! DDS's own writers send the same image in datagrams of up to 64 KB.
 //!
 //! RustDDS still owns the writer: it announces it (SEDP), matches readers by topic and QoS and
-//! reports each match. For each matched reader whose UDP address discovery gives, this module
+//! reports each match (a report lost to its status channel, which holds four, is made good
+//! every second from discovery's readers of the topic). For each matched reader whose UDP
+//! address discovery gives, this module
 //! writes the RTPS message itself (header, INFO_DST, INFO_TS, then one DATA, or one DATA_FRAG
 //! per datagram; RTPS 2.5 sections 8.3.7 and 9.4.5) from its own socket, with the writer's GUID
 //! and its own sequence numbers; a reader with no UDP address (a shared-memory or multicast
@@ -22,8 +24,10 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use byteorder::LittleEndian;
+use rustdds::policy::{Durability, Reliability};
 use rustdds::{
-    DataWriterStatus, DomainParticipant, GUID, RTPSEntity, StatusEvented, WriteOptionsBuilder,
+    DataWriterStatus, DomainParticipant, GUID, RTPSEntity, StatusEvented, TopicDescription,
+    WriteOptionsBuilder,
 };
 
 use crate::dds::Writer;
@@ -62,14 +66,26 @@ pub(crate) struct Reader {
     pub to: Option<SocketAddr>,
 }
 
-/// The readers RustDDS matched to a writer, with their UDP addresses as discovery gives them.
-#[derive(Debug, Default)]
+/// The readers RustDDS matched to a best-effort, volatile writer of `topic`, with their UDP
+/// addresses as discovery gives them.
+#[derive(Debug)]
 pub(crate) struct Matched {
     pub readers: Vec<Reader>,
+    /// The writer's DDS topic.
+    topic: String,
     last_lookup: Option<Instant>,
 }
 
 impl Matched {
+    /// None yet, for a writer of `topic`.
+    pub fn new(topic: &str) -> Self {
+        Self {
+            readers: Vec::new(),
+            topic: topic.to_owned(),
+            last_lookup: None,
+        }
+    }
+
     /// Takes the writer's match and unmatch statuses.
     pub fn follow(&mut self, statuses: impl Iterator<Item = DataWriterStatus>) {
         for status in statuses {
@@ -89,32 +105,49 @@ impl Matched {
         }
     }
 
-    /// Looks up the readers with no address yet, at most every [`LOOKUP_EVERY`].
+    /// At most every [`LOOKUP_EVERY`] (at once after a new match): the readers discovery has
+    /// of the topic that a best-effort, volatile writer matches (what a lost match report
+    /// left out comes in; one gone from discovery goes), and each one's address.
     pub fn look_up(&mut self, participant: &DomainParticipant) {
-        if !self.readers.iter().any(|r| r.to.is_none())
-            || self.last_lookup.is_some_and(|t| t.elapsed() < LOOKUP_EVERY)
-        {
+        if self.last_lookup.is_some_and(|t| t.elapsed() < LOOKUP_EVERY) {
             return;
         }
         self.last_lookup = Some(Instant::now());
         let discovered = participant.discovered_readers();
+        self.readers.retain(|r| {
+            discovered
+                .iter()
+                .any(|d| d.reader_proxy.remote_reader_guid == r.guid)
+        });
+        for d in &discovered {
+            let qos = d.subscription_topic_data.qos();
+            let matches = d.subscription_topic_data.topic_name() == &self.topic
+                && !matches!(qos.reliability(), Some(Reliability::Reliable { .. }))
+                && matches!(qos.durability(), None | Some(Durability::Volatile));
+            let guid = d.reader_proxy.remote_reader_guid;
+            if matches && !self.readers.iter().any(|r| r.guid == guid) {
+                self.readers.push(Reader { guid, to: None });
+            }
+        }
         for reader in self.readers.iter_mut().filter(|r| r.to.is_none()) {
             reader.to = discovered
                 .iter()
                 .find(|d| d.reader_proxy.remote_reader_guid == reader.guid)
-                .and_then(|d| {
-                    d.reader_proxy
-                        .unicast_locator_list
-                        .iter()
-                        .filter(|l| l.is_udp())
-                        .map(|l| SocketAddr::from(*l))
-                        .find(SocketAddr::is_ipv4)
-                });
+                .and_then(|d| first_udp_v4(&d.reader_proxy.unicast_locator_list));
             if let Some(to) = reader.to {
                 tracing::debug!("ROS 2: reader {:?} at {to}", reader.guid);
             }
         }
     }
+}
+
+/// The first IPv4 UDP address among discovery's `locators` (RustDDS's locators turn into
+/// socket addresses; the other kinds become IPv6's unspecified address).
+pub(crate) fn first_udp_v4<L: Copy + Into<SocketAddr>>(locators: &[L]) -> Option<SocketAddr> {
+    locators
+        .iter()
+        .map(|l| (*l).into())
+        .find(|a: &SocketAddr| a.is_ipv4() && a.port() != 0)
 }
 
 /// One sample to send: its writer's GUID, serialized payload (CDR encapsulation first),
@@ -180,10 +213,11 @@ impl<M: RosMessage> BulkWriter<M> {
                 .spawn(move || send_jobs(&shared, &socket))
                 .context("starting a sending thread")?
         };
+        let matched = Matched::new(&writer.topic().name());
         Ok(Self {
             writer,
             participant: participant.clone(),
-            matched: Matched::default(),
+            matched,
             sequence: 0,
             shared,
             sender: Some(sender),
@@ -248,10 +282,16 @@ impl<M: RosMessage + Clone> BulkWriter<M> {
             let only_it = WriteOptionsBuilder::new()
                 .to_single_reader(reader.guid)
                 .build();
-            if let Err(e) = self.writer.write_with_options(msg.clone(), only_it)
-                && !std::mem::replace(&mut self.warned, true)
-            {
-                tracing::warn!("ROS 2: a sample could not be written ({e})");
+            match self.writer.write_with_options(msg.clone(), only_it) {
+                // RustDDS numbers each write: ours never fall behind its.
+                Ok(written) => {
+                    self.sequence = self.sequence.max(i64::from(written.sequence_number));
+                }
+                Err(e) => {
+                    if !std::mem::replace(&mut self.warned, true) {
+                        tracing::warn!("ROS 2: a sample could not be written ({e})");
+                    }
+                }
             }
         }
         Ok(())

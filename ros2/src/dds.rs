@@ -46,11 +46,12 @@ pub fn parameter_events_qos() -> QosPolicies {
 }
 
 /// rcl's `/rosout` QoS: reliable, transient local, keep last 1000, each line kept 10 s (a
-/// late rqt_console gets the recent lines).
+/// late rqt_console gets the recent lines); a write never waits for a full window (a line is
+/// dropped instead).
 pub fn rosout_qos() -> QosPolicies {
     QosPolicyBuilder::new()
         .reliability(Reliability::Reliable {
-            max_blocking_time: rustdds::Duration::from_millis(100),
+            max_blocking_time: rustdds::Duration::from_millis(0),
         })
         .durability(Durability::TransientLocal)
         .history(History::KeepLast { depth: 1000 })

@@ -26,12 +26,12 @@ use rustdds::no_key::{DataReader, DataWriter, Decode, DefaultDecoder, Deserializ
 use rustdds::serialization::deserialize_from_cdr_with_rep_id;
 use rustdds::{
     CDRSerializerAdapter, DomainParticipant, GUID, RTPSEntity, RepresentationIdentifier,
-    SampleIdentity, StatusEvented, TopicKind, WriteOptionsBuilder,
+    SampleIdentity, TopicKind, WriteOptionsBuilder,
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::bulk::{self, CDR_LE, Job, Matched, rtps_time};
+use crate::bulk::{self, CDR_LE, Job, first_udp_v4, rtps_time};
 use crate::dds::default_qos;
 
 /// rmw_cyclonedds_cpp's request header: which client, which of its requests.
@@ -57,8 +57,15 @@ pub struct WithHeader<T> {
 pub enum RequestId {
     /// Cyclone's: the header from the request's payload, written back in the reply's.
     Cyclone(RequestHeader),
-    /// Fast DDS's: the request's sample identity, written back as the reply's related one.
-    FastDds(SampleIdentity),
+    /// Fast DDS's: the request's sample identity, written back as the reply's related one,
+    /// and the client's reply reader (rmw_fastrtps_cpp names it in the request's related
+    /// sample identity).
+    FastDds {
+        /// The request's sample identity.
+        identity: SampleIdentity,
+        /// The reader the reply is for.
+        reply_reader: GUID,
+    },
 }
 
 /// A service type: its request and response messages and their DDS type names.
@@ -194,7 +201,6 @@ impl<S: ServiceType> Server<S> {
             last_sequence: 0,
             large: LargeReplies {
                 participant: participant.clone(),
-                matched: Matched::default(),
                 socket: UdpSocket::bind(("0.0.0.0", 0)).context("opening a UDP socket")?,
                 job: Job::default(),
                 datagram: Vec::new(),
@@ -221,10 +227,14 @@ impl<S: ServiceType> Server<S> {
             };
             let info = sample.sample_info();
             let client = info.writer_guid();
-            let fast_dds = info.related_sample_identity().is_some();
-            let identity = info.sample_identity();
+            let fast_dds = info
+                .related_sample_identity()
+                .map(|related| RequestId::FastDds {
+                    identity: info.sample_identity(),
+                    reply_reader: related.writer_guid,
+                });
             let raw = sample.value();
-            match decode_request::<S::Request>(raw, fast_dds, identity) {
+            match decode_request::<S::Request>(raw, fast_dds) {
                 Ok(request) => return Some(request),
                 Err(what) => self.warn(client, &what),
             }
@@ -238,9 +248,12 @@ impl<S: ServiceType> Server<S> {
                 Reply::WithHeader(WithHeader { header, body }),
                 WriteOptionsBuilder::new().build(),
             ),
-            RequestId::FastDds(identity) => {
-                if fast_dds_reply_bytes(&body) > MAX_FAST_DDS_REPLY_BYTES {
-                    self.reply_large(identity, &body);
+            RequestId::FastDds {
+                identity,
+                reply_reader,
+            } => {
+                if self.large.serialize(&body) > MAX_FAST_DDS_REPLY_BYTES {
+                    self.reply_large(identity, reply_reader);
                     return;
                 }
                 let options = WriteOptionsBuilder::new()
@@ -258,23 +271,19 @@ impl<S: ServiceType> Server<S> {
         }
     }
 
-    /// A Fast DDS reply too large for one DATA: sent by rover as the reply writer's next
-    /// sample ([`LargeReplies`]), then that sample number given to RustDDS with an empty
-    /// placeholder for the client's reader alone, which it already holds and drops, so
-    /// RustDDS's reliable bookkeeping and the reader's agree.
-    fn reply_large(&mut self, identity: SampleIdentity, body: &S::Response) {
-        let writer = &self.replies;
-        self.large
-            .matched
-            .follow(std::iter::from_fn(|| writer.try_recv_status()));
+    /// A Fast DDS reply too large for one DATA (serialized in `self.large`): sent by rover as
+    /// the reply writer's next sample to the client's reply reader ([`LargeReplies`]), then
+    /// that sample number given to RustDDS with an empty placeholder for that reader alone,
+    /// which it already holds and drops, so RustDDS's reliable bookkeeping and the reader's
+    /// agree.
+    fn reply_large(&mut self, identity: SampleIdentity, reader: GUID) {
         let sequence = self.last_sequence + 1;
         let sent = self
             .large
-            .send(self.replies.guid(), sequence, identity, body);
-        let reader = match sent {
-            Ok(reader) => reader,
-            Err(what) => return self.warn(identity.writer_guid, &what),
-        };
+            .send(self.replies.guid(), sequence, identity, reader);
+        if let Err(what) = sent {
+            return self.warn(identity.writer_guid, &what);
+        }
         let only_it = WriteOptionsBuilder::new().to_single_reader(reader).build();
         match self.replies.write_with_options(Reply::Placeholder, only_it) {
             Ok(written) => {
@@ -342,43 +351,54 @@ const PID_SENTINEL: u16 = 0x0001;
 
 /// Fast DDS replies larger than [`MAX_FAST_DDS_REPLY_BYTES`] (`robot_description` through
 /// `get_parameters`), sent by rover itself as `rover_ros2::bulk` sends images: the reply
-/// writer's next sample, from rover's own socket, to the client's reply reader (the reader of
-/// the client's participant matched to the reply writer), with the related sample identity in
-/// each submessage's inline QoS. Over one machine's loopback the few datagrams of a reply
-/// arrive; one lost on a network is not repaired (RustDDS holds only the placeholder) and the
-/// client's call times out.
+/// writer's next sample, from rover's own socket, to the client's reply reader (named in the
+/// request; its address from discovery), with the related sample identity in each
+/// submessage's inline QoS. Over one machine's loopback the few datagrams of a reply arrive;
+/// one lost on a network is not repaired (RustDDS holds only the placeholder) and the client's
+/// call times out.
 struct LargeReplies {
     participant: DomainParticipant,
-    matched: Matched,
     socket: UdpSocket,
+    /// The reply being answered: its payload, serialized by [`Self::serialize`], then the
+    /// rest of its message.
     job: Job,
     datagram: Vec<u8>,
 }
 
 impl LargeReplies {
-    /// Sends `body` as sample `sequence` of the writer `writer`, the reply to the request
-    /// `identity` names; the client's reader it went to, or what went wrong, in words.
-    fn send<R: Serialize>(
+    /// Serializes `body` as a reply's payload (CDR, little endian, after its encapsulation);
+    /// its size in bytes (`usize::MAX` when it does not serialize).
+    fn serialize<R: Serialize>(&mut self, body: &R) -> usize {
+        let payload = &mut self.job.payload;
+        payload.clear();
+        payload.extend_from_slice(&CDR_LE);
+        match rustdds::cdr_encoding::to_writer::<R, byteorder::LittleEndian, _>(&mut *payload, body)
+        {
+            Ok(()) => payload.len(),
+            Err(_) => usize::MAX,
+        }
+    }
+
+    /// Sends the serialized reply as sample `sequence` of the writer `writer`, the reply to
+    /// the request `identity` names, to `reader`; what went wrong, in words.
+    fn send(
         &mut self,
         writer: GUID,
         sequence: i64,
         identity: SampleIdentity,
-        body: &R,
-    ) -> Result<GUID, String> {
-        self.matched.look_up(&self.participant);
-        let client = identity.writer_guid.prefix;
-        let Some((reader, to)) = self
-            .matched
-            .readers
+        reader: GUID,
+    ) -> Result<(), String> {
+        let to = self
+            .participant
+            .discovered_readers()
             .iter()
-            .filter(|r| r.guid.prefix == client)
-            .find_map(|r| Some((r.guid, r.to?)))
-        else {
-            return Err(
-                "a large reply to a Fast DDS client is not sent: its reply reader is not \
-                 matched, or has no UDP address"
-                    .to_owned(),
-            );
+            .find(|d| d.reader_proxy.remote_reader_guid == reader)
+            .and_then(|d| first_udp_v4(&d.reader_proxy.unicast_locator_list));
+        let Some(to) = to else {
+            return Err(format!(
+                "a large reply to a Fast DDS client is not sent: its reply reader {reader:?} is \
+                 not discovered, or has no UDP address"
+            ));
         };
         let job = &mut self.job;
         job.readers.clear();
@@ -386,10 +406,6 @@ impl LargeReplies {
         job.writer = writer.to_bytes();
         job.sequence = sequence;
         job.stamp = rtps_time(SystemTime::now());
-        job.payload.clear();
-        job.payload.extend_from_slice(&CDR_LE);
-        rustdds::cdr_encoding::to_writer::<R, byteorder::LittleEndian, _>(&mut job.payload, body)
-            .map_err(|e| format!("a reply could not be serialized ({e})"))?;
         job.inline_qos.clear();
         let request = i64::from(identity.sequence_number);
         for pid in PID_RELATED_SAMPLE_IDENTITY {
@@ -406,25 +422,18 @@ impl LargeReplies {
             .extend_from_slice(&PID_SENTINEL.to_le_bytes());
         job.inline_qos.extend_from_slice(&0u16.to_le_bytes());
         bulk::send(job, &self.socket, &mut self.datagram, None)
-            .map_err(|e| format!("a large reply could not be sent ({e})"))?;
-        Ok(reader)
+            .map_err(|e| format!("a large reply could not be sent ({e})"))
     }
 }
 
-/// How many bytes `body` takes in CDR (little endian, with the 4-byte encapsulation header).
-fn fast_dds_reply_bytes<T: Serialize>(body: &T) -> usize {
-    rustdds::serialization::to_vec::<T, byteorder::LittleEndian>(body)
-        .map_or(usize::MAX, |v| v.len() + 4)
-}
-
 /// A request's fields and id, read the way its mapping says (`fast_dds`: the sample carried a
-/// related sample identity); what was wrong, in words, when it does not decode.
+/// related sample identity, and this is its id); what was wrong, in words, when it does not
+/// decode.
 fn decode_request<T: DeserializeOwned>(
     raw: &RawRequest,
-    fast_dds: bool,
-    identity: SampleIdentity,
+    fast_dds: Option<RequestId>,
 ) -> Result<(RequestId, T), String> {
-    if fast_dds {
+    if let Some(id) = fast_dds {
         let (body, _) =
             deserialize_from_cdr_with_rep_id::<T>(&raw.bytes, raw.encoding).map_err(|e| {
                 format!(
@@ -433,7 +442,7 @@ fn decode_request<T: DeserializeOwned>(
                     raw.bytes.len()
                 )
             })?;
-        Ok((RequestId::FastDds(identity), body))
+        Ok((id, body))
     } else {
         let (request, _) =
             deserialize_from_cdr_with_rep_id::<WithHeader<T>>(&raw.bytes, raw.encoding).map_err(

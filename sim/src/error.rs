@@ -54,6 +54,14 @@ pub enum SimError {
     /// The robot and world cannot be simulated together (e.g. no drive plugin).
     #[error("{0}")]
     Setup(String),
+    /// A trajectory controller refused a trajectory.
+    #[error("controller \"{controller}\": {error}")]
+    Trajectory {
+        /// The controller.
+        controller: String,
+        /// Why (in the message, so not a source as well).
+        error: crate::physics::TrajectoryError,
+    },
     /// A velocity command was rejected (NaN or infinite components).
     #[error(
         "rejected cmd_vel (linear {linear_mps} m/s, angular {angular_radps} rad/s): components must be finite; keeping the last valid command"

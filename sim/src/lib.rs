@@ -57,8 +57,8 @@ pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, GripperState,
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
     JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook,
-    PlanningScene, SceneContact, SimOptions, Simulation, TrajectoryOutcome, TrajectoryPoint,
-    TrajectoryState, Twist, WheelSpeeds, wrap_angle,
+    PlanningScene, SceneContact, SimOptions, Simulation, TrajectoryError, TrajectoryOutcome,
+    TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{
     BodyLayer, CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError,

@@ -248,52 +248,34 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
         update.runs.get(self.index).copied().unwrap_or_default()
     }
 
-    /// Why joint_trajectory_controller would refuse `t` (with `multi_dof` points too), if it
-    /// would.
+    /// Why joint_trajectory_controller would refuse `t` as a goal (with `multi_dof` points
+    /// too), if it would: the controller's own check ([`JointTrajectory::check`], in sim),
+    /// its error as control_msgs' code, and what a goal must have besides (points, no
+    /// multi-DOF part).
     pub fn check(&self, t: &JointTrajectory, multi_dof: bool) -> Result<(), Rejection> {
-        let reject = |code, why: String| Err(Rejection { code, why });
-        let n = t.joint_names.len();
-        if let Some(name) = t.joint_names.iter().find(|n| !self.joint_names.contains(n)) {
-            return reject(
-                code::INVALID_JOINTS,
-                format!(
-                    "joint {name} is not one of {}'s ({})",
-                    self.controller,
-                    self.joint_names.join(", ")
-                ),
-            );
+        let joints: Vec<&str> = self.joint_names.iter().map(String::as_str).collect();
+        if let Err(e) = t.check(&joints) {
+            let code = if e.is_about_joints() {
+                code::INVALID_JOINTS
+            } else {
+                code::INVALID_GOAL
+            };
+            return Err(Rejection {
+                code,
+                why: format!("{}: {e}", self.controller),
+            });
         }
-        if let Some(name) = self.joint_names.iter().find(|n| !t.joint_names.contains(n)) {
-            // joint_trajectory_controller's allow_partial_joints_goal is false by default.
-            return reject(
-                code::INVALID_JOINTS,
-                format!("the trajectory does not list joint {name}"),
-            );
-        }
+        let reject = |why: &str| {
+            Err(Rejection {
+                code: code::INVALID_GOAL,
+                why: format!("{}: {why}", self.controller),
+            })
+        };
         if t.points.is_empty() {
-            return reject(code::INVALID_GOAL, "the trajectory has no points".into());
+            return reject("the trajectory has no points");
         }
         if multi_dof {
-            return reject(
-                code::INVALID_GOAL,
-                "multi-DOF trajectories are not supported".into(),
-            );
-        }
-        for (k, p) in t.points.iter().enumerate() {
-            let arrays = [&p.positions, &p.velocities, &p.accelerations];
-            if p.positions.len() != n || arrays.iter().any(|a| !a.is_empty() && a.len() != n) {
-                return reject(
-                    code::INVALID_GOAL,
-                    format!("point {k} does not have one value per joint ({n})"),
-                );
-            }
-            let finite = arrays.iter().all(|a| a.iter().all(|v| v.is_finite()));
-            if !finite || !p.time_from_start_s.is_finite() {
-                return reject(
-                    code::INVALID_GOAL,
-                    format!("point {k} has a value that is not a finite number"),
-                );
-            }
+            return reject("multi-DOF trajectories are not supported");
         }
         Ok(())
     }
@@ -612,6 +594,9 @@ mod tests {
             code(&trajectory(&["a", "b"], vec![0.1])),
             Some(code::INVALID_GOAL)
         );
+        let mut twice = trajectory(&["a", "b"], vec![0.1, 0.2]);
+        twice.points.push(twice.points[0].clone());
+        assert_eq!(code(&twice), Some(code::INVALID_GOAL));
         let mut empty = trajectory(&["a", "b"], Vec::new());
         empty.points.clear();
         assert_eq!(code(&empty), Some(code::INVALID_GOAL));
@@ -644,7 +629,7 @@ mod tests {
             Some((
                 GoalState::Aborted,
                 code::INVALID_JOINTS,
-                "joint x is not one of arm_controller's (a, b)".to_owned()
+                "arm_controller: joint \"x\" is not one of its joints (a, b)".to_owned()
             ))
         );
         assert_eq!(g.goal(&1).map(|x| x.state), Some(GoalState::Executing));

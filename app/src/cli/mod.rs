@@ -23,6 +23,7 @@ pub mod eval;
 mod launch;
 mod run;
 mod signals;
+mod transports;
 
 use std::process::ExitCode;
 
@@ -50,11 +51,11 @@ fn xacro(args: args::XacroArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Parses the command line, runs it and turns errors into `rover: error: ...` and exit code 1.
-pub fn main() -> ExitCode {
+/// The log on stderr (`RUST_LOG`, else rover's lines at info and its libraries' quieter), and
+/// the same lines on `/rosout` while a `--ros2` bridge listens.
+fn init_logging() {
     use tracing_subscriber::layer::SubscriberExt as _;
     use tracing_subscriber::util::SubscriberInitExt as _;
-    // The log on stderr, and the same lines on /rosout while a --ros2 bridge listens.
     tracing_subscriber::registry()
         .with(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
@@ -70,6 +71,11 @@ pub fn main() -> ExitCode {
         )
         .with(crate::ros2::rosout_layer())
         .init();
+}
+
+/// Parses the command line, runs it and turns errors into `rover: error: ...` and exit code 1.
+pub fn main() -> ExitCode {
+    init_logging();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Bench {

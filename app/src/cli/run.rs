@@ -6,13 +6,12 @@ use std::time::Duration;
 
 use anyhow::Result;
 use rover_core::{
-    Action, DetectorMode, Fanout, InputSource, RunConfig, RunFiles, Session, SessionOptions,
-    run_headless, run_headless_driven, run_headless_observed,
+    DetectorMode, Fanout, InputSource, RunConfig, RunFiles, Session, SessionOptions, run_headless,
+    run_headless_driven, run_headless_observed,
 };
 
 use super::args::RunArgs;
-use crate::ros::{RosBridge, RosInput};
-use crate::ros2::{Ros2Bridge, Ros2Input};
+use super::transports::Transports;
 use crate::station::{self, WindowOptions};
 use crate::viewer::{self, Recorder};
 
@@ -129,36 +128,16 @@ fn run_with_ros(
     recorder: Option<&mut Recorder>,
 ) -> Result<rover_core::RunSummary> {
     let (world, robot) = config.load_world_and_robot()?;
-    let (mut ros1, mut ros1_input) = match ros.options(config.ground_truth) {
-        Some(options) => {
-            let (bridge, input) = RosBridge::start(&options, &robot)?;
-            (Some(bridge), Some(input))
-        }
-        None => (None, None),
-    };
-    let (mut ros2, mut ros2_input) = start_ros2(ros, &robot, config.ground_truth)?;
+    let mut transports = Transports::start(ros, &robot, config.ground_truth)?;
     let result = {
         let mut fan = Fanout::default();
-        fan.push_some(ros1.as_mut());
-        fan.push_some(ros2.as_mut());
+        let mut inputs = transports.attach(&mut fan);
         fan.push_some(recorder);
-        let mut inputs = Inputs(ros1_input.as_mut(), ros2_input.as_mut());
         run_headless_driven(config, world, robot, &mut fan, true, &mut inputs)
     };
-    if let Some(bridge) = ros1.as_mut() {
-        bridge.finish();
-        if bridge.dropped() > 0 {
-            tracing::info!(
-                "ROS bridge: {} events dropped while it was behind",
-                bridge.dropped()
-            );
-        }
-    }
-    let recorded = ros2
-        .as_mut()
-        .map(|bridge| finish_ros2(bridge, ros.record_mcap.as_deref()));
+    let finished = transports.finish();
     let summary = result?;
-    recorded.transpose()?;
+    finished?;
     Ok(summary)
 }
 
@@ -241,22 +220,13 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         arm: args.arm.arm()?,
         ground_truth: args.follow.ground_truth,
     };
-    let (mut ros, mut ros_input) = match args.ros.options(args.follow.ground_truth) {
-        Some(o) => {
-            let (bridge, input) = RosBridge::start(&o, &robot)?;
-            (Some(bridge), Some(input))
-        }
-        None => (None, None),
-    };
-    let (mut ros2, mut ros2_input) = start_ros2(&args.ros, &robot, args.follow.ground_truth)?;
+    let mut transports = Transports::start(&args.ros, &robot, args.follow.ground_truth)?;
     let summary = {
         let mut fan = Fanout::default();
         fan.push(&mut files);
         fan.push_some(recorder.as_mut());
-        fan.push_some(ros.as_mut());
-        fan.push_some(ros2.as_mut());
-        let mut both = Inputs(ros_input.as_mut(), ros2_input.as_mut());
-        let inputs: &mut dyn InputSource = &mut both;
+        let mut all = transports.attach(&mut fan);
+        let inputs: &mut dyn InputSource = &mut all;
         let session = Session::new(world, robot, &options, &mut fan)?;
         station::run(
             session,
@@ -275,13 +245,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         )?
     };
     let record_failed = recorder.as_mut().and_then(|r| r.finish().err());
-    if let Some(bridge) = ros.as_mut() {
-        bridge.finish();
-    }
-    let recorded = ros2
-        .as_mut()
-        .map(|bridge| finish_ros2(bridge, args.ros.record_mcap.as_deref()));
-    recorded.transpose()?;
+    transports.finish()?;
     say!(
         "rover: {:.1} s sim time in {:.1} s wall; mode {}",
         summary.sim_time_s,
@@ -301,52 +265,4 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         summary.interrupted,
         summary.sim_time_s,
     )
-}
-
-/// The ROS 2 bridge (--ros2 and/or --record-mcap) and its input (with --ros2), when asked for;
-/// `ground_truth`: the run measures it, the bridge publishes it.
-fn start_ros2(
-    ros: &super::args::RosArgs,
-    robot: &rover_sim::RobotModel,
-    ground_truth: bool,
-) -> Result<(Option<Ros2Bridge>, Option<Ros2Input>)> {
-    Ok(match ros.ros2_options()? {
-        Some(options) => {
-            let (bridge, input) = Ros2Bridge::start(&options, robot, ground_truth)?;
-            (Some(bridge), input)
-        }
-        None => (None, None),
-    })
-}
-
-/// Stops the ROS 2 bridge and says what it did: events dropped while behind, what the MCAP
-/// file holds (an error when it could not be written in full).
-fn finish_ros2(bridge: &mut Ros2Bridge, mcap: Option<&std::path::Path>) -> Result<()> {
-    let recorded = bridge.finish().flatten();
-    if bridge.dropped() > 0 {
-        tracing::info!(
-            "ROS 2 bridge: {} events dropped while it was behind",
-            bridge.dropped()
-        );
-    }
-    if let (Some(recorded), Some(path)) = (recorded, mcap) {
-        let summary = recorded?;
-        say!(
-            "MCAP: {} ({} messages on {} topics)",
-            path.display(),
-            summary.messages,
-            summary.channels
-        );
-    }
-    Ok(())
-}
-
-/// The ROS 1 and ROS 2 bridges' inputs, polled in turn (either may be off).
-struct Inputs<'a>(Option<&'a mut RosInput>, Option<&'a mut Ros2Input>);
-
-impl InputSource for Inputs<'_> {
-    fn poll(&mut self) -> Option<Action> {
-        let ros1 = self.0.as_mut().and_then(|i| i.poll());
-        ros1.or_else(|| self.1.as_mut().and_then(|i| i.poll()))
-    }
 }

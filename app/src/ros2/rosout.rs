@@ -10,6 +10,7 @@
 //! 1000). A full channel drops lines rather than wait: logging never blocks the run.
 
 use std::fmt::Write as _;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
 use std::sync::{Mutex, PoisonError};
 use std::time::{SystemTime, UNIX_EPOCH};
@@ -30,8 +31,20 @@ const ROSOUT_TOPIC: &str = "/rosout";
 /// Lines waiting for the publishing thread, at most (more are dropped).
 const WAITING_LINES: usize = 256;
 
-/// Where the layer sends lines: the listening bridge's channel, if one listens.
-static LISTENER: Mutex<Option<SyncSender<Log>>> = Mutex::new(None);
+/// Where the layer sends lines: the listening bridge's channel and its number, if one
+/// listens (a bridge that ends takes its own channel away, not a newer bridge's).
+static LISTENER: Mutex<Option<(u64, SyncSender<Log>)>> = Mutex::new(None);
+
+/// The number the next listening bridge gets.
+static NEXT_LISTENER: AtomicU64 = AtomicU64::new(0);
+
+/// Stops listener `id`, unless another took its place.
+fn stop_listening(id: u64) {
+    let mut listener = LISTENER.lock().unwrap_or_else(PoisonError::into_inner);
+    if listener.as_ref().is_some_and(|(current, _)| *current == id) {
+        *listener = None;
+    }
+}
 
 /// The tracing layer that copies rover's log lines to `/rosout` while a ROS 2 bridge listens.
 pub struct RosoutLayer;
@@ -49,7 +62,7 @@ impl<S: Subscriber> Layer<S> for RosoutLayer {
             return;
         }
         let listener = LISTENER.lock().unwrap_or_else(PoisonError::into_inner);
-        let Some(to) = listener.as_ref() else {
+        let Some((id, to)) = listener.as_ref() else {
             return;
         };
         let meta = event.metadata();
@@ -72,8 +85,9 @@ impl<S: Subscriber> Layer<S> for RosoutLayer {
         };
         // Full: the line is dropped; gone: the bridge ended (it unregisters as it goes).
         if let Err(TrySendError::Disconnected(_)) = to.try_send(line) {
+            let id = *id;
             drop(listener);
-            *LISTENER.lock().unwrap_or_else(PoisonError::into_inner) = None;
+            stop_listening(id);
         }
     }
 }
@@ -113,6 +127,8 @@ impl Visit for Text {
 
 /// `/rosout`'s writer on the publishing thread, and the lines coming to it.
 pub(super) struct Rosout {
+    /// Its number as the listener.
+    id: u64,
     writer: Writer<Log>,
     lines: Receiver<Log>,
     /// The logger's name: the node's (`rover`; `ns.rover` in a namespace, as rcl names it).
@@ -132,10 +148,12 @@ impl Rosout {
         let writer = writer::<Log>(participant, publisher, ROSOUT_TOPIC, &rosout_qos())?;
         let guid = writer.guid();
         let (to, lines) = std::sync::mpsc::sync_channel(WAITING_LINES);
-        *LISTENER.lock().unwrap_or_else(PoisonError::into_inner) = Some(to);
+        let id = NEXT_LISTENER.fetch_add(1, Ordering::Relaxed);
+        *LISTENER.lock().unwrap_or_else(PoisonError::into_inner) = Some((id, to));
         let name = node_name.trim_start_matches('/').replace('/', ".");
         Ok((
             Self {
+                id,
                 writer,
                 lines,
                 name,
@@ -145,14 +163,21 @@ impl Rosout {
         ))
     }
 
-    /// Writes the lines that came.
+    /// Writes the lines that came. A write that fails (a reader that stopped acknowledging
+    /// holds the writer's window full: rcl's QoS, keep last 1000, reliable) drops the lines
+    /// waiting, at once: `/rosout` never holds the publishing thread up.
     fn drain(&mut self) {
         while let Ok(mut line) = self.lines.try_recv() {
             line.name.clone_from(&self.name);
-            if let Err(e) = self.writer.write(line, None)
-                && !std::mem::replace(&mut self.warned, true)
-            {
-                tracing::warn!("ROS 2: {ROSOUT_TOPIC} could not be written ({e})");
+            if let Err(e) = self.writer.write(line, None) {
+                let dropped = self.lines.try_iter().count();
+                if !std::mem::replace(&mut self.warned, true) {
+                    tracing::warn!(
+                        "ROS 2: {ROSOUT_TOPIC} could not be written ({e}); {dropped} lines \
+                         dropped (said once)"
+                    );
+                }
+                return;
             }
         }
     }
@@ -166,7 +191,7 @@ impl TopicFamily for Rosout {
 
 impl Drop for Rosout {
     fn drop(&mut self) {
-        *LISTENER.lock().unwrap_or_else(PoisonError::into_inner) = None;
+        stop_listening(self.id);
         self.drain();
     }
 }

@@ -15,30 +15,7 @@ use crate::model::controllers::{
 };
 use crate::model::robot::{JointId, RobotModel};
 use crate::physics::actuators::{Actuators, JointCommand};
-
-/// A trajectory for a joint trajectory controller (trajectory_msgs/JointTrajectory).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct JointTrajectory {
-    /// When it starts (sim time, s); 0: on arrival (`header.stamp` zero, as rostopic sends).
-    pub start_s: f64,
-    /// The joints each point lists, in the points' order.
-    pub joint_names: Vec<String>,
-    /// The points, in time order.
-    pub points: Vec<TrajectoryPoint>,
-}
-
-/// One point of a [`JointTrajectory`].
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TrajectoryPoint {
-    /// Positions (rad or m), one per joint.
-    pub positions: Vec<f64>,
-    /// Velocities, one per joint, or empty.
-    pub velocities: Vec<f64>,
-    /// Accelerations, one per joint, or empty.
-    pub accelerations: Vec<f64>,
-    /// When the point is due after the trajectory's start (s).
-    pub time_from_start_s: f64,
-}
+use crate::physics::trajectory::JointTrajectory;
 
 /// What a trajectory controller is doing, for its `state` topic.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -317,7 +294,17 @@ impl Controllers {
                 "controller \"{name}\" is not a joint trajectory controller"
             )));
         };
-        let order = check_trajectory(name, trajectory, &run.joints, robot)?;
+        let joints: Vec<&str> = run
+            .joints
+            .iter()
+            .map(|j| robot.joint(*j).name.as_str())
+            .collect();
+        let order = trajectory
+            .check(&joints)
+            .map_err(|error| SimError::Trajectory {
+                controller: name.to_owned(),
+                error,
+            })?;
         let start_s = if trajectory.start_s > 0.0 {
             trajectory.start_s
         } else {
@@ -626,67 +613,6 @@ impl TrajectoryRun {
             }
         }
     }
-}
-
-/// Checks a trajectory against the controller's joints; returns, for each of the controller's
-/// joints, its index in the trajectory's `joint_names`.
-fn check_trajectory(
-    name: &str,
-    trajectory: &JointTrajectory,
-    joints: &[JointId],
-    robot: &RobotModel,
-) -> Result<Vec<usize>> {
-    let bad = |m: String| SimError::Setup(format!("controller \"{name}\": {m}"));
-    let mut order = Vec::with_capacity(joints.len());
-    for j in joints {
-        let joint = &robot.joint(*j).name;
-        let k = trajectory
-            .joint_names
-            .iter()
-            .position(|n| n == joint)
-            .ok_or_else(|| bad(format!("the trajectory does not list joint \"{joint}\"")))?;
-        order.push(k);
-    }
-    if let Some(extra) = trajectory
-        .joint_names
-        .iter()
-        .find(|n| !joints.iter().any(|j| &robot.joint(*j).name == *n))
-    {
-        return Err(bad(format!("joint \"{extra}\" is not one of its joints")));
-    }
-    let n = trajectory.joint_names.len();
-    let mut last_t = -1.0;
-    for (i, p) in trajectory.points.iter().enumerate() {
-        if p.positions.len() != n
-            || !(p.velocities.is_empty() || p.velocities.len() == n)
-            || !(p.accelerations.is_empty() || p.accelerations.len() == n)
-        {
-            return Err(bad(format!(
-                "point {i} must give {n} positions (and 0 or {n} velocities and accelerations), found {}, {}, {}",
-                p.positions.len(),
-                p.velocities.len(),
-                p.accelerations.len()
-            )));
-        }
-        let all = p
-            .positions
-            .iter()
-            .chain(&p.velocities)
-            .chain(&p.accelerations);
-        if !all.clone().all(|x| x.is_finite()) || !p.time_from_start_s.is_finite() {
-            return Err(bad(format!(
-                "point {i} has a value that is not a finite number"
-            )));
-        }
-        if p.time_from_start_s <= last_t {
-            return Err(bad(format!(
-                "point {i}: time_from_start {:.3} s must be later than the point before",
-                p.time_from_start_s
-            )));
-        }
-        last_t = p.time_from_start_s;
-    }
-    Ok(order)
 }
 
 /// Position and velocity of joint `k` at `t` between knots `a` and `b`.

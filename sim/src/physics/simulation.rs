@@ -16,13 +16,14 @@ use crate::physics::build::{
     add_world, joint_mass_ratio, person_body_pose,
 };
 use crate::physics::controllers::{
-    ControllerCommandState, Controllers, GripperState, JointTrajectory, TrajectoryState,
+    ControllerCommandState, Controllers, GripperState, TrajectoryState,
 };
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
 use crate::physics::grip_friction::{ContactHooks, FrictionAnchors};
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
+use crate::physics::trajectory::JointTrajectory;
 
 /// Options that are not part of the world or robot files.
 #[derive(Debug, Clone, Default, PartialEq)]
