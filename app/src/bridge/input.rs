@@ -3,7 +3,6 @@
 //! turn. The transports decode their messages; what the words and values mean is here.
 
 use rover_core::{Action, ArmMode, JointAction};
-use rover_sim::{JointTrajectory, TrajectoryPoint};
 
 /// The arm's task topic.
 pub(crate) const TASK_TOPIC: &str = "/rover/arm/task";
@@ -20,24 +19,6 @@ pub(crate) fn arm_task(word: &str) -> Option<Action> {
             tracing::warn!("{TASK_TOPIC}: \"{other}\" is not a task; expected off, look or reach");
             None
         }
-    }
-}
-
-/// A trajectory_msgs/JointTrajectory as the simulation takes it, for `controller`: its stamp
-/// (s; 0 for "now"), joint names and points, each with its time from the start (s).
-pub(crate) fn trajectory(
-    controller: &str,
-    start_s: f64,
-    joint_names: Vec<String>,
-    points: impl Iterator<Item = TrajectoryPoint>,
-) -> JointAction {
-    JointAction::Trajectory {
-        controller: controller.to_owned(),
-        trajectory: Box::new(JointTrajectory {
-            start_s,
-            joint_names,
-            points: points.collect(),
-        }),
     }
 }
 

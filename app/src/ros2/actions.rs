@@ -21,11 +21,12 @@ use std::sync::mpsc::Sender;
 
 use anyhow::{Context, Result};
 use rover_core::Action;
-use rover_sim::{JointTrajectory, RobotModel, TrajectoryPoint};
+use rover_sim::RobotModel;
 use rustdds::no_key::DataWriter;
 use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, QosPolicies, RTPSEntity, TopicKind};
 use serde::Serialize;
 
+use super::convert::sim_trajectory;
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{
     ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
@@ -118,8 +119,8 @@ impl ActionType for FollowJointTrajectory {
         now: (f64, RunSample),
         to_session: &Sender<Action>,
     ) -> Result<(), (Uuid, Rejection)> {
-        let trajectory = trajectory_of(&goal);
         let multi_dof = !goal.multi_dof_trajectory.points.is_empty();
+        let trajectory = sim_trajectory(goal.trajectory);
         goals.check(&trajectory, multi_dof).map_err(|r| (id, r))?;
         goals.accept_trajectory(id, trajectory, now, to_session);
         Ok(())
@@ -538,26 +539,5 @@ impl TopicFamily for ControllerActions {
         for server in &mut self.grippers {
             server.update(update, &self.to_session);
         }
-    }
-}
-
-/// A goal as the simulation takes it.
-fn trajectory_of(goal: &FollowJointTrajectoryGoal) -> JointTrajectory {
-    let secs = |d: rover_ros2::msgs::Duration| f64::from(d.sec) + f64::from(d.nanosec) * 1e-9;
-    let t = &goal.trajectory;
-    let stamp = t.header.stamp;
-    JointTrajectory {
-        start_s: f64::from(stamp.sec) + f64::from(stamp.nanosec) * 1e-9,
-        joint_names: t.joint_names.clone(),
-        points: t
-            .points
-            .iter()
-            .map(|p| TrajectoryPoint {
-                positions: p.positions.clone(),
-                velocities: p.velocities.clone(),
-                accelerations: p.accelerations.clone(),
-                time_from_start_s: secs(p.time_from_start),
-            })
-            .collect(),
     }
 }

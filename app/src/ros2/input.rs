@@ -10,13 +10,14 @@ use std::sync::mpsc::Receiver;
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
-use rover_sim::{TrajectoryPoint, Twist};
+use rover_sim::Twist;
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;
 
 use crate::bridge::RosPlan;
-use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn, trajectory};
+use super::convert::sim_trajectory;
+use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn};
 use rover_ros2::dds::{dds_topic, default_qos};
 use rover_ros2::msgs::{self, RosMessage};
 use rover_ros2::parameters::Parameters;
@@ -114,19 +115,6 @@ fn ros2_command_topic(ros1_topic: &str, trajectory: bool) -> String {
     }
 }
 
-/// A trajectory message as `controller`'s action.
-fn trajectory_action(controller: &str, msg: msgs::JointTrajectory) -> JointAction {
-    let secs = |sec: i32, nanosec: u32| f64::from(sec) + f64::from(nanosec) * 1e-9;
-    let start_s = secs(msg.header.stamp.sec, msg.header.stamp.nanosec);
-    let points = msg.points.into_iter().map(|p| TrajectoryPoint {
-        time_from_start_s: secs(p.time_from_start.sec, p.time_from_start.nanosec),
-        positions: p.positions,
-        velocities: p.velocities,
-        accelerations: p.accelerations,
-    });
-    trajectory(controller, start_s, msg.joint_names, points)
-}
-
 impl Ros2Input {
     /// Subscribes to the robot's input topics and serves node `node`'s parameters
     /// (`description`: the URDF); replies go out through `publisher`.
@@ -181,7 +169,12 @@ impl Ros2Input {
             &mut self.controllers,
             &mut self.next,
             |(name, command)| match command {
-                Command::Trajectory(reader) => reader.next().map(|m| trajectory_action(name, m)),
+                Command::Trajectory(reader) => {
+                    reader.next().map(|m| JointAction::Trajectory {
+                        controller: name.to_owned(),
+                        trajectory: Box::new(sim_trajectory(m)),
+                    })
+                }
                 Command::Value(reader) => reader.next().and_then(|m| {
                     m.data.first().map(|&value| JointAction::Controller {
                         name: name.clone(),

@@ -38,6 +38,7 @@ mod actions;
 mod arm;
 mod camera;
 mod clock;
+mod convert;
 mod detections;
 mod input;
 mod joint_states;
