@@ -20,6 +20,7 @@
 //! and a line in [`families`]; docs/ARCHITECTURE.md walks through `/rover/status`.
 
 pub(crate) mod action_goals;
+pub(crate) mod action_intake;
 pub(crate) mod arm;
 pub(crate) mod camera;
 pub(crate) mod capture;

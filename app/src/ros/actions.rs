@@ -15,8 +15,8 @@
 //! A topic family on the publishing thread: requests are read at every control update and
 //! accepted trajectories go to the session through the input, as a command on the
 //! controller's topic would. [`Actionlib`] is an actionlib server's topics and bookkeeping,
-//! whatever its action (gripper.rs serves GripperCommand with it); [`ActionFamily`] runs one
-//! server per controller.
+//! whatever its action (gripper.rs serves GripperCommand with it); each server is an
+//! [`ActionWire`], run with the others by the shared intake (app/src/bridge/action_intake.rs).
 
 use std::sync::mpsc::Sender;
 
@@ -31,7 +31,8 @@ use rover_ros1::{Decode, Message, Node, Publisher, Subscriber};
 use super::convert::{seq_of, sim_trajectory};
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{ActionGoals, FeedbackArrays, Goal, GoalState, Rejection};
-use crate::bridge::events::{ControlUpdate, RunSample, TopicFamily};
+use crate::bridge::action_intake::ActionWire;
+use crate::bridge::events::{ControlUpdate, RunSample};
 
 /// Seconds between status messages (actionlib's 5 Hz).
 const STATUS_PERIOD_S: f64 = 0.2;
@@ -199,36 +200,6 @@ impl<G: Decode + Send + 'static, F: Stamped, R: Stamped> Actionlib<G, F, R> {
     }
 }
 
-/// An action server of one controller, run at every control update.
-pub(super) trait ActionServer: Send {
-    /// Takes the goals and cancels that came, follows the controller's run, publishes.
-    fn update(&mut self, update: &ControlUpdate, to_session: &Sender<Action>);
-}
-
-/// The action servers of one kind (one per controller), and the way to the session.
-pub(super) struct ActionFamily<S> {
-    servers: Vec<S>,
-    to_session: Sender<Action>,
-}
-
-impl<S: ActionServer> TopicFamily for ActionFamily<S> {
-    fn control(&mut self, update: &ControlUpdate) {
-        for server in &mut self.servers {
-            server.update(update, &self.to_session);
-        }
-    }
-}
-
-impl<S> ActionFamily<S> {
-    /// The family of `servers`, handing goals to the session through `to_session`.
-    pub fn new(servers: Vec<S>, to_session: Sender<Action>) -> Self {
-        Self {
-            servers,
-            to_session,
-        }
-    }
-}
-
 /// `follow_joint_trajectory` for one trajectory controller.
 pub(super) struct TrajectoryServer {
     io: Actionlib<
@@ -239,26 +210,21 @@ pub(super) struct TrajectoryServer {
     feedback_arrays: FeedbackArrays,
 }
 
-/// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers on `node`;
-/// accepted trajectories go to the session through `to_session`.
-pub(super) fn trajectory_actions(
-    node: &Node,
-    plan: &RosPlan,
-    to_session: Sender<Action>,
-) -> Result<ActionFamily<TrajectoryServer>> {
-    let servers = ActionGoals::trajectories(plan, "~/command")
+/// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers on `node`.
+pub(super) fn trajectory_servers(node: &Node, plan: &RosPlan) -> Result<Vec<Box<dyn ActionWire>>> {
+    ActionGoals::trajectories(plan, "~/command")
         .into_iter()
         .map(|goals| {
-            Ok(TrajectoryServer {
+            let server = TrajectoryServer {
                 io: Actionlib::open(node, goals, "control_msgs/FollowJointTrajectoryAction")?,
                 feedback_arrays: FeedbackArrays::default(),
-            })
+            };
+            Ok(Box::new(server) as Box<dyn ActionWire>)
         })
-        .collect::<Result<_>>()?;
-    Ok(ActionFamily::new(servers, to_session))
+        .collect()
 }
 
-impl ActionServer for TrajectoryServer {
+impl ActionWire for TrajectoryServer {
     fn update(&mut self, update: &ControlUpdate, to_session: &Sender<Action>) {
         let now_s = update.sample.sim_time_s;
         let run = self.io.goals.run(update);

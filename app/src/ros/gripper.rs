@@ -18,7 +18,8 @@ use rover_ros1::msgs::{
     GripperCommandResult,
 };
 
-use super::actions::{ActionFamily, ActionServer, Actionlib, goal_status, rejected};
+use super::actions::{Actionlib, goal_status, rejected};
+use crate::bridge::action_intake::ActionWire;
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{ActionGoals, check_gripper};
 use crate::bridge::events::{ControlUpdate, GripperSample};
@@ -42,26 +43,24 @@ pub(super) struct GripperServer {
     >,
 }
 
-/// Serves `gripper_cmd` for each of the plan's gripper controllers on `node`; accepted
-/// commands go to the session through `to_session`.
-pub(super) fn gripper_actions(
+/// Serves `gripper_cmd` for each of the plan's gripper controllers on `node`.
+pub(super) fn gripper_servers(
     node: &Node,
     plan: &RosPlan,
     robot: &rover_sim::RobotModel,
-    to_session: Sender<Action>,
-) -> Result<ActionFamily<GripperServer>> {
-    let servers = ActionGoals::grippers(plan, robot)
+) -> Result<Vec<Box<dyn ActionWire>>> {
+    ActionGoals::grippers(plan, robot)
         .into_iter()
         .map(|goals| {
-            Ok(GripperServer {
+            let server = GripperServer {
                 io: Actionlib::open(node, goals, "control_msgs/GripperCommandAction")?,
-            })
+            };
+            Ok(Box::new(server) as Box<dyn ActionWire>)
         })
-        .collect::<Result<_>>()?;
-    Ok(ActionFamily::new(servers, to_session))
+        .collect()
 }
 
-impl ActionServer for GripperServer {
+impl ActionWire for GripperServer {
     fn update(&mut self, update: &ControlUpdate, to_session: &Sender<Action>) {
         let now_s = update.sample.sim_time_s;
         let run = self.io.goals.run(update);

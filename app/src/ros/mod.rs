@@ -39,6 +39,7 @@ pub(crate) use crate::bridge::RosPlan;
 pub use cmd_vel::RosCmdVel;
 use controllers::ControllerCommands;
 
+use crate::bridge::action_intake;
 use crate::bridge::tf as tf_family;
 use crate::bridge::{Backlog, Bridge, Transport, arm as arm_family, camera as camera_family};
 use crate::bridge::{clock as clock_family, darknet, joint_states as joint_states_family};
@@ -125,7 +126,7 @@ pub struct RosInput {
     controllers: ControllerCommands,
     arm: arm::ArmTaskInput,
     /// Trajectories of the goals the action servers accepted (and stops for cancelled ones).
-    actions: std::sync::mpsc::Receiver<Action>,
+    actions: action_intake::GoalCommands,
 }
 
 impl InputSource for RosInput {
@@ -134,7 +135,7 @@ impl InputSource for RosInput {
             .poll()
             .or_else(|| self.controllers.poll())
             .or_else(|| self.arm.poll())
-            .or_else(|| self.actions.try_recv().ok())
+            .or_else(|| self.actions.poll())
     }
 }
 
@@ -158,15 +159,10 @@ impl Bridge<()> {
         families.push(Box::new(controller_states::ControllerStates::advertise(
             &node, &plan,
         )?));
-        let (to_session, from_actions) = std::sync::mpsc::channel();
-        families.push(Box::new(actions::trajectory_actions(
-            &node,
-            &plan,
-            to_session.clone(),
-        )?));
-        families.push(Box::new(gripper::gripper_actions(
-            &node, &plan, robot, to_session,
-        )?));
+        let mut servers = actions::trajectory_servers(&node, &plan)?;
+        servers.extend(gripper::gripper_servers(&node, &plan, robot)?);
+        let (actions, goal_commands) = action_intake::intake(servers);
+        families.push(Box::new(actions));
         let cmd = RosCmdVel::subscribe(&node, &plan)?;
         let controllers = ControllerCommands::subscribe(&node, &plan)?;
         let arm_task = arm::ArmTaskInput::subscribe(&node)?;
@@ -213,7 +209,7 @@ impl Bridge<()> {
                 cmd_vel: cmd,
                 controllers,
                 arm: arm_task,
-                actions: from_actions,
+                actions: goal_commands,
             },
         ))
     }

@@ -31,7 +31,8 @@ use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{
     ActionGoals, FeedbackArrays, Goal, GoalState, Rejection, check_gripper, code,
 };
-use crate::bridge::events::{ControlUpdate, GripperSample, RunSample, TopicFamily};
+use crate::bridge::action_intake::ActionWire;
+use crate::bridge::events::{ControlUpdate, GripperSample, RunSample};
 use rover_ros2::action_msgs::{
     CANCEL_ERROR_GOAL_TERMINATED, CANCEL_ERROR_NONE, CANCEL_ERROR_UNKNOWN_GOAL_ID, CancelGoal,
     FEEDBACK_TYPE, FeedbackMessage, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
@@ -362,6 +363,62 @@ impl<A: ActionType> ActionServer<A> {
         writers.push(self.status.guid());
     }
 
+    /// Cancels the goals `info` names (a zero id: all accepted up to its stamp, or all with a
+    /// zero stamp too); the joints stop where they are.
+    fn cancel(
+        &mut self,
+        info: GoalInfo,
+        run: RunSample,
+        to_session: &Sender<Action>,
+    ) -> (i8, Vec<GoalInfo>) {
+        let all = info.goal_id == Uuid::default();
+        let until = f64::from(info.stamp.sec) + f64::from(info.stamp.nanosec) * 1e-9;
+        let named = |g: &Goal<Uuid>| {
+            if all {
+                until == 0.0 || g.accepted_s <= until
+            } else {
+                g.id == info.goal_id
+            }
+        };
+        let (cancelled, ended_before) = A::cancel(&mut self.goals, named, run, to_session);
+        if cancelled.is_empty() {
+            let code = if ended_before {
+                CANCEL_ERROR_GOAL_TERMINATED
+            } else {
+                CANCEL_ERROR_UNKNOWN_GOAL_ID
+            };
+            return (code, Vec::new());
+        }
+        let infos = cancelled
+            .iter()
+            .filter_map(|id| self.goals.goal(id))
+            .map(goal_info)
+            .collect();
+        (CANCEL_ERROR_NONE, infos)
+    }
+
+    /// Replies to the get_result requests whose goal has ended (an unknown goal: aborted, at
+    /// once).
+    fn answer_results(&mut self) {
+        let goals = &self.goals;
+        let mut replies = Vec::new();
+        self.waiting.retain(|(header, id)| match goals.goal(id) {
+            Some(g) if !g.ended() => true,
+            found => {
+                replies.push((*header, A::result(found)));
+                false
+            }
+        });
+        for (header, reply) in replies {
+            self.get_result.reply(header, reply);
+        }
+    }
+}
+
+impl<A: ActionType + Send> ActionWire for ActionServer<A>
+where
+    ActionServer<A>: Send,
+{
     fn update(&mut self, update: &ControlUpdate, to_session: &Sender<Action>) {
         let now_s = update.sample.sim_time_s;
         let run = self.goals.run(update);
@@ -423,121 +480,37 @@ impl<A: ActionType> ActionServer<A> {
             }
         }
     }
-
-    /// Cancels the goals `info` names (a zero id: all accepted up to its stamp, or all with a
-    /// zero stamp too); the joints stop where they are.
-    fn cancel(
-        &mut self,
-        info: GoalInfo,
-        run: RunSample,
-        to_session: &Sender<Action>,
-    ) -> (i8, Vec<GoalInfo>) {
-        let all = info.goal_id == Uuid::default();
-        let until = f64::from(info.stamp.sec) + f64::from(info.stamp.nanosec) * 1e-9;
-        let named = |g: &Goal<Uuid>| {
-            if all {
-                until == 0.0 || g.accepted_s <= until
-            } else {
-                g.id == info.goal_id
-            }
-        };
-        let (cancelled, ended_before) = A::cancel(&mut self.goals, named, run, to_session);
-        if cancelled.is_empty() {
-            let code = if ended_before {
-                CANCEL_ERROR_GOAL_TERMINATED
-            } else {
-                CANCEL_ERROR_UNKNOWN_GOAL_ID
-            };
-            return (code, Vec::new());
-        }
-        let infos = cancelled
-            .iter()
-            .filter_map(|id| self.goals.goal(id))
-            .map(goal_info)
-            .collect();
-        (CANCEL_ERROR_NONE, infos)
-    }
-
-    /// Replies to the get_result requests whose goal has ended (an unknown goal: aborted, at
-    /// once).
-    fn answer_results(&mut self) {
-        let goals = &self.goals;
-        let mut replies = Vec::new();
-        self.waiting.retain(|(header, id)| match goals.goal(id) {
-            Some(g) if !g.ended() => true,
-            found => {
-                replies.push((*header, A::result(found)));
-                false
-            }
-        });
-        for (header, reply) in replies {
-            self.get_result.reply(header, reply);
-        }
-    }
 }
 
-/// The action servers: every joint trajectory controller's and every gripper controller's,
-/// and the way to the session.
-pub(super) struct ControllerActions {
-    trajectories: Vec<ActionServer<FollowJointTrajectory>>,
-    grippers: Vec<ActionServer<GripperCommand>>,
-    to_session: Sender<Action>,
-}
-
-impl ControllerActions {
-    /// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers and
-    /// `gripper_cmd` for each gripper controller; accepted goals go to the session through
-    /// `to_session`.
-    pub fn serve(
-        (participant, subscriber, publisher): (
-            &DomainParticipant,
-            &rustdds::Subscriber,
-            &rustdds::Publisher,
-        ),
-        (plan, robot): (&RosPlan, &RobotModel),
-        distro: RosDistro,
-        to_session: Sender<Action>,
-    ) -> Result<Self> {
-        let dds = Dds {
-            participant,
-            subscriber,
-            publisher,
-            distro,
-        };
-        Ok(Self {
-            trajectories: ActionGoals::trajectories(plan, "~/joint_trajectory")
-                .into_iter()
-                .map(|g| ActionServer::new(g, &dds))
-                .collect::<Result<_>>()?,
-            grippers: ActionGoals::grippers(plan, robot)
-                .into_iter()
-                .map(|g| ActionServer::new(g, &dds))
-                .collect::<Result<_>>()?,
-            to_session,
-        })
+/// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers and
+/// `gripper_cmd` for each gripper controller; the servers, and their readers and writers for
+/// `ros_discovery_info`.
+pub(super) fn serve(
+    (participant, subscriber, publisher): (
+        &DomainParticipant,
+        &rustdds::Subscriber,
+        &rustdds::Publisher,
+    ),
+    (plan, robot): (&RosPlan, &RobotModel),
+    distro: RosDistro,
+) -> Result<(Vec<Box<dyn ActionWire>>, (Vec<GUID>, Vec<GUID>))> {
+    let dds = Dds {
+        participant,
+        subscriber,
+        publisher,
+        distro,
+    };
+    let mut servers: Vec<Box<dyn ActionWire>> = Vec::new();
+    let (mut readers, mut writers) = (Vec::new(), Vec::new());
+    for goals in ActionGoals::trajectories(plan, "~/joint_trajectory") {
+        let server = ActionServer::<FollowJointTrajectory>::new(goals, &dds)?;
+        server.gids(&mut readers, &mut writers);
+        servers.push(Box::new(server));
     }
-
-    /// The servers' readers and writers, for `ros_discovery_info`.
-    pub fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
-        let mut readers = Vec::new();
-        let mut writers = Vec::new();
-        for s in &self.trajectories {
-            s.gids(&mut readers, &mut writers);
-        }
-        for s in &self.grippers {
-            s.gids(&mut readers, &mut writers);
-        }
-        (readers, writers)
+    for goals in ActionGoals::grippers(plan, robot) {
+        let server = ActionServer::<GripperCommand>::new(goals, &dds)?;
+        server.gids(&mut readers, &mut writers);
+        servers.push(Box::new(server));
     }
-}
-
-impl TopicFamily for ControllerActions {
-    fn control(&mut self, update: &ControlUpdate) {
-        for server in &mut self.trajectories {
-            server.update(update, &self.to_session);
-        }
-        for server in &mut self.grippers {
-            server.update(update, &self.to_session);
-        }
-    }
+    Ok((servers, (readers, writers)))
 }

@@ -6,7 +6,6 @@
 //! value) for a single-joint controller, as forward_command_controller takes it. A sample that
 //! does not decode (a peer's garbage, a wrong type) is one warning per topic; the run goes on.
 
-use std::sync::mpsc::Receiver;
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
@@ -16,6 +15,7 @@ use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, Topic
 use serde::de::DeserializeOwned;
 
 use crate::bridge::RosPlan;
+use crate::bridge::action_intake::GoalCommands;
 use super::convert::sim_trajectory;
 use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn};
 use rover_ros2::dds::{dds_topic, default_qos};
@@ -91,7 +91,7 @@ pub struct Ros2Input {
     /// The node's parameter services, answered when polled.
     parameters: Parameters,
     /// Trajectories of the goals the action servers accepted (and stops for cancelled ones).
-    actions: Receiver<Action>,
+    actions: GoalCommands,
     /// The participant, kept until the readers are gone (the bridge thread may stop first;
     /// a reader outliving its participant cannot say goodbye to it).
     _participant: DomainParticipant,
@@ -124,7 +124,7 @@ impl Ros2Input {
         plan: &RosPlan,
         node: &str,
         description: &str,
-        actions: Receiver<Action>,
+        actions: GoalCommands,
     ) -> Result<Self> {
         let subscriber = participant
             .create_subscriber(&default_qos())
@@ -189,7 +189,7 @@ impl Ros2Input {
 impl InputSource for Ros2Input {
     fn poll(&mut self) -> Option<Action> {
         self.parameters.poll();
-        if let Ok(action) = self.actions.try_recv() {
+        if let Some(action) = self.actions.poll() {
             return Some(action);
         }
         let mut newest = None;

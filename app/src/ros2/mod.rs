@@ -58,6 +58,7 @@ use anyhow::{Context, Result};
 use rover_sim::RobotModel;
 use rustdds::DomainParticipant;
 
+use crate::bridge::action_intake::{self, ActionFamily};
 use crate::bridge::{Backlog, Bridge, RosPlan, Transport};
 use crate::bridge::{arm as arm_family, camera as camera_family, clock as clock_family};
 use crate::bridge::{darknet, joint_states as joint_states_family, laser as laser_family};
@@ -289,7 +290,8 @@ struct DdsNode {
     participant: DomainParticipant,
     publisher: rustdds::Publisher,
     input: Ros2Input,
-    actions: actions::ControllerActions,
+    /// The action servers' family, and their readers and writers.
+    actions: (ActionFamily, (Vec<rustdds::GUID>, Vec<rustdds::GUID>)),
     rosout: (rosout::Rosout, rustdds::GUID),
 }
 
@@ -313,24 +315,24 @@ impl DdsNode {
             .context("creating the DDS publisher")?;
         let (namespace, name) = discovery::split_node_name(&options.node_name);
         let node = format!("{}/{name}", namespace.trim_end_matches('/'));
-        let (to_session, from_actions) = std::sync::mpsc::channel();
+        let subscriber = participant
+            .create_subscriber(&default_qos())
+            .context("creating the DDS subscriber")?;
+        let (servers, action_gids) = actions::serve(
+            (&participant, &subscriber, &publisher),
+            (plan, robot),
+            options.distro,
+        )?;
+        let (family, goal_commands) = action_intake::intake(servers);
         let input = Ros2Input::subscribe(
             &participant,
             &publisher,
             plan,
             &node,
             &robot.description,
-            from_actions,
+            goal_commands,
         )?;
-        let subscriber = participant
-            .create_subscriber(&default_qos())
-            .context("creating the DDS subscriber")?;
-        let actions = actions::ControllerActions::serve(
-            (&participant, &subscriber, &publisher),
-            (plan, robot),
-            options.distro,
-            to_session,
-        )?;
+        let actions = (family, action_gids);
         let rosout = rosout::Rosout::create(&participant, &publisher, &node)?;
         Ok(Self {
             participant,
@@ -348,7 +350,7 @@ impl DdsNode {
         self,
         options: &Ros2Options,
         writers: Vec<rustdds::GUID>,
-    ) -> Result<(Ros2Input, Held, actions::ControllerActions, rosout::Rosout)> {
+    ) -> Result<(Ros2Input, Held, ActionFamily, rosout::Rosout)> {
         let mut d = discovery::Discovery::new(
             &self.participant,
             &self.publisher,
@@ -356,7 +358,7 @@ impl DdsNode {
             options.distro,
         )?;
         let (mut readers, mut all_writers) = self.input.gids();
-        let (action_readers, action_writers) = self.actions.gids();
+        let (actions, (action_readers, action_writers)) = self.actions;
         readers.extend(action_readers);
         all_writers.extend(action_writers);
         all_writers.extend(writers);
@@ -366,7 +368,7 @@ impl DdsNode {
         Ok((
             self.input,
             (d, self.publisher, self.participant),
-            self.actions,
+            actions,
             rosout,
         ))
     }
