@@ -19,9 +19,9 @@ use rover_ros1::msgs::{
 };
 
 use super::actions::{Actionlib, goal_status, rejected};
-use crate::bridge::action_intake::ActionWire;
 use crate::bridge::RosPlan;
 use crate::bridge::action_goals::{ActionGoals, check_gripper};
+use crate::bridge::action_intake::ActionWire;
 use crate::bridge::events::{ControlUpdate, GripperSample};
 
 /// GripperCommand's result (and feedback) fields from a sample.

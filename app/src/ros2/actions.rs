@@ -482,6 +482,9 @@ where
     }
 }
 
+/// Readers' and writers' GUIDs, for `ros_discovery_info`.
+pub(super) type Gids = (Vec<GUID>, Vec<GUID>);
+
 /// Serves `follow_joint_trajectory` for each of the plan's trajectory controllers and
 /// `gripper_cmd` for each gripper controller; the servers, and their readers and writers for
 /// `ros_discovery_info`.
@@ -493,7 +496,7 @@ pub(super) fn serve(
     ),
     (plan, robot): (&RosPlan, &RobotModel),
     distro: RosDistro,
-) -> Result<(Vec<Box<dyn ActionWire>>, (Vec<GUID>, Vec<GUID>))> {
+) -> Result<(Vec<Box<dyn ActionWire>>, Gids)> {
     let dds = Dds {
         participant,
         subscriber,

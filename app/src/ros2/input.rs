@@ -6,7 +6,6 @@
 //! value) for a single-joint controller, as forward_command_controller takes it. A sample that
 //! does not decode (a peer's garbage, a wrong type) is one warning per topic; the run goes on.
 
-
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
 use rover_sim::Twist;
@@ -14,9 +13,9 @@ use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;
 
+use super::convert::sim_trajectory;
 use crate::bridge::RosPlan;
 use crate::bridge::action_intake::GoalCommands;
-use super::convert::sim_trajectory;
 use crate::bridge::input::{TASK_TOPIC, arm_task, poll_in_turn};
 use rover_ros2::dds::{dds_topic, default_qos};
 use rover_ros2::msgs::{self, RosMessage};
@@ -169,12 +168,10 @@ impl Ros2Input {
             &mut self.controllers,
             &mut self.next,
             |(name, command)| match command {
-                Command::Trajectory(reader) => {
-                    reader.next().map(|m| JointAction::Trajectory {
-                        controller: name.to_owned(),
-                        trajectory: Box::new(sim_trajectory(m)),
-                    })
-                }
+                Command::Trajectory(reader) => reader.next().map(|m| JointAction::Trajectory {
+                    controller: name.to_owned(),
+                    trajectory: Box::new(sim_trajectory(m)),
+                }),
                 Command::Value(reader) => reader.next().and_then(|m| {
                     m.data.first().map(|&value| JointAction::Controller {
                         name: name.clone(),

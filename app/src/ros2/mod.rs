@@ -291,7 +291,7 @@ struct DdsNode {
     publisher: rustdds::Publisher,
     input: Ros2Input,
     /// The action servers' family, and their readers and writers.
-    actions: (ActionFamily, (Vec<rustdds::GUID>, Vec<rustdds::GUID>)),
+    actions: (ActionFamily, actions::Gids),
     rosout: (rosout::Rosout, rustdds::GUID),
 }
 
