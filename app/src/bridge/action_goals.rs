@@ -572,6 +572,27 @@ mod tests {
         }
     }
 
+    /// The book with goal `id` accepted (its trajectory sent to the session and taken), the
+    /// way to the session and the session's end.
+    fn with_goal(
+        id: u32,
+    ) -> (
+        ActionGoals<u32>,
+        std::sync::mpsc::Sender<Action>,
+        std::sync::mpsc::Receiver<Action>,
+    ) {
+        let (to_session, from) = std::sync::mpsc::channel();
+        let mut g = goals();
+        g.accept_trajectory(
+            id,
+            trajectory(&["a", "b"], vec![0.1, 0.2]),
+            (0.0, RunSample::default()),
+            &to_session,
+        );
+        assert!(from.try_recv().is_ok());
+        (g, to_session, from)
+    }
+
     #[test]
     fn bad_goals_get_control_msgs_codes() {
         let g = goals();
@@ -604,16 +625,8 @@ mod tests {
 
     #[test]
     fn a_refused_goal_ends_aborted_with_its_code_and_the_running_one_goes_on() {
-        let (to_session, from) = std::sync::mpsc::channel();
-        let mut g = goals();
+        let (mut g, _to_session, from) = with_goal(1);
         let idle = RunSample::default();
-        g.accept_trajectory(
-            1,
-            trajectory(&["a", "b"], vec![0.1, 0.2]),
-            (0.0, idle),
-            &to_session,
-        );
-        assert!(from.try_recv().is_ok());
         let bad = trajectory(&["a", "x"], vec![0.1, 0.2]);
         let Err(why) = g.check(&bad, false) else {
             panic!("an unknown joint passed the check");
@@ -641,16 +654,7 @@ mod tests {
 
     #[test]
     fn a_goal_runs_then_succeeds_and_a_newer_one_preempts() {
-        let (to_session, from) = std::sync::mpsc::channel();
-        let mut g = goals();
-        let idle = RunSample::default();
-        g.accept_trajectory(
-            1,
-            trajectory(&["a", "b"], vec![0.1, 0.2]),
-            (0.0, idle),
-            &to_session,
-        );
-        assert!(from.try_recv().is_ok());
+        let (mut g, to_session, _from) = with_goal(1);
         let running = RunSample {
             active: true,
             runs: 1,
@@ -683,15 +687,7 @@ mod tests {
 
     #[test]
     fn a_cancel_stops_the_joints_and_a_goal_never_started_aborts() {
-        let (to_session, from) = std::sync::mpsc::channel();
-        let mut g = goals();
-        g.accept_trajectory(
-            7,
-            trajectory(&["a", "b"], vec![0.1, 0.2]),
-            (0.0, RunSample::default()),
-            &to_session,
-        );
-        let _ = from.try_recv();
+        let (mut g, to_session, from) = with_goal(7);
         let (cancelled, ended_before) = g.cancel_trajectory(|x| x.id == 7, &to_session);
         assert_eq!(cancelled.len(), 1);
         assert!(!ended_before);
