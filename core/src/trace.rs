@@ -323,7 +323,10 @@ pub fn parse_trace(text: &str) -> Result<Vec<TraceRow>, TraceParseError> {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
+#[allow(
+    clippy::unwrap_used,
+    reason = "tests: a failed unwrap is a failed test"
+)]
 mod tests {
     use super::*;
 

@@ -177,7 +177,10 @@ fn by_score(a: f64, b: f64) -> Ordering {
 }
 
 /// Whether COCO's area range `all` leaves out a box of this area (not a NaN one, as in COCO).
-#[allow(clippy::manual_range_contains)]
+#[allow(
+    clippy::manual_range_contains,
+    reason = "a NaN area is inside, as in COCO; `!(0.0..=AREA_MAX).contains(&area)` would put it outside"
+)]
 fn outside_area_range(area: f64) -> bool {
     area < 0.0 || area > AREA_MAX
 }
@@ -628,7 +631,10 @@ impl DetectionMetrics {
 }
 
 #[cfg(test)]
-#[allow(clippy::expect_used)]
+#[allow(
+    clippy::expect_used,
+    reason = "tests: a failed expect is a failed test"
+)]
 mod tests {
     use super::*;
 

@@ -1105,8 +1105,10 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
 }
 
 #[derive(Debug, Subcommand)]
-// Parsed once per process: the variants' size difference costs nothing worth boxing for.
-#[allow(clippy::large_enum_variant)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "parsed once per process: the variants' size difference costs nothing worth boxing for"
+)]
 pub(crate) enum Command {
     /// Run a catkin package's roslaunch file: rover in Gazebo's and darknet_ros' place, the
     /// other nodes started against a ROS master

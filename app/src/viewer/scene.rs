@@ -181,7 +181,10 @@ type Limbs = Vec<(usize, String, Swing, Pose)>;
 /// person walks), or rover's figure as one mesh of its body and, for a walking person, one
 /// per limb that swings (`<path>/limb<k>`, moved per tick); returns the people's paths, the
 /// limbs' and the moving skinned bodies'.
-#[allow(clippy::type_complexity)]
+#[allow(
+    clippy::type_complexity,
+    reason = "one private function's result: the people's, limbs' and skinned bodies' paths"
+)]
 fn log_people(
     rec: &RecordingStream,
     sim: &Simulation,

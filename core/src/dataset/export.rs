@@ -321,7 +321,10 @@ pub fn coco_results(records: &[ImageRecord], split: Split) -> serde_json::Result
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
+#[allow(
+    clippy::unwrap_used,
+    reason = "tests: a failed unwrap is a failed test"
+)]
 mod tests {
     use super::*;
 

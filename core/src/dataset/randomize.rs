@@ -508,7 +508,10 @@ fn spread(spots: &[(String, [f64; 2])], base: &BaseLayout) -> ([f64; 2], [f64; 2
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
+#[allow(
+    clippy::unwrap_used,
+    reason = "tests: a failed unwrap is a failed test"
+)]
 mod tests {
     use super::*;
 

@@ -38,5 +38,8 @@ pub use state::Follower;
 pub use target::{FollowState, FollowTarget};
 
 #[cfg(test)]
-#[allow(clippy::expect_used)]
+#[allow(
+    clippy::expect_used,
+    reason = "tests: a failed expect is a failed test"
+)]
 mod tests;

@@ -237,7 +237,10 @@ fn skin_joints<'a>(
 
 /// The skin mesh's positions (the file's, before the bind shape) and its triangles by
 /// material, with the colour the `<instance_controller>` binds to each.
-#[allow(clippy::type_complexity)]
+#[allow(
+    clippy::type_complexity,
+    reason = "one private function's result: the positions and each material's triangles"
+)]
 fn skin_mesh<'a>(
     mesh: Node<'a, 'a>,
     instance: Node<'a, 'a>,

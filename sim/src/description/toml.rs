@@ -40,14 +40,20 @@ mod tests {
 
     #[derive(Debug, serde::Deserialize)]
     #[serde(deny_unknown_fields)]
-    #[allow(dead_code)]
+    #[allow(
+        dead_code,
+        reason = "read only by the parser under test, never by the test"
+    )]
     struct Outer {
         inner: Vec<Inner>,
     }
 
     #[derive(Debug, serde::Deserialize)]
     #[serde(deny_unknown_fields)]
-    #[allow(dead_code)]
+    #[allow(
+        dead_code,
+        reason = "read only by the parser under test, never by the test"
+    )]
     struct Inner {
         size: f64,
     }

@@ -714,7 +714,10 @@ impl IkSolver {
 }
 
 #[cfg(test)]
-#[allow(clippy::expect_used)]
+#[allow(
+    clippy::expect_used,
+    reason = "tests: a failed expect is a failed test"
+)]
 mod tests {
     use super::*;
 

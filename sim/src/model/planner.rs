@@ -422,7 +422,10 @@ impl TimedPath {
 }
 
 #[cfg(test)]
-#[allow(clippy::expect_used)]
+#[allow(
+    clippy::expect_used,
+    reason = "tests: a failed expect is a failed test"
+)]
 mod tests {
     use super::*;
     use crate::model::kinematics::KinematicChain;
