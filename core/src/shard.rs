@@ -8,7 +8,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 use crate::error::{CoreError, Result};
 
@@ -205,9 +204,7 @@ pub fn check_shard_set(shards: &[(PathBuf, ShardManifest)]) -> Result<()> {
 
 /// SHA-256 of a file's bytes, in hex.
 pub fn sha256_of(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| CoreError::Option(format!("cannot read {}: {e}", path.display())))?;
-    Ok(format!("{:x}", Sha256::digest(&bytes)))
+    rover_assets::registry::sha256_file(path).map_err(|e| CoreError::Option(e.to_string()))
 }
 
 #[cfg(test)]

@@ -43,9 +43,9 @@ pub use detector::{
 pub use draw::{PixelRect, box_outline, draw_box_rgb8};
 pub use error::{PerceptionError, Result};
 pub use fault::{FaultInjector, FaultKind, InjectedFault};
-pub use fetch::{cache_dir, default_model_path, ensure_default_model};
+pub use fetch::{default_model_path, ensure_default_model};
 pub use head::Head;
-pub use labels::{COCO80, parse_metadata_names, read_labels_file};
+pub use labels::{parse_metadata_names, read_labels_file};
 pub use lockstep::LockstepDetector;
 pub use messages::{BoundingBox, BoundingBoxes, FrameStamp, ObjectCount};
 pub use metrics::{

@@ -134,7 +134,7 @@ pub fn find_onnxruntime_library() -> Result<PathBuf> {
         prefixes.push(PathBuf::from(venv).join("lib"));
     }
     // The venv scripts/setup.sh makes, in the cache the default model also lives in.
-    prefixes.push(crate::fetch::cache_dir().join("venv/lib"));
+    prefixes.push(rover_assets::cache_dir().join("venv/lib"));
     if let Some(home) = std::env::var_os("HOME") {
         prefixes.push(PathBuf::from(home).join(".local/lib"));
     }

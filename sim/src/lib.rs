@@ -40,7 +40,7 @@ pub use model::actor;
 /// namespace: nothing in it is re-exported at the root).
 pub use model::human;
 pub use model::{
-    COCO_CLASSES, CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
+    CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
     ControllerKind, ControllerSpec, DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION,
     DepthOutput, DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GraspMode,
     GripperSpec, Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial,

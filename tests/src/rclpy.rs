@@ -38,7 +38,7 @@ impl Rclpy {
 /// `distro`'s rclpy as set-up left it (`<rover's cache>/ros2/DISTRO`, marked complete); `None`,
 /// the skip recorded, when set-up has not built it.
 pub fn rclpy(distro: &str) -> Option<Rclpy> {
-    let root = rover_perception::cache_dir().join("ros2").join(distro);
+    let root = rover_assets::cache_dir().join("ros2").join(distro);
     if root.join(".complete").is_file() && root.join("venv/bin/python").is_file() {
         return Some(Rclpy {
             root,

@@ -284,16 +284,6 @@ fn copy_assets(to: &Path) -> anyhow::Result<()> {
 }
 
 #[test]
-fn rover_and_its_model_fetch_share_one_cache() {
-    // Two crates resolve the cache folder (the body's fetch in rover-sim, the detector model's
-    // in rover-perception): the same environment must give both the same folder.
-    assert_eq!(
-        rover_sim::human::fetch::cache_dir(),
-        rover_perception::cache_dir()
-    );
-}
-
-#[test]
 fn broken_assets_are_located_errors() -> anyhow::Result<()> {
     if makehuman()?.is_none() {
         return Ok(());

@@ -1,7 +1,7 @@
 //! rover's in-process xacro against references: the URDF Hello Robot ships beside its Stretch
 //! xacro sources, and PyPI's `xacro` 2.1.1 (the reference implementation, run here with Python)
 //! on rtb-data's robot packages. Same links, same joints (type, parent, child, origin within
-//! 1e-6). The packages come from PyPI at set-up (scripts/test-data.tsv); the test skips, counted
+//! 1e-6). The packages come from PyPI at set-up (assets/registry.tsv); the test skips, counted
 //! and listed (a failure in strict mode), where they are not in the cache.
 
 use std::collections::{BTreeMap, BTreeSet};

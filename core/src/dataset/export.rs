@@ -5,13 +5,14 @@
 use std::fmt::Write as _;
 
 use rover_perception::{BoundingBoxes, Detection, EvalBox, GroundTruthObject};
-use rover_sim::{COCO_CLASSES, GroundTruthBox, PixelBox};
+use rover_assets::COCO80;
+use rover_sim::{GroundTruthBox, PixelBox};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::randomize::Shot;
 use crate::dataset::store::Split;
 
-/// COCO's category id of each of the 80 classes, in [`COCO_CLASSES`] order (COCO numbers 91
+/// COCO's category id of each of the 80 classes, in [`COCO80`] order (COCO numbers 91
 /// categories and annotates 80 of them).
 pub const COCO_CATEGORY_IDS: [u32; 80] = [
     1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 27, 28,
@@ -22,7 +23,7 @@ pub const COCO_CATEGORY_IDS: [u32; 80] = [
 
 /// The COCO-80 number (YOLO's class id) of `class`.
 pub fn yolo_class(class: &str) -> Option<usize> {
-    COCO_CLASSES.iter().position(|c| *c == class)
+    COCO80.iter().position(|c| *c == class)
 }
 
 /// COCO's category id of `class`.
@@ -187,7 +188,7 @@ pub fn data_yaml() -> String {
          # No `path`: Ultralytics takes this file's folder as the dataset's root.\n\
          train: images/train\nval: images/val\nnc: 80\nnames:\n",
     );
-    for (i, name) in COCO_CLASSES.iter().enumerate() {
+    for (i, name) in COCO80.iter().enumerate() {
         let _ = writeln!(out, "  {i}: {name}");
     }
     out
@@ -279,7 +280,7 @@ pub fn coco_json(records: &[ImageRecord], split: Split) -> serde_json::Result<St
         licenses: [],
         images,
         annotations,
-        categories: COCO_CLASSES
+        categories: COCO80
             .iter()
             .zip(COCO_CATEGORY_IDS)
             .map(|(name, id)| CocoCategory {

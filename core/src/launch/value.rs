@@ -1,6 +1,7 @@
 //! Parameter values as roslaunch sets them: `<param>` text converted by its `type` (roslaunch's
 //! `convert_value`), `<rosparam>` YAML, and the YAML `--dump-params` prints.
 
+use rover_pyexpr::{float_repr, parse_float, parse_int};
 use saphyr::{LoadableYamlNode, Scalar, Yaml};
 
 /// A value on the ROS parameter server.
@@ -72,7 +73,7 @@ impl ParamValue {
         match self {
             Self::Bool(b) => if *b { "True" } else { "False" }.to_owned(),
             Self::Int(i) => i.to_string(),
-            Self::Double(d) => python_float(*d),
+            Self::Double(d) => float_repr(*d),
             Self::Str(s) => s.clone(),
             other => other.to_yaml(),
         }
@@ -86,11 +87,11 @@ pub fn convert_value(text: &str, ty: &str) -> Result<ParamValue, String> {
     match ty.to_ascii_lowercase().as_str() {
         "auto" => {
             if text.contains('.') {
-                if let Some(f) = python_float_parse(text) {
+                if let Some(f) = parse_float(text) {
                     return Ok(ParamValue::Double(f));
                 }
             } else if !text.contains('_')
-                && let Some(i) = python_int_parse(text)
+                && let Some(i) = parse_int(text)
             {
                 return Ok(ParamValue::Int(i));
             }
@@ -101,10 +102,10 @@ pub fn convert_value(text: &str, ty: &str) -> Result<ParamValue, String> {
             Ok(ParamValue::Str(text.to_owned()))
         }
         "str" | "string" => Ok(ParamValue::Str(text.to_owned())),
-        "int" => python_int_parse(text)
+        "int" => parse_int(text)
             .map(ParamValue::Int)
             .ok_or_else(|| format!("\"{text}\" is not an int")),
-        "double" => python_float_parse(text)
+        "double" => parse_float(text)
             .map(ParamValue::Double)
             .ok_or_else(|| format!("\"{text}\" is not a double")),
         "bool" | "boolean" => parse_bool(text)
@@ -127,65 +128,6 @@ pub fn parse_bool(text: &str) -> Option<bool> {
     }
 }
 
-/// Python's `int()` of a string: optional sign, decimal digits, spaces around.
-pub(crate) fn python_int_parse(text: &str) -> Option<i64> {
-    let t = text.trim().replace('_', "");
-    let digits = t.strip_prefix(['+', '-']).unwrap_or(&t);
-    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    t.parse().ok()
-}
-
-/// Python's `float()` of a string: decimal or exponent forms, `inf`, `nan`, spaces around.
-pub(crate) fn python_float_parse(text: &str) -> Option<f64> {
-    let t = text.trim().replace('_', "");
-    let lower = t.to_ascii_lowercase();
-    let body = lower.strip_prefix(['+', '-']).unwrap_or(&lower);
-    match body {
-        "inf" | "infinity" | "nan" => return lower.parse().ok(),
-        _ => {}
-    }
-    if body.is_empty()
-        || !body
-            .bytes()
-            .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'e' | b'+' | b'-'))
-    {
-        return None;
-    }
-    t.parse().ok()
-}
-
-/// Python's `repr`/`str` of a float: the shortest digits that read back, in exponent form
-/// below 1e-4 and from 1e16, with `.0` on whole numbers.
-pub(crate) fn python_float(v: f64) -> String {
-    if v.is_nan() {
-        return "nan".to_owned();
-    }
-    if v.is_infinite() {
-        return if v > 0.0 { "inf" } else { "-inf" }.to_owned();
-    }
-    if v == 0.0 {
-        return if v.is_sign_negative() { "-0.0" } else { "0.0" }.to_owned();
-    }
-    let sci = format!("{v:e}");
-    let (mantissa, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
-    let exp: i32 = exp.parse().unwrap_or(0);
-    if !(-4..16).contains(&exp) {
-        return format!(
-            "{mantissa}e{}{:02}",
-            if exp < 0 { '-' } else { '+' },
-            exp.abs()
-        );
-    }
-    let plain = format!("{v}");
-    if plain.contains('.') {
-        plain
-    } else {
-        format!("{plain}.0")
-    }
-}
-
 /// A float as PyYAML reads it back as a float (it needs a `.` in the mantissa).
 fn yaml_float(v: f64) -> String {
     if v.is_nan() {
@@ -194,7 +136,7 @@ fn yaml_float(v: f64) -> String {
     if v.is_infinite() {
         return if v > 0.0 { ".inf" } else { "-.inf" }.to_owned();
     }
-    let text = python_float(v);
+    let text = float_repr(v);
     match text.split_once('e') {
         Some((m, e)) if !m.contains('.') => format!("{m}.0e{e}"),
         _ => text,
@@ -302,12 +244,9 @@ mod tests {
     }
 
     #[test]
-    fn floats_print_as_python_prints_them() {
-        assert_eq!(python_float(3.0), "3.0");
-        assert_eq!(python_float(0.1 + 0.2), "0.30000000000000004");
-        assert_eq!(python_float(1e-7), "1e-07");
-        assert_eq!(python_float(1.5e20), "1.5e+20");
+    fn yaml_floats_read_back_as_floats() {
         assert_eq!(yaml_float(1e-7), "1.0e-07");
+        assert_eq!(yaml_float(3.0), "3.0");
     }
 
     #[test]

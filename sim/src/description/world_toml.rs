@@ -9,7 +9,8 @@ use crate::description::resource::ResourcePaths;
 use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
-use crate::model::classes::{COCO_CLASSES, is_known_class};
+use crate::model::classes::is_known_class;
+use rover_assets::COCO80;
 use crate::model::drive::DriveSpec;
 use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
@@ -605,7 +606,7 @@ impl Checker<'_> {
                 key,
                 format!(
                     "\"{c}\" is not a COCO class; expected one of: {}",
-                    COCO_CLASSES.join(", ")
+                    COCO80.join(", ")
                 ),
             )),
             other => Ok(other),

@@ -1,90 +1,7 @@
-//! Object classes: COCO's 80 names (what YOLO models trained on COCO report, and the names a
-//! world may give its objects), and the Gazebo models that are known to be one of them.
+//! Object classes: which of COCO's 80 names (`rover_assets::COCO80`: what YOLO models trained
+//! on COCO report, and the names a world may give its objects) the Gazebo models are known to be.
 
-/// COCO's 80 class names in YOLO order (the same list as the detector's default labels; a test
-/// in `tests/` checks they agree).
-pub const COCO_CLASSES: [&str; 80] = [
-    "person",
-    "bicycle",
-    "car",
-    "motorcycle",
-    "airplane",
-    "bus",
-    "train",
-    "truck",
-    "boat",
-    "traffic light",
-    "fire hydrant",
-    "stop sign",
-    "parking meter",
-    "bench",
-    "bird",
-    "cat",
-    "dog",
-    "horse",
-    "sheep",
-    "cow",
-    "elephant",
-    "bear",
-    "zebra",
-    "giraffe",
-    "backpack",
-    "umbrella",
-    "handbag",
-    "tie",
-    "suitcase",
-    "frisbee",
-    "skis",
-    "snowboard",
-    "sports ball",
-    "kite",
-    "baseball bat",
-    "baseball glove",
-    "skateboard",
-    "surfboard",
-    "tennis racket",
-    "bottle",
-    "wine glass",
-    "cup",
-    "fork",
-    "knife",
-    "spoon",
-    "bowl",
-    "banana",
-    "apple",
-    "sandwich",
-    "orange",
-    "broccoli",
-    "carrot",
-    "hot dog",
-    "pizza",
-    "donut",
-    "cake",
-    "chair",
-    "couch",
-    "potted plant",
-    "bed",
-    "dining table",
-    "toilet",
-    "tv",
-    "laptop",
-    "mouse",
-    "remote",
-    "keyboard",
-    "cell phone",
-    "microwave",
-    "oven",
-    "toaster",
-    "sink",
-    "refrigerator",
-    "book",
-    "clock",
-    "vase",
-    "scissors",
-    "teddy bear",
-    "hair drier",
-    "toothbrush",
-];
+use rover_assets::COCO80;
 
 /// Gazebo models (by `model://` name, or the model's own name) that are a COCO class, as
 /// osrf/gazebo_models ships them. Users extend it with a `class` per model.
@@ -130,9 +47,9 @@ pub fn class_of_model(name: &str) -> Option<&'static str> {
         .map(|(_, class)| *class)
 }
 
-/// Whether `class` is one of [`COCO_CLASSES`].
+/// Whether `class` is one of COCO's 80 ([`rover_assets::COCO80`]).
 pub fn is_known_class(class: &str) -> bool {
-    COCO_CLASSES.contains(&class)
+    COCO80.contains(&class)
 }
 
 /// A labelled thing of a world: what a ground-truth box is of.

@@ -140,6 +140,7 @@ fn actuate(
 impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
+        crate::model::human::check_available(&world.people)?;
         let drivable = robot.diff_drive.is_some();
         // A robot bolted to the world (a `world` root link: an arm on a table) is not meant to
         // drive; anything else without a drive is told why cmd_vel does nothing.

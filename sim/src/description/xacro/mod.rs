@@ -14,13 +14,12 @@
 //! The expansion keeps, for every output line, the file and line it came from, so that errors
 //! found later in the URDF still name the xacro file and line the user wrote.
 
-mod expr;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-use expr::{ExprError, Names, Value};
+use rover_pyexpr::{ExprError, Host, Value};
 
 use crate::description::resource::ResourcePaths;
 use crate::error::{Location, Result, SimError};
@@ -213,7 +212,12 @@ impl Expander<'_> {
     }
 
     fn expr_error(&self, text: &str, e: ExprError) -> SimError {
-        self.error(format!("in \"{text}\": {e}"))
+        match e {
+            ExprError::Undefined(name) => {
+                self.error(format!("in \"{text}\": undefined property \"{name}\""))
+            }
+            ExprError::Other(message) => self.error(format!("in \"{text}\": {message}")),
+        }
     }
 
     /// Reads and converts one file; returns its root element.
@@ -485,7 +489,7 @@ impl Expander<'_> {
                         ONode::Elem(_) => "",
                     })
                     .collect();
-                Prop::Value(Value::literal(text.trim()))
+                Prop::Value(literal_value(text.trim()))
             } else {
                 Prop::Block(nodes)
             }
@@ -883,7 +887,7 @@ impl Expander<'_> {
                     parts.push(Value::Str(std::mem::take(&mut literal_buf)));
                 }
                 let mut names = Lookup { ex: self, scope };
-                parts.push(expr::evaluate(&body[..end], &mut names)?);
+                parts.push(rover_pyexpr::evaluate(&body[..end], &mut names)?);
                 rest = &body[end + 1..];
             } else if let Some(body) = after.strip_prefix('(') {
                 let end = matching(body, '(', ')')
@@ -951,7 +955,7 @@ impl Expander<'_> {
             "dirname" => Ok(here.display().to_string()),
             "eval" => {
                 let mut names = Lookup { ex: self, scope };
-                Ok(expr::evaluate(rest, &mut names)?.to_string())
+                Ok(rover_pyexpr::evaluate(rest, &mut names)?.to_string())
             }
             _ => Err(ExprError::Other(format!(
                 "unsupported substitution $({command} ...); expected find, arg, env, optenv, eval or dirname"
@@ -965,20 +969,55 @@ struct Lookup<'a, 'b> {
     scope: usize,
 }
 
-impl Names for Lookup<'_, '_> {
-    fn property(&mut self, name: &str) -> std::result::Result<Option<Value>, ExprError> {
+impl Host for Lookup<'_, '_> {
+    fn name(&mut self, name: &str) -> std::result::Result<Option<Value>, ExprError> {
         self.ex.property_value(name, self.scope)
     }
 
-    fn arg(&mut self, name: &str) -> std::result::Result<Value, ExprError> {
-        Ok(Value::Str(self.ex.arg_value(name)?))
+    /// `arg('name')`, as `$(eval ...)` offers it.
+    fn call(
+        &mut self,
+        name: &str,
+        args: &[Value],
+    ) -> std::result::Result<Option<Value>, ExprError> {
+        match (name, args) {
+            ("arg" | "xacro.arg", [Value::Str(arg)]) => {
+                Ok(Some(Value::Str(self.ex.arg_value(arg)?)))
+            }
+            ("arg" | "xacro.arg", _) => Err(ExprError::Other(
+                "arg() expects one string, the arg's name".into(),
+            )),
+            _ => Ok(None),
+        }
+    }
+}
+
+/// How xacro reads a property's text: an int, else a float, else a boolean word, else the text
+/// itself (`'quoted'` text loses its quotes; text with `_` stays text).
+fn literal_value(text: &str) -> Value {
+    if text.len() >= 2 && text.starts_with('\'') && text.ends_with('\'') {
+        return Value::Str(text[1..text.len() - 1].to_owned());
+    }
+    if text.contains('_') {
+        return Value::Str(text.to_owned());
+    }
+    if let Some(i) = rover_pyexpr::parse_int(text) {
+        return Value::Int(i);
+    }
+    if let Some(x) = rover_pyexpr::parse_float(text) {
+        return Value::Float(x);
+    }
+    match text {
+        "true" | "True" => Value::Bool(true),
+        "false" | "False" => Value::Bool(false),
+        _ => Value::Str(text.to_owned()),
     }
 }
 
 /// Values given as text become numbers or booleans where they read as one (xacro's rule).
 fn literal(v: Value) -> Value {
     match v {
-        Value::Str(s) => Value::literal(&s),
+        Value::Str(s) => literal_value(&s),
         other => other,
     }
 }
@@ -1202,6 +1241,18 @@ fn write_element(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn literals_read_like_xacro() {
+        assert_eq!(literal_value("3"), Value::Int(3));
+        assert_eq!(literal_value("0.5"), Value::Float(0.5));
+        assert_eq!(literal_value("true"), Value::Bool(true));
+        assert_eq!(literal_value("1_000"), Value::Str("1_000".into()));
+        assert_eq!(literal_value("'0.5'"), Value::Str("0.5".into()));
+        assert_eq!(literal_value("base_link"), Value::Str("base_link".into()));
+        assert_eq!(literal_value("infinity"), Value::Float(f64::INFINITY));
+        assert_eq!(literal_value("1 2"), Value::Str("1 2".into()));
+    }
 
     fn expand(files: &[(&str, &str)], args: &[(&str, &str)]) -> Result<String> {
         let dir = tempfile::tempdir().map_err(|source| SimError::Io {

