@@ -406,19 +406,34 @@ fn the_series_simulation_launch_drives_with_the_teleop_keys() -> Result<()> {
     ws.ensure_clean()
 }
 
-/// Compares two outputs as the compare script's MODE says (yaml: the same parameters; lines:
-/// the same node names; args: the same environment and command), anonymous names equalled.
+/// Compares two outputs as the compare script's MODE says (yaml: the same parameters, each of
+/// the same type: Python's `3 == 3.0 == True` would let an int pass for a double; lines: the
+/// same node names; args: the same environment and command), anonymous names equalled. Empty
+/// output on either side is a difference, never a match.
 const COMPARE: &str = r#"
 import re, sys, yaml
 mode, a, b = sys.argv[1], open(sys.argv[2]).read(), open(sys.argv[3]).read()
 anon = lambda s: re.sub(r'([A-Za-z0-9]+)_[A-Za-z0-9_]+?_\d+_\d+', r'\1_ANON', s)
 a, b = anon(a), anon(b)
+def typed(v):
+    if isinstance(v, dict):
+        return ('dict', sorted((k, typed(x)) for k, x in v.items()))
+    if isinstance(v, list):
+        return ('list', [typed(x) for x in v])
+    return (type(v).__name__, v)
+if not a.strip() or not b.strip():
+    print('empty output: roslaunch %d bytes, rover %d bytes' % (len(a), len(b)))
+    sys.exit(1)
 if mode == 'yaml':
     a, b = yaml.safe_load(a) or {}, yaml.safe_load(b) or {}
-    diff = [k for k in sorted(set(a) | set(b)) if a.get(k, '<missing>') != b.get(k, '<missing>')]
+    missing = ('<missing>', None)
+    ta = {k: typed(v) for k, v in a.items()}
+    tb = {k: typed(v) for k, v in b.items()}
+    diff = [k for k in sorted(set(a) | set(b)) if ta.get(k, missing) != tb.get(k, missing)]
     for k in diff:
-        print('param %s: roslaunch %r, rover %r' % (k, a.get(k, '<missing>'), b.get(k, '<missing>')))
+        print('param %s: roslaunch %r, rover %r' % (k, ta.get(k, missing), tb.get(k, missing)))
     print('%d params' % len(a))
+    diff = diff or not a
 elif mode == 'lines':
     a, b = a.split(), b.split()
     diff = a != b
@@ -495,6 +510,9 @@ fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
                 "--nodes" => "lines",
                 _ => "args",
             };
+            if (file, mode) == ("groups_and_params.launch", "yaml") {
+                std::fs::copy(&outputs[0], ws.path("roslaunch-params.yaml"))?;
+            }
             let mut c = Command::new(PYTHON);
             c.arg(&compare).arg(mode).args(&outputs);
             let out = run(c, Duration::from_secs(30))?;
@@ -511,6 +529,50 @@ fn parsing_matches_roslaunch_on_the_seeds_and_every_construct() -> Result<()> {
         failures.join("\n")
     );
     println!("{checked} queries answered as roslaunch answers them");
+    assert_compare_catches_a_mistyped_param(&ws, &compare, &stubs, &check)
+}
+
+/// The comparison is strict enough to fail: a copy of groups_and_params.launch with
+/// `int_as_double` declared `type="int"` (roslaunch reads the original as the double 3.0; rover
+/// reads the copy as the int 3, equal under Python's `==`) differs from roslaunch's parameters,
+/// naming that parameter; so does an empty output.
+fn assert_compare_catches_a_mistyped_param(
+    ws: &Workspace,
+    compare: &Path,
+    stubs: &Path,
+    check: &Path,
+) -> Result<()> {
+    let original = std::fs::read_to_string(check.join("launch/groups_and_params.launch"))?;
+    let declared = r#"<param name="int_as_double" type="double" value="3"/>"#;
+    ensure!(original.contains(declared), "the fixture no longer declares {declared}");
+    let mistyped = ws.path("mistyped.launch");
+    std::fs::write(
+        &mistyped,
+        original.replace(declared, r#"<param name="int_as_double" type="int" value="3"/>"#),
+    )?;
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rover"));
+    c.args(["launch", "--dump-params"]).arg(&mistyped);
+    c.env("ROVER_LAUNCH_SET", "set");
+    ws.env(&mut c, &[stubs, check]);
+    let out = run(c, Duration::from_secs(60))?;
+    ensure!(out.status.success(), "rover launch --dump-params mistyped.launch:\n{}", text(&out));
+    let rover = ws.path("rover-mistyped.yaml");
+    std::fs::write(&rover, &out.stdout)?;
+    let empty = ws.path("empty.yaml");
+    std::fs::write(&empty, "")?;
+    let roslaunch = ws.path("roslaunch-params.yaml");
+    for (against, expected) in [(&rover, "param int_as_double"), (&empty, "empty output")] {
+        let mut c = Command::new(PYTHON);
+        c.arg(compare).arg("yaml").arg(&roslaunch).arg(against);
+        let out = run(c, Duration::from_secs(30))?;
+        let said = text(&out);
+        println!("against {}: {}", against.display(), said.trim());
+        ensure!(
+            !out.status.success() && said.contains(expected),
+            "the comparison passed {} against roslaunch's parameters:\n{said}",
+            against.display()
+        );
+    }
     Ok(())
 }
 

@@ -735,7 +735,10 @@ for m in got:
     # rover's endpoints as DDS discovery saw them, ros_discovery_info's own writer excepted.
     dds_w = {k for k, (p, t) in writers.items() if p == participant and t != 'ros_discovery_info'}
     dds_r = {k for k, (p, t) in readers.items() if p == participant}
-    print('padding %s' % all(b == 0 for b in m.gid.data[16:]))
+    # A Gid is a 16-byte GUID, zero-padded to 24 bytes before Iron. (At 16 bytes there is no
+    # padding: a wrong size shows as the fields after the Gids decoding to nonsense.)
+    if N > 16:
+        print('padding %s' % all(b == 0 for b in m.gid.data[16:]))
     for n in m.node_entities_info_seq:
         w = {bytes(g.data[:16]) for g in n.writer_gid_seq}
         r = {bytes(g.data[:16]) for g in n.reader_gid_seq}
@@ -787,7 +790,7 @@ fn a_late_peer_finds_node_rover_in_ros_discovery_info_for_both_gid_sizes() -> Re
         );
         ensure!(
             lines.contains(&format!("match True True {} {}", counts[0], counts[1]).as_str())
-                && lines.contains(&"padding True"),
+                && (gid_bytes == 16 || lines.contains(&"padding True")),
             "{gid_bytes}-byte Gids: the Gids are not rover's DDS endpoints:\n{out}"
         );
         let topics = lines

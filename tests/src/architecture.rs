@@ -189,6 +189,58 @@ impl CrateSources {
         out
     }
 
+    /// Every `impl` block (inherent or of a trait) longer than `max_lines`, as
+    /// [`LongFunction`]s named after the block's header (`impl Foo`, `impl Bar for Foo`).
+    pub fn long_impls(&self, max_lines: usize) -> Vec<LongFunction> {
+        let mut out = Vec::new();
+        for file in self.files.values() {
+            let code = file.code.as_bytes();
+            let mut i = 0;
+            while let Some(at) = find_word(&file.code, "impl", i) {
+                i = at + 4;
+                // An item: nothing but indentation (or `unsafe`) before it on its line, which
+                // leaves out `impl Trait` in argument and return types.
+                let line_start = file.code[..at].rfind('\n').map_or(0, |n| n + 1);
+                let before = file.code[line_start..at].trim();
+                if !(before.is_empty() || before == "unsafe") {
+                    continue;
+                }
+                let Some(open) = code[i..].iter().position(|&c| c == b'{').map(|p| p + i) else {
+                    continue;
+                };
+                let Some(close) = matching_brace(code, open) else {
+                    continue;
+                };
+                let first = line_at(code, at);
+                let lines = line_at(code, close) - first + 1;
+                if lines > max_lines {
+                    let header: String = file.code[at..open].split_whitespace().collect::<Vec<_>>().join(" ");
+                    out.push(LongFunction {
+                        file: file.relative.clone(),
+                        name: header,
+                        line: first,
+                        lines,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// Every file with more than `max_lines` lines, test-only files (`tests.rs`, and files
+    /// under a `tests/` folder of `src/`) left out, with its line count.
+    pub fn long_files(&self, max_lines: usize) -> Vec<(PathBuf, usize)> {
+        self.files
+            .values()
+            .filter(|f| {
+                !f.relative.ends_with("tests.rs")
+                    && !f.relative.components().any(|c| c.as_os_str() == "tests")
+            })
+            .map(|f| (f.relative.clone(), f.code.lines().count()))
+            .filter(|(_, lines)| *lines > max_lines)
+            .collect()
+    }
+
     /// `pub use` / `pub(crate) use` re-exports of a file: exported name -> full path.
     fn reexports_of(&self, file: &SourceFile) -> BTreeMap<String, Vec<String>> {
         let mut out = BTreeMap::new();

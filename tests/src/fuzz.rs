@@ -897,7 +897,9 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             hang_limit: text_limit,
         });
     } else {
-        eprintln!("fuzz: no /usr/share/darknet/data/coco.names (Debian darknet): labels left out");
+        crate::skip::skip_or_panic(
+            "fuzz target labels: no /usr/share/darknet/data/coco.names (apt-get install darknet; ./test does)",
+        );
     }
 
     // Images for `rover detect`: darknet's photos (JPEG) and a PNG render from docs/.
@@ -916,6 +918,10 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             load: Box::new(|p| outcome(rover_perception::load_rgb(p))),
             hang_limit: text_limit,
         });
+    } else {
+        crate::skip::skip_or_panic(
+            "fuzz target image_jpeg: no /usr/share/darknet/data/person.jpg or dog.jpg (apt-get install darknet; ./test does)",
+        );
     }
     out.push(Target {
         name: "image_png",
@@ -985,10 +991,10 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             hang_limit: Duration::from_secs(30),
         });
     } else {
-        eprintln!(
-            "fuzz: the default model is not fetched yet ({}): onnx left out",
+        crate::skip::skip_or_panic(format!(
+            "fuzz target onnx: the default model is not in rover's cache ({}; scripts/setup.sh test fetches it)",
             model.display()
-        );
+        ));
     }
     Ok(out)
 }

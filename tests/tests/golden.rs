@@ -296,3 +296,51 @@ fn the_golden_tolerance_catches_a_centimetre_on_one_row() -> Result<()> {
     );
     Ok(())
 }
+
+/// The follow tolerances hold at their edges (`Tolerance::FOLLOW`: 5 cm, 0.05 rad): a smooth
+/// drift growing to 4 cm in position, or to 0.04 rad in heading, over the whole run (ground
+/// truth and odometry alike, each row a hair from the one before) passes; the same drift
+/// grown to 6 cm or 0.06 rad fails, on the limit itself rather than on a jump between rows.
+#[test]
+fn the_golden_tolerance_holds_at_its_limits() -> Result<()> {
+    let want = std::fs::read_to_string(repo("tests/golden/follow.csv"))?;
+    let lines: Vec<&str> = want.lines().collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let column = |name: &str| header.iter().position(|c| *c == name);
+    let rows = lines.len() - 1;
+    // Adds `total * i / rows` to `columns` of row i: a drift that grows smoothly to `total`.
+    let drifted = |columns: &[&str], total: f64| -> Result<String> {
+        let indices: Vec<usize> = columns
+            .iter()
+            .map(|c| column(c).ok_or_else(|| anyhow::anyhow!("no column {c}")))
+            .collect::<Result<_>>()?;
+        let mut out = vec![lines[0].to_owned()];
+        for (i, line) in lines[1..].iter().enumerate() {
+            let mut cells: Vec<String> = line.split(',').map(str::to_owned).collect();
+            for &k in &indices {
+                let v: f64 = cells[k].parse()?;
+                cells[k] = format!("{:.9}", v + total * (i + 1) as f64 / rows as f64);
+            }
+            out.push(cells.join(","));
+        }
+        Ok(out.join("\n") + "\n")
+    };
+    let position = ["x_m", "odom_x_m"];
+    let heading = ["yaw_rad", "odom_yaw_rad"];
+    for (columns, inside, outside, limit) in [
+        (&position, 0.04, 0.06, "m from the golden one"),
+        (&heading, 0.04, 0.06, "rad from the golden one"),
+    ] {
+        let drift = golden::compare(&drifted(columns, inside)?, &want, &Tolerance::FOLLOW)
+            .map_err(|p| anyhow::anyhow!("{columns:?} drifting to {inside} failed: {p:?}"))?;
+        println!("{columns:?} drifting to {inside}: {drift:?}");
+        let problems = golden::compare(&drifted(columns, outside)?, &want, &Tolerance::FOLLOW)
+            .err()
+            .unwrap_or_default();
+        assert!(
+            problems.iter().any(|p| p.contains(limit)) && !problems.iter().any(|p| p.contains("jumped")),
+            "{columns:?} drifting to {outside} should fail on the limit alone: {problems:?}"
+        );
+    }
+    Ok(())
+}

@@ -116,16 +116,20 @@ fn stretch_re2v0_expands_to_the_urdf_shipped_beside_it() -> Result<()> {
         return Ok(());
     };
     let dir = wheel.join("stretch_urdf/RE2V0");
-    for variant in [
+    let variants = [
         "tool_stretch_gripper",
         "tool_stretch_dex_wrist",
         "eoa_wrist_dw3_tool_sg3",
-    ] {
+    ];
+    let mut compared = 0;
+    for variant in variants {
         let xacro = dir.join(format!("xacro/stretch_description_RE2V0_{variant}.xacro"));
         let urdf = dir.join(format!("stretch_description_RE2V0_{variant}.urdf"));
-        if !urdf.is_file() {
-            continue;
-        }
+        anyhow::ensure!(
+            urdf.is_file(),
+            "{}: the wheel ships no URDF for {variant}",
+            urdf.display()
+        );
         let ours = describe(&expand(&xacro, &[])?)?;
         let shipped = describe(&std::fs::read_to_string(&urdf)?)?;
         println!(
@@ -134,7 +138,9 @@ fn stretch_re2v0_expands_to_the_urdf_shipped_beside_it() -> Result<()> {
             ours.joints.len()
         );
         assert_same(&ours, &shipped, variant);
+        compared += 1;
     }
+    assert_eq!(compared, variants.len(), "variants compared");
     Ok(())
 }
 

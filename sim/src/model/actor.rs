@@ -20,6 +20,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Mat4, Quat, Vec3};
 
 use crate::geometry::Rgba;
+use crate::model::skin;
 
 /// Time step of the table of distance walked along a script (s).
 const DISTANCE_STEP_S: f64 = 0.01;
@@ -447,7 +448,7 @@ pub struct PosedSkin {
     /// Each skeleton joint's transform in the actor's frame (m).
     pub joints: Vec<Affine3A>,
     world: Vec<Mat4>,
-    skinning: Vec<Mat4>,
+    skinning: Vec<Affine3A>,
 }
 
 impl ActorSkin {
@@ -539,16 +540,11 @@ impl ActorSkin {
         out.skinning.extend(
             self.bind
                 .iter()
-                .map(|&(joint, inverse_bind)| out.world[joint] * inverse_bind),
+                .map(|&(joint, inverse_bind)| Affine3A::from_mat4(out.world[joint] * inverse_bind)),
         );
         out.positions.resize(self.rest.len(), Vec3::ZERO);
         for ((p, rest), weights) in out.positions.iter_mut().zip(&self.rest).zip(&self.weights) {
-            let mut sum = Vec3::ZERO;
-            for &(k, w) in weights.iter().filter(|(_, w)| *w > 0.0) {
-                if let Some(m) = out.skinning.get(k as usize) {
-                    sum += w * m.transform_point3(*rest);
-                }
-            }
+            let sum = skin::blend_point(&out.skinning, weights, *rest);
             *p = self.to_rover.transform_point3(sum);
         }
         out.normals.clear();

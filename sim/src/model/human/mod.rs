@@ -24,6 +24,7 @@ pub use assets::{AssetPaths, BaseMesh, JointRule, MeshGroup, Rig, RigBone, SkinW
 pub use gait::{Posture, STANCE_FRACTION};
 
 use crate::error::{Result, SimError};
+use crate::model::skin;
 use gait::{Arm, Leg, Limbs};
 
 /// What a triangle of the body is drawn as.
@@ -792,15 +793,9 @@ impl Body {
             .zip(out.normals.iter_mut())
             .enumerate()
         {
-            let (rest, rest_n) = (self.rest[v], self.rest_normals[v]);
-            let (mut sum_p, mut sum_n) = (Vec3::ZERO, Vec3::ZERO);
-            for &(bone, w) in self.weights.of(v) {
-                let m = &out.bones[bone as usize];
-                sum_p += w * m.transform_point3(rest);
-                sum_n += w * m.transform_vector3(rest_n);
-            }
-            *p = sum_p;
-            *n = sum_n.normalize_or_zero();
+            let influences = self.weights.of(v);
+            *p = skin::blend_point(&out.bones, influences, self.rest[v]);
+            *n = skin::blend_vector(&out.bones, influences, self.rest_normals[v]).normalize_or_zero();
         }
     }
 }
