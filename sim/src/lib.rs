@@ -12,7 +12,8 @@
 //!
 //! The crate is layered, each layer a folder that imports only the ones before it:
 //! `geometry`/`error`/`io`/`noise` -> `model` (plain data) -> `description` (file formats ->
-//! model) -> `physics` -> `render` -> `sensors`. The modules are private; this page lists the
+//! model) -> `physics` -> `planning` (the arm's planner and its planning scene) -> `render` ->
+//! `sensors`. The modules are private; this page lists the
 //! API. Viewers that draw the scene use the same triangles the camera renders: [`shape_mesh`],
 //! [`object_mesh`] and [`person_parts`] give [`MeshData`] in each thing's own frame.
 
@@ -23,6 +24,7 @@ mod io;
 mod model;
 mod noise;
 mod physics;
+mod planning;
 mod render;
 mod sensors;
 
@@ -47,17 +49,18 @@ pub use model::{
     Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
     Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
     Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, Place,
-    PlanError, PlannerOptions, RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE,
-    TextureImage, TexturedRun, TimedPath, TrajectoryConstraints, TrajectorySpec, Transmission,
+    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE,
+    TextureImage, TexturedRun, TrajectoryConstraints, TrajectorySpec, Transmission,
     Visual, Walk, World, check_step_hz, class_of_model, is_known_class, isometry_from_pose,
-    label_part_of_model, link_from_optical, plan_path,
+    label_part_of_model, link_from_optical,
 };
 pub use noise::SplitMix64;
+pub use planning::{PlanError, PlanningScene, PlannerOptions, SceneContact, TimedPath, plan_path};
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, GripperState,
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
     JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook,
-    PlanningScene, SceneContact, SimOptions, Simulation, TrajectoryError, TrajectoryOutcome,
+    SimOptions, Simulation, TrajectoryError, TrajectoryOutcome,
     TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds, wrap_angle,
 };
 pub use render::{

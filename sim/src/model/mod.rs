@@ -15,7 +15,6 @@ pub mod human;
 pub(crate) mod kinematics;
 pub(crate) mod mesh;
 pub(crate) mod person;
-pub(crate) mod planner;
 pub(crate) mod robot;
 pub(crate) mod sensors;
 pub(crate) mod skin;
@@ -38,7 +37,6 @@ pub use kinematics::{
 };
 pub use mesh::{MeshData, MeshVertex, TextureImage, TexturedRun};
 pub use person::{Person, Walk};
-pub use planner::{PlanError, PlannerOptions, TimedPath, plan_path};
 pub use robot::{
     Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
 };

@@ -60,6 +60,12 @@ pub struct Walk {
 }
 
 impl Person {
+    /// Whether rover draws this person with MakeHuman's body: a shape, and no skin of an
+    /// actor's own.
+    pub fn needs_makehuman(&self) -> bool {
+        self.shape.is_some() && !self.actor.as_ref().is_some_and(|a| a.skin.is_some())
+    }
+
     /// A 1.75 m person in rover's default clothes, standing at `position_m` facing
     /// `heading_rad`.
     pub fn standing(name: impl Into<String>, position_m: [f64; 2], heading_rad: f64) -> Self {

@@ -13,7 +13,6 @@ pub(crate) mod grasp;
 pub(crate) mod grip_friction;
 pub(crate) mod joints;
 pub(crate) mod placement;
-pub(crate) mod scene;
 pub(crate) mod simulation;
 pub(crate) mod states;
 pub(crate) mod trajectory;
@@ -27,7 +26,6 @@ pub use diff_drive::{
     WheelSpeeds, wrap_angle,
 };
 pub use placement::PersonLook;
-pub use scene::{PlanningScene, SceneContact};
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use states::ModelState;
 pub use trajectory::{JointTrajectory, TrajectoryError, TrajectoryPoint};

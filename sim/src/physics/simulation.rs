@@ -140,7 +140,9 @@ fn actuate(
 impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
-        crate::model::human::check_available(&world.people)?;
+        crate::model::human::check_available(
+            world.people.iter().any(crate::model::person::Person::needs_makehuman),
+        )?;
         let drivable = robot.diff_drive.is_some();
         // A robot bolted to the world (a `world` root link: an arm on a table) is not meant to
         // drive; anything else without a drive is told why cmd_vel does nothing.

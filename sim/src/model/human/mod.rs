@@ -834,14 +834,11 @@ pub fn shared() -> Option<Arc<Human>> {
     loaded().as_ref().ok().cloned()
 }
 
-/// Fails, naming the body and why it cannot be had, when one of `people` is drawn with
-/// MakeHuman's body (a shape, no skin of its own), the body cannot be had, and [`REQUIRE_ENV`]
-/// is set. Loads the body (once per process) only when some person needs it.
-pub fn check_available(people: &[crate::model::person::Person]) -> Result<()> {
-    let needs_body = people
-        .iter()
-        .any(|p| p.shape.is_some() && !p.actor.as_ref().is_some_and(|a| a.skin.is_some()));
-    if !needs_body || !required() {
+/// Fails, naming the body and why it cannot be had, when `needed` (some person is drawn with
+/// MakeHuman's body: [`crate::Person::needs_makehuman`]), the body cannot be had, and
+/// [`REQUIRE_ENV`] is set. Loads the body (once per process) only when it is needed.
+pub fn check_available(needed: bool) -> Result<()> {
+    if !needed || !required() {
         return Ok(());
     }
     match loaded() {
