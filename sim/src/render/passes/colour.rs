@@ -7,7 +7,7 @@ use glam::{Mat4, Vec3};
 
 use crate::geometry::{Pose, Rgba};
 use crate::model::world::World;
-use crate::render::passes::scene_pipeline;
+use crate::render::passes::{Uniform, scene_pipeline, uniform};
 use crate::render::scene::Scene;
 
 const SKY: [f32; 3] = [0.62, 0.75, 0.9];
@@ -92,33 +92,16 @@ impl ColourPass {
         let checker_size_m = world.ground.checker_size_m as f32;
         let [sx, sy, sz] = world.sun_direction.map(|v| v as f32);
         let sun = Vec3::new(sx, sy, sz).try_normalize().unwrap_or(Vec3::NEG_Z);
-        let globals = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("globals"),
-            size: std::mem::size_of::<Globals>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("globals layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("globals"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: globals.as_entire_binding(),
-            }],
-        });
+        let Uniform {
+            buffer: globals,
+            layout,
+            bind_group,
+        } = uniform(
+            device,
+            "colour",
+            std::mem::size_of::<Globals>() as u64,
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+        );
         let pipeline = pipeline(device, &layout, &scene.materials.layout);
         let target = texture(device, "camera color", width, height, COLOR_FORMAT, true);
         let depth = texture(device, "camera depth", width, height, DEPTH_FORMAT, true);

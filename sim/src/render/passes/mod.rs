@@ -47,3 +47,55 @@ pub(crate) fn scene_pipeline(
         cache: None,
     })
 }
+
+/// A pass's uniform buffer and the bind group (one buffer at binding 0) that hands it to the
+/// pass's shaders.
+pub(crate) struct Uniform {
+    /// The buffer, written before each draw.
+    pub(crate) buffer: wgpu::Buffer,
+    /// The bind group's layout, for the pass's pipeline layout.
+    pub(crate) layout: wgpu::BindGroupLayout,
+    /// The bind group.
+    pub(crate) bind_group: wgpu::BindGroup,
+}
+
+/// A uniform buffer of `size` bytes seen by the shader stages `visibility`, labelled `label`.
+pub(crate) fn uniform(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    visibility: wgpu::ShaderStages,
+) -> Uniform {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(&format!("{label} globals")),
+        size,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(&format!("{label} layout")),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }],
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: buffer.as_entire_binding(),
+        }],
+    });
+    Uniform {
+        buffer,
+        layout,
+        bind_group,
+    }
+}

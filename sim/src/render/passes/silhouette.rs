@@ -13,7 +13,7 @@ use glam::Mat4;
 
 use crate::render::gpu::{Readback, RenderError};
 use crate::render::passes::colour::View;
-use crate::render::passes::scene_pipeline;
+use crate::render::passes::{Uniform, scene_pipeline, uniform};
 use crate::render::scene::Scene;
 
 /// A silhouette layer's format: 0 outside, 255 inside.
@@ -84,33 +84,16 @@ impl SilhouettePass {
                 })
             })
             .collect();
-        let globals = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("silhouette globals"),
-            size: std::mem::size_of::<Globals>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("silhouette layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("silhouette"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: globals.as_entire_binding(),
-            }],
-        });
+        let Uniform {
+            buffer: globals,
+            layout,
+            bind_group,
+        } = uniform(
+            device,
+            "silhouette",
+            std::mem::size_of::<Globals>() as u64,
+            wgpu::ShaderStages::VERTEX,
+        );
         Ok(Self {
             pipelines: pipelines(device, &layout, per_pass),
             globals,
