@@ -1,0 +1,196 @@
+//! The physics benchmark (`rover bench`, `rover bench physics`): the robot drives a figure of
+//! eight, optionally holding an object, and the real-time factor is measured.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use rover_core::RunConfig;
+use rover_sim::{SimOptions, Simulation, Twist};
+
+use crate::cli::args::{PhysicsBenchArgs, WorldArgs};
+
+/// One benchmark measurement.
+#[derive(Debug, Clone, Copy)]
+pub struct PhysicsBench {
+    /// Physics step rate (Hz).
+    pub step_hz: f64,
+    /// Sim seconds simulated.
+    pub sim_s: f64,
+    /// Wall seconds it took (best of the repeats).
+    pub wall_s: f64,
+    /// With an object held: how far it ended from the end effector (m).
+    pub held_off_m: Option<f64>,
+}
+
+impl PhysicsBench {
+    /// Sim seconds per wall second.
+    pub fn real_time_factor(&self) -> f64 {
+        self.sim_s / self.wall_s
+    }
+
+    /// Wall microseconds per physics step.
+    pub fn us_per_step(&self) -> f64 {
+        self.wall_s * 1e6 / (self.sim_s * self.step_hz)
+    }
+}
+
+/// Steps the world's physics with the robot driving a figure of eight (forward at
+/// [`EIGHT_SPEED_MPS`], a full circle left at [`EIGHT_TURN_RADPS`], then one right) for `sim_s`
+/// seconds, `repeats` times; keeps the fastest. The eight closes, so the robot stays within
+/// 3.5 m of where it started however long it runs (a 20 m ground holds it).
+pub fn physics(
+    config: &RunConfig,
+    step_hz: Option<f64>,
+    (sim_s, repeats): (f64, u32),
+    hold: Option<&str>,
+) -> Result<PhysicsBench> {
+    let (world, robot) = config.load_world_and_robot()?;
+    let options = SimOptions {
+        step_hz,
+        ..config.options.clone()
+    };
+    let mut best = f64::INFINITY;
+    let mut rate = 0.0;
+    let mut held_off_m = None;
+    for _ in 0..repeats.max(1) {
+        let mut sim = Simulation::new(world.clone(), robot.clone(), &options)?;
+        rate = 1.0 / sim.dt_s();
+        let held = hold.map(|name| grasp(&mut sim, name)).transpose()?;
+        let first = sim.step_index();
+        let steps = (sim_s / sim.dt_s()).round() as u64;
+        let started = Instant::now();
+        let mut turning_left = true;
+        let lobe_steps = (std::f64::consts::TAU / EIGHT_TURN_RADPS * rate).round() as u64;
+        while sim.step_index() - first < steps {
+            if (sim.step_index() - first).is_multiple_of(lobe_steps.max(1)) {
+                let turn = if turning_left {
+                    EIGHT_TURN_RADPS
+                } else {
+                    -EIGHT_TURN_RADPS
+                };
+                sim.set_cmd_vel(Twist::new(EIGHT_SPEED_MPS, turn))?;
+                turning_left = !turning_left;
+            }
+            sim.step();
+        }
+        best = best.min(started.elapsed().as_secs_f64());
+        if let Some((object, tool)) = held {
+            held_off_m = Some(object_to_link_m(&sim, object, tool));
+        }
+    }
+    Ok(PhysicsBench {
+        step_hz: rate,
+        sim_s,
+        wall_s: best,
+        held_off_m,
+    })
+}
+
+/// The physics benchmark's driving speed (m/s).
+const EIGHT_SPEED_MPS: f64 = 0.5;
+/// The physics benchmark's turn rate (rad/s): circles of 0.83 m radius.
+const EIGHT_TURN_RADPS: f64 = 0.6;
+
+/// Puts world object `name` in the robot's gripper, untimed: the first gripper controller
+/// opens, the object goes to the end effector (the world's `[robot] ee_link`), the gripper
+/// closes on it with 5 N and settles. Returns the object's index and the end effector.
+fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::LinkId)> {
+    let object = sim
+        .world()
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or_else(|| anyhow::anyhow!("--hold {name}: the world has no object \"{name}\""))?;
+    let ee = sim.world().robot.ee_link.clone().ok_or_else(|| {
+        anyhow::anyhow!("--hold needs the world's [robot] ee_link (where the object is held)")
+    })?;
+    let tool = sim
+        .robot()
+        .link_id(&ee)
+        .ok_or_else(|| anyhow::anyhow!("--hold: the robot has no link \"{ee}\" (ee_link)"))?;
+    let (controller, joint) = sim
+        .robot()
+        .controllers
+        .as_ref()
+        .and_then(|c| c.first_gripper())
+        .map(|(name, g)| (name.to_owned(), g.joint.clone()))
+        .ok_or_else(|| anyhow::anyhow!("--hold needs a gripper controller"))?;
+    let open = sim
+        .robot()
+        .joint_id(&joint)
+        .and_then(|j| sim.robot().joint(j).position_limits())
+        .map_or(0.0, |(_, hi)| f64::from(hi));
+    sim.command_gripper(&controller, open, 0.0)?;
+    let settle = |sim: &mut Simulation, s: f64| {
+        let end = sim.sim_time_s() + s;
+        while sim.sim_time_s() < end {
+            sim.step();
+        }
+    };
+    settle(sim, 1.0);
+    let at = sim.world_from_link(tool).translation;
+    let at = [f64::from(at.x), f64::from(at.y), f64::from(at.z)];
+    sim.place_object(object, at, 0.0)?;
+    sim.command_gripper(&controller, 0.0, 5.0)?;
+    settle(sim, 1.5);
+    let off = object_to_link_m(sim, object, tool);
+    anyhow::ensure!(
+        off < 0.02,
+        "--hold {name}: the gripper did not take it ({off:.3} m from {ee} after closing)"
+    );
+    Ok((object, tool))
+}
+
+/// An object this close to the end effector (m) is still in the hand.
+const HELD_WITHIN_M: f64 = 0.05;
+
+/// How far world object `object` is from link `link` (m).
+fn object_to_link_m(sim: &Simulation, object: usize, link: rover_sim::LinkId) -> f64 {
+    let mut poses = Vec::new();
+    sim.object_poses_into(&mut poses);
+    let o = poses.get(object).map(|p| p.translation).unwrap_or_default();
+    f64::from((o - sim.world_from_link(link).translation).length())
+}
+
+pub(crate) fn bench_cmd(world: WorldArgs, args: PhysicsBenchArgs) -> Result<()> {
+    let (sim_seconds, repeats, rates) = (args.sim_seconds, args.repeats, args.rates);
+    anyhow::ensure!(
+        sim_seconds.is_finite() && sim_seconds > 0.0,
+        "--sim-seconds must be positive, found {sim_seconds}"
+    );
+    let config = world.run_config(None);
+    let mut plan: Vec<Option<f64>> = vec![world.physics_hz];
+    plan.extend(rates.into_iter().map(Some));
+    say!("physics-only benchmark: {sim_seconds} sim s per run, best of {repeats}, one thread");
+    say!(
+        "{:>10} {:>12} {:>12} {:>14}",
+        "step_hz",
+        "wall_s",
+        "us/step",
+        "real-time x"
+    );
+    for step_hz in plan {
+        let b = physics(
+            &config,
+            step_hz,
+            (sim_seconds, repeats),
+            args.hold.as_deref(),
+        )?;
+        say!(
+            "{:>10.0} {:>12.3} {:>12.1} {:>14.0}",
+            b.step_hz,
+            b.wall_s,
+            b.us_per_step(),
+            b.real_time_factor()
+        );
+        if let (Some(name), Some(off)) = (&args.hold, b.held_off_m) {
+            let verdict = if off < HELD_WITHIN_M {
+                "still in the hand"
+            } else {
+                "dropped"
+            };
+            say!("  {name}: {verdict}, {off:.3} m from the end effector at the end");
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,210 @@
+//! The sensor benchmarks: camera frame time (`rover bench camera`) and laser scan time with
+//! the follower's command on it (`rover bench laser`).
+
+use std::time::Instant;
+
+use anyhow::Result;
+use rover_core::RunConfig;
+use rover_sim::{Simulation, Twist};
+
+use super::stats::median;
+use crate::cli::args::WorldArgs;
+
+/// Result of the camera benchmark.
+#[derive(Debug, Clone)]
+pub struct CameraBench {
+    /// Graphics adapter used.
+    pub adapter: String,
+    /// Image size (px).
+    pub size: (u32, u32),
+    /// Median render + readback (ms).
+    pub median_ms: f64,
+    /// Fastest frame (ms).
+    pub best_ms: f64,
+    /// Median with ground truth on: id image and silhouettes read back, boxes measured (ms).
+    pub truth_median_ms: f64,
+    /// Median ms per image with the depth image read back too.
+    pub depth_median_ms: f64,
+    /// Labelled things in the world.
+    pub labelled: usize,
+}
+
+/// Renders `frames` camera images of the world from the robot's camera while it drives a
+/// circle (render + readback + post-processing per frame, after one warm-up), interleaving a
+/// camera without and one with ground truth so both see the same machine load.
+pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
+    let (world, robot) = config.load_world_and_robot()?;
+    let mut sim = Simulation::new(world, robot, &config.options)?;
+    // The colour image alone, then with ground truth, then with a depth image.
+    let mut sensor = rover_sim::CameraSensor::new(&sim)?;
+    sensor.disable_depth();
+    let mut truth = rover_sim::CameraSensor::new(&sim)?;
+    truth.disable_depth();
+    truth.enable_ground_truth(&sim)?;
+    let mut depth = rover_sim::CameraSensor::new(&sim)?;
+    depth.enable_depth();
+    depth.capture(&sim)?;
+    sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
+    sensor.capture(&sim)?;
+    truth.capture(&sim)?;
+    let mut times = Vec::with_capacity(frames);
+    let mut truth_times = Vec::with_capacity(frames);
+    let mut depth_times = Vec::with_capacity(frames);
+    for _ in 0..frames.max(1) {
+        for _ in 0..5 {
+            sim.step();
+        }
+        let start = Instant::now();
+        sensor.capture(&sim)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        let start = Instant::now();
+        truth.capture(&sim)?;
+        truth_times.push(start.elapsed().as_secs_f64() * 1e3);
+        let start = Instant::now();
+        depth.capture(&sim)?;
+        depth_times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok(CameraBench {
+        adapter: sensor.renderer().adapter().to_owned(),
+        size: (sensor.info().width, sensor.info().height),
+        median_ms: median(&mut times),
+        best_ms,
+        truth_median_ms: median(&mut truth_times),
+        depth_median_ms: median(&mut depth_times),
+        labelled: rover_sim::EntityIds::new(sim.world()).len(),
+    })
+}
+
+/// Laser benchmark figures.
+#[derive(Debug, Clone)]
+pub struct LaserBench {
+    /// Rays per scan.
+    pub rays: u32,
+    /// Scans per sim second.
+    pub rate_hz: f64,
+    /// Median wall time of one scan (ms).
+    pub median_ms: f64,
+    /// Fastest scan (ms).
+    pub best_ms: f64,
+    /// Median wall time of one follower command with the scan's obstacles (us).
+    pub follower_us: f64,
+    /// Median wall time of the avoidance's full window search over the scan's returns, with
+    /// the way ahead blocked (the worst case, us).
+    pub window_search_us: f64,
+}
+
+/// Laser: time per scan (ray casts against the physics scene) and the follower's command with
+/// that scan's obstacles, in the configured world with its robot (default: the playground and
+/// the tutorial car with its laser).
+pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
+    let (world, robot) = config.load_world_and_robot()?;
+    anyhow::ensure!(
+        !robot.lasers.is_empty(),
+        "{}: the robot has no <sensor type=\"ray\">; try --robot assets/robots/my_robot_laser.urdf.xacro",
+        robot.source.display()
+    );
+    let mut sim = Simulation::new(world, robot, &config.options)?;
+    let mut sensor = rover_sim::LaserSensor::new(&sim, 0)?;
+    let mount = rover_core::LaserMount::from_base_from_laser(
+        sim.world_from_base().inverse() * sensor.world_from_sensor(&sim),
+    );
+    // The camera's geometry does not matter here: no detections are fed.
+    let geometry = rover_core::CameraGeometry {
+        fx: 381.0,
+        fy: 381.0,
+        cx: 320.5,
+        cy: 240.5,
+        width_px: 640.0,
+        height_px: 480.0,
+        height_m: 0.18,
+        forward_m: 0.15,
+        left_m: 0.0,
+        yaw_rad: 0.0,
+        pitch_down_rad: 0.0,
+    };
+    let mut follower = rover_core::Follower::new(rover_core::FollowerConfig::default(), geometry)
+        .with_laser(mount);
+    sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
+    sensor.scan_now(&sim);
+    let mut times = Vec::with_capacity(scans);
+    let mut follower_times = Vec::with_capacity(scans);
+    let mut window_times = Vec::with_capacity(scans);
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let avoid = rover_core::AvoidConfig::default();
+    for _ in 0..scans.max(1) {
+        for _ in 0..5 {
+            if let Some(sample) = sim.step() {
+                follower.record_pose(sample.sim_time_s, sample.odometry);
+            }
+        }
+        let start = Instant::now();
+        let scan = sensor.scan_now(&sim);
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        points.clear();
+        points.extend(
+            scan.points()
+                .map(|[x, y]| [f64::from(x) + mount.x_m, f64::from(y) + mount.y_m]),
+        );
+        points.push([0.5, 0.0]);
+        follower.observe_scan(scan);
+        let start = Instant::now();
+        let _ = follower.command(sim.sim_time_s(), sim.odometry(), true);
+        follower_times.push(start.elapsed().as_secs_f64() * 1e6);
+        let start = Instant::now();
+        let out = avoid.choose(Twist::new(0.8, 0.0), [4.0, 0.0], &points, 0.8, 1.2, 0.0);
+        window_times.push(start.elapsed().as_secs_f64() * 1e6);
+        std::hint::black_box(out);
+    }
+    let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok(LaserBench {
+        rays: sensor.config().samples,
+        rate_hz: sensor.config().update_rate_hz,
+        median_ms: median(&mut times),
+        best_ms,
+        follower_us: median(&mut follower_times),
+        window_search_us: median(&mut window_times),
+    })
+}
+
+pub(crate) fn bench_laser(world: WorldArgs, scans: usize) -> Result<()> {
+    let config = world.run_config(None);
+    let b = laser(&config, scans)?;
+    say!(
+        "laser benchmark: {} rays at {} Hz, {scans} scans: median {:.3} ms, best {:.3} ms per scan ({:.2}% of a core at {} Hz); follower command {:.1} us; avoidance window search (worst case, every return) {:.0} us",
+        b.rays,
+        b.rate_hz,
+        b.median_ms,
+        b.best_ms,
+        b.median_ms * b.rate_hz / 10.0,
+        b.rate_hz,
+        b.follower_us,
+        b.window_search_us
+    );
+    Ok(())
+}
+
+pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
+    let config = world.run_config(None);
+    let b = camera(&config, frames)?;
+    say!(
+        "camera benchmark: {}x{} on {}, {frames} frames: median {:.2} ms, best {:.2} ms per frame (render + readback)",
+        b.size.0,
+        b.size.1,
+        b.adapter,
+        b.median_ms,
+        b.best_ms
+    );
+    say!(
+        "with ground truth ({} labelled things: id image, silhouettes, boxes): median {:.2} ms, +{:.2} ms",
+        b.labelled,
+        b.truth_median_ms,
+        b.truth_median_ms - b.median_ms
+    );
+    say!(
+        "with a depth image (the depth buffer read back as metres): median {:.2} ms, +{:.2} ms",
+        b.depth_median_ms,
+        b.depth_median_ms - b.median_ms
+    );
+    Ok(())
+}
