@@ -72,7 +72,7 @@ pub struct RunConfig {
     /// Follower settings.
     pub follower: FollowerConfig,
     /// The arm's look and reach (links, classes).
-    pub arm: crate::arm_task::ArmConfig,
+    pub arm: crate::arm::ArmConfig,
     /// Measure ground truth for every camera image and judge each detection against it
     /// (observers get [`crate::Observer::detections_truth`]).
     pub ground_truth: bool,

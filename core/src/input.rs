@@ -24,7 +24,7 @@ pub enum Action {
     /// puts it on the place).
     TogglePick,
     /// Set the arm's task (off, look, reach, pick): what ROS's `/rover/arm/task` asks for.
-    Arm(crate::arm_task::ArmMode),
+    Arm(crate::arm::ArmMode),
     /// Move the robot's joints (the arm); the base's mode does not change.
     Joint(JointAction),
 }

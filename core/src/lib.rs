@@ -11,7 +11,7 @@
 //! Nothing here depends on winit, wgpu surfaces, rerun or gilrs: everything runs headless in
 //! tests. The modules are private; this page lists the API.
 
-mod arm_task;
+mod arm;
 mod dataset;
 mod detection;
 mod error;
@@ -20,13 +20,10 @@ mod headless;
 mod input;
 mod judge;
 mod launch;
-mod look;
 mod observer;
 mod paths;
 mod people_sweep;
-mod pick;
 mod pilot;
-mod reach;
 mod run_files;
 mod scenario;
 mod script;
@@ -35,7 +32,10 @@ mod shard;
 mod teleop;
 mod trace;
 
-pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
+pub use arm::{
+    ArmConfig, ArmMode, ArmStatus, DepthView, Look, LookConfig, Pick, PickConfig, PickState, Reach,
+    ReachConfig, ReachState, ReachStep, object_estimate, object_point, pregrasp,
+};
 pub use dataset::{
     COCO_CATEGORY_IDS, DatasetFormat, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox,
     ImageFormat, ImageRecord, LabelledBox, MANIFEST, MANIFEST_FORMAT, Manifest, PersonShot,
@@ -60,17 +60,12 @@ pub use launch::{
     find_launch_file, find_node_executable, load as load_launch, ns_join, provided_placeholder,
     role_of, shell_split,
 };
-pub use look::{Look, LookConfig};
 pub use observer::{EventLevel, Fanout, LoopStats, NoObserver, Observer};
 pub use paths::{bundled_path, default_robot_path};
 pub use people_sweep::{
     SWEEP_DISTANCES_M, SWEEP_HEADINGS_DEG, SWEEP_POSTURES, SweepPosture, SweepView, sweep,
 };
-pub use pick::{Pick, PickConfig, PickState};
 pub use pilot::{Mode, Pilot};
-pub use reach::{
-    DepthView, Reach, ReachConfig, ReachState, ReachStep, object_estimate, object_point, pregrasp,
-};
 pub use run_files::{FrameSaver, RunFiles, RunFilesWritten, TraceObserver};
 pub use scenario::{
     Scenario, ScenarioCheck, ScenarioCriteria, ScenarioMetrics, ScenarioOptions, ScenarioResult,

@@ -8,7 +8,7 @@ use rover_sim::{
     CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
 };
 
-use crate::arm_task::ArmStatus;
+use crate::arm::ArmStatus;
 use crate::error::CoreError;
 use crate::follower::FollowState;
 use crate::pilot::Mode;

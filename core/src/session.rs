@@ -16,7 +16,7 @@ use rover_sim::{
     SimOptions, Simulation, World,
 };
 
-use crate::arm_task::{ArmConfig, ArmMode, ArmTask};
+use crate::arm::{ArmConfig, ArmMode, ArmTask};
 pub use crate::detection::DetectorMode;
 use crate::detection::{Detected, Detection};
 use crate::error::{CoreError, Result};
@@ -210,12 +210,12 @@ impl Session {
     }
 
     /// The arm's reach controller, when the robot has one (an end effector, a depth camera).
-    pub fn reach(&self) -> Option<&crate::reach::Reach> {
+    pub fn reach(&self) -> Option<&crate::arm::Reach> {
         self.arm.reach()
     }
 
     /// The arm's pick controller, when the robot has one (an end effector, a depth camera).
-    pub fn pick(&self) -> Option<&crate::pick::Pick> {
+    pub fn pick(&self) -> Option<&crate::arm::Pick> {
         self.arm.pick()
     }
 

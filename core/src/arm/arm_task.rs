@@ -11,9 +11,9 @@ use rover_sim::{
     KinematicsError, LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
 };
 
-use crate::look::{Look, LookConfig};
-use crate::pick::{Pick, PickConfig, PickState};
-use crate::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
+use super::look::{Look, LookConfig};
+use super::pick::{Pick, PickConfig, PickState};
+use super::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
 
 /// A tool point whose arm comes this close (m) to anything is refused (touching counts).
 const TOOL_CONTACT_M: f32 = 0.001;
@@ -242,7 +242,7 @@ impl ArmTask {
             })
             .and_then(|ee| {
                 KinematicChain::new(robot, base_name, ee)
-                    .and_then(|chain| IkSolver::new(chain, crate::reach::arm_ik_options()))
+                    .and_then(|chain| IkSolver::new(chain, super::reach::arm_ik_options()))
                     .map_err(|e| e.to_string())
             });
         let look_while_reaching = match (&look, &reach) {
@@ -362,7 +362,10 @@ impl ArmTask {
             mode
         }
     }
+}
 
+// Switching tasks, and what each image, detector message and control update does for them.
+impl ArmTask {
     /// Switches to `next` (the arm stops where it is); the text for the event log, or why it
     /// cannot run (a warning; nothing changes). Setting the mode that runs starts it afresh.
     pub(crate) fn set(&mut self, next: ArmMode, sim: &mut Simulation) -> Result<String, String> {

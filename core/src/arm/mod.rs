@@ -1,0 +1,16 @@
+//! The arm's room: what the arm does with what the camera sees — look (turn a camera's chain
+//! onto a detection), reach (the tool to a pre-grasp point), pick (grasp and place, the base
+//! driving with `fetch`) — and the session's arm task that runs them.
+
+mod arm_task;
+mod look;
+mod pick;
+mod reach;
+
+pub(crate) use arm_task::ArmTask;
+pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
+pub use look::{Look, LookConfig};
+pub use pick::{Pick, PickConfig, PickState};
+pub use reach::{
+    DepthView, Reach, ReachConfig, ReachState, ReachStep, object_estimate, object_point, pregrasp,
+};

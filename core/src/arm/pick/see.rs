@@ -1,0 +1,140 @@
+//! Seeing the object: sightings from detector messages and depth, or a named world object
+//! by its pose, and the plan that follows once it is known.
+
+use nalgebra::{Isometry3, Vector3};
+use rover_perception::BoundingBoxes;
+use rover_sim::{Shape, Simulation, isometry_from_pose};
+
+use crate::arm::reach::{DepthView, object_estimate};
+
+use super::state::{Pick, PickState, Target};
+use super::world::world_object;
+
+impl Pick {
+    /// A detector message with the depth image it came from, taken at `captured_s` (sim time)
+    /// with the arm's base at `world_from_base`: while seeking, a sighting; once the sightings
+    /// agree, the plan. With `fetch`, a sighting out of reach sends the base to it, and each
+    /// sighting on the way corrects where it goes.
+    pub fn observe(
+        &mut self,
+        boxes: &BoundingBoxes,
+        view: &DepthView<'_>,
+        (world_from_base, captured_s): (&Isometry3<f64>, f64),
+        sim: &Simulation,
+    ) {
+        // A named object is taken by its pose ([`Self::update`]), not by what is seen.
+        let fetching = self.state == PickState::Fetching;
+        if !(self.state == PickState::Seeking || fetching) || self.known_object(sim).is_some() {
+            return;
+        }
+        if captured_s < self.settle_until_s {
+            return;
+        }
+        let c = &self.config;
+        let seen = boxes
+            .bounding_boxes
+            .iter()
+            .filter(|b| b.class == c.class && b.probability >= c.min_probability)
+            .max_by(|a, b| a.probability.total_cmp(&b.probability))
+            .and_then(|b| object_estimate(b, view, self.intrinsics, c.max_range_m));
+        let Some(seen) = seen else {
+            self.sightings.clear();
+            return;
+        };
+        if self.fetch_towards(sim, seen.0, world_from_base) {
+            return;
+        }
+        let c = &self.config;
+        if self
+            .sightings
+            .first()
+            .is_some_and(|(p, _)| (p - seen.0).norm() > c.agree_m)
+        {
+            self.sightings.clear();
+        }
+        self.sightings.push(seen);
+        if self.sightings.len() < c.sightings as usize {
+            return;
+        }
+        let n = self.sightings.len() as f64;
+        let centre = self.sightings.iter().map(|(p, _)| p).sum::<Vector3<f64>>() / n;
+        let radius = self.sightings.iter().map(|(_, r)| r).sum::<f64>() / n;
+        let what = format!("the {}", self.config.class);
+        self.plan_for(sim, &what, Target::round(centre, radius));
+    }
+
+    /// Plans the whole pick of `target` (called `what`), and starts it or says why not.
+    fn plan_for(&mut self, sim: &Simulation, what: &str, target: Target) {
+        let centre = target.centre;
+        self.object = Some((centre, target.bound_m));
+        let started = std::time::Instant::now();
+        let planned = self.plan(sim, what, target);
+        self.planning_s = Some(started.elapsed().as_secs_f64());
+        match planned {
+            Ok(steps) => {
+                self.steps = steps;
+                self.state = PickState::Approaching;
+                self.said.push((
+                    false,
+                    format!(
+                        "pick: {what} at ({:.3}, {:.3}, {:.3}) m, {:.3} m across; planned in {:.3} s",
+                        centre.x,
+                        centre.y,
+                        centre.z,
+                        2.0 * target.bound_m,
+                        self.planning_s.unwrap_or_default()
+                    ),
+                ));
+            }
+            Err(why) => self.fail(format!(
+                "{what} at ({:.3}, {:.3}, {:.3}) m: {why}",
+                centre.x, centre.y, centre.z
+            )),
+        }
+    }
+
+    /// The world object to take by its known pose, if one is named (here or in the world's
+    /// `[robot] pick`).
+    pub fn known_object<'a>(&'a self, sim: &'a Simulation) -> Option<&'a str> {
+        (self.config.object.as_deref()).or(sim.world().robot.pick.as_deref())
+    }
+
+    /// Takes the named world object by its pose now (arm base frame): a box by its faces, a
+    /// sphere or anything else as round.
+    pub(super) fn seek_known(&mut self, sim: &Simulation, name: &str) {
+        let (shape, pose) = match world_object(sim, name, "to pick") {
+            Ok(found) => found,
+            Err(why) => return self.fail(why),
+        };
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        let base_from_object = world_from_base.inverse() * isometry_from_pose(&pose);
+        let centre = base_from_object.translation.vector;
+        if self.fetch_towards(sim, centre, &world_from_base) {
+            return;
+        }
+        let Some(half_height_m) = shape.half_height_m().map(f64::from) else {
+            return self.fail(format!(
+                "\"{name}\" is a mesh: pick takes boxes, spheres, cylinders and capsules by name"
+            ));
+        };
+        let target = match shape {
+            Shape::Box { size_m } => {
+                let half = [size_m.x, size_m.y, size_m.z].map(|v| f64::from(v) / 2.0);
+                Target {
+                    centre,
+                    half_height_m,
+                    bound_m: half.iter().map(|h| h * h).sum::<f64>().sqrt(),
+                    cuboid: Some((base_from_object.rotation, half)),
+                }
+            }
+            Shape::Sphere { radius_m }
+            | Shape::Cylinder { radius_m, .. }
+            | Shape::Capsule { radius_m, .. } => Target {
+                half_height_m,
+                ..Target::round(centre, f64::from(*radius_m))
+            },
+            Shape::Mesh { .. } => return,
+        };
+        self.plan_for(sim, &format!("\"{name}\""), target);
+    }
+}

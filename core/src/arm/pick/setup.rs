@@ -1,0 +1,161 @@
+//! Building a pick, starting it afresh or stopping it, and what it reports (its state, the
+//! object, the last plan, what it has to say).
+
+use std::collections::VecDeque;
+
+use nalgebra::Vector3;
+use rover_sim::{
+    CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, KinematicChain, LinkId, Simulation,
+    isometry_from_pose,
+};
+
+use super::config::PickConfig;
+use super::fetch::DriveTo;
+use super::state::{Gripper, Pick, PickState};
+
+impl Pick {
+    /// A pick for the chain from `base_link` to `tool_link` of `sim`'s robot, seeing through
+    /// `camera` (none: it can only take a named object, [`PickConfig::object`]), with the
+    /// robot's first gripper controller.
+    pub fn new(
+        sim: &Simulation,
+        camera: Option<&CameraConfig>,
+        base_link: &str,
+        tool_link: &str,
+        config: PickConfig,
+    ) -> Result<Self, String> {
+        let robot = sim.robot();
+        let chain = KinematicChain::new(robot, base_link, tool_link).map_err(|e| e.to_string())?;
+        let (base, tool) = (chain.base(), chain.tip());
+        let options = IkOptions {
+            tolerance_m: 5e-4,
+            tolerance_rad: 5e-3,
+            ..IkOptions::default()
+        };
+        let solver = IkSolver::new(chain, options).map_err(|e| e.to_string())?;
+        let intrinsics = camera.map_or([0.0; 4], |camera| {
+            let info = CameraInfo::from_config(camera);
+            [info.k[0], info.k[4], info.k[2], info.k[5]]
+        });
+        Ok(Self {
+            config,
+            solver,
+            base,
+            tool,
+            gripper: find_gripper(sim, tool),
+            intrinsics,
+            sightings: Vec::new(),
+            state: PickState::Seeking,
+            steps: VecDeque::new(),
+            running: None,
+            object: None,
+            planning_s: None,
+            path_points: None,
+            q: Vec::new(),
+            v: Vec::new(),
+            said: Vec::new(),
+            drive: DriveTo::default(),
+            leg: None,
+            base_cmd: None,
+            settle_until_s: 0.0,
+            held: None,
+        })
+    }
+
+    /// The joints it moves, base to tool.
+    pub fn joints(&self) -> &[ChainJoint] {
+        self.solver.chain().joints()
+    }
+
+    /// What it is doing.
+    pub fn state(&self) -> PickState {
+        self.state
+    }
+
+    /// The object's centre (base frame, m) and radius (m), once seen.
+    pub fn object(&self) -> Option<(Vector3<f64>, f64)> {
+        self.object
+    }
+
+    /// Wall-clock seconds the plan took, once planned.
+    pub fn planning_s(&self) -> Option<f64> {
+        self.planning_s
+    }
+
+    /// Waypoints of the last plan's joint-space paths (to the pre-grasp, the carry, home; 0
+    /// for a leg without one): 2 is a straight joint move, more goes round something.
+    pub fn path_points(&self) -> Option<[usize; 3]> {
+        self.path_points
+    }
+
+    /// Starts afresh.
+    pub fn reset(&mut self) {
+        self.sightings.clear();
+        self.state = PickState::Seeking;
+        self.steps.clear();
+        self.running = None;
+        self.object = None;
+        self.planning_s = None;
+        self.path_points = None;
+        self.drive.reset();
+        self.leg = None;
+        self.base_cmd = None;
+        self.settle_until_s = 0.0;
+        self.held = None;
+    }
+
+    /// What it has to say since the last call: (warning, text).
+    pub fn drain_said(&mut self) -> impl Iterator<Item = (bool, String)> + '_ {
+        self.said.drain(..)
+    }
+
+    /// Stops where it is (the arm holds, the base is left alone), saying `why`.
+    pub fn stop(&mut self, why: &str) {
+        self.fail(why.to_owned());
+    }
+
+    pub(super) fn fail(&mut self, why: String) {
+        self.state = PickState::Failed;
+        self.steps.clear();
+        self.running = None;
+        self.leg = None;
+        self.base_cmd = None;
+        self.said.push((true, format!("pick: {why}")));
+    }
+}
+
+/// The robot's first gripper controller: its name, finger joint and limits (open at the upper
+/// limit, as Franka's and the arm car's fingers are), and the way its finger moves seen from
+/// `tool` (rigidly on the finger joint's parent, as a tool point on a hand is).
+fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
+    let robot = sim.robot();
+    let spec = robot
+        .controllers
+        .as_ref()
+        .and_then(|c| c.first_gripper())
+        .map(|(name, g)| (name.to_owned(), g.joint.clone()))
+        .ok_or_else(|| {
+            "the robot has no gripper controller (a GripperActionController in its controllers file)"
+                .to_owned()
+        })?;
+    let joint = robot
+        .joint_id(&spec.1)
+        .ok_or_else(|| format!("no finger joint \"{}\"", spec.1))?;
+    let (closed, open) = robot
+        .joint(joint)
+        .position_limits()
+        .map(|(lo, hi)| (f64::from(lo), f64::from(hi)))
+        .ok_or_else(|| format!("finger joint \"{}\" has no limits", spec.1))?;
+    let finger = robot.joint(joint);
+    let world_from = |link| isometry_from_pose(&sim.world_from_link(link));
+    let axis = finger.parent_from_child.rotation * finger.axis;
+    let across_tool = (world_from(tool).rotation.inverse() * world_from(finger.parent).rotation)
+        * Vector3::new(f64::from(axis.x), f64::from(axis.y), f64::from(axis.z));
+    Ok(Gripper {
+        controller: spec.0,
+        joint,
+        open,
+        closed,
+        across_tool,
+    })
+}

@@ -1,0 +1,183 @@
+//! Where the base stands for a pick (`fetch`): driving it to within reach of the object, and
+//! with the object in the hand to the place, then the place's plan from there.
+
+use std::collections::VecDeque;
+
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
+use rover_sim::{Simulation, isometry_from_pose};
+
+use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
+use super::plan::over_place;
+use super::state::{Held, Leg, Pick, PickState, Step};
+
+impl Pick {
+    /// Where the object should be when the base stops to pick it (arm base frame, m), when
+    /// the pick drives the base.
+    pub(super) fn fetch_at(&self, sim: &Simulation) -> Option<Vector2<f64>> {
+        (self.config.fetch_at)
+            .or(sim.world().robot.fetch)
+            .map(|[x, y]| Vector2::new(x, y))
+    }
+
+    /// The object is at `centre` (base frame, the base at `world_from_base`): with fetch, when
+    /// it is out of the arm's spot (or already being driven to), the base drives to it.
+    /// Returns whether it does.
+    pub(super) fn fetch_towards(
+        &mut self,
+        sim: &Simulation,
+        centre: Vector3<f64>,
+        world_from_base: &Isometry3<f64>,
+    ) -> bool {
+        let Some(at) = self.fetch_at(sim) else {
+            return false;
+        };
+        let driving = self.state == PickState::Fetching;
+        if !driving && (centre.xy() - at).norm() < FETCH_FROM_M {
+            return false;
+        }
+        let goal = (world_from_base * Point3::from(centre)).coords;
+        let started_s = match self.leg {
+            Some(leg) if driving => leg.started_s,
+            _ => {
+                self.drive.reset();
+                self.said.push((
+                    false,
+                    format!(
+                        "pick: fetch: driving to the object at ({:.2}, {:.2}) m",
+                        goal.x, goal.y
+                    ),
+                ));
+                sim.sim_time_s()
+            }
+        };
+        self.sightings.clear();
+        self.state = PickState::Fetching;
+        self.leg = Some(Leg {
+            goal,
+            to_place: false,
+            started_s,
+            back_from: None,
+        });
+        true
+    }
+
+    /// One control update of a drive: the base's command, and what comes after it gets there
+    /// (a fresh look at the object, or the place's plan once the base has settled).
+    pub(super) fn drive_base(&mut self, sim: &Simulation, now: f64) {
+        let Some(leg) = self.leg else {
+            return;
+        };
+        let Some(at) = self.fetch_at(sim) else {
+            self.leg = None;
+            return;
+        };
+        if now - leg.started_s > MAX_DRIVE_S {
+            self.leg = None;
+            return self.fail(format!(
+                "fetch: the base did not get there in {MAX_DRIVE_S:.0} s"
+            ));
+        }
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        if let Some(from) = leg.back_from {
+            if (world_from_base.translation.vector.xy() - from).norm() < BACK_OFF_M {
+                self.base_cmd = Some(self.drive.back(now));
+                return;
+            }
+            self.leg = Some(Leg {
+                back_from: None,
+                ..leg
+            });
+        }
+        let point = world_from_base.inverse() * Point3::from(leg.goal);
+        let (cmd, there) = self.drive.command(now, point.coords.xy(), at);
+        self.base_cmd = Some(cmd);
+        if !there {
+            return;
+        }
+        self.leg = None;
+        self.settle_until_s = now + SETTLE_BASE_S;
+        let (x, y) = (point.x, point.y);
+        if leg.to_place {
+            self.said.push((
+                false,
+                format!("pick: fetch: at the place ({x:.3}, {y:.3}) m from the arm's base"),
+            ));
+        } else {
+            self.state = PickState::Seeking;
+            self.said.push((
+                false,
+                format!(
+                    "pick: fetch: the object should be at ({x:.3}, {y:.3}) m from the arm's base; looking again"
+                ),
+            ));
+        }
+    }
+
+    /// After the grasp's steps, with the object held for a fetch: the drive to the place,
+    /// then (the base settled) the place's plan. Returns whether it took over (`false`:
+    /// nothing is held for it, the pick is done).
+    pub(super) fn deliver(&mut self, sim: &Simulation, now: f64) -> bool {
+        let Some(held) = &self.held else {
+            return false;
+        };
+        if self.state != PickState::Delivering {
+            let [x, y, z] = held.place.0;
+            let base = sim.world_from_link(self.base).translation;
+            self.leg = Some(Leg {
+                goal: Vector3::new(x, y, z),
+                to_place: true,
+                started_s: now,
+                back_from: Some(Vector2::new(f64::from(base.x), f64::from(base.y))),
+            });
+            self.drive.reset();
+            self.state = PickState::Delivering;
+            self.said.push((
+                false,
+                format!("pick: fetch: driving to the place at ({x:.2}, {y:.2}) m"),
+            ));
+            return true;
+        }
+        if self.leg.is_some() || now < self.settle_until_s {
+            return true;
+        }
+        let Some(held) = self.held.take() else {
+            return false;
+        };
+        match self.plan_delivery(sim, held) {
+            Ok(steps) => self.steps = VecDeque::from(steps),
+            Err(why) => self.fail(format!("fetch: at the place: {why}")),
+        }
+        true
+    }
+
+    /// The place's plan from where the arm is now, the object held as it was taken.
+    fn plan_delivery(
+        &mut self,
+        sim: &Simulation,
+        held: Held,
+    ) -> Result<Vec<(Step, PickState)>, String> {
+        let (g, world_from_base, mut scene) = self.planning_start(sim)?;
+        let q = self.chain_q(sim);
+        // The object in the hand is carried, not avoided.
+        let tool = self
+            .solver
+            .chain()
+            .base_from_tip(&q)
+            .map_err(|e| e.to_string())?;
+        let in_hand = world_from_base * Point3::from(tool.translation.vector);
+        if let Some(i) = scene.object_near(
+            [in_hand.x, in_hand.y, in_hand.z],
+            held.target.bound_m as f32 + 0.02,
+        ) {
+            scene.ignore_object(i, true);
+        }
+        let over = over_place(&world_from_base, held.place, held.target.half_height_m);
+        self.plan_place(
+            &mut scene,
+            (held.target, held.way),
+            &g,
+            (&q, &held.home_q),
+            over,
+        )
+    }
+}

@@ -1,0 +1,222 @@
+//! What a pick is and keeps: [`Pick`] and its [`PickState`], and the plan's parts (steps, the
+//! gripper, the target, the ways to take hold, the base's legs) the phase files share.
+
+use std::collections::VecDeque;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+use rover_sim::{IkSolver, IkTarget, JointId, LinkId, TimedPath, Twist};
+
+use super::config::PickConfig;
+use super::fetch::DriveTo;
+
+/// What the pick is doing, as the HUD, Rerun and ROS show it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PickState {
+    /// Looking for the object.
+    #[default]
+    Seeking,
+    /// Opening, going to the pre-grasp and in.
+    Approaching,
+    /// Closing on the object.
+    Grasping,
+    /// Lifting it.
+    Lifting,
+    /// Carrying it to the place.
+    Carrying,
+    /// Letting go over the place.
+    Releasing,
+    /// Backing off and going home.
+    Retreating,
+    /// Done.
+    Done,
+    /// Refused or failed (the reason was said).
+    Failed,
+    /// Driving the base to within reach of the object (`fetch`).
+    Fetching,
+    /// Driving the base, the object in the hand, to the place (`fetch`).
+    Delivering,
+}
+
+impl PickState {
+    /// Its name in lower case.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Seeking => "seeking",
+            Self::Approaching => "approaching",
+            Self::Grasping => "grasping",
+            Self::Lifting => "lifting",
+            Self::Carrying => "carrying",
+            Self::Releasing => "releasing",
+            Self::Retreating => "retreating",
+            Self::Done => "done",
+            Self::Failed => "failed",
+            Self::Fetching => "fetching",
+            Self::Delivering => "delivering",
+        }
+    }
+
+    /// 0 seeking ... 8 failed, 9 fetching, 10 delivering (for plots).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// One thing to do.
+#[derive(Debug, Clone)]
+pub(super) enum Step {
+    /// Follow a timed path.
+    Move(TimedPath),
+    /// Command the gripper; done when it reached its goal or stalled. `grip`: it must stall
+    /// on something.
+    Gripper { position: f64, grip: bool },
+    /// Wait (s); with the grasp assist, until it holds (or the time is up).
+    Wait { s: f64, until_held: bool },
+}
+
+/// The joint-space paths of a grasp.
+#[derive(Debug)]
+pub(super) struct Grasp {
+    /// From the start to the pre-grasp.
+    pub(super) to_pre: Vec<Vec<f64>>,
+    /// Straight in, from the pre-grasp to the grasp.
+    pub(super) descent: Vec<Vec<f64>>,
+    /// Straight up with the object.
+    pub(super) lift: Vec<Vec<f64>>,
+    /// How the hand holds it.
+    pub(super) way: Way,
+}
+
+/// The gripper the pick uses.
+#[derive(Debug, Clone)]
+pub(super) struct Gripper {
+    pub(super) controller: String,
+    pub(super) joint: JointId,
+    pub(super) open: f64,
+    pub(super) closed: f64,
+    /// The direction the finger joint moves, in the tool's frame (unit): the fingers close
+    /// across it.
+    pub(super) across_tool: Vector3<f64>,
+}
+
+impl Gripper {
+    /// Each finger's furthest from the middle (m or rad): half the widest the hand opens.
+    pub(super) fn widest_m(&self) -> f64 {
+        self.open.abs().max(self.closed.abs())
+    }
+}
+
+/// What is picked, as the plan needs it (arm base frame, m).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Target {
+    /// Its centre.
+    pub(super) centre: Vector3<f64>,
+    /// From its centre down to what it rests on.
+    pub(super) half_height_m: f64,
+    /// A sphere round it: the hand carries it as this.
+    pub(super) bound_m: f64,
+    /// A box: its orientation (base frame) and half sizes along its axes; the fingers close
+    /// across its x or y faces. `None`: round (any turn of the hand will do).
+    pub(super) cuboid: Option<(UnitQuaternion<f64>, [f64; 3])>,
+}
+
+impl Target {
+    /// A ball (or anything round) of `radius_m` at `centre`.
+    pub(super) fn round(centre: Vector3<f64>, radius_m: f64) -> Self {
+        Self {
+            centre,
+            half_height_m: radius_m,
+            bound_m: radius_m,
+            cuboid: None,
+        }
+    }
+}
+
+/// One way of taking hold: the tool's z along `along` (the way in), its turn about it fixed
+/// by `turn` or free.
+#[derive(Debug, Clone)]
+pub(super) struct Way {
+    /// How a refusal names it.
+    pub(super) label: String,
+    /// The tool's z axis (base frame, unit).
+    pub(super) along: Vector3<f64>,
+    /// The tool's whole orientation (base frame), when its turn matters (across a box's
+    /// faces).
+    pub(super) turn: Option<UnitQuaternion<f64>>,
+    /// Each finger's position closed on the object (m from the middle).
+    pub(super) grip_m: f64,
+}
+
+impl Way {
+    /// The IK target for the tool at `point`.
+    pub(super) fn target(&self, point: Vector3<f64>) -> IkTarget {
+        match self.turn {
+            Some(turn) => IkTarget::pose(&Isometry3::from_parts(Translation3::from(point), turn)),
+            None => IkTarget::approach(point, self.along),
+        }
+    }
+}
+
+/// The pick controller for one arm.
+#[derive(Debug, Clone)]
+pub struct Pick {
+    pub(super) config: PickConfig,
+    pub(super) solver: IkSolver,
+    pub(super) base: LinkId,
+    pub(super) tool: LinkId,
+    pub(super) gripper: Result<Gripper, String>,
+    pub(super) intrinsics: [f64; 4],
+    pub(super) sightings: Vec<(Vector3<f64>, f64)>,
+    pub(super) state: PickState,
+    pub(super) steps: VecDeque<(Step, PickState)>,
+    /// The step running and when it started (s of sim time).
+    pub(super) running: Option<(Step, f64)>,
+    /// The object's centre (base frame) and radius, once seen.
+    pub(super) object: Option<(Vector3<f64>, f64)>,
+    /// Wall-clock seconds the last plan took.
+    pub(super) planning_s: Option<f64>,
+    /// Waypoints of the last plan's joint-space paths: to the pre-grasp, the carry, home
+    /// (2: a straight joint move; more: it goes round something).
+    pub(super) path_points: Option<[usize; 3]>,
+    pub(super) q: Vec<f64>,
+    pub(super) v: Vec<f64>,
+    /// What to say next (a warning when `true`).
+    pub(super) said: Vec<(bool, String)>,
+    /// The base's go-to-point controller (`fetch`).
+    pub(super) drive: DriveTo,
+    /// Where the base is driving to, while it is.
+    pub(super) leg: Option<Leg>,
+    /// What the base is told this control update (`fetch`: zero while the arm works).
+    pub(super) base_cmd: Option<Twist>,
+    /// No sighting from an image taken before this (s of sim time): the base was moving.
+    pub(super) settle_until_s: f64,
+    /// The object in the hand, to be placed once the base is at the place (`fetch`).
+    pub(super) held: Option<Held>,
+}
+
+/// Where the base is driving to.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Leg {
+    /// The point brought to the fetch point (world frame, m): the object's centre, or the
+    /// place's point under the object.
+    pub(super) goal: Vector3<f64>,
+    /// To the place, the object in the hand (else to the object).
+    pub(super) to_place: bool,
+    /// When the drive started (s of sim time).
+    pub(super) started_s: f64,
+    /// Backing away first, from where the base was (world x, y, m).
+    pub(super) back_from: Option<Vector2<f64>>,
+}
+
+/// The object in the hand while the base drives to the place.
+#[derive(Debug, Clone)]
+pub(super) struct Held {
+    /// What it is, as it was taken.
+    pub(super) target: Target,
+    /// How the hand holds it.
+    pub(super) way: Way,
+    /// Where the arm goes back to after the place.
+    pub(super) home_q: Vec<f64>,
+    /// The place ([`Pick::place_under`]): the point under the object (world, m), how high above
+    /// it the carry ends, how far the hand then goes straight down.
+    pub(super) place: ([f64; 3], f64, f64),
+}

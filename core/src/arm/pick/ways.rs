@@ -1,0 +1,189 @@
+//! The ways to take hold of an object (round, or a box across its faces) and the IK that
+//! checks them: a reachable, collision-free pose and straight moves of the tool.
+
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use rover_sim::{IkTarget, PlanningScene};
+
+use super::state::{Gripper, Pick, Way};
+
+/// Joint-space waypoints (the chain's joints each).
+type Waypoints = Vec<Vec<f64>>;
+
+/// Spacing of a straight move's waypoints (m).
+const LINE_STEP_M: f64 = 0.01;
+/// The most one joint may change between a straight move's waypoints (rad): more is IK
+/// jumping to another branch.
+const MAX_LINE_JUMP_RAD: f64 = 0.3;
+
+impl Pick {
+    /// The ways to take hold of something round at `point` (base frame): coming in along
+    /// [`PickConfig::approach_pitches_deg`] below horizontal, away from the arm's base, the
+    /// turn about the way in free; the fingers close to `grip_m`.
+    pub(super) fn ways_round(&self, point: Vector3<f64>, grip_m: f64) -> Vec<Way> {
+        let horizontal = Vector3::new(point.x, point.y, 0.0)
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::x);
+        (self.config.approach_pitches_deg.iter())
+            .map(|pitch_deg| {
+                let pitch = pitch_deg.to_radians();
+                Way {
+                    label: format!("{pitch_deg:.0} deg down"),
+                    along: horizontal * pitch.cos() - Vector3::z() * pitch.sin(),
+                    turn: None,
+                    grip_m,
+                }
+            })
+            .collect()
+    }
+
+    /// The ways to take hold of a box from above: the fingers across one pair of its faces
+    /// (the narrower first), either way round; only faces the open gripper fits round (with
+    /// 5 mm to spare on each side).
+    pub(super) fn ways_across(&self, mut faces: [(Vector3<f64>, f64); 2], g: &Gripper) -> Vec<Way> {
+        faces.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let down = -Vector3::z();
+        let open = g.widest_m();
+        let mut ways = Vec::new();
+        for (k, (axis, half)) in faces.iter().enumerate() {
+            let across = (axis - down * axis.dot(&down)).try_normalize(1e-6);
+            let Some(across) = across.filter(|_| *half + 0.005 <= open) else {
+                continue;
+            };
+            for sign in [1.0, -1.0] {
+                if let Some(turn) = turn_taking(g.across_tool, across * sign, down) {
+                    ways.push(Way {
+                        label: format!(
+                            "from above across its {} faces{}",
+                            ["narrow", "wide"][k],
+                            if sign < 0.0 { ", turned round" } else { "" }
+                        ),
+                        along: down,
+                        turn: Some(turn),
+                        grip_m: *half,
+                    });
+                }
+            }
+        }
+        ways
+    }
+
+    /// Joint positions putting the tool at `point` (base frame) the first of `ways` IK
+    /// reaches there without a collision (with `back_m`, the straight way back out along it
+    /// free too, returned), and which way; else why not each way.
+    pub(super) fn reachable(
+        &mut self,
+        scene: &mut PlanningScene,
+        point: Vector3<f64>,
+        seed: &[f64],
+        what: &str,
+        back_m: Option<f64>,
+        ways: &[Way],
+    ) -> Result<(Vec<f64>, Waypoints, usize), String> {
+        let mut why: Vec<String> = Vec::new();
+        for (k, way) in ways.iter().enumerate() {
+            let label = &way.label;
+            let solution = self
+                .solver
+                .solve(&way.target(point), seed)
+                .map_err(|e| e.to_string())?;
+            if !ik_close(solution.position_error_m, solution.orientation_error_rad) {
+                why.push(format!(
+                    "{label}: out of reach by {:.3} m",
+                    solution.position_error_m
+                ));
+                continue;
+            }
+            if let Some(hit) = scene.collision(&solution.q) {
+                why.push(format!("{label}: {hit}"));
+                continue;
+            }
+            // The straight way in, `back_m` long, must be there too.
+            let back = match back_m {
+                Some(back_m) => {
+                    let to = point - way.along * back_m;
+                    match self.line_at_least(scene, &solution.q, (point, to), Some(way), 1.0) {
+                        Ok(line) => line,
+                        Err(e) => {
+                            why.push(format!("{label}: {e}"));
+                            continue;
+                        }
+                    }
+                }
+                None => Vec::new(),
+            };
+            return Ok((solution.q, back, k));
+        }
+        Err(format!("{what}, coming in {}", why.join("; ")))
+    }
+
+    /// A straight line of the tool from `from` (at `from_q`) to `to` (base frame), held to
+    /// `way`'s direction when given: joint waypoints every centimetre, each by IK from the
+    /// last, each free. It may stop short where IK or the scene ends it once `share` of the way
+    /// is done (a lift or a retreat at the edge of the arm's reach).
+    pub(super) fn line_at_least(
+        &mut self,
+        scene: &mut PlanningScene,
+        from_q: &[f64],
+        (from, to): (Vector3<f64>, Vector3<f64>),
+        way: Option<&Way>,
+        share: f64,
+    ) -> Result<Vec<Vec<f64>>, String> {
+        let n = ((to - from).norm() / LINE_STEP_M).ceil().max(1.0) as usize;
+        let mut waypoints = vec![from_q.to_vec()];
+        for k in 1..=n {
+            let p = from + (to - from) * (k as f64 / n as f64);
+            let last = waypoints.last().cloned().unwrap_or_default();
+            let target = way.map_or(IkTarget::point(p), |w| w.target(p));
+            let s = self
+                .solver
+                .solve(&target, &last)
+                .map_err(|e| e.to_string())?;
+            let jump =
+                s.q.iter()
+                    .zip(&last)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+            let done = (k - 1) as f64 / n as f64;
+            let blocked = !ik_close(s.position_error_m, s.orientation_error_rad)
+                || jump > MAX_LINE_JUMP_RAD
+                || scene.collision(&s.q).is_some();
+            if blocked && done >= share && k > 1 {
+                break;
+            }
+            if !ik_close(s.position_error_m, s.orientation_error_rad) || jump > MAX_LINE_JUMP_RAD {
+                return Err(format!(
+                    "no straight move from ({:.3}, {:.3}, {:.3}) to ({:.3}, {:.3}, {:.3}) m: IK {:.3} m off, a {jump:.2} rad jump",
+                    from.x, from.y, from.z, to.x, to.y, to.z, s.position_error_m
+                ));
+            }
+            if let Some(hit) = scene.collision(&s.q) {
+                return Err(format!("the straight move collides: {hit}"));
+            }
+            waypoints.push(s.q);
+        }
+        Ok(waypoints)
+    }
+}
+
+/// Whether an IK solution is close enough to use: 3 mm and about 2 degrees.
+fn ik_close(position_m: f64, orientation_rad: f64) -> bool {
+    position_m <= 0.003 && orientation_rad <= 0.035
+}
+
+/// The tool's orientation (base frame) whose z is `along` and whose finger direction
+/// (`across_tool`, in the tool's frame) is `across`; `None` when either pair is parallel.
+fn turn_taking(
+    across_tool: Vector3<f64>,
+    across: Vector3<f64>,
+    along: Vector3<f64>,
+) -> Option<UnitQuaternion<f64>> {
+    let frame = |x: Vector3<f64>, z: Vector3<f64>| -> Option<Matrix3<f64>> {
+        let z = z.try_normalize(1e-9)?;
+        let x = (x - z * x.dot(&z)).try_normalize(1e-6)?;
+        Some(Matrix3::from_columns(&[x, z.cross(&x), z]))
+    };
+    let in_tool = frame(across_tool, Vector3::z())?;
+    let in_base = frame(across, along)?;
+    let rotation = Rotation3::from_matrix_unchecked(in_base * in_tool.transpose());
+    Some(UnitQuaternion::from_rotation_matrix(&rotation))
+}
