@@ -544,18 +544,28 @@ fn assert_compare_catches_a_mistyped_param(
 ) -> Result<()> {
     let original = std::fs::read_to_string(check.join("launch/groups_and_params.launch"))?;
     let declared = r#"<param name="int_as_double" type="double" value="3"/>"#;
-    ensure!(original.contains(declared), "the fixture no longer declares {declared}");
+    ensure!(
+        original.contains(declared),
+        "the fixture no longer declares {declared}"
+    );
     let mistyped = ws.path("mistyped.launch");
     std::fs::write(
         &mistyped,
-        original.replace(declared, r#"<param name="int_as_double" type="int" value="3"/>"#),
+        original.replace(
+            declared,
+            r#"<param name="int_as_double" type="int" value="3"/>"#,
+        ),
     )?;
     let mut c = Command::new(env!("CARGO_BIN_EXE_rover"));
     c.args(["launch", "--dump-params"]).arg(&mistyped);
     c.env("ROVER_LAUNCH_SET", "set");
     ws.env(&mut c, &[stubs, check]);
     let out = run(c, Duration::from_secs(60))?;
-    ensure!(out.status.success(), "rover launch --dump-params mistyped.launch:\n{}", text(&out));
+    ensure!(
+        out.status.success(),
+        "rover launch --dump-params mistyped.launch:\n{}",
+        text(&out)
+    );
     let rover = ws.path("rover-mistyped.yaml");
     std::fs::write(&rover, &out.stdout)?;
     let empty = ws.path("empty.yaml");

@@ -362,7 +362,10 @@ impl Session {
     pub fn laser(&self) -> Option<&LaserSensor> {
         self.laser.as_ref()
     }
+}
 
+// One step of the loop: physics, the arm's task, the camera and its detections.
+impl Session {
     /// Advances one physics step: camera and laser (when due), detector, follower, physics.
     /// Returns the control sample when the diff drive's control loop ran.
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<Option<ControlSample>> {

@@ -13,10 +13,10 @@ use crate::fetch;
 use crate::graph;
 use crate::head::{self, Candidate, Head};
 use crate::labels::read_labels_file;
-use rover_assets::COCO80;
 use crate::messages::{BoundingBox, BoundingBoxes, FrameStamp};
 use crate::onnxruntime::{OrtSession, Runtime, find_onnxruntime_library};
 use crate::preprocess::{LetterboxPlan, RgbView};
+use rover_assets::COCO80;
 
 /// Input size the default model runs at: the camera's 4:3 aspect, so camera frames need no
 /// letterbox padding, at 0.8x scale: about half the work of the native 640x640 (measured on

@@ -15,7 +15,8 @@ const MODEL_LICENSE: &str =
 
 /// Where the default model lives once fetched (`CACHE/models/yolov12n.onnx`).
 pub fn default_model_path() -> PathBuf {
-    let file = rover_assets::registry::pin("crate", MODEL_CRATE).map_or("yolov12n.onnx", |p| p.file);
+    let file =
+        rover_assets::registry::pin("crate", MODEL_CRATE).map_or("yolov12n.onnx", |p| p.file);
     rover_assets::cache_dir().join("models").join(file)
 }
 

@@ -1,8 +1,9 @@
 //! The functions an expression may call: Python's conversions and `math` module, and what
 //! the host adds (`arg()`, `find()`, ...).
 
-use crate::eval::compare;
-use crate::{ExprError, R, Value, err, parse_float, parse_int};
+use crate::compare::compare;
+use crate::host::{ExprError, R, err};
+use crate::{Value, parse_float, parse_int};
 
 /// One call of a builtin function: the name as written (`math.sqrt`, for messages) and the
 /// evaluated arguments, with the argument checks the builtins share.
@@ -219,7 +220,10 @@ fn conversion_function(bare: &str, b: &Builtin<'_>) -> Option<R<Value>> {
         "str" => match b.args.as_slice() {
             [] => Ok(Value::Str(String::new())),
             [v] => Ok(Value::Str(v.to_string())),
-            more => err(format!("str() takes at most 1 argument, {} given", more.len())),
+            more => err(format!(
+                "str() takes at most 1 argument, {} given",
+                more.len()
+            )),
         },
         "bool" => b.arity(1).map(|()| Value::Bool(b.args[0].truthy())),
         "len" => b.arity(1).and_then(|()| match &b.args[0] {
@@ -250,4 +254,3 @@ fn to_int(x: f64, name: &str) -> R<Value> {
         err(format!("{name}(): cannot convert {x} to an integer"))
     }
 }
-

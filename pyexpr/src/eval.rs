@@ -1,8 +1,10 @@
 //! The evaluator: walks the tree with Python's semantics for each operator.
 
+use crate::Value;
 use crate::builtins::call;
+use crate::compare::compare;
+use crate::host::{ExprError, Host, R, err};
 use crate::parse::Expr;
-use crate::{ExprError, Host, R, Value, err};
 
 /// Longest string an expression may build (`'x' * 10**9` is refused, not allocated).
 const MAX_STR: usize = 1 << 20;
@@ -75,10 +77,7 @@ pub(crate) fn eval(e: &Expr, host: &mut dyn Host) -> R<Value> {
             }
         }
         Expr::List(items) => Ok(Value::List(
-            items
-                .iter()
-                .map(|i| eval(i, host))
-                .collect::<R<Vec<_>>>()?,
+            items.iter().map(|i| eval(i, host)).collect::<R<Vec<_>>>()?,
         )),
         Expr::Index(target, index) => subscript(eval(target, host)?, &eval(index, host)?),
         Expr::Call(name, args) => {
@@ -200,55 +199,3 @@ fn binary(op: &str, a: Value, b: Value) -> R<Value> {
         _ => type_error(),
     }
 }
-
-pub(crate) fn compare(op: &str, a: &Value, b: &Value) -> R<bool> {
-    if op == "in" || op == "not in" {
-        let found = match (a, b) {
-            (Value::Str(x), Value::Str(y)) => y.contains(x.as_str()),
-            (x, Value::List(items)) => items.iter().any(|i| values_equal(x, i)),
-            _ => {
-                return err(format!(
-                    "'in' needs a string or list on the right, found '{}'",
-                    b.type_name()
-                ));
-            }
-        };
-        return Ok(found == (op == "in"));
-    }
-    if op == "==" {
-        return Ok(values_equal(a, b));
-    }
-    if op == "!=" {
-        return Ok(!values_equal(a, b));
-    }
-    let ordering = match (a, b) {
-        (Value::Str(x), Value::Str(y)) => x.partial_cmp(y),
-        _ => match (a.number(), b.number()) {
-            (Some(x), Some(y)) => x.partial_cmp(&y),
-            _ => {
-                return err(format!(
-                    "'{op}' not supported between '{}' and '{}'",
-                    a.type_name(),
-                    b.type_name()
-                ));
-            }
-        },
-    };
-    let Some(ordering) = ordering else {
-        return Ok(false);
-    };
-    Ok(match op {
-        "<" => ordering.is_lt(),
-        "<=" => ordering.is_le(),
-        ">" => ordering.is_gt(),
-        _ => ordering.is_ge(),
-    })
-}
-
-fn values_equal(a: &Value, b: &Value) -> bool {
-    match (a.number(), b.number()) {
-        (Some(x), Some(y)) => x == y,
-        _ => a == b,
-    }
-}
-

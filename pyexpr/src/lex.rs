@@ -1,6 +1,7 @@
 //! Python's tokens, as far as the expressions use them.
 
-use crate::{ExprError, R, err, parse_float, parse_int};
+use crate::host::{ExprError, R, err};
+use crate::{parse_float, parse_int};
 
 /// One token.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,7 +32,8 @@ pub(crate) fn tokenize(src: &str) -> R<Vec<Token>> {
         {
             let start = i;
             let mut float = false;
-            while i < bytes.len() && (bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'_')) {
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'_'))
+            {
                 float |= bytes[i] == b'.';
                 i += 1;
             }
@@ -105,7 +107,6 @@ pub(crate) fn tokenize(src: &str) -> R<Vec<Token>> {
     }
     Ok(tokens)
 }
-
 
 impl Token {
     /// The token as an error message names it.

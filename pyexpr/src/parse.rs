@@ -1,8 +1,9 @@
 //! The parser: Python's grammar for expressions, from `a if c else b` down to literals,
 //! into a tree the evaluator walks.
 
+use crate::Value;
+use crate::host::{R, err};
 use crate::lex::Token;
-use crate::{R, Value, err};
 
 /// A parsed expression.
 #[derive(Debug, Clone)]
@@ -290,4 +291,3 @@ impl Parser {
         }
     }
 }
-

@@ -42,27 +42,26 @@ pub use model::actor;
 /// namespace: nothing in it is re-exported at the root).
 pub use model::human;
 pub use model::{
-    CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig,
-    ControllerKind, ControllerSpec, DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION,
-    DepthOutput, DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GraspMode,
-    GripperSpec, Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial,
-    Joint, JointId, JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig,
-    Link, LinkId, MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic,
-    Model, ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, Place,
-    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE,
-    TextureImage, TexturedRun, TrajectoryConstraints, TrajectorySpec, Transmission,
-    Visual, Walk, World, check_step_hz, class_of_model, is_known_class, isometry_from_pose,
-    label_part_of_model, link_from_optical,
+    CameraConfig, CameraInfo, ChainJoint, Collision, CommandKind, ControllerConfig, ControllerKind,
+    ControllerSpec, DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, DepthOutput,
+    DiffDriveConfig, Distortion, DriveSpec, EntityIds, GaussianNoise, GraspMode, GripperSpec,
+    Ground, HardwareInterface, IkOptions, IkSolution, IkSolver, IkTarget, Inertial, Joint, JointId,
+    JointKind, JointSolver, KinematicChain, KinematicsError, Labelled, LaserConfig, Link, LinkId,
+    MAX_LASER_SAMPLES, MODEL_CLASSES, MODEL_LABEL_PARTS, MeshData, MeshVertex, Mimic, Model,
+    ModelLink, NamedPose, Object, OdometrySource, Person, Physics, Pid, PixelFormat, Place,
+    RobotModel, RobotSpawn, RosControlPlugin, STEP_HZ_RANGE, TextureImage, TexturedRun,
+    TrajectoryConstraints, TrajectorySpec, Transmission, Visual, Walk, World, check_step_hz,
+    class_of_model, is_known_class, isometry_from_pose, label_part_of_model, link_from_optical,
 };
 pub use noise::SplitMix64;
-pub use planning::{PlanError, PlanningScene, PlannerOptions, SceneContact, TimedPath, plan_path};
 pub use physics::{
     ControlSample, ControllerCommandState, DiffDriveController, EncoderOdometry, GripperState,
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
-    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook,
-    SimOptions, Simulation, TrajectoryError, TrajectoryOutcome,
-    TrajectoryPoint, TrajectoryState, Twist, WheelSpeeds, wrap_angle,
+    JointTrajectory, ModelState, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, PersonLook, SimOptions,
+    Simulation, TrajectoryError, TrajectoryOutcome, TrajectoryPoint, TrajectoryState, Twist,
+    WheelSpeeds, wrap_angle,
 };
+pub use planning::{PlanError, PlannerOptions, PlanningScene, SceneContact, TimedPath, plan_path};
 pub use render::{
     BodyLayer, CameraRenderer, EntityImage, LEG_SWING_RAD, Light, Paint, PersonPart, RenderError,
     SkinnedBody, Swing, object_mesh, person_parts, shape_mesh, visual_mesh,

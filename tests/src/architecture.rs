@@ -214,7 +214,10 @@ impl CrateSources {
                 let first = line_at(code, at);
                 let lines = line_at(code, close) - first + 1;
                 if lines > max_lines {
-                    let header: String = file.code[at..open].split_whitespace().collect::<Vec<_>>().join(" ");
+                    let header: String = file.code[at..open]
+                        .split_whitespace()
+                        .collect::<Vec<_>>()
+                        .join(" ");
                     out.push(LongFunction {
                         file: file.relative.clone(),
                         name: header,

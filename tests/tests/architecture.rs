@@ -125,15 +125,17 @@ fn the_circle_check_finds_a_known_circle_and_follows_reexports() -> anyhow::Resu
     Ok(())
 }
 
+/// sim/src's top level: one folder per layer (description, model, physics, planning, render,
+/// sensors), the leaves every layer shares (error, geometry, io, noise) and lib.rs.
 #[test]
-fn sim_src_top_level_has_at_most_ten_entries() -> anyhow::Result<()> {
+fn sim_src_top_level_is_a_folder_per_layer_and_its_shared_leaves() -> anyhow::Result<()> {
     let mut entries: Vec<String> = std::fs::read_dir(repo("sim/src"))?
         .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
         .collect::<Result<_, _>>()?;
     entries.sort();
     assert!(
-        entries.len() <= 10,
-        "sim/src has {} entries (expected at most 10: a folder per layer): {entries:?}",
+        entries.len() <= 11,
+        "sim/src has {} entries (expected at most 11: a folder per layer, the shared leaves, lib.rs): {entries:?}",
         entries.len()
     );
     Ok(())
@@ -201,7 +203,9 @@ fn the_length_limits_catch_a_long_impl_and_a_long_file() -> anyhow::Result<()> {
     let body = "    fn f(&self) {}\n".repeat(399);
     std::fs::write(
         src.join("lib.rs"),
-        format!("mod long;\npub struct S;\nimpl S {{\n{body}}}\nimpl Clone for S {{\n    fn clone(&self) -> S {{ S }}\n}}\nfn g(_: impl Fn()) {{}}\n"),
+        format!(
+            "mod long;\npub struct S;\nimpl S {{\n{body}}}\nimpl Clone for S {{\n    fn clone(&self) -> S {{ S }}\n}}\nfn g(_: impl Fn()) {{}}\n"
+        ),
     )?;
     std::fs::write(src.join("long.rs"), "// a line\n".repeat(1001))?;
     let sources = rover_tests::architecture::CrateSources::read(src)?;

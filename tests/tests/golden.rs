@@ -338,7 +338,8 @@ fn the_golden_tolerance_holds_at_its_limits() -> Result<()> {
             .err()
             .unwrap_or_default();
         assert!(
-            problems.iter().any(|p| p.contains(limit)) && !problems.iter().any(|p| p.contains("jumped")),
+            problems.iter().any(|p| p.contains(limit))
+                && !problems.iter().any(|p| p.contains("jumped")),
             "{columns:?} drifting to {outside} should fail on the limit alone: {problems:?}"
         );
     }

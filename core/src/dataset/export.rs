@@ -4,8 +4,8 @@
 
 use std::fmt::Write as _;
 
-use rover_perception::{BoundingBoxes, Detection, EvalBox, GroundTruthObject};
 use rover_assets::COCO80;
+use rover_perception::{BoundingBoxes, Detection, EvalBox, GroundTruthObject};
 use rover_sim::{GroundTruthBox, PixelBox};
 use serde::{Deserialize, Serialize};
 

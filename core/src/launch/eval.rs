@@ -44,9 +44,10 @@ impl Host for Launch<'_> {
             "false" => Ok(Some(Value::Bool(false))),
             _ if CONSTANTS.contains(&name) || name.starts_with("math.") => Ok(None),
             _ => {
-                let text = self.0.arg(name).map_err(|e| {
-                    ExprError::Other(format!("name '{name}' is not defined: {e}"))
-                })?;
+                let text = self
+                    .0
+                    .arg(name)
+                    .map_err(|e| ExprError::Other(format!("name '{name}' is not defined: {e}")))?;
                 arg_value(&text).map(Some)
             }
         }
@@ -82,9 +83,10 @@ impl Host for Launch<'_> {
             "env" => {
                 count(1..=1)?;
                 let var = text(0)?;
-                Value::Str(std::env::var(var).map_err(|_| {
-                    other(format!("environment variable '{var}' is not set"))
-                })?)
+                Value::Str(
+                    std::env::var(var)
+                        .map_err(|_| other(format!("environment variable '{var}' is not set")))?,
+                )
             }
             "optenv" => {
                 count(1..=2)?;
@@ -110,13 +112,15 @@ impl Host for Launch<'_> {
 
 /// An arg's text as roslaunch hands it to Python: converted like a `<param>` of type `auto`.
 fn arg_value(text: &str) -> Result<Value, ExprError> {
-    Ok(match convert_value(text, "auto").map_err(ExprError::Other)? {
-        ParamValue::Bool(b) => Value::Bool(b),
-        ParamValue::Int(i) => Value::Int(i),
-        ParamValue::Double(d) => Value::Float(d),
-        ParamValue::Str(s) => Value::Str(s),
-        other => Value::Str(other.as_text()),
-    })
+    Ok(
+        match convert_value(text, "auto").map_err(ExprError::Other)? {
+            ParamValue::Bool(b) => Value::Bool(b),
+            ParamValue::Int(i) => Value::Int(i),
+            ParamValue::Double(d) => Value::Float(d),
+            ParamValue::Str(s) => Value::Str(s),
+            other => Value::Str(other.as_text()),
+        },
+    )
 }
 
 #[cfg(test)]

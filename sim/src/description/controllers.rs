@@ -425,7 +425,10 @@ impl Reader<'_> {
             line,
         })
     }
+}
 
+// The controllers that take more than one joint: grippers, trajectories, named poses.
+impl Reader<'_> {
     /// A gripper action controller: its finger joint must close between limits (prismatic or
     /// revolute) and move a link nothing else moving hangs from (a finger, not an arm joint).
     fn gripper(&self, name: &str, node: &Node) -> Result<GripperSpec> {

@@ -10,7 +10,6 @@ use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
 use crate::model::classes::is_known_class;
-use rover_assets::COCO80;
 use crate::model::drive::DriveSpec;
 use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
@@ -18,6 +17,7 @@ use crate::model::world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, GraspMode, Ground, JointSolver, Object, Physics, Place,
     RobotSpawn, World, check_step_hz,
 };
+use rover_assets::COCO80;
 
 impl World {
     /// Loads a world file: TOML, or a Gazebo SDF world (`.world`, `.sdf`) with `model://`

@@ -23,8 +23,8 @@ pub(crate) mod world;
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
 pub use camera_info::{CameraInfo, link_from_optical};
 pub use classes::{
-    EntityIds, Labelled, MODEL_CLASSES, MODEL_LABEL_PARTS, class_of_model,
-    is_known_class, label_part_of_model,
+    EntityIds, Labelled, MODEL_CLASSES, MODEL_LABEL_PARTS, class_of_model, is_known_class,
+    label_part_of_model,
 };
 pub use controllers::{
     CommandKind, ControllerConfig, ControllerKind, ControllerSpec, GripperSpec, NamedPose,

@@ -45,6 +45,9 @@ mod tests {
         assert!((halfway - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
         // Directions ignore translation; a bone past the list is left out.
         let turned = blend_vector(&bones, &[(1, 0.5), (2, 0.5), (9, 1.0)], rest);
-        assert!((turned - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6, "{turned}");
+        assert!(
+            (turned - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6,
+            "{turned}"
+        );
     }
 }

@@ -460,7 +460,10 @@ impl Actuators {
             a.pid = Some(pid);
         }
     }
+}
 
+// Each physics step: the motors' efforts from their setpoints, applied and measured.
+impl Actuators {
     /// One control update of length `dt_s`: moves setpoints, sets the motors.
     pub(crate) fn update(&mut self, physics: &mut PhysicsWorld, dt_s: f64) {
         self.measure_loads(physics);

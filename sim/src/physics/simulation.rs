@@ -141,7 +141,10 @@ impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
         crate::model::human::check_available(
-            world.people.iter().any(crate::model::person::Person::needs_makehuman),
+            world
+                .people
+                .iter()
+                .any(crate::model::person::Person::needs_makehuman),
         )?;
         let drivable = robot.diff_drive.is_some();
         // A robot bolted to the world (a `world` root link: an arm on a table) is not meant to
@@ -436,7 +439,10 @@ impl Simulation {
             .get(index)
             .map_or(0.0, |p| p.gait_phase_rad(self.sim_time_s()))
     }
+}
 
+// Commanding the robot's joints and controllers (ros_control's commands, trajectories, the gripper).
+impl Simulation {
     /// Commands a joint by name (a controller's command, a script step, a key). Errors: no
     /// such joint, a joint without an actuator, a non-finite value (the command is dropped and
     /// the last one stays in force). Positions outside the joint's limits stop at the limit.
@@ -581,7 +587,10 @@ impl Simulation {
             effort: self.actuators.of(joint).map_or(0.0, |a| a.effort),
         })
     }
+}
 
+// Reading the simulation back: time, the robot and world, poses, odometry, joint states.
+impl Simulation {
     /// Sim time (s): physics steps taken times the step length.
     pub fn sim_time_s(&self) -> f64 {
         self.step_index as f64 * self.dt_s

@@ -56,7 +56,9 @@ pub fn ensure_assets() -> Result<PathBuf> {
     let setup = |e: rover_assets::AssetError| SimError::Setup(e.to_string());
     let pin = rover_assets::registry::pin("people", PACKAGE).map_err(setup)?;
     if !rover_assets::offline() {
-        tracing::info!("fetching people's bodies: PyPI package {PACKAGE} {VERSION} (48 MB, {LICENSE})");
+        tracing::info!(
+            "fetching people's bodies: PyPI package {PACKAGE} {VERSION} (48 MB, {LICENSE})"
+        );
     }
     let wheel = rover_assets::registry::wheel(pin).map_err(|e| match e {
         rover_assets::AssetError::Offline { what, .. } => SimError::Setup(format!(

@@ -795,7 +795,8 @@ impl Body {
         {
             let influences = self.weights.of(v);
             *p = skin::blend_point(&out.bones, influences, self.rest[v]);
-            *n = skin::blend_vector(&out.bones, influences, self.rest_normals[v]).normalize_or_zero();
+            *n = skin::blend_vector(&out.bones, influences, self.rest_normals[v])
+                .normalize_or_zero();
         }
     }
 }
