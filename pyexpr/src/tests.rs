@@ -1,6 +1,7 @@
 //! The evaluator against Python's own results (the values Python 3 gives).
 
 use super::*;
+use crate::host::R;
 use std::collections::HashMap;
 
 struct Table(HashMap<&'static str, Value>);
