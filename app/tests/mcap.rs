@@ -220,7 +220,7 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         ensure!(
             (x - row.odom_x_m).abs() <= 1e-6
                 && (y - row.odom_y_m).abs() <= 1e-6
-                && rover_sim::wrap_angle(yaw - row.odom_yaw_rad).abs() <= 1e-6,
+                && rover_sim::physics::wrap_angle(yaw - row.odom_yaw_rad).abs() <= 1e-6,
             "at {stamp_s} s: odom ({x}, {y}, {yaw}) vs trace ({}, {}, {})",
             row.odom_x_m,
             row.odom_y_m,

@@ -10,7 +10,7 @@ use std::process::Command;
 
 use anyhow::Result;
 use rover_core::{TraceRow, parse_trace, trace_joints};
-use rover_sim::NamedPose;
+use rover_sim::model::NamedPose;
 
 fn repo(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -24,7 +24,8 @@ fn text(bytes: &[u8]) -> String {
 
 /// Every named pose of the arm car's controllers file, as rover reads it.
 fn arm_car_poses() -> Result<Vec<NamedPose>> {
-    let mut robot = rover_sim::RobotModel::load(&repo("assets/robots/my_robot_arm.urdf.xacro"))?;
+    let mut robot =
+        rover_sim::model::RobotModel::load(&repo("assets/robots/my_robot_arm.urdf.xacro"))?;
     robot.load_controllers(&repo("assets/controllers/my_robot_arm.yaml"))?;
     let config = robot
         .controllers

@@ -184,7 +184,7 @@ fn the_arm_car_drives_with_keys_and_its_arm_jogs() -> Result<()> {
 fn h_in_the_real_window_brings_the_jogged_arm_home() -> Result<()> {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut robot =
-        rover_sim::RobotModel::load(&repo.join("assets/robots/my_robot_arm.urdf.xacro"))?;
+        rover_sim::model::RobotModel::load(&repo.join("assets/robots/my_robot_arm.urdf.xacro"))?;
     robot.load_controllers(&repo.join("assets/controllers/my_robot_arm.yaml"))?;
     let home = robot
         .controllers

@@ -8,7 +8,7 @@ use rover_perception::{
     BoundingBoxes, Detect, Detector, DetectorConfig, DetectorWorker, FaultInjector, Frame,
     FrameStamp, InjectedFault, LockstepDetector, PerceptionError, RgbView, WorkerStats,
 };
-use rover_sim::CameraFrame;
+use rover_sim::sensors::CameraFrame;
 
 use crate::error::{CoreError, Result};
 

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use rover_perception::PerceptionError;
-use rover_sim::{RenderError, SimError};
+use rover_sim::{SimError, render::RenderError};
 
 /// Everything that can stop a run from starting or going on.
 #[derive(Debug, thiserror::Error)]

@@ -6,7 +6,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use rover_perception::{DetectorConfig, InjectedFault};
-use rover_sim::{ControlSample, LoadOptions, ResourcePaths, RobotModel, SimOptions, World};
+use rover_sim::{
+    description::{LoadOptions, ResourcePaths},
+    model::{RobotModel, World},
+    physics::{ControlSample, SimOptions},
+};
 
 use crate::error::{CoreError, Result};
 use crate::follower::FollowerConfig;
@@ -31,7 +35,7 @@ pub struct RunConfig {
     /// Where the robot spawns: x m, y m, yaw deg (overrides the world's `[robot]`).
     pub spawn: Option<[f64; 3]>,
     /// Wheels to drive (overrides the world's `[robot.drive]`).
-    pub drive: Option<rover_sim::DriveSpec>,
+    pub drive: Option<rover_sim::model::DriveSpec>,
     /// Which camera to render when the robot has several (default: the world's `[robot]
     /// camera`, else the first in the file).
     pub camera: Option<String>,

@@ -1,7 +1,7 @@
 //! What drives the loop from outside: an [`Action`] (a script step, a key, a gamepad command,
 //! ROS `/cmd_vel`), and [`InputSource`], polled for actions before every physics step.
 
-use rover_sim::{JointCommand, JointTrajectory, Twist};
+use rover_sim::physics::{JointCommand, JointTrajectory, Twist};
 
 use crate::teleop::KeyAction;
 

@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use rover_perception::{BoundingBoxes, Detection, EvalBox, FrameMatch, GroundTruthObject};
-use rover_sim::GroundTruthBox;
+use rover_sim::sensors::GroundTruthBox;
 
 /// Fills `truth` and `found` with one frame's ground truth and detections as the evaluator
 /// takes them, reusing the objects (and their class strings) already there.
@@ -161,7 +161,7 @@ impl LiveJudge {
 mod tests {
     use super::*;
     use rover_perception::{BoundingBox, FrameStamp};
-    use rover_sim::{Labelled, PixelBox};
+    use rover_sim::{model::Labelled, sensors::PixelBox};
 
     fn truth(class: &str, b: [f64; 4], visible_px: u32) -> GroundTruthBox {
         let [xmin, ymin, xmax, ymax] = b;

@@ -5,7 +5,10 @@
 
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
+    geometry::Pose,
+    model::CameraInfo,
+    physics::{ControlSample, Simulation},
+    sensors::{CameraFrame, GroundTruthBox, LaserScan},
 };
 
 use crate::arm::ArmStatus;

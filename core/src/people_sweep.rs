@@ -9,8 +9,13 @@
 use std::path::Path;
 
 use rover_perception::{Detector, FrameStamp, RgbView};
-use rover_sim::human::BodyShape;
-use rover_sim::{CameraSensor, Labelled, Pose, Simulation, Walk, pose_from_position_yaw};
+use rover_sim::model::human::BodyShape;
+use rover_sim::{
+    geometry::{Pose, pose_from_position_yaw},
+    model::{Labelled, Walk},
+    physics::Simulation,
+    sensors::CameraSensor,
+};
 
 use crate::error::{CoreError, Result};
 use crate::headless::RunConfig;
@@ -112,7 +117,7 @@ pub fn sweep(
         f64::from(world_from_person.translation.x),
         f64::from(world_from_person.translation.y),
     );
-    let facing = rover_sim::yaw_of(world_from_person.rotation);
+    let facing = rover_sim::geometry::yaw_of(world_from_person.rotation);
     let mut judge = LiveJudge::default();
     let mut views = Vec::new();
     for heading_deg in SWEEP_HEADINGS_DEG {

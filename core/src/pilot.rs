@@ -1,6 +1,6 @@
 //! Who drives: the human (teleop, scripted cmd_vel) or the follower.
 
-use rover_sim::Twist;
+use rover_sim::physics::Twist;
 
 use crate::input::Action;
 use crate::teleop::{KeyAction, Teleop};

@@ -7,7 +7,12 @@ use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 use rover_perception::BoundingBoxes;
-use rover_sim::{CameraFrame, CameraInfo, ControlSample, GroundTruthBox, Pose, Simulation};
+use rover_sim::{
+    geometry::Pose,
+    model::CameraInfo,
+    physics::{ControlSample, Simulation},
+    sensors::{CameraFrame, GroundTruthBox},
+};
 
 use crate::error::{CoreError, Result};
 use crate::judge::LiveJudge;
@@ -86,7 +91,7 @@ pub struct TraceObserver {
     file: Option<RowFile>,
     writer: Option<TraceWriter<RowFile>>,
     /// The actuated joints, in column order.
-    joints: Vec<rover_sim::JointId>,
+    joints: Vec<rover_sim::model::JointId>,
     failed: Option<CoreError>,
     rows: u64,
     /// With ground truth on: judges each detection result for the ground-truth columns.

@@ -29,7 +29,11 @@ use rover_perception::{
     InjectedFault,
 };
 use rover_sim::{
-    ControlSample, GroundTruthBox, RobotModel, SimError, Simulation, World, WorldFile,
+    SimError,
+    description::WorldFile,
+    model::{RobotModel, World},
+    physics::{ControlSample, Simulation},
+    sensors::GroundTruthBox,
 };
 use serde::{Deserialize, Serialize};
 
@@ -196,7 +200,7 @@ impl Scenario {
     /// [`Scenario::load_with_robot`] with the robot already loaded from `file`
     /// ([`Scenario::load_robot`]).
     pub fn load_with_model(path: &Path, robot: Option<(&Path, &RobotModel)>) -> Result<Self> {
-        let raw: RawScenarioFile = rover_sim::load_toml(path)?;
+        let raw: RawScenarioFile = rover_sim::description::load_toml(path)?;
         let bad = |key: &str, message: String| -> CoreError {
             SimError::invalid(path, None, format!("at `{key}`: {message}")).into()
         };
@@ -776,9 +780,9 @@ pub fn run_scenario(
         trace: options.trace.clone(),
         detector: options.detector.clone(),
         inject_fault: options.inject_fault,
-        options: rover_sim::SimOptions {
+        options: rover_sim::physics::SimOptions {
             seed: scenario.seed,
-            ..rover_sim::SimOptions::default()
+            ..rover_sim::physics::SimOptions::default()
         },
         ground_truth: true,
         ..RunConfig::default()

@@ -19,7 +19,10 @@
 
 use std::path::Path;
 
-use rover_sim::{ControlSample, JointCommand, SimError, Twist};
+use rover_sim::{
+    SimError,
+    physics::{ControlSample, JointCommand, Twist},
+};
 use serde::Deserialize;
 
 use crate::error::Result;
@@ -131,13 +134,13 @@ impl RawStep {
 impl Script {
     /// Loads and validates a script file.
     pub fn load(path: &Path) -> Result<Self> {
-        let raw: RawScript = rover_sim::load_toml(path)?;
+        let raw: RawScript = rover_sim::description::load_toml(path)?;
         Self::from_raw(raw, path)
     }
 
     /// Parses script text; `path` is used in messages.
     pub fn from_str(text: &str, path: &Path) -> Result<Self> {
-        let raw: RawScript = rover_sim::parse_toml(text, path)?;
+        let raw: RawScript = rover_sim::description::parse_toml(text, path)?;
         Self::from_raw(raw, path)
     }
 

@@ -12,8 +12,9 @@ use rover_perception::{
     BoundingBoxes, DetectorConfig, FrameStamp, InjectedFault, PerceptionError, WorkerStats,
 };
 use rover_sim::{
-    CameraInfo, CameraSensor, ControlSample, GroundTruthBox, LaserSensor, LinkId, RobotModel,
-    SimOptions, Simulation, World,
+    model::{CameraInfo, LinkId, RobotModel, World},
+    physics::{ControlSample, SimOptions, Simulation},
+    sensors::{CameraSensor, GroundTruthBox, LaserSensor},
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -479,7 +480,7 @@ impl Session {
         match cmd {
             Some(cmd) if self.pilot.mode() == Mode::Manual => self.sim.set_cmd_vel(cmd)?,
             None if self.fetch_drove && self.pilot.mode() == Mode::Manual => {
-                self.sim.set_cmd_vel(rover_sim::Twist::ZERO)?;
+                self.sim.set_cmd_vel(rover_sim::physics::Twist::ZERO)?;
             }
             _ => {}
         }
@@ -543,7 +544,7 @@ impl Session {
         self.arm.capture(&frame, &self.sim);
         if let Some(slot) = self.truth_frames.get_mut(frame.seq as usize % TRUTH_FRAMES) {
             slot.0 = frame.seq;
-            rover_sim::copy_boxes(&mut slot.1, frame.ground_truth);
+            rover_sim::sensors::copy_boxes(&mut slot.1, frame.ground_truth);
         }
         let stamp = FrameStamp {
             sim_time_s: frame.sim_time_s,
@@ -712,6 +713,6 @@ fn camera_geometry(
 }
 
 /// A chain error from the arm's tasks (a chain built from this robot does not produce one).
-fn arm_error(e: rover_sim::KinematicsError) -> CoreError {
+fn arm_error(e: rover_sim::model::KinematicsError) -> CoreError {
     CoreError::Option(format!("arm: {e}"))
 }

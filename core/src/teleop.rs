@@ -7,7 +7,7 @@
 //! q/z: all speeds x1.1/x0.9   w/x: linear only   e/c: angular only
 //! ```
 
-use rover_sim::Twist;
+use rover_sim::physics::Twist;
 
 /// Default linear speed (m/s), as teleop_twist_keyboard's `~speed`.
 const DEFAULT_SPEED_MPS: f64 = 0.5;

@@ -6,7 +6,7 @@
 
 use std::io::Write;
 
-use rover_sim::{ControlSample, JointState};
+use rover_sim::physics::{ControlSample, JointState};
 
 use crate::follower::FollowState;
 use crate::pilot::Mode;

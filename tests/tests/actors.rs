@@ -9,8 +9,13 @@ use anyhow::Context;
 
 use rover_core::{NoObserver, RunConfig, Scenario, ScenarioOptions, run_scenario};
 use rover_perception::{Detector, DetectorConfig, FrameStamp, RgbView};
-use rover_sim::actor::PosedSkin;
-use rover_sim::{CameraSensor, Labelled, Person, ResourcePaths, Simulation, World};
+use rover_sim::model::actor::PosedSkin;
+use rover_sim::{
+    description::ResourcePaths,
+    model::{Labelled, Person, World},
+    physics::Simulation,
+    sensors::CameraSensor,
+};
 use rover_tests::{repo, shared};
 
 /// The corpus world, or `None` (skip recorded) without ../shared.

@@ -223,7 +223,19 @@ const PUBLIC_MODULES: &[(&str, &[&str])] = &[
     // The pinned list and its fetch, apart from the cache folder and COCO's names at the root.
     ("assets", &["registry"]),
     ("pyexpr", &[]),
-    ("sim", &[]),
+    // Grouped by module as rapier groups its API: one module a layer.
+    (
+        "sim",
+        &[
+            "description",
+            "geometry",
+            "model",
+            "physics",
+            "planning",
+            "render",
+            "sensors",
+        ],
+    ),
     ("perception", &[]),
     ("core", &[]),
     ("msgs", &[]),

@@ -4,8 +4,9 @@
 
 use anyhow::{Context, Result};
 use rover_sim::{
-    JointCommand, JointId, JointSolver, JointState, LoadOptions, Pid, RobotModel, SimOptions,
-    Simulation, Twist, World,
+    description::LoadOptions,
+    model::{JointId, JointSolver, Pid, RobotModel, World},
+    physics::{JointCommand, JointState, SimOptions, Simulation, Twist},
 };
 use rover_tests::{TIAGO_NO_HAND, example_robot_data};
 
@@ -422,7 +423,8 @@ fn an_effort_command_lifts_ur5s_arm_with_either_solver() -> Result<()> {
 #[test]
 fn tiago_ik_solves_20_reachable_targets_and_the_simulated_tool_gets_there() -> Result<()> {
     use rover_sim::{
-        IkOptions, IkSolver, IkTarget, KinematicChain, SplitMix64, isometry_from_pose,
+        SplitMix64,
+        model::{IkOptions, IkSolver, IkTarget, KinematicChain, isometry_from_pose},
     };
     let Some(mut sim) = tiago_sent_home(2.0)? else {
         return Ok(());
@@ -535,7 +537,7 @@ fn tiago_looks_at_the_person_the_detector_sees() -> Result<()> {
     )?;
     let names: Vec<String> = look.joints().iter().map(|j| j.name.clone()).collect();
     assert_eq!(names, ["head_1_joint", "head_2_joint"]);
-    let mut camera = rover_sim::CameraSensor::new(&sim)?;
+    let mut camera = rover_sim::sensors::CameraSensor::new(&sim)?;
     camera.disable_depth();
     let (cx, cy) = (camera.info().k[2], camera.info().k[5]);
     let mut detector = Detector::load(DetectorConfig::default())?;
@@ -580,7 +582,10 @@ fn tiago_looks_at_the_person_the_detector_sees() -> Result<()> {
 /// UR5's SRDF without groups) are located errors that name what exists.
 #[test]
 fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
-    use rover_sim::{KinematicChain, load_arm_group, parse_arm_group};
+    use rover_sim::{
+        description::{load_arm_group, parse_arm_group},
+        model::KinematicChain,
+    };
     let (Some(panda), Some(srdf), Some(ur5_srdf), Some(tiago_urdf)) = (
         example_robot_data("panda_description/urdf/panda.urdf"),
         example_robot_data("panda_description/srdf/panda.srdf"),
@@ -603,10 +608,10 @@ fn srdf_planning_groups_give_the_arms_chain() -> Result<()> {
     let chain = KinematicChain::new(&robot, &group.base_link, &group.tip_link)?;
     assert_eq!(chain.joints().len(), 7);
     // Its <disable_collisions>: 35 pairs, every link the URDF's.
-    let rover_sim::DisabledCollisions {
+    let rover_sim::description::DisabledCollisions {
         pairs,
         unknown_links: unknown,
-    } = rover_sim::load_disabled_collisions(&srdf, &robot)?;
+    } = rover_sim::description::load_disabled_collisions(&srdf, &robot)?;
     let id = |name: &str| robot.link_id(name).context(name.to_owned());
     assert_eq!((pairs.len(), unknown.len()), (35, 0), "{unknown:?}");
     assert!(pairs.contains(&(id("panda_hand")?, id("panda_leftfinger")?)));

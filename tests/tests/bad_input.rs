@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use rover_core::Script;
-use rover_sim::{RobotModel, World};
+use rover_sim::model::{RobotModel, World};
 use rover_tests::repo;
 
 fn robot_text() -> String {
@@ -316,7 +316,7 @@ fn the_bundled_worlds_load() -> anyhow::Result<()> {
                 };
                 options
             } else {
-                rover_sim::LoadOptions::default()
+                rover_sim::description::LoadOptions::default()
             };
             RobotModel::load_with(&urdf, &options)?;
         }
@@ -342,7 +342,7 @@ fn load_robot_files(files: &[(&str, &str)]) -> anyhow::Result<(tempfile::TempDir
     }
     let message = match RobotModel::load_with(
         &dir.path().join(files[0].0),
-        &rover_sim::LoadOptions::default(),
+        &rover_sim::description::LoadOptions::default(),
     ) {
         Ok(_) => String::from("(loaded without error)"),
         Err(e) => e.to_string(),
@@ -451,7 +451,7 @@ fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Res
 </mesh></geometry></library_geometries>
 <library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>"##,
     )?;
-    let message = rover_sim::load_mesh(&dae, glam::Vec3::ONE)
+    let message = rover_sim::description::load_mesh(&dae, glam::Vec3::ONE)
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
@@ -474,7 +474,7 @@ fn collada_without_triangles_and_malformed_sdf_are_clear_errors() -> anyhow::Res
     )?;
     let message = World::load_with(
         &world,
-        &rover_sim::ResourcePaths::default().with_model_path(dir.path()),
+        &rover_sim::description::ResourcePaths::default().with_model_path(dir.path()),
     )
     .err()
     .map(|e| e.to_string())
@@ -717,15 +717,21 @@ fn transmissions_and_mimics_that_make_no_sense() -> anyhow::Result<()> {
 #[test]
 fn joint_commands_that_make_no_sense() -> anyhow::Result<()> {
     let robot = RobotModel::load(&repo("assets/robots/my_robot.urdf"))?;
-    let mut sim =
-        rover_sim::Simulation::new(World::flat()?, robot, &rover_sim::SimOptions::default())?;
+    let mut sim = rover_sim::physics::Simulation::new(
+        World::flat()?,
+        robot,
+        &rover_sim::physics::SimOptions::default(),
+    )?;
     let err = |r: rover_sim::Result<()>| r.err().map(|e| e.to_string()).unwrap_or_default();
-    let missing = err(sim.command_joint("elbow", rover_sim::JointCommand::Position(1.0)));
+    let missing = err(sim.command_joint("elbow", rover_sim::physics::JointCommand::Position(1.0)));
     assert!(
         missing.contains("has no joint \"elbow\"; its moving joints: \"left_wheel_joint\""),
         "{missing}"
     );
-    let wheel = err(sim.command_joint("left_wheel_joint", rover_sim::JointCommand::Position(1.0)));
+    let wheel = err(sim.command_joint(
+        "left_wheel_joint",
+        rover_sim::physics::JointCommand::Position(1.0),
+    ));
     assert!(wheel.contains("has no actuator"), "{wheel}");
     Ok(())
 }
@@ -745,7 +751,7 @@ fn a_texture_that_will_not_decode_leaves_the_mesh_in_its_colour() -> anyhow::Res
     )?;
     std::fs::write(dir.path().join("broken.png"), b"not a png at all")?;
     let path = dir.path().join("quad.obj");
-    let tri = rover_sim::load_mesh(&path, glam::Vec3::ONE)?;
+    let tri = rover_sim::description::load_mesh(&path, glam::Vec3::ONE)?;
     assert_eq!(tri.parts.len(), 1);
     assert!(
         tri.parts[0]
@@ -757,9 +763,9 @@ fn a_texture_that_will_not_decode_leaves_the_mesh_in_its_colour() -> anyhow::Res
     );
     assert_eq!(
         tri.parts[0].color,
-        Some(rover_sim::Rgba::rgb(0.2, 0.4, 0.6))
+        Some(rover_sim::geometry::Rgba::rgb(0.2, 0.4, 0.6))
     );
-    let err = rover_sim::load_texture(&dir.path().join("broken.png"))
+    let err = rover_sim::description::load_texture(&dir.path().join("broken.png"))
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
@@ -767,12 +773,15 @@ fn a_texture_that_will_not_decode_leaves_the_mesh_in_its_colour() -> anyhow::Res
         err.contains("broken.png") && err.contains("cannot decode texture"),
         "{err}"
     );
-    let mesh = rover_sim::shape_mesh(&rover_sim::Shape::Mesh {
+    let mesh = rover_sim::render::shape_mesh(&rover_sim::geometry::Shape::Mesh {
         path,
         scale: glam::Vec3::ONE,
     })?;
     assert_eq!(mesh.indices.len(), 6);
     assert!(mesh.textured.is_empty(), "drawn in its flat colour");
-    assert_eq!(mesh.color, Some(rover_sim::Rgba::rgb(0.2, 0.4, 0.6)));
+    assert_eq!(
+        mesh.color,
+        Some(rover_sim::geometry::Rgba::rgb(0.2, 0.4, 0.6))
+    );
     Ok(())
 }

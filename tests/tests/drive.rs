@@ -1,7 +1,10 @@
 //! Physics and diff-drive behaviour of the tutorial car on real rapier physics.
 
 use anyhow::Result;
-use rover_sim::{SimOptions, Simulation, Twist, World};
+use rover_sim::{
+    model::World,
+    physics::{SimOptions, Simulation, Twist},
+};
 use rover_tests::{drive, flat_sim, my_robot, my_robot_with_plugin_param};
 
 #[test]

@@ -4,7 +4,7 @@
 use anyhow::Result;
 use rover_core::{RunConfig, run_headless};
 use rover_core::{TraceRow, parse_trace};
-use rover_sim::World;
+use rover_sim::model::World;
 use rover_tests::repo;
 
 /// The playground with its person replaced by `person` (TOML lines; empty = nobody).
@@ -44,7 +44,7 @@ fn follow(dir: &std::path::Path, world: &std::path::Path, seconds: f64) -> Resul
 /// from facing them.
 fn range_and_facing(row: &TraceRow, person: (f64, f64)) -> (f64, f64) {
     let (dx, dy) = (person.0 - row.x_m, person.1 - row.y_m);
-    let off = rover_sim::wrap_angle(dy.atan2(dx) - row.yaw_rad);
+    let off = rover_sim::physics::wrap_angle(dy.atan2(dx) - row.yaw_rad);
     (dx.hypot(dy), off.to_degrees().abs())
 }
 
@@ -104,7 +104,7 @@ fn with_nobody_in_view_it_searches_on_the_spot() -> Result<()> {
         .fold(0.0, f64::max);
     let turned: f64 = rows
         .windows(2)
-        .map(|w| rover_sim::wrap_angle(w[1].yaw_rad - w[0].yaw_rad).abs())
+        .map(|w| rover_sim::physics::wrap_angle(w[1].yaw_rad - w[0].yaw_rad).abs())
         .sum();
     println!(
         "searching: moved {moved:.3} m, turned {:.0} deg",

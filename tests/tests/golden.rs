@@ -15,7 +15,10 @@ use std::path::Path;
 
 use anyhow::Result;
 use rover_core::{RunConfig, run_headless};
-use rover_sim::{CameraSensor, SimOptions, Simulation};
+use rover_sim::{
+    physics::{SimOptions, Simulation},
+    sensors::CameraSensor,
+};
 use rover_tests::golden::{self, Tolerance};
 use rover_tests::repo;
 
@@ -101,8 +104,8 @@ fn manual_driving_reproduces_the_golden_trace() -> Result<()> {
 /// the renderer (llvmpipe's JIT). The golden trace was recorded on `follow.machine`.
 fn machine() -> Result<String> {
     let sim = Simulation::new(
-        rover_sim::World::load(&repo("worlds/walking.toml"))?,
-        rover_sim::RobotModel::load(&repo("assets/robots/my_robot.urdf"))?,
+        rover_sim::model::World::load(&repo("worlds/walking.toml"))?,
+        rover_sim::model::RobotModel::load(&repo("assets/robots/my_robot.urdf"))?,
         &SimOptions::default(),
     )?;
     let adapter = CameraSensor::new(&sim)?.renderer().adapter().to_owned();

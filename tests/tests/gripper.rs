@@ -3,7 +3,7 @@
 //! and on Franka's panda (example-robot-data: `panda_finger_joint2` mimics joint1).
 
 use anyhow::{Context, Result, ensure};
-use rover_sim::{JointCommand, LoadOptions, RobotModel};
+use rover_sim::{description::LoadOptions, model::RobotModel, physics::JointCommand};
 
 /// A box with two prismatic fingers; the right one mirrors the left (multiplier -1) with a
 /// 1 cm offset.
@@ -36,14 +36,14 @@ const GRIPPER: &str = r#"<?xml version="1.0"?>
 "#;
 
 /// Steps `sim` for `seconds` of sim time.
-fn run(sim: &mut rover_sim::Simulation, seconds: f64) {
+fn run(sim: &mut rover_sim::physics::Simulation, seconds: f64) {
     let end = sim.sim_time_s() + seconds;
     while sim.sim_time_s() < end {
         sim.step();
     }
 }
 
-fn position(sim: &rover_sim::Simulation, joint: &str) -> Result<f64> {
+fn position(sim: &rover_sim::physics::Simulation, joint: &str) -> Result<f64> {
     let id = sim
         .robot()
         .joint_id(joint)
@@ -134,8 +134,8 @@ fn grasper_world(dir: &std::path::Path, controllers: Option<&str>) -> Result<std
     Ok(dir.join("grasper.toml"))
 }
 
-fn grasper_sim(world: &std::path::Path) -> Result<rover_sim::Simulation> {
-    let world = rover_sim::World::load(world)?;
+fn grasper_sim(world: &std::path::Path) -> Result<rover_sim::physics::Simulation> {
+    let world = rover_sim::model::World::load(world)?;
     let urdf = world
         .robot
         .urdf
@@ -145,15 +145,18 @@ fn grasper_sim(world: &std::path::Path) -> Result<rover_sim::Simulation> {
     if let Some(c) = &world.robot.controllers {
         robot.load_controllers(c)?;
     }
-    Ok(rover_sim::Simulation::new(
+    Ok(rover_sim::physics::Simulation::new(
         world,
         robot,
-        &rover_sim::SimOptions::default(),
+        &rover_sim::physics::SimOptions::default(),
     )?)
 }
 
 /// Runs until the gripper's command ends (at most `limit_s`).
-fn until_done(sim: &mut rover_sim::Simulation, limit_s: f64) -> Result<rover_sim::GripperState> {
+fn until_done(
+    sim: &mut rover_sim::physics::Simulation,
+    limit_s: f64,
+) -> Result<rover_sim::physics::GripperState> {
     let end = sim.sim_time_s() + limit_s;
     loop {
         sim.step();
@@ -255,7 +258,7 @@ fn a_gripper_naming_a_joint_that_is_not_a_finger_is_refused() -> Result<()> {
 }
 
 /// The ball's centre in the palm's frame (m).
-fn ball_in_palm(sim: &rover_sim::Simulation) -> Result<glam::Vec3> {
+fn ball_in_palm(sim: &rover_sim::physics::Simulation) -> Result<glam::Vec3> {
     let mut poses = Vec::new();
     sim.object_poses_into(&mut poses);
     let ball = poses.first().context("no ball")?.translation;
@@ -269,7 +272,10 @@ fn ball_in_palm(sim: &rover_sim::Simulation) -> Result<glam::Vec3> {
 fn lifter_grasp(
     grasp: &str,
     squeeze_n: f64,
-) -> Result<(rover_sim::Simulation, rover_sim::GripperState)> {
+) -> Result<(
+    rover_sim::physics::Simulation,
+    rover_sim::physics::GripperState,
+)> {
     let dir = tempfile::tempdir()?;
     let from = rover_tests::repo("tests/grasper");
     for file in ["lifter.urdf", "grasper.yaml"] {
@@ -303,15 +309,16 @@ fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
     let held = sim.grasp_assist_holds();
     let held_at = ball_in_palm(&sim)?;
     let mut worst = 0.0f32;
-    let mut moves = |sim: &mut rover_sim::Simulation, joint: &str, q: f64, s: f64| -> Result<()> {
-        sim.command_joint(joint, JointCommand::Position(q))?;
-        let end = sim.sim_time_s() + s;
-        while sim.sim_time_s() < end {
-            sim.step();
-            worst = worst.max((ball_in_palm(sim)? - held_at).length());
-        }
-        Ok(())
-    };
+    let mut moves =
+        |sim: &mut rover_sim::physics::Simulation, joint: &str, q: f64, s: f64| -> Result<()> {
+            sim.command_joint(joint, JointCommand::Position(q))?;
+            let end = sim.sim_time_s() + s;
+            while sim.sim_time_s() < end {
+                sim.step();
+                worst = worst.max((ball_in_palm(sim)? - held_at).length());
+            }
+            Ok(())
+        };
     let (wall, sim_start_s) = (std::time::Instant::now(), sim.sim_time_s());
     moves(&mut sim, "lift_joint", 0.2, 1.5)?;
     moves(&mut sim, "wrist_joint", 1.0, 1.5)?;

@@ -6,8 +6,10 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use rover_sim::{
-    CameraInfo, CameraSensor, Distortion, GroundTruthBox, Pose, RobotModel, SimOptions, Simulation,
-    World, link_from_optical,
+    geometry::Pose,
+    model::{CameraInfo, Distortion, RobotModel, World, link_from_optical},
+    physics::{SimOptions, Simulation},
+    sensors::{CameraSensor, GroundTruthBox},
 };
 
 /// A pure red 1 m cube labelled `suitcase` 5 m ahead of the tutorial car, turned 25 degrees so
@@ -129,7 +131,7 @@ fn projected_corners(shot: &Shot, centre: Vec3, size: Vec3, yaw_deg: f32) -> [f6
     b
 }
 
-fn edges(b: &rover_sim::PixelBox) -> [f64; 4] {
+fn edges(b: &rover_sim::sensors::PixelBox) -> [f64; 4] {
     [b.xmin, b.ymin, b.xmax, b.ymax]
 }
 
@@ -327,7 +329,7 @@ fn yolo_finds_the_textured_street_models() -> Result<()> {
     std::fs::write(&path, rover_tests::STREET_WORLD)?;
     let world = World::load_with(
         &path,
-        &rover_sim::ResourcePaths::default().with_model_path(models),
+        &rover_sim::description::ResourcePaths::default().with_model_path(models),
     )?;
     assert_eq!(
         world.sun_direction,
@@ -373,7 +375,7 @@ fn yolo_finds_the_textured_street_models() -> Result<()> {
             .iter()
             .filter(|d| d.class == t.class)
             .map(|d| {
-                let det = rover_sim::PixelBox {
+                let det = rover_sim::sensors::PixelBox {
                     xmin: d.xmin as f64,
                     ymin: d.ymin as f64,
                     xmax: d.xmax as f64,

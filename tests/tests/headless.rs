@@ -3,7 +3,7 @@
 use anyhow::Result;
 use rover_core::{RunConfig, run_headless, run_headless_observed};
 use rover_core::{TRACE_HEADER, parse_trace};
-use rover_sim::SimOptions;
+use rover_sim::physics::SimOptions;
 use rover_tests::repo;
 
 const SCRIPT: &str = r#"
@@ -105,8 +105,8 @@ struct Deliveries {
 impl rover_core::Observer for Deliveries {
     fn control(
         &mut self,
-        _sim: &rover_sim::Simulation,
-        sample: &rover_sim::ControlSample,
+        _sim: &rover_sim::physics::Simulation,
+        sample: &rover_sim::physics::ControlSample,
         _stats: &rover_core::LoopStats,
     ) {
         self.now_s = sample.sim_time_s;

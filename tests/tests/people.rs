@@ -7,7 +7,7 @@ use std::path::Path;
 
 use rover_core::{RunConfig, SWEEP_DISTANCES_M, SweepPosture, sweep};
 use rover_perception::{Detector, DetectorConfig};
-use rover_sim::human::{
+use rover_sim::model::human::{
     BodyShape, HairStyle, Human, Layer, Legwear, Outfit, PosedBody, Posture, STANCE_FRACTION,
 };
 use rover_tests::{makehuman, repo};
@@ -270,7 +270,7 @@ fn load_error(dir: &Path) -> String {
 }
 
 fn copy_assets(to: &Path) -> anyhow::Result<()> {
-    let from = rover_sim::human::fetch::assets_dir();
+    let from = rover_sim::model::human::fetch::assets_dir();
     for relative in [
         "3dobjs/base.obj",
         "rigs/standard/rig.default.json",
@@ -406,8 +406,8 @@ fn a_dataset_varies_bodies_clothes_and_gaits() -> anyhow::Result<()> {
 /// The laser's hits within `radius_m` of `centre` (world xy), as clusters of neighbouring rays:
 /// each cluster's nearest range from the sensor.
 fn laser_clusters(
-    sim: &rover_sim::Simulation,
-    laser: &mut rover_sim::LaserSensor,
+    sim: &rover_sim::physics::Simulation,
+    laser: &mut rover_sim::sensors::LaserSensor,
     centre: [f64; 2],
     radius_m: f64,
 ) -> Vec<f64> {
@@ -460,8 +460,8 @@ fn the_laser_sees_the_legs_of_a_posed_body() -> anyhow::Result<()> {
         let (mut world, robot) = config.load_world_and_robot()?;
         world.people[0].heading_rad = heading_deg.to_radians();
         world.people[0].still_gait_phase_rad = phase_rad;
-        let sim = rover_sim::Simulation::new(world, robot, &config.options)?;
-        let mut laser = rover_sim::LaserSensor::new(&sim, 0)?;
+        let sim = rover_sim::physics::Simulation::new(world, robot, &config.options)?;
+        let mut laser = rover_sim::sensors::LaserSensor::new(&sim, 0)?;
         let clusters = laser_clusters(&sim, &mut laser, [0.0, 0.0], 0.6);
         report.push(format!(
             "phase {phase_rad:.2} rad: {} cluster(s) {clusters:.2?}",

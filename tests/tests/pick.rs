@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use rover_core::{Action, EventLevel, PickState, Session};
-use rover_sim::Pose;
+use rover_sim::geometry::Pose;
 
 /// The ball's index among the world's objects (worlds/arm_car_pick.toml).
 const BALL: usize = 6;
@@ -42,7 +42,7 @@ fn session(seed: u64) -> Result<Session> {
 
 /// [`session`] with the world changed by `change` first; the drive's command timeout off
 /// (a teleop key holds until the next).
-fn session_with(seed: u64, change: impl FnOnce(&mut rover_sim::World)) -> Result<Session> {
+fn session_with(seed: u64, change: impl FnOnce(&mut rover_sim::model::World)) -> Result<Session> {
     session_in("worlds/arm_car_pick.toml", seed, change)
 }
 
@@ -50,7 +50,7 @@ fn session_with(seed: u64, change: impl FnOnce(&mut rover_sim::World)) -> Result
 fn session_in(
     world: &str,
     seed: u64,
-    change: impl FnOnce(&mut rover_sim::World),
+    change: impl FnOnce(&mut rover_sim::model::World),
 ) -> Result<Session> {
     let config = rover_core::RunConfig {
         world: Some(rover_tests::repo(world)),
@@ -348,7 +348,10 @@ fn ball_in_tool(session: &Session) -> Result<glam::Vec3> {
 #[test]
 fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Result<()> {
     use rover_core::KeyAction;
-    let modes = [rover_sim::GraspMode::Friction, rover_sim::GraspMode::Assist];
+    let modes = [
+        rover_sim::model::GraspMode::Friction,
+        rover_sim::model::GraspMode::Assist,
+    ];
     let only = std::env::var("PICK_GRASP").ok();
     for mode in modes
         .into_iter()
@@ -444,14 +447,14 @@ fn the_held_ball_stays_in_the_hand_while_the_car_drives_turns_and_brakes() -> Re
 fn the_arm_carries_the_ball_round_a_board_touching_nothing() -> Result<()> {
     let mut said = Said::default();
     let mut session = session_with(0, |w| {
-        w.objects.push(rover_sim::Object {
+        w.objects.push(rover_sim::model::Object {
             name: "board".into(),
-            shape: rover_sim::Shape::Box {
+            shape: rover_sim::geometry::Shape::Box {
                 size_m: glam::Vec3::new(0.2, 0.01, 0.2),
             },
             position_m: [0.30, -0.055, 0.2],
             yaw_rad: 0.0,
-            color: rover_sim::Rgba([0.9, 0.9, 0.9, 1.0]),
+            color: rover_sim::geometry::Rgba([0.9, 0.9, 0.9, 1.0]),
             mass_kg: None,
             friction: 1.0,
             class: None,
@@ -657,14 +660,18 @@ fn the_planning_scene_checks_the_arm_against_itself_and_reads_the_srdfs_pairs() 
         ..rover_core::RunConfig::default()
     };
     let (world, robot) = config.load_world_and_robot()?;
-    let chain = rover_sim::KinematicChain::new(&robot, "base_link", "tool_link")?;
+    let chain = rover_sim::model::KinematicChain::new(&robot, "base_link", "tool_link")?;
     let folded = [0.0, 0.0, 2.4, 1.8, 0.0];
-    let hit = |world: rover_sim::World| -> Result<[Option<rover_sim::SceneContact>; 2]> {
-        let sim =
-            rover_sim::Simulation::new(world, robot.clone(), &rover_sim::SimOptions::default())?;
-        let mut scene = sim.planning_scene(&chain, 0.01)?;
-        Ok([scene.collision(&[0.0; 5]), scene.collision(&folded)])
-    };
+    let hit =
+        |world: rover_sim::model::World| -> Result<[Option<rover_sim::planning::SceneContact>; 2]> {
+            let sim = rover_sim::physics::Simulation::new(
+                world,
+                robot.clone(),
+                &rover_sim::physics::SimOptions::default(),
+            )?;
+            let mut scene = sim.planning_scene(&chain, 0.01)?;
+            Ok([scene.collision(&[0.0; 5]), scene.collision(&folded)])
+        };
     let [straight, bent] = hit(world.clone())?;
     println!("straight up: {straight:?}; folded: {bent:?}");
     assert_eq!(straight, None);
@@ -680,7 +687,7 @@ fn the_planning_scene_checks_the_arm_against_itself_and_reads_the_srdfs_pairs() 
         ],
     );
     let robots = |l: &str| format!("{l} (the robot's)");
-    let disabled = |c: &rover_sim::SceneContact| {
+    let disabled = |c: &rover_sim::planning::SceneContact| {
         near.iter().any(|n| {
             far.iter().any(|f| {
                 (c.link == *n && c.obstacle == robots(f))
@@ -715,10 +722,14 @@ fn the_planning_scene_checks_the_arm_against_itself_and_reads_the_srdfs_pairs() 
     )?;
     let mut bad = world;
     bad.robot.srdf = Some(srdf);
-    let err = rover_sim::Simulation::new(bad, robot.clone(), &rover_sim::SimOptions::default())
-        .err()
-        .ok_or_else(|| anyhow::anyhow!("a <disable_collisions> without link2 was taken"))?
-        .to_string();
+    let err = rover_sim::physics::Simulation::new(
+        bad,
+        robot.clone(),
+        &rover_sim::physics::SimOptions::default(),
+    )
+    .err()
+    .ok_or_else(|| anyhow::anyhow!("a <disable_collisions> without link2 was taken"))?
+    .to_string();
     println!("{err}");
     assert!(
         err.contains("arm_car.srdf:2") && err.contains("link2"),

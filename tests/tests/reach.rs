@@ -6,7 +6,7 @@ use anyhow::Result;
 use rover_core::{
     Action, ArmConfig, DetectorMode, JointAction, NoObserver, ReachState, Session, SessionOptions,
 };
-use rover_sim::{JointCommand, Pose, World};
+use rover_sim::{geometry::Pose, model::World, physics::JointCommand};
 
 /// The ball's radius (m) and where it rests at first (centre, world frame).
 const BALL_RADIUS_M: f64 = 0.06;

@@ -3,7 +3,12 @@
 use std::f64::consts::PI;
 
 use anyhow::Result;
-use rover_sim::{JointKind, LoadOptions, RobotModel, Shape, Twist, load_mesh};
+use rover_sim::{
+    description::{LoadOptions, load_mesh},
+    geometry::Shape,
+    model::{JointKind, RobotModel},
+    physics::Twist,
+};
 use rover_tests::{drive, flat_sim, shared};
 
 fn turtlebot3(file: &str) -> Result<Option<RobotModel>> {
@@ -147,7 +152,7 @@ fn turtlebot3_autorace_camera_has_gazebos_intrinsics() -> Result<()> {
         .ok_or_else(|| anyhow::anyhow!("the autorace burger's camera was not found"))?;
     assert_eq!(camera.link, "camera_rgb_frame");
     assert_eq!((camera.width_px, camera.height_px), (320, 240));
-    let info = rover_sim::CameraInfo::from_config(camera);
+    let info = rover_sim::model::CameraInfo::from_config(camera);
     // gazebo_ros_camera: f = W / (2 tan(hfov / 2)), c = (W + 1) / 2, (H + 1) / 2.
     let f = 320.0 / (2.0 * (1.085595f64 / 2.0).tan());
     assert!((info.k[0] - f).abs() < 1e-9 && (info.k[4] - f).abs() < 1e-9);
@@ -326,16 +331,17 @@ fn skid_steer_plugin_drives_four_wheels() -> Result<()> {
 /// With `ROVER_SAVE_VIEWS=DIR` the image is also written there (how docs/ got its pictures).
 fn robot_in_view(robot: RobotModel, file: &str) -> Result<usize> {
     let camera = rover_tests::my_robot()?.cameras[0].clone();
-    let world = rover_sim::World::flat()?;
+    let world = rover_sim::model::World::flat()?;
     let mut sim = flat_sim(robot.clone())?;
     drive(&mut sim, Twist::ZERO, 0.5)?;
     let mut poses = Vec::new();
     sim.link_poses_into(&mut poses);
-    let view = rover_sim::pose_from_position_yaw([1.2, 0.3, 0.5], PI + 0.25)
-        * rover_sim::Pose::from_rotation(glam::Quat::from_rotation_y(0.3));
-    let mut renderer = rover_sim::CameraRenderer::new(&world, &robot, &camera, 0)?;
+    let view = rover_sim::geometry::pose_from_position_yaw([1.2, 0.3, 0.5], PI + 0.25)
+        * rover_sim::geometry::Pose::from_rotation(glam::Quat::from_rotation_y(0.3));
+    let mut renderer = rover_sim::render::CameraRenderer::new(&world, &robot, &camera, 0)?;
     let with = renderer.render(&poses, view)?.to_vec();
-    let parked = vec![rover_sim::Pose::from_translation(glam::Vec3::NEG_Z * 100.0); poses.len()];
+    let parked =
+        vec![rover_sim::geometry::Pose::from_translation(glam::Vec3::NEG_Z * 100.0); poses.len()];
     let without = renderer.render(&parked, view)?.to_vec();
     if let Some(dir) = std::env::var_os("ROVER_SAVE_VIEWS") {
         let img = image::RgbImage::from_raw(camera.width_px, camera.height_px, with.clone())

@@ -11,7 +11,7 @@ use anyhow::Result;
 use rover_core::{FollowState, LoopStats, NoObserver, Observer, parse_trace, range_bearing_from};
 use rover_core::{Scenario, ScenarioOptions, collect_scenario_files, run_scenario};
 use rover_perception::{BoundingBoxes, DetectorConfig};
-use rover_sim::{ControlSample, Simulation};
+use rover_sim::physics::{ControlSample, Simulation};
 use rover_tests::repo;
 
 /// The tutorial's car with the laser the obstacle scenarios need.

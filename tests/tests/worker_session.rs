@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use rover_core::{DetectorMode, EventLevel, FollowState, Mode, Observer, Session, SessionOptions};
 use rover_perception::{BoundingBoxes, DetectorConfig};
-use rover_sim::{RobotModel, World};
+use rover_sim::model::{RobotModel, World};
 use rover_tests::repo;
 
 #[derive(Default)]
@@ -104,7 +104,7 @@ fn a_model_that_cannot_load_is_a_warning_and_manual_driving_works() -> Result<()
         events.warnings
     );
     session.input(
-        rover_core::Action::CmdVel(rover_sim::Twist::new(0.5, 0.0)),
+        rover_core::Action::CmdVel(rover_sim::physics::Twist::new(0.5, 0.0)),
         &mut events,
     );
     while session.sim().sim_time_s() < 1.0 {

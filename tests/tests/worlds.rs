@@ -1,7 +1,7 @@
 //! Gazebo SDF worlds nobody on the project wrote: loaded, placed and driven in.
 
 use anyhow::Result;
-use rover_sim::{ResourcePaths, World};
+use rover_sim::{description::ResourcePaths, model::World};
 use rover_tests::shared;
 
 fn playground() -> Result<Option<World>> {
@@ -52,7 +52,7 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
         (t - glam::Vec3::new(1.41131, -1.0, 0.5)).length() < 1e-5,
         "cube at {t}"
     );
-    let yaw = rover_sim::yaw_of(cube.world_from_link.rotation);
+    let yaw = rover_sim::geometry::yaw_of(cube.world_from_link.rotation);
     assert!((yaw - 0.9).abs() < 1e-5, "cube yaw {yaw}");
     let dumpster = link("Dumpster")?;
     assert!(
@@ -63,11 +63,11 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
     let shelf = link("bookshelf")?;
     assert_eq!((shelf.visuals.len(), shelf.collisions.len()), (7, 7));
     let barrier = link("jersey_barrier")?;
-    let rover_sim::Shape::Mesh { path, .. } = &barrier.visuals[0].shape else {
+    let rover_sim::geometry::Shape::Mesh { path, .. } = &barrier.visuals[0].shape else {
         anyhow::bail!("barrier visual is not a mesh");
     };
     assert!(path.ends_with("jersey_barrier/meshes/jersey_barrier.dae"));
-    let mesh = rover_sim::load_mesh(path, glam::Vec3::ONE)?;
+    let mesh = rover_sim::description::load_mesh(path, glam::Vec3::ONE)?;
     let (lo, hi) = mesh.positions.iter().fold(
         (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
@@ -82,7 +82,7 @@ fn turtlebot_playground_places_every_model_with_its_state_pose() -> Result<()> {
     // material script rover cannot read).
     let dumpster_visual = &dumpster.visuals[0];
     assert!(!dumpster_visual.color_given);
-    let m = rover_sim::shape_mesh(&dumpster_visual.shape)?;
+    let m = rover_sim::render::shape_mesh(&dumpster_visual.shape)?;
     let c = m
         .color
         .ok_or_else(|| anyhow::anyhow!("dumpster.dae gave no material colour"))?;
@@ -182,7 +182,7 @@ fn gazebo_people_and_actors_become_rover_people() -> Result<()> {
         );
     }
     let crate_color = world.models[0].links[0].visuals[0].color;
-    assert_eq!(crate_color, rover_sim::Rgba([0.6, 0.3, 0.1, 1.0]));
+    assert_eq!(crate_color, rover_sim::geometry::Rgba([0.6, 0.3, 0.1, 1.0]));
     Ok(())
 }
 
@@ -267,7 +267,7 @@ fn gazebo_models_carry_their_coco_class() -> Result<()> {
 /// (one list for both: `rover_assets::COCO80`).
 #[test]
 fn known_models_are_coco_classes() {
-    for (_, class) in rover_sim::MODEL_CLASSES {
-        assert!(rover_sim::is_known_class(class), "{class}");
+    for (_, class) in rover_sim::model::MODEL_CLASSES {
+        assert!(rover_sim::model::is_known_class(class), "{class}");
     }
 }

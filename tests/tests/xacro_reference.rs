@@ -8,7 +8,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use rover_sim::{ResourcePaths, expand_xacro};
+use rover_sim::description::{ResourcePaths, expand_xacro};
 use rover_tests::pypi;
 
 #[derive(Debug, Clone, PartialEq)]

@@ -14,7 +14,7 @@
 use std::sync::mpsc::Sender;
 
 use rover_core::{Action, JointAction};
-use rover_sim::{JointTrajectory, TrajectoryOutcome};
+use rover_sim::physics::{JointTrajectory, TrajectoryOutcome};
 
 use super::RosPlan;
 use super::events::{ControlUpdate, GripperSample, JointSample, RunSample};
@@ -181,7 +181,7 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
     }
 
     /// One for each of the plan's gripper controllers (`robot` says whether a stall succeeds).
-    pub fn grippers(plan: &RosPlan, robot: &rover_sim::RobotModel) -> Vec<Self> {
+    pub fn grippers(plan: &RosPlan, robot: &rover_sim::model::RobotModel) -> Vec<Self> {
         plan.grippers
             .iter()
             .enumerate()
@@ -193,7 +193,7 @@ impl<Id: Clone + PartialEq> ActionGoals<Id> {
                     .map(|c| &c.kind);
                 let allow_stalling = matches!(
                     spec,
-                    Some(rover_sim::ControllerKind::Gripper(g)) if g.allow_stalling
+                    Some(rover_sim::model::ControllerKind::Gripper(g)) if g.allow_stalling
                 );
                 Self {
                     controller: name.clone(),
@@ -543,7 +543,7 @@ fn gripper_ending(g: GripperSample, allow_stalling: bool) -> (GoalState, i32, &'
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rover_sim::TrajectoryPoint;
+    use rover_sim::physics::TrajectoryPoint;
 
     fn goals() -> ActionGoals<u32> {
         ActionGoals {

@@ -5,7 +5,7 @@
 //! colour camera's: the depth image is rendered with the same intrinsics) on
 //! `/<cameraName>/<depthImageTopicName>` and `/<cameraName>/<depthImageCameraInfoTopicName>`.
 
-use rover_sim::CameraInfo;
+use rover_sim::model::CameraInfo;
 
 use super::events::{ImageFrame, Start, TopicFamily};
 

@@ -4,8 +4,10 @@
 
 use rover_perception::{BoundingBox, BoundingBoxes};
 use rover_sim::{
-    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, JointKind, LaserScan, Pose, RobotModel,
-    Simulation, link_from_optical,
+    geometry::Pose,
+    model::{CameraInfo, JointKind, RobotModel, link_from_optical},
+    physics::{ControlSample, Simulation},
+    sensors::{CameraFrame, GroundTruthBox, LaserScan},
 };
 
 use super::events::{
@@ -116,9 +118,9 @@ pub(crate) fn joints(
     out.extend(joints.iter().map(|j| {
         let state = match j.source {
             JointSource::Joint(id) => sim.joint_state(id).unwrap_or_default(),
-            JointSource::Wheel { .. } => rover_sim::JointState {
+            JointSource::Wheel { .. } => rover_sim::physics::JointState {
                 velocity: j.source.velocity_radps(sample),
-                ..rover_sim::JointState::default()
+                ..rover_sim::physics::JointState::default()
             },
         };
         let setpoint = match j.source {
@@ -277,7 +279,7 @@ mod tests {
     #[test]
     fn a_joints_angle_is_its_turn_about_its_axis_since_rest() -> anyhow::Result<()> {
         // The links only name the joint's frames; the angle depends on the poses alone.
-        let robot = rover_sim::RobotModel::load(&rover_core::default_robot_path())?;
+        let robot = rover_sim::model::RobotModel::load(&rover_core::default_robot_path())?;
         let at_rest = Pose::from_parts(
             glam::Vec3::new(0.0, 0.2, 0.0),
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),

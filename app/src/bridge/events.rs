@@ -10,7 +10,7 @@
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use rover_perception::BoundingBox;
-use rover_sim::{CameraInfo, ControlSample, LaserScan, Pose};
+use rover_sim::{geometry::Pose, model::CameraInfo, physics::ControlSample, sensors::LaserScan};
 
 /// One frame's pose in another, as tf carries it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -69,7 +69,7 @@ pub(crate) struct ControlUpdate {
     /// plan's `grippers`.
     pub runs: Vec<RunSample>,
     /// Every model's world pose and twist (a recycled buffer).
-    pub models: Vec<rover_sim::ModelState>,
+    pub models: Vec<rover_sim::physics::ModelState>,
 }
 
 /// A trajectory controller's run at a control update.
@@ -80,7 +80,7 @@ pub(crate) struct RunSample {
     /// Trajectories started so far.
     pub runs: u64,
     /// How the last one ended (`None` while it runs).
-    pub outcome: Option<rover_sim::TrajectoryOutcome>,
+    pub outcome: Option<rover_sim::physics::TrajectoryOutcome>,
     /// A gripper's finger and how its last command ended (zeros for other controllers).
     pub gripper: GripperSample,
 }
@@ -206,7 +206,7 @@ pub(crate) struct BufferPool {
     boxes: Receiver<Vec<BoundingBox>>,
     joints: Receiver<Vec<JointSample>>,
     runs: Receiver<Vec<RunSample>>,
-    models: Receiver<Vec<rover_sim::ModelState>>,
+    models: Receiver<Vec<rover_sim::physics::ModelState>>,
 }
 
 /// The publishing thread's end: what an event still holds after every family saw it.
@@ -216,7 +216,7 @@ pub(crate) struct BufferReturn {
     boxes: SyncSender<Vec<BoundingBox>>,
     joints: SyncSender<Vec<JointSample>>,
     runs: SyncSender<Vec<RunSample>>,
-    models: SyncSender<Vec<rover_sim::ModelState>>,
+    models: SyncSender<Vec<rover_sim::physics::ModelState>>,
 }
 
 /// A pool and its return path.
@@ -274,7 +274,7 @@ impl BufferPool {
     }
 
     /// A model states buffer (its contents are stale).
-    pub fn take_models(&self) -> Vec<rover_sim::ModelState> {
+    pub fn take_models(&self) -> Vec<rover_sim::physics::ModelState> {
         self.models.try_recv().unwrap_or_default()
     }
 }

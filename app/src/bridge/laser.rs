@@ -1,7 +1,7 @@
 //! The first laser's scans (sensor_msgs/LaserScan on its `topicName`, in its `frameName`), at
 //! its update rate.
 
-use rover_sim::LaserScan;
+use rover_sim::sensors::LaserScan;
 
 use super::events::TopicFamily;
 

@@ -44,7 +44,10 @@ use anyhow::{Context, Result};
 use rover_core::{LoopStats, Observer};
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, RobotModel, Simulation,
+    geometry::Pose,
+    model::{CameraInfo, RobotModel},
+    physics::{ControlSample, Simulation},
+    sensors::{CameraFrame, GroundTruthBox, LaserScan},
 };
 
 use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily};

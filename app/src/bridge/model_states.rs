@@ -1,10 +1,10 @@
 //! `/gazebo/model_states` (gazebo_msgs/ModelStates): every model's name, world pose and world
 //! twist, as gazebo_ros publishes them for Gazebo's models. rover's models are the robot, the
-//! world's objects, its SDF models and its people ([`rover_sim::Simulation::model_states_into`]).
+//! world's objects, its SDF models and its people ([`rover_sim::physics::Simulation::model_states_into`]).
 //! Published each control update (Gazebo publishes each physics step; users judge a grasp or
 //! a place from it, and a control update is rover's unit of change for them).
 
-use rover_sim::ModelState;
+use rover_sim::physics::ModelState;
 
 use super::events::{ControlUpdate, Start, TopicFamily};
 

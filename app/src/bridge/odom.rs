@@ -1,7 +1,7 @@
 //! The diff drive's odometry (nav_msgs/Odometry on `odometryTopic`, with
 //! gazebo_ros_diff_drive's covariance), every control update.
 
-use rover_sim::ControlSample;
+use rover_sim::physics::ControlSample;
 
 use super::events::{ControlUpdate, TopicFamily};
 

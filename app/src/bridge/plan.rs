@@ -2,7 +2,9 @@
 //! the moving joints it reports.
 
 use rover_sim::{
-    CommandKind, ControlSample, ControllerKind, DiffDriveConfig, JointId, LinkId, Pose, RobotModel,
+    geometry::Pose,
+    model::{CommandKind, ControllerKind, DiffDriveConfig, JointId, LinkId, RobotModel},
+    physics::ControlSample,
 };
 
 /// Topic names and frames, from the robot's Gazebo plugins.
@@ -58,7 +60,7 @@ pub(crate) struct ControllerTopic {
     /// Its joints, as indices into the plan's `joints`.
     pub joints: Vec<usize>,
     /// The gains a position controller reports in its state.
-    pub pid: Option<rover_sim::Pid>,
+    pub pid: Option<rover_sim::model::Pid>,
     /// How often `state` goes out (Hz).
     pub state_hz: f64,
 }

@@ -2,7 +2,7 @@
 //! and `/tf_static` (fixed joints, the camera's optical frame, laser frames), kept for late
 //! joiners, as tf2_msgs/TFMessage.
 
-use rover_sim::Pose;
+use rover_sim::geometry::Pose;
 
 use super::events::{ControlUpdate, Start, TopicFamily, Transform};
 use super::odom::odom_pose;

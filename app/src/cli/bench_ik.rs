@@ -4,7 +4,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rover_core::RunConfig;
-use rover_sim::{IkOptions, IkSolver, IkTarget, KinematicChain, SplitMix64};
+use rover_sim::{
+    SplitMix64,
+    model::{IkOptions, IkSolver, IkTarget, KinematicChain},
+};
 
 use super::args::WorldArgs;
 use super::bench::median;

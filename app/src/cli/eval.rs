@@ -103,7 +103,7 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
         let model = Scenario::load_robot(r).with_context(|| format!("robot {}", r.display()))?;
         models.push((r.as_path(), model));
     }
-    let robots: Vec<Option<(&Path, &rover_sim::RobotModel)>> = if models.is_empty() {
+    let robots: Vec<Option<(&Path, &rover_sim::model::RobotModel)>> = if models.is_empty() {
         vec![None]
     } else {
         models.iter().map(|(p, m)| Some((*p, m))).collect()

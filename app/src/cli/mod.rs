@@ -35,7 +35,7 @@ use signals::Interrupted;
 
 /// `rover xacro FILE [name:=value ...]`: the expanded URDF on stdout.
 fn xacro(args: args::XacroArgs) -> anyhow::Result<()> {
-    let mut resources = rover_sim::ResourcePaths::from_env();
+    let mut resources = rover_sim::description::ResourcePaths::from_env();
     resources.packages.extend(args.package_paths);
     let xacro_args = args
         .args
@@ -43,7 +43,7 @@ fn xacro(args: args::XacroArgs) -> anyhow::Result<()> {
         .filter_map(|a| a.split_once(":="))
         .map(|(k, v)| (k.to_owned(), v.to_owned()))
         .collect();
-    let expanded = rover_sim::expand_xacro(&args.file, &xacro_args, &resources)?;
+    let expanded = rover_sim::description::expand_xacro(&args.file, &xacro_args, &resources)?;
     use std::io::Write as _;
     let mut out = std::io::stdout().lock();
     out.write_all(expanded.text.as_bytes())?;

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use rover_core::{Action, Fanout, InputSource, Observer};
-use rover_sim::RobotModel;
+use rover_sim::model::RobotModel;
 
 use super::args::RosArgs;
 use crate::ros::{RosBridge, RosInput};

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
-use rover_sim::CameraInfo;
+use rover_sim::model::CameraInfo;
 
 use super::convert::header;
 use crate::bridge::RosPlan;

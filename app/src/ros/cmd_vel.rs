@@ -4,7 +4,7 @@ use anyhow::Result;
 use rover_core::{Action, InputSource};
 use rover_ros1::msgs;
 use rover_ros1::{Node, Subscriber};
-use rover_sim::Twist;
+use rover_sim::physics::Twist;
 
 use crate::bridge::RosPlan;
 

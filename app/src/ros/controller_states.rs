@@ -58,7 +58,7 @@ impl ControllerStates {
                     }),
                 )
             } else {
-                let pid = topic.pid.unwrap_or(rover_sim::Pid {
+                let pid = topic.pid.unwrap_or(rover_sim::model::Pid {
                     p: 0.0,
                     i: 0.0,
                     d: 0.0,

@@ -2,7 +2,7 @@
 
 use rover_ros1::msgs::{self, Header};
 use rover_ros1::{Message, Publisher};
-use rover_sim::{JointTrajectory, TrajectoryPoint};
+use rover_sim::physics::{JointTrajectory, TrajectoryPoint};
 
 /// A header in `frame_id`, to be numbered and stamped when published.
 pub(super) fn header(frame_id: &str) -> Header {

@@ -47,7 +47,7 @@ pub(super) struct GripperServer {
 pub(super) fn gripper_servers(
     node: &Node,
     plan: &RosPlan,
-    robot: &rover_sim::RobotModel,
+    robot: &rover_sim::model::RobotModel,
 ) -> Result<Vec<Box<dyn ActionWire>>> {
     ActionGoals::grippers(plan, robot)
         .into_iter()

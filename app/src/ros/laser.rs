@@ -3,7 +3,7 @@
 use anyhow::Result;
 use rover_ros1::msgs;
 use rover_ros1::{Node, Publisher};
-use rover_sim::LaserScan;
+use rover_sim::sensors::LaserScan;
 
 use crate::bridge::RosPlan;
 use crate::bridge::laser::ScanWire;

@@ -33,7 +33,7 @@ mod tf;
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource};
 use rover_ros1::{Node, NodeOptions, Value};
-use rover_sim::RobotModel;
+use rover_sim::model::RobotModel;
 
 pub(crate) use crate::bridge::RosPlan;
 pub use cmd_vel::RosCmdVel;

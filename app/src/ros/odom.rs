@@ -3,7 +3,7 @@
 use anyhow::Result;
 use rover_ros1::msgs::{self, Quaternion, Vector3};
 use rover_ros1::{Node, Publisher};
-use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
+use rover_sim::physics::ODOM_POSE_COVARIANCE_DIAGONAL;
 
 use super::convert::{header, seq_of};
 use crate::bridge::RosPlan;

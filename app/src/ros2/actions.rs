@@ -21,7 +21,7 @@ use std::sync::mpsc::Sender;
 
 use anyhow::{Context, Result};
 use rover_core::Action;
-use rover_sim::RobotModel;
+use rover_sim::model::RobotModel;
 use rustdds::no_key::DataWriter;
 use rustdds::{CDRSerializerAdapter, DomainParticipant, GUID, QosPolicies, RTPSEntity, TopicKind};
 use serde::Serialize;

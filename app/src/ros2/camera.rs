@@ -2,7 +2,7 @@
 //! ROS 2, best effort as rclcpp's SensorDataQoS.
 
 use anyhow::Result;
-use rover_sim::CameraInfo;
+use rover_sim::model::CameraInfo;
 
 use super::sinks::{Out, Sinks, header, sensor_qos};
 use crate::bridge::RosPlan;

@@ -2,7 +2,7 @@
 //! the actions that carry them (as `app/src/ros/convert.rs` is ROS 1's).
 
 use rover_ros2::msgs::{self, Duration, Time};
-use rover_sim::{JointTrajectory, TrajectoryPoint};
+use rover_sim::physics::{JointTrajectory, TrajectoryPoint};
 
 /// A trajectory_msgs/msg/JointTrajectory as the simulation takes it (its stamp: when it
 /// starts, 0 for "now"), from a controller's `~/joint_trajectory` or a FollowJointTrajectory

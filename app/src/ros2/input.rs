@@ -8,7 +8,7 @@
 
 use anyhow::{Context, Result};
 use rover_core::{Action, InputSource, JointAction};
-use rover_sim::Twist;
+use rover_sim::physics::Twist;
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, GUID, RTPSEntity, TopicKind};
 use serde::de::DeserializeOwned;

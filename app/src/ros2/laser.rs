@@ -2,7 +2,7 @@
 //! SensorDataQoS.
 
 use anyhow::Result;
-use rover_sim::LaserScan;
+use rover_sim::sensors::LaserScan;
 
 use super::sinks::{Out, Sinks, sensor_qos};
 use crate::bridge::RosPlan;

@@ -55,7 +55,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use anyhow::{Context, Result};
-use rover_sim::RobotModel;
+use rover_sim::model::RobotModel;
 use rustdds::DomainParticipant;
 
 use crate::bridge::action_intake::{self, ActionFamily};

@@ -1,7 +1,7 @@
 //! The diff drive's odometry (nav_msgs/msg/Odometry) on ROS 2.
 
 use anyhow::Result;
-use rover_sim::ODOM_POSE_COVARIANCE_DIAGONAL;
+use rover_sim::physics::ODOM_POSE_COVARIANCE_DIAGONAL;
 
 use super::sinks::{Out, Sinks, header};
 use crate::bridge::RosPlan;

@@ -7,7 +7,10 @@
 //! follows; the joint's limits and the actuator's velocity and effort limits still apply.
 
 use rover_core::{Action, JointAction};
-use rover_sim::{JointCommand, JointId, JointKind, Simulation};
+use rover_sim::{
+    model::{JointId, JointKind},
+    physics::{JointCommand, Simulation},
+};
 
 /// One jog step of a revolute joint (rad).
 pub(super) const JOG_RAD: f64 = 0.1;

@@ -1,7 +1,7 @@
 //! Gamepad teleop (gilrs): left stick drives, right stick turns, a deadman button must be held to
 //! move, a button toggles follow; hot-plug; a pad unplugged while driving stops the car.
 
-use rover_sim::Twist;
+use rover_sim::physics::Twist;
 
 /// Stick values below this are treated as zero.
 pub const DEADZONE: f32 = 0.12;

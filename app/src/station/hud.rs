@@ -212,7 +212,7 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
 pub(super) fn truth_text(
     out: &mut String,
     matched: &rover_perception::FrameMatch,
-    truth: &[rover_sim::GroundTruthBox],
+    truth: &[rover_sim::sensors::GroundTruthBox],
 ) {
     use std::fmt::Write as _;
     out.clear();
@@ -247,7 +247,7 @@ fn split_line(text: &str, chars: usize) -> (&str, &str) {
 struct GoalText(Option<(f64, f64)>);
 
 impl GoalText {
-    fn new(stats: &LoopStats, odom: rover_sim::Odometry) -> Self {
+    fn new(stats: &LoopStats, odom: rover_sim::physics::Odometry) -> Self {
         Self(stats.follow_goal_m.map(|p| range_bearing_from(odom, p)))
     }
 }
@@ -301,12 +301,12 @@ mod tests {
 
     #[test]
     fn the_truth_line_counts_what_was_found_missed_and_false() {
-        let thing = |ignore: bool| rover_sim::GroundTruthBox {
+        let thing = |ignore: bool| rover_sim::sensors::GroundTruthBox {
             id: 1,
-            entity: rover_sim::Labelled::Person(0),
+            entity: rover_sim::model::Labelled::Person(0),
             class: "person".into(),
             name: "alice".into(),
-            full: rover_sim::PixelBox {
+            full: rover_sim::sensors::PixelBox {
                 xmin: 0.0,
                 ymin: 0.0,
                 xmax: 10.0,
@@ -354,10 +354,10 @@ mod tests {
 
     #[test]
     fn the_pursued_point_is_shown_from_the_robot() {
-        let odom = rover_sim::Odometry {
+        let odom = rover_sim::physics::Odometry {
             x_m: 1.0,
             yaw_rad: std::f64::consts::FRAC_PI_2,
-            ..rover_sim::Odometry::default()
+            ..rover_sim::physics::Odometry::default()
         };
         let stats = LoopStats {
             follow_goal_m: Some([1.0, 2.0]),

@@ -23,7 +23,11 @@ use rover_core::{
     Action, CoreError, EventLevel, Fanout, InputSource, JointAction, LoopStats, Mode, Observer,
     Script, ScriptPlayer, Session,
 };
-use rover_sim::{CameraFrame, ControlSample, Pose, Simulation, Twist};
+use rover_sim::{
+    geometry::Pose,
+    physics::{ControlSample, Simulation, Twist},
+    sensors::CameraFrame,
+};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -114,7 +118,7 @@ impl Observer for Feed {
     fn detections_truth(
         &mut self,
         boxes: &rover_perception::BoundingBoxes,
-        truth: &[rover_sim::GroundTruthBox],
+        truth: &[rover_sim::sensors::GroundTruthBox],
     ) {
         let matched = self.judge.judge(boxes, truth);
         hud::truth_text(self.truth.get_or_insert_with(String::new), matched, truth);

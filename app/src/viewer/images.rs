@@ -1,7 +1,7 @@
 //! Camera images for Rerun: at a chosen rate, downscaled and/or JPEG-encoded for long runs.
 
 use rerun::RecordingStream;
-use rover_sim::CameraFrame;
+use rover_sim::sensors::CameraFrame;
 
 /// Entity path of the camera image.
 pub(super) const IMAGE_PATH: &str = "world/robot/camera/image";

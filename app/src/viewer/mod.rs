@@ -46,7 +46,10 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 use rover_core::{EventLevel, LiveJudge, LoopStats, Mode, Observer};
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraFrame, CameraInfo, ControlSample, GroundTruthBox, LaserScan, Pose, Simulation,
+    geometry::Pose,
+    model::CameraInfo,
+    physics::{ControlSample, Simulation},
+    sensors::{CameraFrame, GroundTruthBox, LaserScan},
 };
 
 pub use blueprint::blueprint;
@@ -395,7 +398,7 @@ impl Observer for Recorder {
                 .and_then(|i| u16::try_from(i).ok())
                 .unwrap_or(u16::MAX)
         };
-        let scaled = |b: rover_sim::PixelBox| {
+        let scaled = |b: rover_sim::sensors::PixelBox| {
             (
                 [b.xmin as f32 / k, b.ymin as f32 / k],
                 [b.width() as f32 / k, b.height() as f32 / k],

@@ -3,8 +3,10 @@
 
 use rerun::RecordingStream;
 use rover_sim::{
-    CameraInfo, MeshData, Pose, Rgba, Simulation, SkinnedBody, Swing, Visual, link_from_optical,
-    object_mesh, person_parts, shape_mesh,
+    geometry::{Pose, Rgba},
+    model::{CameraInfo, MeshData, Visual, link_from_optical},
+    physics::Simulation,
+    render::{SkinnedBody, Swing, object_mesh, person_parts, shape_mesh},
 };
 
 use super::images::{IMAGE_PATH, ImageOptions};
@@ -27,7 +29,7 @@ pub(super) struct ScenePaths {
     /// model links.
     pub moving_model_links: Vec<(usize, String)>,
     /// `plots/joints/<joint>` per actuated joint: its position and its actuator's target.
-    pub joints: Vec<(rover_sim::JointId, String)>,
+    pub joints: Vec<(rover_sim::model::JointId, String)>,
 }
 
 /// Logs the static scene and returns the paths per-tick logging uses.
@@ -144,7 +146,7 @@ struct PartsMesh {
 
 impl PartsMesh {
     /// Adds `part`'s mesh, placed at `frame_from_part`.
-    fn add(&mut self, part: &rover_sim::PersonPart, frame_from_part: Pose) {
+    fn add(&mut self, part: &rover_sim::render::PersonPart, frame_from_part: Pose) {
         let base = self.positions.len() as u32;
         for v in &part.mesh.vertices {
             self.positions
@@ -243,7 +245,7 @@ fn log_people(
 }
 
 /// A skinned body as one Rerun mesh: its posed vertices, each coloured by its layer's paint.
-fn skinned_mesh(body: &SkinnedBody, person: &rover_sim::Person) -> rerun::Mesh3D {
+fn skinned_mesh(body: &SkinnedBody, person: &rover_sim::model::Person) -> rerun::Mesh3D {
     let mut colors = vec![rerun::Color::from_rgb(128, 128, 128); body.positions().len()];
     let mut triangles = Vec::new();
     for layer in body.layers() {
@@ -303,7 +305,10 @@ fn log_camera(rec: &RecordingStream, sim: &Simulation, info: &CameraInfo, images
 }
 
 /// The actuated joints' plot paths, with their series named.
-fn log_joint_series(rec: &RecordingStream, sim: &Simulation) -> Vec<(rover_sim::JointId, String)> {
+fn log_joint_series(
+    rec: &RecordingStream,
+    sim: &Simulation,
+) -> Vec<(rover_sim::model::JointId, String)> {
     let robot = sim.robot();
     robot
         .actuated_joints()

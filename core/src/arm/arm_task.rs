@@ -7,8 +7,13 @@
 use nalgebra::Vector3;
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraFrame, ChainJoint, IkSolver, IkTarget, JointCommand, KinematicChain,
-    KinematicsError, LinkId, Pose, Simulation, isometry_from_pose, link_from_optical,
+    geometry::Pose,
+    model::{
+        CameraConfig, ChainJoint, IkSolver, IkTarget, KinematicChain, KinematicsError, LinkId,
+        isometry_from_pose, link_from_optical,
+    },
+    physics::{JointCommand, Simulation},
+    sensors::CameraFrame,
 };
 
 use super::look::{Look, LookConfig};
@@ -32,7 +37,7 @@ pub struct ArmConfig {
     /// no reach.
     pub ee_link: Option<String>,
     /// A MoveIt SRDF whose planning group gives the base and end effector when they are not
-    /// given ([`rover_sim::load_arm_group`]); `None`: the world's `[robot] srdf`.
+    /// given ([`rover_sim::description::load_arm_group`]); `None`: the world's `[robot] srdf`.
     pub srdf: Option<std::path::PathBuf>,
     /// Which SRDF group is the arm (`None`: the world's `[robot] arm_group`, else `arm`, else
     /// the only group).
@@ -115,15 +120,15 @@ impl ArmConfig {
     /// such group (file and line, the groups it has).
     pub fn resolved(
         &self,
-        robot: &rover_sim::RobotModel,
-        spawn: &rover_sim::RobotSpawn,
+        robot: &rover_sim::model::RobotModel,
+        spawn: &rover_sim::model::RobotSpawn,
     ) -> Result<Self, rover_sim::SimError> {
         let mut out = self.clone();
         let Some(srdf) = self.srdf.as_ref().or(spawn.srdf.as_ref()) else {
             return Ok(out);
         };
         let group_name = self.group.as_deref().or(spawn.arm_group.as_deref());
-        let group = rover_sim::load_arm_group(srdf, robot, group_name)?;
+        let group = rover_sim::description::load_arm_group(srdf, robot, group_name)?;
         tracing::info!(
             "arm: SRDF group \"{}\": {} -> {}",
             group.name,
@@ -179,7 +184,7 @@ pub(crate) struct ArmTask {
     /// The end effector moved to points (scripts, Cartesian jogging).
     tool: Result<IkSolver, String>,
     /// The planning scene a tool point is checked in (built at the first point).
-    tool_scene: Option<rover_sim::PlanningScene>,
+    tool_scene: Option<rover_sim::planning::PlanningScene>,
     /// In reach mode the camera's chain looks too, when it shares no joint with the arm.
     look_while_reaching: bool,
     frames: Vec<FrameRecord>,
@@ -568,7 +573,7 @@ impl ArmTask {
     }
 
     /// What the pick tells the base this control update (`fetch`), while pick is on.
-    pub(crate) fn base_command(&self) -> Option<rover_sim::Twist> {
+    pub(crate) fn base_command(&self) -> Option<rover_sim::physics::Twist> {
         if self.mode != ArmMode::Pick {
             return None;
         }

@@ -11,8 +11,11 @@
 use nalgebra::Vector3;
 use rover_perception::BoundingBoxes;
 use rover_sim::{
-    CameraConfig, CameraInfo, ChainJoint, KinematicChain, KinematicsError, Pose, RobotModel,
-    isometry_from_pose, link_from_optical,
+    geometry::Pose,
+    model::{
+        CameraConfig, CameraInfo, ChainJoint, KinematicChain, KinematicsError, RobotModel,
+        isometry_from_pose, link_from_optical,
+    },
 };
 
 /// Look settings.

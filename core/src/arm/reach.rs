@@ -23,7 +23,7 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use rover_perception::{BoundingBox, BoundingBoxes};
-use rover_sim::{
+use rover_sim::model::{
     CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, IkTarget, KinematicChain,
     KinematicsError, RobotModel,
 };

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use rover_assets::COCO80;
 use rover_perception::{BoundingBoxes, Detection, EvalBox, GroundTruthObject};
-use rover_sim::{GroundTruthBox, PixelBox};
+use rover_sim::sensors::{GroundTruthBox, PixelBox};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::randomize::Shot;

@@ -18,7 +18,11 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use rover_perception::{Detector, FrameStamp, RgbView};
-use rover_sim::{CameraSensor, RobotModel, SimOptions, Simulation, World};
+use rover_sim::{
+    model::{RobotModel, World},
+    physics::{SimOptions, Simulation},
+    sensors::CameraSensor,
+};
 
 pub use export::{
     COCO_CATEGORY_IDS, DetectedBox, ImageRecord, LabelledBox, coco_category, coco_json,

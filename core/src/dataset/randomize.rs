@@ -7,7 +7,11 @@ use std::f64::consts::PI;
 
 use glam::{Quat, Vec3};
 use rover_sim::{
-    GaussianNoise, Light, Pose, Rgba, Shape, Simulation, SplitMix64, World, pose_from_position_yaw,
+    SplitMix64,
+    geometry::{Pose, Rgba, Shape, pose_from_position_yaw},
+    model::{GaussianNoise, World},
+    physics::Simulation,
+    render::Light,
 };
 use serde::{Deserialize, Serialize};
 
@@ -135,10 +139,10 @@ const HAIR_COLORS: [[f32; 3]; 6] = [
 /// Fraction of people drawn as children (MakeHuman's age 0.19-0.35, 1.1-1.5 m).
 const CHILD_FRACTION: f64 = 0.2;
 /// Hair styles and how often each is drawn.
-const HAIR_STYLES: [(rover_sim::human::HairStyle, f64); 3] = [
-    (rover_sim::human::HairStyle::Short, 0.5),
-    (rover_sim::human::HairStyle::Long, 0.35),
-    (rover_sim::human::HairStyle::Bald, 0.15),
+const HAIR_STYLES: [(rover_sim::model::human::HairStyle, f64); 3] = [
+    (rover_sim::model::human::HairStyle::Short, 0.5),
+    (rover_sim::model::human::HairStyle::Long, 0.35),
+    (rover_sim::model::human::HairStyle::Bald, 0.15),
 ];
 /// Fraction of people drawn in a skirt (knee-length or long, one as often as the other).
 const SKIRT_FRACTION: f64 = 0.3;
@@ -146,14 +150,14 @@ const SKIRT_FRACTION: f64 = 0.3;
 /// A person's random look: MakeHuman's body in a random shape and height (a person drawn as
 /// rover's figure or an actor's skin keeps it), a skin tone, a hair colour and style,
 /// trousers or a skirt, and half of them mid-stride.
-fn random_look(person: &rover_sim::Person, rng: &mut Rng) -> rover_sim::PersonLook {
+fn random_look(person: &rover_sim::model::Person, rng: &mut Rng) -> rover_sim::physics::PersonLook {
     let child = rng.uniform() < CHILD_FRACTION;
     let (age, height_m) = if child {
         (rng.between(0.19, 0.35), rng.between(1.1, 1.5))
     } else {
         (rng.between(0.4, 0.9), rng.between(1.55, 1.95))
     };
-    let shape = rover_sim::human::BodyShape {
+    let shape = rover_sim::model::human::BodyShape {
         gender: rng.uniform() as f32,
         age: age as f32,
         muscle: rng.between(0.2, 0.8) as f32,
@@ -177,15 +181,15 @@ fn random_look(person: &rover_sim::Person, rng: &mut Rng) -> rover_sim::PersonLo
             style_draw -= share;
             style_draw < 0.0
         })
-        .map_or(rover_sim::human::HairStyle::Short, |(h, _)| *h);
+        .map_or(rover_sim::model::human::HairStyle::Short, |(h, _)| *h);
     let legwear = match rng.uniform() {
-        u if u < SKIRT_FRACTION / 2.0 => rover_sim::human::Legwear::Skirt,
-        u if u < SKIRT_FRACTION => rover_sim::human::Legwear::LongSkirt,
-        _ => rover_sim::human::Legwear::Trousers,
+        u if u < SKIRT_FRACTION / 2.0 => rover_sim::model::human::Legwear::Skirt,
+        u if u < SKIRT_FRACTION => rover_sim::model::human::Legwear::LongSkirt,
+        _ => rover_sim::model::human::Legwear::Trousers,
     };
-    rover_sim::PersonLook {
+    rover_sim::physics::PersonLook {
         shape: person.shape.map(|_| shape),
-        outfit: rover_sim::human::Outfit::new(hair, legwear),
+        outfit: rover_sim::model::human::Outfit::new(hair, legwear),
         height_m: if person.shape.is_some() {
             height_m
         } else {
@@ -289,7 +293,7 @@ pub struct PersonShot {
 }
 
 impl PersonShot {
-    fn of(person: &rover_sim::Person) -> Self {
+    fn of(person: &rover_sim::model::Person) -> Self {
         let rgb = |c: Rgba| [c.0[0], c.0[1], c.0[2]];
         Self {
             name: person.name.clone(),
@@ -313,7 +317,7 @@ impl PersonShot {
 /// Lays out image `rng`'s scene in `sim` and `camera`. Returns what it did.
 pub(crate) fn lay_out(
     sim: &mut Simulation,
-    camera: &mut rover_sim::CameraSensor,
+    camera: &mut rover_sim::sensors::CameraSensor,
     base: &BaseLayout,
     how: &Randomization,
     rng: &mut Rng,
@@ -445,7 +449,7 @@ fn place_robot(
     if !how.robot {
         let p = base.robot_base;
         sim.place_robot(p)?;
-        let yaw = rover_sim::yaw_of(p.rotation);
+        let yaw = rover_sim::geometry::yaw_of(p.rotation);
         return Ok((
             [
                 f64::from(p.translation.x),

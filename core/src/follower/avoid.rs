@@ -7,7 +7,7 @@
 //! leave and how fast they go; arcs that come closer than the hard margin are never taken.
 //! Obstacles are points in the robot's base frame (x forward, y left), the robot a circle.
 
-use rover_sim::{Twist, wrap_angle};
+use rover_sim::physics::{Twist, wrap_angle};
 
 /// Avoidance settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

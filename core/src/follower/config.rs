@@ -1,7 +1,10 @@
 //! The follower's settings and what it knows of its sensors: the camera's geometry, the
 //! laser's mount, and where a point is from the robot.
 
-use rover_sim::{CameraInfo, Odometry, wrap_angle};
+use rover_sim::{
+    model::CameraInfo,
+    physics::{Odometry, wrap_angle},
+};
 
 use super::avoid::AvoidConfig;
 
@@ -188,11 +191,11 @@ pub struct LaserMount {
 
 impl LaserMount {
     /// The planar part of the sensor's pose in the base frame.
-    pub fn from_base_from_laser(base_from_laser: rover_sim::Pose) -> Self {
+    pub fn from_base_from_laser(base_from_laser: rover_sim::geometry::Pose) -> Self {
         Self {
             x_m: f64::from(base_from_laser.translation.x),
             y_m: f64::from(base_from_laser.translation.y),
-            yaw_rad: wrap_angle(rover_sim::yaw_of(base_from_laser.rotation)),
+            yaw_rad: wrap_angle(rover_sim::geometry::yaw_of(base_from_laser.rotation)),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Control: from the state and the estimate to cmd_vel (tracking, pursuing, giving way over
 //! the trail, avoiding, searching, and the acceleration limits).
 
-use rover_sim::{Odometry, Twist, wrap_angle};
+use rover_sim::physics::{Odometry, Twist, wrap_angle};
 
 use super::config::range_bearing_from;
 use super::state::Follower;

@@ -2,7 +2,7 @@
 //! width, and how sure), from the camera's geometry.
 
 use rover_perception::BoundingBox;
-use rover_sim::Odometry;
+use rover_sim::physics::Odometry;
 
 use super::state::Follower;
 use super::target::Measured;

@@ -2,7 +2,7 @@
 
 use std::collections::VecDeque;
 
-use rover_sim::{Odometry, Twist};
+use rover_sim::physics::{Odometry, Twist};
 
 use super::avoid::Avoided;
 use super::config::{CameraGeometry, FollowerConfig, LaserMount};

@@ -4,7 +4,10 @@ use super::tuning::*;
 use super::*;
 use nalgebra::Matrix2;
 use rover_perception::{BoundingBox, BoundingBoxes, FrameStamp};
-use rover_sim::{LaserScan, Odometry, Twist, wrap_angle};
+use rover_sim::{
+    physics::{Odometry, Twist, wrap_angle},
+    sensors::LaserScan,
+};
 
 fn camera() -> CameraGeometry {
     CameraGeometry {
@@ -366,7 +369,7 @@ fn scan_with_person_at(range_m: f32, bearing_rad: f32, t: f64) -> LaserScan {
     let mut ranges = vec![f32::INFINITY; 360];
     for (i, r) in ranges.iter_mut().enumerate() {
         let a = (i as f32).to_radians();
-        let off = rover_sim::wrap_angle(f64::from(a - bearing_rad)) as f32;
+        let off = rover_sim::physics::wrap_angle(f64::from(a - bearing_rad)) as f32;
         if (off * range_m).abs() < 0.13 {
             *r = range_m - 0.1;
         }

@@ -3,7 +3,7 @@
 
 use nalgebra::Matrix2;
 use rover_perception::BoundingBoxes;
-use rover_sim::{LaserScan, wrap_angle};
+use rover_sim::{physics::wrap_angle, sensors::LaserScan};
 
 use super::filter::{TargetFilter, polar_covariance};
 use super::state::Follower;

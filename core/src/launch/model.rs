@@ -32,7 +32,7 @@ pub struct LaunchOptions {
     /// `name:=value` args for the top file, as on roslaunch's command line.
     pub args: Vec<(String, String)>,
     /// Where `$(find)` and packages are found.
-    pub resources: rover_sim::ResourcePaths,
+    pub resources: rover_sim::description::ResourcePaths,
     /// rover's reading: the includes rover does itself (gazebo_ros' `empty_world.launch`,
     /// `darknet_ros.launch`) are recorded in [`Launch::provided`] and not read. Without it,
     /// they are read like any other file when installed (roslaunch's reading, for

@@ -19,7 +19,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 fn options(dir: &Path, rover: bool) -> LaunchOptions {
     LaunchOptions {
-        resources: rover_sim::ResourcePaths::default().with_package("pkg", dir),
+        resources: rover_sim::description::ResourcePaths::default().with_package("pkg", dir),
         rover,
         ..Default::default()
     }

@@ -4,7 +4,7 @@
 //! `collada.rs`), OGRE material
 //! scripts (`ogre.rs`), MoveIt SRDF planning groups (`srdf.rs`), `package://` and `model://` lookup
 //! (`resource.rs`), with the XML helpers they share (`xml.rs`). The entries are
-//! [`RobotModel::load`](crate::RobotModel::load) and [`World::load`](crate::World::load);
+//! [`RobotModel::load`](crate::model::RobotModel::load) and [`World::load`](crate::model::World::load);
 //! nothing here is needed to run a model built in code.
 
 pub(crate) mod collada;

@@ -484,7 +484,7 @@ impl Simulation {
     /// The force (N) the ground (or a collider on no body) pushes on link `link`'s body with,
     /// in the last step (the sum of those contacts' impulses over the step; links welded into
     /// one body share it). 0 for a link not on the ground.
-    pub fn ground_force_n(&self, link: crate::LinkId) -> f32 {
+    pub fn ground_force_n(&self, link: crate::model::LinkId) -> f32 {
         let Some(body) = self.link_body.get(link.index()) else {
             return 0.0;
         };

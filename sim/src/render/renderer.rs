@@ -228,13 +228,13 @@ impl CameraRenderer {
     }
 
     /// Moves the visuals of moving SDF model links to `world_from_model_links` (every model
-    /// link in world order, as [`crate::Simulation::model_link_poses_into`] gives them).
+    /// link in world order, as [`crate::physics::Simulation::model_link_poses_into`] gives them).
     pub fn set_model_link_poses(&mut self, world_from_model_links: &[Pose]) {
         self.scene.set_model_link_poses(world_from_model_links);
     }
 
     /// Moves person `index` (world order) to `world_from_person`, their limbs to gait phase
-    /// `gait_phase_rad` ([`crate::Simulation::person_gait_phase_rad`]; 0: standing), for the
+    /// `gait_phase_rad` ([`crate::physics::Simulation::person_gait_phase_rad`]; 0: standing), for the
     /// following renders.
     pub fn set_person_pose(&mut self, index: usize, world_from_person: Pose, gait_phase_rad: f64) {
         self.scene

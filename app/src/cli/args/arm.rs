@@ -70,7 +70,7 @@ fn parse_fetch(text: &str) -> anyhow::Result<[f64; 2]> {
 }
 
 /// `--place`: three comma-separated finite numbers are a point, anything else an object's name.
-fn parse_place(text: &str) -> anyhow::Result<rover_sim::Place> {
+fn parse_place(text: &str) -> anyhow::Result<rover_sim::model::Place> {
     let numbers: Result<Vec<f64>, _> = text.split(',').map(|p| p.trim().parse::<f64>()).collect();
     if let Ok(point) = numbers
         && let [x, y, z] = point[..]
@@ -79,13 +79,13 @@ fn parse_place(text: &str) -> anyhow::Result<rover_sim::Place> {
             point.iter().all(|v| v.is_finite()),
             "--place {text}: a point must be three finite numbers X,Y,Z (m)"
         );
-        return Ok(rover_sim::Place::Point([x, y, z]));
+        return Ok(rover_sim::model::Place::Point([x, y, z]));
     }
     anyhow::ensure!(
         !text.trim().is_empty(),
         "--place: expected a world object's name or a point X,Y,Z (m), found nothing"
     );
-    Ok(rover_sim::Place::Object(text.to_owned()))
+    Ok(rover_sim::model::Place::Object(text.to_owned()))
 }
 
 impl ArmArgs {

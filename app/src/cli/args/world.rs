@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use rover_core::RunConfig;
-use rover_sim::SimOptions;
+use rover_sim::physics::SimOptions;
 
 use super::parsers::parse_package_path;
 
@@ -41,7 +41,7 @@ pub(crate) struct WorldArgs {
     /// names no drive plugin (separation and diameter from the URDF); overrides the world's
     /// [robot.drive]
     #[arg(long, value_name = "LEFT_JOINT,RIGHT_JOINT", value_parser = parse_drive)]
-    pub(crate) drive: Option<rover_sim::DriveSpec>,
+    pub(crate) drive: Option<rover_sim::model::DriveSpec>,
 
     /// The camera to render when the robot has several: its <sensor name> or cameraName
     /// [default: the first in the file]
@@ -61,7 +61,7 @@ pub(crate) struct WorldArgs {
     /// (a constraint per joint, the default) or multibody (reduced coordinates: long arms
     /// with light links, fixed-base arms)
     #[arg(long, value_name = "SOLVER", value_parser = parse_joint_solver)]
-    pub(crate) joints: Option<rover_sim::JointSolver>,
+    pub(crate) joints: Option<rover_sim::model::JointSolver>,
 
     /// A ros_control controllers YAML for the robot (overrides the world's [robot]
     /// controllers): joint_state_controller, Joint{Position,Velocity,Effort}Controller and
@@ -90,9 +90,9 @@ fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
 }
 
 /// `LEFT_JOINT,RIGHT_JOINT`.
-fn parse_drive(s: &str) -> Result<rover_sim::DriveSpec, String> {
+fn parse_drive(s: &str) -> Result<rover_sim::model::DriveSpec, String> {
     match s.split(',').map(str::trim).collect::<Vec<_>>().as_slice() {
-        [left, right] if !left.is_empty() && !right.is_empty() => Ok(rover_sim::DriveSpec {
+        [left, right] if !left.is_empty() && !right.is_empty() => Ok(rover_sim::model::DriveSpec {
             left_joint: (*left).to_owned(),
             right_joint: (*right).to_owned(),
             wheel_separation_m: None,
@@ -120,8 +120,8 @@ fn parse_spawn(s: &str) -> Result<[f64; 3], String> {
 
 impl WorldArgs {
     /// The robot-loading options these arguments give.
-    pub(crate) fn robot_options(&self) -> rover_sim::LoadOptions {
-        let mut options = rover_sim::LoadOptions::default();
+    pub(crate) fn robot_options(&self) -> rover_sim::description::LoadOptions {
+        let mut options = rover_sim::description::LoadOptions::default();
         options.xacro_args.extend(self.xacro_args.iter().cloned());
         options
             .resources
@@ -155,10 +155,10 @@ impl WorldArgs {
     }
 }
 
-fn parse_joint_solver(text: &str) -> Result<rover_sim::JointSolver, String> {
+fn parse_joint_solver(text: &str) -> Result<rover_sim::model::JointSolver, String> {
     match text {
-        "multibody" => Ok(rover_sim::JointSolver::Multibody),
-        "impulse" => Ok(rover_sim::JointSolver::Impulse),
+        "multibody" => Ok(rover_sim::model::JointSolver::Multibody),
+        "impulse" => Ok(rover_sim::model::JointSolver::Impulse),
         other => Err(format!("expected multibody or impulse, found '{other}'")),
     }
 }

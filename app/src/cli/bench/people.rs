@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rover_core::RunConfig;
-use rover_sim::Simulation;
+use rover_sim::physics::Simulation;
 
 use super::stats::median;
 
@@ -47,11 +47,14 @@ pub(crate) fn bench_people(args: crate::cli::args::PeopleBenchArgs) -> Result<()
     for body in &bodies {
         let (name, shape) = match body {
             SweepBody::Makehuman => {
-                if rover_sim::human::shared().is_none() {
+                if rover_sim::model::human::shared().is_none() {
                     say!("makehuman: not available (see the warning above); skipped");
                     continue;
                 }
-                ("makehuman", Some(rover_sim::human::BodyShape::default()))
+                (
+                    "makehuman",
+                    Some(rover_sim::model::human::BodyShape::default()),
+                )
             }
             SweepBody::Figure => ("figure", None),
         };
@@ -120,7 +123,7 @@ pub(crate) fn bench_people(args: crate::cli::args::PeopleBenchArgs) -> Result<()
 fn frame_ms(
     run: &RunConfig,
     count: usize,
-    shape: Option<rover_sim::human::BodyShape>,
+    shape: Option<rover_sim::model::human::BodyShape>,
 ) -> Result<f64> {
     let (mut world, robot) = run.load_world_and_robot()?;
     let template = world.people.first().cloned();
@@ -135,7 +138,7 @@ fn frame_ms(
         p.name = format!("p{i}");
         p.position_m = [x, y];
         p.shape = shape;
-        p.walk = Some(rover_sim::Walk {
+        p.walk = Some(rover_sim::model::Walk {
             waypoints_m: vec![[x + 1.0, y]],
             speed_mps: 0.8,
             repeat: true,
@@ -144,7 +147,7 @@ fn frame_ms(
         world.people.push(p);
     }
     let mut sim = Simulation::new(world, robot, &run.options)?;
-    let mut camera = rover_sim::CameraSensor::new(&sim)?;
+    let mut camera = rover_sim::sensors::CameraSensor::new(&sim)?;
     camera.disable_depth();
     camera.capture(&sim)?;
     let mut times = Vec::new();
@@ -166,10 +169,13 @@ fn time_frames(run: &RunConfig) -> Result<()> {
     say!("");
     say!("camera frame (median of 60, posing + render + readback): {none:.2} ms with nobody");
     let mut bodies = vec![("figure", None)];
-    if rover_sim::human::shared().is_some() {
+    if rover_sim::model::human::shared().is_some() {
         bodies.insert(
             0,
-            ("makehuman", Some(rover_sim::human::BodyShape::default())),
+            (
+                "makehuman",
+                Some(rover_sim::model::human::BodyShape::default()),
+            ),
         );
     }
     for (name, shape) in bodies {
@@ -186,16 +192,16 @@ fn time_frames(run: &RunConfig) -> Result<()> {
 
 /// Times posing (skinning) the default MakeHuman body through a walk.
 fn time_posing() -> Result<()> {
-    if let Some(human) = rover_sim::human::shared() {
+    if let Some(human) = rover_sim::model::human::shared() {
         let body = human.body(
-            rover_sim::human::BodyShape::default(),
+            rover_sim::model::human::BodyShape::default(),
             1.75,
-            rover_sim::human::Outfit::default(),
+            rover_sim::model::human::Outfit::default(),
         )?;
-        let mut posed = rover_sim::human::PosedBody::default();
+        let mut posed = rover_sim::model::human::PosedBody::default();
         let mut times = Vec::new();
         for k in 0..200 {
-            let posture = rover_sim::human::Posture::Walking {
+            let posture = rover_sim::model::human::Posture::Walking {
                 phase_rad: 0.05 * f64::from(k + 1),
                 stride_m: 1.2,
             };

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rover_core::RunConfig;
-use rover_sim::{SimOptions, Simulation, Twist};
+use rover_sim::physics::{SimOptions, Simulation, Twist};
 
 use crate::cli::args::{PhysicsBenchArgs, WorldArgs};
 
@@ -94,7 +94,7 @@ const EIGHT_TURN_RADPS: f64 = 0.6;
 /// Puts world object `name` in the robot's gripper, untimed: the first gripper controller
 /// opens, the object goes to the end effector (the world's `[robot] ee_link`), the gripper
 /// closes on it with 5 N and settles. Returns the object's index and the end effector.
-fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::LinkId)> {
+fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::model::LinkId)> {
     let object = sim
         .world()
         .objects
@@ -145,7 +145,7 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::LinkId)>
 const HELD_WITHIN_M: f64 = 0.05;
 
 /// How far world object `object` is from link `link` (m).
-fn object_to_link_m(sim: &Simulation, object: usize, link: rover_sim::LinkId) -> f64 {
+fn object_to_link_m(sim: &Simulation, object: usize, link: rover_sim::model::LinkId) -> f64 {
     let mut poses = Vec::new();
     sim.object_poses_into(&mut poses);
     let o = poses.get(object).map(|p| p.translation).unwrap_or_default();

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rover_core::RunConfig;
-use rover_sim::{Simulation, Twist};
+use rover_sim::physics::{Simulation, Twist};
 
 use super::stats::median;
 use crate::cli::args::WorldArgs;
@@ -36,12 +36,12 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
     let (world, robot) = config.load_world_and_robot()?;
     let mut sim = Simulation::new(world, robot, &config.options)?;
     // The colour image alone, then with ground truth, then with a depth image.
-    let mut sensor = rover_sim::CameraSensor::new(&sim)?;
+    let mut sensor = rover_sim::sensors::CameraSensor::new(&sim)?;
     sensor.disable_depth();
-    let mut truth = rover_sim::CameraSensor::new(&sim)?;
+    let mut truth = rover_sim::sensors::CameraSensor::new(&sim)?;
     truth.disable_depth();
     truth.enable_ground_truth(&sim)?;
-    let mut depth = rover_sim::CameraSensor::new(&sim)?;
+    let mut depth = rover_sim::sensors::CameraSensor::new(&sim)?;
     depth.enable_depth();
     depth.capture(&sim)?;
     sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
@@ -72,7 +72,7 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         best_ms,
         truth_median_ms: median(&mut truth_times),
         depth_median_ms: median(&mut depth_times),
-        labelled: rover_sim::EntityIds::new(sim.world()).len(),
+        labelled: rover_sim::model::EntityIds::new(sim.world()).len(),
     })
 }
 
@@ -105,7 +105,7 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
         robot.source.display()
     );
     let mut sim = Simulation::new(world, robot, &config.options)?;
-    let mut sensor = rover_sim::LaserSensor::new(&sim, 0)?;
+    let mut sensor = rover_sim::sensors::LaserSensor::new(&sim, 0)?;
     let mount = rover_core::LaserMount::from_base_from_laser(
         sim.world_from_base().inverse() * sensor.world_from_sensor(&sim),
     );

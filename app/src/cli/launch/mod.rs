@@ -21,7 +21,7 @@ use rover_core::{
     Launch, LaunchOptions, LaunchParam as Param, NodeOutput as Output, NodeRole, ParamSource,
     ParamValue, RoverPart, find_launch_file, find_node_executable, load_launch as load, ns_join,
 };
-use rover_sim::ResourcePaths;
+use rover_sim::description::ResourcePaths;
 
 use super::args::{LaunchArgs, RunArgs};
 use children::{Children, NodeProcess};

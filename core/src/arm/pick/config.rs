@@ -1,7 +1,7 @@
 //! Pick settings ([`PickConfig`]): what to pick, how to come at it, where to put it and
 //! whether the base drives.
 
-use rover_sim::{Place, PlannerOptions};
+use rover_sim::{model::Place, planning::PlannerOptions};
 
 /// Pick settings.
 #[derive(Debug, Clone, PartialEq)]

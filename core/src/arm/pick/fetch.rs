@@ -8,7 +8,7 @@
 //! holding something.
 
 use nalgebra::Vector2;
-use rover_sim::{Twist, wrap_angle};
+use rover_sim::physics::{Twist, wrap_angle};
 
 /// An object this far (m) or more from the fetch point is driven to before it is picked.
 pub(super) const FETCH_FROM_M: f64 = 0.04;

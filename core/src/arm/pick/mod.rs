@@ -6,7 +6,7 @@
 //!    [`crate::object_estimate`]). [`PickConfig::sightings`] sightings in a row that agree
 //!    within [`PickConfig::agree_m`] are averaged: the object.
 //! 2. **Plan** (all of it at once, from the arm's pose now, in the world's planning scene,
-//!    [`rover_sim::PlanningScene`]):
+//!    [`rover_sim::planning::PlanningScene`]):
 //!    - the grasp: the tool at the object's centre, coming in along a direction tilted
 //!      [`PickConfig::approach_pitches_deg`] below horizontal (straight down first), the first
 //!      that IK reaches and where nothing but the object is within the margin with the fingers
@@ -14,7 +14,7 @@
 //!    - the place: the tool over the place's top, the object's bottom
 //!      [`PickConfig::drop_height_m`] above it, the object carried in the hand (a sphere on
 //!      the tool);
-//!    - joint-space paths (RRT-Connect, [`rover_sim::plan_path`]) to the pre-grasp, from the
+//!    - joint-space paths (RRT-Connect, [`rover_sim::planning::plan_path`]) to the pre-grasp, from the
 //!      lift to the place, and home; straight lines by IK for the approach, the lift and the
 //!      retreat. A grasp or place no direction reaches, or one that collides, is refused with
 //!      the reason.

@@ -5,7 +5,10 @@ use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use rover_sim::{
-    GraspMode, Place, PlanningScene, Pose, Simulation, TimedPath, isometry_from_pose, plan_path,
+    geometry::Pose,
+    model::{GraspMode, Place, isometry_from_pose},
+    physics::Simulation,
+    planning::{PlanningScene, TimedPath, plan_path},
 };
 
 use super::state::{Grasp, Gripper, Held, Pick, PickState, Step, Target, Way};

@@ -1,7 +1,10 @@
 //! Running the plan: each control update, the steps' joint setpoints and gripper commands
 //! to the simulation, one step after another.
 
-use rover_sim::{JointCommand, Simulation, TimedPath, Twist};
+use rover_sim::{
+    physics::{JointCommand, Simulation, Twist},
+    planning::TimedPath,
+};
 
 use super::state::{Pick, PickState, Step};
 

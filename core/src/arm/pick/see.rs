@@ -3,7 +3,7 @@
 
 use nalgebra::{Isometry3, Vector3};
 use rover_perception::BoundingBoxes;
-use rover_sim::{Shape, Simulation, isometry_from_pose};
+use rover_sim::{geometry::Shape, model::isometry_from_pose, physics::Simulation};
 
 use crate::arm::reach::{DepthView, object_estimate};
 

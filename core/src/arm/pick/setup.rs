@@ -5,8 +5,11 @@ use std::collections::VecDeque;
 
 use nalgebra::Vector3;
 use rover_sim::{
-    CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, KinematicChain, LinkId, Simulation,
-    isometry_from_pose,
+    model::{
+        CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, KinematicChain, LinkId,
+        isometry_from_pose,
+    },
+    physics::Simulation,
 };
 
 use super::config::PickConfig;

@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Point3, Vector2, Vector3};
-use rover_sim::{Simulation, isometry_from_pose};
+use rover_sim::{model::isometry_from_pose, physics::Simulation};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
 use super::plan::over_place;

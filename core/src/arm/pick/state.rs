@@ -4,7 +4,11 @@
 use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
-use rover_sim::{IkSolver, IkTarget, JointId, LinkId, TimedPath, Twist};
+use rover_sim::{
+    model::{IkSolver, IkTarget, JointId, LinkId},
+    physics::Twist,
+    planning::TimedPath,
+};
 
 use super::config::PickConfig;
 use super::fetch::DriveTo;

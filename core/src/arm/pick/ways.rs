@@ -2,7 +2,7 @@
 //! checks them: a reachable, collision-free pose and straight moves of the tool.
 
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
-use rover_sim::{IkTarget, PlanningScene};
+use rover_sim::{model::IkTarget, planning::PlanningScene};
 
 use super::state::{Gripper, Pick, Way};
 

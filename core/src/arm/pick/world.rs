@@ -1,7 +1,10 @@
 //! The world's named objects as the pick finds them: a shape and its pose now, or an error
 //! listing the names there are.
 
-use rover_sim::{Pose, Shape, Simulation};
+use rover_sim::{
+    geometry::{Pose, Shape},
+    physics::Simulation,
+};
 
 /// World object `name`'s shape and pose now; else an error saying what it was wanted for
 /// (`"to pick"`) and listing the world's objects.

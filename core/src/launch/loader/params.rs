@@ -131,8 +131,9 @@ impl Loader<'_> {
             } else {
                 path
             };
-            let expanded = rover_sim::expand_xacro(&path, &xargs, &self.options.resources)
-                .map_err(|e| format!("xacro: {e}"))?;
+            let expanded =
+                rover_sim::description::expand_xacro(&path, &xargs, &self.options.resources)
+                    .map_err(|e| format!("xacro: {e}"))?;
             return Ok((
                 expanded.text,
                 ParamSource::Xacro {

@@ -4,7 +4,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
-use rover_sim::ResourcePaths;
+use rover_sim::description::ResourcePaths;
 
 use crate::launch::eval::EvalHost;
 use crate::launch::model::{PROVIDED_PACKAGES, absolute, provided_placeholder};

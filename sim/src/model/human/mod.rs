@@ -836,7 +836,7 @@ pub fn shared() -> Option<Arc<Human>> {
 }
 
 /// Fails, naming the body and why it cannot be had, when `needed` (some person is drawn with
-/// MakeHuman's body: [`crate::Person::needs_makehuman`]), the body cannot be had, and
+/// MakeHuman's body: [`crate::model::Person::needs_makehuman`]), the body cannot be had, and
 /// [`REQUIRE_ENV`] is set. Loads the body (once per process) only when it is needed.
 pub fn check_available(needed: bool) -> Result<()> {
     if !needed || !required() {
