@@ -283,11 +283,15 @@ fn ball_place(seed: u64) -> [f64; 3] {
     [0.23 + 0.06 * rng.unit(), 0.05 + 0.075 * rng.unit(), 0.1335]
 }
 
-/// The measure: the ball at 20 seeded random places on the table; at least 19 of 20
-/// picks end with the ball in the bin within 30 s of sim time, nothing but the fingers
-/// touching it before the grasp. Prints each trial, the planning time's median and slowest.
+/// The ball at 20 seeded random places on the table: all 20 picks end with the ball in the bin
+/// within 30 s of sim time (docs/ARM.md's "20 of 20"), nothing but the fingers touching it
+/// before the grasp, and the ball moving less than 5 mm in the hand while it is lifted and
+/// carried (3.7 mm at most, measured). Prints each trial, the planning time's median and
+/// slowest.
 #[test]
 fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
+    /// Most the ball may move in the hand between the grasp and the release (m).
+    const MAX_CARRY_SLIP_M: f32 = 0.005;
     let mut results = Vec::new();
     let only: Option<u64> = std::env::var("PICK_TRIAL")
         .ok()
@@ -301,7 +305,8 @@ fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
         let ok = outcome.state == PickState::Done
             && outcome.took_s < 30.0
             && outcome.in_bin()
-            && outcome.touched.is_empty();
+            && outcome.touched.is_empty()
+            && outcome.slip_m < MAX_CARRY_SLIP_M;
         println!("trial {seed:2}: ball at {at:.3?}: {ok} {outcome:?}");
         if !ok {
             for (t, level, text) in said.0.iter().filter(|(_, l, _)| *l == EventLevel::Warn) {
@@ -323,7 +328,8 @@ fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
         planning.last().copied().unwrap_or(f64::NAN),
         planning.len()
     );
-    assert!(successes >= 19, "{successes}/20");
+    let trials = results.len();
+    assert_eq!(successes, trials, "{successes}/{trials} picks");
     Ok(())
 }
 

@@ -63,7 +63,7 @@ impl Person {
     /// Whether rover draws this person with MakeHuman's body: a shape, and no skin of an
     /// actor's own.
     pub fn needs_makehuman(&self) -> bool {
-        self.shape.is_some() && !self.actor.as_ref().is_some_and(|a| a.skin.is_some())
+        self.shape.is_some() && self.actor.as_ref().is_none_or(|a| a.skin.is_none())
     }
 
     /// A 1.75 m person in rover's default clothes, standing at `position_m` facing
