@@ -449,8 +449,8 @@ fn lift_gently(
 /// N each hold at most 2 mu N, so no squeeze under `m g / (2 mu)` = 0.245 N can lift it. Lifted
 /// gently (0.2 m/s^2: its weight and 2% more), the ball stays on the ground squeezed with 10%
 /// less than that; and the squeeze that holds it is found where it was measured: 0.30 N
-/// slides, 0.36 N lifts it (the grip needs about 1.3 times the bound: the contact solver gives
-/// a little of it up); far from the bound too, 0.05 N slides and 10 N lifts.
+/// slides, 0.36 N lifts it (the grip needs about 1.3 times the bound; docs/ARM.md); far from
+/// the bound too, 0.05 N slides and 10 N lifts.
 #[test]
 fn a_ball_squeezed_too_weakly_for_its_weight_slides_out_of_the_fingers() -> Result<()> {
     const BALL_KG: f64 = 0.05;
