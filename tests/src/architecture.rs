@@ -151,27 +151,59 @@ impl CrateSources {
 
     /// Functions (outside `#[cfg(test)]` items) longer than `max_lines`.
     pub fn long_functions(&self, max_lines: usize) -> Vec<LongFunction> {
+        self.long_blocks("fn", max_lines, |code, at, open| {
+            // A signature without a body ends at `;` before any `{`.
+            let body = open.filter(|&o| !code[at..o].contains(';'))?;
+            let name = code[at + 2..body]
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            Some((body, name))
+        })
+    }
+
+    /// Every `impl` block (inherent or of a trait) longer than `max_lines`, as
+    /// [`LongFunction`]s named after the block's header (`impl Foo`, `impl Bar for Foo`).
+    pub fn long_impls(&self, max_lines: usize) -> Vec<LongFunction> {
+        self.long_blocks("impl", max_lines, |code, at, open| {
+            // An item: nothing but indentation (or `unsafe`) before it on its line, which
+            // leaves out `impl Trait` in argument and return types.
+            let line_start = code[..at].rfind('\n').map_or(0, |n| n + 1);
+            let before = code[line_start..at].trim();
+            if !(before.is_empty() || before == "unsafe") {
+                return None;
+            }
+            let body = open?;
+            let header = code[at..body]
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ");
+            Some((body, header))
+        })
+    }
+
+    /// Every block that starts at the word `keyword` and is longer than `max_lines` (from the
+    /// keyword's line to the closing brace's). `block(code, at, open)` is given the keyword's
+    /// offset and the next `{` after it, and says where the block's body opens and its name,
+    /// or `None` for an occurrence that is no such block.
+    fn long_blocks(
+        &self,
+        keyword: &str,
+        max_lines: usize,
+        block: impl Fn(&str, usize, Option<usize>) -> Option<(usize, String)>,
+    ) -> Vec<LongFunction> {
         let mut out = Vec::new();
         for file in self.files.values() {
             let code = file.code.as_bytes();
             let mut i = 0;
-            while let Some(at) = find_word(&file.code, "fn", i) {
-                i = at + 2;
-                let name: String = file.code[i..]
-                    .trim_start()
-                    .chars()
-                    .take_while(|c| c.is_alphanumeric() || *c == '_')
-                    .collect();
-                // The body: the first `{` before any `;` (a signature without body ends at `;`).
-                let Some(open) = code[i..]
-                    .iter()
-                    .position(|&c| c == b'{' || c == b';')
-                    .map(|p| p + i)
-                    .filter(|&p| code[p] == b'{')
-                else {
+            while let Some(at) = find_word(&file.code, keyword, i) {
+                i = at + keyword.len();
+                let open = code[i..].iter().position(|&c| c == b'{').map(|p| p + i);
+                let Some((body, name)) = block(&file.code, at, open) else {
                     continue;
                 };
-                let Some(close) = matching_brace(code, open) else {
+                let Some(close) = matching_brace(code, body) else {
                     continue;
                 };
                 let first = line_at(code, at);
@@ -180,47 +212,6 @@ impl CrateSources {
                     out.push(LongFunction {
                         file: file.relative.clone(),
                         name,
-                        line: first,
-                        lines,
-                    });
-                }
-            }
-        }
-        out
-    }
-
-    /// Every `impl` block (inherent or of a trait) longer than `max_lines`, as
-    /// [`LongFunction`]s named after the block's header (`impl Foo`, `impl Bar for Foo`).
-    pub fn long_impls(&self, max_lines: usize) -> Vec<LongFunction> {
-        let mut out = Vec::new();
-        for file in self.files.values() {
-            let code = file.code.as_bytes();
-            let mut i = 0;
-            while let Some(at) = find_word(&file.code, "impl", i) {
-                i = at + 4;
-                // An item: nothing but indentation (or `unsafe`) before it on its line, which
-                // leaves out `impl Trait` in argument and return types.
-                let line_start = file.code[..at].rfind('\n').map_or(0, |n| n + 1);
-                let before = file.code[line_start..at].trim();
-                if !(before.is_empty() || before == "unsafe") {
-                    continue;
-                }
-                let Some(open) = code[i..].iter().position(|&c| c == b'{').map(|p| p + i) else {
-                    continue;
-                };
-                let Some(close) = matching_brace(code, open) else {
-                    continue;
-                };
-                let first = line_at(code, at);
-                let lines = line_at(code, close) - first + 1;
-                if lines > max_lines {
-                    let header: String = file.code[at..open]
-                        .split_whitespace()
-                        .collect::<Vec<_>>()
-                        .join(" ");
-                    out.push(LongFunction {
-                        file: file.relative.clone(),
-                        name: header,
                         line: first,
                         lines,
                     });

@@ -243,6 +243,47 @@ pub(super) fn source<'a>(
     })
 }
 
+/// One of a mesh's primitives rover reads (`<triangles>`, `<polylist>`, `<polygons>`).
+pub(crate) struct Primitive<'a> {
+    /// The element.
+    pub(crate) node: Node<'a, 'a>,
+    /// Its tag: `triangles`, `polylist` or `polygons`.
+    pub(crate) kind: &'a str,
+    /// Its `<input>`s.
+    pub(crate) inputs: Vec<Node<'a, 'a>>,
+    /// Indices per corner: the largest input offset + 1.
+    pub(crate) stride: usize,
+}
+
+/// The primitives of `mesh` rover reads, in the file's order.
+pub(crate) fn primitives<'a>(mesh: Node<'a, 'a>) -> impl Iterator<Item = Primitive<'a>> {
+    mesh.children()
+        .filter(Node::is_element)
+        .filter(|p| matches!(p.tag_name().name(), "triangles" | "polylist" | "polygons"))
+        .map(|node| {
+            let inputs: Vec<Node<'a, 'a>> = children(node, "input").collect();
+            let stride = inputs
+                .iter()
+                .map(|i| input_offset(i) + 1)
+                .max()
+                .unwrap_or(1);
+            Primitive {
+                node,
+                kind: node.tag_name().name(),
+                inputs,
+                stride,
+            }
+        })
+}
+
+/// An `<input>`'s `offset` (0 when missing or malformed, as COLLADA's default).
+pub(crate) fn input_offset(input: &Node<'_, '_>) -> usize {
+    input
+        .attribute("offset")
+        .and_then(|o| o.parse::<usize>().ok())
+        .unwrap_or(0)
+}
+
 /// Appends one placed geometry's primitives to `mesh`, a part per primitive.
 fn add_geometry<'a>(
     mesh: &mut TriMesh,
@@ -254,18 +295,14 @@ fn add_geometry<'a>(
     let Some(geometry_mesh) = child(placed.geometry, "mesh") else {
         return Ok(());
     };
-    for prim in geometry_mesh.children().filter(Node::is_element) {
-        let kind = prim.tag_name().name();
-        if !matches!(kind, "triangles" | "polylist" | "polygons") {
-            continue;
-        }
-        let inputs: Vec<Node<'_, '_>> = children(prim, "input").collect();
-        let offset = |i: &Node<'_, '_>| {
-            i.attribute("offset")
-                .and_then(|o| o.parse::<usize>().ok())
-                .unwrap_or(0)
-        };
-        let stride = inputs.iter().map(|i| offset(i) + 1).max().unwrap_or(1);
+    for Primitive {
+        node: prim,
+        kind,
+        inputs,
+        stride,
+    } in primitives(geometry_mesh)
+    {
+        let offset = input_offset;
         let find = |semantic: &str| {
             inputs
                 .iter()

@@ -13,8 +13,8 @@ use glam::{Mat4, Vec3};
 use roxmltree::Node;
 
 use super::collada::{
-    NodeError, child, children, file_basis, floats, index_lists, material_of, node_transform,
-    source,
+    NodeError, Primitive, child, children, file_basis, floats, index_lists, input_offset,
+    material_of, node_transform, primitives, source,
 };
 use super::xml::{line_of, parse_xml};
 use crate::error::{Result, SimError};
@@ -261,22 +261,17 @@ fn skin_mesh<'a>(
         .map(|c| Vec3::new(c[0], c[1], c[2]))
         .collect();
     let mut layers = Vec::new();
-    for prim in mesh.children().filter(Node::is_element) {
-        let kind = prim.tag_name().name();
-        if !matches!(kind, "triangles" | "polylist" | "polygons") {
-            continue;
-        }
-        let inputs: Vec<Node<'_, '_>> = children(prim, "input").collect();
-        let offset = |i: &Node<'_, '_>| {
-            i.attribute("offset")
-                .and_then(|o| o.parse::<usize>().ok())
-                .unwrap_or(0)
-        };
-        let index_stride = inputs.iter().map(|i| offset(i) + 1).max().unwrap_or(1);
+    for Primitive {
+        node: prim,
+        kind,
+        inputs,
+        stride: index_stride,
+    } in primitives(mesh)
+    {
         let vertex_offset = inputs
             .iter()
             .find(|i| i.attribute("semantic") == Some("VERTEX"))
-            .map(offset)
+            .map(input_offset)
             .ok_or_else(|| (prim, format!("<{kind}> without a VERTEX input")))?;
         let (indices, counts) = index_lists(prim, kind, index_stride)?;
         let mut triangles = Vec::new();
