@@ -169,7 +169,7 @@ def main():
         except (RuntimeError, OSError, subprocess.SubprocessError) as e:
             failed.append(f"{distro}: {e}")
     for line in failed:
-        say(f"could not set up {line}; the tests that need it are listed as skipped")
+        say(f"could not set up {line}; set-up stops here (the tests read only rover's cache)")
     sys.exit(1 if failed else 0)
 
 
