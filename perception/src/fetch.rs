@@ -24,12 +24,18 @@ pub fn default_model_path() -> PathBuf {
 /// `ROVER_OFFLINE`, as the tests run). The first call needs crates.io (through cargo); later
 /// ones work offline.
 pub fn ensure_default_model() -> Result<PathBuf> {
+    // Checked (its SHA-256) once per process: every detector and every `rover eval` scenario
+    // asks for it.
+    static CHECKED: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    if let Some(path) = CHECKED.get() {
+        return Ok(path.clone());
+    }
     let fetch = |e: rover_assets::AssetError| PerceptionError::Fetch(e.to_string());
     let pin = rover_assets::registry::pin("crate", MODEL_CRATE).map_err(fetch)?;
     let target = default_model_path();
     if !target.is_file() {
-        tracing::info!("fetching the default detector model (~9 MB, {MODEL_LICENSE})");
+        tracing::info!("unpacking the default detector model (~9 MB, {MODEL_LICENSE})");
     }
     rover_assets::registry::crate_file(pin, &target).map_err(fetch)?;
-    Ok(target)
+    Ok(CHECKED.get_or_init(|| target).clone())
 }
