@@ -154,6 +154,7 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         ("/camera/image_raw", "sensor_msgs/msg/Image"),
         ("/camera/camera_info", "sensor_msgs/msg/CameraInfo"),
         ("/scan", "sensor_msgs/msg/LaserScan"),
+        ("/imu", "sensor_msgs/msg/Imu"),
         (
             "/darknet_ros/bounding_boxes",
             "darknet_ros_msgs/msg/BoundingBoxes",

@@ -544,6 +544,15 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
                     .map(|(w, h)| w * h * 3),
             "{distro}: the image's data is not width x height x 3: {sample}"
         );
+        // The IMU on base_link at rest: gravity up (+9.81 with the accelerometer's bias and
+        // noise), a unit quaternion.
+        let imu = &sample["/imu"];
+        ensure!(
+            imu[0] == "base_link"
+                && imu[1].as_f64().is_some_and(|z| (z - 9.81).abs() < 0.3)
+                && imu[2].as_f64().is_some_and(|w| w.abs() <= 1.0),
+            "{distro}: /imu: {imu}"
+        );
         // rover's log on /rosout (transient local: the lines before the peer came too):
         // the line naming its DDS domain, at INFO, from rover's source.
         let log_lines = sample["/rosout"].as_array().context("no /rosout sample")?;

@@ -429,6 +429,68 @@ if got:
     Ok(())
 }
 
+/// The playground car's IMU and laser reach rospy subscribers of Debian's sensor_msgs/Imu and
+/// LaserScan: the IMU at its 100 Hz in base_link, gravity up at rest, a unit quaternion.
+#[test]
+fn the_imu_and_the_laser_reach_rospy_subscribers() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let mut graph = RosGraph::start()?;
+    let world = repo().join("worlds/playground.toml");
+    graph.spawn_rover(8.0, &["--world", &world.to_string_lossy(), "--no-detector"])?;
+    let script = r#"
+import math, rospy, time
+from sensor_msgs.msg import Imu, LaserScan
+rospy.init_node('imu_check')
+imu, scans = [], []
+rospy.Subscriber('/imu', Imu, imu.append)
+rospy.Subscriber('/scan', LaserScan, scans.append)
+end = time.time() + 20
+while time.time() < end and (len(imu) < 200 or len(scans) < 10):
+    time.sleep(0.05)
+print('counts %d %d' % (len(imu), len(scans)))
+if imu:
+    m = imu[-1]
+    q = m.orientation
+    print('imu %s %.4f %.4f' % (m.header.frame_id, m.linear_acceleration.z,
+                                 math.sqrt(q.x*q.x + q.y*q.y + q.z*q.z + q.w*q.w)))
+    stamps = [x.header.stamp.to_sec() for x in imu[-100:]]
+    gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+    print('period %.5f' % gaps[len(gaps) // 2])
+if scans:
+    print('scan %s %d' % (scans[-1].header.frame_id, len(scans[-1].ranges)))
+"#;
+    let mut c = graph.command(PYTHON);
+    let path = graph.dir.path().join("imu.py");
+    std::fs::write(&path, script)?;
+    c.arg(&path);
+    let out = graph.run(c, Duration::from_secs(40))?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    println!("{out}");
+    let line = |key: &str| -> Result<Vec<String>> {
+        let found = out
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key} ")))
+            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", graph.log("rover")))?;
+        Ok(found.split(' ').map(str::to_owned).collect())
+    };
+    let imu = line("imu")?;
+    ensure!(imu[0] == "base_link", "IMU frame {imu:?}");
+    let az: f64 = imu[1].parse()?;
+    ensure!((az - 9.81).abs() < 0.3, "IMU at rest reads z {az} m/s^2");
+    let norm: f64 = imu[2].parse()?;
+    ensure!((norm - 1.0).abs() < 1e-3, "IMU quaternion norm {norm}");
+    let period: f64 = line("period")?[0].parse()?;
+    ensure!(
+        (period - 0.01).abs() < 1e-4,
+        "IMU stamps {period} s apart (median), 100 Hz expected"
+    );
+    ensure!(line("scan")? == ["base_scan", "360"], "scan: {out}");
+    Ok(())
+}
+
 #[test]
 fn teleop_twist_keyboard_in_tmux_drives_and_stops_the_car() -> Result<()> {
     let _one = lock();

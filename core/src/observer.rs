@@ -8,7 +8,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
 };
 
 use crate::arm::ArmStatus;
@@ -72,6 +72,8 @@ pub trait Observer {
     fn detections_truth(&mut self, _boxes: &BoundingBoxes, _truth: &[GroundTruthBox]) {}
     /// A laser scan, taken from `world_from_laser` (the sensor's frame) at `scan.stamp_s`.
     fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
+    /// An IMU reading (of the robot's IMU `reading.sensor`), at `reading.stamp_s`.
+    fn imu(&mut self, _reading: &ImuReading) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -107,6 +109,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
         self.0.laser_scan(scan, world_from_laser);
         self.1.laser_scan(scan, world_from_laser);
+    }
+    fn imu(&mut self, reading: &ImuReading) {
+        self.0.imu(reading);
+        self.1.imu(reading);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -180,6 +186,11 @@ impl Observer for Fanout<'_> {
     fn laser_scan(&mut self, scan: &LaserScan, world_from_laser: Pose) {
         for o in &mut self.observers {
             o.laser_scan(scan, world_from_laser);
+        }
+    }
+    fn imu(&mut self, reading: &ImuReading) {
+        for o in &mut self.observers {
+            o.imu(reading);
         }
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

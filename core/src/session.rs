@@ -14,7 +14,7 @@ use rover_perception::{
 use rover_sim::{
     model::{CameraInfo, LinkId, RobotModel, World},
     physics::{ControlSample, SimOptions, Simulation},
-    sensors::{CameraSensor, GroundTruthBox, LaserSensor},
+    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor},
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -89,6 +89,8 @@ pub struct Session {
     camera: Option<CameraSensor>,
     camera_link: LinkId,
     laser: Option<LaserSensor>,
+    /// The robot's IMUs, each fed every physics step.
+    imus: Vec<ImuSensor>,
     detection: Detection,
     labels: Vec<String>,
     every_frame: bool,
@@ -146,6 +148,7 @@ impl Session {
         let arm_config = options.arm.resolved(sim.robot(), &sim.world().robot)?;
         let arm = ArmTask::new(&sim, camera_config, &arm_config);
         let laser = start_laser(&sim)?;
+        let imus = start_imus(&sim);
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
@@ -182,6 +185,7 @@ impl Session {
             camera,
             camera_link,
             laser,
+            imus,
             detection,
             labels,
             every_frame: options.every_frame,
@@ -359,6 +363,11 @@ impl Session {
         }
     }
 
+    /// The robot's IMUs (`RobotModel::imus` order).
+    pub fn imus(&self) -> &[ImuSensor] {
+        &self.imus
+    }
+
     /// The laser scanner, when the robot has one.
     pub fn laser(&self) -> Option<&LaserSensor> {
         self.laser.as_ref()
@@ -393,6 +402,11 @@ impl Session {
         {
             self.follower.observe_scan(laser.last());
             observer.laser_scan(laser.last(), laser.world_from_sensor(&self.sim));
+        }
+        for imu in &mut self.imus {
+            if let Some(reading) = imu.update(&self.sim) {
+                observer.imu(reading);
+            }
         }
         if let Some(sample) = &sample {
             if self.pilot.mode() == Mode::Follow {
@@ -669,6 +683,27 @@ fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
         config.update_rate_hz
     );
     Ok(Some(sensor))
+}
+
+/// Every IMU of the robot: each reads the motion of its link after every physics step.
+fn start_imus(sim: &Simulation) -> Vec<ImuSensor> {
+    (0..sim.robot().imus.len())
+        .filter_map(|i| ImuSensor::new(sim, i))
+        .inspect(|imu| {
+            let c = imu.config();
+            tracing::info!(
+                "imu: {} on {} at {}, topic {}",
+                c.name,
+                c.link,
+                if c.update_rate_hz > 0.0 {
+                    format!("{} Hz", c.update_rate_hz)
+                } else {
+                    "every physics step".to_owned()
+                },
+                c.topic
+            );
+        })
+        .collect()
 }
 
 /// The follower's view of the camera: intrinsics, and where the camera sits on the robot as

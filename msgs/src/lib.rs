@@ -129,6 +129,25 @@ pub struct LaserScan<H, R> {
     pub intensities: Vec<f32>,
 }
 
+/// `sensor_msgs/Imu`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Imu<H> {
+    /// Stamp and the sensor's frame.
+    pub header: H,
+    /// Orientation of the sensor.
+    pub orientation: Quaternion,
+    /// Its covariance, row-major 3x3 (about x, y, z).
+    pub orientation_covariance: [f64; 9],
+    /// Angular velocity (rad/s) about the sensor's axes.
+    pub angular_velocity: Vector3,
+    /// Its covariance.
+    pub angular_velocity_covariance: [f64; 9],
+    /// Linear acceleration (m/s^2) along the sensor's axes, gravity included.
+    pub linear_acceleration: Vector3,
+    /// Its covariance.
+    pub linear_acceleration_covariance: [f64; 9],
+}
+
 /// `darknet_ros_msgs/BoundingBox` (ROS 1 names the class `Class`, ROS 2 `class_id`; both
 /// write it last).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -259,8 +278,8 @@ pub struct CameraInfo<H> {
 
 /// Names, in a wire's `msgs` module, the messages above that carry a header, with the wire's
 /// header type, pixel buffer and range buffer: `wire_messages!(Header, Vec<u8>, Vec<f32>)`
-/// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `BoundingBoxes`, `ObjectCount`
-/// and `PointStamped` there.
+/// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `Imu`, `BoundingBoxes`,
+/// `ObjectCount` and `PointStamped` there.
 #[macro_export]
 macro_rules! wire_messages {
     ($header:ty, $pixels:ty, $ranges:ty) => {
@@ -272,6 +291,8 @@ macro_rules! wire_messages {
         pub type JointState = $crate::JointState<$header>;
         /// `sensor_msgs/LaserScan`.
         pub type LaserScan = $crate::LaserScan<$header, $ranges>;
+        /// `sensor_msgs/Imu`.
+        pub type Imu = $crate::Imu<$header>;
         /// `darknet_ros_msgs/BoundingBoxes`.
         pub type BoundingBoxes = $crate::BoundingBoxes<$header>;
         /// `darknet_ros_msgs/ObjectCount`.

@@ -79,6 +79,10 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "sensor_msgs/LaserScan",
         "Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities",
     ),
+    (
+        "sensor_msgs/Imu",
+        "Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance",
+    ),
     ("rosgraph_msgs/Clock", "time clock"),
     ("std_msgs/String", "string data"),
     (

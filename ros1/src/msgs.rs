@@ -163,6 +163,19 @@ impl Message for TfMessage {
     }
 }
 
+impl Message for Imu {
+    const TYPE: &'static str = "sensor_msgs/Imu";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        Geometry::encode(&self.orientation, out);
+        wire::f64_fixed(out, &self.orientation_covariance);
+        Geometry::encode(&self.angular_velocity, out);
+        wire::f64_fixed(out, &self.angular_velocity_covariance);
+        Geometry::encode(&self.linear_acceleration, out);
+        wire::f64_fixed(out, &self.linear_acceleration_covariance);
+    }
+}
+
 /// `nav_msgs/Odometry`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Odometry {
@@ -547,6 +560,7 @@ mod tests {
             ),
             ("sensor_msgs/JointState", "3066dcd76a6cfaef579bd0f34173e9fd"),
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
+            ("sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2"),
             ("std_msgs/Header", "2176decaecbce78abc3b96ef049fabed"),
             ("std_msgs/Float64", "fdb28210bfa9d7c91146260178d9a584"),
             ("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1"),

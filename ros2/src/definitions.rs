@@ -147,6 +147,17 @@ pub const LASER_SCAN: &str = concat!(
     header!()
 );
 
+/// `sensor_msgs/msg/Imu`.
+pub const IMU: &str = concat!(
+    "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n",
+    "float64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\n",
+    "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n",
+    "float64[9] linear_acceleration_covariance\n",
+    header!(),
+    quaternion!(),
+    vector3!()
+);
+
 /// `darknet_ros_msgs/msg/BoundingBoxes` (darknet_ros's ROS 2 branch).
 pub const BOUNDING_BOXES: &str = concat!(
     "std_msgs/Header header\nstd_msgs/Header image_header\n",
@@ -272,6 +283,7 @@ mod tests {
             IMAGE,
             CAMERA_INFO,
             LASER_SCAN,
+            IMU,
             BOUNDING_BOXES,
             OBJECT_COUNT,
             STRING,

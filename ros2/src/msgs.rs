@@ -240,6 +240,11 @@ impl RosMessage for LaserScan {
     const DEFINITION: &'static str = crate::definitions::LASER_SCAN;
 }
 
+impl RosMessage for Imu {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Imu_";
+    const DEFINITION: &'static str = crate::definitions::IMU;
+}
+
 impl RosMessage for BoundingBoxes {
     const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::BoundingBoxes_";
     const DEFINITION: &'static str = crate::definitions::BOUNDING_BOXES;

@@ -90,6 +90,34 @@ fn turtlebot3_burger_xacro_expands_with_its_plugins_and_meshes() -> Result<()> {
     assert_eq!(lds.noise.map(|n| n.stddev), Some(0.01));
     assert_eq!(lds.topic, "scan");
     assert!(!robot.not_simulated.iter().any(|s| s.contains("lds")));
+    // Its IMU, as TurtleBot3 declares it: the model plugin libgazebo_ros_imu.so on imu_link,
+    // every physics step, /imu (and its <sensor type="imu"> without a ROS plugin, listed).
+    let imu = robot
+        .imus
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("the IMU plugin was not read"))?;
+    assert_eq!(robot.imus.len(), 1);
+    assert_eq!(imu.plugin, rover_sim::model::ImuPlugin::Model);
+    assert_eq!(
+        (imu.link.as_str(), imu.frame_name.as_str()),
+        ("imu_link", "imu_link")
+    );
+    assert_eq!((imu.topic.as_str(), imu.update_rate_hz), ("imu", 0.0));
+    assert_eq!(imu.gaussian_noise, 0.0);
+    assert!(
+        robot
+            .not_simulated
+            .iter()
+            .any(|s| s == "sensor \"imu\" (type imu, no ROS plugin: nothing published)"),
+        "{:?}",
+        robot.not_simulated
+    );
+    assert!(
+        !robot
+            .not_simulated
+            .iter()
+            .any(|s| s.contains("gazebo_ros_imu"))
+    );
     // The expanded URDF is kept for ROS's /robot_description.
     assert!(
         robot

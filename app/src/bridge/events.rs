@@ -10,7 +10,12 @@
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use rover_perception::BoundingBox;
-use rover_sim::{geometry::Pose, model::CameraInfo, physics::ControlSample, sensors::LaserScan};
+use rover_sim::{
+    geometry::Pose,
+    model::CameraInfo,
+    physics::ControlSample,
+    sensors::{ImuReading, LaserScan},
+};
 
 /// One frame's pose in another, as tf carries it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -172,6 +177,8 @@ pub(crate) enum Event {
     Truth(Detections),
     /// A laser scan (its ranges in a recycled buffer).
     Scan(LaserScan),
+    /// An IMU reading.
+    Imu(ImuReading),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -192,6 +199,8 @@ pub(crate) trait TopicFamily: Send {
     fn ground_truth(&mut self, _truth: &mut Detections) {}
     /// A laser scan.
     fn scan(&mut self, _scan: &mut LaserScan) {}
+    /// An IMU reading.
+    fn imu(&mut self, _reading: &ImuReading) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in
@@ -296,6 +305,7 @@ impl BufferReturn {
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
+            Event::Imu(_) => {}
         }
     }
 }

@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -28,6 +28,7 @@ pub(crate) mod clock;
 pub(crate) mod darknet;
 pub(crate) mod events;
 pub(crate) mod ground_truth;
+pub(crate) mod imu;
 pub(crate) mod input;
 pub(crate) mod joint_states;
 pub(crate) mod laser;
@@ -47,7 +48,7 @@ use rover_sim::{
     geometry::Pose,
     model::{CameraInfo, RobotModel},
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
 };
 
 use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily};
@@ -81,6 +82,8 @@ pub(crate) trait Transport {
     fn darknet(&mut self) -> Result<Box<dyn darknet::DarknetWire>>;
     /// The laser's scans.
     fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser::ScanWire>>;
+    /// The IMUs' readings.
+    fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn imu::ImuWire>>;
     /// The arm's state and points.
     fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm::ArmWire>>;
     /// `/rover/ground_truth/bounding_boxes`.
@@ -109,6 +112,7 @@ pub(crate) fn families(
         Box::new(camera::Camera::new(transport.camera(plan)?)),
         Box::new(darknet::Darknet::new(transport.darknet()?)),
         Box::new(laser::Laser::new(transport.laser(plan)?)),
+        Box::new(imu::Imu::new(transport.imu(plan)?)),
         Box::new(arm::Arm::new(transport.arm(plan)?)),
         Box::new(status::Status::new(transport.status()?)),
         Box::new(model_states::ModelStates::new(transport.model_states()?)),
@@ -329,6 +333,10 @@ impl<R: Send + 'static> Observer for Bridge<R> {
             b.send(Event::Scan(scan));
         });
     }
+
+    fn imu(&mut self, reading: &ImuReading) {
+        self.timed(|b| b.send(Event::Imu(*reading)));
+    }
 }
 
 /// The publishing thread: every event to every family, in order, until the bridge hangs up;
@@ -348,6 +356,7 @@ fn publish(
                 Event::Detections(detections) => family.detections(detections),
                 Event::Truth(truth) => family.ground_truth(truth),
                 Event::Scan(scan) => family.scan(scan),
+                Event::Imu(reading) => family.imu(reading),
             }
         }
         returns.give_back(event);

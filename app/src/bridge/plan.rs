@@ -33,6 +33,8 @@ pub struct RosPlan {
     pub depth_info_topic: Option<String>,
     /// The first laser's topic (`topicName`).
     pub scan_topic: Option<String>,
+    /// Each IMU's topic and `frame_id`, in `RobotModel::imus` order.
+    pub imus: Vec<(String, String)>,
     /// Every moving joint the session reports, in `/joint_states` order.
     pub(crate) joints: Vec<MovingJoint>,
     /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
@@ -153,6 +155,11 @@ impl RosPlan {
                 .and_then(|c| c.depth.as_ref())
                 .and_then(|d| camera_topic(&d.info_topic)),
             scan_topic: robot.lasers.first().map(|l| topic(&l.topic)),
+            imus: robot
+                .imus
+                .iter()
+                .map(|i| (topic(&i.topic), i.frame_name.clone()))
+                .collect(),
             joints: moving_joints(robot, &drive),
             joint_states_hz: robot.controllers.as_ref().and_then(|c| {
                 c.controllers.iter().find_map(|s| match s.kind {

@@ -3,7 +3,7 @@
 //! and the master's XML-RPC). Here are the encoders, one file per topic family, each
 //! implementing its family's wire trait with ROS 1's messages and publishers (`clock.rs`,
 //! `odom.rs`, `tf.rs`, `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the
-//! ground truth), `laser.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
+//! ground truth), `laser.rs`, `imu.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
 //! `state` topics, which only ROS 1 carries (their control_msgs layouts differ between ROS 2
 //! distributions); `actions.rs`, actionlib's `follow_joint_trajectory` for each trajectory
 //! controller, and `gripper.rs`, `gripper_cmd` for each gripper controller (what a goal
@@ -23,6 +23,7 @@ mod controllers;
 mod convert;
 mod detections;
 mod gripper;
+mod imu;
 mod joint_states;
 mod laser;
 mod model_states;
@@ -94,6 +95,10 @@ impl Transport for Ros1<'_> {
 
     fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser_family::ScanWire>> {
         Ok(Box::new(laser::Laser::advertise(self.node, plan)?))
+    }
+
+    fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::imu::ImuWire>> {
+        Ok(Box::new(imu::Imu::advertise(self.node, plan)?))
     }
 
     fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm_family::ArmWire>> {

@@ -28,6 +28,8 @@
 //! world/odometry/follower/{target,goal}  Points3D: the follower's target estimate, the point it
 //!                                        drives to (the pursued point once the target is lost)
 //! plots/joints/<joint>                   Scalars: an actuated joint's position and target
+//! plots/imu/<sensor>/{angular_velocity,linear_acceleration}  Scalars x, y, z: each IMU's
+//!                                        readings (rad/s; m/s^2, gravity included)
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -49,7 +51,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
 };
 
 pub use blueprint::blueprint;
@@ -96,6 +98,8 @@ pub struct Recorder {
     laser: Option<(String, Pose)>,
     /// Scan points in the link frame (reused).
     scan_points: Vec<[f32; 3]>,
+    /// Each IMU's plot paths: angular velocity, linear acceleration.
+    imu_paths: Vec<[String; 2]>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -153,6 +157,7 @@ impl Recorder {
             model_poses: Vec::new(),
             laser: None,
             scan_points: Vec::new(),
+            imu_paths: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -247,6 +252,15 @@ impl Observer for Recorder {
             let path = self.paths.links.get(link.index())?;
             Some((format!("{path}/scan"), l.link_from_sensor))
         });
+        self.imu_paths = sim
+            .robot()
+            .imus
+            .iter()
+            .map(|i| {
+                ["angular_velocity", "linear_acceleration"]
+                    .map(|what| format!("plots/imu/{}/{what}", i.name))
+            })
+            .collect();
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
@@ -484,6 +498,17 @@ impl Observer for Recorder {
         if let Some((path, _)) = &self.laser {
             self.log(path, &points);
         }
+    }
+
+    fn imu(&mut self, reading: &ImuReading) {
+        let Some([angular, linear]) = self.imu_paths.get(reading.sensor) else {
+            return;
+        };
+        self.rec.set_duration_secs("sim_time", reading.stamp_s);
+        let angular_velocity = rerun::Scalars::new(reading.angular_velocity_radps);
+        let linear_acceleration = rerun::Scalars::new(reading.linear_acceleration_mps2);
+        self.log(angular, &angular_velocity);
+        self.log(linear, &linear_acceleration);
     }
 
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

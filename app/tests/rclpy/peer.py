@@ -111,7 +111,7 @@ def topics(node):
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import Log
     from rosgraph_msgs.msg import Clock
-    from sensor_msgs.msg import CameraInfo, Image, JointState, LaserScan
+    from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
     from std_msgs.msg import String
     from tf2_msgs.msg import TFMessage
 
@@ -135,6 +135,7 @@ def topics(node):
         ("/gazebo/model_states", ModelStates, reliable, "reliable"),
         ("/rover/status", String, reliable, "reliable"),
         ("/scan", LaserScan, qos_profile_sensor_data, "best effort"),
+        ("/imu", Imu, qos_profile_sensor_data, "best effort"),
         ("/rosout", Log, rosout, "reliable, transient local"),
     ]
     counts, last, rover_log = {}, {}, []
@@ -168,6 +169,9 @@ def topics(node):
         sample["/tf_static"] = len(last["/tf_static"].transforms)
     if "/scan" in last:
         sample["/scan"] = len(last["/scan"].ranges)
+    if "/imu" in last:
+        m = last["/imu"]
+        sample["/imu"] = [m.header.frame_id, m.linear_acceleration.z, m.orientation.w]
     sample["/rosout"] = rover_log[:20]
     return {"table": [[n, k.__module__.split(".")[0] + "/msg/" + k.__name__, q, counts.get(n, 0)]
                       for n, k, _, q in table], "sample": sample}

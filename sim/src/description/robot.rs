@@ -147,6 +147,7 @@ impl RobotModel {
             diff_drive: extensions.diff_drive,
             cameras: extensions.cameras,
             lasers: extensions.lasers,
+            imus: extensions.imus,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
             transmissions,

@@ -41,8 +41,8 @@ pub use robot::{
     Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
 };
 pub use sensors::{
-    CameraConfig, DepthOutput, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
-    PixelFormat,
+    AxisNoise, CameraConfig, DepthOutput, Distortion, GaussianNoise, ImuConfig, ImuPlugin,
+    LaserConfig, MAX_LASER_SAMPLES, OrientationReference, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,

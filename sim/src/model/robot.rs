@@ -11,7 +11,7 @@ use crate::model::actuation::{RosControlPlugin, Transmission};
 use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
-use crate::model::sensors::{CameraConfig, LaserConfig};
+use crate::model::sensors::{CameraConfig, ImuConfig, ImuPlugin, LaserConfig};
 
 /// Mass properties of a link, from its `<inertial>`.
 #[derive(Debug, Clone, PartialEq)]
@@ -211,7 +211,10 @@ pub struct RobotModel {
     pub cameras: Vec<CameraConfig>,
     /// 2D laser scanners (`<sensor type="ray">`).
     pub lasers: Vec<LaserConfig>,
-    /// Gazebo sensors and plugins in the file that rover does not simulate (IMU, GPS, ...).
+    /// IMUs (`<sensor type="imu">` with `libgazebo_ros_imu_sensor.so`, or the model plugin
+    /// `libgazebo_ros_imu.so`).
+    pub imus: Vec<ImuConfig>,
+    /// Gazebo sensors and plugins in the file that rover does not simulate (GPS, ...).
     pub not_simulated: Vec<String>,
     /// `<transmission>`s: which joints an actuator drives, through which ros_control
     /// hardware interface.
@@ -468,6 +471,23 @@ impl RobotModel {
                     format!(
                         "<gazebo reference=\"{}\"> <sensor type=\"ray\">: no such link; links in this robot: {}",
                         laser.link,
+                        names(self.links.iter().map(|l| &l.name))
+                    ),
+                ));
+            }
+        }
+        for imu in &self.imus {
+            if self.link_id(&imu.link).is_none() {
+                let element = match imu.plugin {
+                    ImuPlugin::Sensor => "<sensor type=\"imu\">",
+                    ImuPlugin::Model => "<plugin filename=\"libgazebo_ros_imu.so\"> <bodyName>",
+                };
+                return Err(SimError::invalid(
+                    path,
+                    imu.line,
+                    format!(
+                        "{element} \"{}\": no such link; links in this robot: {}",
+                        imu.link,
                         names(self.links.iter().map(|l| &l.name))
                     ),
                 ));

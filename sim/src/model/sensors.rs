@@ -162,3 +162,79 @@ impl LaserConfig {
 
 /// Rays per scan rover accepts (a 0.1 deg lidar has 3600; more is a typo, not a sensor).
 pub const MAX_LASER_SAMPLES: u32 = 100_000;
+
+/// Noise of one axis of an IMU channel, SDF's `<noise type="gaussian">` with a bias: every
+/// sample gets white noise of `mean` and `stddev`; the bias is drawn once, at start, from
+/// `bias_mean` and `bias_stddev` and given a random sign, as Gazebo draws it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AxisNoise {
+    /// `<mean>` of the white noise.
+    pub mean: f64,
+    /// `<stddev>` of the white noise.
+    pub stddev: f64,
+    /// `<bias_mean>`: the bias's magnitude on average.
+    pub bias_mean: f64,
+    /// `<bias_stddev>`: the spread of the bias drawn at start.
+    pub bias_stddev: f64,
+}
+
+impl AxisNoise {
+    /// True when the axis reads exactly (every parameter zero).
+    pub fn is_zero(&self) -> bool {
+        [self.mean, self.stddev, self.bias_mean, self.bias_stddev]
+            .iter()
+            .all(|v| *v == 0.0)
+    }
+}
+
+/// What an IMU's orientation is measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OrientationReference {
+    /// The world's axes (REP-103/REP-145: x east... as the world's x, z up).
+    World,
+    /// The sensor's own orientation when the simulation starts (Gazebo classic's `ImuSensor`
+    /// by default; `initialOrientationAsReference` true).
+    Initial,
+}
+
+/// Which Gazebo plugin declared an IMU: their defaults differ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImuPlugin {
+    /// `<sensor type="imu">` with `libgazebo_ros_imu_sensor.so` inside it.
+    Sensor,
+    /// The model plugin `libgazebo_ros_imu.so` (TurtleBot3's), naming its link by `<bodyName>`.
+    Model,
+}
+
+/// An IMU: orientation, angular velocity and linear acceleration (gravity included, as a real
+/// accelerometer reads it: +9.81 m/s^2 up at rest), published as sensor_msgs/Imu.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuConfig {
+    /// Sensor (or plugin) `name`.
+    pub name: String,
+    /// Which plugin declared it.
+    pub plugin: ImuPlugin,
+    /// Link the IMU is fixed to (`<gazebo reference>`, or the model plugin's `<bodyName>`).
+    pub link: String,
+    /// The sensor's `<pose>` in its link (identity for the model plugin).
+    pub link_from_sensor: Pose,
+    /// Readings per second of sim time (0: every physics step).
+    pub update_rate_hz: f64,
+    /// Topic, resolved as the plugin resolves it (without a leading `/` when relative).
+    pub topic: String,
+    /// `frame_id` of the messages (`<frameName>`).
+    pub frame_name: String,
+    /// `<rpyOffset>` (rad): a fixed rotation applied to the reported orientation.
+    pub rpy_offset_rad: [f64; 3],
+    /// What the orientation is relative to.
+    pub reference: OrientationReference,
+    /// The plugin's `<gaussianNoise>`: white noise of this stddev on every component (the
+    /// quaternion's too, as gazebo_ros does), and the messages' covariance diagonals.
+    pub gaussian_noise: f64,
+    /// SDF `<imu>` noise of the angular velocity, per axis x, y, z (rad/s).
+    pub angular_velocity_noise: [AxisNoise; 3],
+    /// SDF `<imu>` noise of the linear acceleration, per axis x, y, z (m/s^2).
+    pub linear_acceleration_noise: [AxisNoise; 3],
+    /// Line of the declaring element, for messages.
+    pub line: Option<u32>,
+}

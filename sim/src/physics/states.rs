@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::simulation::Simulation;
 use crate::geometry::Pose;
+use crate::model::LinkId;
 
 /// One model's state: world pose, and velocity in the world frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,6 +20,29 @@ pub struct ModelState {
 }
 
 impl Simulation {
+    /// The state of a point fixed to one of the robot's links: its world pose (`world_from_link`
+    /// times `link_from_point`), the point's linear velocity and the link's angular velocity,
+    /// both in the world frame. What an IMU, a GPS or p3d reads.
+    pub fn link_point_state(&self, link: LinkId, link_from_point: Pose) -> ModelState {
+        let pose = self.world_from_link(link) * link_from_point;
+        let Some(body) = self
+            .link_body
+            .get(link.index())
+            .and_then(|h| self.physics.bodies.get(*h))
+        else {
+            return ModelState {
+                pose,
+                linear_mps: Vec3::ZERO,
+                angular_radps: Vec3::ZERO,
+            };
+        };
+        ModelState {
+            pose,
+            linear_mps: body.velocity_at_point(pose.translation),
+            angular_radps: body.angvel(),
+        }
+    }
+
     /// The models' names, in the order of [`Simulation::model_states_into`]: the robot, the
     /// objects, the SDF models, the people.
     pub fn model_state_names(&self) -> Vec<String> {

@@ -1,13 +1,16 @@
-//! Sensors on sim time: the camera (`camera.rs`, rendering through `render`) and the 2D laser
-//! (`laser.rs`, ray casts against the physics scene), both with seeded noise, and the camera's
-//! ground truth (`ground_truth.rs`: where each labelled thing is in the image).
+//! Sensors on sim time: the camera (`camera.rs`, rendering through `render`), the 2D laser
+//! (`laser.rs`, ray casts against the physics scene) and the IMU (`imu.rs`, from the link's
+//! motion), all with seeded noise, and the camera's ground truth (`ground_truth.rs`: where
+//! each labelled thing is in the image).
 
 pub(crate) mod camera;
 pub(crate) mod ground_truth;
+pub(crate) mod imu;
 pub(crate) mod laser;
 
 pub use camera::{CameraFrame, CameraSensor};
 pub use ground_truth::{
     GroundTruth, GroundTruthBox, MIN_VISIBILITY, MIN_VISIBLE_PX, PixelBox, copy_boxes,
 };
+pub use imu::{ImuReading, ImuSensor};
 pub use laser::{LaserScan, LaserSensor};

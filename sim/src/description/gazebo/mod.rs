@@ -1,9 +1,11 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
 //! `<sensor>` blocks (with `libgazebo_ros_camera.so`), 2D laser `<sensor type="ray">` blocks (with
-//! `libgazebo_ros_laser.so`), and per-link friction (`mu1`/`mu2`).
+//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), and per-link friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
+
+mod imu;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -14,8 +16,8 @@ use crate::geometry::{Pose, pose_from_xyz_rpy};
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
-    CameraConfig, DepthOutput, Distortion, GaussianNoise, LaserConfig, MAX_LASER_SAMPLES,
-    PixelFormat,
+    CameraConfig, DepthOutput, Distortion, GaussianNoise, ImuConfig, LaserConfig,
+    MAX_LASER_SAMPLES, PixelFormat,
 };
 
 /// Everything read from `<gazebo>` elements.
@@ -25,6 +27,7 @@ pub(crate) struct Extensions {
     pub ros_control: Option<RosControlPlugin>,
     pub cameras: Vec<CameraConfig>,
     pub lasers: Vec<LaserConfig>,
+    pub imus: Vec<ImuConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
     /// Link name -> contact stiffness `<kp>` (N/m).
@@ -131,6 +134,7 @@ fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
 /// Reads every `<gazebo>` element under `<robot>`.
 pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extensions> {
     let ctx = Ctx { doc, path };
+    let robot_name = doc.root_element().attribute("name").unwrap_or("robot");
     let mut ext = Extensions::default();
     for gz in elements(doc.root_element()).filter(|n| n.has_tag_name("gazebo")) {
         let reference = gz.attribute("reference");
@@ -154,6 +158,8 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ext.diff_drive = Some(parse_diff_drive(&ctx, child)?);
                     } else if file.contains("gazebo_ros_control") {
                         ext.ros_control = Some(parse_ros_control(&ctx, child)?);
+                    } else if imu::is_model_plugin(file) {
+                        ext.imus.push(imu::parse_model_plugin(&ctx, child)?);
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",
@@ -182,6 +188,21 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ));
                     };
                     ext.lasers.push(parse_laser(&ctx, child, link)?);
+                }
+                "sensor" if child.attribute("type") == Some("imu") => {
+                    let Some(link) = reference else {
+                        return Err(ctx.err(
+                            child,
+                            "<sensor type=\"imu\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
+                        ));
+                    };
+                    match imu::parse_sensor(&ctx, child, link, robot_name)? {
+                        Some(imu) => ext.imus.push(imu),
+                        None => ext.ignored.push(format!(
+                            "sensor \"{}\" (type imu, no ROS plugin: nothing published)",
+                            child.attribute("name").unwrap_or("?")
+                        )),
+                    }
                 }
                 "sensor" => ext.ignored.push(format!(
                     "sensor \"{}\" (type {})",
