@@ -140,7 +140,10 @@ fn a_car_at_rest_then_spinning_reads_gravity_its_turn_rate_and_the_world_yaw() -
     // Commanded 1 rad/s, the car turns at about that, its wheels slipping on and off (the true
     // rate swings between ~0.9 and ~1.08 rad/s; the IMU follows it, above).
     let mean_rate = spin.iter().map(|r| r.2).sum::<f64>() / spin.len() as f64;
-    assert!((0.85..1.05).contains(&mean_rate), "mean turn rate {mean_rate}");
+    assert!(
+        (0.85..1.05).contains(&mean_rate),
+        "mean turn rate {mean_rate}"
+    );
     // The skidding turn shakes the car (single readings off by up to ~0.3 m/s^2); on average
     // it still reads gravity.
     let mean_z = spin

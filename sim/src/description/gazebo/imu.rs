@@ -2,7 +2,7 @@
 //! `libgazebo_ros_imu_sensor.so`, and the older model plugin `libgazebo_ros_imu.so` that
 //! TurtleBot3 declares. Parameter names, defaults and topic rules are the plugins' own.
 
-use super::{Ctx, Node, read_sensor_pose, text_of};
+use super::values::{Ctx, Node, read_sensor_pose, text_of};
 use crate::description::xml::{elements, line_of};
 use crate::error::Result;
 use crate::geometry::Pose;

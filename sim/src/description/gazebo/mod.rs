@@ -6,13 +6,16 @@
 //! file, line and element.
 
 mod imu;
+mod values;
 
 use std::collections::BTreeMap;
+
 use std::path::Path;
+use values::{Ctx, Node, read_sensor_pose, text_of};
 
 use crate::description::xml::{elements, line_of};
-use crate::error::{Result, SimError};
-use crate::geometry::{Pose, pose_from_xyz_rpy};
+use crate::error::Result;
+use crate::geometry::Pose;
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
@@ -34,101 +37,6 @@ pub(crate) struct Extensions {
     pub contact_kp: BTreeMap<String, f32>,
     /// Sensors and plugins rover does not simulate, for one summary line.
     pub ignored: Vec<String>,
-}
-
-type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
-
-struct Ctx<'a, 'input> {
-    doc: &'a roxmltree::Document<'input>,
-    path: &'a Path,
-}
-
-impl<'a, 'input> Ctx<'a, 'input> {
-    fn err(&self, node: Node<'_, '_>, message: String) -> SimError {
-        SimError::invalid(self.path, Some(line_of(self.doc, node)), message)
-    }
-
-    fn number(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
-        let text = text_of(node);
-        match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(self.err(
-                node,
-                format!(
-                    "<{}> in {what}: expected a number ({unit}), found '{text}'",
-                    node.tag_name().name()
-                ),
-            )),
-        }
-    }
-
-    fn positive(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
-        let v = self.number(node, what, unit)?;
-        if v > 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(
-                node,
-                format!(
-                    "<{}> in {what}: expected a positive number ({unit}), found {v}",
-                    node.tag_name().name()
-                ),
-            ))
-        }
-    }
-
-    fn non_negative(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
-        let v = self.number(node, what, unit)?;
-        if v >= 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(
-                node,
-                format!(
-                    "<{}> in {what}: expected zero or a positive number ({unit}), found {v}",
-                    node.tag_name().name()
-                ),
-            ))
-        }
-    }
-
-    fn boolean(&self, node: Node<'_, '_>, what: &str) -> Result<bool> {
-        match text_of(node) {
-            "true" | "1" => Ok(true),
-            "false" | "0" => Ok(false),
-            other => Err(self.err(
-                node,
-                format!(
-                    "<{}> in {what}: expected true or false, found '{other}'",
-                    node.tag_name().name()
-                ),
-            )),
-        }
-    }
-
-    fn pixels(&self, node: Node<'_, '_>, what: &str) -> Result<u32> {
-        let text = text_of(node);
-        match text.parse::<u32>() {
-            Ok(v) if (1..=16384).contains(&v) => Ok(v),
-            _ => Err(self.err(
-                node,
-                format!(
-                    "<{}> in {what}: expected a whole number of pixels between 1 and 16384, found '{text}'",
-                    node.tag_name().name()
-                ),
-            )),
-        }
-    }
-}
-
-/// Trimmed text content of an element ("" when empty).
-/// Trimmed text of an element, or its `value` attribute (the older `<mu1 value="1.0"/>` form
-/// Gazebo's URDF reader accepts too).
-fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
-    match node.text().map(str::trim) {
-        Some(text) if !text.is_empty() => text,
-        _ => node.attribute("value").map_or("", str::trim),
-    }
 }
 
 /// Reads every `<gazebo>` element under `<robot>`.
@@ -584,26 +492,6 @@ fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<La
         ));
     }
     Ok(c)
-}
-
-/// A sensor's `<pose>`: six numbers `x y z roll pitch yaw`, the sensor in its link's frame.
-fn read_sensor_pose(ctx: &Ctx<'_, '_>, pose: Node<'_, '_>, what: &str) -> Result<Pose> {
-    let text = text_of(pose);
-    let v: Vec<f64> = text
-        .split_whitespace()
-        .map(str::parse::<f64>)
-        .collect::<std::result::Result<_, _>>()
-        .ok()
-        .filter(|v: &Vec<f64>| v.len() == 6 && v.iter().all(|x| x.is_finite()))
-        .ok_or_else(|| {
-            ctx.err(
-                pose,
-                format!(
-                    "<pose> in {what}: expected six numbers 'x y z roll pitch yaw', found '{text}'"
-                ),
-            )
-        })?;
-    Ok(pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]))
 }
 
 /// Reads the SDF `<ray>` element of laser sensor `what`: its horizontal scan into `scan` and

@@ -1,0 +1,124 @@
+//! Reading values out of `<gazebo>` elements: numbers with their units, booleans, pixel
+//! counts, poses, each a located error (file, line, element) when it does not parse. Shared by
+//! the plugin and sensor readers beside it.
+
+use std::path::Path;
+
+use crate::description::xml::line_of;
+use crate::error::{Result, SimError};
+use crate::geometry::{Pose, pose_from_xyz_rpy};
+
+pub(super) type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
+
+pub(super) struct Ctx<'a, 'input> {
+    pub doc: &'a roxmltree::Document<'input>,
+    pub path: &'a Path,
+}
+
+impl<'a, 'input> Ctx<'a, 'input> {
+    pub fn err(&self, node: Node<'_, '_>, message: String) -> SimError {
+        SimError::invalid(self.path, Some(line_of(self.doc, node)), message)
+    }
+
+    pub fn number(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let text = text_of(node);
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a number ({unit}), found '{text}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+
+    pub fn positive(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let v = self.number(node, what, unit)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a positive number ({unit}), found {v}",
+                    node.tag_name().name()
+                ),
+            ))
+        }
+    }
+
+    pub fn non_negative(&self, node: Node<'_, '_>, what: &str, unit: &str) -> Result<f64> {
+        let v = self.number(node, what, unit)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected zero or a positive number ({unit}), found {v}",
+                    node.tag_name().name()
+                ),
+            ))
+        }
+    }
+
+    pub fn boolean(&self, node: Node<'_, '_>, what: &str) -> Result<bool> {
+        match text_of(node) {
+            "true" | "1" => Ok(true),
+            "false" | "0" => Ok(false),
+            other => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected true or false, found '{other}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+
+    pub fn pixels(&self, node: Node<'_, '_>, what: &str) -> Result<u32> {
+        let text = text_of(node);
+        match text.parse::<u32>() {
+            Ok(v) if (1..=16384).contains(&v) => Ok(v),
+            _ => Err(self.err(
+                node,
+                format!(
+                    "<{}> in {what}: expected a whole number of pixels between 1 and 16384, found '{text}'",
+                    node.tag_name().name()
+                ),
+            )),
+        }
+    }
+}
+
+/// Trimmed text content of an element ("" when empty).
+/// Trimmed text of an element, or its `value` attribute (the older `<mu1 value="1.0"/>` form
+/// Gazebo's URDF reader accepts too).
+pub(super) fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
+    match node.text().map(str::trim) {
+        Some(text) if !text.is_empty() => text,
+        _ => node.attribute("value").map_or("", str::trim),
+    }
+}
+
+/// A sensor's `<pose>`: six numbers `x y z roll pitch yaw`, the sensor in its link's frame.
+pub(super) fn read_sensor_pose(ctx: &Ctx<'_, '_>, pose: Node<'_, '_>, what: &str) -> Result<Pose> {
+    let text = text_of(pose);
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .map(str::parse::<f64>)
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f64>| v.len() == 6 && v.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| {
+            ctx.err(
+                pose,
+                format!(
+                    "<pose> in {what}: expected six numbers 'x y z roll pitch yaw', found '{text}'"
+                ),
+            )
+        })?;
+    Ok(pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]))
+}
