@@ -8,7 +8,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 use crate::arm::ArmStatus;
@@ -74,6 +74,8 @@ pub trait Observer {
     fn laser_scan(&mut self, _scan: &LaserScan, _world_from_laser: Pose) {}
     /// An IMU reading (of the robot's IMU `reading.sensor`), at `reading.stamp_s`.
     fn imu(&mut self, _reading: &ImuReading) {}
+    /// A ground-truth pose reading (of the robot's p3d `reading.sensor`).
+    fn p3d(&mut self, _reading: &PoseReading) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -113,6 +115,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn imu(&mut self, reading: &ImuReading) {
         self.0.imu(reading);
         self.1.imu(reading);
+    }
+    fn p3d(&mut self, reading: &PoseReading) {
+        self.0.p3d(reading);
+        self.1.p3d(reading);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -191,6 +197,11 @@ impl Observer for Fanout<'_> {
     fn imu(&mut self, reading: &ImuReading) {
         for o in &mut self.observers {
             o.imu(reading);
+        }
+    }
+    fn p3d(&mut self, reading: &PoseReading) {
+        for o in &mut self.observers {
+            o.p3d(reading);
         }
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

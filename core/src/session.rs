@@ -14,7 +14,7 @@ use rover_perception::{
 use rover_sim::{
     model::{CameraInfo, LinkId, RobotModel, World},
     physics::{ControlSample, SimOptions, Simulation},
-    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor},
+    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor, P3dSensor},
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -91,6 +91,8 @@ pub struct Session {
     laser: Option<LaserSensor>,
     /// The robot's IMUs, each fed every physics step.
     imus: Vec<ImuSensor>,
+    /// The robot's p3d ground-truth publishers.
+    p3ds: Vec<P3dSensor>,
     detection: Detection,
     labels: Vec<String>,
     every_frame: bool,
@@ -149,6 +151,9 @@ impl Session {
         let arm = ArmTask::new(&sim, camera_config, &arm_config);
         let laser = start_laser(&sim)?;
         let imus = start_imus(&sim);
+        let p3ds = (0..sim.robot().p3ds.len())
+            .filter_map(|i| P3dSensor::new(&sim, i))
+            .collect();
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
@@ -186,6 +191,7 @@ impl Session {
             camera_link,
             laser,
             imus,
+            p3ds,
             detection,
             labels,
             every_frame: options.every_frame,
@@ -406,6 +412,11 @@ impl Session {
         for imu in &mut self.imus {
             if let Some(reading) = imu.update(&self.sim) {
                 observer.imu(reading);
+            }
+        }
+        for p3d in &mut self.p3ds {
+            if let Some(reading) = p3d.update(&self.sim) {
+                observer.p3d(reading);
             }
         }
         if let Some(sample) = &sample {

@@ -14,7 +14,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::ControlSample,
-    sensors::{ImuReading, LaserScan},
+    sensors::{ImuReading, LaserScan, PoseReading},
 };
 
 /// One frame's pose in another, as tf carries it.
@@ -179,6 +179,8 @@ pub(crate) enum Event {
     Scan(LaserScan),
     /// An IMU reading.
     Imu(ImuReading),
+    /// A p3d ground-truth reading.
+    Pose(PoseReading),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -201,6 +203,8 @@ pub(crate) trait TopicFamily: Send {
     fn scan(&mut self, _scan: &mut LaserScan) {}
     /// An IMU reading.
     fn imu(&mut self, _reading: &ImuReading) {}
+    /// A p3d ground-truth reading.
+    fn p3d(&mut self, _reading: &PoseReading) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in
@@ -305,7 +309,7 @@ impl BufferReturn {
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
-            Event::Imu(_) => {}
+            Event::Imu(_) | Event::Pose(_) => {}
         }
     }
 }

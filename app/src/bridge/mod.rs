@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `p3d.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -34,6 +34,7 @@ pub(crate) mod joint_states;
 pub(crate) mod laser;
 pub(crate) mod model_states;
 pub(crate) mod odom;
+pub(crate) mod p3d;
 pub(crate) mod plan;
 pub(crate) mod status;
 pub(crate) mod tf;
@@ -48,7 +49,7 @@ use rover_sim::{
     geometry::Pose,
     model::{CameraInfo, RobotModel},
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily};
@@ -84,6 +85,8 @@ pub(crate) trait Transport {
     fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser::ScanWire>>;
     /// The IMUs' readings.
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn imu::ImuWire>>;
+    /// p3d's ground-truth poses.
+    fn p3d(&mut self, plan: &RosPlan) -> Result<Box<dyn p3d::P3dWire>>;
     /// The arm's state and points.
     fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm::ArmWire>>;
     /// `/rover/ground_truth/bounding_boxes`.
@@ -113,6 +116,7 @@ pub(crate) fn families(
         Box::new(darknet::Darknet::new(transport.darknet()?)),
         Box::new(laser::Laser::new(transport.laser(plan)?)),
         Box::new(imu::Imu::new(transport.imu(plan)?)),
+        Box::new(p3d::P3d::new(transport.p3d(plan)?)),
         Box::new(arm::Arm::new(transport.arm(plan)?)),
         Box::new(status::Status::new(transport.status()?)),
         Box::new(model_states::ModelStates::new(transport.model_states()?)),
@@ -337,6 +341,10 @@ impl<R: Send + 'static> Observer for Bridge<R> {
     fn imu(&mut self, reading: &ImuReading) {
         self.timed(|b| b.send(Event::Imu(*reading)));
     }
+
+    fn p3d(&mut self, reading: &PoseReading) {
+        self.timed(|b| b.send(Event::Pose(*reading)));
+    }
 }
 
 /// The publishing thread: every event to every family, in order, until the bridge hangs up;
@@ -357,6 +365,7 @@ fn publish(
                 Event::Truth(truth) => family.ground_truth(truth),
                 Event::Scan(scan) => family.scan(scan),
                 Event::Imu(reading) => family.imu(reading),
+                Event::Pose(reading) => family.p3d(reading),
             }
         }
         returns.give_back(event);

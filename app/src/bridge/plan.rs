@@ -35,6 +35,8 @@ pub struct RosPlan {
     pub scan_topic: Option<String>,
     /// Each IMU's topic and `frame_id`, in `RobotModel::imus` order.
     pub imus: Vec<(String, String)>,
+    /// Each p3d's topic and frames, in `RobotModel::p3ds` order.
+    pub p3ds: Vec<P3dTopic>,
     /// Every moving joint the session reports, in `/joint_states` order.
     pub(crate) joints: Vec<MovingJoint>,
     /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
@@ -45,6 +47,17 @@ pub struct RosPlan {
     /// The controllers file's gripper controllers: their names and action namespaces
     /// (`/<namespace>/<controller>/gripper_cmd`).
     pub(crate) grippers: Vec<(String, String)>,
+}
+
+/// A p3d plugin's topic and frames.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct P3dTopic {
+    /// `topicName` in `robotNamespace`.
+    pub topic: String,
+    /// `frameName`: the messages' `frame_id`.
+    pub frame: String,
+    /// `bodyName`: the messages' `child_frame_id`.
+    pub child_frame: String,
 }
 
 /// A controller's topics (`/<namespace>/<controller>/command`).
@@ -159,6 +172,15 @@ impl RosPlan {
                 .imus
                 .iter()
                 .map(|i| (topic(&i.topic), i.frame_name.clone()))
+                .collect(),
+            p3ds: robot
+                .p3ds
+                .iter()
+                .map(|p| P3dTopic {
+                    topic: topic(&p.topic),
+                    frame: p.frame_name.clone(),
+                    child_frame: p.link.clone(),
+                })
                 .collect(),
             joints: moving_joints(robot, &drive),
             joint_states_hz: robot.controllers.as_ref().and_then(|c| {

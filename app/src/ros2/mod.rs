@@ -9,7 +9,7 @@
 //! on the topic's sinks
 //! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
 //! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
-//! `laser.rs`, `imu.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
+//! `laser.rs`, `imu.rs`, `p3d.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
 //! is written once, at the start (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
 //! `rt/cmd_vel`, the controllers' commands and `/rover/arm/task` into rover input like a key
 //! press. Stamps are sim time; `/clock` carries it.
@@ -47,6 +47,7 @@ mod laser;
 mod mcap;
 mod model_states;
 mod odom;
+mod p3d;
 mod rosout;
 mod sinks;
 mod status;
@@ -166,6 +167,10 @@ impl Transport for Sinks<'_> {
 
     fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser_family::ScanWire>> {
         Ok(Box::new(laser::Laser::create(self, plan)?))
+    }
+
+    fn p3d(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::p3d::P3dWire>> {
+        Ok(Box::new(p3d::P3d::create(self, plan)?))
     }
 
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::imu::ImuWire>> {

@@ -30,6 +30,7 @@
 //! plots/joints/<joint>                   Scalars: an actuated joint's position and target
 //! plots/imu/<sensor>/{angular_velocity,linear_acceleration}  Scalars x, y, z: each IMU's
 //!                                        readings (rad/s; m/s^2, gravity included)
+//! world/p3d/<plugin>                     Points3D: a world-frame p3d's ground-truth position
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -51,7 +52,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 pub use blueprint::blueprint;
@@ -100,6 +101,8 @@ pub struct Recorder {
     scan_points: Vec<[f32; 3]>,
     /// Each IMU's plot paths: angular velocity, linear acceleration.
     imu_paths: Vec<[String; 2]>,
+    /// Each p3d's entity path (`None`: measured against a link, not drawn in the world).
+    p3d_paths: Vec<Option<String>>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -158,6 +161,7 @@ impl Recorder {
             laser: None,
             scan_points: Vec::new(),
             imu_paths: Vec::new(),
+            p3d_paths: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -259,6 +263,16 @@ impl Observer for Recorder {
             .map(|i| {
                 ["angular_velocity", "linear_acceleration"]
                     .map(|what| format!("plots/imu/{}/{what}", i.name))
+            })
+            .collect();
+        self.p3d_paths = sim
+            .robot()
+            .p3ds
+            .iter()
+            .map(|p| {
+                p.reference_link
+                    .is_none()
+                    .then(|| format!("world/p3d/{}", p.name))
             })
             .collect();
     }
@@ -509,6 +523,18 @@ impl Observer for Recorder {
         let linear_acceleration = rerun::Scalars::new(reading.linear_acceleration_mps2);
         self.log(angular, &angular_velocity);
         self.log(linear, &linear_acceleration);
+    }
+
+    fn p3d(&mut self, reading: &PoseReading) {
+        let Some(Some(path)) = self.p3d_paths.get(reading.sensor) else {
+            return;
+        };
+        self.rec.set_duration_secs("sim_time", reading.stamp_s);
+        let [x, y, z] = reading.position_m.map(|v| v as f32);
+        let point = rerun::Points3D::new([[x, y, z]])
+            .with_radii([0.03f32])
+            .with_colors([rerun::Color::from_rgb(40, 200, 90)]);
+        self.log(path, &point);
     }
 
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

@@ -148,6 +148,7 @@ impl RobotModel {
             cameras: extensions.cameras,
             lasers: extensions.lasers,
             imus: extensions.imus,
+            p3ds: extensions.p3ds,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
             transmissions,

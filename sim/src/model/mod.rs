@@ -42,7 +42,7 @@ pub use robot::{
 };
 pub use sensors::{
     AxisNoise, CameraConfig, DepthOutput, Distortion, GaussianNoise, ImuConfig, ImuPlugin,
-    LaserConfig, MAX_LASER_SAMPLES, OrientationReference, PixelFormat,
+    LaserConfig, MAX_LASER_SAMPLES, OrientationReference, P3dConfig, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,

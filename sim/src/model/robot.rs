@@ -11,7 +11,7 @@ use crate::model::actuation::{RosControlPlugin, Transmission};
 use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
-use crate::model::sensors::{CameraConfig, ImuConfig, ImuPlugin, LaserConfig};
+use crate::model::sensors::{CameraConfig, ImuConfig, ImuPlugin, LaserConfig, P3dConfig};
 
 /// Mass properties of a link, from its `<inertial>`.
 #[derive(Debug, Clone, PartialEq)]
@@ -214,6 +214,8 @@ pub struct RobotModel {
     /// IMUs (`<sensor type="imu">` with `libgazebo_ros_imu_sensor.so`, or the model plugin
     /// `libgazebo_ros_imu.so`).
     pub imus: Vec<ImuConfig>,
+    /// Ground-truth pose publishers (`libgazebo_ros_p3d.so`).
+    pub p3ds: Vec<P3dConfig>,
     /// Gazebo sensors and plugins in the file that rover does not simulate (GPS, ...).
     pub not_simulated: Vec<String>,
     /// `<transmission>`s: which joints an actuator drives, through which ros_control
@@ -491,6 +493,22 @@ impl RobotModel {
                         names(self.links.iter().map(|l| &l.name))
                     ),
                 ));
+            }
+        }
+        for p3d in &self.p3ds {
+            let links = std::iter::once(("bodyName", &p3d.link))
+                .chain(p3d.reference_link.iter().map(|l| ("frameName", l)));
+            for (element, link) in links {
+                if self.link_id(link).is_none() {
+                    return Err(SimError::invalid(
+                        path,
+                        p3d.line,
+                        format!(
+                            "<plugin filename=\"libgazebo_ros_p3d.so\"> <{element}> \"{link}\": no such link; links in this robot: {}",
+                            names(self.links.iter().map(|l| &l.name))
+                        ),
+                    ));
+                }
             }
         }
         for camera in &self.cameras {

@@ -238,3 +238,31 @@ pub struct ImuConfig {
     /// Line of the declaring element, for messages.
     pub line: Option<u32>,
 }
+
+/// Ground truth of a link's pose and velocity: the model plugin `libgazebo_ros_p3d.so`,
+/// published as nav_msgs/Odometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct P3dConfig {
+    /// Plugin `name`.
+    pub name: String,
+    /// The link whose pose is reported (`<bodyName>`).
+    pub link: String,
+    /// Topic (`<topicName>`, in `<robotNamespace>`).
+    pub topic: String,
+    /// `<frameName>`: `world` (or `map`, the default) for the world, else a link of the robot
+    /// the pose and velocity are measured against. The messages' `frame_id`.
+    pub frame_name: String,
+    /// The link measured against, `None` for the world.
+    pub reference_link: Option<String>,
+    /// `<xyzOffsets>` (m), added to the position.
+    pub xyz_offset_m: [f64; 3],
+    /// `<rpyOffsets>` (rad), turning the orientation.
+    pub rpy_offset_rad: [f64; 3],
+    /// `<gaussianNoise>`: white noise of this stddev on position and velocities, and the
+    /// covariance diagonals.
+    pub gaussian_noise: f64,
+    /// `<updateRate>` (Hz; 0: every physics step).
+    pub update_rate_hz: f64,
+    /// Line of the plugin element, for messages.
+    pub line: Option<u32>,
+}

@@ -1,12 +1,13 @@
 //! Sensors on sim time: the camera (`camera.rs`, rendering through `render`), the 2D laser
-//! (`laser.rs`, ray casts against the physics scene) and the IMU (`imu.rs`, from the link's
-//! motion), all with seeded noise, and the camera's ground truth (`ground_truth.rs`: where
-//! each labelled thing is in the image).
+//! (`laser.rs`, ray casts against the physics scene), the IMU (`imu.rs`) and p3d's ground-truth
+//! pose (`p3d.rs`), both from the link's motion, all with seeded noise, and the camera's
+//! ground truth (`ground_truth.rs`: where each labelled thing is in the image).
 
 pub(crate) mod camera;
 pub(crate) mod ground_truth;
 pub(crate) mod imu;
 pub(crate) mod laser;
+pub(crate) mod p3d;
 
 pub use camera::{CameraFrame, CameraSensor};
 pub use ground_truth::{
@@ -14,3 +15,4 @@ pub use ground_truth::{
 };
 pub use imu::{ImuReading, ImuSensor};
 pub use laser::{LaserScan, LaserSensor};
+pub use p3d::{P3dSensor, PoseReading};

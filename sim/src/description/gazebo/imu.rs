@@ -2,7 +2,7 @@
 //! `libgazebo_ros_imu_sensor.so`, and the older model plugin `libgazebo_ros_imu.so` that
 //! TurtleBot3 declares. Parameter names, defaults and topic rules are the plugins' own.
 
-use super::values::{Ctx, Node, read_sensor_pose, text_of};
+use super::values::{Ctx, Node, clean, join_topic, plugin_stem, read_sensor_pose, text_of, vec3};
 use crate::description::xml::{elements, line_of};
 use crate::error::Result;
 use crate::geometry::Pose;
@@ -16,13 +16,6 @@ pub(super) fn is_sensor_plugin(file: &str) -> bool {
 /// True for the model plugin's file name (`libgazebo_ros_imu.so`).
 pub(super) fn is_model_plugin(file: &str) -> bool {
     plugin_stem(file) == "gazebo_ros_imu"
-}
-
-/// `libNAME.so` -> `NAME` (a path before it is dropped).
-fn plugin_stem(file: &str) -> &str {
-    let base = file.rsplit('/').next().unwrap_or(file);
-    let base = base.strip_prefix("lib").unwrap_or(base);
-    base.strip_suffix(".so").unwrap_or(base)
 }
 
 /// `<sensor type="imu">` on `link`. `Ok(None)` when no ROS plugin publishes it (Gazebo then
@@ -163,47 +156,6 @@ pub(super) fn parse_model_plugin(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Res
     c.link = body;
     c.topic = clean(&join_topic(&namespace, &topic));
     Ok(c)
-}
-
-/// A topic as a ROS node handle in `namespace` resolves `topic`: absolute names stay.
-fn join_topic(namespace: &str, topic: &str) -> String {
-    if topic.starts_with('/') || namespace.is_empty() {
-        topic.to_owned()
-    } else {
-        format!("{namespace}{topic}")
-    }
-}
-
-/// A ROS name with its doubled slashes collapsed, as roscpp cleans it (`/robot//imu` is
-/// `/robot/imu`).
-fn clean(name: &str) -> String {
-    let mut out = String::with_capacity(name.len());
-    for c in name.chars() {
-        if !(c == '/' && out.ends_with('/')) {
-            out.push(c);
-        }
-    }
-    out
-}
-
-/// Three numbers `x y z`.
-fn vec3(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str, unit: &str) -> Result<[f64; 3]> {
-    let text = text_of(node);
-    let v: Vec<f64> = text
-        .split_whitespace()
-        .filter_map(|t| t.parse::<f64>().ok())
-        .filter(|x| x.is_finite())
-        .collect();
-    if v.len() != 3 || text.split_whitespace().count() != 3 {
-        return Err(ctx.err(
-            node,
-            format!(
-                "<{}> in {what}: expected three numbers 'x y z' ({unit}), found '{text}'",
-                node.tag_name().name()
-            ),
-        ));
-    }
-    Ok([v[0], v[1], v[2]])
 }
 
 /// The SDF `<imu>` element's noise, in either form: SDF 1.5's per-axis

@@ -1,11 +1,13 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
 //! `<sensor>` blocks (with `libgazebo_ros_camera.so`), 2D laser `<sensor type="ray">` blocks (with
-//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), and per-link friction (`mu1`/`mu2`).
+//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), and per-link
+//! friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
 
 mod imu;
+mod p3d;
 mod values;
 
 use std::collections::BTreeMap;
@@ -20,7 +22,7 @@ use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
     CameraConfig, DepthOutput, Distortion, GaussianNoise, ImuConfig, LaserConfig,
-    MAX_LASER_SAMPLES, PixelFormat,
+    MAX_LASER_SAMPLES, P3dConfig, PixelFormat,
 };
 
 /// Everything read from `<gazebo>` elements.
@@ -31,6 +33,7 @@ pub(crate) struct Extensions {
     pub cameras: Vec<CameraConfig>,
     pub lasers: Vec<LaserConfig>,
     pub imus: Vec<ImuConfig>,
+    pub p3ds: Vec<P3dConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
     /// Link name -> contact stiffness `<kp>` (N/m).
@@ -68,6 +71,8 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ext.ros_control = Some(parse_ros_control(&ctx, child)?);
                     } else if imu::is_model_plugin(file) {
                         ext.imus.push(imu::parse_model_plugin(&ctx, child)?);
+                    } else if p3d::is_plugin(file) {
+                        ext.p3ds.push(p3d::parse(&ctx, child)?);
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",

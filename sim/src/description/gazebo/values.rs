@@ -122,3 +122,56 @@ pub(super) fn read_sensor_pose(ctx: &Ctx<'_, '_>, pose: Node<'_, '_>, what: &str
         })?;
     Ok(pose_from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]))
 }
+
+/// `libNAME.so` -> `NAME` (a path before it is dropped).
+pub(super) fn plugin_stem(file: &str) -> &str {
+    let base = file.rsplit('/').next().unwrap_or(file);
+    let base = base.strip_prefix("lib").unwrap_or(base);
+    base.strip_suffix(".so").unwrap_or(base)
+}
+
+/// A topic as a ROS node handle in `namespace` resolves `topic`: absolute names stay.
+pub(super) fn join_topic(namespace: &str, topic: &str) -> String {
+    if topic.starts_with('/') || namespace.is_empty() {
+        topic.to_owned()
+    } else {
+        format!("{namespace}{topic}")
+    }
+}
+
+/// A ROS name with its doubled slashes collapsed, as roscpp cleans it (`/robot//imu` is
+/// `/robot/imu`).
+pub(super) fn clean(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        if !(c == '/' && out.ends_with('/')) {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Three numbers `x y z`.
+pub(super) fn vec3(
+    ctx: &Ctx<'_, '_>,
+    node: Node<'_, '_>,
+    what: &str,
+    unit: &str,
+) -> Result<[f64; 3]> {
+    let text = text_of(node);
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .filter_map(|t| t.parse::<f64>().ok())
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.len() != 3 || text.split_whitespace().count() != 3 {
+        return Err(ctx.err(
+            node,
+            format!(
+                "<{}> in {what}: expected three numbers 'x y z' ({unit}), found '{text}'",
+                node.tag_name().name()
+            ),
+        ));
+    }
+    Ok([v[0], v[1], v[2]])
+}
