@@ -13,7 +13,7 @@ use rover_core::parse_trace;
 /// - `topic NAME TYPE COUNT` for every channel, with the messages it holds;
 /// - `deffield TYPE` for a type whose definition in the file differs from Humble's;
 /// - `image K EQUAL` for the K-th image against frames/frame_K.png;
-/// - `odom SEC NSEC X Y YAW` for every odometry message;
+/// - `odom SEC NSEC X Y YAW` for every message on /odom;
 /// - `box CLASS XMIN YMIN XMAX YMAX W H` for every darknet box.
 const READER: &str = r#"
 import math, sys
@@ -47,7 +47,7 @@ with Reader(Path(sys.argv[1])) as reader:
             image = m.data.reshape(m.height, m.width, 3)
             frame = imread(Path(sys.argv[2]) / ('frame_%06d.png' % k))[:, :, :3]
             print('image', k, int(np.array_equal(image, frame)), m.encoding, m.header.frame_id)
-        elif c.msgtype == 'nav_msgs/msg/Odometry':
+        elif c.msgtype == 'nav_msgs/msg/Odometry' and c.topic == '/odom':
             p = m.pose.pose
             # The heading of a base that may tilt (odometrySource world), as tf reads it.
             q = p.orientation
@@ -155,6 +155,7 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         ("/camera/camera_info", "sensor_msgs/msg/CameraInfo"),
         ("/scan", "sensor_msgs/msg/LaserScan"),
         ("/imu", "sensor_msgs/msg/Imu"),
+        ("/ground_truth/state", "nav_msgs/msg/Odometry"),
         (
             "/darknet_ros/bounding_boxes",
             "darknet_ros_msgs/msg/BoundingBoxes",

@@ -553,6 +553,14 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
                 && imu[2].as_f64().is_some_and(|w| w.abs() <= 1.0),
             "{distro}: /imu: {imu}"
         );
+        // p3d's ground truth of base_link, in the world frame.
+        let truth = &sample["/ground_truth/state"];
+        ensure!(
+            truth[0] == "world"
+                && truth[1] == "base_link"
+                && truth[2].as_f64().is_some_and(|z| (0.0..0.2).contains(&z)),
+            "{distro}: /ground_truth/state: {truth}"
+        );
         // rover's log on /rosout (transient local: the lines before the peer came too):
         // the line naming its DDS domain, at INFO, from rover's source.
         let log_lines = sample["/rosout"].as_array().context("no /rosout sample")?;

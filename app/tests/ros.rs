@@ -429,10 +429,11 @@ if got:
     Ok(())
 }
 
-/// The playground car's IMU and laser reach rospy subscribers of Debian's sensor_msgs/Imu and
-/// LaserScan: the IMU at its 100 Hz in base_link, gravity up at rest, a unit quaternion.
+/// The playground car's IMU, laser and p3d reach rospy subscribers of Debian's sensor_msgs/Imu,
+/// LaserScan and nav_msgs/Odometry: the IMU at its 100 Hz in base_link, gravity up at rest, a
+/// unit quaternion; the ground truth in the world frame where /gazebo/model_states puts the car.
 #[test]
-fn the_imu_and_the_laser_reach_rospy_subscribers() -> Result<()> {
+fn the_imu_laser_and_p3d_reach_rospy_subscribers() -> Result<()> {
     let _one = lock();
     if let Some(why) = missing_ros() {
         return skip(&why);
@@ -443,14 +444,22 @@ fn the_imu_and_the_laser_reach_rospy_subscribers() -> Result<()> {
     let script = r#"
 import math, rospy, time
 from sensor_msgs.msg import Imu, LaserScan
+from nav_msgs.msg import Odometry
 rospy.init_node('imu_check')
-imu, scans = [], []
+imu, scans, truth = [], [], []
 rospy.Subscriber('/imu', Imu, imu.append)
 rospy.Subscriber('/scan', LaserScan, scans.append)
+rospy.Subscriber('/ground_truth/state', Odometry, truth.append)
 end = time.time() + 20
-while time.time() < end and (len(imu) < 200 or len(scans) < 10):
+while time.time() < end and (len(imu) < 200 or len(scans) < 10 or len(truth) < 100):
     time.sleep(0.05)
-print('counts %d %d' % (len(imu), len(scans)))
+print('counts %d %d %d' % (len(imu), len(scans), len(truth)))
+if truth:
+    m = truth[-1]
+    stamps = [x.header.stamp.to_sec() for x in truth[-50:]]
+    gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+    print('truth %s %s %.4f %.4f %.5f' % (m.header.frame_id, m.child_frame_id,
+          m.pose.pose.position.x, m.pose.pose.position.y, gaps[len(gaps) // 2]))
 if imu:
     m = imu[-1]
     q = m.orientation
@@ -488,6 +497,15 @@ if scans:
         "IMU stamps {period} s apart (median), 100 Hz expected"
     );
     ensure!(line("scan")? == ["base_scan", "360"], "scan: {out}");
+    // The playground spawns the car at the origin, where it stays (no one drives it).
+    let truth = line("truth")?;
+    ensure!(truth[..2] == ["world", "base_link"], "p3d frames {truth:?}");
+    let (x, y, gap): (f64, f64, f64) = (truth[2].parse()?, truth[3].parse()?, truth[4].parse()?);
+    ensure!(x.abs() < 0.01 && y.abs() < 0.01, "p3d at {x} {y}");
+    ensure!(
+        (gap - 0.02).abs() < 1e-4,
+        "p3d every {gap} s, 50 Hz expected"
+    );
     Ok(())
 }
 

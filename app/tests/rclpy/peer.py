@@ -136,6 +136,7 @@ def topics(node):
         ("/rover/status", String, reliable, "reliable"),
         ("/scan", LaserScan, qos_profile_sensor_data, "best effort"),
         ("/imu", Imu, qos_profile_sensor_data, "best effort"),
+        ("/ground_truth/state", Odometry, reliable, "reliable"),
         ("/rosout", Log, rosout, "reliable, transient local"),
     ]
     counts, last, rover_log = {}, {}, []
@@ -169,6 +170,10 @@ def topics(node):
         sample["/tf_static"] = len(last["/tf_static"].transforms)
     if "/scan" in last:
         sample["/scan"] = len(last["/scan"].ranges)
+    if "/ground_truth/state" in last:
+        m = last["/ground_truth/state"]
+        sample["/ground_truth/state"] = [m.header.frame_id, m.child_frame_id,
+                                         m.pose.pose.position.z]
     if "/imu" in last:
         m = last["/imu"]
         sample["/imu"] = [m.header.frame_id, m.linear_acceleration.z, m.orientation.w]
