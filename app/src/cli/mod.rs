@@ -103,6 +103,10 @@ pub fn main() -> ExitCode {
             ..
         }) => bench::bench_laser(world, scans),
         Some(Command::Bench {
+            kind: Some(BenchKind::Sensors { world, steps }),
+            ..
+        }) => bench::bench_sensors(world, steps),
+        Some(Command::Bench {
             kind:
                 Some(BenchKind::Ros {
                     world,

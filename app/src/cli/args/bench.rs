@@ -71,6 +71,16 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value_t = 200)]
         scans: usize,
     },
+    /// Sensors: us per reading of each IMU and p3d publisher of the robot (default: the
+    /// playground car's /imu and /ground_truth/state) while it drives a circle
+    Sensors {
+        #[command(flatten)]
+        world: WorldArgs,
+
+        /// Physics steps to run (each due reading is timed)
+        #[arg(long, default_value_t = 4000)]
+        steps: usize,
+    },
     /// Dataset: labelled 640x480 images per second (layout, render + ground truth, encode and
     /// write), written into a temporary folder
     Dataset {

@@ -1,5 +1,6 @@
-//! The sensor benchmarks: camera frame time (`rover bench camera`) and laser scan time with
-//! the follower's command on it (`rover bench laser`).
+//! The sensor benchmarks: camera frame time (`rover bench camera`), laser scan time with the
+//! follower's command on it (`rover bench laser`), and the IMU's and p3d's cost per reading
+//! (`rover bench sensors`).
 
 use std::time::Instant;
 
@@ -165,6 +166,86 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
         follower_us: median(&mut follower_times),
         window_search_us: median(&mut window_times),
     })
+}
+
+/// IMU and p3d benchmark figures.
+#[derive(Debug, Clone)]
+pub struct SensorsBench {
+    /// Each IMU: its name, readings timed, median wall time per reading (us).
+    pub imus: Vec<(String, usize, f64)>,
+    /// Each p3d: its name, readings timed, median wall time per reading (us).
+    pub p3ds: Vec<(String, usize, f64)>,
+}
+
+/// The robot's IMUs and p3d publishers, each timed per reading (the link's state, the frames,
+/// the noise) over `steps` physics steps of the robot driving a circle; the physics step
+/// itself is not timed.
+pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
+    let (world, robot) = config.load_world_and_robot()?;
+    anyhow::ensure!(
+        !robot.imus.is_empty() || !robot.p3ds.is_empty(),
+        "{}: the robot has no IMU and no p3d plugin; try --robot assets/robots/my_robot_laser.urdf.xacro",
+        robot.source.display()
+    );
+    let mut sim = Simulation::new(world, robot, &config.options)?;
+    let mut imus: Vec<_> = (0..sim.robot().imus.len())
+        .filter_map(|i| rover_sim::sensors::ImuSensor::new(&sim, i))
+        .collect();
+    let mut p3ds: Vec<_> = (0..sim.robot().p3ds.len())
+        .filter_map(|i| rover_sim::sensors::P3dSensor::new(&sim, i))
+        .collect();
+    let mut imu_times = vec![Vec::with_capacity(steps); imus.len()];
+    let mut p3d_times = vec![Vec::with_capacity(steps); p3ds.len()];
+    sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
+    for _ in 0..steps.max(1) {
+        sim.step();
+        for (imu, times) in imus.iter_mut().zip(&mut imu_times) {
+            let start = Instant::now();
+            let read = imu.update(&sim).is_some();
+            let us = start.elapsed().as_secs_f64() * 1e6;
+            if read {
+                times.push(us);
+            }
+        }
+        for (p3d, times) in p3ds.iter_mut().zip(&mut p3d_times) {
+            let start = Instant::now();
+            let read = p3d.update(&sim).is_some();
+            let us = start.elapsed().as_secs_f64() * 1e6;
+            if read {
+                times.push(us);
+            }
+        }
+    }
+    let figures = |names: Vec<String>, times: Vec<Vec<f64>>| -> Vec<(String, usize, f64)> {
+        names
+            .into_iter()
+            .zip(times)
+            .map(|(name, mut t)| (name, t.len(), median(&mut t)))
+            .collect()
+    };
+    Ok(SensorsBench {
+        imus: figures(
+            imus.iter().map(|i| i.config().name.clone()).collect(),
+            imu_times,
+        ),
+        p3ds: figures(
+            p3ds.iter().map(|p| p.config().name.clone()).collect(),
+            p3d_times,
+        ),
+    })
+}
+
+pub(crate) fn bench_sensors(world: WorldArgs, steps: usize) -> Result<()> {
+    let config = world.run_config(None);
+    let b = sensors(&config, steps)?;
+    for (kind, list) in [("IMU", &b.imus), ("p3d", &b.p3ds)] {
+        for (name, n, us) in list {
+            say!(
+                "sensors benchmark: {kind} {name}: median {us:.2} us per reading ({n} readings in {steps} physics steps)"
+            );
+        }
+    }
+    Ok(())
 }
 
 pub(crate) fn bench_laser(world: WorldArgs, scans: usize) -> Result<()> {
