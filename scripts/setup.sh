@@ -80,13 +80,14 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # --- Python tools for the tests: onnxruntime, numpy, scikit-image, PyYAML (the reference xacro),
-# pycocotools (the reference COCO metrics), rosbags (reads ROS 2 MCAP files), the Rerun viewer,
+# pycocotools (the reference COCO metrics), rosbags (reads ROS 2 MCAP files), geographiclib (the
+# GPS test's WGS-84 reference), the Rerun viewer,
 # pinned with their dependencies in scripts/test-tools.txt ---------------------------------------
 # The system python3 when it already has them, else a virtual environment in rover's cache
 # (no sudo, nothing installed into the system's Python). Its bin/ goes first on PATH.
 if [ "$purpose" = test ]; then
   rerun_ok() { "$1" --version 2>/dev/null | grep -q " 0\.36\.3"; }
-  if python3 -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags" 2>/dev/null && rerun_ok rerun; then
+  if python3 -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags, geographiclib" 2>/dev/null && rerun_ok rerun; then
     :
   else
     venv="$cache/venv"
@@ -94,10 +95,10 @@ if [ "$purpose" = test ]; then
       say "creating a Python environment for the test references in $venv"
       python3 -m venv "$venv"
     fi
-    if ! "$venv/bin/python3" -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags" 2>/dev/null || ! rerun_ok "$venv/bin/rerun"; then
+    if ! "$venv/bin/python3" -c "import onnxruntime, numpy, skimage, yaml, pycocotools, rosbags, geographiclib" 2>/dev/null || ! rerun_ok "$venv/bin/rerun"; then
       # Pinned and checked by hash (scripts/test-tools.txt); the hashes are of the CPython 3.11
       # x86_64 wheels, so elsewhere the same versions go in unchecked, saying so.
-      say "installing onnxruntime, numpy, scikit-image, pyyaml, pycocotools, rosbags, rerun-sdk 0.36.3 (scripts/test-tools.txt, hash-checked) from PyPI into $venv"
+      say "installing onnxruntime, numpy, scikit-image, pyyaml, pycocotools, rosbags, geographiclib, rerun-sdk 0.36.3 (scripts/test-tools.txt, hash-checked) from PyPI into $venv"
       if ! "$venv/bin/python3" -m pip install --quiet --disable-pip-version-check --require-hashes \
         --no-deps --only-binary=:all: -r "$root/scripts/test-tools.txt"; then
         say "the pinned wheels' hashes do not fit this platform (they are CPython 3.11 x86_64 Linux's): installing the same versions without the hash check"

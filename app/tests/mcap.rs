@@ -156,6 +156,8 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         ("/scan", "sensor_msgs/msg/LaserScan"),
         ("/imu", "sensor_msgs/msg/Imu"),
         ("/ground_truth/state", "nav_msgs/msg/Odometry"),
+        ("/fix", "sensor_msgs/msg/NavSatFix"),
+        ("/fix_velocity", "geometry_msgs/msg/Vector3Stamped"),
         (
             "/darknet_ros/bounding_boxes",
             "darknet_ros_msgs/msg/BoundingBoxes",

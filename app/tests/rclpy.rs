@@ -561,6 +561,16 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
                 && truth[2].as_f64().is_some_and(|z| (0.0..0.2).contains(&z)),
             "{distro}: /ground_truth/state: {truth}"
         );
+        // hector's GPS at the world's origin: its reference point, GPS service, diagonal known.
+        let fix = &sample["/fix"];
+        ensure!(
+            fix[0] == "base_link"
+                && fix[1].as_f64().is_some_and(|lat| (lat - 49.9).abs() < 1e-6)
+                && fix[2].as_f64().is_some_and(|lon| (lon - 8.9).abs() < 1e-6)
+                && fix[3] == 1
+                && fix[4] == 2,
+            "{distro}: /fix: {fix}"
+        );
         // rover's log on /rosout (transient local: the lines before the peer came too):
         // the line naming its DDS domain, at INFO, from rover's source.
         let log_lines = sample["/rosout"].as_array().context("no /rosout sample")?;

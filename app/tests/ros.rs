@@ -429,11 +429,12 @@ if got:
     Ok(())
 }
 
-/// The playground car's IMU, laser and p3d reach rospy subscribers of Debian's sensor_msgs/Imu,
-/// LaserScan and nav_msgs/Odometry: the IMU at its 100 Hz in base_link, gravity up at rest, a
-/// unit quaternion; the ground truth in the world frame where /gazebo/model_states puts the car.
+/// The playground car's IMU, laser, p3d and GPS reach rospy subscribers of Debian's
+/// sensor_msgs/Imu, LaserScan, NavSatFix and nav_msgs/Odometry: the IMU at its 100 Hz in
+/// base_link, gravity up at rest, a unit quaternion; the ground truth in the world frame where
+/// the car stands; the fix at the GPS's reference point.
 #[test]
-fn the_imu_laser_and_p3d_reach_rospy_subscribers() -> Result<()> {
+fn the_imu_laser_p3d_and_gps_reach_rospy_subscribers() -> Result<()> {
     let _one = lock();
     if let Some(why) = missing_ros() {
         return skip(&why);
@@ -445,13 +446,16 @@ fn the_imu_laser_and_p3d_reach_rospy_subscribers() -> Result<()> {
 import math, rospy, time
 from sensor_msgs.msg import Imu, LaserScan
 from nav_msgs.msg import Odometry
+from sensor_msgs.msg import NavSatFix
 rospy.init_node('imu_check')
-imu, scans, truth = [], [], []
+imu, scans, truth, fixes = [], [], [], []
+rospy.Subscriber('/fix', NavSatFix, fixes.append)
 rospy.Subscriber('/imu', Imu, imu.append)
 rospy.Subscriber('/scan', LaserScan, scans.append)
 rospy.Subscriber('/ground_truth/state', Odometry, truth.append)
 end = time.time() + 20
-while time.time() < end and (len(imu) < 200 or len(scans) < 10 or len(truth) < 100):
+while time.time() < end and (len(imu) < 200 or len(scans) < 10 or len(truth) < 100
+                             or len(fixes) < 8):
     time.sleep(0.05)
 print('counts %d %d %d' % (len(imu), len(scans), len(truth)))
 if truth:
@@ -470,6 +474,10 @@ if imu:
     print('period %.5f' % gaps[len(gaps) // 2])
 if scans:
     print('scan %s %d' % (scans[-1].header.frame_id, len(scans[-1].ranges)))
+if fixes:
+    f = fixes[-1]
+    print('fix %s %.9f %.9f %d %d' % (f.header.frame_id, f.latitude, f.longitude,
+                                     f.status.service, f.position_covariance_type))
 "#;
     let mut c = graph.command(PYTHON);
     let path = graph.dir.path().join("imu.py");

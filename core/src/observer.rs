@@ -8,7 +8,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 use crate::arm::ArmStatus;
@@ -76,6 +76,8 @@ pub trait Observer {
     fn imu(&mut self, _reading: &ImuReading) {}
     /// A ground-truth pose reading (of the robot's p3d `reading.sensor`).
     fn p3d(&mut self, _reading: &PoseReading) {}
+    /// A GPS fix (of the robot's GPS `fix.sensor`).
+    fn gps(&mut self, _fix: &FixReading) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -119,6 +121,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn p3d(&mut self, reading: &PoseReading) {
         self.0.p3d(reading);
         self.1.p3d(reading);
+    }
+    fn gps(&mut self, fix: &FixReading) {
+        self.0.gps(fix);
+        self.1.gps(fix);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -202,6 +208,11 @@ impl Observer for Fanout<'_> {
     fn p3d(&mut self, reading: &PoseReading) {
         for o in &mut self.observers {
             o.p3d(reading);
+        }
+    }
+    fn gps(&mut self, fix: &FixReading) {
+        for o in &mut self.observers {
+            o.gps(fix);
         }
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

@@ -14,7 +14,7 @@ use rover_perception::{
 use rover_sim::{
     model::{CameraInfo, LinkId, RobotModel, World},
     physics::{ControlSample, SimOptions, Simulation},
-    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor, P3dSensor},
+    sensors::{CameraSensor, GpsSensor, GroundTruthBox, ImuSensor, LaserSensor, P3dSensor},
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -93,6 +93,8 @@ pub struct Session {
     imus: Vec<ImuSensor>,
     /// The robot's p3d ground-truth publishers.
     p3ds: Vec<P3dSensor>,
+    /// The robot's GPS receivers.
+    gpss: Vec<GpsSensor>,
     detection: Detection,
     labels: Vec<String>,
     every_frame: bool,
@@ -154,6 +156,9 @@ impl Session {
         let p3ds = (0..sim.robot().p3ds.len())
             .filter_map(|i| P3dSensor::new(&sim, i))
             .collect();
+        let gpss = (0..sim.robot().gpss.len())
+            .filter_map(|i| GpsSensor::new(&sim, i))
+            .collect();
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
@@ -192,6 +197,7 @@ impl Session {
             laser,
             imus,
             p3ds,
+            gpss,
             detection,
             labels,
             every_frame: options.every_frame,
@@ -417,6 +423,11 @@ impl Session {
         for p3d in &mut self.p3ds {
             if let Some(reading) = p3d.update(&self.sim) {
                 observer.p3d(reading);
+            }
+        }
+        for gps in &mut self.gpss {
+            if let Some(fix) = gps.update(&self.sim) {
+                observer.gps(fix);
             }
         }
         if let Some(sample) = &sample {

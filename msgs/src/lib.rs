@@ -148,6 +148,43 @@ pub struct Imu<H> {
     pub linear_acceleration_covariance: [f64; 9],
 }
 
+/// `sensor_msgs/NavSatStatus`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct NavSatStatus {
+    /// -1 no fix, 0 fix, 1 SBAS fix, 2 GBAS fix.
+    pub status: i8,
+    /// Bits: 1 GPS, 2 GLONASS, 4 COMPASS, 8 GALILEO.
+    pub service: u16,
+}
+
+/// `sensor_msgs/NavSatFix`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct NavSatFix<H> {
+    /// Stamp and the receiver's frame.
+    pub header: H,
+    /// Fix status and satellite services.
+    pub status: NavSatStatus,
+    /// Latitude (deg, north positive).
+    pub latitude: f64,
+    /// Longitude (deg, east positive).
+    pub longitude: f64,
+    /// Altitude (m).
+    pub altitude: f64,
+    /// Position covariance (m^2), row-major 3x3 in east, north, up.
+    pub position_covariance: [f64; 9],
+    /// 0 unknown, 1 approximated, 2 diagonal known, 3 known.
+    pub position_covariance_type: u8,
+}
+
+/// `geometry_msgs/Vector3Stamped`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3Stamped<H> {
+    /// Stamp and frame.
+    pub header: H,
+    /// The vector.
+    pub vector: Vector3,
+}
+
 /// `darknet_ros_msgs/BoundingBox` (ROS 1 names the class `Class`, ROS 2 `class_id`; both
 /// write it last).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -278,8 +315,8 @@ pub struct CameraInfo<H> {
 
 /// Names, in a wire's `msgs` module, the messages above that carry a header, with the wire's
 /// header type, pixel buffer and range buffer: `wire_messages!(Header, Vec<u8>, Vec<f32>)`
-/// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `Imu`, `BoundingBoxes`,
-/// `ObjectCount` and `PointStamped` there.
+/// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `Imu`, `NavSatFix`,
+/// `Vector3Stamped`, `BoundingBoxes`, `ObjectCount` and `PointStamped` there.
 #[macro_export]
 macro_rules! wire_messages {
     ($header:ty, $pixels:ty, $ranges:ty) => {
@@ -293,6 +330,10 @@ macro_rules! wire_messages {
         pub type LaserScan = $crate::LaserScan<$header, $ranges>;
         /// `sensor_msgs/Imu`.
         pub type Imu = $crate::Imu<$header>;
+        /// `sensor_msgs/NavSatFix`.
+        pub type NavSatFix = $crate::NavSatFix<$header>;
+        /// `geometry_msgs/Vector3Stamped`.
+        pub type Vector3Stamped = $crate::Vector3Stamped<$header>;
         /// `darknet_ros_msgs/BoundingBoxes`.
         pub type BoundingBoxes = $crate::BoundingBoxes<$header>;
         /// `darknet_ros_msgs/ObjectCount`.
@@ -300,7 +341,8 @@ macro_rules! wire_messages {
         /// `geometry_msgs/PointStamped`.
         pub type PointStamped = $crate::PointStamped<$header>;
         pub use $crate::{
-            BoundingBox, ModelStates, Pose, Quaternion, RegionOfInterest, Text, Twist, Vector3,
+            BoundingBox, ModelStates, NavSatStatus, Pose, Quaternion, RegionOfInterest, Text,
+            Twist, Vector3,
         };
     };
 }

@@ -83,6 +83,18 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "sensor_msgs/Imu",
         "Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance",
     ),
+    (
+        "sensor_msgs/NavSatStatus",
+        "int8 STATUS_NO_FIX=-1\nint8 STATUS_FIX=0\nint8 STATUS_SBAS_FIX=1\nint8 STATUS_GBAS_FIX=2\nuint16 SERVICE_GPS=1\nuint16 SERVICE_GLONASS=2\nuint16 SERVICE_COMPASS=4\nuint16 SERVICE_GALILEO=8\nint8 status\nuint16 service",
+    ),
+    (
+        "sensor_msgs/NavSatFix",
+        "uint8 COVARIANCE_TYPE_UNKNOWN=0\nuint8 COVARIANCE_TYPE_APPROXIMATED=1\nuint8 COVARIANCE_TYPE_DIAGONAL_KNOWN=2\nuint8 COVARIANCE_TYPE_KNOWN=3\nHeader header\nsensor_msgs/NavSatStatus status\nfloat64 latitude\nfloat64 longitude\nfloat64 altitude\nfloat64[9] position_covariance\nuint8 position_covariance_type",
+    ),
+    (
+        "geometry_msgs/Vector3Stamped",
+        "Header header\ngeometry_msgs/Vector3 vector",
+    ),
     ("rosgraph_msgs/Clock", "time clock"),
     ("std_msgs/String", "string data"),
     (

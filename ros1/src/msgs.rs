@@ -163,6 +163,28 @@ impl Message for TfMessage {
     }
 }
 
+impl Message for NavSatFix {
+    const TYPE: &'static str = "sensor_msgs/NavSatFix";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        out.push(self.status.status as u8);
+        out.extend_from_slice(&self.status.service.to_le_bytes());
+        for v in [self.latitude, self.longitude, self.altitude] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        wire::f64_fixed(out, &self.position_covariance);
+        out.push(self.position_covariance_type);
+    }
+}
+
+impl Message for Vector3Stamped {
+    const TYPE: &'static str = "geometry_msgs/Vector3Stamped";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        Geometry::encode(&self.vector, out);
+    }
+}
+
 impl Message for Imu {
     const TYPE: &'static str = "sensor_msgs/Imu";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -561,6 +583,11 @@ mod tests {
             ("sensor_msgs/JointState", "3066dcd76a6cfaef579bd0f34173e9fd"),
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
             ("sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2"),
+            ("sensor_msgs/NavSatFix", "2d3a8cd499b9b4a0249fb98fd05cfa48"),
+            (
+                "geometry_msgs/Vector3Stamped",
+                "7b324c7325e683bf02a9b14b01090ec7",
+            ),
             ("std_msgs/Header", "2176decaecbce78abc3b96ef049fabed"),
             ("std_msgs/Float64", "fdb28210bfa9d7c91146260178d9a584"),
             ("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1"),

@@ -158,6 +158,27 @@ pub const IMU: &str = concat!(
     vector3!()
 );
 
+/// `sensor_msgs/msg/NavSatFix`.
+pub const NAV_SAT_FIX: &str = concat!(
+    "uint8 COVARIANCE_TYPE_UNKNOWN=0\nuint8 COVARIANCE_TYPE_APPROXIMATED=1\n",
+    "uint8 COVARIANCE_TYPE_DIAGONAL_KNOWN=2\nuint8 COVARIANCE_TYPE_KNOWN=3\n",
+    "std_msgs/Header header\nsensor_msgs/NavSatStatus status\nfloat64 latitude\n",
+    "float64 longitude\nfloat64 altitude\nfloat64[9] position_covariance\n",
+    "uint8 position_covariance_type\n",
+    header!(),
+    block!(
+        "sensor_msgs/NavSatStatus",
+        "int8 STATUS_NO_FIX=-1\nint8 STATUS_FIX=0\nint8 STATUS_SBAS_FIX=1\nint8 STATUS_GBAS_FIX=2\nuint16 SERVICE_GPS=1\nuint16 SERVICE_GLONASS=2\nuint16 SERVICE_COMPASS=4\nuint16 SERVICE_GALILEO=8\nint8 status\nuint16 service\n"
+    )
+);
+
+/// `geometry_msgs/msg/Vector3Stamped`.
+pub const VECTOR3_STAMPED: &str = concat!(
+    "std_msgs/Header header\ngeometry_msgs/Vector3 vector\n",
+    header!(),
+    vector3!()
+);
+
 /// `darknet_ros_msgs/msg/BoundingBoxes` (darknet_ros's ROS 2 branch).
 pub const BOUNDING_BOXES: &str = concat!(
     "std_msgs/Header header\nstd_msgs/Header image_header\n",
@@ -284,6 +305,8 @@ mod tests {
             CAMERA_INFO,
             LASER_SCAN,
             IMU,
+            NAV_SAT_FIX,
+            VECTOR3_STAMPED,
             BOUNDING_BOXES,
             OBJECT_COUNT,
             STRING,

@@ -245,6 +245,16 @@ impl RosMessage for Imu {
     const DEFINITION: &'static str = crate::definitions::IMU;
 }
 
+impl RosMessage for NavSatFix {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::NavSatFix_";
+    const DEFINITION: &'static str = crate::definitions::NAV_SAT_FIX;
+}
+
+impl RosMessage for Vector3Stamped {
+    const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::Vector3Stamped_";
+    const DEFINITION: &'static str = crate::definitions::VECTOR3_STAMPED;
+}
+
 impl RosMessage for BoundingBoxes {
     const DDS_TYPE: &'static str = "darknet_ros_msgs::msg::dds_::BoundingBoxes_";
     const DEFINITION: &'static str = crate::definitions::BOUNDING_BOXES;

@@ -14,7 +14,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::ControlSample,
-    sensors::{ImuReading, LaserScan, PoseReading},
+    sensors::{FixReading, ImuReading, LaserScan, PoseReading},
 };
 
 /// One frame's pose in another, as tf carries it.
@@ -181,6 +181,8 @@ pub(crate) enum Event {
     Imu(ImuReading),
     /// A p3d ground-truth reading.
     Pose(PoseReading),
+    /// A GPS fix.
+    Fix(FixReading),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -205,6 +207,8 @@ pub(crate) trait TopicFamily: Send {
     fn imu(&mut self, _reading: &ImuReading) {}
     /// A p3d ground-truth reading.
     fn p3d(&mut self, _reading: &PoseReading) {}
+    /// A GPS fix.
+    fn gps(&mut self, _fix: &FixReading) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in
@@ -309,7 +313,7 @@ impl BufferReturn {
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
-            Event::Imu(_) | Event::Pose(_) => {}
+            Event::Imu(_) | Event::Pose(_) | Event::Fix(_) => {}
         }
     }
 }

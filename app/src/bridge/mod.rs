@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `p3d.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -27,6 +27,7 @@ pub(crate) mod capture;
 pub(crate) mod clock;
 pub(crate) mod darknet;
 pub(crate) mod events;
+pub(crate) mod gps;
 pub(crate) mod ground_truth;
 pub(crate) mod imu;
 pub(crate) mod input;
@@ -49,7 +50,7 @@ use rover_sim::{
     geometry::Pose,
     model::{CameraInfo, RobotModel},
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily};
@@ -87,6 +88,8 @@ pub(crate) trait Transport {
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn imu::ImuWire>>;
     /// p3d's ground-truth poses.
     fn p3d(&mut self, plan: &RosPlan) -> Result<Box<dyn p3d::P3dWire>>;
+    /// hector's GPS fixes and velocities.
+    fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn gps::GpsWire>>;
     /// The arm's state and points.
     fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm::ArmWire>>;
     /// `/rover/ground_truth/bounding_boxes`.
@@ -117,6 +120,7 @@ pub(crate) fn families(
         Box::new(laser::Laser::new(transport.laser(plan)?)),
         Box::new(imu::Imu::new(transport.imu(plan)?)),
         Box::new(p3d::P3d::new(transport.p3d(plan)?)),
+        Box::new(gps::Gps::new(transport.gps(plan)?)),
         Box::new(arm::Arm::new(transport.arm(plan)?)),
         Box::new(status::Status::new(transport.status()?)),
         Box::new(model_states::ModelStates::new(transport.model_states()?)),
@@ -345,6 +349,10 @@ impl<R: Send + 'static> Observer for Bridge<R> {
     fn p3d(&mut self, reading: &PoseReading) {
         self.timed(|b| b.send(Event::Pose(*reading)));
     }
+
+    fn gps(&mut self, fix: &FixReading) {
+        self.timed(|b| b.send(Event::Fix(*fix)));
+    }
 }
 
 /// The publishing thread: every event to every family, in order, until the bridge hangs up;
@@ -366,6 +374,7 @@ fn publish(
                 Event::Scan(scan) => family.scan(scan),
                 Event::Imu(reading) => family.imu(reading),
                 Event::Pose(reading) => family.p3d(reading),
+                Event::Fix(fix) => family.gps(fix),
             }
         }
         returns.give_back(event);

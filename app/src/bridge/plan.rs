@@ -37,6 +37,8 @@ pub struct RosPlan {
     pub imus: Vec<(String, String)>,
     /// Each p3d's topic and frames, in `RobotModel::p3ds` order.
     pub p3ds: Vec<P3dTopic>,
+    /// Each GPS receiver's topics and frame, in `RobotModel::gpss` order.
+    pub gpss: Vec<GpsTopics>,
     /// Every moving joint the session reports, in `/joint_states` order.
     pub(crate) joints: Vec<MovingJoint>,
     /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
@@ -58,6 +60,17 @@ pub(crate) struct P3dTopic {
     pub frame: String,
     /// `bodyName`: the messages' `child_frame_id`.
     pub child_frame: String,
+}
+
+/// A GPS receiver's topics and frame.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct GpsTopics {
+    /// `topicName` (NavSatFix).
+    pub topic: String,
+    /// `velocityTopicName` (Vector3Stamped).
+    pub velocity_topic: String,
+    /// `frameId`.
+    pub frame: String,
 }
 
 /// A controller's topics (`/<namespace>/<controller>/command`).
@@ -180,6 +193,15 @@ impl RosPlan {
                     topic: topic(&p.topic),
                     frame: p.frame_name.clone(),
                     child_frame: p.link.clone(),
+                })
+                .collect(),
+            gpss: robot
+                .gpss
+                .iter()
+                .map(|g| GpsTopics {
+                    topic: topic(&g.topic),
+                    velocity_topic: topic(&g.velocity_topic),
+                    frame: g.frame_id.clone(),
                 })
                 .collect(),
             joints: moving_joints(robot, &drive),

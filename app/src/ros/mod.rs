@@ -3,7 +3,7 @@
 //! and the master's XML-RPC). Here are the encoders, one file per topic family, each
 //! implementing its family's wire trait with ROS 1's messages and publishers (`clock.rs`,
 //! `odom.rs`, `tf.rs`, `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the
-//! ground truth), `laser.rs`, `imu.rs`, `p3d.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
+//! ground truth), `laser.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
 //! `state` topics, which only ROS 1 carries (their control_msgs layouts differ between ROS 2
 //! distributions); `actions.rs`, actionlib's `follow_joint_trajectory` for each trajectory
 //! controller, and `gripper.rs`, `gripper_cmd` for each gripper controller (what a goal
@@ -22,6 +22,7 @@ mod controller_states;
 mod controllers;
 mod convert;
 mod detections;
+mod gps;
 mod gripper;
 mod imu;
 mod joint_states;
@@ -100,6 +101,10 @@ impl Transport for Ros1<'_> {
 
     fn p3d(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::p3d::P3dWire>> {
         Ok(Box::new(p3d::P3d::advertise(self.node, plan)?))
+    }
+
+    fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::gps::GpsWire>> {
+        Ok(Box::new(gps::Gps::advertise(self.node, plan)?))
     }
 
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::imu::ImuWire>> {

@@ -31,6 +31,7 @@
 //! plots/imu/<sensor>/{angular_velocity,linear_acceleration}  Scalars x, y, z: each IMU's
 //!                                        readings (rad/s; m/s^2, gravity included)
 //! world/p3d/<plugin>                     Points3D: a world-frame p3d's ground-truth position
+//! plots/gps/<plugin>/{latitude,longitude,altitude}  Scalars: each GPS fix (deg, deg, m)
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -52,7 +53,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
 };
 
 pub use blueprint::blueprint;
@@ -103,6 +104,8 @@ pub struct Recorder {
     imu_paths: Vec<[String; 2]>,
     /// Each p3d's entity path (`None`: measured against a link, not drawn in the world).
     p3d_paths: Vec<Option<String>>,
+    /// Each GPS's plot paths: latitude, longitude, altitude.
+    gps_paths: Vec<[String; 3]>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -162,6 +165,7 @@ impl Recorder {
             scan_points: Vec::new(),
             imu_paths: Vec::new(),
             p3d_paths: Vec::new(),
+            gps_paths: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -273,6 +277,15 @@ impl Observer for Recorder {
                 p.reference_link
                     .is_none()
                     .then(|| format!("world/p3d/{}", p.name))
+            })
+            .collect();
+        self.gps_paths = sim
+            .robot()
+            .gpss
+            .iter()
+            .map(|g| {
+                ["latitude", "longitude", "altitude"]
+                    .map(|what| format!("plots/gps/{}/{what}", g.name))
             })
             .collect();
     }
@@ -535,6 +548,19 @@ impl Observer for Recorder {
             .with_radii([0.03f32])
             .with_colors([rerun::Color::from_rgb(40, 200, 90)]);
         self.log(path, &point);
+    }
+
+    fn gps(&mut self, fix: &FixReading) {
+        let Some(paths) = self.gps_paths.get(fix.sensor) else {
+            return;
+        };
+        self.rec.set_duration_secs("sim_time", fix.stamp_s);
+        for (path, value) in paths
+            .iter()
+            .zip([fix.latitude_deg, fix.longitude_deg, fix.altitude_m])
+        {
+            self.log(path, &rerun::Scalars::single(value));
+        }
     }
 
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

@@ -111,7 +111,8 @@ def topics(node):
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import Log
     from rosgraph_msgs.msg import Clock
-    from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
+    from geometry_msgs.msg import Vector3Stamped
+    from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, NavSatFix
     from std_msgs.msg import String
     from tf2_msgs.msg import TFMessage
 
@@ -137,6 +138,8 @@ def topics(node):
         ("/scan", LaserScan, qos_profile_sensor_data, "best effort"),
         ("/imu", Imu, qos_profile_sensor_data, "best effort"),
         ("/ground_truth/state", Odometry, reliable, "reliable"),
+        ("/fix", NavSatFix, qos_profile_sensor_data, "best effort"),
+        ("/fix_velocity", Vector3Stamped, qos_profile_sensor_data, "best effort"),
         ("/rosout", Log, rosout, "reliable, transient local"),
     ]
     counts, last, rover_log = {}, {}, []
@@ -174,6 +177,10 @@ def topics(node):
         m = last["/ground_truth/state"]
         sample["/ground_truth/state"] = [m.header.frame_id, m.child_frame_id,
                                          m.pose.pose.position.z]
+    if "/fix" in last:
+        m = last["/fix"]
+        sample["/fix"] = [m.header.frame_id, m.latitude, m.longitude, m.status.service,
+                          m.position_covariance_type]
     if "/imu" in last:
         m = last["/imu"]
         sample["/imu"] = [m.header.frame_id, m.linear_acceleration.z, m.orientation.w]

@@ -122,7 +122,11 @@ impl RobotModel {
         let transmissions = read_transmissions(&urdf, &joints, path)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
-        let extensions = gazebo::parse(&doc, path)?;
+        let mut extensions = gazebo::parse(&doc, path)?;
+        for gps in extensions.gpss.iter_mut().filter(|g| g.link.is_empty()) {
+            // hector's default: the model's first link, which for a URDF is its root.
+            gps.link = links[root.index()].name.clone();
+        }
         for (reference, kp) in &extensions.contact_kp {
             if let Some(&i) = link_index.get(reference) {
                 links[i].contact_kp_n_per_m = Some(*kp);
@@ -149,6 +153,7 @@ impl RobotModel {
             lasers: extensions.lasers,
             imus: extensions.imus,
             p3ds: extensions.p3ds,
+            gpss: extensions.gpss,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
             transmissions,

@@ -11,7 +11,9 @@ use crate::model::actuation::{RosControlPlugin, Transmission};
 use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
-use crate::model::sensors::{CameraConfig, ImuConfig, ImuPlugin, LaserConfig, P3dConfig};
+use crate::model::sensors::{
+    CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, P3dConfig,
+};
 
 /// Mass properties of a link, from its `<inertial>`.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,6 +218,8 @@ pub struct RobotModel {
     pub imus: Vec<ImuConfig>,
     /// Ground-truth pose publishers (`libgazebo_ros_p3d.so`).
     pub p3ds: Vec<P3dConfig>,
+    /// GPS receivers (`libhector_gazebo_ros_gps.so`).
+    pub gpss: Vec<GpsConfig>,
     /// Gazebo sensors and plugins in the file that rover does not simulate (GPS, ...).
     pub not_simulated: Vec<String>,
     /// `<transmission>`s: which joints an actuator drives, through which ros_control
@@ -509,6 +513,19 @@ impl RobotModel {
                         ),
                     ));
                 }
+            }
+        }
+        for gps in &self.gpss {
+            if self.link_id(&gps.link).is_none() {
+                return Err(SimError::invalid(
+                    path,
+                    gps.line,
+                    format!(
+                        "<plugin filename=\"libhector_gazebo_ros_gps.so\"> <bodyName> \"{}\": no such link; links in this robot: {}",
+                        gps.link,
+                        names(self.links.iter().map(|l| &l.name))
+                    ),
+                ));
             }
         }
         for camera in &self.cameras {

@@ -266,3 +266,66 @@ pub struct P3dConfig {
     /// Line of the plugin element, for messages.
     pub line: Option<u32>,
 }
+
+/// One of hector's error models (`SensorModel`), per axis x, y, z: a constant `offset`, a
+/// drift (a first-order Gauss-Markov process of stationary stddev `drift`, mean-reverting at
+/// `drift_frequency_hz`) and white `gaussian_noise`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ErrorModel {
+    /// `<offset>` (or `<velocityOffset>`).
+    pub offset: [f64; 3],
+    /// `<drift>`: the drift's stddev.
+    pub drift: [f64; 3],
+    /// `<driftFrequency>` (Hz; hector's default 1/3600).
+    pub drift_frequency_hz: [f64; 3],
+    /// `<gaussianNoise>`: white noise's stddev.
+    pub gaussian_noise: [f64; 3],
+}
+
+impl Default for ErrorModel {
+    fn default() -> Self {
+        Self {
+            offset: [0.0; 3],
+            drift: [0.0; 3],
+            drift_frequency_hz: [1.0 / 3600.0; 3],
+            gaussian_noise: [0.0; 3],
+        }
+    }
+}
+
+/// A GPS receiver: hector_gazebo_plugins' model plugin `libhector_gazebo_ros_gps.so`, publishing
+/// sensor_msgs/NavSatFix and a geometry_msgs/Vector3Stamped velocity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpsConfig {
+    /// Plugin `name`.
+    pub name: String,
+    /// The link whose origin is located (`<bodyName>`; default the robot's root link).
+    pub link: String,
+    /// `<updateRate>` (Hz; default 4).
+    pub update_rate_hz: f64,
+    /// `<frameId>` (default `/world`, as hector's).
+    pub frame_id: String,
+    /// The fix topic (`<topicName>`, default `fix`, in `<robotNamespace>`).
+    pub topic: String,
+    /// The velocity topic (`<velocityTopicName>`, default `fix_velocity`).
+    pub velocity_topic: String,
+    /// `<referenceLatitude>` (deg; default 49.9) of the world's origin.
+    pub reference_latitude_deg: f64,
+    /// `<referenceLongitude>` (deg; default 8.9).
+    pub reference_longitude_deg: f64,
+    /// `<referenceHeading>` (deg, clockwise from north, of the world's x axis; default 0: x
+    /// north, y west; 90 makes x east and y north).
+    pub reference_heading_deg: f64,
+    /// `<referenceAltitude>` (m) of the world's origin.
+    pub reference_altitude_m: f64,
+    /// `<status>` (NavSatStatus: 0 fix).
+    pub status: i8,
+    /// `<service>` (NavSatStatus: 1 GPS).
+    pub service: u16,
+    /// The position's error model.
+    pub position_error: ErrorModel,
+    /// The velocity's error model (`velocity...` parameters).
+    pub velocity_error: ErrorModel,
+    /// Line of the plugin element.
+    pub line: Option<u32>,
+}

@@ -1,15 +1,18 @@
 //! Sensors on sim time: the camera (`camera.rs`, rendering through `render`), the 2D laser
-//! (`laser.rs`, ray casts against the physics scene), the IMU (`imu.rs`) and p3d's ground-truth
-//! pose (`p3d.rs`), both from the link's motion, all with seeded noise, and the camera's
-//! ground truth (`ground_truth.rs`: where each labelled thing is in the image).
+//! (`laser.rs`, ray casts against the physics scene), and from a link's motion the IMU
+//! (`imu.rs`), p3d's ground-truth pose (`p3d.rs`) and hector's GPS (`gps.rs`), all with seeded
+//! noise; and the camera's ground truth (`ground_truth.rs`: where each labelled thing is in the
+//! image).
 
 pub(crate) mod camera;
+pub(crate) mod gps;
 pub(crate) mod ground_truth;
 pub(crate) mod imu;
 pub(crate) mod laser;
 pub(crate) mod p3d;
 
 pub use camera::{CameraFrame, CameraSensor};
+pub use gps::{FixReading, GpsSensor, WGS84_EQUATORIAL_RADIUS_M, WGS84_FLATTENING, wgs84_radii_m};
 pub use ground_truth::{
     GroundTruth, GroundTruthBox, MIN_VISIBILITY, MIN_VISIBLE_PX, PixelBox, copy_boxes,
 };

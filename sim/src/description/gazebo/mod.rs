@@ -1,11 +1,12 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
 //! `<sensor>` blocks (with `libgazebo_ros_camera.so`), 2D laser `<sensor type="ray">` blocks (with
-//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), and per-link
+//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), and per-link
 //! friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
 
+mod gps;
 mod imu;
 mod p3d;
 mod values;
@@ -21,7 +22,7 @@ use crate::geometry::Pose;
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
-    CameraConfig, DepthOutput, Distortion, GaussianNoise, ImuConfig, LaserConfig,
+    CameraConfig, DepthOutput, Distortion, GaussianNoise, GpsConfig, ImuConfig, LaserConfig,
     MAX_LASER_SAMPLES, P3dConfig, PixelFormat,
 };
 
@@ -34,6 +35,7 @@ pub(crate) struct Extensions {
     pub lasers: Vec<LaserConfig>,
     pub imus: Vec<ImuConfig>,
     pub p3ds: Vec<P3dConfig>,
+    pub gpss: Vec<GpsConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
     /// Link name -> contact stiffness `<kp>` (N/m).
@@ -73,6 +75,8 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ext.imus.push(imu::parse_model_plugin(&ctx, child)?);
                     } else if p3d::is_plugin(file) {
                         ext.p3ds.push(p3d::parse(&ctx, child)?);
+                    } else if gps::is_plugin(file) {
+                        ext.gpss.push(gps::parse(&ctx, child)?);
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",
