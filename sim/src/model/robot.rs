@@ -220,7 +220,8 @@ pub struct RobotModel {
     pub p3ds: Vec<P3dConfig>,
     /// GPS receivers (`libhector_gazebo_ros_gps.so`).
     pub gpss: Vec<GpsConfig>,
-    /// Gazebo sensors and plugins in the file that rover does not simulate (GPS, ...).
+    /// Gazebo sensors and plugins in the file that rover does not simulate (contact sensors,
+    /// Gazebo's own GPS sensor, ...).
     pub not_simulated: Vec<String>,
     /// `<transmission>`s: which joints an actuator drives, through which ros_control
     /// hardware interface.

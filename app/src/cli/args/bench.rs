@@ -71,8 +71,8 @@ pub(crate) enum BenchKind {
         #[arg(long, default_value_t = 200)]
         scans: usize,
     },
-    /// Sensors: us per reading of each IMU and p3d publisher of the robot (default: the
-    /// playground car's /imu and /ground_truth/state) while it drives a circle
+    /// Sensors: us per reading of each IMU, p3d publisher and GPS of the robot (default: the
+    /// playground car's /imu, /ground_truth/state and /fix) while it drives a circle
     Sensors {
         #[command(flatten)]
         world: WorldArgs,

@@ -1,6 +1,6 @@
 //! The sensor benchmarks: camera frame time (`rover bench camera`), laser scan time with the
-//! follower's command on it (`rover bench laser`), and the IMU's and p3d's cost per reading
-//! (`rover bench sensors`).
+//! follower's command on it (`rover bench laser`), and the IMU's, p3d's and GPS's cost per
+//! reading (`rover bench sensors`).
 
 use std::time::Instant;
 
@@ -168,23 +168,25 @@ pub fn laser(config: &RunConfig, scans: usize) -> Result<LaserBench> {
     })
 }
 
-/// IMU and p3d benchmark figures.
+/// IMU, p3d and GPS benchmark figures.
 #[derive(Debug, Clone)]
 pub struct SensorsBench {
     /// Each IMU: its name, readings timed, median wall time per reading (us).
     pub imus: Vec<(String, usize, f64)>,
     /// Each p3d: its name, readings timed, median wall time per reading (us).
     pub p3ds: Vec<(String, usize, f64)>,
+    /// Each GPS: its name, fixes timed, median wall time per fix (us).
+    pub gpss: Vec<(String, usize, f64)>,
 }
 
-/// The robot's IMUs and p3d publishers, each timed per reading (the link's state, the frames,
+/// The robot's IMUs, p3d publishers and GPS receivers, each timed per reading (the link's state, the frames,
 /// the noise) over `steps` physics steps of the robot driving a circle; the physics step
 /// itself is not timed.
 pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
     let (world, robot) = config.load_world_and_robot()?;
     anyhow::ensure!(
-        !robot.imus.is_empty() || !robot.p3ds.is_empty(),
-        "{}: the robot has no IMU and no p3d plugin; try --robot assets/robots/my_robot_laser.urdf.xacro",
+        !robot.imus.is_empty() || !robot.p3ds.is_empty() || !robot.gpss.is_empty(),
+        "{}: the robot has no IMU, p3d or GPS plugin; try --robot assets/robots/my_robot_laser.urdf.xacro",
         robot.source.display()
     );
     let mut sim = Simulation::new(world, robot, &config.options)?;
@@ -194,6 +196,10 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
     let mut p3ds: Vec<_> = (0..sim.robot().p3ds.len())
         .filter_map(|i| rover_sim::sensors::P3dSensor::new(&sim, i))
         .collect();
+    let mut gpss: Vec<_> = (0..sim.robot().gpss.len())
+        .filter_map(|i| rover_sim::sensors::GpsSensor::new(&sim, i))
+        .collect();
+    let mut gps_times = vec![Vec::with_capacity(steps); gpss.len()];
     let mut imu_times = vec![Vec::with_capacity(steps); imus.len()];
     let mut p3d_times = vec![Vec::with_capacity(steps); p3ds.len()];
     sim.set_cmd_vel(Twist::new(0.3, 0.4))?;
@@ -210,6 +216,14 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
         for (p3d, times) in p3ds.iter_mut().zip(&mut p3d_times) {
             let start = Instant::now();
             let read = p3d.update(&sim).is_some();
+            let us = start.elapsed().as_secs_f64() * 1e6;
+            if read {
+                times.push(us);
+            }
+        }
+        for (gps, times) in gpss.iter_mut().zip(&mut gps_times) {
+            let start = Instant::now();
+            let read = gps.update(&sim).is_some();
             let us = start.elapsed().as_secs_f64() * 1e6;
             if read {
                 times.push(us);
@@ -232,13 +246,17 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
             p3ds.iter().map(|p| p.config().name.clone()).collect(),
             p3d_times,
         ),
+        gpss: figures(
+            gpss.iter().map(|g| g.config().name.clone()).collect(),
+            gps_times,
+        ),
     })
 }
 
 pub(crate) fn bench_sensors(world: WorldArgs, steps: usize) -> Result<()> {
     let config = world.run_config(None);
     let b = sensors(&config, steps)?;
-    for (kind, list) in [("IMU", &b.imus), ("p3d", &b.p3ds)] {
+    for (kind, list) in [("IMU", &b.imus), ("p3d", &b.p3ds), ("GPS", &b.gpss)] {
         for (name, n, us) in list {
             say!(
                 "sensors benchmark: {kind} {name}: median {us:.2} us per reading ({n} readings in {steps} physics steps)"
