@@ -470,79 +470,56 @@ impl RobotModel {
                 ));
             }
         }
-        for laser in &self.lasers {
-            if self.link_id(&laser.link).is_none() {
+        for (what, link, line) in self.sensor_links() {
+            if self.link_id(link).is_none() {
                 return Err(SimError::invalid(
                     path,
-                    laser.line,
+                    line,
                     format!(
-                        "<gazebo reference=\"{}\"> <sensor type=\"ray\">: no such link; links in this robot: {}",
-                        laser.link,
-                        names(self.links.iter().map(|l| &l.name))
-                    ),
-                ));
-            }
-        }
-        for imu in &self.imus {
-            if self.link_id(&imu.link).is_none() {
-                let element = match imu.plugin {
-                    ImuPlugin::Sensor => "<sensor type=\"imu\">",
-                    ImuPlugin::Model => "<plugin filename=\"libgazebo_ros_imu.so\"> <bodyName>",
-                };
-                return Err(SimError::invalid(
-                    path,
-                    imu.line,
-                    format!(
-                        "{element} \"{}\": no such link; links in this robot: {}",
-                        imu.link,
-                        names(self.links.iter().map(|l| &l.name))
-                    ),
-                ));
-            }
-        }
-        for p3d in &self.p3ds {
-            let links = std::iter::once(("bodyName", &p3d.link))
-                .chain(p3d.reference_link.iter().map(|l| ("frameName", l)));
-            for (element, link) in links {
-                if self.link_id(link).is_none() {
-                    return Err(SimError::invalid(
-                        path,
-                        p3d.line,
-                        format!(
-                            "<plugin filename=\"libgazebo_ros_p3d.so\"> <{element}> \"{link}\": no such link; links in this robot: {}",
-                            names(self.links.iter().map(|l| &l.name))
-                        ),
-                    ));
-                }
-            }
-        }
-        for gps in &self.gpss {
-            if self.link_id(&gps.link).is_none() {
-                return Err(SimError::invalid(
-                    path,
-                    gps.line,
-                    format!(
-                        "<plugin filename=\"libhector_gazebo_ros_gps.so\"> <bodyName> \"{}\": no such link; links in this robot: {}",
-                        gps.link,
-                        names(self.links.iter().map(|l| &l.name))
-                    ),
-                ));
-            }
-        }
-        for camera in &self.cameras {
-            if self.link_id(&camera.link).is_none() {
-                return Err(SimError::invalid(
-                    path,
-                    camera.line,
-                    format!(
-                        "<gazebo reference=\"{}\"> <sensor type=\"camera\">: no such link; links in this robot: {}",
-                        camera.link,
+                        "{what}: no such link; links in this robot: {}",
                         names(self.links.iter().map(|l| &l.name))
                     ),
                 ));
             }
         }
         Ok(())
+    }
+
+    /// Every link a sensor names: what names it (for the error), the link, the line.
+    fn sensor_links(&self) -> Vec<(String, &str, Option<u32>)> {
+        let mut out = Vec::new();
+        for l in &self.lasers {
+            let what = format!("<gazebo reference=\"{}\"> <sensor type=\"ray\">", l.link);
+            out.push((what, l.link.as_str(), l.line));
+        }
+        for i in &self.imus {
+            let element = match i.plugin {
+                ImuPlugin::Sensor => "<sensor type=\"imu\">",
+                ImuPlugin::Model => "<plugin filename=\"libgazebo_ros_imu.so\"> <bodyName>",
+            };
+            out.push((format!("{element} \"{}\"", i.link), i.link.as_str(), i.line));
+        }
+        for p in &self.p3ds {
+            let links = std::iter::once(("bodyName", &p.link))
+                .chain(p.reference_link.iter().map(|l| ("frameName", l)));
+            for (element, link) in links {
+                let what =
+                    format!("<plugin filename=\"libgazebo_ros_p3d.so\"> <{element}> \"{link}\"");
+                out.push((what, link.as_str(), p.line));
+            }
+        }
+        for g in &self.gpss {
+            let what = format!(
+                "<plugin filename=\"libhector_gazebo_ros_gps.so\"> <bodyName> \"{}\"",
+                g.link
+            );
+            out.push((what, g.link.as_str(), g.line));
+        }
+        for c in &self.cameras {
+            let what = format!("<gazebo reference=\"{}\"> <sensor type=\"camera\">", c.link);
+            out.push((what, c.link.as_str(), c.line));
+        }
+        out
     }
 }
 
