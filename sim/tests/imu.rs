@@ -3,27 +3,15 @@
 //! its readings follow the update rate and repeat with the seed; bad IMU blocks are located
 //! errors.
 
-use std::path::Path;
-
 use rover_sim::{
     model::{ImuPlugin, OrientationReference, RobotModel, World},
     physics::{SimOptions, Simulation, Twist},
     sensors::{ImuReading, ImuSensor},
 };
 
-type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+mod common;
 
-fn my_robot_path() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/robots/my_robot.urdf")
-}
-
-/// The tutorial car with `gazebo` (a `<gazebo>` block) added before `</robot>`.
-fn car_with(gazebo: &str) -> Result<RobotModel> {
-    let path = my_robot_path();
-    let text = std::fs::read_to_string(&path)?;
-    let text = text.replacen("</robot>", &format!("{gazebo}\n</robot>"), 1);
-    Ok(RobotModel::from_str(&text, &path)?)
-}
+use common::{Result, car_with};
 
 /// An IMU on base_link, published at `rate_hz`, with `noise` inside its `<imu>` element.
 fn imu_block(rate_hz: f64, noise: &str) -> String {

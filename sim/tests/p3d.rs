@@ -2,23 +2,15 @@
 //! velocity in the world and against another of its links, its offsets, rate and noise, and
 //! located errors for bad plugin blocks.
 
-use std::path::Path;
-
 use rover_sim::{
     model::{RobotModel, World},
     physics::{SimOptions, Simulation, Twist},
     sensors::P3dSensor,
 };
 
-type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+mod common;
 
-/// The tutorial car with `gazebo` added before `</robot>`.
-fn car_with(gazebo: &str) -> Result<RobotModel> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/robots/my_robot.urdf");
-    let text = std::fs::read_to_string(&path)?;
-    let text = text.replacen("</robot>", &format!("{gazebo}\n</robot>"), 1);
-    Ok(RobotModel::from_str(&text, &path)?)
-}
+use common::{Result, car_with};
 
 fn p3d(params: &str) -> String {
     format!(

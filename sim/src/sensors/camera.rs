@@ -11,6 +11,7 @@ use crate::render::gpu::RenderError;
 use crate::render::passes::colour::Light;
 use crate::render::renderer::{CameraRenderer, EntityImage};
 use crate::sensors::ground_truth::{GroundTruth, GroundTruthBox};
+use crate::sensors::schedule::Schedule;
 
 /// One camera image.
 #[derive(Debug, Clone, Copy)]
@@ -42,8 +43,7 @@ pub struct CameraFrame<'a> {
 pub struct CameraSensor {
     renderer: CameraRenderer,
     link: LinkId,
-    period_s: f64,
-    next_s: f64,
+    schedule: Schedule,
     seq: u64,
     link_poses: Vec<Pose>,
     model_poses: Vec<Pose>,
@@ -76,12 +76,7 @@ impl CameraSensor {
         Ok(Self {
             renderer,
             link,
-            period_s: if config.update_rate_hz > 0.0 {
-                1.0 / config.update_rate_hz
-            } else {
-                0.0
-            },
-            next_s: 0.0,
+            schedule: Schedule::new(config.update_rate_hz),
             seq: 0,
             link_poses: Vec::with_capacity(robot.links.len()),
             model_poses: Vec::new(),
@@ -137,7 +132,7 @@ impl CameraSensor {
 
     /// True when an image is due at the sim's current time.
     pub fn due(&self, sim: &Simulation) -> bool {
-        sim.sim_time_s() + 1e-9 >= self.next_s
+        self.schedule.due(sim.sim_time_s())
     }
 
     /// Renders an image if one is due (schedule accumulated like Gazebo's sensors).
@@ -145,12 +140,8 @@ impl CameraSensor {
         &mut self,
         sim: &Simulation,
     ) -> Result<Option<CameraFrame<'_>>, RenderError> {
-        if !self.due(sim) {
+        if !self.schedule.take(sim.sim_time_s()) {
             return Ok(None);
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < sim.sim_time_s() {
-            self.next_s = sim.sim_time_s() + self.period_s;
         }
         self.capture(sim).map(Some)
     }
@@ -159,12 +150,8 @@ impl CameraSensor {
     /// the schedule and frame numbers advance exactly as [`Self::capture_if_due`] would.
     /// Returns the skipped frame's number.
     pub fn skip_if_due(&mut self, sim: &Simulation) -> Option<u64> {
-        if !self.due(sim) {
+        if !self.schedule.take(sim.sim_time_s()) {
             return None;
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < sim.sim_time_s() {
-            self.next_s = sim.sim_time_s() + self.period_s;
         }
         let seq = self.seq;
         self.seq += 1;

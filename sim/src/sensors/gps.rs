@@ -7,6 +7,7 @@ use crate::geometry::Pose;
 use crate::model::{ErrorModel, GpsConfig, LinkId};
 use crate::noise::SplitMix64 as Rng;
 use crate::physics::Simulation;
+use crate::sensors::schedule::Schedule;
 
 /// WGS-84's equatorial radius (m).
 pub const WGS84_EQUATORIAL_RADIUS_M: f64 = 6_378_137.0;
@@ -58,8 +59,7 @@ pub struct FixReading {
 pub struct GpsSensor {
     config: GpsConfig,
     link: LinkId,
-    period_s: f64,
-    next_s: f64,
+    schedule: Schedule,
     last_s: Option<f64>,
     rng: Rng,
     position_drift: [f64; 3],
@@ -82,12 +82,7 @@ impl GpsSensor {
         };
         Some(Self {
             link,
-            period_s: if config.update_rate_hz > 0.0 {
-                1.0 / config.update_rate_hz
-            } else {
-                0.0
-            },
-            next_s: 0.0,
+            schedule: Schedule::new(config.update_rate_hz),
             last_s: None,
             // Its own stream: adding a GPS leaves the other sensors' noise alone.
             rng: Rng(sim.seed() ^ 0x0006_9500_5EED_6F5D ^ (index as u64)),
@@ -130,12 +125,8 @@ impl GpsSensor {
     /// Call after every physics step: a fix when one is due (`updateRate` on sim time).
     pub fn update(&mut self, sim: &Simulation) -> Option<&FixReading> {
         let now = sim.sim_time_s();
-        if now + 1e-9 < self.next_s {
+        if !self.schedule.take(now) {
             return None;
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < now {
-            self.next_s = now + self.period_s;
         }
         let dt = self.last_s.map_or(0.0, |t| now - t);
         self.last_s = Some(now);

@@ -13,6 +13,7 @@ use glam::{DQuat, DVec3, EulerRot};
 use crate::model::{ImuConfig, ImuPlugin, LinkId, OrientationReference};
 use crate::noise::SplitMix64 as Rng;
 use crate::physics::Simulation;
+use crate::sensors::schedule::Schedule;
 
 /// One IMU reading, in the units and frames of sensor_msgs/Imu. `Copy`: it travels to the ROS
 /// bridge and the recorder without allocating.
@@ -41,8 +42,7 @@ pub struct ImuSensor {
     config: ImuConfig,
     index: usize,
     link: LinkId,
-    period_s: f64,
-    next_s: f64,
+    schedule: Schedule,
     rng: Rng,
     spare: Option<f64>,
     /// Bias of each angular-velocity and linear-acceleration axis, drawn at start.
@@ -89,12 +89,7 @@ impl ImuSensor {
         Some(Self {
             index,
             link,
-            period_s: if config.update_rate_hz > 0.0 {
-                1.0 / config.update_rate_hz
-            } else {
-                0.0
-            },
-            next_s: 0.0,
+            schedule: Schedule::new(config.update_rate_hz),
             rng,
             spare: None,
             bias_radps,
@@ -133,12 +128,8 @@ impl ImuSensor {
     /// time; every step at rate 0, as in Gazebo).
     pub fn update(&mut self, sim: &Simulation) -> Option<&ImuReading> {
         let now = sim.sim_time_s();
-        if now + 1e-9 < self.next_s {
+        if !self.schedule.take(now) {
             return None;
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < now {
-            self.next_s = now + self.period_s;
         }
         let state = sim.link_point_state(self.link, self.config.link_from_sensor);
         let velocity = state.linear_mps.as_dvec3();

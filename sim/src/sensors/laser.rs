@@ -27,6 +27,7 @@ use crate::model::sensors::LaserConfig;
 use crate::noise::SplitMix64 as Rng;
 use crate::physics::simulation::Simulation;
 use crate::render::body::SkinnedBody;
+use crate::sensors::schedule::Schedule;
 
 /// How far above and below the scan plane a bone may reach and still be looked at (m): the
 /// scan plane tilts a little with the robot.
@@ -97,8 +98,7 @@ impl LaserScan {
 pub struct LaserSensor {
     config: LaserConfig,
     link: LinkId,
-    period_s: f64,
-    next_s: f64,
+    schedule: Schedule,
     rng: Rng,
     /// Unit ray directions in the sensor frame, computed once.
     directions: Vec<Vec3>,
@@ -133,11 +133,7 @@ impl LaserSensor {
                 Vec3::new(a.cos() as f32, a.sin() as f32, 0.0)
             })
             .collect();
-        let period_s = if config.update_rate_hz > 0.0 {
-            1.0 / config.update_rate_hz
-        } else {
-            0.0
-        };
+        let schedule = Schedule::new(config.update_rate_hz);
         let scan = LaserScan {
             stamp_s: 0.0,
             seq: 0,
@@ -146,7 +142,7 @@ impl LaserSensor {
             angle_max_rad: config.max_angle_rad as f32,
             angle_increment_rad: increment as f32,
             time_increment_s: 0.0,
-            scan_time_s: period_s as f32,
+            scan_time_s: schedule.period_s() as f32,
             range_min_m: config.range_min_m as f32,
             range_max_m: config.range_max_m as f32,
             ranges_m: Vec::with_capacity(config.samples as usize),
@@ -174,8 +170,7 @@ impl LaserSensor {
             rng: Rng(sim.seed() ^ 0x1A5E_5CA7_1A5E_5CA7 ^ (index as u64)),
             config,
             link,
-            period_s,
-            next_s: 0.0,
+            schedule,
             directions,
             scans: 0,
             scan,
@@ -206,12 +201,8 @@ impl LaserSensor {
     /// time; every step when the rate is 0, as in Gazebo).
     pub fn scan_if_due(&mut self, sim: &Simulation) -> Option<&LaserScan> {
         let now = sim.sim_time_s();
-        if now + 1e-9 < self.next_s {
+        if !self.schedule.take(now) {
             return None;
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < now {
-            self.next_s = now + self.period_s;
         }
         Some(self.scan_now(sim))
     }

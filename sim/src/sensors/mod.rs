@@ -10,6 +10,7 @@ pub(crate) mod ground_truth;
 pub(crate) mod imu;
 pub(crate) mod laser;
 pub(crate) mod p3d;
+pub(crate) mod schedule;
 
 pub use camera::{CameraFrame, CameraSensor};
 pub use gps::{FixReading, GpsSensor, WGS84_EQUATORIAL_RADIUS_M, WGS84_FLATTENING, wgs84_radii_m};

@@ -8,6 +8,7 @@ use crate::geometry::Pose;
 use crate::model::{LinkId, P3dConfig};
 use crate::noise::SplitMix64 as Rng;
 use crate::physics::Simulation;
+use crate::sensors::schedule::Schedule;
 
 /// One p3d reading: nav_msgs/Odometry's numbers. `Copy`, so it travels without allocating.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -37,8 +38,7 @@ pub struct P3dSensor {
     link: LinkId,
     reference: Option<LinkId>,
     offset: DQuat,
-    period_s: f64,
-    next_s: f64,
+    schedule: Schedule,
     rng: Rng,
     reading: PoseReading,
 }
@@ -58,12 +58,7 @@ impl P3dSensor {
             link,
             reference,
             offset: DQuat::from_euler(EulerRot::ZYX, yaw, pitch, roll),
-            period_s: if config.update_rate_hz > 0.0 {
-                1.0 / config.update_rate_hz
-            } else {
-                0.0
-            },
-            next_s: 0.0,
+            schedule: Schedule::new(config.update_rate_hz),
             // Its own stream: adding a p3d leaves the other sensors' noise alone.
             rng: Rng(sim.seed() ^ 0x0F3D_0F3D_5EED_0000 ^ (index as u64)),
             reading: PoseReading {
@@ -89,12 +84,8 @@ impl P3dSensor {
     /// 0, as gazebo_ros).
     pub fn update(&mut self, sim: &Simulation) -> Option<&PoseReading> {
         let now = sim.sim_time_s();
-        if now + 1e-9 < self.next_s {
+        if !self.schedule.take(now) {
             return None;
-        }
-        self.next_s += self.period_s;
-        if self.next_s + 1e-9 < now {
-            self.next_s = now + self.period_s;
         }
         let body = sim.link_point_state(self.link, Pose::IDENTITY);
         let (mut position, mut rotation) = (
