@@ -53,9 +53,10 @@ mod tests {
             let mut s = Schedule::new(rate_hz);
             (1..=200).filter(|k| s.take(f64::from(*k) * step)).count()
         };
-        // One second of 200 Hz steps: the first at once, then one per period.
-        assert_eq!(count(10.0), 10);
-        assert_eq!(count(30.0), 30);
+        // One second of 200 Hz steps: the first at the first step, then one per period up to
+        // and including 1 s.
+        assert_eq!(count(10.0), 11);
+        assert_eq!(count(30.0), 31);
         assert_eq!(count(0.0), 200);
         assert_eq!(count(1000.0), 200, "no faster than the steps");
         let mut s = Schedule::new(10.0);
