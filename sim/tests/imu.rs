@@ -11,7 +11,7 @@ use rover_sim::{
 
 mod common;
 
-use common::{Result, car_with};
+use common::{Result, assert_located_errors, car_with};
 
 /// An IMU on base_link, published at `rate_hz`, with `noise` inside its `<imu>` element.
 fn imu_block(rate_hz: f64, noise: &str) -> String {
@@ -261,7 +261,7 @@ fn turtlebot3s_model_plugin_and_bad_blocks() -> Result<()> {
     assert!(quiet.imus.is_empty());
     assert!(quiet.not_simulated.iter().any(|s| s.contains("\"quiet\"")));
 
-    for (block, expected) in [
+    assert_located_errors([
         (
             r#"<gazebo><plugin name="i" filename="libgazebo_ros_imu.so"><topicName>imu</topicName></plugin></gazebo>"#,
             "missing <bodyName>",
@@ -282,13 +282,5 @@ fn turtlebot3s_model_plugin_and_bad_blocks() -> Result<()> {
             r#"<gazebo reference="base_link"><sensor type="imu" name="s"><imu><noise><type>gaussian</type><rate><stddev>lots</stddev></rate></noise></imu></sensor></gazebo>"#,
             "<stddev>",
         ),
-    ] {
-        let err = car_with(block)
-            .err()
-            .ok_or("expected an error")?
-            .to_string();
-        assert!(err.contains(expected), "{err}");
-        assert!(err.contains("my_robot.urdf:"), "located: {err}");
-    }
-    Ok(())
+    ])
 }

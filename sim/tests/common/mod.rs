@@ -15,3 +15,19 @@ pub fn car_with(gazebo: &str) -> Result<RobotModel> {
     let text = text.replacen("</robot>", &format!("{gazebo}\n</robot>"), 1);
     Ok(RobotModel::from_str(&text, &path)?)
 }
+
+/// Asserts that the car with each `(gazebo block, expected text)` fails to load with an error
+/// containing the text and located in my_robot.urdf (file and line).
+pub fn assert_located_errors<'a>(
+    cases: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> Result<()> {
+    for (block, expected) in cases {
+        let err = car_with(block)
+            .err()
+            .ok_or("expected an error")?
+            .to_string();
+        assert!(err.contains(expected), "{err}");
+        assert!(err.contains("my_robot.urdf:"), "located: {err}");
+    }
+    Ok(())
+}
