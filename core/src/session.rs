@@ -153,12 +153,7 @@ impl Session {
         let arm = ArmTask::new(&sim, camera_config, &arm_config);
         let laser = start_laser(&sim)?;
         let imus = start_imus(&sim);
-        let p3ds = (0..sim.robot().p3ds.len())
-            .filter_map(|i| P3dSensor::new(&sim, i))
-            .collect();
-        let gpss = (0..sim.robot().gpss.len())
-            .filter_map(|i| GpsSensor::new(&sim, i))
-            .collect();
+        let (p3ds, gpss) = start_p3ds_and_gpss(&sim);
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
@@ -707,25 +702,58 @@ fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
     Ok(Some(sensor))
 }
 
+/// "100 Hz", or "every physics step" at rate 0.
+fn rate_text(rate_hz: f64) -> String {
+    if rate_hz > 0.0 {
+        format!("{rate_hz} Hz")
+    } else {
+        "every physics step".to_owned()
+    }
+}
+
 /// Every IMU of the robot: each reads the motion of its link after every physics step.
 fn start_imus(sim: &Simulation) -> Vec<ImuSensor> {
     (0..sim.robot().imus.len())
         .filter_map(|i| ImuSensor::new(sim, i))
         .inspect(|imu| {
             let c = imu.config();
+            let rate = rate_text(c.update_rate_hz);
+            tracing::info!("imu: {} on {} at {rate}, topic {}", c.name, c.link, c.topic);
+        })
+        .collect()
+}
+
+/// Every p3d publisher and GPS receiver of the robot.
+fn start_p3ds_and_gpss(sim: &Simulation) -> (Vec<P3dSensor>, Vec<GpsSensor>) {
+    let p3ds = (0..sim.robot().p3ds.len())
+        .filter_map(|i| P3dSensor::new(sim, i))
+        .inspect(|p| {
+            let c = p.config();
+            let rate = rate_text(c.update_rate_hz);
             tracing::info!(
-                "imu: {} on {} at {}, topic {}",
-                c.name,
+                "p3d: {} ground truth in {} at {rate}, topic {}",
                 c.link,
-                if c.update_rate_hz > 0.0 {
-                    format!("{} Hz", c.update_rate_hz)
-                } else {
-                    "every physics step".to_owned()
-                },
+                c.frame_name,
                 c.topic
             );
         })
-        .collect()
+        .collect();
+    let gpss = (0..sim.robot().gpss.len())
+        .filter_map(|i| GpsSensor::new(sim, i))
+        .inspect(|g| {
+            let c = g.config();
+            let rate = rate_text(c.update_rate_hz);
+            tracing::info!(
+                "gps: {} around {} N {} E at {rate}, topics {} and {}",
+                c.link,
+                c.reference_latitude_deg,
+                c.reference_longitude_deg,
+                c.topic,
+                c.velocity_topic
+            );
+        })
+        .collect();
+    (p3ds, gpss)
 }
 
 /// The follower's view of the camera: intrinsics, and where the camera sits on the robot as

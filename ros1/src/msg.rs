@@ -331,6 +331,10 @@ pub mod wire {
     pub fn i16(out: &mut Vec<u8>, v: i16) {
         out.extend_from_slice(&v.to_le_bytes());
     }
+    /// A u16.
+    pub fn u16(out: &mut Vec<u8>, v: u16) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
     /// A u32.
     pub fn u32(out: &mut Vec<u8>, v: u32) {
         out.extend_from_slice(&v.to_le_bytes());

@@ -167,13 +167,13 @@ impl Message for NavSatFix {
     const TYPE: &'static str = "sensor_msgs/NavSatFix";
     fn encode(&self, out: &mut Vec<u8>) {
         self.header.encode(out);
-        out.push(self.status.status as u8);
-        out.extend_from_slice(&self.status.service.to_le_bytes());
+        wire::i8(out, self.status.status);
+        wire::u16(out, self.status.service);
         for v in [self.latitude, self.longitude, self.altitude] {
-            out.extend_from_slice(&v.to_le_bytes());
+            wire::f64(out, v);
         }
         wire::f64_fixed(out, &self.position_covariance);
-        out.push(self.position_covariance_type);
+        wire::u8(out, self.position_covariance_type);
     }
 }
 

@@ -35,3 +35,47 @@ impl SplitMix64 {
         (r * t.cos(), r * t.sin())
     }
 }
+
+/// Standard normal samples from one seeded stream, both halves of each Box-Muller pair used:
+/// the noise of the IMU, p3d and GPS, each sensor its own stream.
+#[derive(Debug, Clone)]
+pub(crate) struct Normals {
+    rng: SplitMix64,
+    spare: Option<f64>,
+}
+
+impl Normals {
+    /// The stream seeded with `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self {
+            rng: SplitMix64(seed),
+            spare: None,
+        }
+    }
+
+    /// The next standard normal sample.
+    pub fn next(&mut self) -> f64 {
+        match self.spare.take() {
+            Some(z) => z,
+            None => {
+                let (a, b) = self.rng.normal_pair();
+                self.spare = Some(b);
+                a
+            }
+        }
+    }
+
+    /// Zero-mean white noise of `stddev`; no draw at 0, so a noise-free sensor reads exactly.
+    pub fn scaled(&mut self, stddev: f64) -> f64 {
+        if stddev == 0.0 {
+            0.0
+        } else {
+            stddev * self.next()
+        }
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        self.rng.unit()
+    }
+}

@@ -31,12 +31,3 @@ impl TopicFamily for Gps {
 
 /// NavSatFix's `position_covariance_type` for a diagonal known (hector's).
 pub(crate) const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
-
-/// The 3x3 covariance with `diagonal` on its diagonal.
-pub(crate) fn covariance(diagonal: [f64; 3]) -> [f64; 9] {
-    let mut c = [0.0; 9];
-    c[0] = diagonal[0];
-    c[4] = diagonal[1];
-    c[8] = diagonal[2];
-    c
-}

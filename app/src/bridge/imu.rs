@@ -27,12 +27,3 @@ impl TopicFamily for Imu {
         self.wire.imu(reading);
     }
 }
-
-/// The covariance of sensor_msgs/Imu with `diagonal` on its diagonal, as gazebo_ros fills it.
-pub(crate) fn covariance(diagonal: f64) -> [f64; 9] {
-    let mut c = [0.0; 9];
-    c[0] = diagonal;
-    c[4] = diagonal;
-    c[8] = diagonal;
-    c
-}

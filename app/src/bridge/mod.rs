@@ -68,6 +68,17 @@ macro_rules! copy_fields {
 }
 pub(crate) use copy_fields;
 
+/// A row-major `N` x `N` covariance (`NN` = `N` x `N` entries) with `diagonal` on its diagonal
+/// and zeros elsewhere, as gazebo_ros fills odometry's, an IMU's and a fix's.
+pub(crate) fn diagonal<const N: usize, const NN: usize>(diagonal: [f64; N]) -> [f64; NN] {
+    debug_assert_eq!(N * N, NN, "an N x N covariance has N * N entries");
+    let mut c = [0.0; NN];
+    for (i, d) in diagonal.into_iter().enumerate() {
+        c[i * (N + 1)] = d;
+    }
+    c
+}
+
 /// Makes each family's encoder on one transport (advertising its topics there).
 pub(crate) trait Transport {
     /// `/clock`.

@@ -7,7 +7,8 @@ use rover_sim::sensors::FixReading;
 
 use super::convert::header;
 use crate::bridge::RosPlan;
-use crate::bridge::gps::{COVARIANCE_TYPE_DIAGONAL_KNOWN, GpsWire, covariance};
+use crate::bridge::diagonal;
+use crate::bridge::gps::{COVARIANCE_TYPE_DIAGONAL_KNOWN, GpsWire};
 
 /// A receiver's two publishers and their messages.
 struct Receiver {
@@ -61,7 +62,7 @@ impl GpsWire for Gps {
         msg.latitude = r.latitude_deg;
         msg.longitude = r.longitude_deg;
         msg.altitude = r.altitude_m;
-        msg.position_covariance = covariance(r.position_covariance_diagonal);
+        msg.position_covariance = diagonal(r.position_covariance_diagonal);
         publisher.publish(msg);
         let (publisher, msg) = &mut receiver.velocity;
         msg.header.seq = r.seq as u32;

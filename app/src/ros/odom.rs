@@ -6,8 +6,8 @@ use rover_ros1::{Node, Publisher};
 use rover_sim::physics::ODOM_POSE_COVARIANCE_DIAGONAL;
 
 use super::convert::{header, seq_of};
-use crate::bridge::RosPlan;
 use crate::bridge::odom::{OdomSample, OdomWire};
+use crate::bridge::{RosPlan, diagonal};
 
 /// The odometry topic's publisher.
 pub(super) struct Odom {
@@ -15,19 +15,10 @@ pub(super) struct Odom {
     msg: msgs::Odometry,
 }
 
-/// A 6x6 row-major covariance with `diagonal` on its diagonal.
-pub(super) fn covariance(diagonal: [f64; 6]) -> [f64; 36] {
-    let mut c = [0.0; 36];
-    for (i, d) in diagonal.iter().enumerate() {
-        c[i * 7] = *d;
-    }
-    c
-}
-
 impl Odom {
     /// Advertises the plan's odometry topic.
     pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
-        let cov = covariance(ODOM_POSE_COVARIANCE_DIAGONAL);
+        let cov = diagonal(ODOM_POSE_COVARIANCE_DIAGONAL);
         Ok(Self {
             publisher: node.advertise(&plan.odom_topic, 50, false)?,
             msg: msgs::Odometry {

@@ -6,9 +6,8 @@ use rover_ros1::{Node, Publisher};
 use rover_sim::sensors::PoseReading;
 
 use super::convert::header;
-use super::odom::covariance;
-use crate::bridge::RosPlan;
 use crate::bridge::p3d::P3dWire;
+use crate::bridge::{RosPlan, diagonal};
 
 /// One publisher and message per p3d plugin, in the plan's order.
 pub(super) struct P3d {
@@ -51,7 +50,7 @@ impl P3dWire for P3d {
         msg.orientation = Quaternion { x, y, z, w };
         msg.linear = r.linear_mps.into();
         msg.angular = r.angular_radps.into();
-        let c = covariance([r.covariance_diagonal; 6]);
+        let c = diagonal([r.covariance_diagonal; 6]);
         msg.pose_covariance = c;
         msg.twist_covariance = c;
         publisher.publish(msg);

@@ -6,7 +6,8 @@ use rover_sim::sensors::FixReading;
 
 use super::sinks::{Out, Sinks, header, sensor_qos};
 use crate::bridge::RosPlan;
-use crate::bridge::gps::{COVARIANCE_TYPE_DIAGONAL_KNOWN, GpsWire, covariance};
+use crate::bridge::diagonal;
+use crate::bridge::gps::{COVARIANCE_TYPE_DIAGONAL_KNOWN, GpsWire};
 use rover_ros2::msgs::{self, Time};
 
 /// A receiver's two topics and their messages.
@@ -61,7 +62,7 @@ impl GpsWire for Gps {
         msg.latitude = r.latitude_deg;
         msg.longitude = r.longitude_deg;
         msg.altitude = r.altitude_m;
-        msg.position_covariance = covariance(r.position_covariance_diagonal);
+        msg.position_covariance = diagonal(r.position_covariance_diagonal);
         out.put(stamp, msg);
         let (out, msg) = &mut receiver.velocity;
         msg.header.stamp = stamp;

@@ -6,7 +6,8 @@ use rover_sim::sensors::ImuReading;
 
 use super::sinks::{Out, Sinks, sensor_qos};
 use crate::bridge::RosPlan;
-use crate::bridge::imu::{ImuWire, covariance};
+use crate::bridge::diagonal;
+use crate::bridge::imu::ImuWire;
 use rover_ros2::msgs::{self, Time};
 
 /// One topic and message per IMU, in the plan's order.
@@ -40,7 +41,7 @@ impl ImuWire for Imu {
         msg.orientation = msgs::Quaternion { x, y, z, w };
         msg.angular_velocity = r.angular_velocity_radps.into();
         msg.linear_acceleration = r.linear_acceleration_mps2.into();
-        let c = covariance(r.covariance_diagonal);
+        let c = diagonal([r.covariance_diagonal; 3]);
         msg.orientation_covariance = c;
         msg.angular_velocity_covariance = c;
         msg.linear_acceleration_covariance = c;

@@ -4,8 +4,8 @@ use anyhow::Result;
 use rover_sim::physics::ODOM_POSE_COVARIANCE_DIAGONAL;
 
 use super::sinks::{Out, Sinks, header};
-use crate::bridge::RosPlan;
 use crate::bridge::odom::{OdomSample, OdomWire};
+use crate::bridge::{RosPlan, diagonal};
 use rover_ros2::dds::default_qos;
 use rover_ros2::msgs::{self, Covariance, Time};
 
@@ -18,10 +18,7 @@ pub(super) struct Odom {
 impl Odom {
     /// Creates the plan's odometry topic on `sinks`.
     pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
-        let mut cov = [0.0; 36];
-        for (i, d) in ODOM_POSE_COVARIANCE_DIAGONAL.iter().enumerate() {
-            cov[i * 7] = *d;
-        }
+        let cov = diagonal(ODOM_POSE_COVARIANCE_DIAGONAL);
         let mut msg = msgs::Odometry {
             header: header(&plan.odom_frame),
             child_frame_id: plan.base_frame.clone(),

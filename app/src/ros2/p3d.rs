@@ -4,8 +4,8 @@ use anyhow::Result;
 use rover_sim::sensors::PoseReading;
 
 use super::sinks::{Out, Sinks, header};
-use crate::bridge::RosPlan;
 use crate::bridge::p3d::P3dWire;
+use crate::bridge::{RosPlan, diagonal};
 use rover_ros2::dds::default_qos;
 use rover_ros2::msgs::{self, Covariance, Time};
 
@@ -44,10 +44,7 @@ impl P3dWire for P3d {
         msg.pose.pose.orientation = msgs::Quaternion { x, y, z, w };
         msg.twist.twist.linear = r.linear_mps.into();
         msg.twist.twist.angular = r.angular_radps.into();
-        let mut c = [0.0; 36];
-        for i in 0..6 {
-            c[i * 7] = r.covariance_diagonal;
-        }
+        let c = diagonal([r.covariance_diagonal; 6]);
         msg.pose.covariance = Covariance(c);
         msg.twist.covariance = Covariance(c);
         out.put(msg.header.stamp, msg);

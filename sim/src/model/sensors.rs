@@ -249,7 +249,7 @@ pub struct P3dConfig {
     pub link: String,
     /// Topic (`<topicName>`, in `<robotNamespace>`).
     pub topic: String,
-    /// `<frameName>`: `world` (or `map`, the default) for the world, else a link of the robot
+    /// `<frameName>` (default `world`): `world` or `map` for the world, else a link of the robot
     /// the pose and velocity are measured against. The messages' `frame_id`.
     pub frame_name: String,
     /// The link measured against, `None` for the world.

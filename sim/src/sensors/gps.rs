@@ -5,7 +5,7 @@
 
 use crate::geometry::Pose;
 use crate::model::{ErrorModel, GpsConfig, LinkId};
-use crate::noise::SplitMix64 as Rng;
+use crate::noise::Normals;
 use crate::physics::Simulation;
 use crate::sensors::schedule::Schedule;
 
@@ -61,7 +61,7 @@ pub struct GpsSensor {
     link: LinkId,
     schedule: Schedule,
     last_s: Option<f64>,
-    rng: Rng,
+    noise: Normals,
     position_drift: [f64; 3],
     velocity_drift: [f64; 3],
     radius_north_m: f64,
@@ -85,7 +85,7 @@ impl GpsSensor {
             schedule: Schedule::new(config.update_rate_hz),
             last_s: None,
             // Its own stream: adding a GPS leaves the other sensors' noise alone.
-            rng: Rng(sim.seed() ^ 0x0006_9500_5EED_6F5D ^ (index as u64)),
+            noise: Normals::new(sim.seed() ^ 0x0006_9500_5EED_6F5D ^ (index as u64)),
             position_drift: [0.0; 3],
             velocity_drift: [0.0; 3],
             radius_north_m,
@@ -166,17 +166,11 @@ impl GpsSensor {
             return current;
         }
         let decay = (-f * dt).exp();
-        decay * current + sd * (1.0 - decay * decay).sqrt() * self.rng.normal_pair().0
+        decay * current + self.noise.scaled(sd * (1.0 - decay * decay).sqrt())
     }
 
     /// Offset, drift and white noise of axis `i`.
     fn error(&mut self, model: &ErrorModel, drift: f64, i: usize) -> f64 {
-        let noise = model.gaussian_noise[i];
-        let white = if noise == 0.0 {
-            0.0
-        } else {
-            noise * self.rng.normal_pair().0
-        };
-        model.offset[i] + drift + white
+        model.offset[i] + drift + self.noise.scaled(model.gaussian_noise[i])
     }
 }

@@ -10,8 +10,8 @@
 
 use glam::{DQuat, DVec3, EulerRot};
 
-use crate::model::{ImuConfig, ImuPlugin, LinkId, OrientationReference};
-use crate::noise::SplitMix64 as Rng;
+use crate::model::{ImuConfig, LinkId, OrientationReference};
+use crate::noise::Normals;
 use crate::physics::Simulation;
 use crate::sensors::schedule::Schedule;
 
@@ -40,11 +40,9 @@ pub struct ImuReading {
 #[derive(Debug, Clone)]
 pub struct ImuSensor {
     config: ImuConfig,
-    index: usize,
     link: LinkId,
     schedule: Schedule,
-    rng: Rng,
-    spare: Option<f64>,
+    noise: Normals,
     /// Bias of each angular-velocity and linear-acceleration axis, drawn at start.
     bias_radps: [f64; 3],
     bias_mps2: [f64; 3],
@@ -66,32 +64,25 @@ impl ImuSensor {
         let link = sim.robot().link_id(&config.link)?;
         let g = sim.world().physics.gravity_mps2;
         // Its own stream: adding an IMU leaves the camera's and the laser's noise alone.
-        let mut rng = Rng(sim.seed() ^ 0x0154_1A0B_1D5E_ED00 ^ (index as u64));
+        let mut noise = Normals::new(sim.seed() ^ 0x0154_1A0B_1D5E_ED00 ^ (index as u64));
+        // The model plugin's axes are all zero (it reads only gaussianNoise): no bias there.
         let mut bias = |axes: &[crate::model::AxisNoise; 3]| {
             axes.map(|a| {
                 if a.bias_mean == 0.0 && a.bias_stddev == 0.0 {
                     return 0.0;
                 }
                 // Gazebo: drawn once from N(bias_mean, bias_stddev), then a random sign.
-                let b = a.bias_mean + a.bias_stddev * rng.normal_pair().0;
-                if rng.unit() < 0.5 { -b } else { b }
+                let b = a.bias_mean + noise.scaled(a.bias_stddev);
+                if noise.unit() < 0.5 { -b } else { b }
             })
         };
-        let (bias_radps, bias_mps2) = match config.plugin {
-            ImuPlugin::Sensor => (
-                bias(&config.angular_velocity_noise),
-                bias(&config.linear_acceleration_noise),
-            ),
-            // gazebo_ros's model plugin reads only gaussianNoise.
-            ImuPlugin::Model => ([0.0; 3], [0.0; 3]),
-        };
+        let bias_radps = bias(&config.angular_velocity_noise);
+        let bias_mps2 = bias(&config.linear_acceleration_noise);
         let [roll, pitch, yaw] = config.rpy_offset_rad;
         Some(Self {
-            index,
             link,
             schedule: Schedule::new(config.update_rate_hz),
-            rng,
-            spare: None,
+            noise,
             bias_radps,
             bias_mps2,
             last_velocity: None,
@@ -112,11 +103,6 @@ impl ImuSensor {
     /// The sensor's settings.
     pub fn config(&self) -> &ImuConfig {
         &self.config
-    }
-
-    /// Its index in `RobotModel::imus`.
-    pub fn index(&self) -> usize {
-        self.index
     }
 
     /// The newest reading (zeros before the first).
@@ -152,44 +138,25 @@ impl ImuSensor {
         let plugin_noise = self.config.gaussian_noise;
         let mut quaternion = orientation.to_array();
         for q in &mut quaternion {
-            *q += self.white(plugin_noise);
+            *q += self.noise.scaled(plugin_noise);
         }
         self.reading.orientation_xyzw = quaternion;
         for i in 0..3 {
-            let (w, a) = match self.config.plugin {
-                ImuPlugin::Sensor => (
-                    self.config.angular_velocity_noise[i],
-                    self.config.linear_acceleration_noise[i],
-                ),
-                ImuPlugin::Model => Default::default(),
-            };
+            let (w, a) = (
+                self.config.angular_velocity_noise[i],
+                self.config.linear_acceleration_noise[i],
+            );
             self.reading.angular_velocity_radps[i] = angular[i]
                 + self.bias_radps[i]
                 + w.mean
-                + self.white(w.stddev)
-                + self.white(plugin_noise);
+                + self.noise.scaled(w.stddev)
+                + self.noise.scaled(plugin_noise);
             self.reading.linear_acceleration_mps2[i] = specific_force[i]
                 + self.bias_mps2[i]
                 + a.mean
-                + self.white(a.stddev)
-                + self.white(plugin_noise);
+                + self.noise.scaled(a.stddev)
+                + self.noise.scaled(plugin_noise);
         }
         Some(&self.reading)
-    }
-
-    /// Zero-mean white noise of `stddev`. No draw at 0, so a noise-free IMU reads exactly.
-    fn white(&mut self, stddev: f64) -> f64 {
-        if stddev == 0.0 {
-            return 0.0;
-        }
-        let z = match self.spare.take() {
-            Some(z) => z,
-            None => {
-                let (a, b) = self.rng.normal_pair();
-                self.spare = Some(b);
-                a
-            }
-        };
-        stddev * z
     }
 }

@@ -6,7 +6,7 @@ use glam::{DQuat, DVec3, EulerRot};
 
 use crate::geometry::Pose;
 use crate::model::{LinkId, P3dConfig};
-use crate::noise::SplitMix64 as Rng;
+use crate::noise::Normals;
 use crate::physics::Simulation;
 use crate::sensors::schedule::Schedule;
 
@@ -39,7 +39,7 @@ pub struct P3dSensor {
     reference: Option<LinkId>,
     offset: DQuat,
     schedule: Schedule,
-    rng: Rng,
+    noise: Normals,
     reading: PoseReading,
 }
 
@@ -60,7 +60,7 @@ impl P3dSensor {
             offset: DQuat::from_euler(EulerRot::ZYX, yaw, pitch, roll),
             schedule: Schedule::new(config.update_rate_hz),
             // Its own stream: adding a p3d leaves the other sensors' noise alone.
-            rng: Rng(sim.seed() ^ 0x0F3D_0F3D_5EED_0000 ^ (index as u64)),
+            noise: Normals::new(sim.seed() ^ 0x0F3D_0F3D_5EED_0000 ^ (index as u64)),
             reading: PoseReading {
                 sensor: index,
                 covariance_diagonal: config.gaussian_noise * config.gaussian_noise,
@@ -108,16 +108,10 @@ impl P3dSensor {
         r.seq += 1;
         r.position_m = position.to_array();
         r.orientation_xyzw = rotation.to_array();
-        let noise = self.config.gaussian_noise;
-        let mut white = |v: f64| {
-            if noise == 0.0 {
-                v
-            } else {
-                v + noise * self.rng.normal_pair().0
-            }
-        };
-        r.linear_mps = linear.to_array().map(&mut white);
-        r.angular_radps = angular.to_array().map(&mut white);
+        let stddev = self.config.gaussian_noise;
+        let noise = &mut self.noise;
+        r.linear_mps = linear.to_array().map(|v| v + noise.scaled(stddev));
+        r.angular_radps = angular.to_array().map(|v| v + noise.scaled(stddev));
         Some(&self.reading)
     }
 }

@@ -206,28 +206,13 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
     for _ in 0..steps.max(1) {
         sim.step();
         for (imu, times) in imus.iter_mut().zip(&mut imu_times) {
-            let start = Instant::now();
-            let read = imu.update(&sim).is_some();
-            let us = start.elapsed().as_secs_f64() * 1e6;
-            if read {
-                times.push(us);
-            }
+            time_reading(times, || imu.update(&sim).is_some());
         }
         for (p3d, times) in p3ds.iter_mut().zip(&mut p3d_times) {
-            let start = Instant::now();
-            let read = p3d.update(&sim).is_some();
-            let us = start.elapsed().as_secs_f64() * 1e6;
-            if read {
-                times.push(us);
-            }
+            time_reading(times, || p3d.update(&sim).is_some());
         }
         for (gps, times) in gpss.iter_mut().zip(&mut gps_times) {
-            let start = Instant::now();
-            let read = gps.update(&sim).is_some();
-            let us = start.elapsed().as_secs_f64() * 1e6;
-            if read {
-                times.push(us);
-            }
+            time_reading(times, || gps.update(&sim).is_some());
         }
     }
     let figures = |names: Vec<String>, times: Vec<Vec<f64>>| -> Vec<(String, usize, f64)> {
@@ -251,6 +236,16 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
             gps_times,
         ),
     })
+}
+
+/// Times `update` (us) into `times` when it read something.
+fn time_reading(times: &mut Vec<f64>, update: impl FnOnce() -> bool) {
+    let start = Instant::now();
+    let read = update();
+    let us = start.elapsed().as_secs_f64() * 1e6;
+    if read {
+        times.push(us);
+    }
 }
 
 pub(crate) fn bench_sensors(world: WorldArgs, steps: usize) -> Result<()> {

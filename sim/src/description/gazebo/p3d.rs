@@ -12,7 +12,7 @@ pub(super) fn is_plugin(file: &str) -> bool {
 }
 
 /// The plugin element: `<bodyName>` and `<topicName>` are required, as gazebo_ros requires
-/// them; `<frameName>` `world` (or `map`, the default) is the world, anything else a link.
+/// them; `<frameName>` (default `world`) is the world when `world` or `map`, else a link.
 pub(super) fn parse(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<P3dConfig> {
     let name = plugin.attribute("name").unwrap_or("p3d").to_owned();
     let what = format!("<plugin name=\"{name}\" filename=\"libgazebo_ros_p3d.so\">");
