@@ -151,6 +151,7 @@ impl RobotModel {
             diff_drive: extensions.diff_drive,
             cameras: extensions.cameras,
             lasers: extensions.lasers,
+            lidars: extensions.lidars,
             imus: extensions.imus,
             p3ds: extensions.p3ds,
             gpss: extensions.gpss,

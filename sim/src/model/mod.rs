@@ -42,8 +42,8 @@ pub use robot::{
 };
 pub use sensors::{
     AxisNoise, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise, GpsConfig,
-    ImuConfig, ImuPlugin, LaserConfig, MAX_LASER_SAMPLES, OrientationReference, P3dConfig,
-    PixelFormat,
+    ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES, OrientationReference,
+    P3dConfig, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,

@@ -12,7 +12,7 @@ use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
 use crate::model::sensors::{
-    CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, P3dConfig,
+    CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, P3dConfig,
 };
 
 /// Mass properties of a link, from its `<inertial>`.
@@ -211,8 +211,10 @@ pub struct RobotModel {
     pub diff_drive: Option<DiffDriveConfig>,
     /// Camera sensors (`<sensor type="camera">`).
     pub cameras: Vec<CameraConfig>,
-    /// 2D laser scanners (`<sensor type="ray">`).
+    /// 2D laser scanners (`<sensor type="ray">` with one vertical sample).
     pub lasers: Vec<LaserConfig>,
+    /// 3D lidars (`<sensor type="ray">` with several vertical samples).
+    pub lidars: Vec<LidarConfig>,
     /// IMUs (`<sensor type="imu">` with `libgazebo_ros_imu_sensor.so`, or the model plugin
     /// `libgazebo_ros_imu.so`).
     pub imus: Vec<ImuConfig>,
@@ -491,6 +493,13 @@ impl RobotModel {
         for l in &self.lasers {
             let what = format!("<gazebo reference=\"{}\"> <sensor type=\"ray\">", l.link);
             out.push((what, l.link.as_str(), l.line));
+        }
+        for l in &self.lidars {
+            let what = format!(
+                "<gazebo reference=\"{}\"> <sensor type=\"ray\">",
+                l.rays.link
+            );
+            out.push((what, l.rays.link.as_str(), l.rays.line));
         }
         for i in &self.imus {
             let element = match i.plugin {

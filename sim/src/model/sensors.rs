@@ -97,13 +97,21 @@ pub struct CameraConfig {
 }
 
 /// What a depth camera (`<sensor type="depth">`, gazebo_ros_openni_kinect) publishes besides
-/// its colour image: a 32FC1 depth image (metres along the optical axis) and its camera_info.
+/// its colour image: a 32FC1 depth image (metres along the optical axis), its camera_info and
+/// an organized point cloud.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DepthOutput {
     /// `<depthImageTopicName>` (default `depth/image_raw`).
     pub image_topic: String,
     /// `<depthImageCameraInfoTopicName>` (default `depth/camera_info`).
     pub info_topic: String,
+    /// `<pointCloudTopicName>` (default `points`): the organized cloud, x y z rgb.
+    pub cloud_topic: String,
+    /// `<pointCloudCutoff>` (m, default 0.4): nearer depths are no point (NaN).
+    pub cloud_cutoff_m: f64,
+    /// `<pointCloudCutoffMax>` (m; 5.0 for gazebo_ros_openni_kinect, none for
+    /// gazebo_ros_depth_camera): farther depths are no point (NaN).
+    pub cloud_cutoff_max_m: f64,
 }
 
 impl Default for DepthOutput {
@@ -111,6 +119,9 @@ impl Default for DepthOutput {
         Self {
             image_topic: "depth/image_raw".to_owned(),
             info_topic: "depth/camera_info".to_owned(),
+            cloud_topic: "points".to_owned(),
+            cloud_cutoff_m: 0.4,
+            cloud_cutoff_max_m: 5.0,
         }
     }
 }
@@ -157,6 +168,55 @@ impl LaserConfig {
         } else {
             0.0
         }
+    }
+}
+
+/// A 3D lidar: a `<sensor type="ray">` (or `gpu_ray`) whose `<scan><vertical><samples>` is more
+/// than one, published as a sensor_msgs/PointCloud2 of x y z intensity ring (the fields
+/// velodyne_pointcloud uses), never flattened to a LaserScan. velodyne_simulator's
+/// `libgazebo_ros_velodyne_laser.so` (and `_gpu_laser`) parameters; any other ray plugin's
+/// `topicName` and `frameName`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LidarConfig {
+    /// The ray sensor as a 2D laser reads it: name, link, pose, rate, the horizontal scan,
+    /// `<range>`, `<noise>`, the plugin's topic (default `points`) and frame.
+    pub rays: LaserConfig,
+    /// `<vertical><samples>` times `<resolution>`: beams (rings).
+    pub vertical_samples: u32,
+    /// `<vertical><min_angle>` (rad, elevation of the lowest beam, up positive).
+    pub vertical_min_angle_rad: f64,
+    /// `<vertical><max_angle>` (rad).
+    pub vertical_max_angle_rad: f64,
+    /// The plugin's `<min_range>` (m, default 0): returns at or inside it are dropped.
+    pub min_range_m: f64,
+    /// The plugin's `<max_range>` (m, default none): returns at or beyond it are dropped.
+    pub max_range_m: f64,
+    /// The plugin's `<gaussianNoise>` (m, stddev; default 0).
+    pub gaussian_noise_m: f64,
+    /// The plugin's `<organize_cloud>` (default false): rings as rows with NaN where a beam
+    /// has no return; otherwise one row of the returns only.
+    pub organize: bool,
+}
+
+impl LidarConfig {
+    /// Angle between two beams (rad): the samples spread from min to max inclusive.
+    pub fn vertical_increment_rad(&self) -> f64 {
+        if self.vertical_samples > 1 {
+            (self.vertical_max_angle_rad - self.vertical_min_angle_rad)
+                / f64::from(self.vertical_samples - 1)
+        } else {
+            0.0
+        }
+    }
+
+    /// Elevation of ring `ring` (rad; ring 0 is the lowest beam).
+    pub fn ring_elevation_rad(&self, ring: u32) -> f64 {
+        self.vertical_min_angle_rad + f64::from(ring) * self.vertical_increment_rad()
+    }
+
+    /// Rays per scan (beams times horizontal samples).
+    pub fn rays_per_scan(&self) -> u64 {
+        u64::from(self.vertical_samples) * u64::from(self.rays.samples)
     }
 }
 

@@ -8,44 +8,22 @@
 //! reads `-inf`. Hits get the sensor's gaussian noise (seeded by the simulation's seed), then are
 //! clamped into `[range_min, range_max]` and rounded to the range resolution.
 //!
-//! People drawn with a skinned body (MakeHuman's, a Gazebo actor's) are seen as their posed
-//! skeleton's bones, each a capsule as thick as the skin it moves (`SkinnedBody::
-//! bone_capsules`): two legs that scissor as they walk, arms, the torso at its height. Capsules
-//! rather than the posed mesh: a scan needs only the few bones that cross the scan plane, posed
-//! without skinning 20,000 vertices, and a capsule's surface is within a centimetre or two of
-//! the skin's. rover's figure stays its one physics capsule.
+//! People with a skinned body are seen as their posed bones (`rays.rs`).
 
 use glam::Vec3;
-use rapier3d::parry::query::{Ray, RayCast};
-use rapier3d::parry::shape::Capsule;
 
 use crate::error::{Result, SimError};
 use crate::geometry::Pose;
-use crate::model::actor::BoneCapsule;
 use crate::model::robot::LinkId;
 use crate::model::sensors::LaserConfig;
 use crate::noise::SplitMix64 as Rng;
 use crate::physics::simulation::Simulation;
-use crate::render::body::SkinnedBody;
+use crate::sensors::rays::RayCaster;
 use crate::sensors::schedule::Schedule;
 
 /// How far above and below the scan plane a bone may reach and still be looked at (m): the
 /// scan plane tilts a little with the robot.
 const PLANE_SLACK_M: f32 = 0.1;
-
-/// A person the laser sees as bone capsules.
-struct SeenPerson {
-    body: SkinnedBody,
-    capsules: Vec<BoneCapsule>,
-    /// Reused: the posed joints (person frame).
-    joints: Vec<Vec3>,
-}
-
-impl std::fmt::Debug for SeenPerson {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SeenPerson({} capsules)", self.capsules.len())
-    }
-}
 
 /// One scan, shaped like `sensor_msgs/LaserScan` (f32 fields as in the message).
 #[derive(Debug, Clone, PartialEq)]
@@ -104,12 +82,7 @@ pub struct LaserSensor {
     directions: Vec<Vec3>,
     scans: u64,
     scan: LaserScan,
-    /// Per person (world order): their bones, when they have a skinned body.
-    people: Vec<Option<SeenPerson>>,
-    /// Which people are seen as bones (their physics capsule is not).
-    skip: Vec<bool>,
-    /// Reused: this scan's capsules near the scan plane (world frame).
-    near: Vec<Capsule>,
+    rays: RayCaster,
 }
 
 impl LaserSensor {
@@ -147,25 +120,8 @@ impl LaserSensor {
             range_max_m: config.range_max_m as f32,
             ranges_m: Vec::with_capacity(config.samples as usize),
         };
-        let people: Vec<Option<SeenPerson>> = sim
-            .world()
-            .people
-            .iter()
-            .map(|p| {
-                let body = SkinnedBody::of(p)?;
-                let capsules = body.bone_capsules();
-                (!capsules.is_empty()).then(|| SeenPerson {
-                    body,
-                    capsules,
-                    joints: Vec::new(),
-                })
-            })
-            .collect();
-        let skip = people.iter().map(Option::is_some).collect();
         Ok(Self {
-            people,
-            skip,
-            near: Vec::new(),
+            rays: RayCaster::new(sim),
             // Its own stream, independent of the camera's: adding a laser leaves images alone.
             rng: Rng(sim.seed() ^ 0x1A5E_5CA7_1A5E_5CA7 ^ (index as u64)),
             config,
@@ -216,20 +172,12 @@ impl LaserSensor {
         let noise = self.config.noise;
         self.scan.ranges_m.clear();
         let mut spare: Option<f64> = None;
-        self.collect_bones(sim, origin.z);
+        // Bones that reach the scan plane, which tilts a little with the robot.
+        let band = (origin.z - PLANE_SLACK_M, origin.z + PLANE_SLACK_M);
+        self.rays.pose_people(sim, Some(band));
         for dir in &self.directions {
             let world_dir = world_from_sensor.rotation * *dir;
-            let ray = Ray::new(origin, world_dir);
-            let bone = self
-                .near
-                .iter()
-                .filter_map(|c| c.cast_local_ray(&ray, max as f32, true))
-                .reduce(f32::min);
-            let world = sim.cast_world_ray_past_people(origin, world_dir, max as f32, &self.skip);
-            let hit = match (world, bone) {
-                (Some(a), Some(b)) => Some(a.min(b)),
-                (a, b) => a.or(b),
-            };
+            let hit = self.rays.cast(sim, origin, world_dir, max as f32);
             let range = match hit {
                 None => f32::INFINITY,
                 Some(hit) if f64::from(hit) < min => f32::NEG_INFINITY,
@@ -259,34 +207,5 @@ impl LaserSensor {
         self.scan.seq = self.scans;
         self.scans += 1;
         &self.scan
-    }
-
-    /// Poses the people seen as bones and keeps the capsules that reach the scan plane at
-    /// height `plane_z` (world frame).
-    fn collect_bones(&mut self, sim: &Simulation, plane_z: f32) {
-        self.near.clear();
-        for (i, seen) in self.people.iter_mut().enumerate() {
-            let Some(seen) = seen else { continue };
-            let person = &sim.world().people[i];
-            seen.body.pose_joints(
-                sim.person_gait_phase_rad(i),
-                person.stride_m(),
-                &mut seen.joints,
-            );
-            let world_from_person = sim.world_from_person(i);
-            for c in &seen.capsules {
-                let (Some(a), Some(b)) = (seen.joints.get(c.from), seen.joints.get(c.to)) else {
-                    continue;
-                };
-                let (a, b) = (
-                    world_from_person.transform_point(*a),
-                    world_from_person.transform_point(*b),
-                );
-                let reach = c.radius_m + PLANE_SLACK_M;
-                if a.z.min(b.z) - reach <= plane_z && a.z.max(b.z) + reach >= plane_z {
-                    self.near.push(Capsule::new(a, b, c.radius_m));
-                }
-            }
-        }
     }
 }

@@ -1,6 +1,6 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
-//! `<sensor>` blocks (with `libgazebo_ros_camera.so`), 2D laser `<sensor type="ray">` blocks (with
-//! `libgazebo_ros_laser.so`), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), and per-link
+//! `<sensor>` blocks (with `libgazebo_ros_camera.so`), ray sensors (`ray.rs`: 2D lasers and 3D
+//! lidars), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), and per-link
 //! friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
@@ -9,21 +9,21 @@
 mod gps;
 mod imu;
 mod p3d;
+mod ray;
 mod values;
 
 use std::collections::BTreeMap;
 
 use std::path::Path;
-use values::{Ctx, Node, read_sensor_pose, text_of};
+use values::{Ctx, Node, parse_noise, text_of};
 
 use crate::description::xml::{elements, line_of};
 use crate::error::Result;
-use crate::geometry::Pose;
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
-    CameraConfig, DepthOutput, Distortion, GaussianNoise, GpsConfig, ImuConfig, LaserConfig,
-    MAX_LASER_SAMPLES, P3dConfig, PixelFormat,
+    CameraConfig, DepthOutput, Distortion, GpsConfig, ImuConfig, LaserConfig, LidarConfig,
+    P3dConfig, PixelFormat,
 };
 
 /// Everything read from `<gazebo>` elements.
@@ -33,6 +33,7 @@ pub(crate) struct Extensions {
     pub ros_control: Option<RosControlPlugin>,
     pub cameras: Vec<CameraConfig>,
     pub lasers: Vec<LaserConfig>,
+    pub lidars: Vec<LidarConfig>,
     pub imus: Vec<ImuConfig>,
     pub p3ds: Vec<P3dConfig>,
     pub gpss: Vec<GpsConfig>,
@@ -104,7 +105,10 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                             "<sensor type=\"ray\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
                         ));
                     };
-                    ext.lasers.push(parse_laser(&ctx, child, link)?);
+                    match ray::parse(&ctx, child, link)? {
+                        ray::RaySensor::Planar(laser) => ext.lasers.push(laser),
+                        ray::RaySensor::Lidar(lidar) => ext.lidars.push(lidar),
+                    }
                 }
                 "sensor" if child.attribute("type") == Some("imu") => {
                     let Some(link) = reference else {
@@ -283,9 +287,30 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
         match s.tag_name().name() {
             "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
             "camera" => read_camera_element(ctx, s, what, &mut c, &mut sdf_distortion)?,
-            "plugin" => read_camera_plugin(ctx, s, what, &mut c, &mut plugin_distortion)?,
+            "plugin" => {
+                // gazebo_ros_depth_camera has no far cutoff; gazebo_ros_openni_kinect's is 5 m.
+                if let Some(d) = &mut c.depth
+                    && s.attribute("filename")
+                        .unwrap_or("")
+                        .contains("gazebo_ros_depth_camera")
+                {
+                    d.cloud_cutoff_max_m = f64::INFINITY;
+                }
+                read_camera_plugin(ctx, s, what, &mut c, &mut plugin_distortion)?
+            }
             _ => {}
         }
+    }
+    if let Some(d) = &c.depth
+        && d.cloud_cutoff_m >= d.cloud_cutoff_max_m
+    {
+        return Err(ctx.err(
+            sensor,
+            format!(
+                "{what}: expected <pointCloudCutoff> below <pointCloudCutoffMax>, found {} and {}",
+                d.cloud_cutoff_m, d.cloud_cutoff_max_m
+            ),
+        ));
     }
     c.distortion = sdf_distortion.unwrap_or(plugin_distortion);
     Ok(c)
@@ -421,6 +446,23 @@ fn read_camera_plugin(
                     d.info_topic = text();
                 }
             }
+            "pointCloudTopicName" => {
+                if let Some(d) = &mut c.depth {
+                    d.cloud_topic = text();
+                }
+            }
+            "pointCloudCutoff" => {
+                let v = ctx.non_negative(p, what, "metres")?;
+                if let Some(d) = &mut c.depth {
+                    d.cloud_cutoff_m = v;
+                }
+            }
+            "pointCloudCutoffMax" => {
+                let v = ctx.positive(p, what, "metres")?;
+                if let Some(d) = &mut c.depth {
+                    d.cloud_cutoff_max_m = v;
+                }
+            }
             "distortionK1" => plugin_distortion.k1 = ctx.number(p, what, "coefficient")?,
             "distortionK2" => plugin_distortion.k2 = ctx.number(p, what, "coefficient")?,
             "distortionK3" => plugin_distortion.k3 = ctx.number(p, what, "coefficient")?,
@@ -430,180 +472,4 @@ fn read_camera_plugin(
         }
     }
     Ok(())
-}
-
-/// A laser's horizontal `<scan>` as written: `<samples>` and `<resolution>` (rays per sample),
-/// Gazebo's defaults until read.
-struct HorizontalScan {
-    samples: u32,
-    resolution: f64,
-}
-
-/// A 2D laser `<sensor type="ray">` on `link`: the SDF `<ray>` element and the
-/// gazebo_ros_laser plugin's parameters, Gazebo's defaults where both are silent.
-fn parse_laser(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<LaserConfig> {
-    let name = sensor.attribute("name").unwrap_or("laser").to_owned();
-    let what = format!("<sensor name=\"{name}\">");
-    let what = what.as_str();
-    // Gazebo's defaults for a ray sensor.
-    let mut c = LaserConfig {
-        name,
-        link: link.to_owned(),
-        link_from_sensor: Pose::IDENTITY,
-        update_rate_hz: 10.0,
-        samples: 640,
-        min_angle_rad: 0.0,
-        max_angle_rad: 0.0,
-        range_min_m: 0.1,
-        range_max_m: 10.0,
-        range_resolution_m: 0.01,
-        noise: None,
-        topic: "scan".to_owned(),
-        frame_name: link.to_owned(),
-        line: Some(line_of(ctx.doc, sensor)),
-    };
-    let mut scan = HorizontalScan {
-        samples: 640,
-        resolution: 1.0,
-    };
-    for s in elements(sensor) {
-        match s.tag_name().name() {
-            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
-            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
-            "ray" => read_ray_element(ctx, s, what, &mut c, &mut scan)?,
-            "plugin" => {
-                for p in elements(s) {
-                    match p.tag_name().name() {
-                        "topicName" => c.topic = text_of(p).to_owned(),
-                        "frameName" => c.frame_name = text_of(p).to_owned(),
-                        _ => {}
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    let rays = (f64::from(scan.samples) * scan.resolution).round();
-    if !(1.0..=f64::from(MAX_LASER_SAMPLES)).contains(&rays) {
-        return Err(ctx.err(
-            sensor,
-            format!("{what}: <samples> x <resolution> gives {rays} rays; expected 1 to {MAX_LASER_SAMPLES}"),
-        ));
-    }
-    c.samples = rays as u32;
-    if c.max_angle_rad < c.min_angle_rad {
-        return Err(ctx.err(
-            sensor,
-            format!(
-                "<horizontal> in {what}: expected min_angle <= max_angle, found {} and {}",
-                c.min_angle_rad, c.max_angle_rad
-            ),
-        ));
-    }
-    Ok(c)
-}
-
-/// Reads the SDF `<ray>` element of laser sensor `what`: its horizontal scan into `scan` and
-/// `c`'s angles, its `<range>` and `<noise>` into `c`.
-fn read_ray_element(
-    ctx: &Ctx<'_, '_>,
-    ray_element: Node<'_, '_>,
-    what: &str,
-    c: &mut LaserConfig,
-    scan: &mut HorizontalScan,
-) -> Result<()> {
-    for ray in elements(ray_element) {
-        match ray.tag_name().name() {
-            "scan" => {
-                for h in elements(ray).filter(|n| n.has_tag_name("horizontal")) {
-                    read_horizontal_scan(ctx, h, what, c, scan)?;
-                }
-            }
-            "range" => {
-                for r in elements(ray) {
-                    match r.tag_name().name() {
-                        "min" => c.range_min_m = ctx.non_negative(r, what, "metres")?,
-                        "max" => c.range_max_m = ctx.positive(r, what, "metres")?,
-                        "resolution" => {
-                            c.range_resolution_m = ctx.non_negative(r, what, "metres")?
-                        }
-                        _ => {}
-                    }
-                }
-                if c.range_min_m >= c.range_max_m {
-                    return Err(ctx.err(
-                        ray,
-                        format!(
-                            "<range> in {what}: expected min < max, found min {} and max {}",
-                            c.range_min_m, c.range_max_m
-                        ),
-                    ));
-                }
-            }
-            "noise" => c.noise = parse_noise(ctx, ray, what, "metres")?,
-            _ => {}
-        }
-    }
-    Ok(())
-}
-
-/// Reads one `<ray><scan><horizontal>` of laser sensor `what`: samples and resolution into
-/// `scan`, the angle limits into `c`.
-fn read_horizontal_scan(
-    ctx: &Ctx<'_, '_>,
-    horizontal: Node<'_, '_>,
-    what: &str,
-    c: &mut LaserConfig,
-    scan: &mut HorizontalScan,
-) -> Result<()> {
-    for p in elements(horizontal) {
-        match p.tag_name().name() {
-            "samples" => {
-                let text = text_of(p);
-                scan.samples = match text.parse::<u32>() {
-                    Ok(n) if (1..=MAX_LASER_SAMPLES).contains(&n) => n,
-                    _ => {
-                        return Err(ctx.err(
-                            p,
-                            format!("<samples> in {what}: expected a whole number of rays between 1 and {MAX_LASER_SAMPLES}, found '{text}'"),
-                        ));
-                    }
-                }
-            }
-            "resolution" => scan.resolution = ctx.positive(p, what, "rays per sample")?,
-            "min_angle" => c.min_angle_rad = ctx.number(p, what, "radians")?,
-            "max_angle" => c.max_angle_rad = ctx.number(p, what, "radians")?,
-            _ => {}
-        }
-    }
-    Ok(())
-}
-
-fn parse_noise(
-    ctx: &Ctx<'_, '_>,
-    node: Node<'_, '_>,
-    what: &str,
-    unit: &str,
-) -> Result<Option<GaussianNoise>> {
-    let mut kind = "gaussian".to_owned();
-    let mut noise = GaussianNoise {
-        mean: 0.0,
-        stddev: 0.0,
-    };
-    for n in elements(node) {
-        match n.tag_name().name() {
-            "type" => kind = text_of(n).to_owned(),
-            "mean" => noise.mean = ctx.number(n, what, unit)?,
-            "stddev" => noise.stddev = ctx.non_negative(n, what, unit)?,
-            _ => {}
-        }
-    }
-    match kind.as_str() {
-        "gaussian" => Ok((noise.stddev > 0.0 || noise.mean != 0.0).then_some(noise)),
-        "none" => Ok(None),
-        other => Err(ctx.err(
-            node,
-            format!("<noise><type> in {what}: expected gaussian or none, found '{other}'"),
-        )),
-    }
 }

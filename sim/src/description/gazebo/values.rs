@@ -4,9 +4,10 @@
 
 use std::path::Path;
 
-use crate::description::xml::line_of;
+use crate::description::xml::{elements, line_of};
 use crate::error::{Result, SimError};
 use crate::geometry::{Pose, pose_from_xyz_rpy};
+use crate::model::sensors::GaussianNoise;
 
 pub(super) type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
 
@@ -174,4 +175,34 @@ pub(super) fn vec3(
         ));
     }
     Ok([v[0], v[1], v[2]])
+}
+
+/// An SDF `<noise>` element in `what`: `None` when its type is `none` or it adds nothing.
+pub(super) fn parse_noise(
+    ctx: &Ctx<'_, '_>,
+    node: Node<'_, '_>,
+    what: &str,
+    unit: &str,
+) -> Result<Option<GaussianNoise>> {
+    let mut kind = "gaussian".to_owned();
+    let mut noise = GaussianNoise {
+        mean: 0.0,
+        stddev: 0.0,
+    };
+    for n in elements(node) {
+        match n.tag_name().name() {
+            "type" => kind = text_of(n).to_owned(),
+            "mean" => noise.mean = ctx.number(n, what, unit)?,
+            "stddev" => noise.stddev = ctx.non_negative(n, what, unit)?,
+            _ => {}
+        }
+    }
+    match kind.as_str() {
+        "gaussian" => Ok((noise.stddev > 0.0 || noise.mean != 0.0).then_some(noise)),
+        "none" => Ok(None),
+        other => Err(ctx.err(
+            node,
+            format!("<noise><type> in {what}: expected gaussian or none, found '{other}'"),
+        )),
+    }
 }
