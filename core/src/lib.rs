@@ -27,6 +27,7 @@ mod pilot;
 mod run_files;
 mod scenario;
 mod script;
+mod sensors;
 mod session;
 mod shard;
 mod teleop;

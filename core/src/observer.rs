@@ -8,7 +8,9 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{
+        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+    },
 };
 
 use crate::arm::ArmStatus;
@@ -78,6 +80,9 @@ pub trait Observer {
     fn p3d(&mut self, _reading: &PoseReading) {}
     /// A GPS fix (of the robot's GPS `fix.sensor`).
     fn gps(&mut self, _fix: &FixReading) {}
+    /// A point cloud (a 3D lidar's, a depth camera's; `cloud.source` says which) in
+    /// `cloud.frame_id`, that frame at `world_from_sensor` when it was taken.
+    fn point_cloud(&mut self, _cloud: &PointCloud, _world_from_sensor: Pose) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -125,6 +130,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn gps(&mut self, fix: &FixReading) {
         self.0.gps(fix);
         self.1.gps(fix);
+    }
+    fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
+        self.0.point_cloud(cloud, world_from_sensor);
+        self.1.point_cloud(cloud, world_from_sensor);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -213,6 +222,11 @@ impl Observer for Fanout<'_> {
     fn gps(&mut self, fix: &FixReading) {
         for o in &mut self.observers {
             o.gps(fix);
+        }
+    }
+    fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
+        for o in &mut self.observers {
+            o.point_cloud(cloud, world_from_sensor);
         }
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

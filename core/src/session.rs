@@ -14,7 +14,7 @@ use rover_perception::{
 use rover_sim::{
     model::{CameraInfo, LinkId, RobotModel, World},
     physics::{ControlSample, SimOptions, Simulation},
-    sensors::{CameraSensor, GpsSensor, GroundTruthBox, ImuSensor, LaserSensor, P3dSensor},
+    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor},
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -25,6 +25,7 @@ use crate::follower::{CameraGeometry, Follower, FollowerConfig, LaserMount};
 use crate::input::{Action, JointAction};
 use crate::observer::{EventLevel, LoopStats, Observer};
 use crate::pilot::{Mode, Pilot};
+use crate::sensors::ObservedSensors;
 
 /// Everything a session needs besides the world and the robot.
 #[derive(Debug, Clone)]
@@ -89,12 +90,8 @@ pub struct Session {
     camera: Option<CameraSensor>,
     camera_link: LinkId,
     laser: Option<LaserSensor>,
-    /// The robot's IMUs, each fed every physics step.
-    imus: Vec<ImuSensor>,
-    /// The robot's p3d ground-truth publishers.
-    p3ds: Vec<P3dSensor>,
-    /// The robot's GPS receivers.
-    gpss: Vec<GpsSensor>,
+    /// The IMUs, p3d, GPS receivers, 3D lidars and the depth cloud.
+    sensors: ObservedSensors,
     detection: Detection,
     labels: Vec<String>,
     every_frame: bool,
@@ -152,8 +149,7 @@ impl Session {
         let arm_config = options.arm.resolved(sim.robot(), &sim.world().robot)?;
         let arm = ArmTask::new(&sim, camera_config, &arm_config);
         let laser = start_laser(&sim)?;
-        let imus = start_imus(&sim);
-        let (p3ds, gpss) = start_p3ds_and_gpss(&sim);
+        let sensors = ObservedSensors::start(&sim, camera.as_ref().map(|c| c.info()))?;
         let geometry = camera_geometry(&sim, camera.as_ref().map(|c| c.info()), camera_link);
         let mut follower = Follower::new(options.follower.clone(), geometry);
         if let Some(l) = &laser {
@@ -190,9 +186,7 @@ impl Session {
             camera,
             camera_link,
             laser,
-            imus,
-            p3ds,
-            gpss,
+            sensors,
             detection,
             labels,
             every_frame: options.every_frame,
@@ -372,7 +366,7 @@ impl Session {
 
     /// The robot's IMUs (`RobotModel::imus` order).
     pub fn imus(&self) -> &[ImuSensor] {
-        &self.imus
+        self.sensors.imus()
     }
 
     /// The laser scanner, when the robot has one.
@@ -410,21 +404,7 @@ impl Session {
             self.follower.observe_scan(laser.last());
             observer.laser_scan(laser.last(), laser.world_from_sensor(&self.sim));
         }
-        for imu in &mut self.imus {
-            if let Some(reading) = imu.update(&self.sim) {
-                observer.imu(reading);
-            }
-        }
-        for p3d in &mut self.p3ds {
-            if let Some(reading) = p3d.update(&self.sim) {
-                observer.p3d(reading);
-            }
-        }
-        for gps in &mut self.gpss {
-            if let Some(fix) = gps.update(&self.sim) {
-                observer.gps(fix);
-            }
-        }
+        self.sensors.update(&self.sim, observer);
         if let Some(sample) = &sample {
             if self.pilot.mode() == Mode::Follow {
                 let before = self.follower.state();
@@ -572,6 +552,8 @@ impl Session {
         };
         self.stats.frames += 1;
         observer.camera_frame(&frame, world_from_camera);
+        self.sensors
+            .camera_frame(&frame, world_from_camera, observer);
         self.arm.capture(&frame, &self.sim);
         if let Some(slot) = self.truth_frames.get_mut(frame.seq as usize % TRUTH_FRAMES) {
             slot.0 = frame.seq;
@@ -700,60 +682,6 @@ fn start_laser(sim: &Simulation) -> Result<Option<LaserSensor>> {
         config.update_rate_hz
     );
     Ok(Some(sensor))
-}
-
-/// "100 Hz", or "every physics step" at rate 0.
-fn rate_text(rate_hz: f64) -> String {
-    if rate_hz > 0.0 {
-        format!("{rate_hz} Hz")
-    } else {
-        "every physics step".to_owned()
-    }
-}
-
-/// Every IMU of the robot: each reads the motion of its link after every physics step.
-fn start_imus(sim: &Simulation) -> Vec<ImuSensor> {
-    (0..sim.robot().imus.len())
-        .filter_map(|i| ImuSensor::new(sim, i))
-        .inspect(|imu| {
-            let c = imu.config();
-            let rate = rate_text(c.update_rate_hz);
-            tracing::info!("imu: {} on {} at {rate}, topic {}", c.name, c.link, c.topic);
-        })
-        .collect()
-}
-
-/// Every p3d publisher and GPS receiver of the robot.
-fn start_p3ds_and_gpss(sim: &Simulation) -> (Vec<P3dSensor>, Vec<GpsSensor>) {
-    let p3ds = (0..sim.robot().p3ds.len())
-        .filter_map(|i| P3dSensor::new(sim, i))
-        .inspect(|p| {
-            let c = p.config();
-            let rate = rate_text(c.update_rate_hz);
-            tracing::info!(
-                "p3d: {} ground truth in {} at {rate}, topic {}",
-                c.link,
-                c.frame_name,
-                c.topic
-            );
-        })
-        .collect();
-    let gpss = (0..sim.robot().gpss.len())
-        .filter_map(|i| GpsSensor::new(sim, i))
-        .inspect(|g| {
-            let c = g.config();
-            let rate = rate_text(c.update_rate_hz);
-            tracing::info!(
-                "gps: {} around {} N {} E at {rate}, topics {} and {}",
-                c.link,
-                c.reference_latitude_deg,
-                c.reference_longitude_deg,
-                c.topic,
-                c.velocity_topic
-            );
-        })
-        .collect();
-    (p3ds, gpss)
 }
 
 /// The follower's view of the camera: intrinsics, and where the camera sits on the robot as

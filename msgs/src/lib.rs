@@ -313,10 +313,46 @@ pub struct CameraInfo<H> {
     pub roi: RegionOfInterest,
 }
 
+/// `sensor_msgs/PointField`: one field of every point of a [`PointCloud2`].
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PointField {
+    /// Its name (`x`, `rgb`, `ring`, ...).
+    pub name: String,
+    /// Where it starts in the point (bytes).
+    pub offset: u32,
+    /// `INT8 = 1` ... `FLOAT64 = 8`.
+    pub datatype: u8,
+    /// Values in the field.
+    pub count: u32,
+}
+
+/// `sensor_msgs/PointCloud2`, with the wire's header `H` and its byte buffer `B`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PointCloud2<H, B> {
+    /// Stamp and the points' frame.
+    pub header: H,
+    /// Rows (1: unorganized).
+    pub height: u32,
+    /// Points per row.
+    pub width: u32,
+    /// What each point holds.
+    pub fields: Vec<PointField>,
+    /// Big-endian data (rover: never).
+    pub is_bigendian: bool,
+    /// Bytes per point.
+    pub point_step: u32,
+    /// Bytes per row.
+    pub row_step: u32,
+    /// The points.
+    pub data: B,
+    /// No point is invalid (NaN).
+    pub is_dense: bool,
+}
+
 /// Names, in a wire's `msgs` module, the messages above that carry a header, with the wire's
 /// header type, pixel buffer and range buffer: `wire_messages!(Header, Vec<u8>, Vec<f32>)`
 /// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `Imu`, `NavSatFix`,
-/// `Vector3Stamped`, `BoundingBoxes`, `ObjectCount` and `PointStamped` there.
+/// `Vector3Stamped`, `BoundingBoxes`, `ObjectCount`, `PointStamped` and `PointCloud2` there.
 #[macro_export]
 macro_rules! wire_messages {
     ($header:ty, $pixels:ty, $ranges:ty) => {
@@ -340,9 +376,11 @@ macro_rules! wire_messages {
         pub type ObjectCount = $crate::ObjectCount<$header>;
         /// `geometry_msgs/PointStamped`.
         pub type PointStamped = $crate::PointStamped<$header>;
+        /// `sensor_msgs/PointCloud2`.
+        pub type PointCloud2 = $crate::PointCloud2<$header, $pixels>;
         pub use $crate::{
-            BoundingBox, ModelStates, NavSatStatus, Pose, Quaternion, RegionOfInterest, Text,
-            Twist, Vector3,
+            BoundingBox, ModelStates, NavSatStatus, PointField, Pose, Quaternion, RegionOfInterest,
+            Text, Twist, Vector3,
         };
     };
 }

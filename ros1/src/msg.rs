@@ -95,6 +95,14 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "geometry_msgs/Vector3Stamped",
         "Header header\ngeometry_msgs/Vector3 vector",
     ),
+    (
+        "sensor_msgs/PointField",
+        "uint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\nuint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\nuint32 offset\nuint8 datatype\nuint32 count",
+    ),
+    (
+        "sensor_msgs/PointCloud2",
+        "Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\nbool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense",
+    ),
     ("rosgraph_msgs/Clock", "time clock"),
     ("std_msgs/String", "string data"),
     (

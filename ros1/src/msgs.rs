@@ -246,6 +246,27 @@ impl Message for Image {
     }
 }
 
+impl Message for PointCloud2 {
+    const TYPE: &'static str = "sensor_msgs/PointCloud2";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::u32(out, self.height);
+        wire::u32(out, self.width);
+        wire::len(out, self.fields.len());
+        for f in &self.fields {
+            wire::string(out, &f.name);
+            wire::u32(out, f.offset);
+            wire::u8(out, f.datatype);
+            wire::u32(out, f.count);
+        }
+        wire::u8(out, u8::from(self.is_bigendian));
+        wire::u32(out, self.point_step);
+        wire::u32(out, self.row_step);
+        wire::bytes(out, &self.data);
+        wire::u8(out, u8::from(self.is_dense));
+    }
+}
+
 impl Message for CameraInfo {
     const TYPE: &'static str = "sensor_msgs/CameraInfo";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -583,6 +604,11 @@ mod tests {
             ("sensor_msgs/JointState", "3066dcd76a6cfaef579bd0f34173e9fd"),
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
             ("sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2"),
+            ("sensor_msgs/PointField", "268eacb2962780ceac86cbd17e328150"),
+            (
+                "sensor_msgs/PointCloud2",
+                "1158d486dd51d683ce2f1be655c3c181",
+            ),
             ("sensor_msgs/NavSatFix", "2d3a8cd499b9b4a0249fb98fd05cfa48"),
             (
                 "geometry_msgs/Vector3Stamped",

@@ -147,6 +147,17 @@ pub const LASER_SCAN: &str = concat!(
     header!()
 );
 
+/// `sensor_msgs/msg/PointCloud2`.
+pub const POINT_CLOUD2: &str = concat!(
+    "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n",
+    "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",
+    header!(),
+    block!(
+        "sensor_msgs/PointField",
+        "uint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\nuint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\nuint32 offset\nuint8 datatype\nuint32 count\n"
+    )
+);
+
 /// `sensor_msgs/msg/Imu`.
 pub const IMU: &str = concat!(
     "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n",

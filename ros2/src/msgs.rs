@@ -240,6 +240,11 @@ impl RosMessage for LaserScan {
     const DEFINITION: &'static str = crate::definitions::LASER_SCAN;
 }
 
+impl RosMessage for PointCloud2 {
+    const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::PointCloud2_";
+    const DEFINITION: &'static str = crate::definitions::POINT_CLOUD2;
+}
+
 impl RosMessage for Imu {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Imu_";
     const DEFINITION: &'static str = crate::definitions::IMU;

@@ -230,3 +230,68 @@ fn a_depth_cameras_noise_is_gaussian_in_metres_and_seeded() -> Result<()> {
     assert!(same, "two renders with the same seed differ");
     Ok(())
 }
+
+/// A depth camera's point cloud (gazebo_ros_openni_kinect's organized x y z rgb in the optical
+/// frame): a wall 3 m ahead, square to the camera and then turned 30 deg; every point that is
+/// not the ground lies within 1 cm of the wall's face once put back in the world, and carries
+/// its pixel's colour; beyond the cutoffs the points are NaN.
+#[test]
+fn a_depth_clouds_points_lie_on_the_wall_they_see() -> Result<()> {
+    use rover_sim::model::link_from_optical;
+    use rover_sim::sensors::{CloudLayout, CloudSource, DepthCloudBuilder, PointCloud};
+    let robot = robot()?;
+    let config = robot.cameras[0].clone();
+    let info = CameraInfo::from_config(&config);
+    let builder = DepthCloudBuilder::new(&info);
+    let camera = Pose::from_translation(Vec3::new(0.0, 0.0, 0.5));
+    let world_from_optical = camera * Pose::from_rotation(link_from_optical());
+    for yaw_deg in [0.0f32, 30.0] {
+        // The wall's face passes through (3, 0) with its normal turned by yaw.
+        let normal = Vec3::new(yaw_deg.to_radians().cos(), yaw_deg.to_radians().sin(), 0.0);
+        let centre = Vec3::new(3.0, 0.0, 1.5) + normal * 0.1;
+        let text = format!(
+            "[ground]\ncolor = \"#202020\"\nchecker_color = \"#202020\"\n[[box]]\nsize_m = [0.2, 8.0, 3.0]\nposition_m = [{}, {}, 0.0]\nyaw_deg = {yaw_deg}\ncolor = \"#ff0000\"\n",
+            centre.x, centre.y
+        );
+        let world = World::from_str(&text, Path::new("wall.toml"))?;
+        let mut renderer = CameraRenderer::new(&world, &robot, &config, 0)?;
+        renderer.enable_depth();
+        let rgb = renderer.render(&parked(&robot), camera)?.to_vec();
+        let depth = renderer.depth_m().ok_or("no depth image")?;
+        let mut cloud = PointCloud::new(
+            CloudSource::DepthCamera,
+            &info.frame_id,
+            CloudLayout::XyzRgb,
+        );
+        builder.fill(depth, &rgb, (0.4, 5.0), &mut cloud);
+        assert_eq!((cloud.width, cloud.height), (info.width, info.height));
+        assert_eq!(cloud.len(), (info.width * info.height) as usize);
+        assert!(!cloud.is_dense, "the sky is NaN");
+        let (mut on_wall, mut worst_m) = (0, 0.0f32);
+        for (i, p) in cloud.points() {
+            assert!(p[2] > 0.4 && p[2] < 5.0, "point {i} at depth {}", p[2]);
+            let w = world_from_optical.transform_point(Vec3::from(p));
+            if w.z < 0.05 {
+                continue; // the ground
+            }
+            let off_m = (w - Vec3::new(3.0, 0.0, 0.0)).dot(normal).abs();
+            worst_m = worst_m.max(off_m);
+            let [r, g, b] = cloud.rgb(i).ok_or("no colour")?;
+            assert!(
+                r > 60 && g < 40 && b < 40,
+                "point {i} of the red wall is {r} {g} {b}"
+            );
+            on_wall += 1;
+        }
+        assert!(on_wall > 10_000, "{on_wall} points on the wall");
+        assert!(
+            worst_m < 0.01,
+            "yaw {yaw_deg}: a wall point {worst_m:.4} m off its face"
+        );
+        println!(
+            "yaw {yaw_deg} deg: {on_wall} points, worst {:.2} mm off the wall",
+            worst_m * 1000.0
+        );
+    }
+    Ok(())
+}

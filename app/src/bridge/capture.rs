@@ -7,7 +7,7 @@ use rover_sim::{
     geometry::Pose,
     model::{CameraInfo, JointKind, RobotModel, link_from_optical},
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, GroundTruthBox, LaserScan},
+    sensors::{CameraFrame, GroundTruthBox, LaserScan, PointCloud},
 };
 
 use super::events::{
@@ -38,6 +38,16 @@ pub(crate) fn image(
         height: frame.height,
         pixels,
         depth,
+    }
+}
+
+/// The cloud to hand over: `cloud` copied, its points into the recycled `data`.
+pub(crate) fn cloud(cloud: &PointCloud, mut data: Vec<u8>) -> PointCloud {
+    data.clone_from(&cloud.data);
+    PointCloud {
+        frame_id: cloud.frame_id.clone(),
+        data,
+        ..*cloud
     }
 }
 

@@ -14,7 +14,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::ControlSample,
-    sensors::{FixReading, ImuReading, LaserScan, PoseReading},
+    sensors::{FixReading, ImuReading, LaserScan, PointCloud, PoseReading},
 };
 
 /// One frame's pose in another, as tf carries it.
@@ -183,6 +183,8 @@ pub(crate) enum Event {
     Pose(PoseReading),
     /// A GPS fix.
     Fix(FixReading),
+    /// A point cloud (its data in a recycled buffer).
+    Cloud(PointCloud),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -209,6 +211,8 @@ pub(crate) trait TopicFamily: Send {
     fn p3d(&mut self, _reading: &PoseReading) {}
     /// A GPS fix.
     fn gps(&mut self, _fix: &FixReading) {}
+    /// A point cloud.
+    fn cloud(&mut self, _cloud: &mut PointCloud) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in
@@ -265,7 +269,7 @@ pub(crate) fn buffer_pool() -> (BufferPool, BufferReturn) {
 }
 
 impl BufferPool {
-    /// An image buffer (its contents are stale).
+    /// An image or cloud buffer (its contents are stale).
     pub fn take_pixels(&self) -> Vec<u8> {
         self.pixels.try_recv().unwrap_or_default()
     }
@@ -313,6 +317,7 @@ impl BufferReturn {
             }
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
+            Event::Cloud(c) => send(&self.pixels, c.data),
             Event::Imu(_) | Event::Pose(_) | Event::Fix(_) => {}
         }
     }

@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -25,6 +25,7 @@ pub(crate) mod arm;
 pub(crate) mod camera;
 pub(crate) mod capture;
 pub(crate) mod clock;
+pub(crate) mod cloud;
 pub(crate) mod darknet;
 pub(crate) mod events;
 pub(crate) mod gps;
@@ -50,7 +51,9 @@ use rover_sim::{
     geometry::Pose,
     model::{CameraInfo, RobotModel},
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{
+        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+    },
 };
 
 use events::{BufferPool, BufferReturn, ControlUpdate, Event, Start, TopicFamily};
@@ -95,6 +98,8 @@ pub(crate) trait Transport {
     fn darknet(&mut self) -> Result<Box<dyn darknet::DarknetWire>>;
     /// The laser's scans.
     fn laser(&mut self, plan: &RosPlan) -> Result<Box<dyn laser::ScanWire>>;
+    /// The 3D lidars' and the depth camera's point clouds.
+    fn cloud(&mut self, plan: &RosPlan) -> Result<Box<dyn cloud::CloudWire>>;
     /// The IMUs' readings.
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn imu::ImuWire>>;
     /// p3d's ground-truth poses.
@@ -129,6 +134,7 @@ pub(crate) fn families(
         Box::new(camera::Camera::new(transport.camera(plan)?)),
         Box::new(darknet::Darknet::new(transport.darknet()?)),
         Box::new(laser::Laser::new(transport.laser(plan)?)),
+        Box::new(cloud::Clouds::new(transport.cloud(plan)?, plan)),
         Box::new(imu::Imu::new(transport.imu(plan)?)),
         Box::new(p3d::P3d::new(transport.p3d(plan)?)),
         Box::new(gps::Gps::new(transport.gps(plan)?)),
@@ -364,6 +370,13 @@ impl<R: Send + 'static> Observer for Bridge<R> {
     fn gps(&mut self, fix: &FixReading) {
         self.timed(|b| b.send(Event::Fix(*fix)));
     }
+
+    fn point_cloud(&mut self, cloud: &PointCloud, _world_from_sensor: Pose) {
+        self.timed(|b| {
+            let cloud = capture::cloud(cloud, b.buffers.take_pixels());
+            b.send(Event::Cloud(cloud));
+        });
+    }
 }
 
 /// The publishing thread: every event to every family, in order, until the bridge hangs up;
@@ -386,6 +399,7 @@ fn publish(
                 Event::Imu(reading) => family.imu(reading),
                 Event::Pose(reading) => family.p3d(reading),
                 Event::Fix(fix) => family.gps(fix),
+                Event::Cloud(cloud) => family.cloud(cloud),
             }
         }
         returns.give_back(event);

@@ -31,8 +31,12 @@ pub struct RosPlan {
     /// A depth camera's depth camera_info topic
     /// (`/<cameraName>/<depthImageCameraInfoTopicName>`).
     pub depth_info_topic: Option<String>,
+    /// A depth camera's point cloud topic (`/<cameraName>/<pointCloudTopicName>`).
+    pub depth_cloud_topic: Option<String>,
     /// The first laser's topic (`topicName`).
     pub scan_topic: Option<String>,
+    /// Each 3D lidar's cloud topic (`topicName`), in `RobotModel::lidars` order.
+    pub lidar_topics: Vec<String>,
     /// Each IMU's topic and `frame_id`, in `RobotModel::imus` order.
     pub imus: Vec<(String, String)>,
     /// Each p3d's topic and frames, in `RobotModel::p3ds` order.
@@ -180,7 +184,11 @@ impl RosPlan {
             depth_info_topic: camera
                 .and_then(|c| c.depth.as_ref())
                 .and_then(|d| camera_topic(&d.info_topic)),
+            depth_cloud_topic: camera
+                .and_then(|c| c.depth.as_ref())
+                .and_then(|d| camera_topic(&d.cloud_topic)),
             scan_topic: robot.lasers.first().map(|l| topic(&l.topic)),
+            lidar_topics: robot.lidars.iter().map(|l| topic(&l.rays.topic)).collect(),
             imus: robot
                 .imus
                 .iter()

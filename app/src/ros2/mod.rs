@@ -9,7 +9,7 @@
 //! on the topic's sinks
 //! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
 //! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
-//! `laser.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
+//! `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
 //! is written once, at the start (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
 //! `rt/cmd_vel`, the controllers' commands and `/rover/arm/task` into rover input like a key
 //! press. Stamps are sim time; `/clock` carries it.
@@ -38,6 +38,7 @@ mod actions;
 mod arm;
 mod camera;
 mod clock;
+mod cloud;
 mod convert;
 mod detections;
 mod gps;
@@ -176,6 +177,10 @@ impl Transport for Sinks<'_> {
 
     fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::gps::GpsWire>> {
         Ok(Box::new(gps::Gps::create(self, plan)?))
+    }
+
+    fn cloud(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::cloud::CloudWire>> {
+        Ok(Box::new(cloud::Clouds::create(self, plan)?))
     }
 
     fn imu(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::imu::ImuWire>> {

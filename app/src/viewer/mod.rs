@@ -32,6 +32,8 @@
 //!                                        readings (rad/s; m/s^2, gravity included)
 //! world/p3d/<plugin>                     Points3D: a world-frame p3d's ground-truth position
 //! plots/gps/<plugin>/{latitude,longitude,altitude}  Scalars: each GPS fix (deg, deg, m)
+//! world/clouds/<sensor>                  Points3D: each 3D lidar's cloud, coloured by height
+//! world/clouds/depth                     Points3D: the depth camera's cloud, in its colours
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
 //!                                        detector latency/Hz/dropped, real-time factor
 //! log                                    TextLog: mode changes, warnings
@@ -39,6 +41,7 @@
 //! Timelines: `sim_time` (seconds of simulated time) and `frame` (camera frame number).
 
 mod blueprint;
+mod clouds;
 mod images;
 mod scene;
 mod sinks;
@@ -53,7 +56,9 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::{ControlSample, Simulation},
-    sensors::{CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PoseReading},
+    sensors::{
+        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+    },
 };
 
 pub use blueprint::blueprint;
@@ -106,6 +111,8 @@ pub struct Recorder {
     p3d_paths: Vec<Option<String>>,
     /// Each GPS's plot paths: latitude, longitude, altitude.
     gps_paths: Vec<[String; 3]>,
+    /// The point clouds' paths and points.
+    clouds: clouds::Clouds,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -166,6 +173,7 @@ impl Recorder {
             imu_paths: Vec::new(),
             p3d_paths: Vec::new(),
             gps_paths: Vec::new(),
+            clouds: clouds::Clouds::default(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -288,6 +296,7 @@ impl Observer for Recorder {
                     .map(|what| format!("plots/gps/{}/{what}", g.name))
             })
             .collect();
+        self.clouds.start(sim);
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
@@ -560,6 +569,15 @@ impl Observer for Recorder {
             .zip([fix.latitude_deg, fix.longitude_deg, fix.altitude_m])
         {
             self.log(path, &rerun::Scalars::single(value));
+        }
+    }
+
+    fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
+        self.rec.set_duration_secs("sim_time", cloud.stamp_s);
+        if let Some((path, points)) = self.clouds.points(cloud, world_from_sensor) {
+            if let Err(e) = self.rec.log(path, &points) {
+                tracing::warn!("rerun: {path}: {e}");
+            }
         }
     }
 

@@ -1,0 +1,74 @@
+//! Point clouds as 3D points in the world: each 3D lidar's under `world/clouds/<sensor>`,
+//! coloured by height (blue at the ground, through green, to red 2 m up); the depth camera's
+//! under `world/clouds/depth`, in the colours its camera saw. NaN points (nothing in range) are
+//! left out.
+
+use rover_sim::{
+    geometry::Pose,
+    physics::Simulation,
+    sensors::{CloudSource, PointCloud},
+};
+
+/// The depth camera's cloud's entity path.
+pub(super) const DEPTH_CLOUD_PATH: &str = "world/clouds/depth";
+
+/// Height (m) at the top of the lidar colour ramp.
+const RAMP_TOP_M: f32 = 2.0;
+
+/// Each cloud's path and the points of the newest one (world frame), reused.
+#[derive(Debug, Default)]
+pub(super) struct Clouds {
+    lidar_paths: Vec<String>,
+    points: Vec<[f32; 3]>,
+    colours: Vec<rerun::Color>,
+}
+
+impl Clouds {
+    /// The paths of `sim`'s robot's lidars.
+    pub fn start(&mut self, sim: &Simulation) {
+        self.lidar_paths = sim
+            .robot()
+            .lidars
+            .iter()
+            .map(|l| format!("world/clouds/{}", l.rays.name))
+            .collect();
+    }
+
+    /// `cloud`, taken from `world_from_sensor`, as its path and points.
+    pub fn points(
+        &mut self,
+        cloud: &PointCloud,
+        world_from_sensor: Pose,
+    ) -> Option<(&str, rerun::Points3D)> {
+        let path = match cloud.source {
+            CloudSource::Lidar(n) => self.lidar_paths.get(n)?.as_str(),
+            CloudSource::DepthCamera => DEPTH_CLOUD_PATH,
+        };
+        self.points.clear();
+        self.colours.clear();
+        for (i, p) in cloud.points() {
+            let w = world_from_sensor.transform_point(glam::Vec3::from(p));
+            self.points.push(w.to_array());
+            let colour = match cloud.rgb(i) {
+                Some([r, g, b]) => rerun::Color::from_rgb(r, g, b),
+                None => height_colour(w.z),
+            };
+            self.colours.push(colour);
+        }
+        let points = rerun::Points3D::new(self.points.iter().copied())
+            .with_colors(self.colours.iter().copied())
+            .with_radii([0.01f32]);
+        Some((path, points))
+    }
+}
+
+/// Blue at the ground, green at mid-height, red at [`RAMP_TOP_M`] and above.
+fn height_colour(z_m: f32) -> rerun::Color {
+    let t = (z_m / RAMP_TOP_M).clamp(0.0, 1.0);
+    let (r, g, b) = if t < 0.5 {
+        (0.0, 2.0 * t, 1.0 - 2.0 * t)
+    } else {
+        (2.0 * t - 1.0, 2.0 - 2.0 * t, 0.0)
+    };
+    rerun::Color::from_rgb((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
+}
