@@ -1040,6 +1040,87 @@ fn rostopic_drives_tiagos_torso_and_arm_through_its_controllers() -> Result<()> 
     Ok(())
 }
 
+/// The VLP-16 car (assets/robots/my_robot_vlp16.urdf.xacro) in the playground: a rospy node
+/// reads `/velodyne_points` with Debian's sensor_msgs.point_cloud2 — velodyne_pointcloud's
+/// fields (x y z intensity float32 at 0 4 8 16, ring uint16 at 20, 32 bytes a point), an
+/// unorganized dense cloud in the frame `velodyne`, all 16 rings, every point within the
+/// plugin's 0.9-100 m, at 10 Hz of sim time.
+#[test]
+fn a_vlp16s_cloud_reaches_a_rospy_subscriber() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let mut graph = RosGraph::start()?;
+    let world = repo().join("worlds/playground.toml");
+    let robot = repo().join("assets/robots/my_robot_vlp16.urdf.xacro");
+    graph.spawn_rover(
+        6.0,
+        &[
+            "--world",
+            &world.to_string_lossy(),
+            "--robot",
+            &robot.to_string_lossy(),
+            "--no-detector",
+        ],
+    )?;
+    let out = graph.run_python(
+        "cloud.py",
+        r#"
+import math, rospy, time
+from sensor_msgs.msg import PointCloud2
+import sensor_msgs.point_cloud2 as pc2
+rospy.init_node('cloud_check')
+clouds = []
+rospy.Subscriber('/velodyne_points', PointCloud2, clouds.append)
+end = time.time() + 30
+while time.time() < end and len(clouds) < 6:
+    time.sleep(0.05)
+m = clouds[-1]
+print('fields ' + ' '.join('%s:%d:%d' % (f.name, f.offset, f.datatype) for f in m.fields))
+print('shape %d %d %d %d %d %s' % (m.height, m.width, m.point_step, m.row_step, int(m.is_dense), m.header.frame_id))
+pts = list(pc2.read_points(m, field_names=('x', 'y', 'z', 'ring')))
+r = [math.sqrt(x*x + y*y + z*z) for x, y, z, _ in pts]
+print('points %d %d %.3f %.3f' % (len(pts), len(set(p[3] for p in pts)), min(r), max(r)))
+stamps = [c.header.stamp.to_sec() for c in clouds]
+gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+print('period %.4f' % gaps[len(gaps) // 2])
+"#,
+        Duration::from_secs(60),
+    )?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    println!("{out}");
+    let line = |key: &str| -> Result<Vec<String>> {
+        let found = out
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key} ")))
+            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", graph.log("rover")))?;
+        Ok(found.split(' ').map(str::to_owned).collect())
+    };
+    ensure!(
+        line("fields")? == ["x:0:7", "y:4:7", "z:8:7", "intensity:16:7", "ring:20:4"],
+        "fields: {out}"
+    );
+    let shape = line("shape")?;
+    ensure!(shape[0] == "1" && shape[2] == "32" && shape[4] == "1", "shape {shape:?}");
+    ensure!(shape[5] == "velodyne", "frame {}", shape[5]);
+    let width: u64 = shape[1].parse()?;
+    ensure!(shape[3] == (32 * width).to_string(), "row_step {shape:?}");
+    let points = line("points")?;
+    let (n, rings, lo, hi): (u64, u64, f64, f64) = (
+        points[0].parse()?,
+        points[1].parse()?,
+        points[2].parse()?,
+        points[3].parse()?,
+    );
+    ensure!(n == width && n > 5000, "{n} points, width {width}");
+    ensure!(rings == 16, "{rings} rings");
+    ensure!(lo > 0.9 && hi < 100.0, "ranges {lo}..{hi} m");
+    let period: f64 = line("period")?[0].parse()?;
+    ensure!((period - 0.1).abs() < 1e-3, "clouds {period} s apart, 10 Hz expected");
+    Ok(())
+}
+
 /// TIAGo's xtion is a depth camera (`<sensor type="depth">`, gazebo_ros_openni_kinect): a rospy
 /// node receives `/xtion/depth_registered/image_raw` as 32FC1 (4-byte rows, little-endian,
 /// metres within the sensor's 0.3-8 m clip range or NaN) with a camera_info of the same size
@@ -1057,7 +1138,7 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
     graph.spawn_tiago(20.0, &urdf, &[])?;
     let out = graph.run_python(
         "depth.py",
-        "import math, struct, rospy\nfrom sensor_msgs.msg import Image, CameraInfo\nrospy.init_node('depth_check')\nimg = rospy.wait_for_message('/xtion/depth_registered/image_raw', Image, timeout=40)\ninfo = rospy.wait_for_message('/xtion/depth_registered/camera_info', CameraInfo, timeout=20)\nvals = struct.unpack('<%df' % (len(img.data) // 4), img.data)\nfinite = [v for v in vals if not math.isnan(v)]\nprint('image %s %d %d %d %d %d %s' % (img.encoding, img.width, img.height, img.step, len(img.data), img.is_bigendian, img.header.frame_id))\nprint('info %d %d %.3f %s' % (info.width, info.height, info.K[0], info.header.frame_id))\nprint('values %d %.4f %.4f' % (len(finite), min(finite) if finite else -1, max(finite) if finite else -1))\n",
+        "import math, struct, rospy\nfrom sensor_msgs.msg import Image, CameraInfo\nrospy.init_node('depth_check')\nimg = rospy.wait_for_message('/xtion/depth_registered/image_raw', Image, timeout=40)\ninfo = rospy.wait_for_message('/xtion/depth_registered/camera_info', CameraInfo, timeout=20)\nvals = struct.unpack('<%df' % (len(img.data) // 4), img.data)\nfinite = [v for v in vals if not math.isnan(v)]\nprint('image %s %d %d %d %d %d %s' % (img.encoding, img.width, img.height, img.step, len(img.data), img.is_bigendian, img.header.frame_id))\nprint('info %d %d %.3f %s' % (info.width, info.height, info.K[0], info.header.frame_id))\nprint('values %d %.4f %.4f' % (len(finite), min(finite) if finite else -1, max(finite) if finite else -1))\nfrom sensor_msgs.msg import PointCloud2\ncloud = rospy.wait_for_message('/xtion/depth_registered/points', PointCloud2, timeout=20)\nprint('cloud %d %d %d %d %s %s' % (cloud.width, cloud.height, cloud.point_step, int(cloud.is_dense), cloud.header.frame_id, ','.join('%s:%d' % (f.name, f.offset) for f in cloud.fields)))\nzs = [struct.unpack_from('<f', cloud.data, 32 * i + 8)[0] for i in range(0, cloud.width * cloud.height, 7)]\nzs = [z for z in zs if not math.isnan(z)]\nprint('cloudz %d %.4f %.4f' % (len(zs), min(zs) if zs else -1, max(zs) if zs else -1))\n",
         Duration::from_secs(60),
     )?;
     println!("{out}");
@@ -1094,6 +1175,20 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
         lo >= 0.3 - 1e-3 && hi <= 8.0 + 1e-3,
         "depth {lo}..{hi} m outside the clip range"
     );
+    // The organized cloud on `pointCloudTopicName`: a point per pixel in the same frame, x y z
+    // rgb, NaN outside the plugin's 0.5-8 m cutoffs.
+    let cloud = line("cloud ");
+    ensure!(cloud.len() == 7, "no cloud:\n{out}");
+    ensure!(
+        cloud[1..5] == ["640", "480", "32", "0"],
+        "cloud {cloud:?}"
+    );
+    ensure!(cloud[5] == info[4], "cloud frame {}", cloud[5]);
+    ensure!(cloud[6] == "x:0,y:4,z:8,rgb:16", "fields {}", cloud[6]);
+    let z = line("cloudz ");
+    let (n, zlo, zhi): (usize, f64, f64) = (z[1].parse()?, z[2].parse()?, z[3].parse()?);
+    ensure!(n > 100, "{n} cloud points in range");
+    ensure!(zlo > 0.5 && zhi < 8.0, "cloud z {zlo}..{zhi} m outside the cutoffs");
     graph.wait_rover(Duration::from_secs(120))?;
     Ok(())
 }
