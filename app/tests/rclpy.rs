@@ -588,6 +588,65 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
     Ok(())
 }
 
+/// The VLP-16 car's cloud reaches an rclpy subscriber (sensor data QoS) as a real
+/// sensor_msgs/msg/PointCloud2: velodyne_pointcloud's fields, an unorganized dense cloud in the
+/// frame `velodyne` with all 16 rings within the plugin's 0.9-100 m.
+#[test]
+fn an_rclpy_subscriber_reads_the_vlp16s_point_cloud() -> Result<()> {
+    let Some(distros) = distros() else {
+        return Ok(());
+    };
+    let robot = repo("assets/robots/my_robot_vlp16.urdf.xacro");
+    for (k, rclpy) in distros.into_iter().enumerate() {
+        let distro = rclpy.distro.clone();
+        let mut session = Session::start(
+            rclpy,
+            41 + k as u16,
+            20.0,
+            &["--robot", &robot.to_string_lossy(), "--no-detector"],
+        )?;
+        let found = session.peer(&["cloud"], Duration::from_secs(90))?;
+        let c = &found["cloud"];
+        println!("{distro}: {c}");
+        ensure!(
+            c["clouds"].as_u64().is_some_and(|n| n >= 5),
+            "{distro}: clouds: {c}\nrover:\n{}",
+            session.rover_log()
+        );
+        ensure!(c["frame"] == "velodyne", "{distro}: {c}");
+        ensure!(
+            c["fields"]
+                == serde_json::json!([
+                    ["x", 0, 7, 1],
+                    ["y", 4, 7, 1],
+                    ["z", 8, 7, 1],
+                    ["intensity", 16, 7, 1],
+                    ["ring", 20, 4, 1]
+                ]),
+            "{distro}: fields {c}"
+        );
+        let shape = &c["shape"];
+        let width = shape[1].as_u64().unwrap_or(0);
+        ensure!(
+            shape[0] == 1
+                && width > 5000
+                && shape[2] == 32
+                && shape[3].as_u64() == Some(32 * width)
+                && shape[4] == true
+                && shape[5] == false,
+            "{distro}: shape {shape}"
+        );
+        ensure!(c["rings"] == 16, "{distro}: rings {c}");
+        let (lo, hi) = (
+            c["range"][0].as_f64().unwrap_or(0.0),
+            c["range"][1].as_f64().unwrap_or(f64::MAX),
+        );
+        ensure!(lo > 0.9 && hi < 100.0, "{distro}: ranges {lo}..{hi}");
+        session.wait(Duration::from_secs(90))?;
+    }
+    Ok(())
+}
+
 /// The tutorial's listener_yolo as a real rclpy node (examples/ros2/listener_yolo_rclpy.py,
 /// with the darknet_ros_msgs set-up built): it prints `person` and its 0.1 m/s on /cmd_vel
 /// moves the car >= 0.5 m toward the person.

@@ -339,6 +339,30 @@ def publish_images(node):
     return {"sent": sent}
 
 
+def cloud(node):
+    """/velodyne_points from the VLP-16 car: its fields, shape and rings, read from the bytes."""
+    import math
+    import struct
+    from sensor_msgs.msg import PointCloud2
+    got = []
+    node.create_subscription(PointCloud2, "/velodyne_points", got.append,
+                             qos_profile_sensor_data)
+    spin_for(node, 5.0)
+    if not got:
+        return {"clouds": 0}
+    m = got[-1]
+    rings, ranges = set(), []
+    for i in range(0, m.width * m.height):
+        x, y, z = struct.unpack_from("<fff", m.data, i * m.point_step)
+        rings.add(struct.unpack_from("<H", m.data, i * m.point_step + 20)[0])
+        ranges.append(math.sqrt(x * x + y * y + z * z))
+    return {"clouds": len(got), "frame": m.header.frame_id,
+            "fields": [[f.name, f.offset, f.datatype, f.count] for f in m.fields],
+            "shape": [m.height, m.width, m.point_step, m.row_step, m.is_dense,
+                      m.is_bigendian],
+            "rings": len(rings), "range": [min(ranges), max(ranges)]}
+
+
 def main():
     rclpy.init()
     node = Node("rover_test_peer")
@@ -347,7 +371,8 @@ def main():
     checks = {"graph": graph, "params": params, "parameter_events": parameter_events,
               "topics": topics, "trajectory": trajectory,
               "arm_car_trajectory": arm_car_trajectory, "gripper": gripper,
-              "camera_rate": camera_rate, "publish_images": publish_images}
+              "camera_rate": camera_rate, "publish_images": publish_images,
+              "cloud": cloud}
     for check in sys.argv[1:]:
         out[check] = checks[check](node)
     print(json.dumps(out), flush=True)
