@@ -1102,7 +1102,10 @@ print('period %.4f' % gaps[len(gaps) // 2])
         "fields: {out}"
     );
     let shape = line("shape")?;
-    ensure!(shape[0] == "1" && shape[2] == "32" && shape[4] == "1", "shape {shape:?}");
+    ensure!(
+        shape[0] == "1" && shape[2] == "32" && shape[4] == "1",
+        "shape {shape:?}"
+    );
     ensure!(shape[5] == "velodyne", "frame {}", shape[5]);
     let width: u64 = shape[1].parse()?;
     ensure!(shape[3] == (32 * width).to_string(), "row_step {shape:?}");
@@ -1117,7 +1120,10 @@ print('period %.4f' % gaps[len(gaps) // 2])
     ensure!(rings == 16, "{rings} rings");
     ensure!(lo > 0.9 && hi < 100.0, "ranges {lo}..{hi} m");
     let period: f64 = line("period")?[0].parse()?;
-    ensure!((period - 0.1).abs() < 1e-3, "clouds {period} s apart, 10 Hz expected");
+    ensure!(
+        (period - 0.1).abs() < 1e-3,
+        "clouds {period} s apart, 10 Hz expected"
+    );
     Ok(())
 }
 
@@ -1179,16 +1185,16 @@ fn tiagos_xtion_publishes_a_32fc1_depth_image_with_its_camera_info() -> Result<(
     // rgb, NaN outside the plugin's 0.5-8 m cutoffs.
     let cloud = line("cloud ");
     ensure!(cloud.len() == 7, "no cloud:\n{out}");
-    ensure!(
-        cloud[1..5] == ["640", "480", "32", "0"],
-        "cloud {cloud:?}"
-    );
+    ensure!(cloud[1..5] == ["640", "480", "32", "0"], "cloud {cloud:?}");
     ensure!(cloud[5] == info[4], "cloud frame {}", cloud[5]);
     ensure!(cloud[6] == "x:0,y:4,z:8,rgb:16", "fields {}", cloud[6]);
     let z = line("cloudz ");
     let (n, zlo, zhi): (usize, f64, f64) = (z[1].parse()?, z[2].parse()?, z[3].parse()?);
     ensure!(n > 100, "{n} cloud points in range");
-    ensure!(zlo > 0.5 && zhi < 8.0, "cloud z {zlo}..{zhi} m outside the cutoffs");
+    ensure!(
+        zlo > 0.5 && zhi < 8.0,
+        "cloud z {zlo}..{zhi} m outside the cutoffs"
+    );
     graph.wait_rover(Duration::from_secs(120))?;
     Ok(())
 }

@@ -1,12 +1,13 @@
 //! The sensor benchmarks: camera frame time (`rover bench camera`), laser scan time with the
-//! follower's command on it (`rover bench laser`), and the IMU's, p3d's and GPS's cost per
-//! reading (`rover bench sensors`).
+//! follower's command on it (`rover bench laser`), the depth cloud's build time, and the IMU's,
+//! p3d's, GPS's cost per reading and the 3D lidar's per scan (`rover bench sensors`).
 
 use std::time::Instant;
 
 use anyhow::Result;
 use rover_core::RunConfig;
 use rover_sim::physics::{Simulation, Twist};
+use rover_sim::sensors::{CloudLayout, CloudSource, DepthCloudBuilder, LidarSensor, PointCloud};
 
 use super::stats::median;
 use crate::cli::args::WorldArgs;
@@ -26,6 +27,9 @@ pub struct CameraBench {
     pub truth_median_ms: f64,
     /// Median ms per image with the depth image read back too.
     pub depth_median_ms: f64,
+    /// Median ms to build the depth camera's organized point cloud (x y z rgb) from one depth
+    /// image and its colour image.
+    pub depth_cloud_median_ms: f64,
     /// Labelled things in the world.
     pub labelled: usize,
 }
@@ -51,6 +55,9 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
     let mut times = Vec::with_capacity(frames);
     let mut truth_times = Vec::with_capacity(frames);
     let mut depth_times = Vec::with_capacity(frames);
+    let mut cloud_times = Vec::with_capacity(frames);
+    let builder = DepthCloudBuilder::new(depth.info());
+    let mut cloud = PointCloud::new(CloudSource::DepthCamera, "bench", CloudLayout::XyzRgb);
     for _ in 0..frames.max(1) {
         for _ in 0..5 {
             sim.step();
@@ -62,8 +69,13 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         truth.capture(&sim)?;
         truth_times.push(start.elapsed().as_secs_f64() * 1e3);
         let start = Instant::now();
-        depth.capture(&sim)?;
+        let frame = depth.capture(&sim)?;
         depth_times.push(start.elapsed().as_secs_f64() * 1e3);
+        if let Some(depth_m) = frame.depth_m {
+            let start = Instant::now();
+            builder.fill(depth_m, frame.rgb, (0.4, 5.0), &mut cloud);
+            cloud_times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
     }
     let best_ms = times.iter().copied().fold(f64::INFINITY, f64::min);
     Ok(CameraBench {
@@ -73,6 +85,7 @@ pub fn camera(config: &RunConfig, frames: usize) -> Result<CameraBench> {
         best_ms,
         truth_median_ms: median(&mut truth_times),
         depth_median_ms: median(&mut depth_times),
+        depth_cloud_median_ms: median(&mut cloud_times),
         labelled: rover_sim::model::EntityIds::new(sim.world()).len(),
     })
 }
@@ -177,6 +190,8 @@ pub struct SensorsBench {
     pub p3ds: Vec<(String, usize, f64)>,
     /// Each GPS: its name, fixes timed, median wall time per fix (us).
     pub gpss: Vec<(String, usize, f64)>,
+    /// Each 3D lidar: its name, scans timed, median wall time per scan (ms), its rate (Hz).
+    pub lidars: Vec<(String, usize, f64, f64)>,
 }
 
 /// The robot's IMUs, p3d publishers and GPS receivers, each timed per reading (the link's state, the frames,
@@ -185,8 +200,11 @@ pub struct SensorsBench {
 pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
     let (world, robot) = config.load_world_and_robot()?;
     anyhow::ensure!(
-        !robot.imus.is_empty() || !robot.p3ds.is_empty() || !robot.gpss.is_empty(),
-        "{}: the robot has no IMU, p3d or GPS plugin; try --robot assets/robots/my_robot_laser.urdf.xacro",
+        !robot.imus.is_empty()
+            || !robot.p3ds.is_empty()
+            || !robot.gpss.is_empty()
+            || !robot.lidars.is_empty(),
+        "{}: the robot has no IMU, p3d, GPS or 3D lidar; try --robot assets/robots/my_robot_laser.urdf.xacro or my_robot_vlp16.urdf.xacro",
         robot.source.display()
     );
     let mut sim = Simulation::new(world, robot, &config.options)?;
@@ -199,6 +217,10 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
     let mut gpss: Vec<_> = (0..sim.robot().gpss.len())
         .filter_map(|i| rover_sim::sensors::GpsSensor::new(&sim, i))
         .collect();
+    let mut lidars = (0..sim.robot().lidars.len())
+        .map(|i| LidarSensor::new(&sim, i))
+        .collect::<rover_sim::Result<Vec<_>>>()?;
+    let mut lidar_times = vec![Vec::with_capacity(steps); lidars.len()];
     let mut gps_times = vec![Vec::with_capacity(steps); gpss.len()];
     let mut imu_times = vec![Vec::with_capacity(steps); imus.len()];
     let mut p3d_times = vec![Vec::with_capacity(steps); p3ds.len()];
@@ -213,6 +235,9 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
         }
         for (gps, times) in gpss.iter_mut().zip(&mut gps_times) {
             time_reading(times, || gps.update(&sim).is_some());
+        }
+        for (lidar, times) in lidars.iter_mut().zip(&mut lidar_times) {
+            time_reading(times, || lidar.scan_if_due(&sim).is_some());
         }
     }
     let figures = |names: Vec<String>, times: Vec<Vec<f64>>| -> Vec<(String, usize, f64)> {
@@ -235,6 +260,19 @@ pub fn sensors(config: &RunConfig, steps: usize) -> Result<SensorsBench> {
             gpss.iter().map(|g| g.config().name.clone()).collect(),
             gps_times,
         ),
+        lidars: lidars
+            .iter()
+            .zip(lidar_times)
+            .map(|(l, mut t)| {
+                let c = &l.config().rays;
+                (
+                    c.name.clone(),
+                    t.len(),
+                    median(&mut t) / 1e3,
+                    c.update_rate_hz,
+                )
+            })
+            .collect(),
     })
 }
 
@@ -257,6 +295,12 @@ pub(crate) fn bench_sensors(world: WorldArgs, steps: usize) -> Result<()> {
                 "sensors benchmark: {kind} {name}: median {us:.2} us per reading ({n} readings in {steps} physics steps)"
             );
         }
+    }
+    for (name, n, ms, rate_hz) in &b.lidars {
+        say!(
+            "sensors benchmark: lidar {name}: median {ms:.2} ms per scan ({n} scans in {steps} physics steps): {:.1}% of one core at {rate_hz} Hz",
+            ms * rate_hz / 10.0
+        );
     }
     Ok(())
 }
@@ -299,6 +343,12 @@ pub(crate) fn bench_camera(world: WorldArgs, frames: usize) -> Result<()> {
         "with a depth image (the depth buffer read back as metres): median {:.2} ms, +{:.2} ms",
         b.depth_median_ms,
         b.depth_median_ms - b.median_ms
+    );
+    say!(
+        "the depth image as an organized point cloud (x y z rgb, {}x{}): median {:.2} ms per frame",
+        b.size.0,
+        b.size.1,
+        b.depth_cloud_median_ms
     );
     Ok(())
 }
