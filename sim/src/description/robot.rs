@@ -155,6 +155,7 @@ impl RobotModel {
             imus: extensions.imus,
             p3ds: extensions.p3ds,
             gpss: extensions.gpss,
+            bumpers: extensions.bumpers,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
             transmissions,

@@ -41,9 +41,9 @@ pub use robot::{
     Collision, Inertial, Joint, JointId, JointKind, Link, LinkId, Mimic, RobotModel, Visual,
 };
 pub use sensors::{
-    AxisNoise, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise, GpsConfig,
-    ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES, OrientationReference,
-    P3dConfig, PixelFormat,
+    AxisNoise, BumperConfig, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise,
+    GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
+    OrientationReference, P3dConfig, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,

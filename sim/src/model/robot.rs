@@ -12,7 +12,8 @@ use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
 use crate::model::sensors::{
-    CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, P3dConfig,
+    BumperConfig, CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig,
+    P3dConfig,
 };
 
 /// Mass properties of a link, from its `<inertial>`.
@@ -222,6 +223,8 @@ pub struct RobotModel {
     pub p3ds: Vec<P3dConfig>,
     /// GPS receivers (`libhector_gazebo_ros_gps.so`).
     pub gpss: Vec<GpsConfig>,
+    /// Bumpers (`<sensor type="contact">` with `libgazebo_ros_bumper.so`).
+    pub bumpers: Vec<BumperConfig>,
     /// Gazebo sensors and plugins in the file that rover does not simulate (contact sensors,
     /// Gazebo's own GPS sensor, ...).
     pub not_simulated: Vec<String>,
@@ -523,6 +526,19 @@ impl RobotModel {
                 g.link
             );
             out.push((what, g.link.as_str(), g.line));
+        }
+        for b in &self.bumpers {
+            let what = format!(
+                "<gazebo reference=\"{}\"> <sensor type=\"contact\">",
+                b.link
+            );
+            out.push((what, b.link.as_str(), b.line));
+            if let Some(frame) = &b.reference_link {
+                let what = format!(
+                    "<plugin filename=\"libgazebo_ros_bumper.so\"> <frameName> \"{frame}\""
+                );
+                out.push((what, frame.as_str(), b.line));
+            }
         }
         for c in &self.cameras {
             let what = format!("<gazebo reference=\"{}\"> <sensor type=\"camera\">", c.link);

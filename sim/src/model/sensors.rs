@@ -389,3 +389,28 @@ pub struct GpsConfig {
     /// Line of the plugin element.
     pub line: Option<u32>,
 }
+
+/// A bumper: `<sensor type="contact">` with `libgazebo_ros_bumper.so`, reporting what its link
+/// touches as gazebo_msgs/ContactsState.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BumperConfig {
+    /// Sensor `name`.
+    pub name: String,
+    /// Link the sensor is attached to (`<gazebo reference>`): its own collision shapes (not
+    /// those of links lumped into it by fixed joints, which Gazebo names apart).
+    pub link: String,
+    /// `<contact><collision>`: the collision the sensor watches, as written (the messages'
+    /// `collision1_name` ends with it).
+    pub collision: String,
+    /// `<update_rate>` (Hz, sim time; 0: every physics step).
+    pub update_rate_hz: f64,
+    /// The plugin's `<bumperTopicName>` (default `bumper_states`), in its `<robotNamespace>`.
+    pub topic: String,
+    /// The plugin's `<frameName>` (default `world`): positions, normals and forces are given
+    /// in the world, or in this link's frame.
+    pub frame_name: String,
+    /// The link the contacts are expressed in, `None` for the world.
+    pub reference_link: Option<String>,
+    /// Line of the `<sensor>` element, for messages.
+    pub line: Option<u32>,
+}

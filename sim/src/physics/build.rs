@@ -261,6 +261,8 @@ pub(crate) fn add_robot(
                 .friction(robot.links[i].friction.unwrap_or(1.0))
                 .friction_combine_rule(CoefficientCombineRule::Min)
                 .collision_groups(robot_groups)
+                // Which link the collider is, behind its welded body: `link + 1`.
+                .user_data(i as u128 + 1)
                 .active_hooks(if kp.is_some() {
                     ActiveHooks::MODIFY_SOLVER_CONTACTS
                 } else {

@@ -7,6 +7,7 @@
 pub(crate) mod actuators;
 pub(crate) mod build;
 pub(crate) mod contact_springs;
+pub(crate) mod contacts;
 pub(crate) mod controllers;
 pub(crate) mod diff_drive;
 pub(crate) mod grasp;
@@ -20,6 +21,7 @@ pub(crate) mod trajectory;
 pub use actuators::{
     HOLD_BANDWIDTH_HZ, HOLD_FRICTION_ERROR, HOLD_INTEGRAL_S, JointCommand, JointState,
 };
+pub use contacts::LinkContact;
 pub use controllers::{ControllerCommandState, GripperState, TrajectoryOutcome, TrajectoryState};
 pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,

@@ -505,7 +505,7 @@ impl Simulation {
     }
 
     /// The name of a body that is not the robot's.
-    fn body_name(&self, body: RigidBodyHandle) -> String {
+    pub(crate) fn body_name(&self, body: RigidBodyHandle) -> String {
         if body == self.ground {
             return "ground".to_owned();
         }

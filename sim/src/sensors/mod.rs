@@ -1,10 +1,11 @@
 //! Sensors on sim time: the camera (`camera.rs`, rendering through `render`; its depth image
-//! as a point cloud, `cloud.rs`), the 2D laser (`laser.rs`) and the 3D lidar (`lidar.rs`), ray
-//! casts against the physics scene and people's bones (`rays.rs`), and from a link's motion the IMU
-//! (`imu.rs`), p3d's ground-truth pose (`p3d.rs`) and hector's GPS (`gps.rs`), all with seeded
-//! noise; and the camera's ground truth (`ground_truth.rs`: where each labelled thing is in the
-//! image).
+//! as a point cloud, `cloud.rs`); the 2D laser (`laser.rs`) and the 3D lidar (`lidar.rs`), ray
+//! casts against the physics scene and people's bones (`rays.rs`); from a link's motion the
+//! IMU (`imu.rs`), p3d's ground-truth pose (`p3d.rs`) and hector's GPS (`gps.rs`), all with
+//! seeded noise; bumpers from the physics contacts (`bumper.rs`); and the camera's ground
+//! truth (`ground_truth.rs`: where each labelled thing is in the image).
 
+pub(crate) mod bumper;
 pub(crate) mod camera;
 pub(crate) mod cloud;
 pub(crate) mod gps;
@@ -16,6 +17,7 @@ pub(crate) mod p3d;
 pub(crate) mod rays;
 pub(crate) mod schedule;
 
+pub use bumper::{BumperSensor, ContactsReading};
 pub use camera::{CameraFrame, CameraSensor};
 pub use cloud::{
     CloudField, CloudLayout, CloudSource, DepthCloudBuilder, POINT_FIELD_FLOAT32,

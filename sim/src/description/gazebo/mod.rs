@@ -1,11 +1,12 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
 //! `<sensor>` blocks (with `libgazebo_ros_camera.so`), ray sensors (`ray.rs`: 2D lasers and 3D
-//! lidars), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), and per-link
+//! lidars), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), bumpers (`bumper.rs`), and per-link
 //! friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
 
+mod bumper;
 mod gps;
 mod imu;
 mod p3d;
@@ -22,8 +23,8 @@ use crate::error::Result;
 use crate::model::actuation::RosControlPlugin;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
 use crate::model::sensors::{
-    CameraConfig, DepthOutput, Distortion, GpsConfig, ImuConfig, LaserConfig, LidarConfig,
-    P3dConfig, PixelFormat,
+    BumperConfig, CameraConfig, DepthOutput, Distortion, GpsConfig, ImuConfig, LaserConfig,
+    LidarConfig, P3dConfig, PixelFormat,
 };
 
 /// Everything read from `<gazebo>` elements.
@@ -37,6 +38,7 @@ pub(crate) struct Extensions {
     pub imus: Vec<ImuConfig>,
     pub p3ds: Vec<P3dConfig>,
     pub gpss: Vec<GpsConfig>,
+    pub bumpers: Vec<BumperConfig>,
     /// Link name -> friction coefficient (min of mu1 and mu2).
     pub friction: BTreeMap<String, f32>,
     /// Link name -> contact stiffness `<kp>` (N/m).
@@ -121,6 +123,21 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         Some(imu) => ext.imus.push(imu),
                         None => ext.ignored.push(format!(
                             "sensor \"{}\" (type imu, no ROS plugin: nothing published)",
+                            child.attribute("name").unwrap_or("?")
+                        )),
+                    }
+                }
+                "sensor" if child.attribute("type") == Some("contact") => {
+                    let Some(link) = reference else {
+                        return Err(ctx.err(
+                            child,
+                            "<sensor type=\"contact\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
+                        ));
+                    };
+                    match bumper::parse(&ctx, child, link)? {
+                        Some(b) => ext.bumpers.push(b),
+                        None => ext.ignored.push(format!(
+                            "sensor \"{}\" (type contact, no libgazebo_ros_bumper.so: nothing published)",
                             child.attribute("name").unwrap_or("?")
                         )),
                     }
