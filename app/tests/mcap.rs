@@ -158,6 +158,7 @@ fn rosbags_reads_the_recording_as_rover_wrote_it() -> Result<()> {
         ("/ground_truth/state", "nav_msgs/msg/Odometry"),
         ("/fix", "sensor_msgs/msg/NavSatFix"),
         ("/fix_velocity", "geometry_msgs/msg/Vector3Stamped"),
+        ("/bumper_states", "gazebo_msgs/msg/ContactsState"),
         (
             "/darknet_ros/bounding_boxes",
             "darknet_ros_msgs/msg/BoundingBoxes",

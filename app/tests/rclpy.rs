@@ -571,6 +571,12 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
                 && fix[4] == 2,
             "{distro}: /fix: {fix}"
         );
+        // The bumper on base_link's box, touching nothing in the playground.
+        let bumper = &sample["/bumper_states"];
+        ensure!(
+            *bumper == serde_json::json!(["base_link", 0]),
+            "{distro}: /bumper_states: {bumper}"
+        );
         // rover's log on /rosout (transient local: the lines before the peer came too):
         // the line naming its DDS domain, at INFO, from rover's source.
         let log_lines = sample["/rosout"].as_array().context("no /rosout sample")?;

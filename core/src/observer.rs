@@ -9,7 +9,8 @@ use rover_sim::{
     model::CameraInfo,
     physics::{ControlSample, Simulation},
     sensors::{
-        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+        CameraFrame, ContactsReading, FixReading, GroundTruthBox, ImuReading, LaserScan,
+        PointCloud, PoseReading,
     },
 };
 
@@ -83,6 +84,8 @@ pub trait Observer {
     /// A point cloud (a 3D lidar's, a depth camera's; `cloud.source` says which) in
     /// `cloud.frame_id`, that frame at `world_from_sensor` when it was taken.
     fn point_cloud(&mut self, _cloud: &PointCloud, _world_from_sensor: Pose) {}
+    /// A bumper reading (of the robot's bumper `reading.sensor`): what its link touches now.
+    fn contacts(&mut self, _reading: &ContactsReading) {}
     /// A mode change, a warning.
     fn event(&mut self, _sim_time_s: f64, _level: EventLevel, _text: &str) {}
     /// An observer that can no longer do its job (a trace or frame it cannot write) says so
@@ -134,6 +137,10 @@ impl<A: Observer + ?Sized, B: Observer + ?Sized> Observer for (&mut A, &mut B) {
     fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
         self.0.point_cloud(cloud, world_from_sensor);
         self.1.point_cloud(cloud, world_from_sensor);
+    }
+    fn contacts(&mut self, reading: &ContactsReading) {
+        self.0.contacts(reading);
+        self.1.contacts(reading);
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {
         self.0.event(sim_time_s, level, text);
@@ -227,6 +234,11 @@ impl Observer for Fanout<'_> {
     fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
         for o in &mut self.observers {
             o.point_cloud(cloud, world_from_sensor);
+        }
+    }
+    fn contacts(&mut self, reading: &ContactsReading) {
+        for o in &mut self.observers {
+            o.contacts(reading);
         }
     }
     fn event(&mut self, sim_time_s: f64, level: EventLevel, text: &str) {

@@ -1,5 +1,6 @@
 //! The sensors a session only shows its observers (the pilot reads none of them): the IMUs,
-//! p3d's ground truth, the GPS receivers and the 3D lidars, each read after every physics step
+//! p3d's ground truth, the GPS receivers, the bumpers and the 3D lidars, each read after every
+//! physics step
 //! when due, and the depth camera's point cloud, built from each depth image.
 
 use rover_sim::{
@@ -7,8 +8,8 @@ use rover_sim::{
     model::{CameraInfo, link_from_optical},
     physics::Simulation,
     sensors::{
-        CameraFrame, CloudLayout, CloudSource, DepthCloudBuilder, GpsSensor, ImuSensor,
-        LidarSensor, P3dSensor, PointCloud,
+        BumperSensor, CameraFrame, CloudLayout, CloudSource, DepthCloudBuilder, GpsSensor,
+        ImuSensor, LidarSensor, P3dSensor, PointCloud,
     },
 };
 
@@ -30,6 +31,7 @@ pub(crate) struct ObservedSensors {
     p3ds: Vec<P3dSensor>,
     gpss: Vec<GpsSensor>,
     lidars: Vec<LidarSensor>,
+    bumpers: Vec<BumperSensor>,
     depth_cloud: Option<DepthCloud>,
 }
 
@@ -91,6 +93,21 @@ impl ObservedSensors {
                 c.rays.topic
             );
         }
+        let bumpers = (0..robot.bumpers.len())
+            .filter_map(|i| BumperSensor::new(sim, i))
+            .inspect(|b| {
+                let c = b.config();
+                let rate = rate_text(c.update_rate_hz);
+                tracing::info!(
+                    "bumper: {} on {} ({}) at {rate}, topic {} in {}",
+                    c.name,
+                    c.link,
+                    c.collision,
+                    c.topic,
+                    c.frame_name
+                );
+            })
+            .collect();
         let depth = robot.cameras.first().and_then(|c| c.depth.as_ref());
         let depth_cloud = camera.zip(depth).map(|(info, d)| {
             tracing::info!(
@@ -114,6 +131,7 @@ impl ObservedSensors {
             p3ds,
             gpss,
             lidars,
+            bumpers,
             depth_cloud,
         })
     }
@@ -138,6 +156,11 @@ impl ObservedSensors {
         for gps in &mut self.gpss {
             if let Some(fix) = gps.update(sim) {
                 observer.gps(fix);
+            }
+        }
+        for bumper in &mut self.bumpers {
+            if let Some(reading) = bumper.update(sim) {
+                observer.contacts(reading);
             }
         }
         for lidar in &mut self.lidars {

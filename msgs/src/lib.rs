@@ -349,10 +349,49 @@ pub struct PointCloud2<H, B> {
     pub is_dense: bool,
 }
 
+/// `geometry_msgs/Wrench`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Wrench {
+    /// Force (N).
+    pub force: Vector3,
+    /// Torque (N m).
+    pub torque: Vector3,
+}
+
+/// `gazebo_msgs/ContactState`: one collision touching another.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactState {
+    /// Free text.
+    pub info: String,
+    /// The bumper's collision, scoped (`model::link::collision`).
+    pub collision1_name: String,
+    /// The other collision.
+    pub collision2_name: String,
+    /// The wrench at each contact point, on collision 1.
+    pub wrenches: Vec<Wrench>,
+    /// Their sum.
+    pub total_wrench: Wrench,
+    /// Contact points.
+    pub contact_positions: Vec<Vector3>,
+    /// Contact normals.
+    pub contact_normals: Vec<Vector3>,
+    /// Penetration depths (m).
+    pub depths: Vec<f64>,
+}
+
+/// `gazebo_msgs/ContactsState`, with the wire's header `H`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactsState<H> {
+    /// Stamp and the frame of the points, normals and wrenches.
+    pub header: H,
+    /// One per collision touched.
+    pub states: Vec<ContactState>,
+}
+
 /// Names, in a wire's `msgs` module, the messages above that carry a header, with the wire's
 /// header type, pixel buffer and range buffer: `wire_messages!(Header, Vec<u8>, Vec<f32>)`
 /// declares `Image`, `CameraInfo`, `JointState`, `LaserScan`, `Imu`, `NavSatFix`,
-/// `Vector3Stamped`, `BoundingBoxes`, `ObjectCount`, `PointStamped` and `PointCloud2` there.
+/// `Vector3Stamped`, `BoundingBoxes`, `ObjectCount`, `PointStamped`, `PointCloud2` and `ContactsState` there.
 #[macro_export]
 macro_rules! wire_messages {
     ($header:ty, $pixels:ty, $ranges:ty) => {
@@ -378,9 +417,11 @@ macro_rules! wire_messages {
         pub type PointStamped = $crate::PointStamped<$header>;
         /// `sensor_msgs/PointCloud2`.
         pub type PointCloud2 = $crate::PointCloud2<$header, $pixels>;
+        /// `gazebo_msgs/ContactsState`.
+        pub type ContactsState = $crate::ContactsState<$header>;
         pub use $crate::{
-            BoundingBox, ModelStates, NavSatStatus, PointField, Pose, Quaternion, RegionOfInterest,
-            Text, Twist, Vector3,
+            BoundingBox, ContactState, ModelStates, NavSatStatus, PointField, Pose, Quaternion,
+            RegionOfInterest, Text, Twist, Vector3, Wrench,
         };
     };
 }

@@ -103,6 +103,18 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "sensor_msgs/PointCloud2",
         "Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\nbool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense",
     ),
+    (
+        "geometry_msgs/Wrench",
+        "geometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque",
+    ),
+    (
+        "gazebo_msgs/ContactState",
+        "string info\nstring collision1_name\nstring collision2_name\ngeometry_msgs/Wrench[] wrenches\ngeometry_msgs/Wrench total_wrench\ngeometry_msgs/Vector3[] contact_positions\ngeometry_msgs/Vector3[] contact_normals\nfloat64[] depths",
+    ),
+    (
+        "gazebo_msgs/ContactsState",
+        "Header header\ngazebo_msgs/ContactState[] states",
+    ),
     ("rosgraph_msgs/Clock", "time clock"),
     ("std_msgs/String", "string data"),
     (

@@ -106,6 +106,44 @@ impl Decode for Twist {
     }
 }
 
+impl Geometry for Wrench {
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.force.encode(out);
+        self.torque.encode(out);
+    }
+    fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        Ok(Self {
+            force: Vector3::decode(r)?,
+            torque: Vector3::decode(r)?,
+        })
+    }
+}
+
+impl Message for ContactsState {
+    const TYPE: &'static str = "gazebo_msgs/ContactsState";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        wire::len(out, self.states.len());
+        for s in &self.states {
+            wire::string(out, &s.info);
+            wire::string(out, &s.collision1_name);
+            wire::string(out, &s.collision2_name);
+            wire::len(out, s.wrenches.len());
+            for w in &s.wrenches {
+                w.encode(out);
+            }
+            s.total_wrench.encode(out);
+            for points in [&s.contact_positions, &s.contact_normals] {
+                wire::len(out, points.len());
+                for p in points {
+                    p.encode(out);
+                }
+            }
+            wire::f64_array(out, &s.depths);
+        }
+    }
+}
+
 impl Message for ModelStates {
     const TYPE: &'static str = "gazebo_msgs/ModelStates";
     fn encode(&self, out: &mut Vec<u8>) {
@@ -605,6 +643,15 @@ mod tests {
             ("sensor_msgs/LaserScan", "90c7ef2dc6895d81024acba2ac42f369"),
             ("sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2"),
             ("sensor_msgs/PointField", "268eacb2962780ceac86cbd17e328150"),
+            ("geometry_msgs/Wrench", "4f539cf138b23283b520fd271b567936"),
+            (
+                "gazebo_msgs/ContactState",
+                "48c0ffb054b8c444f870cecea1ee50d9",
+            ),
+            (
+                "gazebo_msgs/ContactsState",
+                "acbcb1601a8e525bf72509f18e6f668d",
+            ),
             (
                 "sensor_msgs/PointCloud2",
                 "1158d486dd51d683ce2f1be655c3c181",

@@ -220,6 +220,21 @@ pub const MODEL_STATES: &str = concat!(
     vector3!()
 );
 
+/// `gazebo_msgs/msg/ContactsState`.
+pub const CONTACTS_STATE: &str = concat!(
+    "std_msgs/Header header\ngazebo_msgs/ContactState[] states\n",
+    header!(),
+    block!(
+        "gazebo_msgs/ContactState",
+        "string info\nstring collision1_name\nstring collision2_name\ngeometry_msgs/Wrench[] wrenches\ngeometry_msgs/Wrench total_wrench\ngeometry_msgs/Vector3[] contact_positions\ngeometry_msgs/Vector3[] contact_normals\nfloat64[] depths\n"
+    ),
+    block!(
+        "geometry_msgs/Wrench",
+        "geometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque\n"
+    ),
+    vector3!()
+);
+
 /// `geometry_msgs/msg/PointStamped`.
 pub const POINT_STAMPED: &str = concat!(
     "std_msgs/Header header\ngeometry_msgs/Point point\n",
@@ -318,6 +333,8 @@ mod tests {
             IMU,
             NAV_SAT_FIX,
             VECTOR3_STAMPED,
+            POINT_CLOUD2,
+            CONTACTS_STATE,
             BOUNDING_BOXES,
             OBJECT_COUNT,
             STRING,

@@ -245,6 +245,11 @@ impl RosMessage for PointCloud2 {
     const DEFINITION: &'static str = crate::definitions::POINT_CLOUD2;
 }
 
+impl RosMessage for ContactsState {
+    const DDS_TYPE: &'static str = "gazebo_msgs::msg::dds_::ContactsState_";
+    const DEFINITION: &'static str = crate::definitions::CONTACTS_STATE;
+}
+
 impl RosMessage for Imu {
     const DDS_TYPE: &'static str = "sensor_msgs::msg::dds_::Imu_";
     const DEFINITION: &'static str = crate::definitions::IMU;

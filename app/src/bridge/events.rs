@@ -14,7 +14,7 @@ use rover_sim::{
     geometry::Pose,
     model::CameraInfo,
     physics::ControlSample,
-    sensors::{FixReading, ImuReading, LaserScan, PointCloud, PoseReading},
+    sensors::{ContactsReading, FixReading, ImuReading, LaserScan, PointCloud, PoseReading},
 };
 
 /// One frame's pose in another, as tf carries it.
@@ -185,6 +185,8 @@ pub(crate) enum Event {
     Fix(FixReading),
     /// A point cloud (its data in a recycled buffer).
     Cloud(PointCloud),
+    /// A bumper reading.
+    Contacts(ContactsReading),
 }
 
 /// One topic family on the publishing thread: its publishers and the messages it keeps from one
@@ -213,6 +215,8 @@ pub(crate) trait TopicFamily: Send {
     fn gps(&mut self, _fix: &FixReading) {}
     /// A point cloud.
     fn cloud(&mut self, _cloud: &mut PointCloud) {}
+    /// A bumper reading.
+    fn contacts(&mut self, _reading: &ContactsReading) {}
 }
 
 /// Images kept waiting for reuse: more than the detection image's ring of 4 and a few in
@@ -318,7 +322,7 @@ impl BufferReturn {
             Event::Detections(d) | Event::Truth(d) => send(&self.boxes, d.boxes),
             Event::Scan(s) => send(&self.ranges, s.ranges_m),
             Event::Cloud(c) => send(&self.pixels, c.data),
-            Event::Imu(_) | Event::Pose(_) | Event::Fix(_) => {}
+            Event::Imu(_) | Event::Pose(_) | Event::Fix(_) | Event::Contacts(_) => {}
         }
     }
 }

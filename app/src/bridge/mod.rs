@@ -9,7 +9,7 @@
 //!   asks that nothing be lost. The publishing thread shows each event to every topic family
 //!   in turn and sends the buffers back.
 //! - The topic families, one file each: `clock.rs`, `odom.rs`, `tf.rs`, `joint_states.rs`,
-//!   `camera.rs`, `darknet.rs`, `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
+//!   `camera.rs`, `darknet.rs`, `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `bumper.rs`, `arm.rs`, `ground_truth.rs`, `status.rs`, `model_states.rs`. A family
 //!   decides when and what is published (rates, changes, which frames, drawing the detection
 //!   image); its wire trait (`OdomWire`, ...) is what a transport implements to put that on
 //!   the wire: ROS 1's encoders in app/src/ros/, ROS 2's in app/src/ros2/. [`Transport`]
@@ -22,6 +22,7 @@
 pub(crate) mod action_goals;
 pub(crate) mod action_intake;
 pub(crate) mod arm;
+pub(crate) mod bumper;
 pub(crate) mod camera;
 pub(crate) mod capture;
 pub(crate) mod clock;
@@ -52,7 +53,8 @@ use rover_sim::{
     model::{CameraInfo, RobotModel},
     physics::{ControlSample, Simulation},
     sensors::{
-        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+        CameraFrame, ContactsReading, FixReading, GroundTruthBox, ImuReading, LaserScan,
+        PointCloud, PoseReading,
     },
 };
 
@@ -106,6 +108,8 @@ pub(crate) trait Transport {
     fn p3d(&mut self, plan: &RosPlan) -> Result<Box<dyn p3d::P3dWire>>;
     /// hector's GPS fixes and velocities.
     fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn gps::GpsWire>>;
+    /// The bumpers' contacts.
+    fn bumper(&mut self, plan: &RosPlan) -> Result<Box<dyn bumper::BumperWire>>;
     /// The arm's state and points.
     fn arm(&mut self, plan: &RosPlan) -> Result<Box<dyn arm::ArmWire>>;
     /// `/rover/ground_truth/bounding_boxes`.
@@ -138,6 +142,7 @@ pub(crate) fn families(
         Box::new(imu::Imu::new(transport.imu(plan)?)),
         Box::new(p3d::P3d::new(transport.p3d(plan)?)),
         Box::new(gps::Gps::new(transport.gps(plan)?)),
+        Box::new(bumper::Bumper::new(transport.bumper(plan)?)),
         Box::new(arm::Arm::new(transport.arm(plan)?)),
         Box::new(status::Status::new(transport.status()?)),
         Box::new(model_states::ModelStates::new(transport.model_states()?)),
@@ -371,6 +376,10 @@ impl<R: Send + 'static> Observer for Bridge<R> {
         self.timed(|b| b.send(Event::Fix(*fix)));
     }
 
+    fn contacts(&mut self, reading: &ContactsReading) {
+        self.timed(|b| b.send(Event::Contacts(reading.clone())));
+    }
+
     fn point_cloud(&mut self, cloud: &PointCloud, _world_from_sensor: Pose) {
         self.timed(|b| {
             let cloud = capture::cloud(cloud, b.buffers.take_pixels());
@@ -400,6 +409,7 @@ fn publish(
                 Event::Pose(reading) => family.p3d(reading),
                 Event::Fix(fix) => family.gps(fix),
                 Event::Cloud(cloud) => family.cloud(cloud),
+                Event::Contacts(reading) => family.contacts(reading),
             }
         }
         returns.give_back(event);

@@ -43,6 +43,8 @@ pub struct RosPlan {
     pub p3ds: Vec<P3dTopic>,
     /// Each GPS receiver's topics and frame, in `RobotModel::gpss` order.
     pub gpss: Vec<GpsTopics>,
+    /// Each bumper's topic, in `RobotModel::bumpers` order.
+    pub bumpers: Vec<String>,
     /// Every moving joint the session reports, in `/joint_states` order.
     pub(crate) joints: Vec<MovingJoint>,
     /// `/joint_states` rate from a joint_state_controller's `publish_rate` (Hz); `None`:
@@ -203,6 +205,7 @@ impl RosPlan {
                     child_frame: p.link.clone(),
                 })
                 .collect(),
+            bumpers: robot.bumpers.iter().map(|b| topic(&b.topic)).collect(),
             gpss: robot
                 .gpss
                 .iter()

@@ -3,7 +3,7 @@
 //! and the master's XML-RPC). Here are the encoders, one file per topic family, each
 //! implementing its family's wire trait with ROS 1's messages and publishers (`clock.rs`,
 //! `odom.rs`, `tf.rs`, `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the
-//! ground truth), `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
+//! ground truth), `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `bumper.rs`, `arm.rs`, `status.rs`); `controller_states.rs`, the controllers'
 //! `state` topics, which only ROS 1 carries (their control_msgs layouts differ between ROS 2
 //! distributions); `actions.rs`, actionlib's `follow_joint_trajectory` for each trajectory
 //! controller, and `gripper.rs`, `gripper_cmd` for each gripper controller (what a goal
@@ -15,6 +15,7 @@
 
 mod actions;
 mod arm;
+mod bumper;
 mod camera;
 mod clock;
 mod cloud;
@@ -106,6 +107,10 @@ impl Transport for Ros1<'_> {
 
     fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::gps::GpsWire>> {
         Ok(Box::new(gps::Gps::advertise(self.node, plan)?))
+    }
+
+    fn bumper(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::bumper::BumperWire>> {
+        Ok(Box::new(bumper::Bumper::advertise(self.node, plan)?))
     }
 
     fn cloud(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::cloud::CloudWire>> {

@@ -9,7 +9,7 @@
 //! on the topic's sinks
 //! (`sinks.rs`: its DDS writer, its MCAP channel, or both): `clock.rs`, `odom.rs`, `tf.rs`,
 //! `joint_states.rs`, `camera.rs`, `detections.rs` (darknet_ros and the ground truth),
-//! `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
+//! `laser.rs`, `cloud.rs`, `imu.rs`, `p3d.rs`, `gps.rs`, `bumper.rs`, `arm.rs`, `status.rs`, `rosout.rs` (rover's log lines); `/robot_description`
 //! is written once, at the start (transient local, as robot_state_publisher keeps it). The input half (`input.rs`) turns
 //! `rt/cmd_vel`, the controllers' commands and `/rover/arm/task` into rover input like a key
 //! press. Stamps are sim time; `/clock` carries it.
@@ -36,6 +36,7 @@
 
 mod actions;
 mod arm;
+mod bumper;
 mod camera;
 mod clock;
 mod cloud;
@@ -177,6 +178,10 @@ impl Transport for Sinks<'_> {
 
     fn gps(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::gps::GpsWire>> {
         Ok(Box::new(gps::Gps::create(self, plan)?))
+    }
+
+    fn bumper(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::bumper::BumperWire>> {
+        Ok(Box::new(bumper::Bumper::create(self, plan)?))
     }
 
     fn cloud(&mut self, plan: &RosPlan) -> Result<Box<dyn crate::bridge::cloud::CloudWire>> {

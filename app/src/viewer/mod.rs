@@ -32,6 +32,7 @@
 //!                                        readings (rad/s; m/s^2, gravity included)
 //! world/p3d/<plugin>                     Points3D: a world-frame p3d's ground-truth position
 //! plots/gps/<plugin>/{latitude,longitude,altitude}  Scalars: each GPS fix (deg, deg, m)
+//! plots/bumper/<sensor>/contacts         Scalars: how many collisions each bumper touches
 //! world/clouds/<sensor>                  Points3D: each 3D lidar's cloud, coloured by height
 //! world/clouds/depth                     Points3D: the depth camera's cloud, in its colours
 //! plots/...                              Scalars: cmd/measured velocity, wheel speeds, mode,
@@ -57,7 +58,8 @@ use rover_sim::{
     model::CameraInfo,
     physics::{ControlSample, Simulation},
     sensors::{
-        CameraFrame, FixReading, GroundTruthBox, ImuReading, LaserScan, PointCloud, PoseReading,
+        CameraFrame, ContactsReading, FixReading, GroundTruthBox, ImuReading, LaserScan,
+        PointCloud, PoseReading,
     },
 };
 
@@ -113,6 +115,8 @@ pub struct Recorder {
     gps_paths: Vec<[String; 3]>,
     /// The point clouds' paths and points.
     clouds: clouds::Clouds,
+    /// Each bumper's plot path (how many collisions it touches).
+    bumper_paths: Vec<String>,
     watch: Option<ViewerWatch>,
     viewer_gone: bool,
     started: Instant,
@@ -174,6 +178,7 @@ impl Recorder {
             p3d_paths: Vec::new(),
             gps_paths: Vec::new(),
             clouds: clouds::Clouds::default(),
+            bumper_paths: Vec::new(),
             paths: ScenePaths::default(),
             watch: sinks.watch,
             viewer_gone: false,
@@ -297,6 +302,9 @@ impl Observer for Recorder {
             })
             .collect();
         self.clouds.start(sim);
+        self.bumper_paths = (sim.robot().bumpers.iter())
+            .map(|b| format!("plots/bumper/{}/contacts", b.name))
+            .collect();
     }
 
     fn control(&mut self, sim: &Simulation, sample: &ControlSample, stats: &LoopStats) {
@@ -570,6 +578,15 @@ impl Observer for Recorder {
         {
             self.log(path, &rerun::Scalars::single(value));
         }
+    }
+
+    fn contacts(&mut self, reading: &ContactsReading) {
+        let Some(path) = self.bumper_paths.get(reading.sensor) else {
+            return;
+        };
+        self.rec.set_duration_secs("sim_time", reading.stamp_s);
+        let touching = rerun::Scalars::single(reading.contacts.len() as f64);
+        self.log(path, &touching);
     }
 
     fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {

@@ -107,7 +107,7 @@ def parameter_events(node):
 def topics(node):
     """Each topic of docs/ROS2.md's table, subscribed with its real type and QoS."""
     from darknet_ros_msgs.msg import BoundingBoxes, ObjectCount
-    from gazebo_msgs.msg import ModelStates
+    from gazebo_msgs.msg import ContactsState, ModelStates
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import Log
     from rosgraph_msgs.msg import Clock
@@ -140,6 +140,7 @@ def topics(node):
         ("/ground_truth/state", Odometry, reliable, "reliable"),
         ("/fix", NavSatFix, qos_profile_sensor_data, "best effort"),
         ("/fix_velocity", Vector3Stamped, qos_profile_sensor_data, "best effort"),
+        ("/bumper_states", ContactsState, reliable, "reliable"),
         ("/rosout", Log, rosout, "reliable, transient local"),
     ]
     counts, last, rover_log = {}, {}, []
@@ -181,6 +182,9 @@ def topics(node):
         m = last["/fix"]
         sample["/fix"] = [m.header.frame_id, m.latitude, m.longitude, m.status.service,
                           m.position_covariance_type]
+    if "/bumper_states" in last:
+        m = last["/bumper_states"]
+        sample["/bumper_states"] = [m.header.frame_id, len(m.states)]
     if "/imu" in last:
         m = last["/imu"]
         sample["/imu"] = [m.header.frame_id, m.linear_acceleration.z, m.orientation.w]
