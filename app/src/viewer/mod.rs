@@ -591,10 +591,10 @@ impl Observer for Recorder {
 
     fn point_cloud(&mut self, cloud: &PointCloud, world_from_sensor: Pose) {
         self.rec.set_duration_secs("sim_time", cloud.stamp_s);
-        if let Some((path, points)) = self.clouds.points(cloud, world_from_sensor) {
-            if let Err(e) = self.rec.log(path, &points) {
-                tracing::warn!("rerun: {path}: {e}");
-            }
+        if let Some((path, points)) = self.clouds.points(cloud, world_from_sensor)
+            && let Err(e) = self.rec.log(path, &points)
+        {
+            tracing::warn!("rerun: {path}: {e}");
         }
     }
 

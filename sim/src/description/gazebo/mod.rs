@@ -91,62 +91,7 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ));
                     }
                 }
-                "sensor" if matches!(child.attribute("type"), Some("camera" | "depth")) => {
-                    let Some(link) = reference else {
-                        return Err(ctx.err(
-                            child,
-                            "<sensor type=\"camera\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
-                        ));
-                    };
-                    ext.cameras.push(parse_camera(&ctx, child, link)?);
-                }
-                "sensor" if matches!(child.attribute("type"), Some("ray" | "gpu_ray")) => {
-                    let Some(link) = reference else {
-                        return Err(ctx.err(
-                            child,
-                            "<sensor type=\"ray\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
-                        ));
-                    };
-                    match ray::parse(&ctx, child, link)? {
-                        ray::RaySensor::Planar(laser) => ext.lasers.push(laser),
-                        ray::RaySensor::Lidar(lidar) => ext.lidars.push(lidar),
-                    }
-                }
-                "sensor" if child.attribute("type") == Some("imu") => {
-                    let Some(link) = reference else {
-                        return Err(ctx.err(
-                            child,
-                            "<sensor type=\"imu\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
-                        ));
-                    };
-                    match imu::parse_sensor(&ctx, child, link, robot_name)? {
-                        Some(imu) => ext.imus.push(imu),
-                        None => ext.ignored.push(format!(
-                            "sensor \"{}\" (type imu, no ROS plugin: nothing published)",
-                            child.attribute("name").unwrap_or("?")
-                        )),
-                    }
-                }
-                "sensor" if child.attribute("type") == Some("contact") => {
-                    let Some(link) = reference else {
-                        return Err(ctx.err(
-                            child,
-                            "<sensor type=\"contact\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on".to_owned(),
-                        ));
-                    };
-                    match bumper::parse(&ctx, child, link)? {
-                        Some(b) => ext.bumpers.push(b),
-                        None => ext.ignored.push(format!(
-                            "sensor \"{}\" (type contact, no libgazebo_ros_bumper.so: nothing published)",
-                            child.attribute("name").unwrap_or("?")
-                        )),
-                    }
-                }
-                "sensor" => ext.ignored.push(format!(
-                    "sensor \"{}\" (type {})",
-                    child.attribute("name").unwrap_or("?"),
-                    child.attribute("type").unwrap_or("?")
-                )),
+                "sensor" => read_sensor(&ctx, child, reference, robot_name, &mut ext)?,
                 "mu1" => {
                     mu[0] = Some(ctx.non_negative(
                         child,
@@ -181,6 +126,54 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
         }
     }
     Ok(ext)
+}
+
+/// A `<sensor>` in a `<gazebo>` element (on link `reference`) into `ext`; kinds and plugins
+/// rover does not simulate are listed in `ext.ignored`.
+fn read_sensor(
+    ctx: &Ctx<'_, '_>,
+    sensor: Node<'_, '_>,
+    reference: Option<&str>,
+    robot_name: &str,
+    ext: &mut Extensions,
+) -> Result<()> {
+    let kind = sensor.attribute("type").unwrap_or("?");
+    let name = sensor.attribute("name").unwrap_or("?");
+    let simulated = matches!(
+        kind,
+        "camera" | "depth" | "ray" | "gpu_ray" | "imu" | "contact"
+    );
+    let link = match reference {
+        Some(link) => link,
+        None if simulated => {
+            return Err(ctx.err(
+                sensor,
+                format!("<sensor type=\"{kind}\"> must sit in <gazebo reference=\"LINK\"> naming the link it is mounted on"),
+            ));
+        }
+        None => "",
+    };
+    match kind {
+        "camera" | "depth" => ext.cameras.push(parse_camera(ctx, sensor, link)?),
+        "ray" | "gpu_ray" => match ray::parse(ctx, sensor, link)? {
+            ray::RaySensor::Planar(laser) => ext.lasers.push(laser),
+            ray::RaySensor::Lidar(lidar) => ext.lidars.push(lidar),
+        },
+        "imu" => match imu::parse_sensor(ctx, sensor, link, robot_name)? {
+            Some(imu) => ext.imus.push(imu),
+            None => ext.ignored.push(format!(
+                "sensor \"{name}\" (type imu, no ROS plugin: nothing published)"
+            )),
+        },
+        "contact" => match bumper::parse(ctx, sensor, link)? {
+            Some(b) => ext.bumpers.push(b),
+            None => ext.ignored.push(format!(
+                "sensor \"{name}\" (type contact, no libgazebo_ros_bumper.so: nothing published)"
+            )),
+        },
+        _ => ext.ignored.push(format!("sensor \"{name}\" (type {kind})")),
+    }
+    Ok(())
 }
 
 /// gazebo_ros_control: the namespace of the controllers' topics and the control period.
