@@ -57,7 +57,7 @@ impl Clouds {
         }
         let points = rerun::Points3D::new(self.points.iter().copied())
             .with_colors(self.colours.iter().copied())
-            .with_radii([0.01f32]);
+            .with_radii([rerun::components::Radius::new_ui_points(1.5)]);
         Some((path, points))
     }
 }
