@@ -124,8 +124,24 @@ fn keys_sent_to_the_real_window_drive_the_car_and_switch_mode() -> Result<()> {
     assert_eq!(rows[0].mode, "manual");
     assert_eq!(end.mode, "follow");
     // The window's image was written at exit.
-    assert_eq!((run.shot.width(), run.shot.height()), (640, 592));
+    assert_eq!((run.shot.width(), run.shot.height()), (640, 614));
+    if let Some(path) = std::env::var_os("ROVER_KEEP_SCREENSHOT") {
+        run.shot.save(path)?;
+    }
+    // The HUD's last line reads the playground car's laser, IMU, GPS and bumper: text there.
+    assert!(
+        text_pixels(&run.shot.to_rgb8(), 480 + 110..614) > 300,
+        "no sensor line under the HUD"
+    );
     Ok(())
+}
+
+/// Pixels that are not the HUD's background in rows `rows` of `shot`.
+fn text_pixels(shot: &image::RgbImage, rows: std::ops::Range<u32>) -> usize {
+    let background = image::Rgb([24u8, 26, 30]);
+    rows.flat_map(|y| (0..shot.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| *shot.get_pixel(x, y) != background)
+        .count()
 }
 
 /// The example car with an arm (worlds/arm_car.toml): the teleop keys drive it, `2` picks the
@@ -170,7 +186,7 @@ fn the_arm_car_drives_with_keys_and_its_arm_jogs() -> Result<()> {
         (elbow_end - 0.1).abs() < 0.03,
         "3 then ] should move the elbow to 0.1 rad: {elbow_end:.3}"
     );
-    assert_eq!((run.shot.width(), run.shot.height()), (640, 592));
+    assert_eq!((run.shot.width(), run.shot.height()), (640, 614));
     Ok(())
 }
 
@@ -261,13 +277,13 @@ fn a_narrow_camera_gets_a_hud_whose_lines_fit() -> Result<()> {
     let shot = run.shot.to_rgb8();
     assert_eq!(
         (shot.width(), shot.height()),
-        (640, 240 + 112),
+        (640, 240 + 134),
         "{}",
         run.log
     );
     let background = image::Rgb([24u8, 26, 30]);
     // The HUD strip, right of where a 320 px canvas would have ended.
-    let text_beyond = (240..352)
+    let text_beyond = (240..374)
         .flat_map(|y| (330..630).map(move |x| (x, y)))
         .filter(|&(x, y)| *shot.get_pixel(x, y) != background)
         .count();
@@ -275,6 +291,12 @@ fn a_narrow_camera_gets_a_hud_whose_lines_fit() -> Result<()> {
         text_beyond > 200,
         "no HUD text right of 330 px ({text_beyond} pixels): lines are cut; log:\n{}",
         run.log
+    );
+    // The arm car carries no sensor but its cameras: no sensor line.
+    assert_eq!(
+        text_pixels(&shot, 240 + 110..374),
+        0,
+        "a sensor line without sensors"
     );
     // The image is centred: background at the left margin, the render in the middle.
     assert_eq!(*shot.get_pixel(100, 120), background);

@@ -141,6 +141,21 @@ impl ObservedSensors {
         &self.imus
     }
 
+    /// The robot's GPS receivers (`RobotModel::gpss` order).
+    pub fn gpss(&self) -> &[GpsSensor] {
+        &self.gpss
+    }
+
+    /// The robot's bumpers (`RobotModel::bumpers` order).
+    pub fn bumpers(&self) -> &[BumperSensor] {
+        &self.bumpers
+    }
+
+    /// The robot's 3D lidars (`RobotModel::lidars` order).
+    pub fn lidars(&self) -> &[LidarSensor] {
+        &self.lidars
+    }
+
     /// Reads every sensor that is due after a physics step and shows what it read.
     pub fn update(&mut self, sim: &Simulation, observer: &mut dyn Observer) {
         for imu in &mut self.imus {

@@ -14,7 +14,9 @@ use rover_perception::{
 use rover_sim::{
     model::{CameraInfo, LinkId, RobotModel, World},
     physics::{ControlSample, SimOptions, Simulation},
-    sensors::{CameraSensor, GroundTruthBox, ImuSensor, LaserSensor},
+    sensors::{
+        BumperSensor, CameraSensor, GpsSensor, GroundTruthBox, ImuSensor, LaserSensor, LidarSensor,
+    },
 };
 
 use crate::arm::{ArmConfig, ArmMode, ArmTask};
@@ -367,6 +369,21 @@ impl Session {
     /// The robot's IMUs (`RobotModel::imus` order).
     pub fn imus(&self) -> &[ImuSensor] {
         self.sensors.imus()
+    }
+
+    /// The robot's GPS receivers (`RobotModel::gpss` order).
+    pub fn gpss(&self) -> &[GpsSensor] {
+        self.sensors.gpss()
+    }
+
+    /// The robot's bumpers (`RobotModel::bumpers` order).
+    pub fn bumpers(&self) -> &[BumperSensor] {
+        self.sensors.bumpers()
+    }
+
+    /// The robot's 3D lidars (`RobotModel::lidars` order).
+    pub fn lidars(&self) -> &[LidarSensor] {
+        self.sensors.lidars()
     }
 
     /// The laser scanner, when the robot has one.

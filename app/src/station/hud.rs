@@ -6,7 +6,7 @@ use rover_perception::box_outline;
 use super::canvas::{CHAR_W, Canvas, Rgb};
 
 /// Height of the HUD strip under the camera image (px).
-pub(super) const HUD_H: usize = 112;
+pub(super) const HUD_H: usize = 134;
 
 /// The HUD's background, also the margin colour when the window is scaled.
 pub(super) const BACKGROUND: Rgb = [24, 26, 30];
@@ -205,6 +205,52 @@ pub(super) fn compose(canvas: &mut Canvas<'_>, hud: &HudState<'_>) {
             };
         }
     }
+    if let Some(sensors) = sensor_line(session) {
+        let (text, _) = split_line(&sensors, LINE_CHARS);
+        canvas.text(8, y0 + 108, text, [150, 200, 230]);
+    }
+}
+
+/// One line with the newest reading of each kind of sensor the robot carries besides its
+/// camera (`None`: none): the laser's nearest return, the first IMU's vertical acceleration
+/// (gravity in it), the first GPS fix, what the first bumper touches (the other model's
+/// name), the first lidar's points.
+fn sensor_line(session: &Session) -> Option<String> {
+    use std::fmt::Write as _;
+    let mut line = String::new();
+    if let Some(laser) = session.laser() {
+        let nearest = laser
+            .last()
+            .ranges_m
+            .iter()
+            .copied()
+            .filter(|r| r.is_finite())
+            .fold(f32::INFINITY, f32::min);
+        if nearest.is_finite() {
+            let _ = write!(line, "scan {nearest:.2} m  ");
+        } else {
+            line.push_str("scan -  ");
+        }
+    }
+    if let Some(imu) = session.imus().first() {
+        let r = imu.last();
+        let _ = write!(line, "imu {:.2} m/s2  ", r.linear_acceleration_mps2[2]);
+    }
+    if let Some(gps) = session.gpss().first() {
+        let f = gps.last();
+        let _ = write!(line, "gps {:.5},{:.5}  ", f.latitude_deg, f.longitude_deg);
+    }
+    if let Some(bumper) = session.bumpers().first() {
+        let touching = bumper.last().contacts.first().map_or("-", |c| {
+            c.other.split("::").next().unwrap_or(c.other.as_str())
+        });
+        let _ = write!(line, "bump {touching}  ");
+    }
+    if let Some(lidar) = session.lidars().first() {
+        let _ = write!(line, "lidar {} pts", lidar.last().points().count());
+    }
+    let line = line.trim_end();
+    (!line.is_empty()).then(|| line.to_owned())
 }
 
 /// One detection result against its image's ground truth, for the HUD's detector line:
