@@ -5,7 +5,7 @@
 
 use rover_sim::{
     geometry::Pose,
-    model::{CameraInfo, link_from_optical},
+    model::{CameraInfo, GpsSource, link_from_optical},
     physics::Simulation,
     sensors::{
         BumperSensor, CameraFrame, CloudLayout, CloudSource, DepthCloudBuilder, GpsSensor,
@@ -66,11 +66,24 @@ impl ObservedSensors {
             .inspect(|g| {
                 let c = g.config();
                 let rate = rate_text(c.update_rate_hz);
+                let (lat, lon, model) = match c.source {
+                    GpsSource::Hector => (
+                        c.reference_latitude_deg,
+                        c.reference_longitude_deg,
+                        "hector's reference",
+                    ),
+                    GpsSource::Sensor => {
+                        let sc = &sim.world().spherical_coordinates;
+                        (
+                            sc.latitude_deg,
+                            sc.longitude_deg,
+                            "the world's spherical coordinates",
+                        )
+                    }
+                };
                 tracing::info!(
-                    "gps: {} around {} N {} E at {rate}, topics {} and {}",
+                    "gps: {} around {lat} N {lon} E ({model}) at {rate}, topics {} and {}",
                     c.link,
-                    c.reference_latitude_deg,
-                    c.reference_longitude_deg,
                     c.topic,
                     c.velocity_topic
                 );

@@ -271,3 +271,73 @@ fn known_models_are_coco_classes() {
         assert!(rover_sim::model::is_known_class(class), "{class}");
     }
 }
+
+/// An SDF world's `<spherical_coordinates>` (what Gazebo's GPS sensor reads) and the TOML
+/// form; a surface other than WGS-84 or a latitude off the Earth is a located error.
+#[test]
+fn spherical_coordinates_come_from_sdf_and_toml_worlds() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let sdf = |inner: &str| {
+        format!(
+            "<?xml version=\"1.0\"?>\n<sdf version=\"1.6\">\n  <world name=\"w\">\n    <spherical_coordinates>\n{inner}\n    </spherical_coordinates>\n  </world>\n</sdf>\n"
+        )
+    };
+    let path = dir.path().join("geo.world");
+    std::fs::write(
+        &path,
+        sdf(
+            "<surface_model>EARTH_WGS84</surface_model><latitude_deg>-33.8688</latitude_deg>\
+             <longitude_deg>151.2093</longitude_deg><elevation>58</elevation><heading_deg>12</heading_deg>",
+        ),
+    )?;
+    let world = World::load_with(&path, &ResourcePaths::default())?;
+    let sc = world.spherical_coordinates;
+    assert_eq!(
+        (
+            sc.latitude_deg,
+            sc.longitude_deg,
+            sc.elevation_m,
+            sc.heading_deg
+        ),
+        (-33.8688, 151.2093, 58.0, 12.0)
+    );
+    for (inner, expected) in [
+        (
+            "<surface_model>MOON_SCS</surface_model>",
+            "expected EARTH_WGS84",
+        ),
+        (
+            "<latitude_deg>91</latitude_deg>",
+            "<latitude_deg>: expected -90 to 90",
+        ),
+        ("<longitude_deg>east</longitude_deg>", "longitude_deg"),
+    ] {
+        std::fs::write(&path, sdf(inner))?;
+        let err = World::load_with(&path, &ResourcePaths::default())
+            .err()
+            .ok_or_else(|| anyhow::anyhow!("{inner} loaded"))?
+            .to_string();
+        assert!(
+            err.contains(expected) && err.contains("geo.world:"),
+            "{err}"
+        );
+    }
+    let toml = World::from_str(
+        "[spherical_coordinates]\nlatitude_deg = 49.9\nlongitude_deg = 8.9\n",
+        std::path::Path::new("geo.toml"),
+    )?;
+    assert_eq!(toml.spherical_coordinates.latitude_deg, 49.9);
+    assert_eq!(World::flat()?.spherical_coordinates.latitude_deg, 0.0);
+    let err = World::from_str(
+        "[spherical_coordinates]\nlatitude_deg = 123.0\n",
+        std::path::Path::new("geo.toml"),
+    )
+    .err()
+    .ok_or_else(|| anyhow::anyhow!("latitude 123 loaded"))?
+    .to_string();
+    assert!(
+        err.contains("[spherical_coordinates]") && err.contains("geo.toml"),
+        "{err}"
+    );
+    Ok(())
+}

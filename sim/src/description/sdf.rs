@@ -24,7 +24,9 @@ use crate::model::actor::{Actor, ActorSkin, Script, Trajectory, Waypoint};
 use crate::model::classes::{class_of_model, label_part_of_model};
 use crate::model::person::Person;
 use crate::model::robot::{Collision, Visual};
-use crate::model::world::{DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, World};
+use crate::model::world::{
+    DEFAULT_STEP_HZ, Model, ModelLink, STEP_HZ_RANGE, SphericalCoordinates, World,
+};
 
 /// Largest magnitude of any number rover reads from an SDF world (sizes, masses, gravity, step
 /// size; positions are held to [`MAX_COORDINATE_M`] besides): values far outside physical sense
@@ -84,8 +86,8 @@ pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
 }
 
 /// Reads the world-level settings of `<world>` into `world`: the physics step
-/// (`<physics><max_step_size>`, outside rover's range a warning and the default) and gravity
-/// (`<physics><gravity>`, overridden by `<world><gravity>`).
+/// (`<physics><max_step_size>`, outside rover's range a warning and the default), gravity
+/// (`<physics><gravity>`, overridden by `<world><gravity>`) and `<spherical_coordinates>`.
 fn read_physics(ctx: &Ctx<'_, '_>, world_el: Node<'_, '_>, world: &mut World) -> Result<()> {
     let physics = &mut world.physics;
     if let Some(p) = child(world_el, "physics") {
@@ -110,6 +112,48 @@ fn read_physics(ctx: &Ctx<'_, '_>, world_el: Node<'_, '_>, world: &mut World) ->
     }
     if let Some(g) = child(world_el, "gravity") {
         physics.gravity_mps2 = ctx.numbers::<3>(g)?;
+    }
+    if let Some(sc) = child(world_el, "spherical_coordinates") {
+        read_spherical_coordinates(ctx, sc, &mut world.spherical_coordinates)?;
+    }
+    Ok(())
+}
+
+/// `<spherical_coordinates>`: the world's origin on WGS-84 (the only surface model Gazebo has)
+/// and its heading, Gazebo's defaults (zero) where absent.
+fn read_spherical_coordinates(
+    ctx: &Ctx<'_, '_>,
+    sc: Node<'_, '_>,
+    out: &mut SphericalCoordinates,
+) -> Result<()> {
+    for e in sc.children().filter(Node::is_element) {
+        match e.tag_name().name() {
+            "surface_model" => {
+                let model = e.text().map(str::trim).unwrap_or_default();
+                if model != "EARTH_WGS84" {
+                    return Err(ctx.err(
+                        e,
+                        format!("<surface_model>: expected EARTH_WGS84, found '{model}'"),
+                    ));
+                }
+            }
+            "latitude_deg" => {
+                out.latitude_deg = ctx.number(e)?;
+                if out.latitude_deg.abs() > 90.0 {
+                    return Err(ctx.err(
+                        e,
+                        format!(
+                            "<latitude_deg>: expected -90 to 90, found {}",
+                            out.latitude_deg
+                        ),
+                    ));
+                }
+            }
+            "longitude_deg" => out.longitude_deg = ctx.number(e)?,
+            "elevation" => out.elevation_m = ctx.number(e)?,
+            "heading_deg" => out.heading_deg = ctx.number(e)?,
+            _ => {}
+        }
     }
     Ok(())
 }
@@ -170,7 +214,7 @@ fn read_world_entities(
                 }
             }
             "actor" => world.people.push(actor(ctx, loader, node)?),
-            "physics" | "gravity" | "state" => {}
+            "physics" | "gravity" | "state" | "spherical_coordinates" => {}
             other => {
                 loader.skipped.insert(format!("<{other}>"));
             }

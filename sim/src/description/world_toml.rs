@@ -15,7 +15,7 @@ use crate::model::human::{BodyShape, HairStyle, Legwear, Outfit};
 use crate::model::person::{DEFAULT_PERSON_HEIGHT_M, Person, Walk};
 use crate::model::world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, GraspMode, Ground, JointSolver, Object, Physics, Place,
-    RobotSpawn, World, check_step_hz,
+    RobotSpawn, SphericalCoordinates, World, check_step_hz,
 };
 use rover_assets::COCO80;
 
@@ -94,6 +94,18 @@ struct RawWorld {
     walls: Vec<RawWall>,
     #[serde(default, rename = "person")]
     people: Vec<RawPerson>,
+    #[serde(default)]
+    spherical_coordinates: RawSpherical,
+}
+
+/// `[spherical_coordinates]`: SDF's `<spherical_coordinates>` (WGS-84), Gazebo's defaults.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RawSpherical {
+    latitude_deg: f64,
+    longitude_deg: f64,
+    elevation_m: f64,
+    heading_deg: f64,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -542,6 +554,7 @@ impl RawWorld {
             people,
             models: Vec::new(),
             sun_direction: crate::model::world::DEFAULT_SUN_DIRECTION,
+            spherical_coordinates: spherical(self.spherical_coordinates, path)?,
         })
     }
 }
@@ -865,6 +878,32 @@ impl RawPerson {
 /// A size in metres as the model stores it (f32, like URDF shapes).
 fn vec3_f32(v: [f64; 3]) -> glam::Vec3 {
     glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+}
+
+/// `[spherical_coordinates]` checked: a latitude on the Earth, finite numbers.
+fn spherical(raw: RawSpherical, path: &Path) -> Result<SphericalCoordinates> {
+    let values = [
+        raw.latitude_deg,
+        raw.longitude_deg,
+        raw.elevation_m,
+        raw.heading_deg,
+    ];
+    if !values.iter().all(|v| v.is_finite()) || raw.latitude_deg.abs() > 90.0 {
+        return Err(SimError::invalid(
+            path,
+            None,
+            format!(
+                "[spherical_coordinates]: expected latitude_deg within -90..90 and finite numbers, found latitude {} longitude {} elevation {} heading {}",
+                raw.latitude_deg, raw.longitude_deg, raw.elevation_m, raw.heading_deg
+            ),
+        ));
+    }
+    Ok(SphericalCoordinates {
+        latitude_deg: raw.latitude_deg,
+        longitude_deg: raw.longitude_deg,
+        elevation_m: raw.elevation_m,
+        heading_deg: raw.heading_deg,
+    })
 }
 
 #[cfg(test)]

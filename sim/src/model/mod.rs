@@ -42,10 +42,11 @@ pub use robot::{
 };
 pub use sensors::{
     AxisNoise, BumperConfig, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise,
-    GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
+    GpsConfig, GpsSource, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
     OrientationReference, P3dConfig, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,
-    Model, ModelLink, Object, Physics, Place, RobotSpawn, STEP_HZ_RANGE, World, check_step_hz,
+    Model, ModelLink, Object, Physics, Place, RobotSpawn, STEP_HZ_RANGE, SphericalCoordinates,
+    World, check_step_hz,
 };

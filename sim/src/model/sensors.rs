@@ -327,6 +327,18 @@ pub struct P3dConfig {
     pub line: Option<u32>,
 }
 
+/// Which GPS model a receiver follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpsSource {
+    /// hector_gazebo_plugins' model plugin, `libhector_gazebo_ros_gps.so`: its own reference
+    /// point and heading, WGS-84's radii at the reference latitude.
+    Hector,
+    /// Gazebo's `<sensor type="gps">` with `libgazebo_ros_gps_sensor.so`: the world's
+    /// `<spherical_coordinates>`, exact on the WGS-84 ellipsoid; the position the sensor's,
+    /// the velocity east, north, up.
+    Sensor,
+}
+
 /// One of hector's error models (`SensorModel`), per axis x, y, z: a constant `offset`, a
 /// drift (a first-order Gauss-Markov process of stationary stddev `drift`, mean-reverting at
 /// `drift_frequency_hz`) and white `gaussian_noise`.
@@ -359,11 +371,17 @@ impl Default for ErrorModel {
 pub struct GpsConfig {
     /// Plugin `name`.
     pub name: String,
-    /// The link whose origin is located (`<bodyName>`; default the robot's root link).
+    /// Which GPS model declared it.
+    pub source: GpsSource,
+    /// The link whose origin is located (`<bodyName>`; default the robot's root link; the
+    /// sensor form: its `<gazebo reference>`).
     pub link: String,
+    /// The sensor's `<pose>` in its link (the sensor form; identity for hector's).
+    pub link_from_sensor: Pose,
     /// `<updateRate>` (Hz; default 4).
     pub update_rate_hz: f64,
-    /// `<frameId>` (default `/world`, as hector's).
+    /// `<frameId>` (default `/world`, as hector's; the sensor form: `<frame_name>`, default its
+    /// link).
     pub frame_id: String,
     /// The fix topic (`<topicName>`, default `fix`, in `<robotNamespace>`).
     pub topic: String,

@@ -35,6 +35,25 @@ pub struct World {
     /// The direction sunlight travels (world frame, unit): from a Gazebo world's directional
     /// light (`model://sun`'s is (-0.5, 0.1, -0.9)), else [`DEFAULT_SUN_DIRECTION`].
     pub sun_direction: [f64; 3],
+    /// Where the world is on the Earth (`<spherical_coordinates>`, `[spherical_coordinates]`):
+    /// what a Gazebo GPS sensor reads.
+    pub spherical_coordinates: SphericalCoordinates,
+}
+
+/// The world's place on WGS-84, as SDF's `<spherical_coordinates>` gives it (surface model
+/// `EARTH_WGS84`): the world's origin at `latitude_deg`, `longitude_deg` and `elevation_m`,
+/// its x axis `heading_deg` from east (0: x east, y north, z up, ENU). Gazebo's defaults: all
+/// zero.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SphericalCoordinates {
+    /// Latitude of the world's origin (deg, north positive).
+    pub latitude_deg: f64,
+    /// Longitude of the world's origin (deg, east positive).
+    pub longitude_deg: f64,
+    /// Height of the world's origin above the ellipsoid (m).
+    pub elevation_m: f64,
+    /// Heading of the world frame (deg): east is `x cos h + y sin h`, north `-x sin h + y cos h`.
+    pub heading_deg: f64,
 }
 
 /// rover's own sun: late morning, from behind-left of a car facing +x.

@@ -23,7 +23,9 @@ pub use cloud::{
     CloudField, CloudLayout, CloudSource, DepthCloudBuilder, POINT_FIELD_FLOAT32,
     POINT_FIELD_UINT16, PointCloud,
 };
-pub use gps::{FixReading, GpsSensor, WGS84_EQUATORIAL_RADIUS_M, WGS84_FLATTENING, wgs84_radii_m};
+pub use gps::{
+    Ellipsoid, FixReading, GpsSensor, WGS84_EQUATORIAL_RADIUS_M, WGS84_FLATTENING, wgs84_radii_m,
+};
 pub use ground_truth::{
     GroundTruth, GroundTruthBox, MIN_VISIBILITY, MIN_VISIBLE_PX, PixelBox, copy_boxes,
 };

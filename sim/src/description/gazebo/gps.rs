@@ -1,11 +1,15 @@
-//! hector_gazebo_plugins' GPS, `libhector_gazebo_ros_gps.so`: a link's origin as latitude,
-//! longitude and altitude on WGS-84 around a reference point, with hector's parameter names,
-//! defaults and error models.
+//! GPS receivers: hector_gazebo_plugins' `libhector_gazebo_ros_gps.so`, a link's origin as
+//! latitude, longitude and altitude on WGS-84 around a reference point, with hector's parameter
+//! names, defaults and error models; and Gazebo's `<sensor type="gps">` with gazebo_ros's
+//! `libgazebo_ros_gps_sensor.so`, on the world's `<spherical_coordinates>`.
 
-use super::values::{Ctx, Node, clean, join_topic, plugin_stem, text_of};
+use super::values::{
+    Ctx, Node, clean, join_topic, parse_noise, plugin_stem, read_sensor_pose, text_of,
+};
 use crate::description::xml::{elements, line_of};
 use crate::error::Result;
-use crate::model::sensors::{ErrorModel, GpsConfig};
+use crate::geometry::Pose;
+use crate::model::sensors::{ErrorModel, GpsConfig, GpsSource};
 
 /// True for the plugin's file name.
 pub(super) fn is_plugin(file: &str) -> bool {
@@ -23,7 +27,9 @@ pub(super) fn parse(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<GpsConfig
     let mut velocity_topic = "fix_velocity".to_owned();
     let mut c = GpsConfig {
         name,
+        source: GpsSource::Hector,
         link: String::new(),
+        link_from_sensor: Pose::IDENTITY,
         update_rate_hz: 4.0,
         frame_id: "/world".to_owned(),
         topic: String::new(),
@@ -72,6 +78,122 @@ pub(super) fn parse(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<GpsConfig
     c.topic = clean(&join_topic(&namespace, &topic));
     c.velocity_topic = clean(&join_topic(&namespace, &velocity_topic));
     Ok(c)
+}
+
+/// A `<sensor type="gps">` on `link`; `None` when no `libgazebo_ros_gps_sensor.so` publishes
+/// it. Its `<gps>` noise (`position_sensing`/`velocity_sensing`, `horizontal`/`vertical`
+/// gaussian mean and stddev, metres) becomes an error model of offset and white noise; the
+/// plugin's topics are gazebo_ros's `~/out` and `~/vel` (`/<namespace>/<plugin name>/out`),
+/// or what `<ros><remapping>` makes them.
+pub(super) fn parse_sensor(
+    ctx: &Ctx<'_, '_>,
+    sensor: Node<'_, '_>,
+    link: &str,
+) -> Result<Option<GpsConfig>> {
+    let name = sensor.attribute("name").unwrap_or("gps").to_owned();
+    let what = format!("<sensor name=\"{name}\" type=\"gps\">");
+    let what = what.as_str();
+    let mut c = GpsConfig {
+        name,
+        source: GpsSource::Sensor,
+        link: link.to_owned(),
+        link_from_sensor: Pose::IDENTITY,
+        update_rate_hz: 0.0,
+        frame_id: link.to_owned(),
+        topic: String::new(),
+        velocity_topic: String::new(),
+        reference_latitude_deg: 0.0,
+        reference_longitude_deg: 0.0,
+        reference_heading_deg: 0.0,
+        reference_altitude_m: 0.0,
+        status: 0,
+        service: 1,
+        position_error: ErrorModel::default(),
+        velocity_error: ErrorModel::default(),
+        line: Some(line_of(ctx.doc, sensor)),
+    };
+    let mut plugin = None;
+    for s in elements(sensor) {
+        match s.tag_name().name() {
+            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
+            "gps" => {
+                for sensing in elements(s) {
+                    let model = match sensing.tag_name().name() {
+                        "position_sensing" => &mut c.position_error,
+                        "velocity_sensing" => &mut c.velocity_error,
+                        _ => continue,
+                    };
+                    read_sensing(ctx, sensing, what, model)?;
+                }
+            }
+            "plugin"
+                if plugin_stem(s.attribute("filename").unwrap_or(""))
+                    == "gazebo_ros_gps_sensor" =>
+            {
+                plugin = Some(s);
+            }
+            _ => {}
+        }
+    }
+    let Some(plugin) = plugin else {
+        return Ok(None);
+    };
+    let node = plugin.attribute("name").unwrap_or("gps");
+    let mut namespace = String::new();
+    let (mut out, mut vel) = (format!("{node}/out"), format!("{node}/vel"));
+    for p in elements(plugin) {
+        match p.tag_name().name() {
+            "frame_name" => c.frame_id = text_of(p).to_owned(),
+            "ros" => {
+                for r in elements(p) {
+                    let text = text_of(r);
+                    match r.tag_name().name() {
+                        "namespace" => namespace = format!("{}/", text.trim_end_matches('/')),
+                        "remapping" | "argument" => {
+                            if let Some(t) = text.strip_prefix("~/out:=") {
+                                out = t.to_owned();
+                            } else if let Some(t) = text.strip_prefix("~/vel:=") {
+                                vel = t.to_owned();
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let root = |t: &str| clean(&format!("/{}", join_topic(&namespace, t)));
+    c.topic = root(&out);
+    c.velocity_topic = root(&vel);
+    Ok(Some(c))
+}
+
+/// One `<position_sensing>` or `<velocity_sensing>`: its `<horizontal>` noise on x and y, its
+/// `<vertical>` noise on z.
+fn read_sensing(
+    ctx: &Ctx<'_, '_>,
+    sensing: Node<'_, '_>,
+    what: &str,
+    model: &mut ErrorModel,
+) -> Result<()> {
+    for axis in elements(sensing) {
+        let axes = match axis.tag_name().name() {
+            "horizontal" => 0..2,
+            "vertical" => 2..3,
+            _ => continue,
+        };
+        for n in elements(axis).filter(|n| n.has_tag_name("noise")) {
+            if let Some(noise) = parse_noise(ctx, n, what, "metres")? {
+                for i in axes.clone() {
+                    model.offset[i] = noise.mean;
+                    model.gaussian_noise[i] = noise.stddev;
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn latitude(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str) -> Result<f64> {

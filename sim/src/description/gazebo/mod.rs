@@ -165,6 +165,12 @@ fn read_sensor(
                 "sensor \"{name}\" (type imu, no ROS plugin: nothing published)"
             )),
         },
+        "gps" => match gps::parse_sensor(ctx, sensor, link)? {
+            Some(g) => ext.gpss.push(g),
+            None => ext.ignored.push(format!(
+                "sensor \"{name}\" (type gps, no libgazebo_ros_gps_sensor.so: nothing published)"
+            )),
+        },
         "contact" => match bumper::parse(ctx, sensor, link)? {
             Some(b) => ext.bumpers.push(b),
             None => ext.ignored.push(format!(

@@ -184,7 +184,8 @@ pub(super) fn parse_noise(
     what: &str,
     unit: &str,
 ) -> Result<Option<GaussianNoise>> {
-    let mut kind = "gaussian".to_owned();
+    // SDF writes the type as an attribute (`<noise type="gaussian">`) or an element.
+    let mut kind = node.attribute("type").unwrap_or("gaussian").to_owned();
     let mut noise = GaussianNoise {
         mean: 0.0,
         stddev: 0.0,
