@@ -562,9 +562,11 @@ import math, rospy, time
 from sensor_msgs.msg import Imu, LaserScan
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import NavSatFix
+from geometry_msgs.msg import Vector3Stamped
 rospy.init_node('imu_check')
-imu, scans, truth, fixes = [], [], [], []
+imu, scans, truth, fixes, velocities = [], [], [], [], []
 rospy.Subscriber('/fix', NavSatFix, fixes.append)
+rospy.Subscriber('/fix_velocity', Vector3Stamped, velocities.append)
 rospy.Subscriber('/imu', Imu, imu.append)
 rospy.Subscriber('/scan', LaserScan, scans.append)
 rospy.Subscriber('/ground_truth/state', Odometry, truth.append)
@@ -593,6 +595,10 @@ if fixes:
     f = fixes[-1]
     print('fix %s %.9f %.9f %d %d' % (f.header.frame_id, f.latitude, f.longitude,
                                      f.status.service, f.position_covariance_type))
+if velocities:
+    v = velocities[-1]
+    print('velocity %s %d %.4f' % (v.header.frame_id, len(velocities),
+                                   abs(v.vector.x) + abs(v.vector.y) + abs(v.vector.z)))
 "#;
     let mut c = graph.command(PYTHON);
     let path = graph.dir.path().join("imu.py");
@@ -620,6 +626,11 @@ if fixes:
         "IMU stamps {period} s apart (median), 100 Hz expected"
     );
     ensure!(line("scan")? == ["base_scan", "360"], "scan: {out}");
+    // hector's velocity beside each fix, in the same frame; the car stands still.
+    let velocity = line("velocity")?;
+    ensure!(velocity[0] == "base_link", "velocity frame {velocity:?}");
+    let (n, speed): (u32, f64) = (velocity[1].parse()?, velocity[2].parse()?);
+    ensure!(n >= 8 && speed < 0.01, "velocity {velocity:?}");
     // The playground spawns the car at the origin, where it stays (no one drives it).
     let truth = line("truth")?;
     ensure!(truth[..2] == ["world", "base_link"], "p3d frames {truth:?}");
