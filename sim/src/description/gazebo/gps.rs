@@ -26,23 +26,11 @@ pub(super) fn parse(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<GpsConfig
     let mut topic = "fix".to_owned();
     let mut velocity_topic = "fix_velocity".to_owned();
     let mut c = GpsConfig {
-        name,
-        source: GpsSource::Hector,
-        link: String::new(),
-        link_from_sensor: Pose::IDENTITY,
         update_rate_hz: 4.0,
         frame_id: "/world".to_owned(),
-        topic: String::new(),
-        velocity_topic: String::new(),
         reference_latitude_deg: 49.9,
         reference_longitude_deg: 8.9,
-        reference_heading_deg: 0.0,
-        reference_altitude_m: 0.0,
-        status: 0,
-        service: 1,
-        position_error: ErrorModel::default(),
-        velocity_error: ErrorModel::default(),
-        line: Some(line_of(ctx.doc, plugin)),
+        ..base(name, GpsSource::Hector, "", line_of(ctx.doc, plugin))
     };
     for p in elements(plugin) {
         let tag = p.tag_name().name();
@@ -94,23 +82,8 @@ pub(super) fn parse_sensor(
     let what = format!("<sensor name=\"{name}\" type=\"gps\">");
     let what = what.as_str();
     let mut c = GpsConfig {
-        name,
-        source: GpsSource::Sensor,
-        link: link.to_owned(),
-        link_from_sensor: Pose::IDENTITY,
-        update_rate_hz: 0.0,
         frame_id: link.to_owned(),
-        topic: String::new(),
-        velocity_topic: String::new(),
-        reference_latitude_deg: 0.0,
-        reference_longitude_deg: 0.0,
-        reference_heading_deg: 0.0,
-        reference_altitude_m: 0.0,
-        status: 0,
-        service: 1,
-        position_error: ErrorModel::default(),
-        velocity_error: ErrorModel::default(),
-        line: Some(line_of(ctx.doc, sensor)),
+        ..base(name, GpsSource::Sensor, link, line_of(ctx.doc, sensor))
     };
     let mut plugin = None;
     for s in elements(sensor) {
@@ -194,6 +167,30 @@ fn read_sensing(
         }
     }
     Ok(())
+}
+
+/// A receiver of `source` named `name` on `link`, declared at `line`: every setting zero,
+/// empty or exact (no error), a fix from the GPS service, every physics step.
+fn base(name: String, source: GpsSource, link: &str, line: u32) -> GpsConfig {
+    GpsConfig {
+        name,
+        source,
+        link: link.to_owned(),
+        link_from_sensor: Pose::IDENTITY,
+        update_rate_hz: 0.0,
+        frame_id: String::new(),
+        topic: String::new(),
+        velocity_topic: String::new(),
+        reference_latitude_deg: 0.0,
+        reference_longitude_deg: 0.0,
+        reference_heading_deg: 0.0,
+        reference_altitude_m: 0.0,
+        status: 0,
+        service: 1,
+        position_error: ErrorModel::default(),
+        velocity_error: ErrorModel::default(),
+        line: Some(line),
+    }
 }
 
 fn latitude(ctx: &Ctx<'_, '_>, node: Node<'_, '_>, what: &str) -> Result<f64> {
