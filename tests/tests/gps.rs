@@ -325,5 +325,35 @@ fn bad_gps_blocks_are_located_errors() -> Result<()> {
         1,
     );
     ensure!(RobotModel::from_str(&text, &path)?.gpss[0].link == "base_link");
+    // Gazebo's sensor: bad noise is a located error; without its plugin it is listed.
+    let sensor = |inner: &str| {
+        let block = format!(
+            r#"<gazebo reference="base_link"><sensor type="gps" name="fixer">{inner}</sensor></gazebo></robot>"#
+        );
+        std::fs::read_to_string(&path).map(|t| t.replacen("</robot>", &block, 1))
+    };
+    let text = sensor(
+        r#"<gps><position_sensing><horizontal><noise type="gaussian"><stddev>-1</stddev></noise></horizontal></position_sensing></gps>
+        <plugin name="g" filename="libgazebo_ros_gps_sensor.so"/>"#,
+    )?;
+    let err = RobotModel::from_str(&text, &path)
+        .err()
+        .context("expected an error")?
+        .to_string();
+    ensure!(
+        err.contains("<stddev> in <sensor name=\"fixer\" type=\"gps\">")
+            && err.contains("my_robot.urdf:"),
+        "{err}"
+    );
+    let robot = RobotModel::from_str(&sensor("<update_rate>5</update_rate>")?, &path)?;
+    ensure!(robot.gpss.is_empty());
+    ensure!(
+        robot
+            .not_simulated
+            .iter()
+            .any(|s| s.contains("\"fixer\" (type gps")),
+        "{:?}",
+        robot.not_simulated
+    );
     Ok(())
 }
