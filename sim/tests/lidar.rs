@@ -259,3 +259,26 @@ fn bad_vertical_scans_and_plugin_ranges_are_located_errors() -> Result<()> {
     ];
     assert_located_errors(cases.iter().map(|(b, e)| (b.as_str(), *e)))
 }
+
+#[test]
+fn a_range_finder_is_listed_not_read_as_a_laser_or_a_lidar() -> Result<()> {
+    let robot = car_with(
+        r#"<gazebo reference="camera_link"><sensor type="ray" name="sonar_front">
+          <ray><scan>
+            <horizontal><samples>5</samples><min_angle>-0.1</min_angle><max_angle>0.1</max_angle></horizontal>
+            <vertical><samples>5</samples><min_angle>-0.1</min_angle><max_angle>0.1</max_angle></vertical>
+          </scan><range><min>0.02</min><max>3</max></range></ray>
+          <plugin name="sonar" filename="libgazebo_ros_range.so"><topicName>sonar</topicName></plugin>
+        </sensor></gazebo>"#,
+    )?;
+    assert!(robot.lasers.is_empty() && robot.lidars.is_empty());
+    assert!(
+        robot
+            .not_simulated
+            .iter()
+            .any(|s| s.contains("\"sonar_front\" (a range finder")),
+        "{:?}",
+        robot.not_simulated
+    );
+    Ok(())
+}

@@ -155,6 +155,17 @@ fn read_sensor(
     };
     match kind {
         "camera" | "depth" => ext.cameras.push(parse_camera(ctx, sensor, link)?),
+        "ray" | "gpu_ray"
+            if elements(sensor).any(|p| {
+                p.has_tag_name("plugin")
+                    && values::plugin_stem(p.attribute("filename").unwrap_or(""))
+                        .ends_with("ros_range")
+            }) =>
+        {
+            ext.ignored.push(format!(
+                "sensor \"{name}\" (a range finder: sensor_msgs/Range is not simulated)"
+            ));
+        }
         "ray" | "gpu_ray" => match ray::parse(ctx, sensor, link)? {
             ray::RaySensor::Planar(laser) => ext.lasers.push(laser),
             ray::RaySensor::Lidar(lidar) => ext.lidars.push(lidar),
