@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# Redraws the pictures README.md and docs/ show, each from a named world and script, with
+# today's rover, and says what it wrote. Run it when what rover draws changes (a body, a
+# mesh, the HUD, the Rerun layout, a sensor's drawing): see docs/TESTING.md.
+#
+#   scripts/docs-pictures.sh            every picture below
+#   scripts/docs-pictures.sh NAME...    only these (e.g. camera-playground window)
+#
+# Deterministic (the same bytes on every run, on any machine with the same renderer):
+#   camera-playground   worlds/playground.toml, examples/scripts/follow.toml: the car's camera
+#                       at 4 s, following MakeHuman's walker, YOLO's boxes drawn (rover detect)
+#   person-sweep        rover bench people (worlds/people.toml): MakeHuman's body standing at
+#                       3, 5 and 8 m, facing the camera, YOLO's boxes drawn, side by side
+#   robots              turtlebot3-burger.png and tiago.png: each robot at rest from 1.2 m
+#                       (tests/tests/robots.rs with ROVER_SAVE_VIEWS; needs ../shared's corpus
+#                       and example-robot-data from set-up)
+# Live (a window or a browser on wall time, so their bytes differ between runs):
+#   window              the driver's station under Xvfb in worlds/playground.toml, `f` pressed:
+#                       the follower at work, boxes and HUD (the detector on its own thread)
+#   rerun-web           a headless follow run in worlds/playground.toml served to Rerun's web
+#                       viewer, shot in headless Chromium: 3D scene, camera, plots
+#   rerun-vlp16         the VLP-16 car in worlds/people.toml in Rerun's web viewer: its cloud
+#
+# Needs what ./run and ./test set up (scripts/setup.sh: the detector model, MakeHuman's body,
+# xvfb, xdotool, chromium and the node packages, the Python venv with Pillow).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rover/target}"
+cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
+python="$cache/venv/bin/python3"
+all=(camera-playground person-sweep robots window rerun-web rerun-vlp16)
+wanted=("$@")
+[ ${#wanted[@]} -eq 0 ] && wanted=("${all[@]}")
+for name in "${wanted[@]}"; do
+  case " ${all[*]} " in *" $name "*) ;; *) echo "unknown picture '$name'; one of: ${all[*]}" >&2; exit 2 ;; esac
+done
+
+cargo build --release --quiet
+rover="$CARGO_TARGET_DIR/release/rover"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+wrote() { echo "docs-pictures: wrote $1 ($2)"; }
+
+camera_playground() {
+  "$rover" --headless --world worlds/playground.toml --script examples/scripts/follow.toml \
+    --duration 4 --save-frames "$work/frames" --frame-every 10 > "$work/run.log" 2>&1
+  local frame
+  frame="$(ls "$work/frames"/*.png | tail -n 1)"
+  "$rover" detect "$frame" --out docs/camera-playground.png > /dev/null
+  wrote docs/camera-playground.png "worlds/playground.toml at 4 s of examples/scripts/follow.toml, YOLO's boxes"
+}
+
+person_sweep() {
+  "$rover" bench people --bodies makehuman --postures standing --save "$work/sweep" \
+    > "$work/sweep.log" 2>&1
+  local parts=()
+  for d in 3 5 8; do
+    local image="$work/sweep/makehuman/standing_000deg_${d}.0m.png"
+    [ -f "$image" ] || { echo "no $image (rover bench people --save changed its names?)" >&2; exit 1; }
+    "$rover" detect "$image" --out "$work/sweep_$d.png" > /dev/null
+    parts+=("$work/sweep_$d.png")
+  done
+  "$python" - docs/person-sweep.png "${parts[@]}" <<'EOF'
+import sys
+from PIL import Image
+out, paths = sys.argv[1], sys.argv[2:]
+images = [Image.open(p).convert("RGB") for p in paths]
+w, h = images[0].size
+row = Image.new("RGB", (w * len(images) + 8 * (len(images) - 1), h), (24, 26, 30))
+for i, im in enumerate(images):
+    row.paste(im, (i * (w + 8), 0))
+row.save(out, optimize=False)
+EOF
+  wrote docs/person-sweep.png "rover bench people, MakeHuman's body standing at 3, 5 and 8 m with YOLO's boxes"
+}
+
+robots() {
+  ROVER_SAVE_VIEWS="$PWD/docs" cargo test --quiet --workspace --test robots \
+    turtlebot3_and_tiago_render_with_their_meshes > "$work/robots.log" 2>&1 \
+    || { cat "$work/robots.log" >&2; exit 1; }
+  wrote docs/turtlebot3-burger.png "the TurtleBot3 burger from ../shared's xacro, at rest from 1.2 m"
+  wrote docs/tiago.png "TIAGo from example-robot-data, at rest from 1.2 m"
+}
+
+window() {
+  cat > "$work/window.sh" <<'EOF'
+set -eu
+"$ROVER" --world worlds/playground.toml --duration 5 --screenshot "$SHOT" --viewer none \
+  2> "$WORK/window.log" &
+pid=$!
+wid=$(timeout 120 xdotool search --sync --onlyvisible --name "driver's station" | head -n 1)
+sleep 2
+xdotool windowfocus --sync "$wid"
+xdotool key f
+wait "$pid"
+EOF
+  ROVER="$rover" SHOT="$PWD/docs/window.png" WORK="$work" \
+    xvfb-run -a -s "-screen 0 1280x800x24" bash "$work/window.sh"
+  wrote docs/window.png "the driver's station under Xvfb, worlds/playground.toml, follow mode at 5 s"
+}
+
+# Serves `rover ARGS...` headless to the web viewer and shoots it into FILE.
+web_shot() {
+  local file="$1"
+  shift
+  local web_port=$((20000 + RANDOM % 10000))
+  local grpc_port=$((web_port + 1))
+  "$rover" --headless --viewer web --web-port "$web_port" --grpc-port "$grpc_port" "$@" \
+    > "$work/web.out" 2> "$work/web.log" &
+  local pid=$!
+  local url=""
+  for _ in $(seq 300); do
+    url="$(grep -o 'still serving the web viewer at [^ ]*' "$work/web.out" | awk '{print $NF}' || true)"
+    [ -n "$url" ] && break
+    sleep 1
+  done
+  [ -n "$url" ] || { kill "$pid"; cat "$work/web.log" >&2; echo "rover never served the viewer" >&2; exit 1; }
+  node scripts/webview/screenshot.mjs "$url" "$file" --wait-s 150 > "$work/shot.json" 2> /dev/null \
+    || { kill "$pid"; cat "$work/shot.json" >&2; exit 1; }
+  kill "$pid" 2> /dev/null || true
+  wait "$pid" 2> /dev/null || true
+}
+
+rerun_web() {
+  web_shot docs/rerun-web.png --world worlds/playground.toml --script examples/scripts/follow.toml \
+    --duration 8
+  wrote docs/rerun-web.png "Rerun's web viewer in headless Chromium: worlds/playground.toml, follow mode"
+}
+
+rerun_vlp16() {
+  web_shot docs/rerun-vlp16.png --world worlds/people.toml \
+    --robot assets/robots/my_robot_vlp16.urdf.xacro --no-detector --duration 3
+  wrote docs/rerun-vlp16.png "Rerun's web viewer: the VLP-16 car's cloud in worlds/people.toml"
+}
+
+for name in "${wanted[@]}"; do
+  "${name//-/_}"
+done
