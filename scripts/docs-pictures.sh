@@ -14,9 +14,13 @@
 #   robots              turtlebot3-burger.png and tiago.png: each robot at rest from 1.2 m
 #                       (tests/tests/robots.rs with ROVER_SAVE_VIEWS; needs ../shared's corpus
 #                       and example-robot-data from set-up)
+#   playground-world    the tutorial car's first camera image in turtlebot_gazebo's
+#                       playground.world (../shared/corpus; skipped without it)
 # Live (a window or a browser on wall time, so their bytes differ between runs):
 #   window              the driver's station under Xvfb in worlds/playground.toml, `f` pressed:
 #                       the follower at work, boxes and HUD (the detector on its own thread)
+#   arm-car-window      the arm car's window (worlds/arm_car.toml) after driving and jogging
+#                       its shoulder lift and elbow with the keys, as tests/window.rs does
 #   rerun-web           a headless follow run in worlds/playground.toml served to Rerun's web
 #                       viewer, shot in headless Chromium: 3D scene, camera, plots
 #   rerun-vlp16         the VLP-16 car in worlds/people.toml in Rerun's web viewer: its cloud
@@ -28,7 +32,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rover/target}"
 cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
 python="$cache/venv/bin/python3"
-all=(camera-playground person-sweep robots window rerun-web rerun-vlp16)
+all=(camera-playground person-sweep robots playground-world window arm-car-window rerun-web rerun-vlp16)
 wanted=("$@")
 [ ${#wanted[@]} -eq 0 ] && wanted=("${all[@]}")
 for name in "${wanted[@]}"; do
@@ -82,21 +86,48 @@ robots() {
   wrote docs/tiago.png "TIAGo from example-robot-data, at rest from 1.2 m"
 }
 
-window() {
-  cat > "$work/window.sh" <<'EOF'
+playground_world() {
+  local shared=../shared/corpus
+  if [ ! -d "$shared/turtlebot_gazebo" ]; then
+    echo "docs-pictures: skipped playground-world: no $shared (../shared beside the repository)" >&2
+    return
+  fi
+  "$rover" --headless --world "$shared/turtlebot_gazebo/worlds/playground.world" \
+    --model-path "$shared/gazebo_models" --no-detector --duration 0.1 \
+    --save-frames "$work/world" > "$work/world.log" 2>&1
+  cp "$(ls "$work/world"/*.png | head -n 1)" docs/playground-world.png
+  wrote docs/playground-world.png "the tutorial car's first camera image in turtlebot_gazebo's playground.world"
+}
+
+# Runs the window under Xvfb in WORLD for SECONDS, runs KEYS (xdotool lines, in $KEYS) once it
+# shows, and writes its last image to FILE.
+window_shot() {
+  local world="$1" seconds="$2" keys="$3" file="$4"
+  cat > "$work/window.sh" <<'SCRIPT'
 set -eu
-"$ROVER" --world worlds/playground.toml --duration 5 --screenshot "$SHOT" --viewer none \
+"$ROVER" --world "$WORLD" --duration "$SECONDS_SIM" --screenshot "$SHOT" --viewer none \
   2> "$WORK/window.log" &
 pid=$!
 wid=$(timeout 120 xdotool search --sync --onlyvisible --name "driver's station" | head -n 1)
 sleep 2
 xdotool windowfocus --sync "$wid"
-xdotool key f
+eval "$KEYS"
 wait "$pid"
-EOF
-  ROVER="$rover" SHOT="$PWD/docs/window.png" WORK="$work" \
-    xvfb-run -a -s "-screen 0 1280x800x24" bash "$work/window.sh"
+SCRIPT
+  ROVER="$rover" WORLD="$world" SECONDS_SIM="$seconds" KEYS="$keys" SHOT="$PWD/$file" \
+    WORK="$work" xvfb-run -a -s "-screen 0 1280x800x24" bash "$work/window.sh"
+}
+
+window() {
+  window_shot worlds/playground.toml 5 "xdotool key f" docs/window.png
   wrote docs/window.png "the driver's station under Xvfb, worlds/playground.toml, follow mode at 5 s"
+}
+
+arm_car_window() {
+  window_shot worlds/arm_car.toml 16 "xdotool keydown i; sleep 2; xdotool keyup i; sleep 1
+xdotool key 2; for n in 1 2 3 4 5; do xdotool key bracketright; sleep 0.3; done
+sleep 4; xdotool key 3; xdotool key bracketright; sleep 2" docs/arm-car-window.png
+  wrote docs/arm-car-window.png "the arm car's window after driving and jogging its arm (worlds/arm_car.toml)"
 }
 
 # Serves `rover ARGS...` headless to the web viewer and shoots it into FILE.
