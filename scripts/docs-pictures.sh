@@ -16,6 +16,10 @@
 #                       and example-robot-data from set-up)
 #   playground-world    the tutorial car's first camera image in turtlebot_gazebo's
 #                       playground.world (../shared/corpus; skipped without it)
+#   arm-car-reach       worlds/arm_car_reach.toml's workspace camera 5 s into
+#                       examples/scripts/reach.toml: the hand 10 cm short of the ball
+#   people-dataset      rover dataset on the playground (seed 11), the first 16 people seen
+#                       whole (scripts/people_grid.py)
 # Live (a window or a browser on wall time, so their bytes differ between runs):
 #   window              the driver's station under Xvfb in worlds/playground.toml, `f` pressed:
 #                       the follower at work, boxes and HUD (the detector on its own thread)
@@ -23,6 +27,9 @@
 #                       its shoulder lift and elbow with the keys, as tests/window.rs does
 #   rerun-web           a headless follow run in worlds/playground.toml served to Rerun's web
 #                       viewer, shot in headless Chromium: 3D scene, camera, plots
+#   rerun-ground-truth  worlds/playground.toml followed at once with --ground-truth: the truth
+#                       boxes beside YOLO's
+#   fetch-rerun         worlds/arm_car_fetch.toml's fetch (pick toggled at 1 s) at its end, 38 s
 #   rerun-vlp16         the VLP-16 car in worlds/people.toml in Rerun's web viewer: its cloud
 #
 # Needs what ./run and ./test set up (scripts/setup.sh: the detector model, MakeHuman's body,
@@ -32,7 +39,8 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rover/target}"
 cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
 python="$cache/venv/bin/python3"
-all=(camera-playground person-sweep robots playground-world window arm-car-window rerun-web rerun-vlp16)
+all=(camera-playground person-sweep robots playground-world arm-car-reach people-dataset
+  window arm-car-window rerun-web rerun-ground-truth fetch-rerun rerun-vlp16)
 wanted=("$@")
 [ ${#wanted[@]} -eq 0 ] && wanted=("${all[@]}")
 for name in "${wanted[@]}"; do
@@ -84,6 +92,20 @@ robots() {
     || { cat "$work/robots.log" >&2; exit 1; }
   wrote docs/turtlebot3-burger.png "the TurtleBot3 burger from ../shared's xacro, at rest from 1.2 m"
   wrote docs/tiago.png "TIAGo from example-robot-data, at rest from 1.2 m"
+}
+
+arm_car_reach() {
+  "$rover" --headless --world worlds/arm_car_reach.toml --script examples/scripts/reach.toml \
+    --duration 5.5 --save-frames "$work/reach" --frame-every 5 > "$work/reach.log" 2>&1
+  cp "$(ls "$work/reach"/*.png | tail -n 1)" docs/arm-car-reach.png
+  wrote docs/arm-car-reach.png "worlds/arm_car_reach.toml's workspace camera 5 s after reach (examples/scripts/reach.toml)"
+}
+
+people_dataset() {
+  "$rover" dataset --out "$work/people" --images 40 --seed 11 --distance 2.5,4 --background 0 \
+    > "$work/people.log" 2>&1
+  "$python" scripts/people_grid.py "$work/people" docs/people-dataset.png > /dev/null
+  wrote docs/people-dataset.png "rover dataset on the playground (seed 11), the first 16 people seen whole"
 }
 
 playground_world() {
@@ -156,6 +178,19 @@ rerun_web() {
   web_shot docs/rerun-web.png --world worlds/playground.toml --script examples/scripts/follow.toml \
     --duration 8
   wrote docs/rerun-web.png "Rerun's web viewer in headless Chromium: worlds/playground.toml, follow mode"
+}
+
+rerun_ground_truth() {
+  echo 'steps = [ { at = 0.0, toggle = "follow" } ]' > "$work/follow.toml"
+  web_shot docs/rerun-ground-truth.png --script "$work/follow.toml" --ground-truth --duration 6
+  wrote docs/rerun-ground-truth.png "Rerun's web viewer: worlds/playground.toml followed at once, --ground-truth"
+}
+
+fetch_rerun() {
+  echo 'steps = [ { at = 1.0, toggle = "pick" } ]' > "$work/pick.toml"
+  web_shot docs/fetch-rerun.png --world worlds/arm_car_fetch.toml --script "$work/pick.toml" \
+    --duration 38
+  wrote docs/fetch-rerun.png "Rerun's web viewer at the end of worlds/arm_car_fetch.toml's fetch"
 }
 
 rerun_vlp16() {
