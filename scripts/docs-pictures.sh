@@ -20,6 +20,9 @@
 #                       examples/scripts/reach.toml: the hand 10 cm short of the ball
 #   people-dataset      rover dataset on the playground (seed 11), the first 16 people seen
 #                       whole (scripts/people_grid.py)
+#   street              street-textured.png (tests/worlds/street.world from a 1 m mast, as
+#                       tests/tests/ground_truth.rs renders it) and dataset-street.png (a rover
+#                       dataset of it, scripts/dataset_preview.py); needs ../shared's models
 # Live (a window or a browser on wall time, so their bytes differ between runs):
 #   window              the driver's station under Xvfb in worlds/playground.toml, `f` pressed:
 #                       the follower at work, boxes and HUD (the detector on its own thread)
@@ -39,7 +42,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rover/target}"
 cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
 python="$cache/venv/bin/python3"
-all=(camera-playground person-sweep robots playground-world arm-car-reach people-dataset
+all=(camera-playground person-sweep robots playground-world arm-car-reach people-dataset street
   window arm-car-window rerun-web rerun-ground-truth fetch-rerun rerun-vlp16)
 wanted=("$@")
 [ ${#wanted[@]} -eq 0 ] && wanted=("${all[@]}")
@@ -99,6 +102,23 @@ arm_car_reach() {
     --duration 5.5 --save-frames "$work/reach" --frame-every 5 > "$work/reach.log" 2>&1
   cp "$(ls "$work/reach"/*.png | tail -n 1)" docs/arm-car-reach.png
   wrote docs/arm-car-reach.png "worlds/arm_car_reach.toml's workspace camera 5 s after reach (examples/scripts/reach.toml)"
+}
+
+street() {
+  local models=../shared/corpus/gazebo_models
+  if [ ! -d "$models" ]; then
+    echo "docs-pictures: skipped street: no $models (../shared beside the repository)" >&2
+    return
+  fi
+  ROVER_TEST_OUT="$work" cargo test --quiet --workspace --test ground_truth \
+    yolo_finds_the_textured_street_models > "$work/street.log" 2>&1 \
+    || { cat "$work/street.log" >&2; exit 1; }
+  cp "$work/street.png" docs/street-textured.png
+  wrote docs/street-textured.png "tests/worlds/street.world from the tutorial car's camera on a 1 m mast"
+  "$rover" dataset --world tests/worlds/street.world --model-path "$models" --out "$work/ds" \
+    --images 80 --seed 3 --distance 3,9 > "$work/ds.log" 2>&1
+  "$python" scripts/dataset_preview.py "$work/ds" docs/dataset-street.png 0 24 44 56 > /dev/null
+  wrote docs/dataset-street.png "rover dataset of tests/worlds/street.world (seed 3), images 0 24 44 56 with their labels"
 }
 
 people_dataset() {

@@ -254,14 +254,7 @@ pub fn half_turn_error_deg(
 /// translated node, its effect's image) and cafe_table (COLLADA in inches, instanced nodes, two
 /// wood textures) — with Gazebo's sun and ground plane, ahead of a robot at the origin facing
 /// +x.
-pub const STREET_WORLD: &str = r#"<sdf version="1.6"><world name="street">
-  <include><uri>model://sun</uri></include>
-  <include><uri>model://ground_plane</uri></include>
-  <include><uri>model://hatchback</uri><name>parked_car</name><pose>9 3.4 0 0 0 1.1</pose></include>
-  <include><uri>model://stop_sign</uri><pose>7 -1.5 0 0 0 -1.5708</pose></include>
-  <include><uri>model://fire_hydrant</uri><pose>3 -1.5 0 0 0 0</pose></include>
-  <include><uri>model://cafe_table</uri><pose>3.5 0.3 0 0 0 0</pose></include>
-</world></sdf>"#;
+pub const STREET_WORLD: &str = include_str!("../worlds/street.world");
 
 /// Every file under `dir`, at any depth, in name order.
 pub fn files_under(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
