@@ -5,6 +5,7 @@
 #
 #   scripts/docs-pictures.sh            every picture below
 #   scripts/docs-pictures.sh NAME...    only these (e.g. camera-playground window)
+#   scripts/docs-pictures.sh --long     every picture, the 70 minutes of soak plots too
 #
 # Deterministic (the same bytes on every run, on any machine with the same renderer):
 #   camera-playground   worlds/playground.toml, examples/scripts/follow.toml: the car's camera
@@ -34,6 +35,9 @@
 #                       boxes beside YOLO's
 #   fetch-rerun         worlds/arm_car_fetch.toml's fetch (pick toggled at 1 s) at its end, 38 s
 #   rerun-vlp16         the VLP-16 car in worlds/people.toml in Rerun's web viewer: its cloud
+# Long (measurement runs, only when named or with --long):
+#   soak-window         scripts/soak.sh window: the window's RSS over a 10-minute soak
+#   soak-headless       scripts/soak.sh headless: RSS over a 60-minute headless recording
 #
 # Needs what ./run and ./test set up (scripts/setup.sh: the detector model, MakeHuman's body,
 # xvfb, xdotool, chromium and the node packages, the Python venv with Pillow).
@@ -44,10 +48,18 @@ cache="${ROVER_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rover}"
 python="$cache/venv/bin/python3"
 all=(camera-playground person-sweep robots playground-world arm-car-reach people-dataset street
   window arm-car-window rerun-web rerun-ground-truth fetch-rerun rerun-vlp16)
+long=(soak-window soak-headless)
 wanted=("$@")
-[ ${#wanted[@]} -eq 0 ] && wanted=("${all[@]}")
+if [ ${#wanted[@]} -eq 0 ]; then
+  wanted=("${all[@]}")
+elif [ "${wanted[*]}" = "--long" ]; then
+  wanted=("${all[@]}" "${long[@]}")
+fi
 for name in "${wanted[@]}"; do
-  case " ${all[*]} " in *" $name "*) ;; *) echo "unknown picture '$name'; one of: ${all[*]}" >&2; exit 2 ;; esac
+  case " ${all[*]} ${long[*]} " in
+    *" $name "*) ;;
+    *) echo "unknown picture '$name'; one of: ${all[*]} ${long[*]} (or --long)" >&2; exit 2 ;;
+  esac
 done
 
 cargo build --release --quiet
@@ -217,6 +229,18 @@ rerun_vlp16() {
   web_shot docs/rerun-vlp16.png --world worlds/people.toml \
     --robot assets/robots/my_robot_vlp16.urdf.xacro --no-detector --duration 3
   wrote docs/rerun-vlp16.png "Rerun's web viewer: the VLP-16 car's cloud in worlds/people.toml"
+}
+
+soak_window() {
+  SOAK_OUT="$work/soak-window" scripts/soak.sh window
+  cp "$work/soak-window/rss.png" docs/soak-window-rss.png
+  wrote docs/soak-window-rss.png "scripts/soak.sh window: RSS over a 10-minute soak"
+}
+
+soak_headless() {
+  SOAK_OUT="$work/soak-headless" scripts/soak.sh headless
+  cp "$work/soak-headless/rss.png" docs/soak-headless-rss.png
+  wrote docs/soak-headless-rss.png "scripts/soak.sh headless: RSS over a 60-minute recording"
 }
 
 for name in "${wanted[@]}"; do
