@@ -242,11 +242,35 @@ impl RosGraph {
 
     /// Writes `script` to `<dir>/<name>` and runs it with the graph's python, as [`Self::run`].
     fn run_python(&self, name: &str, script: &str, timeout: Duration) -> Result<String> {
+        self.run_python_with(name, script, None, timeout)
+    }
+
+    /// As [`Self::run_python`], with `python_path` (generated messages) on its PYTHONPATH.
+    fn run_python_with(
+        &self,
+        name: &str,
+        script: &str,
+        python_path: Option<&Path>,
+        timeout: Duration,
+    ) -> Result<String> {
         let path = self.dir.path().join(name);
         std::fs::write(&path, script)?;
         let mut c = self.command(PYTHON);
         c.arg(&path);
+        if let Some(py) = python_path {
+            c.env("PYTHONPATH", py);
+        }
         self.run(c, timeout)
+    }
+
+    /// The words after `key ` on the first line of `out` that starts with it; an error with
+    /// the output and rover's log when none does.
+    fn keyed_line(&self, out: &str, key: &str) -> Result<Vec<String>> {
+        let found = out
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key} ")))
+            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", self.log("rover")))?;
+        Ok(found.split(' ').map(str::to_owned).collect())
     }
 
     /// Starts the Python `script` as the child `ros2_peer` (its output in that log), with
@@ -400,11 +424,12 @@ if got:
     for n, p, t in zip(m.name, m.pose, m.twist):
         print('model %s %.4f %.4f %.4f %.4f %.4f' % (n, p.position.x, p.position.y, p.position.z, t.linear.x, p.orientation.w))
 "#;
-    let mut c = graph.command(PYTHON);
-    let path = graph.dir.path().join("model_states.py");
-    std::fs::write(&path, script)?;
-    c.arg(&path).env("PYTHONPATH", &py);
-    let out = graph.run(c, Duration::from_secs(40))?;
+    let out = graph.run_python_with(
+        "model_states.py",
+        script,
+        Some(&py),
+        Duration::from_secs(40),
+    )?;
     graph.wait_rover(Duration::from_secs(120))?;
     println!("{out}");
     let model = |name: &str| -> Result<Vec<f64>> {
@@ -496,20 +521,10 @@ if touching:
     print('names %s %s' % (s.collision1_name, s.collision2_name))
     print('first %.4f %.4f' % (s.contact_positions[0].x, s.total_wrench.force.x))
 "#;
-    let mut c = graph.command(PYTHON);
-    let path = graph.dir.path().join("bumper.py");
-    std::fs::write(&path, script)?;
-    c.arg(&path).env("PYTHONPATH", &py);
-    let out = graph.run(c, Duration::from_secs(60))?;
+    let out = graph.run_python_with("bumper.py", script, Some(&py), Duration::from_secs(60))?;
     graph.wait_rover(Duration::from_secs(120))?;
     println!("{out}");
-    let line = |key: &str| -> Result<Vec<String>> {
-        let found = out
-            .lines()
-            .find_map(|l| l.strip_prefix(&format!("{key} ")))
-            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", graph.log("rover")))?;
-        Ok(found.split(' ').map(str::to_owned).collect())
-    };
+    let line = |key: &str| graph.keyed_line(&out, key);
     let counts: Vec<u64> = line("counts")?
         .iter()
         .filter_map(|w| w.parse().ok())
@@ -597,20 +612,10 @@ if velocities:
     print('velocity %s %d %.4f' % (v.header.frame_id, len(velocities),
                                    abs(v.vector.x) + abs(v.vector.y) + abs(v.vector.z)))
 "#;
-    let mut c = graph.command(PYTHON);
-    let path = graph.dir.path().join("imu.py");
-    std::fs::write(&path, script)?;
-    c.arg(&path);
-    let out = graph.run(c, Duration::from_secs(40))?;
+    let out = graph.run_python("imu.py", script, Duration::from_secs(40))?;
     graph.wait_rover(Duration::from_secs(120))?;
     println!("{out}");
-    let line = |key: &str| -> Result<Vec<String>> {
-        let found = out
-            .lines()
-            .find_map(|l| l.strip_prefix(&format!("{key} ")))
-            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", graph.log("rover")))?;
-        Ok(found.split(' ').map(str::to_owned).collect())
-    };
+    let line = |key: &str| graph.keyed_line(&out, key);
     let imu = line("imu")?;
     ensure!(imu[0] == "base_link", "IMU frame {imu:?}");
     let az: f64 = imu[1].parse()?;
@@ -1213,13 +1218,7 @@ print('period %.4f' % gaps[len(gaps) // 2])
     )?;
     graph.wait_rover(Duration::from_secs(120))?;
     println!("{out}");
-    let line = |key: &str| -> Result<Vec<String>> {
-        let found = out
-            .lines()
-            .find_map(|l| l.strip_prefix(&format!("{key} ")))
-            .with_context(|| format!("no {key}:\n{out}\nrover:\n{}", graph.log("rover")))?;
-        Ok(found.split(' ').map(str::to_owned).collect())
-    };
+    let line = |key: &str| graph.keyed_line(&out, key);
     ensure!(
         line("fields")? == ["x:0:7", "y:4:7", "z:8:7", "intensity:16:7", "ring:20:4"],
         "fields: {out}"
@@ -2044,11 +2043,7 @@ fn run_action_client(
     script: &str,
     py: &Path,
 ) -> Result<(String, String)> {
-    let path = graph.dir.path().join(name);
-    std::fs::write(&path, script)?;
-    let mut c = graph.command(PYTHON);
-    c.arg(&path).env("PYTHONPATH", py);
-    let out = graph.run(c, Duration::from_secs(90))?;
+    let out = graph.run_python_with(name, script, Some(py), Duration::from_secs(90))?;
     println!("{out}");
     let log = graph.log("rover");
     ensure!(

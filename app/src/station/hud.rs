@@ -247,7 +247,7 @@ fn sensor_line(session: &Session) -> Option<String> {
         let _ = write!(line, "bump {touching}  ");
     }
     if let Some(lidar) = session.lidars().first() {
-        let _ = write!(line, "lidar {} pts", lidar.last().points().count());
+        let _ = write!(line, "lidar {} pts", lidar.last().valid_len());
     }
     let line = line.trim_end();
     (!line.is_empty()).then(|| line.to_owned())

@@ -155,6 +155,15 @@ impl PointCloud {
         [self.f32_at(i, 0), self.f32_at(i, 4), self.f32_at(i, 8)]
     }
 
+    /// How many points are not NaN (no scan for a dense cloud).
+    pub fn valid_len(&self) -> usize {
+        if self.is_dense {
+            self.len()
+        } else {
+            self.points().count()
+        }
+    }
+
     /// The points that are not NaN, with their index.
     pub fn points(&self) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
         (0..self.len())
