@@ -16,6 +16,7 @@ pub(crate) mod ogre;
 pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod sdf;
+pub(crate) mod sdf_robot;
 pub(crate) mod srdf;
 pub(crate) mod toml;
 pub(crate) mod trimesh;

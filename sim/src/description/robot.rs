@@ -87,21 +87,50 @@ impl RobotModel {
     fn parse(text: &str, path: &Path, resources: &ResourcePaths) -> Result<Self> {
         let doc = parse_xml(text, path)?;
         let root = doc.root_element();
+        if root.has_tag_name("sdf") {
+            return super::sdf_robot::load(&doc, text, path, resources);
+        }
         if root.tag_name().name() != "robot" {
             return Err(SimError::invalid(
                 path,
                 Some(line_of(&doc, root)),
                 format!(
-                    "expected a <robot> root element, found <{}>",
+                    "expected a <robot> root element (URDF) or <sdf> with a <model>, found <{}>",
                     root.tag_name().name()
                 ),
             ));
         }
         validate_numbers(&doc, path)?;
         let lines = ElementLines::collect(&doc);
-
         let urdf = urdf::read(&doc, path)?;
+        let extensions = gazebo::parse(&doc, path)?;
+        Self::build(
+            Parts {
+                urdf,
+                lines,
+                extensions,
+                root_line: Some(line_of(&doc, root)),
+            },
+            text,
+            path,
+            resources,
+        )
+    }
 
+    /// The robot from its read parts (a URDF's, or an SDF model's as `sdf_robot.rs` reads
+    /// them): links, joints and their checks, the Gazebo extensions applied.
+    pub(crate) fn build(
+        parts: Parts,
+        text: &str,
+        path: &Path,
+        resources: &ResourcePaths,
+    ) -> Result<Self> {
+        let Parts {
+            urdf,
+            lines,
+            mut extensions,
+            root_line,
+        } = parts;
         let base_dir = path.parent().unwrap_or(Path::new("."));
         let materials: HashMap<&str, Rgba> = urdf
             .materials
@@ -115,17 +144,24 @@ impl RobotModel {
             (base_dir, resources),
             path,
             &lines,
-            || Some(line_of(&doc, root)),
+            || root_line,
         )?;
         let mut joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
         resolve_mimics(&urdf.joints, &mut joints, path, &lines)?;
         let transmissions = read_transmissions(&urdf, &joints, path)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
-        let mut extensions = gazebo::parse(&doc, path)?;
         for gps in extensions.gpss.iter_mut().filter(|g| g.link.is_empty()) {
             // hector's default: the model's first link, which for a URDF is its root.
             gps.link = links[root.index()].name.clone();
+        }
+        if let Some(dd) = extensions
+            .diff_drive
+            .as_mut()
+            .filter(|d| d.robot_base_frame.is_empty())
+        {
+            // gz-sim's DiffDrive: `<model>/<canonical link>`.
+            dd.robot_base_frame = format!("{}/{}", urdf.name, links[root.index()].name);
         }
         for (reference, kp) in &extensions.contact_kp {
             if let Some(&i) = link_index.get(reference) {
@@ -158,6 +194,7 @@ impl RobotModel {
             bumpers: extensions.bumpers,
             description: text.to_owned(),
             not_simulated: extensions.ignored,
+            joint_state_publisher: extensions.joint_state_publisher,
             transmissions,
             ros_control: extensions.ros_control,
             controllers: None,
@@ -172,6 +209,18 @@ impl RobotModel {
         model.validate_plugins(path)?;
         Ok(model)
     }
+}
+
+/// What a robot description file gives before it becomes a [`RobotModel`].
+pub(crate) struct Parts {
+    /// Links, joints, materials and transmissions, as URDF has them.
+    pub urdf: urdf::RobotEl,
+    /// Where each link and joint is written.
+    pub lines: ElementLines,
+    /// The Gazebo plugins and sensors.
+    pub extensions: gazebo::Extensions,
+    /// The line of the root element.
+    pub root_line: Option<u32>,
 }
 
 /// Converts the links (file order) and indexes them by name; duplicate names and a robot
@@ -327,9 +376,10 @@ fn rgba(c: [f64; 4]) -> Rgba {
 }
 
 /// Lines of `<link>` and `<joint>` elements by name, for messages about them.
-struct ElementLines {
-    links: HashMap<String, u32>,
-    joints: HashMap<String, u32>,
+#[derive(Debug, Default)]
+pub(crate) struct ElementLines {
+    pub links: HashMap<String, u32>,
+    pub joints: HashMap<String, u32>,
 }
 
 impl ElementLines {

@@ -276,17 +276,17 @@ fn apply_state_poses(path: &Path, models: &mut [Model], state_models: &StatePose
     Ok(())
 }
 
-struct Ctx<'a, 'input> {
-    path: &'a Path,
-    doc: &'a roxmltree::Document<'input>,
+pub(crate) struct Ctx<'a, 'input> {
+    pub(crate) path: &'a Path,
+    pub(crate) doc: &'a roxmltree::Document<'input>,
 }
 
 impl Ctx<'_, '_> {
-    fn err(&self, node: Node<'_, '_>, message: impl Into<String>) -> SimError {
+    pub(crate) fn err(&self, node: Node<'_, '_>, message: impl Into<String>) -> SimError {
         SimError::invalid(self.path, Some(line_of(self.doc, node)), message)
     }
 
-    fn number(&self, node: Node<'_, '_>) -> Result<f64> {
+    pub(crate) fn number(&self, node: Node<'_, '_>) -> Result<f64> {
         let text = node.text().unwrap_or("").trim();
         text.parse::<f64>()
             .ok()
@@ -303,7 +303,7 @@ impl Ctx<'_, '_> {
             })
     }
 
-    fn numbers<const N: usize>(&self, node: Node<'_, '_>) -> Result<[f64; N]> {
+    pub(crate) fn numbers<const N: usize>(&self, node: Node<'_, '_>) -> Result<[f64; N]> {
         let text = node.text().unwrap_or("");
         let values: Vec<f64> = text
             .split_whitespace()
@@ -327,7 +327,7 @@ impl Ctx<'_, '_> {
         })
     }
 
-    fn pose(&self, node: Node<'_, '_>) -> Result<Pose> {
+    pub(crate) fn pose(&self, node: Node<'_, '_>) -> Result<Pose> {
         let [x, y, z, roll, pitch, yaw] = self.numbers::<6>(node)?;
         if let Some(v) = [x, y, z].into_iter().find(|v| v.abs() > MAX_COORDINATE_M) {
             return Err(self.err(
@@ -340,11 +340,11 @@ impl Ctx<'_, '_> {
         Ok(pose_from_xyz_rpy([x, y, z], [roll, pitch, yaw]))
     }
 
-    fn local_pose(&self, node: Node<'_, '_>) -> Result<Pose> {
+    pub(crate) fn local_pose(&self, node: Node<'_, '_>) -> Result<Pose> {
         child(node, "pose").map_or(Ok(Pose::IDENTITY), |p| self.pose(p))
     }
 
-    fn flag(&self, node: Node<'_, '_>) -> bool {
+    pub(crate) fn flag(&self, node: Node<'_, '_>) -> bool {
         matches!(node.text().map(str::trim), Some("1" | "true"))
     }
 }
@@ -883,7 +883,7 @@ fn actor_script(ctx: &Ctx<'_, '_>, script: Node<'_, '_>) -> Result<Option<Script
 }
 
 /// The SDF file of a model folder: the newest `<sdf>` model.config names, else model.sdf.
-fn model_file(dir: &Path) -> std::result::Result<PathBuf, String> {
+pub(crate) fn model_file(dir: &Path) -> std::result::Result<PathBuf, String> {
     let config = dir.join("model.config");
     if let Ok(text) = std::fs::read_to_string(&config)
         && let Ok(doc) = roxmltree::Document::parse(&text)
@@ -917,7 +917,7 @@ fn model_file(dir: &Path) -> std::result::Result<PathBuf, String> {
 
 /// A visual's colour: `<material><diffuse>` (else `<ambient>`), else a known Gazebo material
 /// script name; `None` when the file says nothing rover can use.
-fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Option<Rgba>> {
+pub(crate) fn material_color(ctx: &Ctx<'_, '_>, visual: Node<'_, '_>) -> Result<Option<Rgba>> {
     let Some(material) = child(visual, "material") else {
         return Ok(None);
     };

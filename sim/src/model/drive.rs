@@ -59,6 +59,90 @@ pub struct DiffDriveConfig {
     pub cmd_timeout_s: Option<f64>,
     /// Line of the `<plugin>` element, for messages.
     pub line: Option<u32>,
+    /// Which plugin the parameters came from (names in messages, and the control rules).
+    pub plugin: DrivePlugin,
+    /// gz-sim DiffDrive's speed limiter on the body's forward speed (`*_linear_*` /
+    /// `*_velocity`, `*_acceleration`, `*_jerk`); `None`: gazebo_ros_diff_drive's rim ramp.
+    pub linear_limits: Option<SpeedLimits>,
+    /// gz-sim DiffDrive's speed limiter on the turn rate (`*_angular_*`).
+    pub angular_limits: Option<SpeedLimits>,
+    /// gz-sim DiffDrive's `<odom_publisher_frequency>` (Hz): odometry and its transform go out
+    /// at this rate; `None`: every control update, as gazebo_ros_diff_drive publishes.
+    pub odometry_rate_hz: Option<f64>,
+    /// gz-sim DiffDrive's `<tf_topic>`: where odom -> base goes (`None`: `/tf`).
+    pub tf_topic: Option<String>,
+}
+
+/// The plugin a diff drive was declared with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DrivePlugin {
+    /// Gazebo classic's `libgazebo_ros_diff_drive.so` (or skid steer, or rover's `[robot.drive]`).
+    #[default]
+    GazeboRos,
+    /// Modern Gazebo's `gz-sim-diff-drive-system` (`gz::sim::systems::DiffDrive`).
+    GzSim,
+}
+
+impl DrivePlugin {
+    /// The plugin's file name, for messages.
+    pub fn filename(self) -> &'static str {
+        match self {
+            Self::GazeboRos => "libgazebo_ros_diff_drive.so",
+            Self::GzSim => "gz-sim-diff-drive-system",
+        }
+    }
+
+    /// The parameter naming the left (`right`: right) wheel joint, for messages.
+    pub fn joint_parameter(self, right: bool) -> &'static str {
+        match (self, right) {
+            (Self::GazeboRos, false) => "leftJoint",
+            (Self::GazeboRos, true) => "rightJoint",
+            (Self::GzSim, false) => "left_joint",
+            (Self::GzSim, true) => "right_joint",
+        }
+    }
+}
+
+/// gz-sim's SpeedLimiter bounds on one velocity (forward m/s or turn rad/s): each bound
+/// infinite when not given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedLimits {
+    /// `min_*_velocity` .. `max_*_velocity`.
+    pub velocity: (f64, f64),
+    /// `min_*_acceleration` .. `max_*_acceleration` (per second).
+    pub acceleration: (f64, f64),
+    /// `min_*_jerk` .. `max_*_jerk` (per second squared).
+    pub jerk: (f64, f64),
+}
+
+impl Default for SpeedLimits {
+    fn default() -> Self {
+        let none = (f64::NEG_INFINITY, f64::INFINITY);
+        Self {
+            velocity: none,
+            acceleration: none,
+            jerk: none,
+        }
+    }
+}
+
+impl SpeedLimits {
+    /// gz-sim's SpeedLimiter::Limit: `v` bounded by jerk (from the last two values `v0`,
+    /// `v1`), then acceleration (from `v0`), then velocity, over the step `dt_s`.
+    pub fn limit(&self, v: f64, v0: f64, v1: f64, dt_s: f64) -> f64 {
+        if dt_s <= 0.0 {
+            return v.clamp(self.velocity.0, self.velocity.1);
+        }
+        let mut out = v;
+        // Jerk: the change of acceleration from (v1 -> v0) to (v0 -> out).
+        let dv = out - v0;
+        let dv0 = v0 - v1;
+        let da = (dv - dv0).clamp(self.jerk.0 * dt_s * dt_s, self.jerk.1 * dt_s * dt_s);
+        out = v0 + dv0 + da;
+        let dv = (out - v0).clamp(self.acceleration.0 * dt_s, self.acceleration.1 * dt_s);
+        out = v0 + dv;
+        out.clamp(self.velocity.0, self.velocity.1)
+    }
 }
 
 impl Default for DiffDriveConfig {
@@ -84,6 +168,11 @@ impl Default for DiffDriveConfig {
             publish_wheel_joint_state: false,
             cmd_timeout_s: None,
             line: None,
+            plugin: DrivePlugin::GazeboRos,
+            linear_limits: None,
+            angular_limits: None,
+            odometry_rate_hz: None,
+            tf_topic: None,
         }
     }
 }

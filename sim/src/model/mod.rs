@@ -30,7 +30,7 @@ pub use controllers::{
     CommandKind, ControllerConfig, ControllerKind, ControllerSpec, GripperSpec, NamedPose,
     TrajectoryConstraints, TrajectorySpec,
 };
-pub use drive::{DiffDriveConfig, DriveSpec, OdometrySource};
+pub use drive::{DiffDriveConfig, DrivePlugin, DriveSpec, OdometrySource, SpeedLimits};
 pub use kinematics::{
     ChainJoint, IkOptions, IkSolution, IkSolver, IkTarget, KinematicChain, KinematicsError,
     isometry_from_pose,
@@ -42,7 +42,7 @@ pub use robot::{
 };
 pub use sensors::{
     AxisNoise, BumperConfig, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise,
-    GpsConfig, GpsSource, ImuConfig, ImuPlugin, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
+    GpsConfig, GpsSource, ImuConfig, ImuPlugin, JointStatePublisherConfig, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
     OrientationReference, P3dConfig, PixelFormat,
 };
 pub use world::{

@@ -12,8 +12,8 @@ use crate::model::controllers::ControllerConfig;
 use crate::model::drive::{DiffDriveConfig, DriveSpec};
 use crate::model::mesh::MeshData;
 use crate::model::sensors::{
-    BumperConfig, CameraConfig, GpsConfig, ImuConfig, ImuPlugin, LaserConfig, LidarConfig,
-    P3dConfig,
+    BumperConfig, CameraConfig, GpsConfig, ImuConfig, ImuPlugin, JointStatePublisherConfig,
+    LaserConfig, LidarConfig, P3dConfig,
 };
 
 /// Mass properties of a link, from its `<inertial>`.
@@ -228,6 +228,9 @@ pub struct RobotModel {
     /// Gazebo sensors and plugins in the file that rover does not simulate (contact sensors,
     /// Gazebo's own GPS sensor, ...).
     pub not_simulated: Vec<String>,
+    /// gz-sim's JointStatePublisher system: where the joints' states go (`None`: gazebo_ros's
+    /// `/joint_states`).
+    pub joint_state_publisher: Option<JointStatePublisherConfig>,
     /// `<transmission>`s: which joints an actuator drives, through which ros_control
     /// hardware interface.
     pub transmissions: Vec<Transmission>,
@@ -427,24 +430,27 @@ impl RobotModel {
 
     pub(crate) fn validate_plugins(&self, path: &Path) -> Result<()> {
         if let Some(dd) = &self.diff_drive {
+            let file = dd.plugin.filename();
+            let (left, right) = (dd.plugin.joint_parameter(false), dd.plugin.joint_parameter(true));
+            let (rear_left, rear_right) = match dd.plugin {
+                crate::model::DrivePlugin::GazeboRos => ("leftRearJoint", "rightRearJoint"),
+                crate::model::DrivePlugin::GzSim => (left, right),
+            };
             let extras = dd
                 .extra_left_joints
                 .iter()
-                .map(|j| ("leftRearJoint", j))
-                .chain(dd.extra_right_joints.iter().map(|j| ("rightRearJoint", j)));
-            for (role, name) in [
-                ("leftJoint", &dd.left_joint),
-                ("rightJoint", &dd.right_joint),
-            ]
-            .into_iter()
-            .chain(extras)
+                .map(|j| (rear_left, j))
+                .chain(dd.extra_right_joints.iter().map(|j| (rear_right, j)));
+            for (role, name) in [(left, &dd.left_joint), (right, &dd.right_joint)]
+                .into_iter()
+                .chain(extras)
             {
                 let Some(id) = self.joint_id(name) else {
                     return Err(SimError::invalid(
                         path,
                         dd.line,
                         format!(
-                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: no such joint; joints in this robot: {}",
+                            "<plugin filename=\"{file}\"> <{role}>{name}</{role}>: no such joint; joints in this robot: {}",
                             names(self.joints.iter().map(|j| &j.name))
                         ),
                     ));
@@ -458,7 +464,7 @@ impl RobotModel {
                         path,
                         dd.line,
                         format!(
-                            "<plugin filename=\"libgazebo_ros_diff_drive.so\"> <{role}>{name}</{role}>: the joint is {}, expected a continuous or revolute wheel joint",
+                            "<plugin filename=\"{file}\"> <{role}>{name}</{role}>: the joint is {}, expected a continuous or revolute wheel joint",
                             kind_name(&joint.kind)
                         ),
                     ));
@@ -469,7 +475,7 @@ impl RobotModel {
                     path,
                     dd.line,
                     format!(
-                        "<plugin filename=\"libgazebo_ros_diff_drive.so\">: leftJoint and rightJoint are both \"{}\"; expected two different wheel joints",
+                        "<plugin filename=\"{file}\">: {left} and {right} are both \"{}\"; expected two different wheel joints",
                         dd.left_joint
                     ),
                 ));

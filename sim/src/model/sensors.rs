@@ -432,3 +432,16 @@ pub struct BumperConfig {
     /// Line of the `<sensor>` element, for messages.
     pub line: Option<u32>,
 }
+
+/// gz-sim's JointStatePublisher system (`gz-sim-joint-state-publisher-system`): the joints'
+/// states on a topic, every update.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointStatePublisherConfig {
+    /// `<topic>` (gz-sim's default `/world/<world>/model/<model>/joint_state`; rover names the
+    /// world `default`).
+    pub topic: String,
+    /// `<joint_name>`s; empty: every joint.
+    pub joints: Vec<String>,
+    /// Line of the `<plugin>` element, for messages.
+    pub line: Option<u32>,
+}

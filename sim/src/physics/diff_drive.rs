@@ -69,6 +69,8 @@ pub struct DiffDriveController {
     cmd_stamp_s: f64,
     timed_out: bool,
     wheel_cmd_radps: WheelSpeeds,
+    /// gz-sim's limiter state: the body command of the last two updates (newest first).
+    limited: [Twist; 2],
 }
 
 impl DiffDriveController {
@@ -88,6 +90,7 @@ impl DiffDriveController {
             cmd_stamp_s: 0.0,
             timed_out: false,
             wheel_cmd_radps: [0.0; 2],
+            limited: [Twist::ZERO; 2],
         }
     }
 
@@ -174,6 +177,31 @@ impl DiffDriveController {
             self.next_update_s = now_s + self.period_s;
         }
 
+        if self.config.linear_limits.is_some() || self.config.angular_limits.is_some() {
+            // gz-sim's DiffDrive limits the body's speeds, then sets the wheels exactly.
+            let cmd = self.command();
+            let [v0, v1] = self.limited;
+            let limit = |l: Option<crate::model::SpeedLimits>, v: f64, a: f64, b: f64| {
+                l.map_or(v, |l| l.limit(v, a, b, dt))
+            };
+            let body = Twist::new(
+                limit(
+                    self.config.linear_limits,
+                    cmd.linear_mps,
+                    v0.linear_mps,
+                    v1.linear_mps,
+                ),
+                limit(
+                    self.config.angular_limits,
+                    cmd.angular_radps,
+                    v0.angular_radps,
+                    v1.angular_radps,
+                ),
+            );
+            self.limited = [body, v0];
+            self.wheel_cmd_radps = self.wheel_speeds_for(body);
+            return true;
+        }
         let target = self.wheel_speeds_for(self.command());
         // gazebo_ros_diff_drive ramps the rim speed (m/s) by wheelAcceleration * dt.
         let radius_m = self.config.wheel_diameter_m / 2.0;

@@ -85,30 +85,11 @@ pub(super) fn parse_sensor(
         frame_id: link.to_owned(),
         ..base(name, GpsSource::Sensor, link, line_of(ctx.doc, sensor))
     };
-    let mut plugin = None;
-    for s in elements(sensor) {
-        match s.tag_name().name() {
-            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
-            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
-            "gps" => {
-                for sensing in elements(s) {
-                    let model = match sensing.tag_name().name() {
-                        "position_sensing" => &mut c.position_error,
-                        "velocity_sensing" => &mut c.velocity_error,
-                        _ => continue,
-                    };
-                    read_sensing(ctx, sensing, what, model)?;
-                }
-            }
-            "plugin"
-                if plugin_stem(s.attribute("filename").unwrap_or(""))
-                    == "gazebo_ros_gps_sensor" =>
-            {
-                plugin = Some(s);
-            }
-            _ => {}
-        }
-    }
+    read_sdf(ctx, sensor, what, &mut c)?;
+    let plugin = elements(sensor).find(|s| {
+        s.has_tag_name("plugin")
+            && plugin_stem(s.attribute("filename").unwrap_or("")) == "gazebo_ros_gps_sensor"
+    });
     let Some(plugin) = plugin else {
         return Ok(None);
     };
@@ -141,6 +122,51 @@ pub(super) fn parse_sensor(
     c.topic = root(&out);
     c.velocity_topic = root(&vel);
     Ok(Some(c))
+}
+
+/// Reads the SDF side of GPS sensor `what` (`<update_rate>`, `<pose>`, the `<gps>` or
+/// `<navsat>` sensing noise) into `c`.
+fn read_sdf(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, what: &str, c: &mut GpsConfig) -> Result<()> {
+    for s in elements(sensor) {
+        match s.tag_name().name() {
+            "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
+            "gps" | "navsat" => {
+                for sensing in elements(s) {
+                    let model = match sensing.tag_name().name() {
+                        "position_sensing" => &mut c.position_error,
+                        "velocity_sensing" => &mut c.velocity_error,
+                        _ => continue,
+                    };
+                    read_sensing(ctx, sensing, what, model)?;
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// A gz-sim NavSat sensor (no ROS plugin: the NavSat system publishes it) on `link`: a fix on
+/// `topic` in `frame` from the world's spherical coordinates; its velocity stays inside gz
+/// (ros_gz_bridge's NavSatFix has none), so no velocity topic.
+pub(super) fn parse_gz(
+    ctx: &Ctx<'_, '_>,
+    sensor: Node<'_, '_>,
+    link: &str,
+    topic: String,
+    frame: String,
+) -> Result<GpsConfig> {
+    let name = sensor.attribute("name").unwrap_or("navsat").to_owned();
+    let what = format!("<sensor name=\"{name}\" type=\"navsat\">");
+    let mut c = GpsConfig {
+        frame_id: frame,
+        topic,
+        velocity_topic: String::new(),
+        ..base(name, GpsSource::Sensor, link, line_of(ctx.doc, sensor))
+    };
+    read_sdf(ctx, sensor, &what, &mut c)?;
+    Ok(c)
 }
 
 /// One `<position_sensing>` or `<velocity_sensing>`: its `<horizontal>` noise on x and y, its

@@ -45,15 +45,7 @@ pub(super) fn parse_sensor(
         linear_acceleration_noise: [AxisNoise::default(); 3],
         line: Some(line_of(ctx.doc, sensor)),
     };
-    let mut sensor_rate_hz = 0.0;
-    for s in elements(sensor) {
-        match s.tag_name().name() {
-            "update_rate" => sensor_rate_hz = ctx.non_negative(s, what, "Hz")?,
-            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
-            "imu" => read_imu_noise(ctx, s, what, &mut c)?,
-            _ => {}
-        }
-    }
+    let sensor_rate_hz = read_sdf(ctx, sensor, what, &mut c)?;
     // Read above even without a plugin: a malformed block is an error either way.
     let Some(plugin) = elements(sensor).find(|n| {
         n.has_tag_name("plugin") && n.attribute("filename").is_some_and(is_sensor_plugin)
@@ -103,6 +95,51 @@ pub(super) fn parse_sensor(
         _ => plugin_rate_hz,
     };
     Ok(Some(c))
+}
+
+/// Reads the SDF side of IMU sensor `what` (`<update_rate>`, `<pose>`, `<imu>` noise) into `c`;
+/// returns the sensor's update rate (Hz, 0 = every step).
+fn read_sdf(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, what: &str, c: &mut ImuConfig) -> Result<f64> {
+    let mut sensor_rate_hz = 0.0;
+    for s in elements(sensor) {
+        match s.tag_name().name() {
+            "update_rate" => sensor_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
+            "imu" => read_imu_noise(ctx, s, what, c)?,
+            _ => {}
+        }
+    }
+    Ok(sensor_rate_hz)
+}
+
+/// A gz-sim IMU (no ROS plugin: the IMU system publishes it) on `link`, on `topic` in `frame`:
+/// orientation against the world (gz-sim's default), at the sensor's `<update_rate>`.
+pub(super) fn parse_gz(
+    ctx: &Ctx<'_, '_>,
+    sensor: Node<'_, '_>,
+    link: &str,
+    topic: String,
+    frame: String,
+) -> Result<ImuConfig> {
+    let name = sensor.attribute("name").unwrap_or("imu").to_owned();
+    let what = format!("<sensor name=\"{name}\" type=\"imu\">");
+    let mut c = ImuConfig {
+        name,
+        plugin: ImuPlugin::Sensor,
+        link: link.to_owned(),
+        link_from_sensor: Pose::IDENTITY,
+        update_rate_hz: 0.0,
+        topic,
+        frame_name: frame,
+        rpy_offset_rad: [0.0; 3],
+        reference: OrientationReference::World,
+        gaussian_noise: 0.0,
+        angular_velocity_noise: [AxisNoise::default(); 3],
+        linear_acceleration_noise: [AxisNoise::default(); 3],
+        line: Some(line_of(ctx.doc, sensor)),
+    };
+    c.update_rate_hz = read_sdf(ctx, sensor, &what, &mut c)?;
+    Ok(c)
 }
 
 /// The model plugin `libgazebo_ros_imu.so`: an IMU on link `<bodyName>`, orientation against

@@ -8,6 +8,8 @@
 
 mod bumper;
 mod gps;
+pub(crate) mod gz;
+mod gz_sensors;
 mod imu;
 mod p3d;
 mod ray;
@@ -45,21 +47,54 @@ pub(crate) struct Extensions {
     pub contact_kp: BTreeMap<String, f32>,
     /// Sensors and plugins rover does not simulate, for one summary line.
     pub ignored: Vec<String>,
+    /// gz-sim's JointStatePublisher system.
+    pub joint_state_publisher: Option<crate::model::sensors::JointStatePublisherConfig>,
 }
 
 /// Reads every `<gazebo>` element under `<robot>`.
 pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extensions> {
-    let ctx = Ctx { doc, path };
+    let blocks = elements(doc.root_element())
+        .filter(|n| n.has_tag_name("gazebo"))
+        .map(|gz| (gz.attribute("reference"), gz));
     let robot_name = doc.root_element().attribute("name").unwrap_or("robot");
+    parse_blocks(doc, path, robot_name, false, blocks)
+}
+
+/// Reads the Gazebo extensions in `blocks`: each an element whose children are plugins,
+/// sensors and surface parameters, on the link it names (`<gazebo reference>`, or an SDF
+/// `<link>`) or on the model (`None`). `sdf`: the description is an SDF model.
+pub(crate) fn parse_blocks<'a, 'input: 'a>(
+    doc: &'a roxmltree::Document<'input>,
+    path: &Path,
+    robot_name: &str,
+    sdf: bool,
+    blocks: impl Iterator<Item = (Option<&'a str>, Node<'a, 'input>)>,
+) -> Result<Extensions> {
+    let modern = sdf
+        || doc.descendants().any(|n| {
+            n.has_tag_name("plugin")
+                && gz::is_system(
+                    n.attribute("filename").unwrap_or(""),
+                    n.attribute("name").unwrap_or(""),
+                )
+        });
+    let ctx = Ctx {
+        doc,
+        path,
+        modern,
+        model: robot_name,
+    };
     let mut ext = Extensions::default();
-    for gz in elements(doc.root_element()).filter(|n| n.has_tag_name("gazebo")) {
-        let reference = gz.attribute("reference");
+    for (reference, gz) in blocks {
         let mut mu: [Option<f64>; 2] = [None, None];
         for child in elements(gz) {
             match child.tag_name().name() {
                 "plugin" => {
                     let file = child.attribute("filename").unwrap_or("");
-                    if file.contains("gazebo_ros_diff_drive")
+                    let name = child.attribute("name").unwrap_or("");
+                    if gz::is_system(file, name) {
+                        read_system(&ctx, child, &mut ext)?;
+                    } else if file.contains("gazebo_ros_diff_drive")
                         || file.contains("gazebo_ros_skid_steer_drive")
                     {
                         if let Some(first) = &ext.diff_drive {
@@ -91,7 +126,7 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
                         ));
                     }
                 }
-                "sensor" => read_sensor(&ctx, child, reference, robot_name, &mut ext)?,
+                "sensor" => read_sensor(&ctx, child, reference, &mut ext)?,
                 "mu1" => {
                     mu[0] = Some(ctx.non_negative(
                         child,
@@ -128,20 +163,62 @@ pub(crate) fn parse(doc: &roxmltree::Document<'_>, path: &Path) -> Result<Extens
     Ok(ext)
 }
 
+/// A gz-sim system on the model into `ext`.
+fn read_system(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>, ext: &mut Extensions) -> Result<()> {
+    let file = plugin.attribute("filename").unwrap_or("");
+    let name = plugin.attribute("name").unwrap_or("");
+    match gz::system(file, name) {
+        gz::System::DiffDrive => {
+            if let Some(first) = &ext.diff_drive {
+                return Err(ctx.err(
+                    plugin,
+                    format!(
+                        "a second drive plugin (the first is at line {}); expected one diff drive system",
+                        first.line.unwrap_or(0)
+                    ),
+                ));
+            }
+            ext.diff_drive = Some(gz::parse_diff_drive(ctx, plugin, ctx.model)?);
+        }
+        gz::System::JointStatePublisher => {
+            ext.joint_state_publisher =
+                Some(gz::parse_joint_state_publisher(plugin, ctx.doc, ctx.model));
+        }
+        gz::System::World => {}
+        gz::System::Other => {
+            let entry = format!("system {file} ({name})");
+            if !ext.ignored.contains(&entry) {
+                ext.ignored.push(entry);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A `<sensor>` in a `<gazebo>` element (on link `reference`) into `ext`; kinds and plugins
 /// rover does not simulate are listed in `ext.ignored`.
 fn read_sensor(
     ctx: &Ctx<'_, '_>,
     sensor: Node<'_, '_>,
     reference: Option<&str>,
-    robot_name: &str,
     ext: &mut Extensions,
 ) -> Result<()> {
+    let robot_name = ctx.model;
     let kind = sensor.attribute("type").unwrap_or("?");
     let name = sensor.attribute("name").unwrap_or("?");
     let simulated = matches!(
         kind,
-        "camera" | "depth" | "ray" | "gpu_ray" | "imu" | "contact"
+        "camera"
+            | "depth"
+            | "ray"
+            | "gpu_ray"
+            | "imu"
+            | "contact"
+            | "gpu_lidar"
+            | "lidar"
+            | "depth_camera"
+            | "rgbd_camera"
+            | "navsat"
     );
     let link = match reference {
         Some(link) => link,
@@ -153,6 +230,9 @@ fn read_sensor(
         }
         None => "",
     };
+    if ctx.modern && !elements(sensor).any(|p| p.has_tag_name("plugin")) {
+        return gz_sensors::read(ctx, sensor, link, ext);
+    }
     match kind {
         "camera" | "depth" => ext.cameras.push(parse_camera(ctx, sensor, link)?),
         "ray" | "gpu_ray"
@@ -305,7 +385,11 @@ fn parse_camera(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<C
         frame_name: link.to_owned(),
         image_topic: "image_raw".to_owned(),
         info_topic: "camera_info".to_owned(),
-        depth: (sensor.attribute("type") == Some("depth")).then(DepthOutput::default),
+        depth: matches!(
+            sensor.attribute("type"),
+            Some("depth" | "depth_camera" | "rgbd_camera")
+        )
+        .then(DepthOutput::default),
         line: Some(line_of(ctx.doc, sensor)),
     };
     let mut plugin_distortion = Distortion::default();

@@ -110,7 +110,10 @@ pub(super) fn parse(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Resu
         match s.tag_name().name() {
             "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
             "pose" => c.link_from_sensor = read_sensor_pose(ctx, s, what)?,
-            "ray" => read_ray_element(ctx, s, what, &mut c, [&mut horizontal, &mut vertical])?,
+            // gz-sim names the element <lidar>; Gazebo classic <ray>.
+            "ray" | "lidar" => {
+                read_ray_element(ctx, s, what, &mut c, [&mut horizontal, &mut vertical])?
+            }
             "plugin" => read_plugin(ctx, s, what, &mut c, &mut plugin)?,
             _ => {}
         }

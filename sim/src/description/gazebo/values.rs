@@ -14,6 +14,11 @@ pub(super) type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
 pub(super) struct Ctx<'a, 'input> {
     pub doc: &'a roxmltree::Document<'input>,
     pub path: &'a Path,
+    /// Whether the description is modern Gazebo's (an SDF model, or one with gz-sim systems):
+    /// its sensors without a ROS plugin publish on their `<topic>`, as gz-sim's do.
+    pub modern: bool,
+    /// The model's name, for gz-sim's default topic and frame names.
+    pub model: &'a str,
 }
 
 impl<'a, 'input> Ctx<'a, 'input> {
