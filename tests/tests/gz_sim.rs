@@ -180,3 +180,46 @@ fn turtlebot3_waffle_pi_sdf_has_its_camera() -> Result<()> {
     assert_eq!(robot.lasers.len(), 1);
     Ok(())
 }
+
+#[test]
+fn turtlebot3_world_loads_with_fuel_sun_and_ground_plane_as_rovers() -> Result<()> {
+    let Some(dir) = tb3_gz() else {
+        return Ok(());
+    };
+    let path = dir.join("worlds/turtlebot3_world.world");
+    let resources = ResourcePaths::default().with_model_path(dir.join("models"));
+    let world = rover_sim::model::World::load_with(&path, &resources)?;
+    // The Fuel Sun is Gazebo's sun (its light direction); the Fuel Ground Plane is rover's
+    // ground; the gz-sim world systems need nothing; the world's model:// obstacles load.
+    assert_eq!(world.sun_direction, [-0.5, 0.1, -0.9]);
+    assert_eq!(world.physics.step_hz, 1000.0);
+    let names: Vec<&str> = world.models.iter().map(|m| m.name.as_str()).collect();
+    assert!(
+        names.iter().any(|n| n.starts_with("turtlebot3_world")),
+        "{names:?}"
+    );
+    let collisions: usize = world
+        .models
+        .iter()
+        .flat_map(|m| &m.links)
+        .map(|l| l.collisions.len())
+        .sum();
+    assert!(collisions >= 9, "{collisions} collision shapes; expected the world's pillars and walls");
+    assert!(world.models.iter().all(|m| m.is_static));
+
+    // A Fuel model that is no built-in and not on this machine: a located error.
+    let tmp = tempfile::tempdir()?;
+    let bad = tmp.path().join("fuel.world");
+    std::fs::write(
+        &bad,
+        "<?xml version=\"1.0\"?>\n<sdf version=\"1.8\">\n  <world name=\"w\">\n    <include>\n      <uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Cafe table</uri>\n    </include>\n  </world>\n</sdf>\n",
+    )?;
+    let err = match rover_sim::model::World::load_with(&bad, &resources) {
+        Ok(_) => anyhow::bail!("loaded a world whose Fuel model is nowhere"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("fuel.world:5"), "{err}");
+    assert!(err.contains("Cafe table"), "{err}");
+    assert!(err.contains("does not download at run time"), "{err}");
+    Ok(())
+}

@@ -10,6 +10,7 @@
 pub(crate) mod collada;
 pub(crate) mod collada_skin;
 pub(crate) mod controllers;
+pub(crate) mod fuel;
 pub(crate) mod gazebo;
 pub(crate) mod mesh_file;
 pub(crate) mod ogre;

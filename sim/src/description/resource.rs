@@ -46,12 +46,14 @@ pub struct ResourcePaths {
     pub packages: BTreeMap<String, PathBuf>,
     /// Folders searched for packages (`ROS_PACKAGE_PATH`).
     pub package_search: Vec<PathBuf>,
-    /// Folders holding Gazebo models (`--model-path`, `GAZEBO_MODEL_PATH`).
+    /// Folders holding Gazebo models (`--model-path`, `GZ_SIM_RESOURCE_PATH`,
+    /// `IGN_GAZEBO_RESOURCE_PATH`, `GAZEBO_MODEL_PATH`).
     pub model_search: Vec<PathBuf>,
 }
 
 impl ResourcePaths {
-    /// Paths from the environment: `ROS_PACKAGE_PATH` and `GAZEBO_MODEL_PATH`.
+    /// Paths from the environment: `ROS_PACKAGE_PATH`; `GZ_SIM_RESOURCE_PATH`,
+    /// `IGN_GAZEBO_RESOURCE_PATH` and `GAZEBO_MODEL_PATH` for models.
     pub fn from_env() -> Self {
         let split = |var: &str| -> Vec<PathBuf> {
             std::env::var_os(var)
@@ -62,10 +64,14 @@ impl ResourcePaths {
                 })
                 .unwrap_or_default()
         };
+        // Modern Gazebo's resource paths first, then Gazebo classic's.
+        let mut model_search = split("GZ_SIM_RESOURCE_PATH");
+        model_search.extend(split("IGN_GAZEBO_RESOURCE_PATH"));
+        model_search.extend(split("GAZEBO_MODEL_PATH"));
         Self {
             packages: BTreeMap::new(),
             package_search: split("ROS_PACKAGE_PATH"),
-            model_search: split("GAZEBO_MODEL_PATH"),
+            model_search,
         }
     }
 
@@ -155,7 +161,7 @@ impl ResourcePaths {
             searched.push(root.clone());
         }
         let hint = if self.model_search.is_empty() {
-            "; GAZEBO_MODEL_PATH is not set: set it to the folder holding the model, or pass --model-path DIR".to_owned()
+            "; no model path is set: set GZ_SIM_RESOURCE_PATH (or GAZEBO_MODEL_PATH) to the folder holding the model, or pass --model-path DIR".to_owned()
         } else {
             String::new()
         };

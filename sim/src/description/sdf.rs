@@ -214,6 +214,7 @@ fn read_world_entities(
                 }
             }
             "actor" => world.people.push(actor(ctx, loader, node)?),
+            "plugin" => world_system(node, loader),
             "physics" | "gravity" | "state" | "spherical_coordinates" => {}
             other => {
                 loader.skipped.insert(format!("<{other}>"));
@@ -221,6 +222,19 @@ fn read_world_entities(
         }
     }
     Ok(())
+}
+
+/// A world `<plugin>`: gz-sim's world systems are rover's own work (physics, sensors, IMU,
+/// NavSat) or have nothing to do here (scene broadcaster, user commands; the sensors' render
+/// engine: rover renders with wgpu); any other plugin is listed as skipped.
+fn world_system(node: Node<'_, '_>, loader: &mut Loader<'_>) {
+    let file = node.attribute("filename").unwrap_or("");
+    let name = node.attribute("name").unwrap_or("");
+    if super::gazebo::gz::is_world_system(file) {
+        tracing::debug!("world system {file} ({name}): done by rover's own simulation");
+    } else {
+        loader.skipped.insert(format!("world plugin {file} ({name})"));
+    }
 }
 
 /// A person standing where `<include>` of the person model `model` puts it, named by the
@@ -631,6 +645,9 @@ impl Loader<'_> {
             self.resources
                 .find_model(name.trim_end_matches('/'))
                 .map_err(|e| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {e}")))?
+        } else if let Some(fuel) = super::fuel::parse(uri) {
+            super::fuel::find_local(&fuel, self.resources)
+                .map_err(|e| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {e}")))?
         } else {
             let p = PathBuf::from(uri.strip_prefix("file://").unwrap_or(uri));
             let base = ctx.path.parent().unwrap_or(Path::new("."));
@@ -679,10 +696,14 @@ impl Loader<'_> {
 /// The direction of the light in Gazebo's `model://sun` (a directional light).
 const GAZEBO_SUN_DIRECTION: [f64; 3] = [-0.5, 0.1, -0.9];
 
-/// The `model://NAME` an `<include>` names, if it names one.
+/// The `model://NAME` an `<include>` names, if it names one; Fuel's Sun and Ground Plane as
+/// `sun` and `ground_plane`.
 fn included_name<'a>(include: Node<'a, '_>) -> Option<&'a str> {
     let uri = child(include, "uri")?.text()?.trim();
-    Some(uri.strip_prefix("model://")?.trim_end_matches('/'))
+    match uri.strip_prefix("model://") {
+        Some(name) => Some(name.trim_end_matches('/')),
+        None => super::fuel::parse(uri).as_ref().and_then(super::fuel::builtin),
+    }
 }
 
 /// A world's `<light type="directional">`: the `<direction>` its light travels (Gazebo's

@@ -53,6 +53,12 @@ pub(crate) fn system_stem(filename: &str) -> Option<&str> {
     Some(rest.strip_suffix("-system").unwrap_or(rest))
 }
 
+/// Whether a plugin file is one of gz-sim's world systems, whose work rover's simulation
+/// always does.
+pub(crate) fn is_world_system(filename: &str) -> bool {
+    system_stem(filename).is_some_and(|s| WORLD_SYSTEMS.contains(&s))
+}
+
 /// Whether a plugin is a gz-sim system (by file name or `gz::sim::systems::` /
 /// `ignition::gazebo::systems::` name).
 pub(crate) fn is_system(filename: &str, name: &str) -> bool {
