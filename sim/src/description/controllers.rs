@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use saphyr::{LoadableYamlNode, MarkedYaml, Scalar, YamlData};
+use super::yaml::{self, Node, Value};
 
 use crate::error::{Result, SimError};
 use crate::model::actuation::Pid;
@@ -45,54 +45,6 @@ fn carries(
     false
 }
 
-/// A YAML node reduced to what a controllers file uses, with its line.
-#[derive(Debug, Clone)]
-struct Node {
-    line: u32,
-    value: Value,
-}
-
-#[derive(Debug, Clone)]
-enum Value {
-    Null,
-    Bool(bool),
-    Number(f64),
-    Text(String),
-    Map(Vec<(String, Node)>),
-    List(Vec<Node>),
-}
-
-impl Node {
-    fn get(&self, key: &str) -> Option<&Node> {
-        match &self.value {
-            Value::Map(entries) => entries.iter().find(|(k, _)| k == key).map(|(_, v)| v),
-            _ => None,
-        }
-    }
-
-    fn entries(&self) -> &[(String, Node)] {
-        match &self.value {
-            Value::Map(entries) => entries,
-            _ => &[],
-        }
-    }
-
-    fn is_map(&self) -> bool {
-        matches!(self.value, Value::Map(_))
-    }
-
-    fn describe(&self) -> &'static str {
-        match self.value {
-            Value::Null => "nothing",
-            Value::Bool(_) => "a boolean",
-            Value::Number(_) => "a number",
-            Value::Text(_) => "text",
-            Value::Map(_) => "a mapping",
-            Value::List(_) => "a list",
-        }
-    }
-}
-
 /// Reads and checks a controllers file for `robot`.
 pub fn load_controllers(path: &Path, robot: &RobotModel) -> Result<ControllerConfig> {
     let text = crate::io::read_text(path)?;
@@ -101,13 +53,7 @@ pub fn load_controllers(path: &Path, robot: &RobotModel) -> Result<ControllerCon
 
 /// Parses and checks controllers YAML text; `path` is used in messages.
 pub fn parse_controllers(text: &str, path: &Path, robot: &RobotModel) -> Result<ControllerConfig> {
-    let docs = MarkedYaml::load_from_str(text).map_err(|e| {
-        SimError::invalid(
-            path,
-            u32::try_from(e.marker().line()).ok(),
-            format!("not valid YAML: {}", e.info()),
-        )
-    })?;
+    let first = yaml::load(text, path)?;
     let mut reader = Reader {
         path,
         robot,
@@ -116,10 +62,9 @@ pub fn parse_controllers(text: &str, path: &Path, robot: &RobotModel) -> Result<
             ..ControllerConfig::default()
         },
     };
-    let Some(doc) = docs.first() else {
+    let Some(root) = first else {
         return Err(reader.error(1, "the file is empty; expected controllers, e.g.\n  arm_controller:\n    type: position_controllers/JointTrajectoryController\n    joints: [shoulder_joint, elbow_joint]"));
     };
-    let root = convert(doc, path)?;
     if !root.is_map() {
         return Err(reader.error(
             root.line,
@@ -137,56 +82,6 @@ pub fn parse_controllers(text: &str, path: &Path, robot: &RobotModel) -> Result<
         ));
     }
     Ok(reader.config)
-}
-
-fn convert(node: &MarkedYaml<'_>, path: &Path) -> Result<Node> {
-    let line = u32::try_from(node.span.start.line()).unwrap_or(u32::MAX);
-    let value = match &node.data {
-        YamlData::Value(Scalar::Null) => Value::Null,
-        YamlData::Value(Scalar::Boolean(b)) => Value::Bool(*b),
-        YamlData::Value(Scalar::Integer(i)) => Value::Number(*i as f64),
-        YamlData::Value(Scalar::FloatingPoint(f)) => Value::Number(f.into_inner()),
-        YamlData::Value(Scalar::String(s)) => Value::Text(s.to_string()),
-        YamlData::Representation(s, _, _) => Value::Text(s.to_string()),
-        YamlData::Sequence(items) => Value::List(
-            items
-                .iter()
-                .map(|i| convert(i, path))
-                .collect::<Result<_>>()?,
-        ),
-        YamlData::Mapping(map) => {
-            let mut entries = Vec::with_capacity(map.len());
-            for (k, v) in map {
-                let key = match &k.data {
-                    YamlData::Value(Scalar::String(s)) => s.to_string(),
-                    YamlData::Value(Scalar::Integer(i)) => i.to_string(),
-                    _ => {
-                        return Err(SimError::invalid(
-                            path,
-                            u32::try_from(k.span.start.line()).ok(),
-                            "expected a name as mapping key",
-                        ));
-                    }
-                };
-                let mut value = convert(v, path)?;
-                if matches!(value.value, Value::Map(_) | Value::List(_)) {
-                    // A block collection starts on the line after its key: point at the key.
-                    value.line = u32::try_from(k.span.start.line()).unwrap_or(value.line);
-                }
-                entries.push((key, value));
-            }
-            Value::Map(entries)
-        }
-        YamlData::Tagged(_, inner) => return convert(inner, path),
-        YamlData::Alias(_) | YamlData::BadValue => {
-            return Err(SimError::invalid(
-                path,
-                Some(line),
-                "aliases and malformed values are not supported here",
-            ));
-        }
-    };
-    Ok(Node { line, value })
 }
 
 struct Reader<'a> {

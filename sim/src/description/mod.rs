@@ -7,6 +7,7 @@
 //! [`RobotModel::load`](crate::model::RobotModel::load) and [`World::load`](crate::model::World::load);
 //! nothing here is needed to run a model built in code.
 
+pub(crate) mod bridge_map;
 pub(crate) mod collada;
 pub(crate) mod collada_skin;
 pub(crate) mod controllers;
@@ -25,7 +26,9 @@ pub(crate) mod urdf;
 pub(crate) mod world_toml;
 pub(crate) mod xacro;
 pub(crate) mod xml;
+pub(crate) mod yaml;
 
+pub use bridge_map::{BridgeDirection, TopicBridge, TopicMap};
 pub use controllers::{load_controllers, parse_controllers};
 pub use mesh_file::{load_mesh, load_texture};
 pub use resource::{NotFound, ResourcePaths};
