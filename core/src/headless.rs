@@ -41,6 +41,9 @@ pub struct RunConfig {
     pub camera: Option<String>,
     /// A ros_control controllers YAML for the robot (overrides the world's `controllers`).
     pub controllers: Option<PathBuf>,
+    /// A ros_gz_bridge topic map for the robot's gz topics (overrides the world's
+    /// `bridge_config`).
+    pub bridge_config: Option<PathBuf>,
     /// Input script.
     pub script: Option<PathBuf>,
     /// Sim seconds to run (default: the script's last step + 1 s, or 10 s without a script).
@@ -177,6 +180,14 @@ impl RunConfig {
             .or(world.robot.controllers.as_ref())
         {
             robot.load_controllers(path)?;
+        }
+        if let Some(path) = self
+            .bridge_config
+            .as_ref()
+            .or(world.robot.bridge_config.as_ref())
+        {
+            let map = rover_sim::description::TopicMap::load(path)?;
+            robot.bridge_topics(&map)?;
         }
         if let Some(name) = self.camera.as_ref().or(world.robot.camera.as_ref()) {
             robot.select_camera(name)?;

@@ -89,6 +89,16 @@ pub struct Twist {
     pub angular: Vector3,
 }
 
+/// `geometry_msgs/TwistStamped`, with the wire's header `H` (what Jazzy's TurtleBot3 bridge
+/// file puts on cmd_vel).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwistStamped<H> {
+    /// Stamp and frame.
+    pub header: H,
+    /// The twist.
+    pub twist: Twist,
+}
+
 /// `sensor_msgs/JointState`, with the wire's header `H`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct JointState<H> {
@@ -401,6 +411,8 @@ macro_rules! wire_messages {
         pub type CameraInfo = $crate::CameraInfo<$header>;
         /// `sensor_msgs/JointState`.
         pub type JointState = $crate::JointState<$header>;
+        /// `geometry_msgs/TwistStamped`.
+        pub type TwistStamped = $crate::TwistStamped<$header>;
         /// `sensor_msgs/LaserScan`.
         pub type LaserScan = $crate::LaserScan<$header, $ranges>;
         /// `sensor_msgs/Imu`.

@@ -28,6 +28,10 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular",
     ),
     (
+        "geometry_msgs/TwistStamped",
+        "Header header\ngeometry_msgs/Twist twist",
+    ),
+    (
         "geometry_msgs/Pose",
         "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation",
     ),

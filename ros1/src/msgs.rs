@@ -106,6 +106,27 @@ impl Decode for Twist {
     }
 }
 
+impl Message for TwistStamped {
+    const TYPE: &'static str = "geometry_msgs/TwistStamped";
+    fn encode(&self, out: &mut Vec<u8>) {
+        self.header.encode(out);
+        Message::encode(&self.twist, out);
+    }
+}
+
+impl Decode for TwistStamped {
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes);
+        Ok(Self {
+            header: Header::decode(&mut r)?,
+            twist: Twist {
+                linear: Vector3::decode(&mut r)?,
+                angular: Vector3::decode(&mut r)?,
+            },
+        })
+    }
+}
+
 impl Geometry for Wrench {
     fn encode(&self, out: &mut Vec<u8>) {
         self.force.encode(out);
@@ -622,6 +643,10 @@ mod tests {
     fn md5_sums_match_genmsg() -> Result<()> {
         for (t, sum) in [
             ("geometry_msgs/Twist", "9f195f881246fdfa2798d1d3eebca84a"),
+            (
+                "geometry_msgs/TwistStamped",
+                "98d34b0043a2093cf9d9345ab6eef12e",
+            ),
             ("nav_msgs/Odometry", "cd5e73d190d741a2f92e81eda573aca7"),
             ("tf2_msgs/TFMessage", "94810edda583a504dfda3829e70d7eec"),
             ("sensor_msgs/Image", "060021388200f6f0f447d0fcd9c64743"),

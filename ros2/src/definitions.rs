@@ -82,6 +82,14 @@ macro_rules! transform_stamped {
 /// `geometry_msgs/msg/Twist`.
 pub const TWIST: &str = concat!(twist_fields!(), vector3!());
 
+/// `geometry_msgs/msg/TwistStamped`.
+pub const TWIST_STAMPED: &str = concat!(
+    "std_msgs/Header header\ngeometry_msgs/Twist twist\n",
+    header!(),
+    block!("geometry_msgs/Twist", twist_fields!()),
+    vector3!()
+);
+
 /// `nav_msgs/msg/Odometry`.
 pub const ODOMETRY: &str = concat!(
     "std_msgs/Header header\nstring child_frame_id\n",

@@ -56,6 +56,11 @@ impl RosMessage for Twist {
     const DEFINITION: &'static str = crate::definitions::TWIST;
 }
 
+impl RosMessage for TwistStamped {
+    const DDS_TYPE: &'static str = "geometry_msgs::msg::dds_::TwistStamped_";
+    const DEFINITION: &'static str = crate::definitions::TWIST_STAMPED;
+}
+
 /// A 6x6 row-major covariance: `float64[36]`, written without a length as CDR fixed arrays are
 /// (serde's arrays stop at 32, hence the tuple).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,6 +3,7 @@
 //! `publish_rate`).
 
 use super::events::{ControlUpdate, TopicFamily};
+use super::odom::Every;
 use super::plan::RosPlan;
 
 /// The joints' state at a control update, in the plan's order, as sensor_msgs/JointState's
@@ -28,10 +29,8 @@ pub(crate) struct JointStates {
     wire: Box<dyn JointStatesWire>,
     /// Whether the robot has moving joints.
     any: bool,
-    /// Seconds between messages (0: every control update).
-    period_s: f64,
-    /// Sim time of the next message.
-    next_s: f64,
+    /// When messages go out (every control update, or a joint_state_controller's rate).
+    rate: Every,
     /// The arrays, reused.
     arrays: JointArrays,
 }
@@ -42,8 +41,7 @@ impl JointStates {
         Self {
             wire,
             any: !plan.joints.is_empty(),
-            period_s: plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz),
-            next_s: 0.0,
+            rate: Every::new(plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz)),
             arrays: JointArrays::default(),
         }
     }
@@ -52,10 +50,9 @@ impl JointStates {
 impl TopicFamily for JointStates {
     fn control(&mut self, update: &ControlUpdate) {
         let now_s = update.sample.sim_time_s;
-        if !self.any || now_s + 1e-9 < self.next_s {
+        if !self.any || !self.rate.due(now_s) {
             return;
         }
-        self.next_s = now_s + self.period_s;
         let a = &mut self.arrays;
         a.position.clear();
         a.position.extend(update.joints.iter().map(|j| j.position));

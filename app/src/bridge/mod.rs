@@ -129,7 +129,7 @@ pub(crate) fn families(
 ) -> Result<Vec<Box<dyn TopicFamily>>> {
     let mut families: Vec<Box<dyn TopicFamily>> = vec![
         Box::new(clock::Clock::new(transport.clock()?)),
-        Box::new(odom::Odom::new(transport.odom(plan)?)),
+        Box::new(odom::Odom::new(transport.odom(plan)?, plan)),
         Box::new(tf::Tf::new(transport.tf()?, plan)),
         Box::new(joint_states::JointStates::new(
             transport.joint_states(plan)?,

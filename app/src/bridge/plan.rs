@@ -12,6 +12,14 @@ use rover_sim::{
 pub struct RosPlan {
     /// `/cmd_vel` (diff drive `commandTopic`).
     pub cmd_topic: String,
+    /// The command topic carries geometry_msgs/TwistStamped (a ros_gz_bridge map says so),
+    /// not Twist.
+    pub cmd_stamped: bool,
+    /// Seconds between odometry messages and transforms (0: every control update;
+    /// gz-sim's DiffDrive: `1 / odom_publish_frequency`).
+    pub odom_period_s: f64,
+    /// Where the joints' states go: `/joint_states`, or gz-sim's JointStatePublisher `<topic>`.
+    pub joint_states_topic: String,
     /// `/odom` (diff drive `odometryTopic`).
     pub odom_topic: String,
     /// Odometry frame (`odometryFrame`).
@@ -173,6 +181,12 @@ impl RosPlan {
         };
         Self {
             cmd_topic: topic(&drive.command_topic),
+            cmd_stamped: drive.command_stamped,
+            odom_period_s: drive.odometry_rate_hz.map_or(0.0, |hz| 1.0 / hz),
+            joint_states_topic: robot
+                .joint_state_publisher
+                .as_ref()
+                .map_or_else(|| "/joint_states".to_owned(), |j| topic(&j.topic)),
             odom_topic: topic(&drive.odometry_topic),
             odom_frame: drive.odometry_frame.clone(),
             base_frame: drive.robot_base_frame.clone(),

@@ -5,7 +5,7 @@
 use rover_sim::geometry::Pose;
 
 use super::events::{ControlUpdate, Start, TopicFamily, Transform};
-use super::odom::odom_pose;
+use super::odom::{Every, odom_pose};
 use super::plan::{JointSource, RosPlan};
 
 /// `/tf` and `/tf_static` on one transport.
@@ -25,6 +25,8 @@ pub(crate) struct Tf {
     /// order after odom -> base.
     joints_on_tf: Vec<usize>,
     transforms: Vec<Transform>,
+    /// The odometry's rate (gz-sim's DiffDrive publishes its transform with its odometry).
+    rate: Every,
 }
 
 impl Tf {
@@ -48,6 +50,7 @@ impl Tf {
             odom_tf: plan.odom_tf,
             joints_on_tf,
             transforms,
+            rate: Every::new(plan.odom_period_s),
         }
     }
 }
@@ -58,6 +61,9 @@ impl TopicFamily for Tf {
     }
 
     fn control(&mut self, update: &ControlUpdate) {
+        if !self.rate.due(update.sample.sim_time_s) {
+            return;
+        }
         let mut next = self.transforms.iter_mut();
         if self.odom_tf
             && let Some(t) = next.next()

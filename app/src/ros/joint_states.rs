@@ -18,7 +18,7 @@ impl JointStates {
     /// Advertises `/joint_states`, for the plan's joints.
     pub fn advertise(node: &Node, plan: &RosPlan) -> Result<Self> {
         Ok(Self {
-            publisher: node.advertise("/joint_states", 50, false)?,
+            publisher: node.advertise(&plan.joint_states_topic, 50, false)?,
             msg: msgs::JointState {
                 header: header(""),
                 name: plan.joints.iter().map(|j| j.name.clone()).collect(),

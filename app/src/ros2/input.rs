@@ -1,5 +1,5 @@
 //! The bridge's input half: what ROS 2 peers send rover, as rover input — `rt/cmd_vel`
-//! (geometry_msgs/msg/Twist, like a key press), `rt/rover/arm/task` (std_msgs/msg/String:
+//! (geometry_msgs/msg/Twist, like a key press; TwistStamped where a ros_gz_bridge map says so), `rt/rover/arm/task` (std_msgs/msg/String:
 //! `off`, `look`, `reach`) and each controller's command topic as ros2_control names it:
 //! `/<controller>/joint_trajectory` (trajectory_msgs/msg/JointTrajectory) for a joint
 //! trajectory controller, `/<controller>/commands` (std_msgs/msg/Float64MultiArray, its joint's
@@ -79,9 +79,33 @@ enum Command {
     Value(Reader<msgs::Float64MultiArray>),
 }
 
+/// The drive's command topic, of the plan's type.
+enum CmdVel {
+    /// geometry_msgs/msg/Twist.
+    Twist(Reader<msgs::Twist>),
+    /// geometry_msgs/msg/TwistStamped (a ros_gz_bridge map says so).
+    Stamped(Reader<msgs::TwistStamped>),
+}
+
+impl CmdVel {
+    fn next(&mut self) -> Option<msgs::Twist> {
+        match self {
+            Self::Twist(r) => r.next(),
+            Self::Stamped(r) => r.next().map(|m| m.twist),
+        }
+    }
+
+    fn guid(&self) -> GUID {
+        match self {
+            Self::Twist(r) => r.reader.guid(),
+            Self::Stamped(r) => r.reader.guid(),
+        }
+    }
+}
+
 /// The input half of the bridge.
 pub struct Ros2Input {
-    cmd_vel: Reader<msgs::Twist>,
+    cmd_vel: CmdVel,
     task: Reader<msgs::Text>,
     /// Each controller's name and command topic.
     controllers: Vec<(String, Command)>,
@@ -140,7 +164,11 @@ impl Ros2Input {
             controllers.push((c.name.clone(), command));
         }
         Ok(Self {
-            cmd_vel: Reader::new(participant, &subscriber, &plan.cmd_topic)?,
+            cmd_vel: if plan.cmd_stamped {
+                CmdVel::Stamped(Reader::new(participant, &subscriber, &plan.cmd_topic)?)
+            } else {
+                CmdVel::Twist(Reader::new(participant, &subscriber, &plan.cmd_topic)?)
+            },
             task: Reader::new(participant, &subscriber, TASK_TOPIC)?,
             controllers,
             next: 0,
@@ -152,7 +180,7 @@ impl Ros2Input {
 
     /// The readers' and writers' GUIDs (topics and services), for `ros_discovery_info`.
     pub(super) fn gids(&self) -> (Vec<GUID>, Vec<GUID>) {
-        let mut readers = vec![self.cmd_vel.reader.guid(), self.task.reader.guid()];
+        let mut readers = vec![self.cmd_vel.guid(), self.task.reader.guid()];
         readers.extend(self.controllers.iter().map(|(_, c)| match c {
             Command::Trajectory(r) => r.reader.guid(),
             Command::Value(r) => r.reader.guid(),

@@ -18,7 +18,7 @@ impl JointStates {
     /// Creates `/joint_states` on `sinks`, for the plan's joints.
     pub fn create(sinks: &mut Sinks<'_>, plan: &RosPlan) -> Result<Self> {
         Ok(Self {
-            out: sinks.out("/joint_states", &default_qos())?,
+            out: sinks.out(&plan.joint_states_topic, &default_qos())?,
             msg: msgs::JointState {
                 header: Header::default(),
                 name: plan.joints.iter().map(|j| j.name.clone()).collect(),

@@ -121,6 +121,7 @@ struct RawRobot {
     #[serde(default)]
     drive: Option<DriveSpec>,
     controllers: Option<PathBuf>,
+    bridge_config: Option<PathBuf>,
     camera: Option<String>,
     srdf: Option<PathBuf>,
     arm_group: Option<String>,
@@ -466,6 +467,7 @@ impl RawWorld {
             xacro_args: raw_robot.xacro_args,
             drive: raw_robot.drive,
             controllers: raw_robot.controllers.map(|c| base_dir.join(c)),
+            bridge_config: raw_robot.bridge_config.map(|c| base_dir.join(c)),
             camera: raw_robot.camera,
             srdf: raw_robot.srdf.map(|s| base_dir.join(s)),
             arm_group: raw_robot.arm_group,

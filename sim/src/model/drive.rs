@@ -71,6 +71,9 @@ pub struct DiffDriveConfig {
     pub odometry_rate_hz: Option<f64>,
     /// gz-sim DiffDrive's `<tf_topic>`: where odom -> base goes (`None`: `/tf`).
     pub tf_topic: Option<String>,
+    /// The command topic carries geometry_msgs/TwistStamped rather than Twist (a ros_gz_bridge
+    /// map says so: Jazzy's TurtleBot3 bridge file does).
+    pub command_stamped: bool,
 }
 
 /// The plugin a diff drive was declared with.
@@ -173,6 +176,7 @@ impl Default for DiffDriveConfig {
             angular_limits: None,
             odometry_rate_hz: None,
             tf_topic: None,
+            command_stamped: false,
         }
     }
 }

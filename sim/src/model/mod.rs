@@ -7,6 +7,7 @@
 
 pub mod actor;
 pub(crate) mod actuation;
+pub(crate) mod bridged;
 pub(crate) mod camera_info;
 pub(crate) mod classes;
 pub(crate) mod controllers;
@@ -21,6 +22,7 @@ pub(crate) mod skin;
 pub(crate) mod world;
 
 pub use actuation::{HardwareInterface, Pid, RosControlPlugin, Transmission};
+pub use bridged::Bridged;
 pub use camera_info::{CameraInfo, link_from_optical};
 pub use classes::{
     EntityIds, Labelled, MODEL_CLASSES, MODEL_LABEL_PARTS, class_of_model, is_known_class,

@@ -75,6 +75,9 @@ pub struct RobotSpawn {
     /// `controllers`: a ros_control controllers YAML for the robot, resolved against the world
     /// file's folder.
     pub controllers: Option<PathBuf>,
+    /// `bridge_config`: a ros_gz_bridge topic map (YAML) naming the robot's gz topics on ROS,
+    /// resolved against the world file's folder.
+    pub bridge_config: Option<PathBuf>,
     /// `camera`: which of the robot's cameras to render, by `<sensor name>` or cameraName
     /// (default: the first).
     pub camera: Option<String>,

@@ -70,6 +70,14 @@ pub(crate) struct WorldArgs {
     #[arg(long, value_name = "FILE.yaml")]
     pub(crate) controllers: Option<PathBuf>,
 
+    /// A ros_gz_bridge topic map (the YAML parameter_bridge takes as config_file) naming the
+    /// robot's gz-sim topics on ROS 1 and ROS 2: each entry's gz_topic_name is published as its
+    /// ros_topic_name and ros_type_name (cmd_vel as geometry_msgs/msg/TwistStamped where it
+    /// says so). Overrides the world's [robot] bridge_config. Without one, a gz topic's ROS
+    /// name is the gz name itself
+    #[arg(long = "bridge-config", value_name = "FILE.yaml")]
+    pub(crate) bridge_config: Option<PathBuf>,
+
     /// Seed for everything random; the same seed gives the same run
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,
@@ -144,6 +152,7 @@ impl WorldArgs {
             drive: self.drive.clone(),
             camera: self.camera.clone(),
             controllers: self.controllers.clone(),
+            bridge_config: self.bridge_config.clone(),
             options: SimOptions {
                 seed: self.seed,
                 cmd_timeout_s,
