@@ -29,7 +29,10 @@ pub(crate) fn waffle_pi_copy(
     let text = std::fs::read_to_string(models.join("turtlebot3_waffle_pi/model.sdf"))?;
     let missing = "model://turtlebot3_common/meshes/bases/waffle_pi_base.stl";
     anyhow::ensure!(text.contains(missing), "the waffle_pi model changed");
-    let text = text.replace(missing, "model://turtlebot3_common/meshes/waffle_pi_base.dae");
+    let text = text.replace(
+        missing,
+        "model://turtlebot3_common/meshes/waffle_pi_base.dae",
+    );
     let copy = tmp.join("turtlebot3_waffle_pi");
     std::fs::create_dir_all(&copy)?;
     std::fs::write(copy.join("model.sdf"), text)?;
@@ -78,7 +81,10 @@ fn turtlebot3_burger_sdf_loads_with_its_gz_systems_and_sensors() -> Result<()> {
     );
     let dd = robot.diff_drive.as_ref().context("DiffDrive not read")?;
     assert_eq!(dd.plugin, DrivePlugin::GzSim);
-    assert_eq!((dd.left_joint.as_str(), dd.right_joint.as_str()), ("wheel_left_joint", "wheel_right_joint"));
+    assert_eq!(
+        (dd.left_joint.as_str(), dd.right_joint.as_str()),
+        ("wheel_left_joint", "wheel_right_joint")
+    );
     assert_eq!(dd.wheel_separation_m, 0.160);
     assert!((dd.wheel_diameter_m - 0.066).abs() < 1e-12);
     assert_eq!(dd.command_topic, "cmd_vel");
@@ -109,7 +115,10 @@ fn turtlebot3_burger_sdf_loads_with_its_gz_systems_and_sensors() -> Result<()> {
     assert_eq!(lds.frame_name, "base_scan");
     // base_scan's pose is in the model frame; its URDF frame (fixed joint) stays there.
     let t = lds.link_from_sensor.translation;
-    assert!((t - glam::Vec3::new(-0.032, 0.0, 0.171)).length() < 1e-5, "{t:?}");
+    assert!(
+        (t - glam::Vec3::new(-0.032, 0.0, 0.171)).length() < 1e-5,
+        "{t:?}"
+    );
     let imu = robot.imus.first().context("imu not read")?;
     assert_eq!(imu.topic, "imu");
     assert_eq!(imu.update_rate_hz, 200.0);
@@ -204,7 +213,10 @@ fn turtlebot3_world_loads_with_fuel_sun_and_ground_plane_as_rovers() -> Result<(
         .flat_map(|m| &m.links)
         .map(|l| l.collisions.len())
         .sum();
-    assert!(collisions >= 9, "{collisions} collision shapes; expected the world's pillars and walls");
+    assert!(
+        collisions >= 9,
+        "{collisions} collision shapes; expected the world's pillars and walls"
+    );
     assert!(world.models.iter().all(|m| m.is_static));
 
     // A Fuel model that is no built-in and not on this machine: a located error.
@@ -221,5 +233,156 @@ fn turtlebot3_world_loads_with_fuel_sun_and_ground_plane_as_rovers() -> Result<(
     assert!(err.contains("fuel.world:5"), "{err}");
     assert!(err.contains("Cafe table"), "{err}");
     assert!(err.contains("does not download at run time"), "{err}");
+    Ok(())
+}
+
+/// The tutorial car written with gz-sim systems (my_robot_gz.urdf) and with gazebo_ros's
+/// plugins (my_robot_laser.urdf.xacro).
+fn tutorial_cars() -> Result<(RobotModel, RobotModel)> {
+    let gz = RobotModel::load(&rover_tests::repo("assets/robots/my_robot_gz.urdf"))?;
+    let classic = RobotModel::load(&rover_tests::repo(
+        "assets/robots/my_robot_laser.urdf.xacro",
+    ))?;
+    Ok((gz, classic))
+}
+
+/// The two files describe one body: the same links (inertials, shapes, where they sit,
+/// friction) and joints.
+#[test]
+fn the_tutorial_cars_gz_file_has_the_classic_body() -> Result<()> {
+    let (gz, classic) = tutorial_cars()?;
+    assert_eq!(gz.links.len(), classic.links.len());
+    for (a, b) in gz.links.iter().zip(&classic.links) {
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.inertial, b.inertial, "{}", a.name);
+        assert_eq!(a.collisions, b.collisions, "{}", a.name);
+        assert_eq!(a.visuals, b.visuals, "{}", a.name);
+        assert_eq!(a.friction, b.friction, "{}", a.name);
+    }
+    assert_eq!(gz.joints, classic.joints);
+    let (g, c) = (
+        gz.diff_drive.as_ref().context("gz drive")?,
+        classic.diff_drive.as_ref().context("classic drive")?,
+    );
+    assert_eq!(g.plugin, DrivePlugin::GzSim);
+    assert_eq!(
+        (g.wheel_separation_m, g.wheel_diameter_m, g.wheel_torque_nm),
+        (c.wheel_separation_m, c.wheel_diameter_m, c.wheel_torque_nm)
+    );
+    Ok(())
+}
+
+/// A scripted 10 s run: forward, then a turn added, the turn dropped, a stop. Each change
+/// moves the speed or the turn rate, not both, so gazebo_ros's ramp on the rim speed and
+/// gz-sim's limits on the body's speeds ask the same of the wheels.
+const SCRIPT: [(f64, f64, f64); 4] = [
+    (0.4, 0.0, 3.0),
+    (0.4, 0.8, 3.0),
+    (0.4, 0.0, 2.0),
+    (0.0, 0.0, 2.0),
+];
+
+fn scripted_path(robot: RobotModel) -> Result<Vec<[f64; 3]>> {
+    let mut sim = flat_sim(robot)?;
+    let mut path = Vec::new();
+    for (v, w, seconds) in SCRIPT {
+        let chunks = (seconds / 0.25).round() as usize;
+        for _ in 0..chunks {
+            drive(&mut sim, Twist::new(v, w), 0.25)?;
+            let g = sim.ground_truth();
+            path.push([g.x_m, g.y_m, g.yaw_rad]);
+        }
+    }
+    Ok(path)
+}
+
+#[test]
+fn the_gz_car_drives_the_classic_cars_trajectory_within_a_centimetre() -> Result<()> {
+    let (gz, classic) = tutorial_cars()?;
+    let a = scripted_path(gz)?;
+    let b = scripted_path(classic)?;
+    assert_eq!(a.len(), 40);
+    let mut worst = 0.0_f64;
+    for (p, q) in a.iter().zip(&b) {
+        worst = worst.max((p[0] - q[0]).hypot(p[1] - q[1]));
+    }
+    let end = a.last().context("no path")?;
+    println!(
+        "gz car ends at ({:.3}, {:.3}, {:.1} deg); worst gap to the classic car {:.2} mm",
+        end[0],
+        end[1],
+        end[2].to_degrees(),
+        worst * 1000.0
+    );
+    // The run goes somewhere: 2 m forward and a 138 degree turn.
+    assert!(end[0].hypot(end[1]) > 1.5, "{end:?}");
+    assert!(worst < 0.01, "the trajectories differ by {worst} m");
+    Ok(())
+}
+
+#[test]
+fn the_gz_cars_gpu_lidar_scans_as_its_classic_ray_sensor() -> Result<()> {
+    let (gz, classic) = tutorial_cars()?;
+    let (lg, lc) = (&gz.lasers[0], &classic.lasers[0]);
+    assert_eq!(
+        (
+            lg.samples,
+            lg.min_angle_rad,
+            lg.max_angle_rad,
+            lg.update_rate_hz
+        ),
+        (
+            lc.samples,
+            lc.min_angle_rad,
+            lc.max_angle_rad,
+            lc.update_rate_hz
+        )
+    );
+    assert_eq!(
+        (
+            lg.range_min_m,
+            lg.range_max_m,
+            lg.range_resolution_m,
+            lg.noise
+        ),
+        (
+            lc.range_min_m,
+            lc.range_max_m,
+            lc.range_resolution_m,
+            lc.noise
+        )
+    );
+    assert_eq!(
+        (lg.link_from_sensor, lg.frame_name.as_str()),
+        (lc.link_from_sensor, "base_scan")
+    );
+    let world_text = "[[box]]\nname = \"crate\"\nsize_m = [0.6, 0.6, 0.6]\nposition_m = [1.5, 0.4]\n\n[[cylinder]]\nname = \"post\"\nradius_m = 0.1\nlength_m = 1.0\nposition_m = [-1.0, -1.2]\n";
+    let scan = |robot: RobotModel| -> Result<Vec<f32>> {
+        let world = rover_sim::model::World::from_str(
+            world_text,
+            &rover_tests::repo("worlds/scan_compare.toml"),
+        )?;
+        let mut sim = rover_sim::physics::Simulation::new(
+            world,
+            robot,
+            &rover_sim::physics::SimOptions::default(),
+        )?;
+        drive(&mut sim, Twist::ZERO, 0.5)?;
+        let mut laser = rover_sim::sensors::LaserSensor::new(&sim, 0)?;
+        Ok(laser.scan_now(&sim).ranges_m.clone())
+    };
+    let (a, b) = (scan(gz)?, scan(classic)?);
+    let hits = a.iter().filter(|r| r.is_finite()).count();
+    assert!(
+        hits > 20,
+        "only {hits} returns: the crate and the post should be seen"
+    );
+    assert_eq!(a.len(), b.len());
+    for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert!(
+            x == y || (x - y).abs() < 1e-4,
+            "ray {i}: {x} m (gz) vs {y} m (classic)"
+        );
+    }
     Ok(())
 }

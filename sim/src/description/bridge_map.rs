@@ -65,7 +65,10 @@ pub struct TopicMap {
 const PAIRS: &[(&str, &[&str])] = &[
     ("rosgraph_msgs/Clock", &["gz.msgs.Clock"]),
     ("sensor_msgs/JointState", &["gz.msgs.Model"]),
-    ("nav_msgs/Odometry", &["gz.msgs.Odometry", "gz.msgs.OdometryWithCovariance"]),
+    (
+        "nav_msgs/Odometry",
+        &["gz.msgs.Odometry", "gz.msgs.OdometryWithCovariance"],
+    ),
     ("tf2_msgs/TFMessage", &["gz.msgs.Pose_V"]),
     ("geometry_msgs/Twist", &["gz.msgs.Twist"]),
     ("geometry_msgs/TwistStamped", &["gz.msgs.Twist"]),
@@ -106,7 +109,10 @@ impl TopicMap {
         let Value::List(items) = &root.value else {
             return Err(err(
                 root.line,
-                format!("expected a YAML list of bridges at the top level, found {}", root.describe()),
+                format!(
+                    "expected a YAML list of bridges at the top level, found {}",
+                    root.describe()
+                ),
             ));
         };
         let mut entries = Vec::with_capacity(items.len());
@@ -136,7 +142,10 @@ fn read_entry(item: &Node, path: &Path) -> Result<TopicBridge> {
     if !item.is_map() {
         return Err(err(
             item.line,
-            format!("expected a bridge (a mapping of ros_topic_name, gz_topic_name, ros_type_name, gz_type_name, direction), found {}", item.describe()),
+            format!(
+                "expected a bridge (a mapping of ros_topic_name, gz_topic_name, ros_type_name, gz_type_name, direction), found {}",
+                item.describe()
+            ),
         ));
     }
     let text = |key: &str| -> Result<Option<(String, u32)>> {
@@ -172,7 +181,11 @@ fn read_entry(item: &Node, path: &Path) -> Result<TopicBridge> {
             );
         }
     }
-    let (topic, ros, gz) = (text("topic_name")?, text("ros_topic_name")?, text("gz_topic_name")?);
+    let (topic, ros, gz) = (
+        text("topic_name")?,
+        text("ros_topic_name")?,
+        text("gz_topic_name")?,
+    );
     let (ros_topic, gz_topic) = match (topic, ros, gz) {
         (Some((_, line)), Some(_), _) | (Some((_, line)), _, Some(_)) => {
             return Err(err(
@@ -231,7 +244,9 @@ fn read_entry(item: &Node, path: &Path) -> Result<TopicBridge> {
             other => {
                 return Err(err(
                     line,
-                    format!("direction: invalid direction '{other}'; expected BIDIRECTIONAL, GZ_TO_ROS or ROS_TO_GZ"),
+                    format!(
+                        "direction: invalid direction '{other}'; expected BIDIRECTIONAL, GZ_TO_ROS or ROS_TO_GZ"
+                    ),
                 ));
             }
         },
@@ -279,10 +294,15 @@ mod tests {
 ";
         let map = TopicMap::parse(text, Path::new("b.yaml"))?;
         assert_eq!(map.entries.len(), 2);
-        let cmd = map.for_gz_topic("model/tb3/cmd_vel").ok_or_else(|| SimError::invalid(Path::new("x"), None, "missing"))?;
+        let cmd = map
+            .for_gz_topic("model/tb3/cmd_vel")
+            .ok_or_else(|| SimError::invalid(Path::new("x"), None, "missing"))?;
         assert_eq!(cmd.direction, BridgeDirection::RosToGz);
         assert_eq!(cmd.ros_type_short(), "geometry_msgs/TwistStamped");
-        assert_eq!(map.ros_name("/model/tb3/cmd_vel").as_deref(), Some("/cmd_vel"));
+        assert_eq!(
+            map.ros_name("/model/tb3/cmd_vel").as_deref(),
+            Some("/cmd_vel")
+        );
         assert_eq!(map.ros_name("clock").as_deref(), Some("/clock"));
         assert_eq!(map.entries[1].direction, BridgeDirection::Bidirectional);
         assert!(map.entries[1].lazy);

@@ -31,7 +31,9 @@ pub(crate) fn parse(uri: &str) -> Option<FuelUri> {
     let host = parts.next()?.to_owned();
     let segments: Vec<&str> = parts.filter(|s| !s.is_empty()).collect();
     // [api version,] owner, "models", name, [version, ...]
-    let at = segments.iter().position(|s| s.eq_ignore_ascii_case("models"))?;
+    let at = segments
+        .iter()
+        .position(|s| s.eq_ignore_ascii_case("models"))?;
     let owner = segments.get(at.checked_sub(1)?)?;
     let name = segments.get(at + 1)?;
     let version = segments
@@ -70,7 +72,12 @@ fn decode(s: &str) -> String {
 /// The built-in a Fuel model is (`sun`, `ground_plane`: the names the `model://` forms have),
 /// if it is one.
 pub(crate) fn builtin(uri: &FuelUri) -> Option<&'static str> {
-    match uri.name.to_ascii_lowercase().replace([' ', '-'], "_").as_str() {
+    match uri
+        .name
+        .to_ascii_lowercase()
+        .replace([' ', '-'], "_")
+        .as_str()
+    {
         "sun" => Some("sun"),
         "ground_plane" => Some("ground_plane"),
         _ => None,

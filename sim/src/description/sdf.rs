@@ -233,7 +233,9 @@ fn world_system(node: Node<'_, '_>, loader: &mut Loader<'_>) {
     if super::gazebo::gz::is_world_system(file) {
         tracing::debug!("world system {file} ({name}): done by rover's own simulation");
     } else {
-        loader.skipped.insert(format!("world plugin {file} ({name})"));
+        loader
+            .skipped
+            .insert(format!("world plugin {file} ({name})"));
     }
 }
 
@@ -702,7 +704,9 @@ fn included_name<'a>(include: Node<'a, '_>) -> Option<&'a str> {
     let uri = child(include, "uri")?.text()?.trim();
     match uri.strip_prefix("model://") {
         Some(name) => Some(name.trim_end_matches('/')),
-        None => super::fuel::parse(uri).as_ref().and_then(super::fuel::builtin),
+        None => super::fuel::parse(uri)
+            .as_ref()
+            .and_then(super::fuel::builtin),
     }
 }
 

@@ -74,12 +74,15 @@ pub(crate) fn load(
     };
     for link in children(model, "link") {
         let link_name = link.attribute("name").unwrap_or("");
-        lines
-            .links
-            .insert(link_name.to_owned(), line_of(doc, link));
+        lines.links.insert(link_name.to_owned(), line_of(doc, link));
         let urdf_from_sdf = frames.urdf_from_sdf(link_name);
-        urdf.links
-            .push(read_link(&ctx, link, link_name, urdf_from_sdf, &mut friction)?);
+        urdf.links.push(read_link(
+            &ctx,
+            link,
+            link_name,
+            urdf_from_sdf,
+            &mut friction,
+        )?);
     }
     for joint in children(model, "joint") {
         let joint_name = joint.attribute("name").unwrap_or("");
@@ -90,9 +93,8 @@ pub(crate) fn load(
             urdf.joints.push(j);
         }
     }
-    let blocks = std::iter::once((None, model)).chain(
-        children(model, "link").map(|l| (l.attribute("name"), l)),
-    );
+    let blocks = std::iter::once((None, model))
+        .chain(children(model, "link").map(|l| (l.attribute("name"), l)));
     let mut extensions = gazebo::parse_blocks(doc, path, &name, true, blocks)?;
     extensions.friction.extend(friction);
     // Sensors sit in their link's SDF frame; the link may have moved to its joint.
@@ -194,8 +196,8 @@ impl Frames {
                 .unwrap_or("")
                 .trim();
             if let Some(child_pose) = model_from_link.get(child_name) {
-                let joint_in_child = child(joint, "pose")
-                    .map_or(Ok(Pose::IDENTITY), |p| ctx.pose(p))?;
+                let joint_in_child =
+                    child(joint, "pose").map_or(Ok(Pose::IDENTITY), |p| ctx.pose(p))?;
                 model_from_urdf.insert(child_name.to_owned(), *child_pose * joint_in_child);
             }
         }
@@ -207,7 +209,10 @@ impl Frames {
 
     /// Maps a link's SDF frame into its URDF frame (identity unless it was re-framed).
     fn urdf_from_sdf(&self, link: &str) -> Pose {
-        match (self.model_from_urdf.get(link), self.model_from_link.get(link)) {
+        match (
+            self.model_from_urdf.get(link),
+            self.model_from_link.get(link),
+        ) {
             (Some(urdf), Some(sdf)) => urdf.inverse() * *sdf,
             _ => Pose::IDENTITY,
         }
@@ -251,7 +256,10 @@ fn read_link(
             let mass = child(i, "mass").map_or(Ok(1.0), |m| ctx.number(m))?;
             let mut inertia = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0];
             if let Some(t) = child(i, "inertia") {
-                for (k, tag) in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"].iter().enumerate() {
+                for (k, tag) in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]
+                    .iter()
+                    .enumerate()
+                {
                     if let Some(v) = child(t, tag) {
                         inertia[k] = ctx.number(v)?;
                     }
@@ -315,7 +323,10 @@ fn surface_friction(ctx: &Ctx<'_, '_>, collision: Node<'_, '_>) -> Result<Option
         if let Some(n) = child(ode, tag) {
             let v = ctx.number(n)?;
             if v < 0.0 {
-                return Err(ctx.err(n, format!("<{tag}>: expected a friction coefficient of 0 or more, found {v}")));
+                return Err(ctx.err(
+                    n,
+                    format!("<{tag}>: expected a friction coefficient of 0 or more, found {v}"),
+                ));
             }
             mu = Some(mu.map_or(v, |m| m.min(v)));
         }
@@ -344,14 +355,17 @@ fn read_geometry(ctx: &Ctx<'_, '_>, element: Node<'_, '_>) -> Result<Option<Geom
         })?;
         let v = ctx.number(n)?;
         if v <= 0.0 {
-            return Err(ctx.err(n, format!("<{tag}>: expected a positive size in metres, found {v}")));
+            return Err(ctx.err(
+                n,
+                format!("<{tag}>: expected a positive size in metres, found {v}"),
+            ));
         }
         Ok(v)
     };
     Ok(Some(match shape.tag_name().name() {
         "box" => {
-            let size_node = child(shape, "size")
-                .ok_or_else(|| ctx.err(shape, "<box> has no <size>"))?;
+            let size_node =
+                child(shape, "size").ok_or_else(|| ctx.err(shape, "<box> has no <size>"))?;
             Geometry::Box {
                 size: ctx.numbers::<3>(size_node)?,
             }

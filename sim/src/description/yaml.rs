@@ -116,4 +116,3 @@ fn convert(node: &MarkedYaml<'_>, path: &Path) -> Result<Node> {
     };
     Ok(Node { line, value })
 }
-

@@ -40,7 +40,11 @@ fn check(entry: &TopicBridge, slot: &Slot<'_>, path: &Path) -> Result<()> {
             format!(
                 "gz topic '{}' flows {} here; the map bridges it the other way ({:?})",
                 entry.gz_topic,
-                if slot.inbound { "from ROS into the simulation" } else { "out of the simulation" },
+                if slot.inbound {
+                    "from ROS into the simulation"
+                } else {
+                    "out of the simulation"
+                },
                 entry.direction
             ),
         ));

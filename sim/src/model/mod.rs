@@ -44,8 +44,8 @@ pub use robot::{
 };
 pub use sensors::{
     AxisNoise, BumperConfig, CameraConfig, DepthOutput, Distortion, ErrorModel, GaussianNoise,
-    GpsConfig, GpsSource, ImuConfig, ImuPlugin, JointStatePublisherConfig, LaserConfig, LidarConfig, MAX_LASER_SAMPLES,
-    OrientationReference, P3dConfig, PixelFormat,
+    GpsConfig, GpsSource, ImuConfig, ImuPlugin, JointStatePublisherConfig, LaserConfig,
+    LidarConfig, MAX_LASER_SAMPLES, OrientationReference, P3dConfig, PixelFormat,
 };
 pub use world::{
     DEFAULT_CONTACT_HZ, DEFAULT_STEP_HZ, DEFAULT_SUN_DIRECTION, GraspMode, Ground, JointSolver,

@@ -431,7 +431,10 @@ impl RobotModel {
     pub(crate) fn validate_plugins(&self, path: &Path) -> Result<()> {
         if let Some(dd) = &self.diff_drive {
             let file = dd.plugin.filename();
-            let (left, right) = (dd.plugin.joint_parameter(false), dd.plugin.joint_parameter(true));
+            let (left, right) = (
+                dd.plugin.joint_parameter(false),
+                dd.plugin.joint_parameter(true),
+            );
             let (rear_left, rear_right) = match dd.plugin {
                 crate::model::DrivePlugin::GazeboRos => ("leftRearJoint", "rightRearJoint"),
                 crate::model::DrivePlugin::GzSim => (left, right),

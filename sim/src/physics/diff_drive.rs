@@ -71,6 +71,8 @@ pub struct DiffDriveController {
     wheel_cmd_radps: WheelSpeeds,
     /// gz-sim's limiter state: the body command of the last two updates (newest first).
     limited: [Twist; 2],
+    /// The physics step (s): the first update's time step when the loop runs every step.
+    step_s: f64,
 }
 
 impl DiffDriveController {
@@ -91,7 +93,15 @@ impl DiffDriveController {
             timed_out: false,
             wheel_cmd_radps: [0.0; 2],
             limited: [Twist::ZERO; 2],
+            step_s: 0.0,
         }
+    }
+
+    /// The controller for a simulation stepping every `step_s` seconds (a loop that runs every
+    /// step limits its first update over one step, as gz-sim's does).
+    pub fn with_step(mut self, step_s: f64) -> Self {
+        self.step_s = step_s;
+        self
     }
 
     /// The plugin configuration.
@@ -169,7 +179,7 @@ impl DiffDriveController {
         }
         let dt = self
             .last_update_s
-            .map_or(self.period_s, |last| now_s - last);
+            .map_or(self.period_s.max(self.step_s), |last| now_s - last);
         self.last_update_s = Some(now_s);
         self.next_update_s += self.period_s;
         if self.next_update_s + 1e-9 < now_s {

@@ -238,7 +238,7 @@ impl Simulation {
             body_from_link: robot_bodies.body_from_link,
             base,
             wheels,
-            drive: DiffDriveController::new(drive_config),
+            drive: DiffDriveController::new(drive_config).with_step(dt_s),
             encoder,
             step_index: 0,
             dt_s,

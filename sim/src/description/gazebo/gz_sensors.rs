@@ -155,7 +155,10 @@ mod tests {
 
     #[test]
     fn camera_info_goes_beside_the_image() {
-        assert_eq!(sibling("camera/image_raw", "camera_info"), "camera/camera_info");
+        assert_eq!(
+            sibling("camera/image_raw", "camera_info"),
+            "camera/camera_info"
+        );
         assert_eq!(sibling("image", "camera_info"), "camera_info");
         assert_eq!(sibling("/a/b/image", "camera_info"), "/a/b/camera_info");
     }
