@@ -1,0 +1,319 @@
+//! Modern Gazebo's TurtleBot3 over ROS (issue 62): ROBOTIS' Jazzy burger (an SDF model with
+//! gz-sim systems, ../shared/corpus/turtlebot3_gz) in turtlebot3_world.world, its topics named
+//! by its own ros_gz_bridge file (cmd_vel as geometry_msgs/TwistStamped), driven a metre by a
+//! rospy node on a real ROS 1 master and by an rclpy node on Fast DDS; /scan, /imu, /odom,
+//! /joint_states and /tf checked at their declared rates.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use anyhow::{Context, Result, ensure};
+
+#[path = "ros/graph.rs"]
+mod graph;
+use graph::*;
+
+/// The corpus's turtlebot3_gazebo package, or `None` (skip recorded).
+fn tb3_gz() -> Option<PathBuf> {
+    rover_tests::shared("corpus/turtlebot3_gz/turtlebot3_gazebo")
+}
+
+/// rover's arguments for the burger in its world, as ROBOTIS' launch files start them: the
+/// model spawned at (-2, -0.5), the bridge's YAML, the package's models on the resource path.
+fn burger_args(tb3: &std::path::Path) -> Vec<String> {
+    let p = |rel: &str| tb3.join(rel).to_string_lossy().into_owned();
+    vec![
+        "--robot".into(),
+        p("models/turtlebot3_burger/model.sdf"),
+        "--bridge-config".into(),
+        p("params/turtlebot3_burger_bridge.yaml"),
+        "--world".into(),
+        p("worlds/turtlebot3_world.world"),
+        "--model-path".into(),
+        p("models"),
+        "--spawn=-2,-0.5".into(),
+        "--no-detector".into(),
+    ]
+}
+
+/// The rospy node: it drives with TwistStamped until /odom says a metre, stops, and reports
+/// what each topic carried (median stamp gaps, the scan's shape, the distance).
+const ROSPY_DRIVER: &str = r#"
+import rospy, struct, time
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, JointState, LaserScan
+rospy.init_node('tb3_gz_driver')
+got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': []}
+def keep(name):
+    return lambda m: got[name].append(m)
+def tf_raw(m):
+    # tf2_msgs/TFMessage, read from the wire (no tf2_msgs for Python here): the first
+    # transform's stamp and frames.
+    b = m._buff
+    secs, nsecs = struct.unpack_from('<II', b, 8)
+    n = struct.unpack_from('<I', b, 16)[0]
+    frame = b[20:20 + n].decode()
+    m2 = struct.unpack_from('<I', b, 20 + n)[0]
+    child = b[24 + n:24 + n + m2].decode()
+    got['tf'].append((secs + nsecs * 1e-9, frame, child))
+rospy.Subscriber('/scan', LaserScan, keep('scan'))
+rospy.Subscriber('/imu', Imu, keep('imu'))
+rospy.Subscriber('/odom', Odometry, keep('odom'))
+rospy.Subscriber('/joint_states', JointState, keep('joint_states'))
+rospy.Subscriber('/tf', rospy.AnyMsg, tf_raw)
+pub = rospy.Publisher('/cmd_vel', TwistStamped, queue_size=1)
+end = time.time() + 30
+while time.time() < end and (not got['odom'] or pub.get_num_connections() == 0):
+    time.sleep(0.05)
+start = got['odom'][-1].pose.pose.position.x if got['odom'] else float('nan')
+cmd = TwistStamped()
+cmd.header.frame_id = 'base_footprint'
+cmd.twist.linear.x = 0.2
+end = time.time() + 15
+while time.time() < end and got['odom'][-1].pose.pose.position.x - start < 1.0:
+    cmd.header.stamp = rospy.Time.now()
+    pub.publish(cmd)
+    time.sleep(0.02)
+cmd.twist.linear.x = 0.0
+for _ in range(20):
+    pub.publish(cmd)
+    time.sleep(0.05)
+time.sleep(1.0)
+odom = got['odom'][-1]
+print('odom %s %s %.4f' % (odom.header.frame_id, odom.child_frame_id,
+                          odom.pose.pose.position.x - start))
+def median_gap(stamps):
+    stamps = stamps[-200:]
+    gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+    return gaps[len(gaps) // 2] if gaps else float('nan')
+for name in ['scan', 'imu', 'odom', 'joint_states']:
+    print('gap %s %.5f %d' % (name, median_gap([m.header.stamp.to_sec() for m in got[name]]),
+                              len(got[name])))
+print('gap tf %.5f %d' % (median_gap([t[0] for t in got['tf'] if t[1] == 'odom']),
+                          len(got['tf'])))
+s = got['scan'][-1]
+print('scan %s %d %.3f %.3f' % (s.header.frame_id, len(s.ranges), s.range_min, s.range_max))
+print('imu %s' % got['imu'][-1].header.frame_id)
+print('tf %s' % ' '.join(sorted(set('%s>%s' % (t[1], t[2]) for t in got['tf']))))
+j = got['joint_states'][-1]
+print('joints %s' % ' '.join(j.name))
+"#;
+
+/// Checks the driver's report: a metre by odometry and by the truth, every topic at its
+/// declared rate.
+fn check_report(
+    out: &str,
+    keyed: impl Fn(&str) -> Result<Vec<String>>,
+    truth_m: f64,
+) -> Result<()> {
+    println!("{out}");
+    let odom = keyed("odom")?;
+    ensure!(
+        odom[..2] == ["odom", "base_footprint"],
+        "odom frames {odom:?}"
+    );
+    let by_odom: f64 = odom[2].parse()?;
+    ensure!(
+        (1.0..1.08).contains(&by_odom),
+        "odometry moved {by_odom} m; expected a metre (and the stop's few cm)"
+    );
+    ensure!(
+        (truth_m - by_odom).abs() < 0.03,
+        "the truth moved {truth_m} m, odometry {by_odom} m"
+    );
+    // Declared: the LDS at 5 Hz, the IMU at 200 Hz, the DiffDrive's odometry and tf at gz-sim's
+    // 50 Hz default (the file's <odom_publisher_frequency> is not a gz-sim parameter), the
+    // JointStatePublisher every step of the world's 1 kHz physics.
+    for (topic, period_s) in [
+        ("scan", 0.2),
+        ("imu", 0.005),
+        ("odom", 0.02),
+        ("joint_states", 0.001),
+        ("tf", 0.02),
+    ] {
+        let gap = keyed(&format!("gap {topic}"))?;
+        let got: f64 = gap[0].parse()?;
+        ensure!(
+            (got - period_s).abs() < period_s * 0.02 + 1e-6,
+            "/{topic} every {got} s (median of stamps); declared {period_s} s"
+        );
+    }
+    let scan = keyed("scan")?;
+    ensure!(
+        scan[..2] == ["base_scan", "360"] && scan[2] == "0.120" && scan[3] == "3.500",
+        "scan {scan:?}"
+    );
+    ensure!(
+        keyed("imu")? == ["turtlebot3_burger::imu_link::tb3_imu"],
+        "imu frame"
+    );
+    let tf = keyed("tf")?;
+    ensure!(tf.contains(&"odom>base_footprint".to_owned()), "tf {tf:?}");
+    ensure!(
+        keyed("joints")? == ["wheel_left_joint", "wheel_right_joint"],
+        "joint names"
+    );
+    Ok(())
+}
+
+/// How far the trace's ground truth moved from its first row to its last (m).
+fn truth_distance(rows: &[rover_core::TraceRow]) -> Result<f64> {
+    let (a, b) = (
+        rows.first().context("empty trace")?,
+        rows.last().context("empty trace")?,
+    );
+    Ok((b.x_m - a.x_m).hypot(b.y_m - a.y_m))
+}
+
+#[test]
+fn a_rospy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(tb3) = tb3_gz() else {
+        return Ok(());
+    };
+    let mut graph = RosGraph::start()?;
+    let args = burger_args(&tb3);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    graph.spawn_rover(25.0, &args)?;
+    let out = graph.run_python("driver.py", ROSPY_DRIVER, Duration::from_secs(60))?;
+    let rows = graph.wait_rover(Duration::from_secs(120))?;
+    let log = graph.log("rover");
+    ensure!(
+        !log.contains("not in the bridge map"),
+        "the burger's bridge file maps every topic rover publishes for it:\n{log}"
+    );
+    check_report(&out, |k| graph.keyed_line(&out, k), truth_distance(&rows)?)
+}
+
+/// The same driver as an rclpy node (Jazzy, Fast DDS), against `rover --ros2`.
+#[test]
+fn an_rclpy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()> {
+    let Some(tb3) = tb3_gz() else {
+        return Ok(());
+    };
+    let Some(rclpy) = rover_tests::rclpy::rclpy("jazzy") else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let domain = (std::process::id() % 150) as u16 + 40;
+    let trace = dir.path().join("trace.csv");
+    let log = std::fs::File::create(dir.path().join("rover.log"))?;
+    let mut rover = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args([
+            "--headless",
+            "--ros2",
+            "--rtf",
+            "1",
+            "--ros-distro",
+            "jazzy",
+        ])
+        .args(["--duration", "30", "--trace"])
+        .arg(&trace)
+        .args(burger_args(&tb3))
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("RUST_LOG", "info")
+        .stdin(Stdio::null())
+        .stdout(log.try_clone()?)
+        .stderr(log)
+        .spawn()
+        .context("starting rover")?;
+    let script = dir.path().join("driver.py");
+    std::fs::write(&script, RCLPY_DRIVER)?;
+    let out_path = dir.path().join("driver.log");
+    let out_file = std::fs::File::create(&out_path)?;
+    let mut peer = rclpy
+        .python(domain)
+        .arg(&script)
+        .stdin(Stdio::null())
+        .stdout(out_file.try_clone()?)
+        .stderr(out_file)
+        .spawn()
+        .context("starting rclpy")?;
+    rover_tests::wait_or_kill(&mut peer, Duration::from_secs(90))?;
+    let status = rover.wait()?;
+    let rover_log = std::fs::read_to_string(dir.path().join("rover.log")).unwrap_or_default();
+    ensure!(status.success(), "rover failed:\n{rover_log}");
+    let out = std::fs::read_to_string(&out_path)?;
+    let rows = rover_core::parse_trace(&std::fs::read_to_string(&trace)?)?;
+    let keyed = |key: &str| -> Result<Vec<String>> {
+        let found = out
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key} ")))
+            .with_context(|| format!("no {key}:\n{out}\nrover:\n{rover_log}"))?;
+        Ok(found.split(' ').map(str::to_owned).collect())
+    };
+    ensure!(keyed("rmw")? == ["rmw_fastrtps_cpp"], "the peer's RMW");
+    check_report(&out, keyed, truth_distance(&rows)?)
+}
+
+/// [`ROSPY_DRIVER`] as an rclpy node.
+const RCLPY_DRIVER: &str = r#"
+import time
+import rclpy
+from rclpy.qos import qos_profile_sensor_data
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, JointState, LaserScan
+from tf2_msgs.msg import TFMessage
+rclpy.init()
+node = rclpy.create_node('tb3_gz_driver')
+got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': []}
+def keep(name):
+    return lambda m: got[name].append(m)
+node.create_subscription(LaserScan, '/scan', keep('scan'), qos_profile_sensor_data)
+node.create_subscription(Imu, '/imu', keep('imu'), qos_profile_sensor_data)
+node.create_subscription(Odometry, '/odom', keep('odom'), 10)
+node.create_subscription(JointState, '/joint_states', keep('joint_states'), 1000)
+node.create_subscription(TFMessage, '/tf', keep('tf'), 100)
+pub = node.create_publisher(TwistStamped, '/cmd_vel', 10)
+def spin(seconds):
+    end = time.time() + seconds
+    while time.time() < end:
+        rclpy.spin_once(node, timeout_sec=0.01)
+end = time.time() + 40
+while time.time() < end and (not got['odom'] or pub.get_subscription_count() == 0):
+    spin(0.05)
+start = got['odom'][-1].pose.pose.position.x if got['odom'] else float('nan')
+cmd = TwistStamped()
+cmd.header.frame_id = 'base_footprint'
+cmd.twist.linear.x = 0.2
+end = time.time() + 15
+while time.time() < end and got['odom'][-1].pose.pose.position.x - start < 1.0:
+    cmd.header.stamp = node.get_clock().now().to_msg()
+    pub.publish(cmd)
+    spin(0.02)
+cmd.twist.linear.x = 0.0
+for _ in range(20):
+    pub.publish(cmd)
+    spin(0.05)
+spin(1.0)
+def stamp(h):
+    return h.stamp.sec + h.stamp.nanosec * 1e-9
+odom = got['odom'][-1]
+print('odom %s %s %.4f' % (odom.header.frame_id, odom.child_frame_id,
+                          odom.pose.pose.position.x - start))
+def median_gap(stamps):
+    stamps = stamps[-200:]
+    gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+    return gaps[len(gaps) // 2] if gaps else float('nan')
+for name in ['scan', 'imu', 'odom', 'joint_states']:
+    print('gap %s %.5f %d' % (name, median_gap([stamp(m.header) for m in got[name]]),
+                              len(got[name])))
+tf_odom = [stamp(t.header) for m in got['tf'] for t in m.transforms[:1]
+           if t.header.frame_id == 'odom']
+print('gap tf %.5f %d' % (median_gap(tf_odom), len(got['tf'])))
+s = got['scan'][-1]
+print('scan %s %d %.3f %.3f' % (s.header.frame_id, len(s.ranges), s.range_min, s.range_max))
+print('imu %s' % got['imu'][-1].header.frame_id)
+print('tf %s' % ' '.join(sorted(set('%s>%s' % (t.header.frame_id, t.child_frame_id)
+                                    for m in got['tf'] for t in m.transforms))))
+j = got['joint_states'][-1]
+print('joints %s' % ' '.join(j.name))
+from rclpy.utilities import get_rmw_implementation_identifier
+print('rmw %s' % get_rmw_implementation_identifier())
+"#;
