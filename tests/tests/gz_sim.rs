@@ -15,30 +15,6 @@ fn tb3_gz() -> Option<std::path::PathBuf> {
     shared("corpus/turtlebot3_gz/turtlebot3_gazebo")
 }
 
-/// TurtleBot3's waffle_pi model as ../shared has it, but for its base mesh: the corpus lacks
-/// `bases/waffle_pi_base.stl` (README there), so a copy of the model in `tmp` names the same
-/// base's COLLADA file the corpus has (`meshes/waffle_pi_base.dae`, millimetres like the STL).
-/// Returns the copy's model.sdf and the corpus's models folder.
-pub(crate) fn waffle_pi_copy(
-    tmp: &std::path::Path,
-) -> Result<Option<(std::path::PathBuf, std::path::PathBuf)>> {
-    let Some(dir) = tb3_gz() else {
-        return Ok(None);
-    };
-    let models = dir.join("models");
-    let text = std::fs::read_to_string(models.join("turtlebot3_waffle_pi/model.sdf"))?;
-    let missing = "model://turtlebot3_common/meshes/bases/waffle_pi_base.stl";
-    anyhow::ensure!(text.contains(missing), "the waffle_pi model changed");
-    let text = text.replace(
-        missing,
-        "model://turtlebot3_common/meshes/waffle_pi_base.dae",
-    );
-    let copy = tmp.join("turtlebot3_waffle_pi");
-    std::fs::create_dir_all(&copy)?;
-    std::fs::write(copy.join("model.sdf"), text)?;
-    Ok(Some((copy.join("model.sdf"), models)))
-}
-
 fn tb3_model(name: &str) -> Result<Option<RobotModel>> {
     let Some(dir) = tb3_gz() else {
         return Ok(None);
@@ -165,7 +141,7 @@ fn turtlebot3_burger_sdf_rests_and_drives_a_metre() -> Result<()> {
 #[test]
 fn turtlebot3_waffle_pi_sdf_has_its_camera() -> Result<()> {
     let tmp = tempfile::tempdir()?;
-    let Some((path, models)) = waffle_pi_copy(tmp.path())? else {
+    let Some((path, models)) = rover_tests::turtlebot3_gz_waffle_pi(tmp.path())? else {
         return Ok(());
     };
     let options = LoadOptions {
@@ -187,6 +163,18 @@ fn turtlebot3_waffle_pi_sdf_has_its_camera() -> Result<()> {
     let dd = robot.diff_drive.as_ref().context("no DiffDrive")?;
     assert_eq!(dd.wheel_separation_m, 0.287);
     assert_eq!(robot.lasers.len(), 1);
+    // It drives: a metre at 0.2 m/s, straight.
+    let mut sim = flat_sim(robot)?;
+    drive(&mut sim, Twist::ZERO, 1.0)?;
+    let rest = sim.ground_truth();
+    drive(&mut sim, Twist::new(0.2, 0.0), 5.0)?;
+    drive(&mut sim, Twist::ZERO, 1.0)?;
+    let moved = sim.ground_truth();
+    let distance = (moved.x_m - rest.x_m).hypot(moved.y_m - rest.y_m);
+    assert!(
+        (distance - 0.98).abs() <= 0.05,
+        "0.2 m/s for 5 s moved {distance} m; expected 0.98 m within 5 cm"
+    );
     Ok(())
 }
 

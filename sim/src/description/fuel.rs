@@ -1,6 +1,6 @@
 //! Gazebo Fuel model URIs in worlds (`https://fuel.gazebosim.org/1.0/OWNER/models/NAME[/VERSION]`),
 //! resolved without the network: Fuel's Sun and Ground Plane are rover's built-in sun and
-//! ground; any other model comes from a model folder of that name on the model path
+//! ground, its Standing person and Walking person rover's people; any other model comes from a model folder of that name on the model path
 //! (`--model-path`, `GZ_SIM_RESOURCE_PATH`, `GAZEBO_MODEL_PATH`) or from the local Fuel cache
 //! gz-sim downloads into (`GZ_FUEL_CACHE_PATH`, else `~/.gz/fuel`). rover never fetches at run
 //! time: a model found nowhere is an error naming the URI and every place looked at.
@@ -69,8 +69,8 @@ fn decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// The built-in a Fuel model is (`sun`, `ground_plane`: the names the `model://` forms have),
-/// if it is one.
+/// The built-in a Fuel model is (`sun`, `ground_plane`, `person_standing`, `person_walking`:
+/// the names the `model://` forms have), if it is one.
 pub(crate) fn builtin(uri: &FuelUri) -> Option<&'static str> {
     match uri
         .name
@@ -80,6 +80,8 @@ pub(crate) fn builtin(uri: &FuelUri) -> Option<&'static str> {
     {
         "sun" => Some("sun"),
         "ground_plane" => Some("ground_plane"),
+        "standing_person" => Some("person_standing"),
+        "walking_person" => Some("person_walking"),
         _ => None,
     }
 }

@@ -698,8 +698,9 @@ impl Loader<'_> {
 /// The direction of the light in Gazebo's `model://sun` (a directional light).
 const GAZEBO_SUN_DIRECTION: [f64; 3] = [-0.5, 0.1, -0.9];
 
-/// The `model://NAME` an `<include>` names, if it names one; Fuel's Sun and Ground Plane as
-/// `sun` and `ground_plane`.
+/// The `model://NAME` an `<include>` names, if it names one; Fuel's Sun, Ground Plane,
+/// Standing person and Walking person as `sun`, `ground_plane`, `person_standing`,
+/// `person_walking`.
 fn included_name<'a>(include: Node<'a, '_>) -> Option<&'a str> {
     let uri = child(include, "uri")?.text()?.trim();
     match uri.strip_prefix("model://") {
@@ -732,8 +733,7 @@ fn directional_light(ctx: &Ctx<'_, '_>, light: Node<'_, '_>) -> Result<Option<[f
 /// `person_standing` or `person_walking` when an `<include>` brings in one of Gazebo's people
 /// (they become rover people: the figure the detector is tested on, not the mesh).
 fn person_model(include: Node<'_, '_>) -> Option<String> {
-    let uri = child(include, "uri")?.text()?.trim();
-    let name = uri.strip_prefix("model://")?.trim_end_matches('/');
+    let name = included_name(include)?;
     matches!(name, "person_standing" | "person_walking").then(|| name.to_owned())
 }
 
