@@ -1,8 +1,9 @@
-//! Modern Gazebo's TurtleBot3 over ROS (issue 62): ROBOTIS' Jazzy burger (an SDF model with
-//! gz-sim systems, ../shared/corpus/turtlebot3_gz) in turtlebot3_world.world, its topics named
-//! by its own ros_gz_bridge file (cmd_vel as geometry_msgs/TwistStamped), driven a metre by a
-//! rospy node on a real ROS 1 master and by an rclpy node on Fast DDS; /scan, /imu, /odom,
-//! /joint_states and /tf checked at their declared rates.
+//! Modern Gazebo's TurtleBot3s over ROS (issue 62): ROBOTIS' Jazzy burger and waffle_pi (SDF
+//! models with gz-sim systems, ../shared/corpus/turtlebot3_gz) in turtlebot3_world.world, their
+//! topics named by their own ros_gz_bridge files (cmd_vel as geometry_msgs/TwistStamped), each
+//! driven a metre by a rospy node on a real ROS 1 master and by an rclpy node on Fast DDS;
+//! /scan, /imu, /odom, /joint_states and /tf checked at their declared rates, the waffle_pi's
+//! camera images received.
 
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
@@ -19,22 +20,82 @@ fn tb3_gz() -> Option<PathBuf> {
     rover_tests::shared("corpus/turtlebot3_gz/turtlebot3_gazebo")
 }
 
-/// rover's arguments for the burger in its world, as ROBOTIS' launch files start them: the
-/// model spawned at (-2, -0.5), the bridge's YAML, the package's models on the resource path.
-fn burger_args(tb3: &std::path::Path) -> Vec<String> {
+/// One of ROBOTIS' Jazzy TurtleBot3s, as its launch files start it.
+struct Tb3 {
+    /// `turtlebot3_burger` or `turtlebot3_waffle_pi`.
+    model: &'static str,
+    /// rover's arguments: the model spawned at (-2, -0.5), the bridge's YAML, the package's
+    /// models on the resource path.
+    args: Vec<String>,
+    /// The topics its bridge file leaves out (the waffle_pi's image: ROBOTIS bridges it with
+    /// ros_gz_image's image_bridge).
+    unbridged: &'static str,
+    /// Its LDS's declared `<update_rate>` as a period (s).
+    scan_period_s: f64,
+    /// Kept until the test ends (the waffle_pi's copy).
+    _tmp: tempfile::TempDir,
+}
+
+/// The burger and the waffle_pi, or `None` (skip recorded) without ../shared.
+fn turtlebots() -> Result<Option<Vec<Tb3>>> {
+    let Some(tb3) = tb3_gz() else {
+        return Ok(None);
+    };
+    let tmp = tempfile::tempdir()?;
+    let Some((waffle_pi, _)) = rover_tests::turtlebot3_gz_waffle_pi(tmp.path())? else {
+        return Ok(None);
+    };
     let p = |rel: &str| tb3.join(rel).to_string_lossy().into_owned();
-    vec![
-        "--robot".into(),
-        p("models/turtlebot3_burger/model.sdf"),
-        "--bridge-config".into(),
-        p("params/turtlebot3_burger_bridge.yaml"),
-        "--world".into(),
-        p("worlds/turtlebot3_world.world"),
-        "--model-path".into(),
-        p("models"),
-        "--spawn=-2,-0.5".into(),
-        "--no-detector".into(),
-    ]
+    let args = |robot: String, bridge: &str| {
+        vec![
+            "--robot".into(),
+            robot,
+            "--bridge-config".into(),
+            p(bridge),
+            "--world".into(),
+            p("worlds/turtlebot3_world.world"),
+            "--model-path".into(),
+            p("models"),
+            "--spawn=-2,-0.5".into(),
+            "--no-detector".into(),
+        ]
+    };
+    Ok(Some(vec![
+        Tb3 {
+            model: "turtlebot3_burger",
+            args: args(
+                p("models/turtlebot3_burger/model.sdf"),
+                "params/turtlebot3_burger_bridge.yaml",
+            ),
+            unbridged: "",
+            scan_period_s: 0.2,
+            _tmp: tempfile::tempdir()?,
+        },
+        Tb3 {
+            model: "turtlebot3_waffle_pi",
+            args: args(
+                waffle_pi.to_string_lossy().into_owned(),
+                "params/turtlebot3_waffle_pi_bridge.yaml",
+            ),
+            unbridged: "camera/image_raw",
+            scan_period_s: 0.1,
+            _tmp: tmp,
+        },
+    ]))
+}
+
+/// Whether rover's log lists exactly `unbridged` as not in the bridge map.
+fn check_unbridged(log: &str, unbridged: &str) -> Result<()> {
+    let listed = log
+        .lines()
+        .find_map(|l| l.split("published under their gz names: ").nth(1))
+        .unwrap_or("")
+        .trim();
+    ensure!(
+        listed == unbridged,
+        "not in the bridge map: '{listed}'; expected '{unbridged}'\n{log}"
+    );
+    Ok(())
 }
 
 /// The rospy node: it drives with TwistStamped until /odom says a metre, stops, and reports
@@ -43,9 +104,9 @@ const ROSPY_DRIVER: &str = r#"
 import rospy, struct, time
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, JointState, LaserScan
+from sensor_msgs.msg import Image, Imu, JointState, LaserScan
 rospy.init_node('tb3_gz_driver')
-got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': []}
+got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': [], 'image': []}
 def keep(name):
     return lambda m: got[name].append(m)
 def tf_raw(m):
@@ -63,6 +124,7 @@ rospy.Subscriber('/imu', Imu, keep('imu'))
 rospy.Subscriber('/odom', Odometry, keep('odom'))
 rospy.Subscriber('/joint_states', JointState, keep('joint_states'))
 rospy.Subscriber('/tf', rospy.AnyMsg, tf_raw)
+rospy.Subscriber('/camera/image_raw', Image, keep('image'))
 pub = rospy.Publisher('/cmd_vel', TwistStamped, queue_size=1)
 end = time.time() + 30
 while time.time() < end and (not got['odom'] or pub.get_num_connections() == 0):
@@ -99,16 +161,19 @@ print('imu %s' % got['imu'][-1].header.frame_id)
 print('tf %s' % ' '.join(sorted(set('%s>%s' % (t[1], t[2]) for t in got['tf']))))
 j = got['joint_states'][-1]
 print('joints %s' % ' '.join(j.name))
+i = got['image'][-1] if got['image'] else None
+print('image %d %d %d' % (i.width if i else 0, i.height if i else 0, len(got['image'])))
 "#;
 
 /// Checks the driver's report: a metre by odometry and by the truth, every topic at its
 /// declared rate.
 fn check_report(
+    tb3: &Tb3,
     out: &str,
     keyed: impl Fn(&str) -> Result<Vec<String>>,
     truth_m: f64,
 ) -> Result<()> {
-    println!("{out}");
+    println!("{}:\n{out}", tb3.model);
     let odom = keyed("odom")?;
     ensure!(
         odom[..2] == ["odom", "base_footprint"],
@@ -123,11 +188,11 @@ fn check_report(
         (truth_m - by_odom).abs() < 0.03,
         "the truth moved {truth_m} m, odometry {by_odom} m"
     );
-    // Declared: the LDS at 5 Hz, the IMU at 200 Hz, the DiffDrive's odometry and tf at gz-sim's
+    // Declared: the LDS at 5 Hz (the waffle_pi's at 10 Hz), the IMU at 200 Hz, the DiffDrive's odometry and tf at gz-sim's
     // 50 Hz default (the file's <odom_publisher_frequency> is not a gz-sim parameter), the
     // JointStatePublisher every step of the world's 1 kHz physics.
     for (topic, period_s) in [
-        ("scan", 0.2),
+        ("scan", tb3.scan_period_s),
         ("imu", 0.005),
         ("odom", 0.02),
         ("joint_states", 0.001),
@@ -146,9 +211,19 @@ fn check_report(
         "scan {scan:?}"
     );
     ensure!(
-        keyed("imu")? == ["turtlebot3_burger::imu_link::tb3_imu"],
+        keyed("imu")? == [format!("{}::imu_link::tb3_imu", tb3.model)],
         "imu frame"
     );
+    // The waffle_pi's camera: 640 x 480 images (the burger has none).
+    let image = keyed("image")?;
+    if tb3.model == "turtlebot3_waffle_pi" {
+        ensure!(
+            image[..2] == ["640", "480"] && image[2] != "0",
+            "camera images {image:?}"
+        );
+    } else {
+        ensure!(image[2] == "0", "the burger has no camera: {image:?}");
+    }
     let tf = keyed("tf")?;
     ensure!(tf.contains(&"odom>base_footprint".to_owned()), "tf {tf:?}");
     ensure!(
@@ -168,39 +243,51 @@ fn truth_distance(rows: &[rover_core::TraceRow]) -> Result<f64> {
 }
 
 #[test]
-fn a_rospy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()> {
+fn a_rospy_node_drives_the_gz_turtlebots_a_metre_with_twist_stamped() -> Result<()> {
     let _one = lock();
     if let Some(why) = missing_ros() {
         return skip(&why);
     }
-    let Some(tb3) = tb3_gz() else {
+    let Some(turtlebots) = turtlebots()? else {
         return Ok(());
     };
-    let mut graph = RosGraph::start()?;
-    let args = burger_args(&tb3);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    graph.spawn_rover(25.0, &args)?;
-    let out = graph.run_python("driver.py", ROSPY_DRIVER, Duration::from_secs(60))?;
-    let rows = graph.wait_rover(Duration::from_secs(120))?;
-    let log = graph.log("rover");
-    ensure!(
-        !log.contains("not in the bridge map"),
-        "the burger's bridge file maps every topic rover publishes for it:\n{log}"
-    );
-    check_report(&out, |k| graph.keyed_line(&out, k), truth_distance(&rows)?)
+    for tb3 in &turtlebots {
+        let mut graph = RosGraph::start()?;
+        let args: Vec<&str> = tb3.args.iter().map(String::as_str).collect();
+        graph.spawn_rover(25.0, &args)?;
+        let out = graph.run_python("driver.py", ROSPY_DRIVER, Duration::from_secs(90))?;
+        let rows = graph.wait_rover(Duration::from_secs(180))?;
+        check_unbridged(&graph.log("rover"), tb3.unbridged)?;
+        check_report(
+            tb3,
+            &out,
+            |k| graph.keyed_line(&out, k),
+            truth_distance(&rows)?,
+        )?;
+    }
+    Ok(())
 }
 
 /// The same driver as an rclpy node (Jazzy, Fast DDS), against `rover --ros2`.
 #[test]
-fn an_rclpy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()> {
-    let Some(tb3) = tb3_gz() else {
+fn an_rclpy_node_drives_the_gz_turtlebots_a_metre_with_twist_stamped() -> Result<()> {
+    let _one = lock();
+    let Some(turtlebots) = turtlebots()? else {
         return Ok(());
     };
     let Some(rclpy) = rover_tests::rclpy::rclpy("jazzy") else {
         return Ok(());
     };
+    for (k, tb3) in turtlebots.iter().enumerate() {
+        rclpy_drive(&rclpy, tb3, k as u32)?;
+    }
+    Ok(())
+}
+
+/// One TurtleBot3 driven by [`RCLPY_DRIVER`] in a DDS domain of its own.
+fn rclpy_drive(rclpy: &rover_tests::rclpy::Rclpy, tb3: &Tb3, salt: u32) -> Result<()> {
     let dir = tempfile::tempdir()?;
-    let domain = (std::process::id() % 150) as u16 + 40;
+    let domain = ((std::process::id() + 7 * salt) % 150) as u16 + 40;
     let trace = dir.path().join("trace.csv");
     let log = std::fs::File::create(dir.path().join("rover.log"))?;
     let mut rover = Command::new(env!("CARGO_BIN_EXE_rover"))
@@ -214,7 +301,7 @@ fn an_rclpy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()>
         ])
         .args(["--duration", "30", "--trace"])
         .arg(&trace)
-        .args(burger_args(&tb3))
+        .args(&tb3.args)
         .env("ROS_DOMAIN_ID", domain.to_string())
         .env("RUST_LOG", "info")
         .stdin(Stdio::null())
@@ -234,10 +321,11 @@ fn an_rclpy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()>
         .stderr(out_file)
         .spawn()
         .context("starting rclpy")?;
-    rover_tests::wait_or_kill(&mut peer, Duration::from_secs(90))?;
-    let status = rover.wait()?;
+    rover_tests::wait_or_kill(&mut peer, Duration::from_secs(120))?;
+    rover_tests::wait_or_kill(&mut rover, Duration::from_secs(180))?;
     let rover_log = std::fs::read_to_string(dir.path().join("rover.log")).unwrap_or_default();
-    ensure!(status.success(), "rover failed:\n{rover_log}");
+    let status = rover.try_wait()?.context("rover did not exit")?;
+    ensure!(status.success(), "rover failed ({status}):\n{rover_log}");
     let out = std::fs::read_to_string(&out_path)?;
     let rows = rover_core::parse_trace(&std::fs::read_to_string(&trace)?)?;
     let keyed = |key: &str| -> Result<Vec<String>> {
@@ -248,7 +336,8 @@ fn an_rclpy_node_drives_the_gz_burger_a_metre_with_twist_stamped() -> Result<()>
         Ok(found.split(' ').map(str::to_owned).collect())
     };
     ensure!(keyed("rmw")? == ["rmw_fastrtps_cpp"], "the peer's RMW");
-    check_report(&out, keyed, truth_distance(&rows)?)
+    check_unbridged(&rover_log, tb3.unbridged)?;
+    check_report(tb3, &out, keyed, truth_distance(&rows)?)
 }
 
 /// [`ROSPY_DRIVER`] as an rclpy node.
@@ -260,9 +349,10 @@ from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState, LaserScan
 from tf2_msgs.msg import TFMessage
+from sensor_msgs.msg import Image
 rclpy.init()
 node = rclpy.create_node('tb3_gz_driver')
-got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': []}
+got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': [], 'image': []}
 def keep(name):
     return lambda m: got[name].append(m)
 node.create_subscription(LaserScan, '/scan', keep('scan'), qos_profile_sensor_data)
@@ -270,6 +360,7 @@ node.create_subscription(Imu, '/imu', keep('imu'), qos_profile_sensor_data)
 node.create_subscription(Odometry, '/odom', keep('odom'), 10)
 node.create_subscription(JointState, '/joint_states', keep('joint_states'), 1000)
 node.create_subscription(TFMessage, '/tf', keep('tf'), 100)
+node.create_subscription(Image, '/camera/image_raw', keep('image'), qos_profile_sensor_data)
 pub = node.create_publisher(TwistStamped, '/cmd_vel', 10)
 def spin(seconds):
     end = time.time() + seconds
@@ -314,6 +405,8 @@ print('tf %s' % ' '.join(sorted(set('%s>%s' % (t.header.frame_id, t.child_frame_
                                     for m in got['tf'] for t in m.transforms))))
 j = got['joint_states'][-1]
 print('joints %s' % ' '.join(j.name))
+i = got['image'][-1] if got['image'] else None
+print('image %d %d %d' % (i.width if i else 0, i.height if i else 0, len(got['image'])))
 from rclpy.utilities import get_rmw_implementation_identifier
 print('rmw %s' % get_rmw_implementation_identifier())
 "#;
