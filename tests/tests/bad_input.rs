@@ -785,3 +785,72 @@ fn a_texture_that_will_not_decode_leaves_the_mesh_in_its_colour() -> anyhow::Res
     );
     Ok(())
 }
+
+/// Modern Gazebo's inputs (issue 62), each refused at its line: a gz-sim DiffDrive without
+/// joints, one naming a joint that is not there, a bridge map entry of an unknown type or
+/// direction, a ros_gz_bridge map bridging a topic as a type rover does not publish on it.
+#[test]
+fn gz_sim_systems_and_bridge_maps_are_refused_at_their_lines() -> anyhow::Result<()> {
+    let gz = std::fs::read_to_string(repo("assets/robots/my_robot_gz.urdf"))?;
+    // A joint that is not there: the plugin's line, and the joints that are.
+    let text = gz.replacen("left_wheel_joint</left_joint>", "nope</left_joint>", 1);
+    let message = urdf_error(&text);
+    let line = line_of(&text, "gz-sim-diff-drive-system");
+    assert!(
+        message.contains(&format!("bad.urdf:{line}:"))
+            && message.contains("<left_joint>nope</left_joint>: no such joint")
+            && message.contains("\"left_wheel_joint\""),
+        "{message}"
+    );
+    let text = gz
+        .replacen("<left_joint>left_wheel_joint</left_joint>", "", 1)
+        .replacen("<right_joint>right_wheel_joint</right_joint>", "", 1);
+    let message = urdf_error(&text);
+    let line = line_of(&text, "gz-sim-diff-drive-system");
+    assert!(
+        message.contains(&format!("bad.urdf:{line}:"))
+            && message.contains("expected at least one <left_joint> and one <right_joint>"),
+        "{message}"
+    );
+
+    let map = std::fs::read_to_string(repo("assets/robots/my_robot_gz_bridge.yaml"))?;
+    let map_error = |text: &str| -> String {
+        match rover_sim::description::TopicMap::parse(text, Path::new("bridge.yaml")) {
+            Ok(m) => {
+                let mut robot = match RobotModel::from_str(&gz, &repo("assets/robots/x.urdf")) {
+                    Ok(r) => r,
+                    Err(e) => return e.to_string(),
+                };
+                match robot.bridge_topics(&m) {
+                    Ok(_) => String::from("(bridged without error)"),
+                    Err(e) => e.to_string(),
+                }
+            }
+            Err(e) => e.to_string(),
+        }
+    };
+    for (from, to, expect) in [
+        (
+            "direction: ROS_TO_GZ",
+            "direction: ROS2GZ",
+            "invalid direction 'ROS2GZ'",
+        ),
+        (
+            "\"sensor_msgs/msg/LaserScan\"",
+            "\"sensor_msgs/msg/LaserScann\"",
+            "unknown type 'sensor_msgs/msg/LaserScann'",
+        ),
+        (
+            "\"geometry_msgs/msg/Twist\"\n  gz_type_name: \"gz.msgs.Twist\"\n  direction: ROS_TO_GZ",
+            "\"geometry_msgs/msg/Twist\"\n  gz_type_name: \"gz.msgs.Twist\"\n  direction: GZ_TO_ROS",
+            "the map bridges it the other way",
+        ),
+    ] {
+        anyhow::ensure!(map.contains(from), "the bridge file has no {from}");
+        let text = map.replacen(from, to, 1);
+        let message = map_error(&text);
+        assert!(message.contains(expect), "{message}");
+        assert!(message.contains("bridge.yaml:"), "{message}");
+    }
+    Ok(())
+}

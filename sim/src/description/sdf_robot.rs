@@ -528,6 +528,21 @@ mod tests {
     }
 
     #[test]
+    fn an_unknown_system_is_listed_once_by_file_and_name() -> crate::error::Result<()> {
+        let text = "<sdf version=\"1.8\">\n<model name=\"m\">\n<link name=\"a\"/>\n\
+            <plugin filename=\"gz-sim-buoyancy-system\" name=\"gz::sim::systems::Buoyancy\"/>\n\
+            <plugin filename=\"gz-sim-buoyancy-system\" name=\"gz::sim::systems::Buoyancy\"/>\n\
+            <plugin filename=\"gz-sim-sensors-system\" name=\"gz::sim::systems::Sensors\"/>\n\
+            </model></sdf>";
+        let robot = RobotModel::from_str(text, Path::new("robot.sdf"))?;
+        assert_eq!(
+            robot.not_simulated,
+            ["system gz-sim-buoyancy-system (gz::sim::systems::Buoyancy)"]
+        );
+        Ok(())
+    }
+
+    #[test]
     fn errors_name_the_file_and_line() {
         let path = Path::new("robot.sdf");
         let cases = [
