@@ -181,60 +181,8 @@ fn read_entry(item: &Node, path: &Path) -> Result<TopicBridge> {
             );
         }
     }
-    let (topic, ros, gz) = (
-        text("topic_name")?,
-        text("ros_topic_name")?,
-        text("gz_topic_name")?,
-    );
-    let (ros_topic, gz_topic) = match (topic, ros, gz) {
-        (Some((_, line)), Some(_), _) | (Some((_, line)), _, Some(_)) => {
-            return Err(err(
-                line,
-                "topic_name and ros_topic_name/gz_topic_name are mutually exclusive".to_owned(),
-            ));
-        }
-        (Some((t, _)), None, None) => (t.clone(), t),
-        (None, Some((r, _)), Some((g, _))) => (r, g),
-        (None, Some((t, _)), None) | (None, None, Some((t, _))) => (t.clone(), t),
-        (None, None, None) => {
-            return Err(err(
-                item.line,
-                "expected topic_name, or ros_topic_name and gz_topic_name".to_owned(),
-            ));
-        }
-    };
-    let (Some((ros_type, ros_line)), Some((gz_type, gz_line))) =
-        (text("ros_type_name")?, text("gz_type_name")?)
-    else {
-        return Err(err(
-            item.line,
-            "both ros_type_name and gz_type_name must be set".to_owned(),
-        ));
-    };
-    let short = ros_type.replace("/msg/", "/");
-    let Some((_, gz_types)) = PAIRS.iter().find(|(r, _)| *r == short) else {
-        return Err(err(
-            ros_line,
-            format!(
-                "ros_type_name: unknown type '{ros_type}'; expected one of {}",
-                PAIRS
-                    .iter()
-                    .map(|(r, _)| r.replacen('/', "/msg/", 1))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        ));
-    };
-    let gz_norm = gz_type.replace("ignition.msgs.", "gz.msgs.");
-    if !gz_types.contains(&gz_norm.as_str()) {
-        return Err(err(
-            gz_line,
-            format!(
-                "gz_type_name: no bridge between {ros_type} and '{gz_type}'; expected {}",
-                gz_types.join(" or ")
-            ),
-        ));
-    }
+    let (ros_topic, gz_topic) = topic_names(item, &text, path)?;
+    let (ros_type, gz_norm) = type_names(item, &text, path)?;
     let direction = match text("direction")? {
         None => BridgeDirection::Bidirectional,
         Some((d, line)) => match d.as_str() {
@@ -273,6 +221,75 @@ fn read_entry(item: &Node, path: &Path) -> Result<TopicBridge> {
         lazy,
         line: item.line,
     })
+}
+
+/// The text of `key` in an entry, with its line.
+type TextOf<'a> = dyn Fn(&str) -> Result<Option<(String, u32)>> + 'a;
+
+/// An entry's ROS and gz topic names, by ros_gz_bridge's rules.
+fn topic_names(item: &Node, text: &TextOf<'_>, path: &Path) -> Result<(String, String)> {
+    let err = |line: u32, m: &str| SimError::invalid(path, Some(line), m);
+    let (topic, ros, gz) = (
+        text("topic_name")?,
+        text("ros_topic_name")?,
+        text("gz_topic_name")?,
+    );
+    Ok(match (topic, ros, gz) {
+        (Some((_, line)), Some(_), _) | (Some((_, line)), _, Some(_)) => {
+            return Err(err(
+                line,
+                "topic_name and ros_topic_name/gz_topic_name are mutually exclusive",
+            ));
+        }
+        (Some((t, _)), None, None) => (t.clone(), t),
+        (None, Some((r, _)), Some((g, _))) => (r, g),
+        (None, Some((t, _)), None) | (None, None, Some((t, _))) => (t.clone(), t),
+        (None, None, None) => {
+            return Err(err(
+                item.line,
+                "expected topic_name, or ros_topic_name and gz_topic_name",
+            ));
+        }
+    })
+}
+
+/// An entry's ROS type (as written) and gz type (`ignition.msgs.` read as `gz.msgs.`), a pair
+/// ros_gz_bridge bridges.
+fn type_names(item: &Node, text: &TextOf<'_>, path: &Path) -> Result<(String, String)> {
+    let err = |line: u32, m: String| SimError::invalid(path, Some(line), m);
+    let (Some((ros_type, ros_line)), Some((gz_type, gz_line))) =
+        (text("ros_type_name")?, text("gz_type_name")?)
+    else {
+        return Err(err(
+            item.line,
+            "both ros_type_name and gz_type_name must be set".to_owned(),
+        ));
+    };
+    let short = ros_type.replace("/msg/", "/");
+    let Some((_, gz_types)) = PAIRS.iter().find(|(r, _)| *r == short) else {
+        return Err(err(
+            ros_line,
+            format!(
+                "ros_type_name: unknown type '{ros_type}'; expected one of {}",
+                PAIRS
+                    .iter()
+                    .map(|(r, _)| r.replacen('/', "/msg/", 1))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    };
+    let gz_norm = gz_type.replace("ignition.msgs.", "gz.msgs.");
+    if !gz_types.contains(&gz_norm.as_str()) {
+        return Err(err(
+            gz_line,
+            format!(
+                "gz_type_name: no bridge between {ros_type} and '{gz_type}'; expected {}",
+                gz_types.join(" or ")
+            ),
+        ));
+    }
+    Ok((ros_type, gz_norm))
 }
 
 #[cfg(test)]

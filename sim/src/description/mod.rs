@@ -15,6 +15,7 @@ pub(crate) mod fuel;
 pub(crate) mod gazebo;
 pub(crate) mod mesh_file;
 pub(crate) mod ogre;
+pub(crate) mod parts;
 pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod sdf;

@@ -11,6 +11,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::description::gazebo;
+use crate::description::parts::{ElementLines, Parts};
 use crate::description::resource::ResourcePaths;
 use crate::description::urdf;
 use crate::description::xacro::{self, Expanded};
@@ -211,18 +212,6 @@ impl RobotModel {
     }
 }
 
-/// What a robot description file gives before it becomes a [`RobotModel`].
-pub(crate) struct Parts {
-    /// Links, joints, materials and transmissions, as URDF has them.
-    pub urdf: urdf::RobotEl,
-    /// Where each link and joint is written.
-    pub lines: ElementLines,
-    /// The Gazebo plugins and sensors.
-    pub extensions: gazebo::Extensions,
-    /// The line of the root element.
-    pub root_line: Option<u32>,
-}
-
 /// Converts the links (file order) and indexes them by name; duplicate names and a robot
 /// without links are errors.
 fn read_links(
@@ -373,43 +362,6 @@ fn find_root(
 
 fn rgba(c: [f64; 4]) -> Rgba {
     Rgba(c.map(|v| v.clamp(0.0, 1.0) as f32))
-}
-
-/// Lines of `<link>` and `<joint>` elements by name, for messages about them.
-#[derive(Debug, Default)]
-pub(crate) struct ElementLines {
-    pub links: HashMap<String, u32>,
-    pub joints: HashMap<String, u32>,
-}
-
-impl ElementLines {
-    fn collect(doc: &roxmltree::Document<'_>) -> Self {
-        let mut links = HashMap::new();
-        let mut joints = HashMap::new();
-        for node in doc.root_element().children().filter(|n| n.is_element()) {
-            let Some(name) = node.attribute("name") else {
-                continue;
-            };
-            match node.tag_name().name() {
-                "link" => {
-                    links.entry(name.to_owned()).or_insert(line_of(doc, node));
-                }
-                "joint" => {
-                    joints.entry(name.to_owned()).or_insert(line_of(doc, node));
-                }
-                _ => {}
-            }
-        }
-        Self { links, joints }
-    }
-
-    fn link(&self, name: &str) -> Option<u32> {
-        self.links.get(name).copied()
-    }
-
-    fn joint(&self, name: &str) -> Option<u32> {
-        self.joints.get(name).copied()
-    }
 }
 
 /// Checks every numeric URDF attribute before the elements are read, so a typo is reported with its

@@ -17,8 +17,8 @@ use glam::EulerRot;
 use roxmltree::Node;
 
 use crate::description::gazebo;
+use crate::description::parts::{ElementLines, Parts};
 use crate::description::resource::ResourcePaths;
-use crate::description::robot::{ElementLines, Parts};
 use crate::description::sdf::{Ctx, material_color};
 use crate::description::urdf::{
     CollisionEl, Geometry, InertialEl, JointEl, JointType, LinkEl, MaterialEl, Origin, RobotEl,

@@ -13,9 +13,27 @@
 //! | `navsat`, `gps` | NavSatFix on `<topic>` |
 
 use super::values::{Ctx, Node, text_of};
-use super::{Extensions, gps, imu, parse_camera, ray};
+use super::{camera, gps, imu, ray};
 use crate::description::xml::elements;
 use crate::error::Result;
+use crate::model::sensors::{CameraConfig, GpsConfig, ImuConfig, LaserConfig, LidarConfig};
+
+/// What a gz-sim sensor is to rover.
+#[derive(Debug)]
+pub(super) enum GzSensor {
+    /// A one-plane lidar.
+    Laser(LaserConfig),
+    /// A multi-beam lidar.
+    Lidar(LidarConfig),
+    /// A camera (colour, depth or RGB-D).
+    Camera(Box<CameraConfig>),
+    /// An IMU.
+    Imu(ImuConfig),
+    /// A NavSat receiver.
+    Gps(GpsConfig),
+    /// Not simulated: why, for the summary line.
+    Ignored(String),
+}
 
 /// The `<topic>` and frame a gz-sim sensor names, gz-sim's defaults when absent.
 struct Names {
@@ -54,28 +72,23 @@ fn sibling(topic: &str, leaf: &str) -> String {
     }
 }
 
-/// Reads gz-sim sensor `sensor` on `link` into `ext`.
-pub(super) fn read(
-    ctx: &Ctx<'_, '_>,
-    sensor: Node<'_, '_>,
-    link: &str,
-    ext: &mut Extensions,
-) -> Result<()> {
+/// Reads gz-sim sensor `sensor` on `link`.
+pub(super) fn read(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Result<GzSensor> {
     let kind = sensor.attribute("type").unwrap_or("?");
     let name = sensor.attribute("name").unwrap_or("?");
-    match kind {
+    Ok(match kind {
         "gpu_lidar" | "lidar" | "gpu_ray" | "ray" => {
             let n = names(ctx, sensor, link, "scan");
             match ray::parse(ctx, sensor, link)? {
                 ray::RaySensor::Planar(mut laser) => {
                     laser.topic = n.topic;
                     laser.frame_name = n.frame;
-                    ext.lasers.push(laser);
+                    GzSensor::Laser(laser)
                 }
                 ray::RaySensor::Lidar(mut lidar) => {
                     lidar.rays.topic = format!("{}/points", n.topic);
                     lidar.rays.frame_name = n.frame;
-                    ext.lidars.push(lidar);
+                    GzSensor::Lidar(lidar)
                 }
             }
         }
@@ -87,7 +100,7 @@ pub(super) fn read(
             };
             let mut n = names(ctx, sensor, link, leaf);
             n.topic = n.topic.trim_end_matches('/').to_owned();
-            let mut c = parse_camera(ctx, sensor, link)?;
+            let mut c = camera::parse(ctx, sensor, link)?;
             let camera_child = |tag: &str| {
                 elements(sensor)
                     .filter(|e| e.has_tag_name("camera"))
@@ -129,24 +142,21 @@ pub(super) fn read(
                 d.cloud_cutoff_m = c.clip_near_m;
                 d.cloud_cutoff_max_m = c.clip_far_m;
             }
-            ext.cameras.push(c);
+            GzSensor::Camera(Box::new(c))
         }
         "imu" => {
             let n = names(ctx, sensor, link, "imu");
-            ext.imus
-                .push(imu::parse_gz(ctx, sensor, link, n.topic, n.frame)?);
+            GzSensor::Imu(imu::parse_gz(ctx, sensor, link, n.topic, n.frame)?)
         }
         "navsat" | "gps" => {
             let n = names(ctx, sensor, link, "navsat");
-            ext.gpss
-                .push(gps::parse_gz(ctx, sensor, link, n.topic, n.frame)?);
+            GzSensor::Gps(gps::parse_gz(ctx, sensor, link, n.topic, n.frame)?)
         }
-        "contact" => ext.ignored.push(format!(
+        "contact" => GzSensor::Ignored(format!(
             "sensor \"{name}\" (gz-sim contact: ros_gz_interfaces/Contacts is not published; a libgazebo_ros_bumper.so plugin gives gazebo_msgs/ContactsState)"
         )),
-        _ => ext.ignored.push(format!("sensor \"{name}\" (type {kind})")),
-    }
-    Ok(())
+        _ => GzSensor::Ignored(format!("sensor \"{name}\" (type {kind})")),
+    })
 }
 
 #[cfg(test)]
