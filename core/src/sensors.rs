@@ -82,10 +82,14 @@ impl ObservedSensors {
                     }
                 };
                 tracing::info!(
-                    "gps: {} around {lat} N {lon} E ({model}) at {rate}, topics {} and {}",
+                    "gps: {} around {lat} N {lon} E ({model}) at {rate}, topic {}{}",
                     c.link,
                     c.topic,
-                    c.velocity_topic
+                    if c.velocity_topic.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" and {}", c.velocity_topic)
+                    }
                 );
             })
             .collect();

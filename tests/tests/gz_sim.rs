@@ -374,3 +374,74 @@ fn the_gz_cars_gpu_lidar_scans_as_its_classic_ray_sensor() -> Result<()> {
     }
     Ok(())
 }
+
+/// gz-sim's other sensors, with and without `<topic>` and `<gz_frame_id>`: each kind's topics
+/// as gz-sim names them.
+#[test]
+fn gz_sim_sensor_kinds_take_gz_sims_topic_names() -> Result<()> {
+    let text = r#"<sdf version="1.9">
+<model name="bot">
+  <link name="base"><inertial><mass>1</mass></inertial>
+    <collision name="c"><geometry><box><size>0.2 0.2 0.1</size></box></geometry></collision>
+    <sensor name="rgbd" type="rgbd_camera"><topic>cam</topic>
+      <camera><image><width>64</width><height>48</height></image></camera></sensor>
+    <sensor name="depth" type="depth_camera">
+      <camera><image><width>64</width><height>48</height></image>
+        <clip><near>0.1</near><far>8</far></clip></camera></sensor>
+    <sensor name="vlp" type="gpu_lidar"><topic>lidar</topic><gz_frame_id>base</gz_frame_id>
+      <lidar><scan><horizontal><samples>90</samples><min_angle>-3.14</min_angle><max_angle>3.14</max_angle></horizontal>
+        <vertical><samples>8</samples><min_angle>-0.2</min_angle><max_angle>0.2</max_angle></vertical></scan>
+        <range><min>0.2</min><max>30</max></range></lidar></sensor>
+    <sensor name="gps" type="navsat"><topic>navsat</topic><update_rate>4</update_rate></sensor>
+    <sensor name="bump" type="contact"><contact><collision>c</collision></contact></sensor>
+  </link>
+</model>
+</sdf>"#;
+    let robot = RobotModel::from_str(text, std::path::Path::new("bot.sdf"))?;
+    let rgbd = &robot.cameras[0];
+    let d = rgbd.depth.as_ref().context("rgbd depth")?;
+    assert_eq!(
+        (
+            rgbd.image_topic.as_str(),
+            rgbd.info_topic.as_str(),
+            d.image_topic.as_str(),
+            d.cloud_topic.as_str()
+        ),
+        (
+            "cam/image",
+            "cam/camera_info",
+            "cam/depth_image",
+            "cam/points"
+        )
+    );
+    assert_eq!(rgbd.frame_name, "bot::base::rgbd");
+    let depth = &robot.cameras[1];
+    let d = depth.depth.as_ref().context("depth camera depth")?;
+    let default = "/world/default/model/bot/link/base/sensor/depth/depth_image";
+    assert_eq!(d.image_topic, default);
+    assert_eq!(d.cloud_topic, format!("{default}/points"));
+    assert_eq!(
+        depth.info_topic,
+        "/world/default/model/bot/link/base/sensor/depth/camera_info"
+    );
+    // The cloud keeps what the clip planes allow.
+    assert_eq!((d.cloud_cutoff_m, d.cloud_cutoff_max_m), (0.1, 8.0));
+    let lidar = &robot.lidars[0];
+    assert_eq!(lidar.vertical_samples, 8);
+    assert_eq!(
+        (lidar.rays.topic.as_str(), lidar.rays.frame_name.as_str()),
+        ("lidar/points", "base")
+    );
+    let gps = &robot.gpss[0];
+    assert_eq!((gps.topic.as_str(), gps.update_rate_hz), ("navsat", 4.0));
+    assert!(gps.velocity_topic.is_empty());
+    assert!(
+        robot
+            .not_simulated
+            .iter()
+            .any(|s| s.starts_with("sensor \"bump\" (gz-sim contact")),
+        "{:?}",
+        robot.not_simulated
+    );
+    Ok(())
+}

@@ -81,8 +81,8 @@ pub(crate) struct P3dTopic {
 pub(crate) struct GpsTopics {
     /// `topicName` (NavSatFix).
     pub topic: String,
-    /// `velocityTopicName` (Vector3Stamped).
-    pub velocity_topic: String,
+    /// `velocityTopicName` (Vector3Stamped); `None` for gz-sim's NavSat (no velocity topic).
+    pub velocity_topic: Option<String>,
     /// `frameId`.
     pub frame: String,
 }
@@ -225,7 +225,8 @@ impl RosPlan {
                 .iter()
                 .map(|g| GpsTopics {
                     topic: topic(&g.topic),
-                    velocity_topic: topic(&g.velocity_topic),
+                    velocity_topic: (!g.velocity_topic.is_empty())
+                        .then(|| topic(&g.velocity_topic)),
                     frame: g.frame_id.clone(),
                 })
                 .collect(),

@@ -13,7 +13,8 @@ use crate::bridge::gps::{COVARIANCE_TYPE_DIAGONAL_KNOWN, GpsWire};
 /// A receiver's two publishers and their messages.
 struct Receiver {
     fix: (Publisher<msgs::NavSatFix>, msgs::NavSatFix),
-    velocity: (Publisher<msgs::Vector3Stamped>, msgs::Vector3Stamped),
+    /// hector's velocity topic (gz-sim's NavSat has none).
+    velocity: Option<(Publisher<msgs::Vector3Stamped>, msgs::Vector3Stamped)>,
 }
 
 /// Every receiver, in the plan's order.
@@ -39,7 +40,10 @@ impl Gps {
                 };
                 Ok(Receiver {
                     fix: (node.advertise(&t.topic, 10, false)?, fix),
-                    velocity: (node.advertise(&t.velocity_topic, 10, false)?, velocity),
+                    velocity: match &t.velocity_topic {
+                        Some(topic) => Some((node.advertise(topic, 10, false)?, velocity)),
+                        None => None,
+                    },
                 })
             })
             .collect::<Result<_>>()?;
@@ -64,10 +68,11 @@ impl GpsWire for Gps {
         msg.altitude = r.altitude_m;
         msg.position_covariance = diagonal(r.position_covariance_diagonal);
         publisher.publish(msg);
-        let (publisher, msg) = &mut receiver.velocity;
-        msg.header.seq = r.seq as u32;
-        msg.header.stamp_s = r.stamp_s;
-        msg.vector = r.velocity_mps.into();
-        publisher.publish(msg);
+        if let Some((publisher, msg)) = &mut receiver.velocity {
+            msg.header.seq = r.seq as u32;
+            msg.header.stamp_s = r.stamp_s;
+            msg.vector = r.velocity_mps.into();
+            publisher.publish(msg);
+        }
     }
 }

@@ -13,7 +13,8 @@ use rover_ros2::msgs::{self, Time};
 /// A receiver's two topics and their messages.
 struct Receiver {
     fix: (Out<msgs::NavSatFix>, msgs::NavSatFix),
-    velocity: (Out<msgs::Vector3Stamped>, msgs::Vector3Stamped),
+    /// hector's velocity topic (gz-sim's NavSat has none).
+    velocity: Option<(Out<msgs::Vector3Stamped>, msgs::Vector3Stamped)>,
 }
 
 /// Every receiver, in the plan's order.
@@ -39,7 +40,10 @@ impl Gps {
                 };
                 Ok(Receiver {
                     fix: (sinks.out(&t.topic, &sensor_qos())?, fix),
-                    velocity: (sinks.out(&t.velocity_topic, &sensor_qos())?, velocity),
+                    velocity: match &t.velocity_topic {
+                        Some(topic) => Some((sinks.out(topic, &sensor_qos())?, velocity)),
+                        None => None,
+                    },
                 })
             })
             .collect::<Result<_>>()?;
@@ -64,9 +68,10 @@ impl GpsWire for Gps {
         msg.altitude = r.altitude_m;
         msg.position_covariance = diagonal(r.position_covariance_diagonal);
         out.put(stamp, msg);
-        let (out, msg) = &mut receiver.velocity;
-        msg.header.stamp = stamp;
-        msg.vector = r.velocity_mps.into();
-        out.put(stamp, msg);
+        if let Some((out, msg)) = &mut receiver.velocity {
+            msg.header.stamp = stamp;
+            msg.vector = r.velocity_mps.into();
+            out.put(stamp, msg);
+        }
     }
 }
