@@ -410,3 +410,141 @@ print('image %d %d %d' % (i.width if i else 0, i.height if i else 0, len(got['im
 from rclpy.utilities import get_rmw_implementation_identifier
 print('rmw %s' % get_rmw_implementation_identifier())
 "#;
+
+/// A one-joint arm with gz-sim's JointPositionController and its bridge map (written in the
+/// test's folder): the command topic and the joint states under their ROS names.
+fn gz_arm(dir: &std::path::Path) -> Result<Vec<String>> {
+    let model = dir.join("bot.sdf");
+    let text = std::fs::read_to_string(rover_tests::repo("tests/tests/gz_arm.sdf"))?;
+    std::fs::write(&model, text)?;
+    let map = dir.join("bot_bridge.yaml");
+    std::fs::write(
+        &map,
+        "- ros_topic_name: arm_cmd\n  gz_topic_name: /model/bot/joint/arm_joint/0/cmd_pos\n  ros_type_name: std_msgs/msg/Float64\n  gz_type_name: gz.msgs.Double\n  direction: ROS_TO_GZ\n- ros_topic_name: joint_states\n  gz_topic_name: /world/default/model/bot/joint_state\n  ros_type_name: sensor_msgs/msg/JointState\n  gz_type_name: gz.msgs.Model\n  direction: GZ_TO_ROS\n",
+    )?;
+    Ok(vec![
+        "--robot".into(),
+        model.to_string_lossy().into_owned(),
+        "--bridge-config".into(),
+        map.to_string_lossy().into_owned(),
+        "--no-detector".into(),
+    ])
+}
+
+/// Sends 0.8 rad on /arm_cmd for 3 s, then reports arm_joint's position on /joint_states.
+const ROSPY_ARM: &str = r#"
+import rospy, time
+from std_msgs.msg import Float64
+from sensor_msgs.msg import JointState
+rospy.init_node('gz_arm')
+states = []
+rospy.Subscriber('/joint_states', JointState, states.append)
+pub = rospy.Publisher('/arm_cmd', Float64, queue_size=1)
+end = time.time() + 30
+while time.time() < end and (not states or pub.get_num_connections() == 0):
+    time.sleep(0.05)
+for _ in range(60):
+    pub.publish(Float64(0.8))
+    time.sleep(0.05)
+s = states[-1]
+print('arm %.4f' % s.position[list(s.name).index('arm_joint')])
+"#;
+
+/// [`ROSPY_ARM`] as an rclpy node.
+const RCLPY_ARM: &str = r#"
+import time
+import rclpy
+from std_msgs.msg import Float64
+from sensor_msgs.msg import JointState
+rclpy.init()
+node = rclpy.create_node('gz_arm')
+states = []
+node.create_subscription(JointState, '/joint_states', states.append, 100)
+pub = node.create_publisher(Float64, '/arm_cmd', 10)
+def spin(seconds):
+    end = time.time() + seconds
+    while time.time() < end:
+        rclpy.spin_once(node, timeout_sec=0.01)
+end = time.time() + 40
+while time.time() < end and (not states or pub.get_subscription_count() == 0):
+    spin(0.05)
+for _ in range(60):
+    pub.publish(Float64(data=0.8))
+    spin(0.05)
+s = states[-1]
+print('arm %.4f' % s.position[list(s.name).index('arm_joint')])
+"#;
+
+/// gz-sim's JointPositionController takes std_msgs/Float64 on its bridged topic, from rospy
+/// (ROS 1) and from rclpy (Jazzy, Fast DDS).
+#[test]
+fn rospy_and_rclpy_move_a_gz_joint_position_controller() -> Result<()> {
+    let _one = lock();
+    if let Some(why) = missing_ros() {
+        return skip(&why);
+    }
+    let Some(rclpy) = rover_tests::rclpy::rclpy("jazzy") else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let args = gz_arm(dir.path())?;
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let mut graph = RosGraph::start()?;
+    graph.spawn_rover(12.0, &args)?;
+    let out = graph.run_python("arm.py", ROSPY_ARM, Duration::from_secs(60))?;
+    graph.wait_rover(Duration::from_secs(120))?;
+    let at: f64 = graph.keyed_line(&out, "arm")?[0].parse()?;
+    ensure!(
+        (at - 0.8).abs() < 0.05,
+        "rospy: arm_joint at {at} rad; sent 0.8"
+    );
+
+    let domain = (std::process::id() % 150) as u16 + 41;
+    let log = std::fs::File::create(dir.path().join("rover2.log"))?;
+    let mut rover = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args([
+            "--headless",
+            "--ros2",
+            "--rtf",
+            "1",
+            "--ros-distro",
+            "jazzy",
+        ])
+        .args(["--duration", "15"])
+        .args(&args)
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .stdin(Stdio::null())
+        .stdout(log.try_clone()?)
+        .stderr(log)
+        .spawn()
+        .context("starting rover")?;
+    let script = dir.path().join("arm2.py");
+    std::fs::write(&script, RCLPY_ARM)?;
+    let out = rclpy
+        .python(domain)
+        .arg(&script)
+        .stdin(Stdio::null())
+        .output()?;
+    rover_tests::wait_or_kill(&mut rover, Duration::from_secs(60))?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let at: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("arm "))
+        .with_context(|| {
+            format!(
+                "rclpy said:\n{text}\nrover:\n{}",
+                std::fs::read_to_string(dir.path().join("rover2.log")).unwrap_or_default()
+            )
+        })?
+        .trim()
+        .parse()?;
+    ensure!(
+        (at - 0.8).abs() < 0.05,
+        "rclpy: arm_joint at {at} rad; sent 0.8"
+    );
+    Ok(())
+}

@@ -90,6 +90,9 @@ pub const TWIST_STAMPED: &str = concat!(
     vector3!()
 );
 
+/// `std_msgs/msg/Float64`.
+pub const FLOAT64: &str = "float64 data\n";
+
 /// `nav_msgs/msg/Odometry`.
 pub const ODOMETRY: &str = concat!(
     "std_msgs/Header header\nstring child_frame_id\n",
@@ -331,6 +334,8 @@ mod tests {
     fn every_used_type_is_defined_once() {
         for def in [
             TWIST,
+            TWIST_STAMPED,
+            FLOAT64,
             ODOMETRY,
             CLOCK,
             TF_MESSAGE,

@@ -404,6 +404,18 @@ pub struct Float64MultiArray {
     pub data: Vec<f64>,
 }
 
+/// `std_msgs/msg/Float64`: what a gz-sim joint controller system takes through ros_gz_bridge.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Float64 {
+    /// The value.
+    pub data: f64,
+}
+
+impl RosMessage for Float64 {
+    const DDS_TYPE: &'static str = "std_msgs::msg::dds_::Float64_";
+    const DEFINITION: &'static str = crate::definitions::FLOAT64;
+}
+
 impl RosMessage for Float64MultiArray {
     const DDS_TYPE: &'static str = "std_msgs::msg::dds_::Float64MultiArray_";
     const DEFINITION: &'static str = crate::definitions::FLOAT64_MULTI_ARRAY;

@@ -101,6 +101,9 @@ pub(crate) struct ControllerTopic {
     pub state_topic: Option<String>,
     /// Its joints, as indices into the plan's `joints`.
     pub joints: Vec<usize>,
+    /// The topic is gz-sim's own (a joint controller system's `<topic>`): the same on ROS 1
+    /// and ROS 2, a single value as std_msgs/Float64.
+    pub explicit: bool,
     /// The gains a position controller reports in its state.
     pub pid: Option<rover_sim::model::Pid>,
     /// How often `state` goes out (Hz).
@@ -328,10 +331,16 @@ fn controller_topics(robot: &RobotModel) -> Vec<ControllerTopic> {
             };
             ControllerTopic {
                 name: c.name.clone(),
-                command_topic: format!("{prefix}/{}/command", c.name),
+                command_topic: c
+                    .topic
+                    .as_deref()
+                    .map_or_else(|| format!("{prefix}/{}/command", c.name), topic),
                 trajectory: matches!(c.kind, ControllerKind::Trajectory(_)),
-                state_topic: state.then(|| format!("{prefix}/{}/state", c.name)),
+                // gz-sim's joint controllers publish no state.
+                state_topic: (state && c.topic.is_none())
+                    .then(|| format!("{prefix}/{}/state", c.name)),
                 joints: Vec::new(),
+                explicit: c.topic.is_some(),
                 pid,
                 state_hz,
             }

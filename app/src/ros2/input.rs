@@ -77,6 +77,8 @@ enum Command {
     Trajectory(Reader<msgs::JointTrajectory>),
     /// A single-joint controller's `~/commands`.
     Value(Reader<msgs::Float64MultiArray>),
+    /// A gz-sim joint controller system's `<topic>` (std_msgs/msg/Float64 through ros_gz_bridge).
+    Single(Reader<msgs::Float64>),
 }
 
 /// The drive's command topic, of the plan's type.
@@ -155,11 +157,15 @@ impl Ros2Input {
         let parameters = Parameters::serve(participant, &subscriber, publisher, node, description)?;
         let mut controllers = Vec::with_capacity(plan.controllers.len());
         for c in &plan.controllers {
-            let topic = ros2_command_topic(&c.command_topic, c.trajectory);
-            let command = if c.trajectory {
-                Command::Trajectory(Reader::new(participant, &subscriber, &topic)?)
+            let topic = if c.explicit {
+                c.command_topic.clone()
             } else {
-                Command::Value(Reader::new(participant, &subscriber, &topic)?)
+                ros2_command_topic(&c.command_topic, c.trajectory)
+            };
+            let command = match (c.trajectory, c.explicit) {
+                (true, _) => Command::Trajectory(Reader::new(participant, &subscriber, &topic)?),
+                (false, false) => Command::Value(Reader::new(participant, &subscriber, &topic)?),
+                (false, true) => Command::Single(Reader::new(participant, &subscriber, &topic)?),
             };
             controllers.push((c.name.clone(), command));
         }
@@ -184,6 +190,7 @@ impl Ros2Input {
         readers.extend(self.controllers.iter().map(|(_, c)| match c {
             Command::Trajectory(r) => r.reader.guid(),
             Command::Value(r) => r.reader.guid(),
+            Command::Single(r) => r.reader.guid(),
         }));
         let (requests, replies) = self.parameters.gids();
         readers.extend(requests);
@@ -205,6 +212,10 @@ impl Ros2Input {
                         name: name.clone(),
                         value,
                     })
+                }),
+                Command::Single(reader) => reader.next().map(|m| JointAction::Controller {
+                    name: name.clone(),
+                    value: m.data,
                 }),
             },
         )

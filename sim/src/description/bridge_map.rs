@@ -81,6 +81,10 @@ const PAIRS: &[(&str, &[&str])] = &[
     ("geometry_msgs/PoseArray", &["gz.msgs.Pose_V"]),
     ("geometry_msgs/PoseStamped", &["gz.msgs.Pose"]),
     ("std_msgs/Float64", &["gz.msgs.Double"]),
+    (
+        "trajectory_msgs/JointTrajectory",
+        &["gz.msgs.JointTrajectory"],
+    ),
     ("std_msgs/Bool", &["gz.msgs.Boolean"]),
     ("std_msgs/String", &["gz.msgs.StringMsg"]),
 ];

@@ -318,6 +318,7 @@ impl Reader<'_> {
             type_name,
             kind,
             line,
+            topic: None,
         })
     }
 }

@@ -179,7 +179,8 @@ impl RobotModel {
             }
         }
 
-        let model = Self {
+        let gz_controllers = std::mem::take(&mut extensions.gz_controllers);
+        let mut model = Self {
             name: urdf.name.clone(),
             source: path.to_path_buf(),
             links,
@@ -208,6 +209,9 @@ impl RobotModel {
             );
         }
         model.validate_plugins(path)?;
+        if !gz_controllers.is_empty() {
+            model.controllers = Some(gazebo::gz_joints::config(&model, gz_controllers, path)?);
+        }
         Ok(model)
     }
 }

@@ -153,6 +153,25 @@ impl RobotModel {
                     types: &["sensor_msgs/NavSatFix"],
                 });
             }
+            for c in self
+                .controllers
+                .iter_mut()
+                .flat_map(|c| c.controllers.iter_mut())
+            {
+                let types: &'static [&'static str] =
+                    if matches!(c.kind, crate::model::ControllerKind::Trajectory(_)) {
+                        &["trajectory_msgs/JointTrajectory"]
+                    } else {
+                        &["std_msgs/Float64"]
+                    };
+                if let Some(topic) = &mut c.topic {
+                    slots.push(Slot {
+                        topic,
+                        inbound: true,
+                        types,
+                    });
+                }
+            }
             for (index, slot) in slots.into_iter().enumerate() {
                 let gz = slot.topic.clone();
                 match map.for_gz_topic(&gz) {

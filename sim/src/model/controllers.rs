@@ -67,6 +67,10 @@ pub struct ControllerSpec {
     pub kind: ControllerKind,
     /// Line of its key in the file.
     pub line: u32,
+    /// gz-sim's joint controller systems: the command `<topic>` (std_msgs/Float64, or
+    /// trajectory_msgs/JointTrajectory for a trajectory), no state topic. `None`: ros_control's
+    /// `<namespace>/<name>/command`.
+    pub topic: Option<String>,
 }
 
 impl ControllerSpec {

@@ -17,6 +17,8 @@ pub(super) enum System {
     DiffDrive,
     /// `gz-sim-joint-state-publisher-system` / `gz::sim::systems::JointStatePublisher`.
     JointStatePublisher,
+    /// A joint controller (position, velocity, trajectory).
+    Joint(super::gz_joints::JointSystem),
     /// A world-level system rover needs nothing from (its work is always done).
     World,
     /// Any other gz-sim system.
@@ -70,7 +72,11 @@ pub(crate) fn is_system(filename: &str, name: &str) -> bool {
 /// Which system a gz-sim plugin is.
 pub(super) fn system(filename: &str, name: &str) -> System {
     let class = name.rsplit("::").next().unwrap_or(name);
-    match (system_stem(filename).unwrap_or(""), class) {
+    let stem = system_stem(filename).unwrap_or("");
+    if let Some(joint) = super::gz_joints::JointSystem::of(stem, class) {
+        return System::Joint(joint);
+    }
+    match (stem, class) {
         ("diff-drive", _) | (_, "DiffDrive") => System::DiffDrive,
         ("joint-state-publisher", _) | (_, "JointStatePublisher") => System::JointStatePublisher,
         (stem, _) if WORLD_SYSTEMS.contains(&stem) => System::World,

@@ -10,6 +10,7 @@ mod bumper;
 mod camera;
 mod gps;
 pub(crate) mod gz;
+pub(crate) mod gz_joints;
 mod gz_sensors;
 mod imu;
 mod p3d;
@@ -49,6 +50,8 @@ pub(crate) struct Extensions {
     pub ignored: Vec<String>,
     /// gz-sim's JointStatePublisher system.
     pub joint_state_publisher: Option<crate::model::sensors::JointStatePublisherConfig>,
+    /// gz-sim's joint controller systems, as rover's controllers (each on its gz topic).
+    pub gz_controllers: Vec<crate::model::ControllerSpec>,
 }
 
 /// Reads every `<gazebo>` element under `<robot>`.
@@ -184,6 +187,9 @@ fn read_system(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>, ext: &mut Extensions) ->
             ext.joint_state_publisher =
                 Some(gz::parse_joint_state_publisher(plugin, ctx.doc, ctx.model));
         }
+        gz::System::Joint(system) => ext
+            .gz_controllers
+            .push(gz_joints::parse(ctx, plugin, system)?),
         gz::System::World => {}
         gz::System::Other => {
             let entry = format!("system {file} ({name})");
