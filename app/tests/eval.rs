@@ -329,10 +329,11 @@ fn bad_scenario_files_are_refused_with_file_line_and_key() -> Result<()> {
 /// Modern Gazebo's TurtleBot3 world (issue 62): turtlebot3_world.world as ROBOTIS ships it
 /// (Fuel's Sun and Ground Plane become rover's), with Fuel's Standing person added 2.6 m west
 /// of where ROBOTIS' launch file spawns the robot (turned to face them: the follower's 0.25 m
-/// robot circle and 0.17 m margin do not fit between the world's pillars, 0.8 m apart). The waffle_pi (its SDF model, its camera's images
-/// through the detector) follows the person; the burger, which carries no camera, is skipped.
+/// robot circle and 0.17 m margin do not fit between the world's pillars, 0.8 m apart). The
+/// waffle_pi and the burger_cam (SDF models, their cameras' images through the detector) follow
+/// the person; the plain burger, which carries no camera, is skipped.
 #[test]
-fn the_gz_waffle_pi_follows_a_person_in_turtlebot3_world() -> Result<()> {
+fn the_gz_turtlebots_follow_a_person_in_turtlebot3_world() -> Result<()> {
     let dir = tempfile::tempdir()?;
     let Some((waffle_pi, models)) = rover_tests::turtlebot3_gz_waffle_pi(dir.path())? else {
         return Ok(());
@@ -352,6 +353,9 @@ fn the_gz_waffle_pi_follows_a_person_in_turtlebot3_world() -> Result<()> {
         "world_file = \"../tb3_person.world\"\n[scenario]\ndescription = \"a person 2.6 m ahead, west of TurtleBot3 world's pillars\"\nduration_s = 20.0\ntarget = \"alice\"\nspawn = [-2.0, -0.5, 180.0]\n[criteria]\nacquire_within_s = 3.0\nfinal_range_m = [1.2, 1.8]\nmin_person_range_m = 1.0\n",
     )?;
     let burger = tb3.join("models/turtlebot3_burger/model.sdf");
+    let Some((burger_cam, _)) = rover_tests::turtlebot3_gz_burger_cam(dir.path())? else {
+        return Ok(());
+    };
     let out = Command::new(env!("CARGO_BIN_EXE_rover"))
         .args(["eval"])
         .arg(&scenarios)
@@ -361,13 +365,15 @@ fn the_gz_waffle_pi_follows_a_person_in_turtlebot3_world() -> Result<()> {
         .arg(&waffle_pi)
         .arg("--robot")
         .arg(&burger)
+        .arg("--robot")
+        .arg(&burger_cam)
         .env("GZ_SIM_RESOURCE_PATH", &models)
         .env("RUST_LOG", "warn")
         .output()?;
     let table = text(&out.stdout);
     println!("{table}{}", text(&out.stderr));
     assert!(out.status.success(), "{table}{}", text(&out.stderr));
-    assert!(table.contains("1/1 scenarios passed"), "{table}");
+    assert!(table.contains("2/2 scenarios passed"), "{table}");
     let skipped = table
         .lines()
         .find(|l| l.starts_with("tb3_person_ahead") && l.contains("skip"))
@@ -378,7 +384,10 @@ fn the_gz_waffle_pi_follows_a_person_in_turtlebot3_world() -> Result<()> {
     );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/eval.json"))?)?;
-    let result = &report["results"][0];
-    println!("{result}");
+    let results = report["results"].as_array().cloned().unwrap_or_default();
+    assert_eq!(results.len(), 3, "{report}");
+    for result in results.iter().filter(|r| r["skipped"].is_null()) {
+        assert!(result["passed"] == true, "{result}");
+    }
     Ok(())
 }

@@ -284,13 +284,16 @@ fn an_rclpy_node_drives_the_gz_turtlebots_a_metre_with_twist_stamped() -> Result
     Ok(())
 }
 
-/// One TurtleBot3 driven by [`RCLPY_DRIVER`] in a DDS domain of its own.
-fn rclpy_drive(rclpy: &rover_tests::rclpy::Rclpy, tb3: &Tb3, salt: u32) -> Result<()> {
-    let dir = tempfile::tempdir()?;
-    let domain = ((std::process::id() + 7 * salt) % 150) as u16 + 40;
-    let trace = dir.path().join("trace.csv");
-    let log = std::fs::File::create(dir.path().join("rover.log"))?;
-    let mut rover = Command::new(env!("CARGO_BIN_EXE_rover"))
+/// `rover --headless --ros2` (Jazzy's Gids, real time) in DDS domain `domain` for
+/// `duration_s`, with `args`; its output in `log`.
+fn ros2_rover(
+    log: &std::path::Path,
+    domain: u16,
+    duration_s: f64,
+    args: &[impl AsRef<std::ffi::OsStr>],
+) -> Result<std::process::Child> {
+    let log = std::fs::File::create(log)?;
+    Command::new(env!("CARGO_BIN_EXE_rover"))
         .args([
             "--headless",
             "--ros2",
@@ -299,16 +302,26 @@ fn rclpy_drive(rclpy: &rover_tests::rclpy::Rclpy, tb3: &Tb3, salt: u32) -> Resul
             "--ros-distro",
             "jazzy",
         ])
-        .args(["--duration", "30", "--trace"])
-        .arg(&trace)
-        .args(&tb3.args)
+        .arg("--duration")
+        .arg(duration_s.to_string())
+        .args(args)
         .env("ROS_DOMAIN_ID", domain.to_string())
         .env("RUST_LOG", "info")
         .stdin(Stdio::null())
         .stdout(log.try_clone()?)
         .stderr(log)
         .spawn()
-        .context("starting rover")?;
+        .context("starting rover")
+}
+
+/// One TurtleBot3 driven by [`RCLPY_DRIVER`] in a DDS domain of its own.
+fn rclpy_drive(rclpy: &rover_tests::rclpy::Rclpy, tb3: &Tb3, salt: u32) -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let domain = ((std::process::id() + 7 * salt) % 150) as u16 + 40;
+    let trace = dir.path().join("trace.csv");
+    let mut args = vec!["--trace".to_owned(), trace.to_string_lossy().into_owned()];
+    args.extend(tb3.args.iter().cloned());
+    let mut rover = ros2_rover(&dir.path().join("rover.log"), domain, 30.0, &args)?;
     let script = dir.path().join("driver.py");
     std::fs::write(&script, RCLPY_DRIVER)?;
     let out_path = dir.path().join("driver.log");
@@ -500,24 +513,7 @@ fn rospy_and_rclpy_move_a_gz_joint_position_controller() -> Result<()> {
     );
 
     let domain = (std::process::id() % 150) as u16 + 41;
-    let log = std::fs::File::create(dir.path().join("rover2.log"))?;
-    let mut rover = Command::new(env!("CARGO_BIN_EXE_rover"))
-        .args([
-            "--headless",
-            "--ros2",
-            "--rtf",
-            "1",
-            "--ros-distro",
-            "jazzy",
-        ])
-        .args(["--duration", "15"])
-        .args(&args)
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .stdin(Stdio::null())
-        .stdout(log.try_clone()?)
-        .stderr(log)
-        .spawn()
-        .context("starting rover")?;
+    let mut rover = ros2_rover(&dir.path().join("rover2.log"), domain, 15.0, &args)?;
     let script = dir.path().join("arm2.py");
     std::fs::write(&script, RCLPY_ARM)?;
     let out = rclpy

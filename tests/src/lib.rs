@@ -72,6 +72,22 @@ pub fn drive(sim: &mut Simulation, cmd: Twist, seconds: f64) -> anyhow::Result<V
     Ok(samples)
 }
 
+/// Drives `sim` straight at `speed_mps` for `seconds`, then stops it for a second; returns how
+/// far its ground truth moved (m) and how far sideways (m, along its starting left).
+pub fn straight_run(
+    sim: &mut Simulation,
+    speed_mps: f64,
+    seconds: f64,
+) -> anyhow::Result<(f64, f64)> {
+    let rest = sim.ground_truth();
+    drive(sim, Twist::new(speed_mps, 0.0), seconds)?;
+    drive(sim, Twist::ZERO, 1.0)?;
+    let moved = sim.ground_truth();
+    let (dx, dy) = (moved.x_m - rest.x_m, moved.y_m - rest.y_m);
+    let (s, c) = rest.yaw_rad.sin_cos();
+    Ok((dx.hypot(dy), -s * dx + c * dy))
+}
+
 /// A simulation of `robot` on flat, empty ground with default settings.
 pub fn flat_sim(robot: RobotModel) -> anyhow::Result<Simulation> {
     Ok(Simulation::new(
@@ -140,6 +156,40 @@ pub fn turtlebot3_gz_waffle_pi(tmp: &Path) -> anyhow::Result<Option<(PathBuf, Pa
         "model://turtlebot3_common/meshes/waffle_pi_base.dae",
     );
     let copy = tmp.join("turtlebot3_waffle_pi");
+    std::fs::create_dir_all(&copy)?;
+    std::fs::write(copy.join("model.sdf"), text)?;
+    Ok(Some((copy.join("model.sdf"), models)))
+}
+
+/// ROBOTIS' burger_cam (TURTLEBOT3_MODEL=burger_cam: the burger with a Raspberry Pi camera;
+/// its model is not in the corpus, its URDF and bridge file are): the burger's model.sdf with
+/// the waffle_pi's camera sensor, on a link where `urdf/turtlebot3_burger_cam.urdf` puts
+/// `camera_rgb_frame` (0.043, 0, 0.129 m above base_footprint), written to
+/// `tmp/turtlebot3_burger_cam/model.sdf`. Returns it and the corpus's models folder.
+pub fn turtlebot3_gz_burger_cam(tmp: &Path) -> anyhow::Result<Option<(PathBuf, PathBuf)>> {
+    let Some(dir) = shared("corpus/turtlebot3_gz/turtlebot3_gazebo") else {
+        return Ok(None);
+    };
+    let models = dir.join("models");
+    let burger = std::fs::read_to_string(models.join("turtlebot3_burger/model.sdf"))?;
+    let waffle = std::fs::read_to_string(models.join("turtlebot3_waffle_pi/model.sdf"))?;
+    let start = waffle.find("<sensor name=\"camera\" type=\"camera\">");
+    let end = waffle.find("</sensor>\n    </link>");
+    let (Some(start), Some(end)) = (start, end.filter(|e| start.is_some_and(|s| *e > s))) else {
+        anyhow::bail!("the waffle_pi model's camera sensor moved");
+    };
+    let camera = &waffle[start..end + "</sensor>".len()];
+    let link = format!(
+        "<link name=\"camera_rgb_frame\">\n      <pose>0.043 0 0.129 0 0 0</pose>\n      <inertial><mass>0.035</mass><inertia><ixx>0.001</ixx><iyy>0.001</iyy><izz>0.001</izz></inertia></inertial>\n      {camera}\n    </link>\n    <joint name=\"camera_rgb_joint\" type=\"fixed\">\n      <parent>base_link</parent>\n      <child>camera_rgb_frame</child>\n    </joint>\n\n  </model>"
+    );
+    anyhow::ensure!(burger.contains("  </model>"), "the burger model changed");
+    let text = burger
+        .replace(
+            "<model name=\"turtlebot3_burger\">",
+            "<model name=\"turtlebot3_burger_cam\">",
+        )
+        .replace("  </model>", &link);
+    let copy = tmp.join("turtlebot3_burger_cam");
     std::fs::create_dir_all(&copy)?;
     std::fs::write(copy.join("model.sdf"), text)?;
     Ok(Some((copy.join("model.sdf"), models)))

@@ -114,27 +114,19 @@ fn turtlebot3_burger_sdf_rests_and_drives_a_metre() -> Result<()> {
     };
     let mut sim = flat_sim(robot)?;
     drive(&mut sim, Twist::ZERO, 1.0)?;
-    let rest = sim.ground_truth();
     let base = sim.world_from_base();
     let (roll, pitch, _) = base.rotation.to_euler(glam::EulerRot::XYZ);
     assert!(
         roll.abs() < 0.05 && pitch.abs() < 0.1,
         "resting tilted: roll {roll} pitch {pitch} rad"
     );
-    drive(&mut sim, Twist::new(0.2, 0.0), 5.0)?;
-    drive(&mut sim, Twist::ZERO, 1.0)?;
-    let moved = sim.ground_truth();
-    let distance = (moved.x_m - rest.x_m).hypot(moved.y_m - rest.y_m);
+    let (distance, sideways) = rover_tests::straight_run(&mut sim, 0.2, 5.0)?;
     // gz-sim's limiter (max_linear_acceleration 1) costs 0.02 m of the ramp up.
     assert!(
         (distance - 0.98).abs() <= 0.05,
         "0.2 m/s for 5 s moved {distance} m; expected 0.98 m within 5 cm"
     );
-    assert!(
-        (moved.y_m - rest.y_m).abs() < 0.05,
-        "drifted sideways {} m",
-        moved.y_m - rest.y_m
-    );
+    assert!(sideways.abs() < 0.05, "drifted sideways {sideways} m");
     Ok(())
 }
 
@@ -166,11 +158,7 @@ fn turtlebot3_waffle_pi_sdf_has_its_camera() -> Result<()> {
     // It drives: a metre at 0.2 m/s, straight.
     let mut sim = flat_sim(robot)?;
     drive(&mut sim, Twist::ZERO, 1.0)?;
-    let rest = sim.ground_truth();
-    drive(&mut sim, Twist::new(0.2, 0.0), 5.0)?;
-    drive(&mut sim, Twist::ZERO, 1.0)?;
-    let moved = sim.ground_truth();
-    let distance = (moved.x_m - rest.x_m).hypot(moved.y_m - rest.y_m);
+    let (distance, _) = rover_tests::straight_run(&mut sim, 0.2, 5.0)?;
     assert!(
         (distance - 0.98).abs() <= 0.05,
         "0.2 m/s for 5 s moved {distance} m; expected 0.98 m within 5 cm"

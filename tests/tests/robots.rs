@@ -135,7 +135,6 @@ fn turtlebot3_burger_rests_drives_a_metre_and_turns_half_a_turn() -> Result<()> 
     };
     let mut sim = flat_sim(robot.clone())?;
     drive(&mut sim, Twist::ZERO, 1.0)?;
-    let rest = sim.ground_truth();
     let base = sim.world_from_base();
     // base_footprint is on the ground when the wheels (r = 0.033 at z = 0.033) carry it.
     assert!(
@@ -149,10 +148,7 @@ fn turtlebot3_burger_rests_drives_a_metre_and_turns_half_a_turn() -> Result<()> 
         "resting tilted: roll {roll} pitch {pitch} rad"
     );
 
-    drive(&mut sim, Twist::new(0.2, 0.0), 5.0)?;
-    drive(&mut sim, Twist::ZERO, 1.0)?;
-    let moved = sim.ground_truth();
-    let distance = (moved.x_m - rest.x_m).hypot(moved.y_m - rest.y_m);
+    let (distance, _) = rover_tests::straight_run(&mut sim, 0.2, 5.0)?;
     assert!(
         (distance - 1.0).abs() <= 0.05,
         "0.2 m/s for 5 s moved {distance} m; expected 1.0 m within 5%"

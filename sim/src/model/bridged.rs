@@ -74,110 +74,13 @@ impl RobotModel {
         let mut out = Bridged::default();
         let mut stamped = None;
         {
-            let mut slots: Vec<Slot<'_>> = Vec::new();
-            if let Some(dd) = &mut self.diff_drive {
-                slots.push(Slot {
-                    topic: &mut dd.command_topic,
-                    inbound: true,
-                    types: &["geometry_msgs/Twist", "geometry_msgs/TwistStamped"],
-                });
-                slots.push(Slot {
-                    topic: &mut dd.odometry_topic,
-                    inbound: false,
-                    types: &["nav_msgs/Odometry"],
-                });
-                if let Some(tf) = &mut dd.tf_topic {
-                    slots.push(Slot {
-                        topic: tf,
-                        inbound: false,
-                        types: &["tf2_msgs/TFMessage"],
-                    });
-                }
-            }
-            if let Some(jsp) = &mut self.joint_state_publisher {
-                slots.push(Slot {
-                    topic: &mut jsp.topic,
-                    inbound: false,
-                    types: &["sensor_msgs/JointState"],
-                });
-            }
-            for c in self.cameras.iter_mut().filter(|c| c.camera_name.is_empty()) {
-                slots.push(Slot {
-                    topic: &mut c.image_topic,
-                    inbound: false,
-                    types: &["sensor_msgs/Image"],
-                });
-                slots.push(Slot {
-                    topic: &mut c.info_topic,
-                    inbound: false,
-                    types: &["sensor_msgs/CameraInfo"],
-                });
-                if let Some(d) = &mut c.depth {
-                    slots.push(Slot {
-                        topic: &mut d.image_topic,
-                        inbound: false,
-                        types: &["sensor_msgs/Image"],
-                    });
-                    slots.push(Slot {
-                        topic: &mut d.cloud_topic,
-                        inbound: false,
-                        types: &["sensor_msgs/PointCloud2"],
-                    });
-                }
-            }
-            for l in &mut self.lasers {
-                slots.push(Slot {
-                    topic: &mut l.topic,
-                    inbound: false,
-                    types: &["sensor_msgs/LaserScan"],
-                });
-            }
-            for l in &mut self.lidars {
-                slots.push(Slot {
-                    topic: &mut l.rays.topic,
-                    inbound: false,
-                    types: &["sensor_msgs/PointCloud2"],
-                });
-            }
-            for i in &mut self.imus {
-                slots.push(Slot {
-                    topic: &mut i.topic,
-                    inbound: false,
-                    types: &["sensor_msgs/Imu"],
-                });
-            }
-            for g in &mut self.gpss {
-                slots.push(Slot {
-                    topic: &mut g.topic,
-                    inbound: false,
-                    types: &["sensor_msgs/NavSatFix"],
-                });
-            }
-            for c in self
-                .controllers
-                .iter_mut()
-                .flat_map(|c| c.controllers.iter_mut())
-            {
-                let types: &'static [&'static str] =
-                    if matches!(c.kind, crate::model::ControllerKind::Trajectory(_)) {
-                        &["trajectory_msgs/JointTrajectory"]
-                    } else {
-                        &["std_msgs/Float64"]
-                    };
-                if let Some(topic) = &mut c.topic {
-                    slots.push(Slot {
-                        topic,
-                        inbound: true,
-                        types,
-                    });
-                }
-            }
-            for (index, slot) in slots.into_iter().enumerate() {
+            let slots = self.topic_slots();
+            for slot in slots {
                 let gz = slot.topic.clone();
                 match map.for_gz_topic(&gz) {
                     Some(entry) => {
                         check(entry, &slot, &map.source)?;
-                        if index == 0 && slot.inbound {
+                        if slot.types.contains(&"geometry_msgs/TwistStamped") {
                             stamped = Some(entry.ros_type_short() == "geometry_msgs/TwistStamped");
                         }
                         let ros = format!("/{}", entry.ros_topic.trim_start_matches('/'));
@@ -199,5 +102,108 @@ impl RobotModel {
             );
         }
         Ok(out)
+    }
+
+    /// Every topic of the robot a bridge map may rename, the drive's command first.
+    fn topic_slots(&mut self) -> Vec<Slot<'_>> {
+        let mut slots: Vec<Slot<'_>> = Vec::new();
+        if let Some(dd) = &mut self.diff_drive {
+            slots.push(Slot {
+                topic: &mut dd.command_topic,
+                inbound: true,
+                types: &["geometry_msgs/Twist", "geometry_msgs/TwistStamped"],
+            });
+            slots.push(Slot {
+                topic: &mut dd.odometry_topic,
+                inbound: false,
+                types: &["nav_msgs/Odometry"],
+            });
+            if let Some(tf) = &mut dd.tf_topic {
+                slots.push(Slot {
+                    topic: tf,
+                    inbound: false,
+                    types: &["tf2_msgs/TFMessage"],
+                });
+            }
+        }
+        if let Some(jsp) = &mut self.joint_state_publisher {
+            slots.push(Slot {
+                topic: &mut jsp.topic,
+                inbound: false,
+                types: &["sensor_msgs/JointState"],
+            });
+        }
+        for c in self.cameras.iter_mut().filter(|c| c.camera_name.is_empty()) {
+            slots.push(Slot {
+                topic: &mut c.image_topic,
+                inbound: false,
+                types: &["sensor_msgs/Image"],
+            });
+            slots.push(Slot {
+                topic: &mut c.info_topic,
+                inbound: false,
+                types: &["sensor_msgs/CameraInfo"],
+            });
+            if let Some(d) = &mut c.depth {
+                slots.push(Slot {
+                    topic: &mut d.image_topic,
+                    inbound: false,
+                    types: &["sensor_msgs/Image"],
+                });
+                slots.push(Slot {
+                    topic: &mut d.cloud_topic,
+                    inbound: false,
+                    types: &["sensor_msgs/PointCloud2"],
+                });
+            }
+        }
+        for l in &mut self.lasers {
+            slots.push(Slot {
+                topic: &mut l.topic,
+                inbound: false,
+                types: &["sensor_msgs/LaserScan"],
+            });
+        }
+        for l in &mut self.lidars {
+            slots.push(Slot {
+                topic: &mut l.rays.topic,
+                inbound: false,
+                types: &["sensor_msgs/PointCloud2"],
+            });
+        }
+        for i in &mut self.imus {
+            slots.push(Slot {
+                topic: &mut i.topic,
+                inbound: false,
+                types: &["sensor_msgs/Imu"],
+            });
+        }
+        for g in &mut self.gpss {
+            slots.push(Slot {
+                topic: &mut g.topic,
+                inbound: false,
+                types: &["sensor_msgs/NavSatFix"],
+            });
+        }
+        for c in self
+            .controllers
+            .iter_mut()
+            .flat_map(|c| c.controllers.iter_mut())
+        {
+            let types: &'static [&'static str] =
+                if matches!(c.kind, crate::model::ControllerKind::Trajectory(_)) {
+                    &["trajectory_msgs/JointTrajectory"]
+                } else {
+                    &["std_msgs/Float64"]
+                };
+            if let Some(topic) = &mut c.topic {
+                slots.push(Slot {
+                    topic,
+                    inbound: true,
+                    types,
+                });
+            }
+        }
+        slots
     }
 }

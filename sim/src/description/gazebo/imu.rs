@@ -26,25 +26,9 @@ pub(super) fn parse_sensor(
     link: &str,
     robot_name: &str,
 ) -> Result<Option<ImuConfig>> {
-    let name = sensor.attribute("name").unwrap_or("imu").to_owned();
-    let what = format!("<sensor name=\"{name}\" type=\"imu\">");
+    // Gazebo classic's ImuSensor measures against its own starting orientation.
+    let (mut c, what) = sensor_config(ctx, sensor, link, OrientationReference::Initial);
     let what = what.as_str();
-    let mut c = ImuConfig {
-        name,
-        plugin: ImuPlugin::Sensor,
-        link: link.to_owned(),
-        link_from_sensor: Pose::IDENTITY,
-        update_rate_hz: 0.0,
-        topic: String::new(),
-        frame_name: String::new(),
-        rpy_offset_rad: [0.0; 3],
-        // Gazebo classic's ImuSensor measures against its own starting orientation.
-        reference: OrientationReference::Initial,
-        gaussian_noise: 0.0,
-        angular_velocity_noise: [AxisNoise::default(); 3],
-        linear_acceleration_noise: [AxisNoise::default(); 3],
-        line: Some(line_of(ctx.doc, sensor)),
-    };
     let sensor_rate_hz = read_sdf(ctx, sensor, what, &mut c)?;
     // Read above even without a plugin: a malformed block is an error either way.
     let Some(plugin) = elements(sensor).find(|n| {
@@ -97,6 +81,34 @@ pub(super) fn parse_sensor(
     Ok(Some(c))
 }
 
+/// An IMU `<sensor>` on `link` before its elements are read (no topic or frame yet), and the
+/// words naming it in messages.
+fn sensor_config(
+    ctx: &Ctx<'_, '_>,
+    sensor: Node<'_, '_>,
+    link: &str,
+    reference: OrientationReference,
+) -> (ImuConfig, String) {
+    let name = sensor.attribute("name").unwrap_or("imu").to_owned();
+    let what = format!("<sensor name=\"{name}\" type=\"imu\">");
+    let c = ImuConfig {
+        name,
+        plugin: ImuPlugin::Sensor,
+        link: link.to_owned(),
+        link_from_sensor: Pose::IDENTITY,
+        update_rate_hz: 0.0,
+        topic: String::new(),
+        frame_name: String::new(),
+        rpy_offset_rad: [0.0; 3],
+        reference,
+        gaussian_noise: 0.0,
+        angular_velocity_noise: [AxisNoise::default(); 3],
+        linear_acceleration_noise: [AxisNoise::default(); 3],
+        line: Some(line_of(ctx.doc, sensor)),
+    };
+    (c, what)
+}
+
 /// Reads the SDF side of IMU sensor `what` (`<update_rate>`, `<pose>`, `<imu>` noise) into `c`;
 /// returns the sensor's update rate (Hz, 0 = every step).
 fn read_sdf(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, what: &str, c: &mut ImuConfig) -> Result<f64> {
@@ -121,23 +133,9 @@ pub(super) fn parse_gz(
     topic: String,
     frame: String,
 ) -> Result<ImuConfig> {
-    let name = sensor.attribute("name").unwrap_or("imu").to_owned();
-    let what = format!("<sensor name=\"{name}\" type=\"imu\">");
-    let mut c = ImuConfig {
-        name,
-        plugin: ImuPlugin::Sensor,
-        link: link.to_owned(),
-        link_from_sensor: Pose::IDENTITY,
-        update_rate_hz: 0.0,
-        topic,
-        frame_name: frame,
-        rpy_offset_rad: [0.0; 3],
-        reference: OrientationReference::World,
-        gaussian_noise: 0.0,
-        angular_velocity_noise: [AxisNoise::default(); 3],
-        linear_acceleration_noise: [AxisNoise::default(); 3],
-        line: Some(line_of(ctx.doc, sensor)),
-    };
+    let (mut c, what) = sensor_config(ctx, sensor, link, OrientationReference::World);
+    c.topic = topic;
+    c.frame_name = frame;
     c.update_rate_hz = read_sdf(ctx, sensor, &what, &mut c)?;
     Ok(c)
 }
