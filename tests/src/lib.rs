@@ -173,10 +173,11 @@ pub fn turtlebot3_gz_burger_cam(tmp: &Path) -> anyhow::Result<Option<(PathBuf, P
     let models = dir.join("models");
     let burger = std::fs::read_to_string(models.join("turtlebot3_burger/model.sdf"))?;
     let waffle = std::fs::read_to_string(models.join("turtlebot3_waffle_pi/model.sdf"))?;
-    let start = waffle.find("<sensor name=\"camera\" type=\"camera\">");
-    let end = waffle.find("</sensor>\n    </link>");
-    let (Some(start), Some(end)) = (start, end.filter(|e| start.is_some_and(|s| *e > s))) else {
-        anyhow::bail!("the waffle_pi model's camera sensor moved");
+    let Some(start) = waffle.find("<sensor name=\"camera\" type=\"camera\">") else {
+        anyhow::bail!("the waffle_pi model has no camera sensor");
+    };
+    let Some(end) = waffle[start..].find("</sensor>").map(|e| start + e) else {
+        anyhow::bail!("the waffle_pi model's camera sensor does not end");
     };
     let camera = &waffle[start..end + "</sensor>".len()];
     let link = format!(
