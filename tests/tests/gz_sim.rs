@@ -496,3 +496,97 @@ fn gz_sims_joint_controllers_move_the_joints() -> Result<()> {
     assert!(err.contains("<joint_name>tool</joint_name>"), "{err}");
     Ok(())
 }
+
+/// gz_ros2_control with its ros2_control controllers file (controller_manager's format): the
+/// joint state broadcaster, a trajectory controller over both joints, run as rover's own; a
+/// controller type rover does not run is refused at its line.
+#[test]
+fn gz_ros2_control_runs_its_ros2_control_controllers() -> Result<()> {
+    let tmp = tempfile::tempdir()?;
+    let text = gz_arm()?;
+    // The same arm, its joints driven by gz_ros2_control instead of gz-sim's joint systems.
+    let start = text
+        .find("  <plugin filename=\"gz-sim-joint-position-controller-system\"")
+        .context("the arm's systems")?;
+    let end = text
+        .find("  <plugin filename=\"gz-sim-joint-state-publisher-system\"")
+        .context("the arm's systems")?;
+    let model = format!(
+        "{}  <plugin filename=\"gz_ros2_control-system\" name=\"gz_ros2_control::GazeboSimROS2ControlPlugin\">\n    <parameters>controllers.yaml</parameters>\n  </plugin>\n{}",
+        &text[..start],
+        &text[end..]
+    );
+    std::fs::write(tmp.path().join("bot.sdf"), &model)?;
+    let yaml = "controller_manager:\n  ros__parameters:\n    update_rate: 100\n    joint_state_broadcaster:\n      type: joint_state_broadcaster/JointStateBroadcaster\n    arm_controller:\n      type: joint_trajectory_controller/JointTrajectoryController\n\narm_controller:\n  ros__parameters:\n    joints:\n      - arm_joint\n      - tool_joint\n    command_interfaces:\n      - position\n    state_interfaces:\n      - position\n      - velocity\n";
+    std::fs::write(tmp.path().join("controllers.yaml"), yaml)?;
+    let robot = RobotModel::load(&tmp.path().join("bot.sdf"))?;
+    let config = robot.controllers.as_ref().context("no controllers")?;
+    let kinds: Vec<(&str, &str)> = config
+        .controllers
+        .iter()
+        .map(|c| (c.name.as_str(), c.type_name.as_str()))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            (
+                "joint_state_broadcaster",
+                "joint_state_controller/JointStateController"
+            ),
+            (
+                "arm_controller",
+                "position_controllers/JointTrajectoryController"
+            )
+        ]
+    );
+    let (arm, tool) = (
+        robot.joint_id("arm_joint").context("arm_joint")?,
+        robot.joint_id("tool_joint").context("tool_joint")?,
+    );
+    let mut sim = flat_sim(robot)?;
+    drive(&mut sim, Twist::ZERO, 0.5)?;
+    let trajectory = rover_sim::physics::JointTrajectory {
+        start_s: 0.0,
+        joint_names: vec!["arm_joint".into(), "tool_joint".into()],
+        points: vec![rover_sim::physics::TrajectoryPoint {
+            positions: vec![0.6, -0.4],
+            time_from_start_s: 1.5,
+            ..Default::default()
+        }],
+    };
+    sim.follow_trajectory("arm_controller", &trajectory)?;
+    drive(&mut sim, Twist::ZERO, 3.0)?;
+    let a = sim.joint_state(arm).context("arm")?.position;
+    let t = sim.joint_state(tool).context("tool")?.position;
+    assert!(
+        (a - 0.6).abs() < 0.02 && (t + 0.4).abs() < 0.02,
+        "joints at {a} and {t} rad; the trajectory ends at 0.6 and -0.4"
+    );
+    // A type rover does not run: refused at the line of its type.
+    let bad = yaml.replace(
+        "joint_trajectory_controller/JointTrajectoryController",
+        "diff_drive_controller/DiffDriveController",
+    );
+    std::fs::write(tmp.path().join("controllers.yaml"), &bad)?;
+    let err = match RobotModel::load(&tmp.path().join("bot.sdf")) {
+        Ok(_) => anyhow::bail!("loaded a controller type rover does not run"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("controllers.yaml:7"), "{err}");
+    assert!(
+        err.contains("'diff_drive_controller/DiffDriveController' is not one rover runs"),
+        "{err}"
+    );
+    // A group controller over two joints: rover runs one joint per controller.
+    let group = yaml.replace(
+        "joint_trajectory_controller/JointTrajectoryController",
+        "position_controllers/JointGroupPositionController",
+    );
+    std::fs::write(tmp.path().join("controllers.yaml"), &group)?;
+    let err = match RobotModel::load(&tmp.path().join("bot.sdf")) {
+        Ok(_) => anyhow::bail!("loaded a two-joint group controller"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("2 joints"), "{err}");
+    Ok(())
+}

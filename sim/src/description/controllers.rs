@@ -3,6 +3,8 @@
 //! actuated, every controller type must be one rover runs, gains must be there where the type
 //! needs them. Errors name the file, the line and what was expected.
 //!
+//! ros2_control's files (controller_manager's format) are read too (`ros2_controllers.rs`).
+//!
 //! Controllers may sit at the top level or under one namespace (`arm: {my_controller: ...}`);
 //! `gazebo_ros_control/pid_gains` and rover's `named_poses` may sit at either level too.
 
@@ -74,6 +76,13 @@ pub fn parse_controllers(text: &str, path: &Path, robot: &RobotModel) -> Result<
             ),
         ));
     }
+    // ros2_control's format (controller_manager: ros__parameters:) as the ros_control file it
+    // amounts to.
+    let root = if super::ros2_controllers::is_ros2(&root) {
+        super::ros2_controllers::to_ros1(&root, path)?
+    } else {
+        root
+    };
     reader.level(&root, "", true)?;
     if reader.config.controllers.is_empty() {
         return Err(reader.error(

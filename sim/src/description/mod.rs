@@ -18,6 +18,7 @@ pub(crate) mod ogre;
 pub(crate) mod parts;
 pub(crate) mod resource;
 pub(crate) mod robot;
+pub(crate) mod ros2_controllers;
 pub(crate) mod sdf;
 pub(crate) mod sdf_robot;
 pub(crate) mod srdf;

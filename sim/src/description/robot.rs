@@ -180,6 +180,7 @@ impl RobotModel {
         }
 
         let gz_controllers = std::mem::take(&mut extensions.gz_controllers);
+        let ros2_control = extensions.ros2_control.take();
         let mut model = Self {
             name: urdf.name.clone(),
             source: path.to_path_buf(),
@@ -211,6 +212,23 @@ impl RobotModel {
         model.validate_plugins(path)?;
         if !gz_controllers.is_empty() {
             model.controllers = Some(gazebo::gz_joints::config(&model, gz_controllers, path)?);
+        }
+        if let Some((file, line)) = ros2_control {
+            if model.controllers.is_some() {
+                return Err(SimError::invalid(
+                    path,
+                    Some(line),
+                    "gz_ros2_control and gz-sim's joint controller systems both drive this robot; expected one of them",
+                ));
+            }
+            let yaml = resources.resolve(&file, base_dir).map_err(|e| {
+                SimError::invalid(
+                    path,
+                    Some(line),
+                    format!("gz_ros2_control <parameters>: {e}"),
+                )
+            })?;
+            model.load_controllers(&yaml)?;
         }
         Ok(model)
     }

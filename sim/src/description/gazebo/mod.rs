@@ -52,6 +52,8 @@ pub(crate) struct Extensions {
     pub joint_state_publisher: Option<crate::model::sensors::JointStatePublisherConfig>,
     /// gz-sim's joint controller systems, as rover's controllers (each on its gz topic).
     pub gz_controllers: Vec<crate::model::ControllerSpec>,
+    /// gz_ros2_control's `<parameters>` (a ros2_control controllers file) and the plugin's line.
+    pub ros2_control: Option<(String, u32)>,
 }
 
 /// Reads every `<gazebo>` element under `<robot>`.
@@ -75,11 +77,10 @@ pub(crate) fn parse_blocks<'a, 'input: 'a>(
 ) -> Result<Extensions> {
     let modern = sdf
         || doc.descendants().any(|n| {
+            let file = n.attribute("filename").unwrap_or("");
             n.has_tag_name("plugin")
-                && gz::is_system(
-                    n.attribute("filename").unwrap_or(""),
-                    n.attribute("name").unwrap_or(""),
-                )
+                && (gz::is_system(file, n.attribute("name").unwrap_or(""))
+                    || file.contains("gz_ros2_control"))
         });
     let ctx = Ctx {
         doc,
@@ -110,6 +111,9 @@ pub(crate) fn parse_blocks<'a, 'input: 'a>(
                             ));
                         }
                         ext.diff_drive = Some(parse_diff_drive(&ctx, child)?);
+                    } else if file.contains("gz_ros2_control") || file.contains("ign_ros2_control")
+                    {
+                        ext.ros2_control = Some(parse_ros2_control(&ctx, child)?);
                     } else if file.contains("gazebo_ros_control") {
                         ext.ros_control = Some(parse_ros_control(&ctx, child)?);
                     } else if imu::is_model_plugin(file) {
@@ -285,6 +289,28 @@ fn read_sensor(
         _ => ext.ignored.push(format!("sensor \"{name}\" (type {kind})")),
     }
     Ok(())
+}
+
+/// gz_ros2_control's `<parameters>`: the controllers file (one; a second is an error).
+fn parse_ros2_control(ctx: &Ctx<'_, '_>, plugin: Node<'_, '_>) -> Result<(String, u32)> {
+    let files: Vec<Node<'_, '_>> = elements(plugin)
+        .filter(|p| p.has_tag_name("parameters"))
+        .collect();
+    match files.as_slice() {
+        [one] if !text_of(*one).is_empty() => {
+            Ok((text_of(*one).to_owned(), line_of(ctx.doc, plugin)))
+        }
+        [] | [_] => Err(ctx.err(
+            plugin,
+            "the gz_ros2_control plugin: expected <parameters> naming its controllers YAML"
+                .to_owned(),
+        )),
+        [_, second, ..] => Err(ctx.err(
+            *second,
+            "a second <parameters> in the gz_ros2_control plugin: rover reads one controllers file"
+                .to_owned(),
+        )),
+    }
 }
 
 /// gazebo_ros_control: the namespace of the controllers' topics and the control period.
