@@ -419,6 +419,36 @@ fn an_rclpy_action_client_follows_trajectories_and_cancels_on_the_arm_car() -> R
     Ok(())
 }
 
+/// The same from the same controllers written in ros2_control's format (what gz_ros2_control
+/// reads; `assets/controllers/my_robot_arm_trajectory_ros2.yaml`), on Jazzy: the same action,
+/// the same trajectories.
+#[test]
+fn an_rclpy_action_client_follows_trajectories_from_a_ros2_control_file() -> Result<()> {
+    let Some(rclpy) = rclpy("jazzy") else {
+        return Ok(());
+    };
+    let robot = repo("assets/robots/my_robot_arm.urdf.xacro");
+    let controllers = repo("assets/controllers/my_robot_arm_trajectory_ros2.yaml");
+    let mut session = Session::start(
+        rclpy,
+        79,
+        50.0,
+        &[
+            "--no-detector",
+            "--robot",
+            &robot.to_string_lossy(),
+            "--controllers",
+            &controllers.to_string_lossy(),
+            "--joints",
+            "multibody",
+        ],
+    )?;
+    let found = session.peer(&["arm_car_trajectory"], Duration::from_secs(120))?;
+    let log = session.rover_log();
+    assert_trajectories("jazzy", &found["arm_car_trajectory"], 5, &log)?;
+    session.wait(Duration::from_secs(120))
+}
+
 /// The same on TIAGo's arm (example-robot-data; position_controllers, 7 joints); and
 /// TIAGo's `robot_description` through the parameter client, a reply in DATA_FRAGs.
 #[test]

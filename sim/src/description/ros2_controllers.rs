@@ -72,7 +72,13 @@ pub(crate) fn to_ros1(root: &Node, path: &Path) -> Result<Node> {
             ));
         }
     };
-    let mut out = Vec::new();
+    // rover's own named poses ride along as they are.
+    let mut out: Vec<(String, Node)> = root
+        .entries()
+        .iter()
+        .filter(|(k, _)| k == "named_poses")
+        .cloned()
+        .collect();
     for (name, entry) in manager.entries() {
         let Some(type_node) = entry.get("type") else {
             continue;
