@@ -80,98 +80,109 @@ pub(crate) fn to_ros1(root: &Node, path: &Path) -> Result<Node> {
         .cloned()
         .collect();
     for (name, entry) in manager.entries() {
-        let Some(type_node) = entry.get("type") else {
-            continue;
-        };
-        let Value::Text(kind) = &type_node.value else {
-            return Err(err(
-                type_node.line,
-                format!(
-                    "{name}: type must be a name, found {}",
-                    type_node.describe()
-                ),
-            ));
-        };
-        let params = root.get(name).and_then(|n| n.get("ros__parameters"));
-        let mut fields: Vec<(String, Node)> = params.map_or(Vec::new(), |p| {
-            p.entries()
-                .iter()
-                .filter(|(k, _)| {
-                    !matches!(
-                        k.as_str(),
-                        "command_interfaces"
-                            | "state_interfaces"
-                            | "interface_name"
-                            | "joints"
-                            | "type"
-                    )
-                })
-                .cloned()
-                .collect()
-        });
-        let joints = params.and_then(|p| p.get("joints"));
-        let ros1 = match kind.as_str() {
-            "joint_state_broadcaster/JointStateBroadcaster" => {
-                fields.push((
-                    "publish_rate".into(),
-                    Node {
-                        line: entry.line,
-                        value: Value::Number(update_rate),
-                    },
-                ));
-                "joint_state_controller/JointStateController".to_owned()
-            }
-            "joint_trajectory_controller/JointTrajectoryController" => {
-                if let Some(j) = joints {
-                    fields.push(("joints".into(), j.clone()));
-                }
-                let interface = first_text(params.and_then(|p| p.get("command_interfaces")))
-                    .unwrap_or("position");
-                format!("{interface}_controllers/JointTrajectoryController")
-            }
-            "position_controllers/JointGroupPositionController"
-            | "velocity_controllers/JointGroupVelocityController"
-            | "effort_controllers/JointGroupEffortController"
-            | "forward_command_controller/ForwardCommandController" => {
-                let interface = match kind.split('_').next() {
-                    Some(i @ ("position" | "velocity" | "effort")) => i,
-                    _ => first_text(params.and_then(|p| p.get("interface_name")))
-                        .unwrap_or("position"),
-                };
-                fields.push(("joint".into(), one_joint(joints, name, entry.line, path)?));
-                match interface {
-                    "velocity" => "velocity_controllers/JointVelocityController".to_owned(),
-                    "effort" => "effort_controllers/JointEffortController".to_owned(),
-                    _ => "position_controllers/JointPositionController".to_owned(),
-                }
-            }
-            "position_controllers/GripperActionController"
-            | "parallel_gripper_action_controller/GripperActionController"
-            | "gripper_controllers/GripperActionController" => {
-                "position_controllers/GripperActionController".to_owned()
-            }
-            other => {
-                return Err(err(
-                    type_node.line,
-                    format!(
-                        "{name}: controller type '{other}' is not one rover runs; expected one of: {SUPPORTED}"
-                    ),
-                ));
-            }
-        };
-        fields.push(("type".into(), text(type_node.line, &ros1)));
-        out.push((
-            name.clone(),
-            Node {
-                line: entry.line,
-                value: Value::Map(fields),
-            },
-        ));
+        if let Some(controller) = controller(root, name, entry, update_rate, path)? {
+            out.push((name.clone(), controller));
+        }
     }
     Ok(Node {
         line: root.line,
         value: Value::Map(out),
     })
+}
+
+/// Controller `name` of the controller manager (its `entry` there, its parameters under
+/// `root`), as ros_control would have it; `None` for a manager entry that is no controller.
+fn controller(
+    root: &Node,
+    name: &str,
+    entry: &Node,
+    update_rate: f64,
+    path: &Path,
+) -> Result<Option<Node>> {
+    let err = |line: u32, m: String| SimError::invalid(path, Some(line), m);
+    let Some(type_node) = entry.get("type") else {
+        return Ok(None);
+    };
+    let Value::Text(kind) = &type_node.value else {
+        return Err(err(
+            type_node.line,
+            format!(
+                "{name}: type must be a name, found {}",
+                type_node.describe()
+            ),
+        ));
+    };
+    let params = root.get(name).and_then(|n| n.get("ros__parameters"));
+    let mut fields: Vec<(String, Node)> = params.map_or(Vec::new(), |p| {
+        p.entries()
+            .iter()
+            .filter(|(k, _)| {
+                !matches!(
+                    k.as_str(),
+                    "command_interfaces"
+                        | "state_interfaces"
+                        | "interface_name"
+                        | "joints"
+                        | "type"
+                )
+            })
+            .cloned()
+            .collect()
+    });
+    let joints = params.and_then(|p| p.get("joints"));
+    let ros1 = match kind.as_str() {
+        "joint_state_broadcaster/JointStateBroadcaster" => {
+            fields.push((
+                "publish_rate".into(),
+                Node {
+                    line: entry.line,
+                    value: Value::Number(update_rate),
+                },
+            ));
+            "joint_state_controller/JointStateController".to_owned()
+        }
+        "joint_trajectory_controller/JointTrajectoryController" => {
+            if let Some(j) = joints {
+                fields.push(("joints".into(), j.clone()));
+            }
+            let interface =
+                first_text(params.and_then(|p| p.get("command_interfaces"))).unwrap_or("position");
+            format!("{interface}_controllers/JointTrajectoryController")
+        }
+        "position_controllers/JointGroupPositionController"
+        | "velocity_controllers/JointGroupVelocityController"
+        | "effort_controllers/JointGroupEffortController"
+        | "forward_command_controller/ForwardCommandController" => {
+            let interface = match kind.split('_').next() {
+                Some(i @ ("position" | "velocity" | "effort")) => i,
+                _ => first_text(params.and_then(|p| p.get("interface_name"))).unwrap_or("position"),
+            };
+            fields.push(("joint".into(), one_joint(joints, name, entry.line, path)?));
+            match interface {
+                "velocity" => "velocity_controllers/JointVelocityController".to_owned(),
+                "effort" => "effort_controllers/JointEffortController".to_owned(),
+                _ => "position_controllers/JointPositionController".to_owned(),
+            }
+        }
+        "position_controllers/GripperActionController"
+        | "parallel_gripper_action_controller/GripperActionController"
+        | "gripper_controllers/GripperActionController" => {
+            "position_controllers/GripperActionController".to_owned()
+        }
+        other => {
+            return Err(err(
+                type_node.line,
+                format!(
+                    "{name}: controller type '{other}' is not one rover runs; expected one of: {SUPPORTED}"
+                ),
+            ));
+        }
+    };
+    fields.push(("type".into(), text(type_node.line, &ros1)));
+    Ok(Some(Node {
+        line: entry.line,
+        value: Value::Map(fields),
+    }))
 }
 
 /// The first name of a list (`command_interfaces: [position]`) or a name.
