@@ -393,28 +393,8 @@ fn an_rclpy_action_client_follows_trajectories_and_cancels_on_the_arm_car() -> R
     let Some(distros) = distros() else {
         return Ok(());
     };
-    let robot = repo("assets/robots/my_robot_arm.urdf.xacro");
-    let controllers = repo("assets/controllers/my_robot_arm_trajectory.yaml");
     for (k, rclpy) in distros.into_iter().enumerate() {
-        let distro = rclpy.distro.clone();
-        let mut session = Session::start(
-            rclpy,
-            71 + k as u16,
-            50.0,
-            &[
-                "--no-detector",
-                "--robot",
-                &robot.to_string_lossy(),
-                "--controllers",
-                &controllers.to_string_lossy(),
-                "--joints",
-                "multibody",
-            ],
-        )?;
-        let found = session.peer(&["arm_car_trajectory"], Duration::from_secs(120))?;
-        let log = session.rover_log();
-        assert_trajectories(&distro, &found["arm_car_trajectory"], 5, &log)?;
-        session.wait(Duration::from_secs(120))?;
+        arm_car_trajectories(rclpy, 71 + k as u16, "my_robot_arm_trajectory.yaml")?;
     }
     Ok(())
 }
@@ -427,11 +407,18 @@ fn an_rclpy_action_client_follows_trajectories_from_a_ros2_control_file() -> Res
     let Some(rclpy) = rclpy("jazzy") else {
         return Ok(());
     };
+    arm_car_trajectories(rclpy, 79, "my_robot_arm_trajectory_ros2.yaml")
+}
+
+/// The arm car with `assets/controllers/<controllers>`: the peer's trajectories followed and
+/// cancelled through the arm controller's action.
+fn arm_car_trajectories(rclpy: Rclpy, salt: u16, controllers: &str) -> Result<()> {
+    let distro = rclpy.distro.clone();
     let robot = repo("assets/robots/my_robot_arm.urdf.xacro");
-    let controllers = repo("assets/controllers/my_robot_arm_trajectory_ros2.yaml");
+    let controllers = repo("assets/controllers").join(controllers);
     let mut session = Session::start(
         rclpy,
-        79,
+        salt,
         50.0,
         &[
             "--no-detector",
@@ -445,7 +432,7 @@ fn an_rclpy_action_client_follows_trajectories_from_a_ros2_control_file() -> Res
     )?;
     let found = session.peer(&["arm_car_trajectory"], Duration::from_secs(120))?;
     let log = session.rover_log();
-    assert_trajectories("jazzy", &found["arm_car_trajectory"], 5, &log)?;
+    assert_trajectories(&distro, &found["arm_car_trajectory"], 5, &log)?;
     session.wait(Duration::from_secs(120))
 }
 
