@@ -101,29 +101,20 @@ fn check_unbridged(log: &str, unbridged: &str) -> Result<()> {
 /// The rospy node: it drives with TwistStamped until /odom says a metre, stops, and reports
 /// what each topic carried (median stamp gaps, the scan's shape, the distance).
 const ROSPY_DRIVER: &str = r#"
-import rospy, struct, time
+import rospy, time
 from geometry_msgs.msg import TwistStamped
+from tf2_msgs.msg import TFMessage
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Image, Imu, JointState, LaserScan
 rospy.init_node('tb3_gz_driver')
 got = {'scan': [], 'imu': [], 'odom': [], 'joint_states': [], 'tf': [], 'image': []}
 def keep(name):
     return lambda m: got[name].append(m)
-def tf_raw(m):
-    # tf2_msgs/TFMessage, read from the wire (no tf2_msgs for Python here): the first
-    # transform's stamp and frames.
-    b = m._buff
-    secs, nsecs = struct.unpack_from('<II', b, 8)
-    n = struct.unpack_from('<I', b, 16)[0]
-    frame = b[20:20 + n].decode()
-    m2 = struct.unpack_from('<I', b, 20 + n)[0]
-    child = b[24 + n:24 + n + m2].decode()
-    got['tf'].append((secs + nsecs * 1e-9, frame, child))
 rospy.Subscriber('/scan', LaserScan, keep('scan'))
 rospy.Subscriber('/imu', Imu, keep('imu'))
 rospy.Subscriber('/odom', Odometry, keep('odom'))
 rospy.Subscriber('/joint_states', JointState, keep('joint_states'))
-rospy.Subscriber('/tf', rospy.AnyMsg, tf_raw)
+rospy.Subscriber('/tf', TFMessage, keep('tf'))
 rospy.Subscriber('/camera/image_raw', Image, keep('image'))
 pub = rospy.Publisher('/cmd_vel', TwistStamped, queue_size=1)
 end = time.time() + 30
@@ -153,12 +144,14 @@ def median_gap(stamps):
 for name in ['scan', 'imu', 'odom', 'joint_states']:
     print('gap %s %.5f %d' % (name, median_gap([m.header.stamp.to_sec() for m in got[name]]),
                               len(got[name])))
-print('gap tf %.5f %d' % (median_gap([t[0] for t in got['tf'] if t[1] == 'odom']),
-                          len(got['tf'])))
+tf_odom = [t.header.stamp.to_sec() for m in got['tf'] for t in m.transforms[:1]
+           if t.header.frame_id == 'odom']
+print('gap tf %.5f %d' % (median_gap(tf_odom), len(got['tf'])))
 s = got['scan'][-1]
 print('scan %s %d %.3f %.3f' % (s.header.frame_id, len(s.ranges), s.range_min, s.range_max))
 print('imu %s' % got['imu'][-1].header.frame_id)
-print('tf %s' % ' '.join(sorted(set('%s>%s' % (t[1], t[2]) for t in got['tf']))))
+print('tf %s' % ' '.join(sorted(set('%s>%s' % (t.header.frame_id, t.child_frame_id)
+                                    for m in got['tf'] for t in m.transforms))))
 j = got['joint_states'][-1]
 print('joints %s' % ' '.join(j.name))
 i = got['image'][-1] if got['image'] else None
@@ -225,7 +218,16 @@ fn check_report(
         ensure!(image[2] == "0", "the burger has no camera: {image:?}");
     }
     let tf = keyed("tf")?;
-    ensure!(tf.contains(&"odom>base_footprint".to_owned()), "tf {tf:?}");
+    // The DiffDrive's odom -> base_footprint, and the wheels as robot_state_publisher would
+    // put them from /joint_states.
+    ensure!(
+        tf == [
+            "base_link>wheel_left_link",
+            "base_link>wheel_right_link",
+            "odom>base_footprint"
+        ],
+        "tf {tf:?}"
+    );
     ensure!(
         keyed("joints")? == ["wheel_left_joint", "wheel_right_joint"],
         "joint names"

@@ -63,6 +63,9 @@ fn turtlebot3_burger_sdf_loads_with_its_gz_systems_and_sensors() -> Result<()> {
     );
     assert_eq!(dd.wheel_separation_m, 0.160);
     assert!((dd.wheel_diameter_m - 0.066).abs() < 1e-12);
+    // The wheel joints' <limit><effort> bounds the motors, as the physics engine bounds gz-sim's
+    // velocity commands.
+    assert_eq!(dd.wheel_torque_nm, 20.0);
     assert_eq!(dd.command_topic, "cmd_vel");
     assert_eq!(dd.odometry_topic, "odom");
     assert_eq!(

@@ -2,8 +2,9 @@
 //! its position, velocity and effort, every control update (or at a joint_state_controller's
 //! `publish_rate`).
 
+use rover_sim::sensors::Schedule;
+
 use super::events::{ControlUpdate, TopicFamily};
-use super::odom::Every;
 use super::plan::RosPlan;
 
 /// The joints' state at a control update, in the plan's order, as sensor_msgs/JointState's
@@ -30,7 +31,7 @@ pub(crate) struct JointStates {
     /// Whether the robot has moving joints.
     any: bool,
     /// When messages go out (every control update, or a joint_state_controller's rate).
-    rate: Every,
+    rate: Schedule,
     /// The arrays, reused.
     arrays: JointArrays,
 }
@@ -41,7 +42,7 @@ impl JointStates {
         Self {
             wire,
             any: !plan.joints.is_empty(),
-            rate: Every::new(plan.joint_states_hz.map_or(0.0, |hz| 1.0 / hz)),
+            rate: Schedule::new(plan.joint_states_hz.unwrap_or(0.0)),
             arrays: JointArrays::default(),
         }
     }
@@ -50,7 +51,7 @@ impl JointStates {
 impl TopicFamily for JointStates {
     fn control(&mut self, update: &ControlUpdate) {
         let now_s = update.sample.sim_time_s;
-        if !self.any || !self.rate.due(now_s) {
+        if !self.any || !self.rate.take(now_s) {
             return;
         }
         let a = &mut self.arrays;

@@ -3,6 +3,7 @@
 //! `odom_publish_frequency`.
 
 use rover_sim::physics::ControlSample;
+use rover_sim::sensors::Schedule;
 
 use super::events::{ControlUpdate, TopicFamily};
 use super::plan::RosPlan;
@@ -31,7 +32,7 @@ pub(crate) trait OdomWire: Send {
 /// The odometry family.
 pub(crate) struct Odom {
     wire: Box<dyn OdomWire>,
-    rate: Every,
+    rate: Schedule,
 }
 
 impl Odom {
@@ -39,44 +40,14 @@ impl Odom {
     pub fn new(wire: Box<dyn OdomWire>, plan: &RosPlan) -> Self {
         Self {
             wire,
-            rate: Every::new(plan.odom_period_s),
+            rate: Schedule::new(plan.odom_rate_hz),
         }
-    }
-}
-
-/// A schedule on sim time: due every `period_s` (0: every time asked).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Every {
-    period_s: f64,
-    next_s: f64,
-}
-
-impl Every {
-    /// Due first at sim time 0, then every `period_s`.
-    pub fn new(period_s: f64) -> Self {
-        Self {
-            period_s,
-            next_s: 0.0,
-        }
-    }
-
-    /// Whether it is due at `now_s`; if so, the next time is scheduled.
-    pub fn due(&mut self, now_s: f64) -> bool {
-        if now_s + 1e-9 < self.next_s {
-            return false;
-        }
-        self.next_s = if self.next_s + self.period_s + 1e-9 < now_s {
-            now_s + self.period_s
-        } else {
-            self.next_s + self.period_s
-        };
-        true
     }
 }
 
 impl TopicFamily for Odom {
     fn control(&mut self, update: &ControlUpdate) {
-        if !self.rate.due(update.sample.sim_time_s) {
+        if !self.rate.take(update.sample.sim_time_s) {
             return;
         }
         let (position, orientation) = odom_pose(&update.sample);

@@ -15,9 +15,9 @@ pub struct RosPlan {
     /// The command topic carries geometry_msgs/TwistStamped (a ros_gz_bridge map says so),
     /// not Twist.
     pub cmd_stamped: bool,
-    /// Seconds between odometry messages and transforms (0: every control update;
-    /// gz-sim's DiffDrive: `1 / odom_publish_frequency`).
-    pub odom_period_s: f64,
+    /// Odometry messages and transforms per second of sim time (0: every control update;
+    /// gz-sim's DiffDrive: its `odom_publish_frequency`).
+    pub odom_rate_hz: f64,
     /// Where the joints' states go: `/joint_states`, or gz-sim's JointStatePublisher `<topic>`.
     pub joint_states_topic: String,
     /// `/odom` (diff drive `odometryTopic`).
@@ -185,7 +185,7 @@ impl RosPlan {
         Self {
             cmd_topic: topic(&drive.command_topic),
             cmd_stamped: drive.command_stamped,
-            odom_period_s: drive.odometry_rate_hz.map_or(0.0, |hz| 1.0 / hz),
+            odom_rate_hz: drive.odometry_rate_hz.unwrap_or(0.0),
             joint_states_topic: robot
                 .joint_state_publisher
                 .as_ref()

@@ -3,9 +3,10 @@
 //! joiners, as tf2_msgs/TFMessage.
 
 use rover_sim::geometry::Pose;
+use rover_sim::sensors::Schedule;
 
 use super::events::{ControlUpdate, Start, TopicFamily, Transform};
-use super::odom::{Every, odom_pose};
+use super::odom::odom_pose;
 use super::plan::{JointSource, RosPlan};
 
 /// `/tf` and `/tf_static` on one transport.
@@ -26,7 +27,7 @@ pub(crate) struct Tf {
     joints_on_tf: Vec<usize>,
     transforms: Vec<Transform>,
     /// The odometry's rate (gz-sim's DiffDrive publishes its transform with its odometry).
-    rate: Every,
+    rate: Schedule,
 }
 
 impl Tf {
@@ -50,7 +51,7 @@ impl Tf {
             odom_tf: plan.odom_tf,
             joints_on_tf,
             transforms,
-            rate: Every::new(plan.odom_period_s),
+            rate: Schedule::new(plan.odom_rate_hz),
         }
     }
 }
@@ -61,7 +62,7 @@ impl TopicFamily for Tf {
     }
 
     fn control(&mut self, update: &ControlUpdate) {
-        if !self.rate.due(update.sample.sim_time_s) {
+        if !self.rate.take(update.sample.sim_time_s) {
             return;
         }
         let mut next = self.transforms.iter_mut();

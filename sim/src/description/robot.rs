@@ -164,6 +164,24 @@ impl RobotModel {
             // gz-sim's DiffDrive: `<model>/<canonical link>`.
             dd.robot_base_frame = format!("{}/{}", urdf.name, links[root.index()].name);
         }
+        if let Some(dd) = extensions
+            .diff_drive
+            .as_mut()
+            .filter(|d| d.plugin == crate::model::DrivePlugin::GzSim)
+        {
+            // gz-sim sets the wheels' speeds and the physics engine reaches them within the
+            // joints' effort limit (rover's motor torque where they give none).
+            let wheels = [&dd.left_joint, &dd.right_joint]
+                .into_iter()
+                .chain(&dd.extra_left_joints)
+                .chain(&dd.extra_right_joints);
+            let effort = wheels
+                .filter_map(|w| joints.iter().find(|j| &j.name == w)?.effort_limit)
+                .fold(f32::INFINITY, f32::min);
+            if effort.is_finite() && effort > 0.0 {
+                dd.wheel_torque_nm = f64::from(effort);
+            }
+        }
         for (reference, kp) in &extensions.contact_kp {
             if let Some(&i) = link_index.get(reference) {
                 links[i].contact_kp_n_per_m = Some(*kp);

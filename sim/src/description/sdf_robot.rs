@@ -111,6 +111,17 @@ pub(crate) fn load(
     for gps in &mut extensions.gpss {
         gps.link_from_sensor = frames.urdf_from_sdf(&gps.link) * gps.link_from_sensor;
     }
+    // A camera sits at its link's origin, which a moving joint's child has moved to the joint.
+    for camera in &extensions.cameras {
+        if frames.urdf_from_sdf(&camera.link).translation.length() > 1e-6 {
+            tracing::warn!(
+                "{}: camera \"{}\" on link \"{}\": rover's camera sits at the link's joint, not at the link's SDF origin",
+                path.display(),
+                camera.name,
+                camera.link
+            );
+        }
+    }
     // model:// meshes beside the model's own folder (a package's models/), after the paths given.
     let mut resources = resources.clone();
     if let Some(models) = path.parent().and_then(Path::parent) {
@@ -195,11 +206,33 @@ impl Frames {
                 .and_then(|c| c.text())
                 .unwrap_or("")
                 .trim();
-            if let Some(child_pose) = model_from_link.get(child_name) {
-                let joint_in_child =
-                    child(joint, "pose").map_or(Ok(Pose::IDENTITY), |p| ctx.pose(p))?;
-                model_from_urdf.insert(child_name.to_owned(), *child_pose * joint_in_child);
-            }
+            let Some(child_pose) = model_from_link.get(child_name) else {
+                continue;
+            };
+            // A joint's <pose> is in its child link's frame unless `relative_to` says otherwise.
+            let model_from_joint = match child(joint, "pose") {
+                None => *child_pose,
+                Some(p) => {
+                    let pose = ctx.pose(p)?;
+                    match p.attribute("relative_to").unwrap_or("") {
+                        "" => *child_pose * pose,
+                        "__model__" => pose,
+                        other => match model_from_link.get(other) {
+                            Some(base) => *base * pose,
+                            None => {
+                                return Err(ctx.err(
+                                    p,
+                                    format!(
+                                        "<joint name=\"{}\"> <pose relative_to=\"{other}\">: no link of that name in the model; expected a link or __model__",
+                                        joint.attribute("name").unwrap_or("")
+                                    ),
+                                ));
+                            }
+                        },
+                    }
+                }
+            };
+            model_from_urdf.insert(child_name.to_owned(), model_from_joint);
         }
         Ok(Self {
             model_from_link,
@@ -525,6 +558,31 @@ mod tests {
         let back = crate::geometry::pose_from_xyz_rpy(o.xyz, o.rpy);
         assert!((back.translation - p.translation).length() < 1e-6);
         assert!(back.rotation.dot(p.rotation).abs() > 1.0 - 1e-6);
+    }
+
+    #[test]
+    fn a_joint_pose_may_be_relative_to_the_model_or_a_link() -> crate::error::Result<()> {
+        let model = |pose: &str| {
+            format!(
+                "<sdf version=\"1.8\"><model name=\"m\">\
+                 <link name=\"a\"/><link name=\"b\"><pose>0 0.1 0 0 0 0</pose></link>\
+                 <joint name=\"j\" type=\"revolute\"><parent>a</parent><child>b</child>{pose}\
+                 <axis><xyz>0 0 1</xyz></axis></joint></model></sdf>"
+            )
+        };
+        let at = |pose: &str| -> crate::error::Result<glam::Vec3> {
+            let robot = RobotModel::from_str(&model(pose), Path::new("m.sdf"))?;
+            Ok(robot.joints[0].parent_from_child.translation)
+        };
+        let expected = glam::Vec3::new(0.2, 0.1, 0.0);
+        for pose in [
+            "<pose>0.2 0 0 0 0 0</pose>",
+            "<pose relative_to=\"__model__\">0.2 0.1 0 0 0 0</pose>",
+            "<pose relative_to=\"a\">0.2 0.1 0 0 0 0</pose>",
+        ] {
+            assert!((at(pose)? - expected).length() < 1e-6, "{pose}");
+        }
+        Ok(())
     }
 
     #[test]

@@ -33,3 +33,4 @@ pub use imu::{ImuReading, ImuSensor};
 pub use laser::{LaserScan, LaserSensor};
 pub use lidar::LidarSensor;
 pub use p3d::{P3dSensor, PoseReading};
+pub use schedule::Schedule;

@@ -2,9 +2,9 @@
 //! it (the next time is the last one plus the period, so a rate that does not divide the step
 //! keeps its average), and every physics step at a rate of 0.
 
-/// A sensor's schedule on sim time.
+/// A sensor's (or a topic's) schedule on sim time.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Schedule {
+pub struct Schedule {
     period_s: f64,
     next_s: f64,
 }

@@ -2,7 +2,7 @@
 //! `rgbd_camera`): the SDF `<camera>` element and the gazebo_ros_camera plugin's parameters,
 //! Gazebo's defaults where both are silent.
 
-use super::values::{Ctx, Node, parse_noise, text_of};
+use super::values::{Ctx, Node, parse_noise, read_sensor_pose, text_of};
 use crate::description::xml::{elements, line_of};
 use crate::error::Result;
 use crate::model::sensors::{CameraConfig, DepthOutput, Distortion, PixelFormat};
@@ -41,6 +41,20 @@ pub(super) fn parse(ctx: &Ctx<'_, '_>, sensor: Node<'_, '_>, link: &str) -> Resu
     for s in elements(sensor) {
         match s.tag_name().name() {
             "update_rate" => c.update_rate_hz = ctx.non_negative(s, what, "Hz")?,
+            "pose" => {
+                // Read (a malformed pose is an error) but not applied: said, not silent.
+                let pose = read_sensor_pose(ctx, s, what)?;
+                if pose.translation.length() > 1e-6
+                    || pose.rotation.angle_between(glam::Quat::IDENTITY) > 1e-6
+                {
+                    tracing::warn!(
+                        "{}:{}: <pose> of {what}: not applied; rover's camera sits at its link's origin ({}), looking along its x axis",
+                        ctx.path.display(),
+                        line_of(ctx.doc, s),
+                        c.link
+                    );
+                }
+            }
             "camera" => read_camera_element(ctx, s, what, &mut c, &mut sdf_distortion)?,
             "plugin" => {
                 // gazebo_ros_depth_camera has no far cutoff; gazebo_ros_openni_kinect's is 5 m.

@@ -115,9 +115,10 @@ pub(super) fn parse_diff_drive(
         ..DiffDriveConfig::default()
     };
     let (mut left, mut right) = (Vec::new(), Vec::new());
-    let mut linear = SpeedLimits::default();
-    let mut angular = SpeedLimits::default();
-    let mut limited = false;
+    // Speed limits as (shared, tag, value): applied shared first, so that the specific ones
+    // win wherever they are written, as gz-sim reads them.
+    let mut limits: Vec<(bool, &str, f64)> = Vec::new();
+    let mut misnamed_rate = None;
     for p in elements(plugin) {
         let text = || text_of(p).to_owned();
         let tag = p.tag_name().name();
@@ -135,29 +136,23 @@ pub(super) fn parse_diff_drive(
                 let hz = ctx.number(p, what, "Hz, 0 or less = every step")?;
                 c.odometry_rate_hz = (hz > 0.0).then_some(hz);
             }
-            "odom_publisher_frequency" => tracing::warn!(
-                "{}:{}: <odom_publisher_frequency> in {what}: gz-sim reads <odom_publish_frequency>; ignored as gz-sim ignores it (odometry at {} Hz)",
-                ctx.path.display(),
-                line_of(ctx.doc, p),
-                c.odometry_rate_hz.unwrap_or(0.0)
-            ),
-            _ => {
-                let slots = limit_slots(tag, &mut linear, &mut angular);
-                if slots.is_empty() {
-                    tracing::warn!(
-                        "{}:{}: <{tag}> in {what}: unknown parameter, ignored",
-                        ctx.path.display(),
-                        line_of(ctx.doc, p)
-                    );
-                } else {
-                    let v = ctx.number(p, what, "a speed limit")?;
-                    limited = true;
-                    for slot in slots {
-                        *slot = v;
-                    }
-                }
-            }
+            "odom_publisher_frequency" => misnamed_rate = Some(line_of(ctx.doc, p)),
+            _ => match limit_kind(tag) {
+                Some(shared) => limits.push((shared, tag, ctx.number(p, what, "a speed limit")?)),
+                None => tracing::warn!(
+                    "{}:{}: <{tag}> in {what}: unknown parameter, ignored",
+                    ctx.path.display(),
+                    line_of(ctx.doc, p)
+                ),
+            },
         }
+    }
+    if let Some(line) = misnamed_rate {
+        tracing::warn!(
+            "{}:{line}: <odom_publisher_frequency> in {what}: gz-sim reads <odom_publish_frequency>; ignored as gz-sim ignores it (odometry at {} Hz)",
+            ctx.path.display(),
+            c.odometry_rate_hz.unwrap_or(0.0)
+        );
     }
     if left.is_empty() || right.is_empty() {
         return Err(ctx.err(
@@ -173,11 +168,33 @@ pub(super) fn parse_diff_drive(
     c.right_joint = right.remove(0);
     c.extra_left_joints = left;
     c.extra_right_joints = right;
-    if limited {
+    if !limits.is_empty() {
+        let (mut linear, mut angular) = (SpeedLimits::default(), SpeedLimits::default());
+        limits.sort_by_key(|(shared, _, _)| !shared);
+        for (_, tag, v) in limits {
+            for slot in limit_slots(tag, &mut linear, &mut angular) {
+                *slot = v;
+            }
+        }
         c.linear_limits = Some(linear);
         c.angular_limits = Some(angular);
     }
     Ok(c)
+}
+
+/// Whether `tag` is a DiffDrive speed limit, and if so whether it is a shared one
+/// (`max_velocity`, for both) rather than a specific one (`max_linear_velocity`).
+fn limit_kind(tag: &str) -> Option<bool> {
+    let (bound, rest) = tag.split_once('_')?;
+    let quantity = |q: &str| matches!(q, "velocity" | "acceleration" | "jerk");
+    if !matches!(bound, "min" | "max") {
+        return None;
+    }
+    match rest.split_once('_') {
+        None => quantity(rest).then_some(true),
+        Some(("linear" | "angular", q)) => quantity(q).then_some(false),
+        Some(_) => None,
+    }
 }
 
 /// Where a DiffDrive speed limit parameter goes: `{min,max}_{linear,angular}_{velocity,
@@ -258,6 +275,36 @@ mod tests {
         );
         assert_eq!(system("gz-sim-sensors-system", ""), System::World);
         assert_eq!(system("gz-sim-buoyancy-system", ""), System::Other);
+    }
+
+    #[test]
+    fn specific_limits_win_over_shared_ones_wherever_written() -> Result<()> {
+        let text = "<plugin filename=\"gz-sim-diff-drive-system\" name=\"gz::sim::systems::DiffDrive\">\
+            <left_joint>l</left_joint><right_joint>r</right_joint>\
+            <max_linear_acceleration>1</max_linear_acceleration>\
+            <max_acceleration>3</max_acceleration>\
+            <odom_publish_frequency>20</odom_publish_frequency></plugin>";
+        let doc = roxmltree::Document::parse(text).map_err(|e| {
+            crate::error::SimError::invalid(std::path::Path::new("x"), None, e.to_string())
+        })?;
+        let ctx = Ctx {
+            doc: &doc,
+            path: std::path::Path::new("x.urdf"),
+            modern: true,
+            model: "m",
+        };
+        let c = parse_diff_drive(&ctx, doc.root_element(), "m")?;
+        let (lin, ang) = (
+            c.linear_limits.unwrap_or_default(),
+            c.angular_limits.unwrap_or_default(),
+        );
+        assert_eq!((lin.acceleration.1, ang.acceleration.1), (1.0, 3.0));
+        assert_eq!(c.odometry_rate_hz, Some(20.0));
+        assert_eq!(c.command_topic, "/model/m/cmd_vel");
+        assert_eq!(limit_kind("max_jerk"), Some(true));
+        assert_eq!(limit_kind("min_angular_velocity"), Some(false));
+        assert_eq!(limit_kind("max_wheel_torque"), None);
+        Ok(())
     }
 
     #[test]

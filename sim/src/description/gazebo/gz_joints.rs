@@ -73,6 +73,15 @@ pub(super) fn parse(
     let Some(first) = joints.first().cloned() else {
         return Err(ctx.err(plugin, format!("{what}: expected a <joint_name>")));
     };
+    if joints.len() > 1 && system != JointSystem::Trajectory {
+        return Err(ctx.err(
+            plugin,
+            format!(
+                "{what}: {} <joint_name>s; rover drives one joint per joint controller system: give each joint its own",
+                joints.len()
+            ),
+        ));
+    }
     let topic_of = |default: String| {
         elements(plugin)
             .find(|p| p.has_tag_name("topic"))
@@ -89,14 +98,24 @@ pub(super) fn parse(
                 d: 0.01,
                 i_clamp: 1.0,
             };
-            let mut index = 0.0;
+            let mut index = 0u32;
             for p in elements(plugin) {
                 match p.tag_name().name() {
                     "p_gain" => pid.p = ctx.non_negative(p, &what, "gain")?,
                     "i_gain" => pid.i = ctx.non_negative(p, &what, "gain")?,
                     "d_gain" => pid.d = ctx.non_negative(p, &what, "gain")?,
                     "i_max" => pid.i_clamp = ctx.non_negative(p, &what, "N m")?,
-                    "joint_index" => index = ctx.non_negative(p, &what, "an axis index")?,
+                    "joint_index" => {
+                        index = text_of(p).parse().map_err(|_| {
+                            ctx.err(
+                                p,
+                                format!(
+                                    "<joint_index> in {what}: expected 0 or a positive whole number, found '{}'",
+                                    text_of(p)
+                                ),
+                            )
+                        })?
+                    }
                     _ => {}
                 }
             }
