@@ -152,36 +152,12 @@ impl RobotModel {
         let transmissions = read_transmissions(&urdf, &joints, path)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
-        for gps in extensions.gpss.iter_mut().filter(|g| g.link.is_empty()) {
-            // hector's default: the model's first link, which for a URDF is its root.
-            gps.link = links[root.index()].name.clone();
-        }
-        if let Some(dd) = extensions
-            .diff_drive
-            .as_mut()
-            .filter(|d| d.robot_base_frame.is_empty())
-        {
-            // gz-sim's DiffDrive: `<model>/<canonical link>`.
-            dd.robot_base_frame = format!("{}/{}", urdf.name, links[root.index()].name);
-        }
-        if let Some(dd) = extensions
-            .diff_drive
-            .as_mut()
-            .filter(|d| d.plugin == crate::model::DrivePlugin::GzSim)
-        {
-            // gz-sim sets the wheels' speeds and the physics engine reaches them within the
-            // joints' effort limit (rover's motor torque where they give none).
-            let wheels = [&dd.left_joint, &dd.right_joint]
-                .into_iter()
-                .chain(&dd.extra_left_joints)
-                .chain(&dd.extra_right_joints);
-            let effort = wheels
-                .filter_map(|w| joints.iter().find(|j| &j.name == w)?.effort_limit)
-                .fold(f32::INFINITY, f32::min);
-            if effort.is_finite() && effort > 0.0 {
-                dd.wheel_torque_nm = f64::from(effort);
-            }
-        }
+        complete_defaults(
+            &mut extensions,
+            &urdf.name,
+            &links[root.index()].name,
+            &joints,
+        );
         for (reference, kp) in &extensions.contact_kp {
             if let Some(&i) = link_index.get(reference) {
                 links[i].contact_kp_n_per_m = Some(*kp);
@@ -249,6 +225,46 @@ impl RobotModel {
             model.load_controllers(&yaml)?;
         }
         Ok(model)
+    }
+}
+
+/// The defaults that need the whole robot: hector's GPS on the root link, gz-sim DiffDrive's
+/// `<model>/<canonical link>` base frame and its wheels' effort limit.
+fn complete_defaults(
+    extensions: &mut gazebo::Extensions,
+    model: &str,
+    root_link: &str,
+    joints: &[Joint],
+) {
+    for gps in extensions.gpss.iter_mut().filter(|g| g.link.is_empty()) {
+        // hector's default: the model's first link, which for a URDF is its root.
+        gps.link = root_link.to_owned();
+    }
+    if let Some(dd) = extensions
+        .diff_drive
+        .as_mut()
+        .filter(|d| d.robot_base_frame.is_empty())
+    {
+        // gz-sim's DiffDrive: `<model>/<canonical link>`.
+        dd.robot_base_frame = format!("{model}/{root_link}");
+    }
+    if let Some(dd) = extensions
+        .diff_drive
+        .as_mut()
+        .filter(|d| d.plugin == crate::model::DrivePlugin::GzSim)
+    {
+        // gz-sim sets the wheels' speeds and the physics engine reaches them within the
+        // joints' effort limit (rover's motor torque where they give none).
+        let wheels = [&dd.left_joint, &dd.right_joint]
+            .into_iter()
+            .chain(&dd.extra_left_joints)
+            .chain(&dd.extra_right_joints);
+        let effort = wheels
+            .filter_map(|w| joints.iter().find(|j| &j.name == w)?.effort_limit)
+            .fold(f32::INFINITY, f32::min);
+        if effort.is_finite() && effort > 0.0 {
+            dd.wheel_torque_nm = f64::from(effort);
+        }
     }
 }
 
