@@ -464,41 +464,60 @@ impl Session {
                 };
                 emit(observer, now, level, &text);
             });
-            let before = self.stats.arm;
-            self.stats.arm = self.arm.status();
-            if before.mode == ArmMode::Reach
-                && self.stats.arm.mode == ArmMode::Reach
-                && before.reach != self.stats.arm.reach
-            {
-                emit(
-                    observer,
-                    sample.sim_time_s,
-                    EventLevel::Info,
-                    &format!(
-                        "reach: {} -> {}",
-                        before.reach.as_str(),
-                        self.stats.arm.reach.as_str()
-                    ),
-                );
-            }
-            if before.mode == ArmMode::Pick
-                && self.stats.arm.mode == ArmMode::Pick
-                && before.pick != self.stats.arm.pick
-            {
-                emit(
-                    observer,
-                    sample.sim_time_s,
-                    EventLevel::Info,
-                    &format!(
-                        "pick: {} -> {}",
-                        before.pick.as_str(),
-                        self.stats.arm.pick.as_str()
-                    ),
-                );
-            }
+            self.arm_events(sample.sim_time_s, observer);
             observer.control(&self.sim, sample, &self.stats);
         }
         Ok(sample)
+    }
+
+    /// The arm's status after a control update, and its changes as events: the reach's and
+    /// the pick's states, and the object hidden by the robot or in view again.
+    fn arm_events(&mut self, now_s: f64, observer: &mut dyn Observer) {
+        let before = self.stats.arm;
+        self.stats.arm = self.arm.status();
+        if before.mode == ArmMode::Reach
+            && self.stats.arm.mode == ArmMode::Reach
+            && before.reach != self.stats.arm.reach
+        {
+            emit(
+                observer,
+                now_s,
+                EventLevel::Info,
+                &format!(
+                    "reach: {} -> {}",
+                    before.reach.as_str(),
+                    self.stats.arm.reach.as_str()
+                ),
+            );
+        }
+        if before.mode == self.stats.arm.mode && before.hidden != self.stats.arm.hidden {
+            let text = if self.stats.arm.hidden {
+                "the object is hidden by the robot's own links: going on with its last estimate"
+            } else {
+                "the object is in view again"
+            };
+            emit(
+                observer,
+                now_s,
+                EventLevel::Info,
+                &format!("{}: {text}", self.stats.arm.mode.as_str()),
+            );
+        }
+        if before.mode == ArmMode::Pick
+            && self.stats.arm.mode == ArmMode::Pick
+            && before.pick != self.stats.arm.pick
+        {
+            emit(
+                observer,
+                now_s,
+                EventLevel::Info,
+                &format!(
+                    "pick: {} -> {}",
+                    before.pick.as_str(),
+                    self.stats.arm.pick.as_str()
+                ),
+            );
+        }
     }
 
     /// A fetch's base command (pick driving the base) goes to the drive; a stop once it lets
@@ -559,6 +578,10 @@ impl Session {
                 camera.skip_if_due(&self.sim);
                 return Ok(None);
             }
+        }
+        if self.arm.wants_robot_pixels() {
+            // The self filter's robot pixels (allocated once, on the first reach or pick).
+            camera.enable_id_image();
         }
         let world_from_camera = self.sim.world_from_link(self.camera_link);
         let Some(frame) = camera

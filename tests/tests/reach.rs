@@ -4,7 +4,8 @@
 
 use anyhow::Result;
 use rover_core::{
-    Action, ArmConfig, DetectorMode, JointAction, NoObserver, ReachState, Session, SessionOptions,
+    Action, ArmConfig, DetectorMode, JointAction, NoObserver, ReachState, ReachStep, Session,
+    SessionOptions,
 };
 use rover_sim::{geometry::Pose, model::World, physics::JointCommand};
 
@@ -501,5 +502,227 @@ fn tiagos_head_looks_at_the_ball_when_look_is_switched_on() -> Result<()> {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(arm_moved < 0.01, "the arm moved {arm_moved} rad");
+    Ok(())
+}
+
+/// Events said, kept in order.
+#[derive(Default)]
+struct Events(Vec<(f64, String)>);
+
+impl rover_core::Observer for Events {
+    fn event(&mut self, t: f64, _level: rover_core::EventLevel, text: &str) {
+        self.0.push((t, text.to_owned()));
+    }
+}
+
+/// The orange's index among worlds/arm_car_orange.toml's objects (table, tray, orange).
+const ORANGE: usize = 2;
+
+/// worlds/arm_car_orange.toml as shipped, the arm's tasks on "orange", detecting at 5 Hz of
+/// sim time in lockstep, run 0.5 s and switched to reach.
+fn orange_reach(events: &mut Events) -> Result<Session> {
+    let config = rover_core::RunConfig {
+        world: Some(rover_tests::repo("worlds/arm_car_orange.toml")),
+        ..rover_core::RunConfig::default()
+    };
+    let (world, robot) = config.load_world_and_robot()?;
+    let options = SessionOptions {
+        arm: ArmConfig::default().with_class("orange"),
+        ..rover_tests::lockstep_options(0)
+    };
+    let mut session = Session::new(world, robot, &options, events)?;
+    let mut run = Run::default();
+    run_for(&mut session, 0.5, &mut run)?;
+    session.input(Action::ToggleReach, events);
+    Ok(session)
+}
+
+/// Self-occlusion (the case): the mast camera looks past the arm at an orange on a low
+/// table to the car's right, so the arm on its way covers the orange and YOLO loses it. The
+/// reach says the orange is hidden by the robot (the case happens), is never lost, and its
+/// tool ends within 2 cm of the point 10 cm short of the orange's true centre.
+#[test]
+fn the_arm_car_reaches_the_orange_its_own_arm_hides() -> Result<()> {
+    let mut events = Events::default();
+    let mut session = orange_reach(&mut events)?;
+    let mut run = Run::default();
+    let end = session.sim().sim_time_s() + 8.0;
+    while session.sim().sim_time_s() < end {
+        session.step(&mut events)?;
+        let status = session.stats().arm;
+        if let Some(tool) = status.tool_world_m {
+            run.tool
+                .push((session.sim().sim_time_s(), tool, status.reach));
+        }
+    }
+    let goal = pregrasp_truth_of(&session, "base_link", ORANGE, 0.1)?;
+    let status = session.stats().arm;
+    let end = status.tool_world_m.unwrap_or([f64::NAN; 3]);
+    for (t, text) in &events.0 {
+        println!("  {t:6.2} {text}");
+    }
+    println!(
+        "{status:?}; the tool {:.4} m from the pre-grasp point; the centre estimated {:.4} m off",
+        distance(end, goal),
+        centre_error(&session, ORANGE)
+    );
+    let said = |what: &str| events.0.iter().any(|(_, t)| t.contains(what));
+    assert!(
+        said("reach: the object is hidden by the robot's own links"),
+        "the arm never hid the orange: the test does not test the self filter"
+    );
+    assert!(!said("-> lost"), "the reach lost the orange");
+    assert!(
+        run.tool.iter().all(|(_, _, s)| *s != ReachState::Lost),
+        "lost on the way"
+    );
+    assert_eq!(status.reach, ReachState::Arrived);
+    assert!(distance(end, goal) <= 0.02, "tool {end:?}, goal {goal:?}");
+    Ok(())
+}
+
+/// The self filter does not hide a real loss: the orange taken away as soon as the reach has
+/// seen it (the arm not yet in front of it) ends `lost`, the arm held where it stopped, and
+/// "hidden by the robot" is never said.
+#[test]
+fn an_orange_taken_away_in_plain_view_is_lost() -> Result<()> {
+    let mut events = Events::default();
+    let mut session = orange_reach(&mut events)?;
+    let limit = session.sim().sim_time_s() + 2.0;
+    while session.stats().arm.reach != ReachState::Moving && session.sim().sim_time_s() < limit {
+        session.step(&mut events)?;
+    }
+    assert_eq!(session.stats().arm.reach, ReachState::Moving);
+    session.place_object(ORANGE, [0.0, -6.0, 0.037], 0.0)?;
+    let end = session.sim().sim_time_s() + 3.0;
+    while session.sim().sim_time_s() < end {
+        session.step(&mut events)?;
+    }
+    for (t, text) in &events.0 {
+        println!("  {t:6.2} {text}");
+    }
+    let status = session.stats().arm;
+    assert_eq!(status.reach, ReachState::Lost, "{status:?}");
+    assert!(!status.hidden);
+    assert!(events.0.iter().any(|(_, t)| t == "reach: moving -> lost"));
+    assert!(
+        !events.0.iter().any(|(_, t)| t.contains("hidden")),
+        "{:?}",
+        events.0
+    );
+    Ok(())
+}
+
+/// A detector message at `t` with at most one "orange" box.
+fn message(t: f64, frame: u64, b: Option<[i64; 4]>) -> rover_perception::BoundingBoxes {
+    rover_perception::BoundingBoxes {
+        image_stamp: rover_perception::FrameStamp {
+            sim_time_s: t,
+            frame,
+        },
+        frame_id: "workspace_camera_optical_frame".into(),
+        bounding_boxes: b
+            .map(|[xmin, ymin, xmax, ymax]| rover_perception::BoundingBox {
+                class: "orange".into(),
+                probability: 0.9,
+                xmin,
+                ymin,
+                xmax,
+                ymax,
+                id: 49,
+            })
+            .into_iter()
+            .collect(),
+        latency_ms: 0.0,
+    }
+}
+
+/// Self-occlusion forced, message by message, on the arm car's real chain and camera: an
+/// orange seen once, then no box while the robot's pixels cover half its disc and the rest
+/// shows its surface, is hidden (the reach goes on: no hold, still moving); the same without
+/// the robot's pixels (a view with nothing where it was) is lost after `lost_after` messages
+/// and the arm holds.
+#[test]
+fn reach_keeps_an_object_the_robot_covers_and_loses_one_that_is_gone() -> Result<()> {
+    let config = rover_core::RunConfig {
+        world: Some(rover_tests::repo("worlds/arm_car_reach.toml")),
+        ..rover_core::RunConfig::default()
+    };
+    let (_, robot) = config.load_world_and_robot()?;
+    let camera = (robot.cameras.iter())
+        .find(|c| c.name == "workspace_camera")
+        .ok_or_else(|| anyhow::anyhow!("no workspace_camera"))?;
+    let reach_config = rover_core::ReachConfig {
+        class: "orange".into(),
+        ..rover_core::ReachConfig::default()
+    };
+    let mut reach = rover_core::Reach::new(&robot, camera, "base_link", "tool_link", reach_config)?;
+    let info = rover_sim::model::CameraInfo::from_config(camera);
+    let (w, h) = (info.width as usize, info.height as usize);
+    let [fx, cx, cy] = [info.k[0], info.k[2], info.k[5]];
+    // The camera looks along the base's x from 0.4 m up; the orange (r = 0.037) 0.3 m ahead.
+    let base_from_optical = nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(0.0, 0.0, 0.4),
+        nalgebra::UnitQuaternion::from_matrix(&nalgebra::Matrix3::new(
+            0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0,
+        )),
+    );
+    let (r, z) = (0.037f64, 0.3f64);
+    let r_px = fx * r / (z + r);
+    let disc = |x: usize, y: usize| (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) <= r_px;
+    let mut depth = vec![2.0f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            if disc(x, y) {
+                depth[y * w + x] = z as f32;
+            }
+        }
+    }
+    let b = [cx - r_px, cy - r_px, cx + r_px, cy + r_px].map(|v| v.round() as i64);
+    let view = |depth_m, robot_px| rover_core::DepthView {
+        depth_m,
+        width: w as u32,
+        height: h as u32,
+        base_from_optical,
+        robot_px,
+    };
+    let q = vec![0.0; reach.joints().len()];
+    let step = reach.observe(&message(0.0, 0, Some(b)), &view(&depth, &[]), &q)?;
+    assert!(matches!(step, ReachStep::Move(_)), "{step:?}");
+    assert_eq!(reach.state(), ReachState::Moving);
+    // The robot in front of the left half of the disc, nearer than the orange.
+    let mut covered = depth.clone();
+    let mut robot_px = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            if disc(x, y) && (x as f64) < cx {
+                covered[y * w + x] = 0.15;
+                robot_px[y * w + x] = true;
+            }
+        }
+    }
+    for k in 1..=5 {
+        let step = reach.observe(
+            &message(0.2 * k as f64, k, None),
+            &view(&covered, &robot_px),
+            &q,
+        )?;
+        assert_eq!(step, ReachStep::Keep, "message {k}");
+        assert!(reach.hidden(), "message {k}");
+        assert_eq!(reach.state(), ReachState::Moving, "message {k}");
+    }
+    // Gone: the background where it was, the robot covering the same pixels.
+    let mut gone = vec![2.0f32; w * h];
+    for (d, &is_robot) in gone.iter_mut().zip(&robot_px) {
+        if is_robot {
+            *d = 0.15;
+        }
+    }
+    let first = reach.observe(&message(1.2, 6, None), &view(&gone, &robot_px), &q)?;
+    let second = reach.observe(&message(1.4, 7, None), &view(&gone, &robot_px), &q)?;
+    assert_eq!(first, ReachStep::Keep);
+    assert_eq!(second, ReachStep::Hold);
+    assert!(!reach.hidden());
+    assert_eq!(reach.state(), ReachState::Lost);
     Ok(())
 }

@@ -119,9 +119,15 @@ impl ArmKeys {
 }
 
 /// The HUD's arm line while look or reach runs: the task, the reach's state and how far the
-/// tool is from its goal, and the key that stops it; `None` when neither runs.
+/// tool is from its goal, whether the robot hides the object, and the key that stops it;
+/// `None` when neither runs.
 pub fn task_line(status: &rover_core::ArmStatus) -> Option<String> {
     use rover_core::ArmMode;
+    let hidden = if status.hidden {
+        " (hidden by the robot)"
+    } else {
+        ""
+    };
     match status.mode {
         ArmMode::Off => None,
         ArmMode::Look => Some("arm LOOK at the class   v stops   g reach".to_owned()),
@@ -131,10 +137,13 @@ pub fn task_line(status: &rover_core::ArmStatus) -> Option<String> {
                 .map(|d| format!(", tool {d:.2} m from the goal"))
                 .unwrap_or_default();
             Some(format!(
-                "arm REACH {}{to_goal}   g stops",
+                "arm REACH {}{hidden}{to_goal}   g stops",
                 status.reach.as_str()
             ))
         }
-        ArmMode::Pick => Some(format!("arm PICK {}   r stops", status.pick.as_str())),
+        ArmMode::Pick => Some(format!(
+            "arm PICK {}{hidden}   r stops",
+            status.pick.as_str()
+        )),
     }
 }

@@ -9,16 +9,17 @@ use rover_perception::BoundingBoxes;
 use rover_sim::{
     geometry::Pose,
     model::{
-        CameraConfig, ChainJoint, IkSolver, IkTarget, KinematicChain, KinematicsError, LinkId,
-        isometry_from_pose, link_from_optical,
+        CameraConfig, ChainJoint, EntityIds, IkSolver, IkTarget, KinematicChain, KinematicsError,
+        LinkId, isometry_from_pose, link_from_optical,
     },
     physics::{JointCommand, Simulation},
     sensors::CameraFrame,
 };
 
+use super::depth::DepthView;
 use super::look::{Look, LookConfig};
 use super::pick::{Pick, PickConfig, PickState};
-use super::reach::{DepthView, Reach, ReachConfig, ReachState, ReachStep};
+use super::reach::{Reach, ReachConfig, ReachState, ReachStep};
 
 /// A tool point whose arm comes this close (m) to anything is refused (touching counts).
 const TOOL_CONTACT_M: f32 = 0.001;
@@ -91,6 +92,9 @@ pub struct ArmStatus {
     pub goal_world_m: Option<[f64; 3]>,
     /// The tool, world frame (m).
     pub tool_world_m: Option<[f64; 3]>,
+    /// The object is hidden by the robot's own links (reach and pick go on with their last
+    /// estimate).
+    pub hidden: bool,
 }
 
 impl Default for ArmConfig {
@@ -115,6 +119,14 @@ impl Default for ArmConfig {
 }
 
 impl ArmConfig {
+    /// The config looking at, reaching for and picking `class` (`--arm-class`).
+    pub fn with_class(mut self, class: &str) -> Self {
+        class.clone_into(&mut self.look.class);
+        class.clone_into(&mut self.reach.class);
+        class.clone_into(&mut self.pick.class);
+        self
+    }
+
     /// The config with the SRDF's planning group (here or in the world's `[robot]`) read into
     /// the base and end effector not given; an error for an SRDF that cannot be read or has no
     /// such group (file and line, the groups it has).
@@ -160,6 +172,8 @@ impl ArmStatus {
 struct FrameRecord {
     seq: u64,
     depth_m: Vec<f32>,
+    /// Per pixel, whether it shows the robot (empty: the frame had no id image).
+    robot_px: Vec<bool>,
     width: u32,
     height: u32,
     /// The optical frame in the arm's base frame.
@@ -404,6 +418,7 @@ impl ArmTask {
                 FrameRecord {
                     seq: u64::MAX,
                     depth_m: Vec::new(),
+                    robot_px: Vec::new(),
                     width: 0,
                     height: 0,
                     base_from_optical: nalgebra::Isometry3::identity(),
@@ -417,8 +432,13 @@ impl ArmTask {
         Ok(format!("arm: {}", next.as_str()))
     }
 
-    /// Keeps what a camera image's detections will need: its depth, where the camera was and
-    /// the joints' positions (only while a task runs).
+    /// Whether a task runs that needs the camera's id image (the robot's own pixels).
+    pub(crate) fn wants_robot_pixels(&self) -> bool {
+        matches!(self.mode, ArmMode::Reach | ArmMode::Pick)
+    }
+
+    /// Keeps what a camera image's detections will need: its depth, which pixels are the
+    /// robot's, where the camera was and the joints' positions (only while a task runs).
     pub(crate) fn capture(&mut self, frame: &CameraFrame<'_>, sim: &Simulation) {
         if self.mode == ArmMode::Off {
             return;
@@ -432,6 +452,10 @@ impl ArmTask {
         slot.depth_m.clear();
         slot.depth_m
             .extend_from_slice(frame.depth_m.unwrap_or_default());
+        slot.robot_px.clear();
+        if let Some(image) = frame.entities {
+            (slot.robot_px).extend(image.ids.iter().map(|&id| id == EntityIds::ROBOT));
+        }
         let base_from_camera =
             sim.world_from_link(self.base_link).inverse() * sim.world_from_link(self.camera_link);
         slot.base_from_optical =
@@ -474,6 +498,7 @@ impl ArmTask {
                 width: record.width,
                 height: record.height,
                 base_from_optical: record.base_from_optical,
+                robot_px: &record.robot_px,
             };
             pick.observe(
                 boxes,
@@ -492,6 +517,7 @@ impl ArmTask {
                 width: record.width,
                 height: record.height,
                 base_from_optical: record.base_from_optical,
+                robot_px: &record.robot_px,
             };
             match reach.observe(boxes, &view, &self.chain_q)? {
                 ReachStep::Keep => {}
@@ -528,6 +554,7 @@ impl ArmTask {
             object_world_m: reach.object_m().map(world),
             goal_world_m: reach.goal_m().map(world),
             tool_world_m: Some(world(tool)),
+            hidden: reach.hidden(),
             ..ArmStatus::default()
         };
         Ok(())
@@ -558,6 +585,7 @@ impl ArmTask {
             pick: pick.state(),
             object_world_m: pick.object().map(|(p, _)| world(p)),
             tool_world_m: tool,
+            hidden: pick.hidden(),
             ..ArmStatus::default()
         };
         Ok(())

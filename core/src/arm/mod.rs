@@ -3,14 +3,14 @@
 //! driving with `fetch`) — and the session's arm task that runs them.
 
 mod arm_task;
+mod depth;
 mod look;
 mod pick;
 mod reach;
 
 pub(crate) use arm_task::ArmTask;
 pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
+pub use depth::{DepthView, hidden_by_robot, object_estimate, object_point, robot_share};
 pub use look::{Look, LookConfig};
 pub use pick::{Pick, PickConfig, PickState};
-pub use reach::{
-    DepthView, Reach, ReachConfig, ReachState, ReachStep, object_estimate, object_point, pregrasp,
-};
+pub use reach::{Reach, ReachConfig, ReachState, ReachStep, pregrasp};

@@ -20,13 +20,20 @@
 //! 4. [`ReachConfig::lost_after`] messages in a row without the object: an arm on its way is
 //!    told to stay where it is (hold still); one that has arrived holds its targets. Seen
 //!    again where it was, the arm goes on; elsewhere, a new goal (3).
+//!
+//! The robot's own links are filtered out ([`crate::arm::depth`], MoveIt's self filter): their
+//! pixels never enter an estimate; a box the robot partly covers keeps the last estimate (its
+//! visible part would shift the centre); an object no longer detected where the robot now
+//! covers it is *hidden by the robot*, not lost: the arm goes on to the goal it has.
 
-use nalgebra::{Isometry3, Point3, Vector3};
-use rover_perception::{BoundingBox, BoundingBoxes};
+use nalgebra::Vector3;
+use rover_perception::BoundingBoxes;
 use rover_sim::model::{
     CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, IkTarget, KinematicChain,
     KinematicsError, RobotModel,
 };
+
+use super::depth::{DepthView, PARTLY_HIDDEN_SHARE, hidden_by_robot, object_estimate, robot_share};
 
 /// Reach settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,21 +113,6 @@ impl ReachState {
     }
 }
 
-/// One camera image as reach needs it: its depth (the optical frame's z per pixel, row-major,
-/// NaN where nothing was hit) and where the camera's optical frame was in the arm's base frame
-/// when it was taken.
-#[derive(Debug, Clone, Copy)]
-pub struct DepthView<'a> {
-    /// Depth per pixel (m).
-    pub depth_m: &'a [f32],
-    /// Image width (px).
-    pub width: u32,
-    /// Image height (px).
-    pub height: u32,
-    /// The optical frame (z forward, x right, y down) in the arm's base frame.
-    pub base_from_optical: Isometry3<f64>,
-}
-
 /// What the arm should do after a detector message.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ReachStep {
@@ -150,6 +142,10 @@ pub struct Reach {
     intrinsics: [f64; 4],
     /// The object reached for (base frame, m) and when its image was taken (s).
     object: Option<(Vector3<f64>, f64)>,
+    /// The object's radius as last estimated (m).
+    radius_m: f64,
+    /// The object is not detected and the robot's own links cover where it was.
+    hidden: bool,
     goal: Option<Goal>,
     missed: u32,
     state: ReachState,
@@ -174,6 +170,8 @@ impl Reach {
             solver: IkSolver::new(chain, arm_ik_options())?,
             intrinsics: [info.k[0], info.k[4], info.k[2], info.k[5]],
             object: None,
+            radius_m: 0.0,
+            hidden: false,
             goal: None,
             missed: 0,
             state: ReachState::Seeking,
@@ -201,6 +199,12 @@ impl Reach {
         self.state
     }
 
+    /// Whether the object is hidden by the robot's own links (not detected, the robot covering
+    /// where it was): the arm goes on with its last estimate.
+    pub fn hidden(&self) -> bool {
+        self.hidden
+    }
+
     /// The object point reached for (base frame, m), once seen.
     pub fn object_m(&self) -> Option<Vector3<f64>> {
         self.object.map(|(p, _)| p)
@@ -214,6 +218,7 @@ impl Reach {
     /// Starts afresh (nothing seen, nothing planned).
     pub fn reset(&mut self) {
         self.object = None;
+        self.hidden = false;
         self.goal = None;
         self.missed = 0;
         self.state = ReachState::Seeking;
@@ -247,7 +252,16 @@ impl Reach {
         q: &[f64],
     ) -> Result<ReachStep, KinematicsError> {
         let t = boxes.image_stamp.sim_time_s;
-        let Some(point) = self.pick(boxes, view, t) else {
+        let Some((point, radius_m)) = self.pick(boxes, view, t) else {
+            if let Some((last, _)) = self.object
+                && hidden_by_robot(view, self.intrinsics, last, self.radius_m)
+            {
+                // Behind the arm, not gone: go on to the goal there is.
+                self.hidden = true;
+                self.missed = 0;
+                return Ok(ReachStep::Keep);
+            }
+            self.hidden = false;
             self.missed = self.missed.saturating_add(1);
             if self.missed == self.config.lost_after && self.state != ReachState::Seeking {
                 // An arm on its way stops where it is; one that arrived (or was refused a
@@ -261,7 +275,9 @@ impl Reach {
             return Ok(ReachStep::Keep);
         };
         self.missed = 0;
+        self.hidden = false;
         self.object = Some((point, t));
+        self.radius_m = radius_m;
         let moved = self
             .goal
             .as_ref()
@@ -303,8 +319,15 @@ impl Reach {
         }
     }
 
-    /// The object point of the box to reach for in this message, if any.
-    fn pick(&self, boxes: &BoundingBoxes, view: &DepthView<'_>, t: f64) -> Option<Vector3<f64>> {
+    /// The object point and radius of the box to reach for in this message, if any. A box the
+    /// robot partly covers gives the last estimate (when it is that object) rather than its
+    /// own.
+    fn pick(
+        &self,
+        boxes: &BoundingBoxes,
+        view: &DepthView<'_>,
+        t: f64,
+    ) -> Option<(Vector3<f64>, f64)> {
         let c = &self.config;
         let keep = self
             .object
@@ -315,17 +338,23 @@ impl Reach {
             .iter()
             .filter(|b| b.class == c.class && b.probability >= c.min_probability)
             .filter_map(|b| {
-                let p = object_point(b, view, self.intrinsics, c.max_range_m)?;
+                let (p, r) = object_estimate(b, view, self.intrinsics, c.max_range_m)?;
                 match keep {
                     Some(last) => {
                         let gap = (p - last).norm();
-                        (gap <= c.gate_m).then_some((p, -gap))
+                        let partly = robot_share(b, view) >= PARTLY_HIDDEN_SHARE;
+                        let seen = if partly {
+                            (last, self.radius_m)
+                        } else {
+                            (p, r)
+                        };
+                        (gap <= c.gate_m).then_some((seen, -gap))
                     }
-                    None => Some((p, b.probability)),
+                    None => Some(((p, r), b.probability)),
                 }
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(p, _)| p)
+            .map(|(seen, _)| seen)
     }
 }
 
@@ -348,156 +377,9 @@ pub fn pregrasp(object_m: Vector3<f64>, standoff_m: f64) -> Vector3<f64> {
     object_m - standoff_m * approach
 }
 
-/// A box's object point in the arm's base frame: the object's centre, on the ray through the
-/// box's centre pixel. The median depth of the box's central part (half its width and height
-/// around the centre) is the surface the camera sees there; the centre lies one radius further
-/// along the ray. The radius is the one whose silhouette fills the box: a sphere of radius `r`
-/// whose centre is `d` away subtends `asin(r / d)`, and the box's larger side gives that angle
-/// (the smaller may be cut by the image's edge or an occluder). `None` when the central part
-/// holds no depth within `max_range_m`.
-pub fn object_point(
-    b: &BoundingBox,
-    view: &DepthView<'_>,
-    intrinsics: [f64; 4],
-    max_range_m: f64,
-) -> Option<Vector3<f64>> {
-    object_estimate(b, view, intrinsics, max_range_m).map(|(centre, _)| centre)
-}
-
-/// [`object_point`] with the radius it used (m).
-pub fn object_estimate(
-    b: &BoundingBox,
-    view: &DepthView<'_>,
-    [fx, fy, cx, cy]: [f64; 4],
-    max_range_m: f64,
-) -> Option<(Vector3<f64>, f64)> {
-    let (w, h) = (i64::from(view.width), i64::from(view.height));
-    let (xmin, xmax, ymin, ymax) = (b.xmin, b.xmax, b.ymin, b.ymax);
-    let (qx, qy) = ((xmax - xmin) / 4, (ymax - ymin) / 4);
-    let (x0, x1) = ((xmin + qx).clamp(0, w - 1), (xmax - qx).clamp(0, w - 1));
-    let (y0, y1) = ((ymin + qy).clamp(0, h - 1), (ymax - qy).clamp(0, h - 1));
-    // A box of a few pixels: at most 400 samples, so the median costs nothing.
-    let step = (((x1 - x0 + 1) * (y1 - y0 + 1)) as f64 / 400.0)
-        .sqrt()
-        .ceil() as usize;
-    let mut samples = [0.0f32; 512];
-    let mut n = 0;
-    for y in (y0..=y1).step_by(step.max(1)) {
-        for x in (x0..=x1).step_by(step.max(1)) {
-            let d = view
-                .depth_m
-                .get((y * w + x) as usize)
-                .copied()
-                .unwrap_or(f32::NAN);
-            if d.is_finite() && d > 0.0 && f64::from(d) <= max_range_m && n < samples.len() {
-                samples[n] = d;
-                n += 1;
-            }
-        }
-    }
-    if n == 0 {
-        return None;
-    }
-    let samples = &mut samples[..n];
-    samples.sort_unstable_by(f32::total_cmp);
-    let z = f64::from(samples[n / 2]);
-    let u = (b.xmin + b.xmax) as f64 / 2.0;
-    let v = (b.ymin + b.ymax) as f64 / 2.0;
-    let surface = Vector3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
-    let radius = radius_seen(
-        (xmax - xmin) as f64 / fx,
-        (ymax - ymin) as f64 / fy,
-        surface.norm(),
-    );
-    let centre = surface + surface.normalize() * radius;
-    Some((
-        (view.base_from_optical * Point3::from(centre)).coords,
-        radius,
-    ))
-}
-
-/// The radius (m) of a sphere whose silhouette spans `width` by `height` (the box's sides over
-/// the focal length: tangents of the full angle, near the image centre) and whose nearest
-/// point is `surface_m` away: with half-angle `a`, `sin a = r / (surface_m + r)`, so
-/// `r = surface_m sin a / (1 - sin a)`.
-fn radius_seen(width: f64, height: f64, surface_m: f64) -> f64 {
-    let half_angle = (width.max(height) / 2.0).atan();
-    let s = half_angle.sin().min(0.9);
-    surface_m * s / (1.0 - s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn ball_box(xmin: i64, ymin: i64, xmax: i64, ymax: i64) -> BoundingBox {
-        BoundingBox {
-            class: "sports ball".into(),
-            probability: 0.8,
-            xmin,
-            ymin,
-            xmax,
-            ymax,
-            id: 32,
-        }
-    }
-
-    #[test]
-    fn the_object_point_is_the_box_centre_at_its_median_depth() {
-        // 40x30 image, fx = fy = 20, centre (20, 15); background at 3 m, a 10x10 px patch
-        // at 1 m centred on (30, 15); the camera 0.5 m above the base, looking along +x.
-        let (w, h) = (40u32, 30u32);
-        let mut depth = vec![3.0f32; (w * h) as usize];
-        for y in 10..20 {
-            for x in 25..35 {
-                depth[y * w as usize + x] = 1.0;
-            }
-        }
-        // Optical z forward -> base x, optical x right -> base -y, optical y down -> base -z.
-        let rotation = nalgebra::UnitQuaternion::from_matrix(&nalgebra::Matrix3::new(
-            0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0,
-        ));
-        let view = DepthView {
-            depth_m: &depth,
-            width: w,
-            height: h,
-            base_from_optical: Isometry3::from_parts(
-                nalgebra::Translation3::new(0.0, 0.0, 0.5),
-                rotation,
-            ),
-        };
-        // The box is a little larger than the patch: its edges see the background.
-        let p = object_point(
-            &ball_box(23, 8, 37, 22),
-            &view,
-            [20.0, 20.0, 20.0, 15.0],
-            4.0,
-        );
-        let p = p.unwrap_or_else(Vector3::zeros);
-        // The surface at 1 m along the ray through (30, 15), then one radius on: the 14 px box
-        // spans 0.7 rad-tangents, a sphere of r = d sin(a) / (1 - sin(a)) with a = atan(0.35).
-        let surface: Vector3<f64> = Vector3::new(1.0, -0.5, 0.5);
-        let sin_a = 0.35f64.atan().sin();
-        let r = surface.xy().norm() * sin_a / (1.0 - sin_a);
-        let along: Vector3<f64> = Vector3::new(1.0, -0.5, 0.0).normalize();
-        let want = surface + along * r;
-        assert!((p - want).norm() < 1e-9, "{p:?}, want {want:?}");
-        // Nothing within range: no point.
-        assert!(object_point(&ball_box(23, 8, 37, 22), &view, [20.0; 4], 0.5).is_none());
-        // A box off the image is clamped to it, not read out of bounds.
-        let _ = object_point(&ball_box(-50, -50, 500, 500), &view, [20.0; 4], 4.0);
-    }
-
-    /// A sphere seen straight on: the estimate puts the centre where it is.
-    #[test]
-    fn a_spheres_centre_is_one_radius_beyond_its_surface() {
-        // A 6 cm ball 0.5 m ahead (its surface at 0.44 m), fx = 300: its silhouette's half
-        // angle is asin(0.06 / 0.5), tangent 0.1209, so the box is 72.5 px wide.
-        let r = 0.06f64;
-        let tan = (r / 0.5).asin().tan();
-        let radius = radius_seen(2.0 * tan, 2.0 * tan, 0.44);
-        assert!((radius - r).abs() < 1e-9, "{radius}");
-    }
 
     #[test]
     fn the_pregrasp_point_is_short_of_the_object_along_the_line_from_the_base() {

@@ -76,6 +76,11 @@ pub struct EntityIds {
 }
 
 impl EntityIds {
+    /// The id the renderer writes for the robot's own links: never a labelled thing (no box,
+    /// no silhouette), it tells a self filter which pixels are the robot (MoveIt's
+    /// robot_self_filter and mesh filter).
+    pub const ROBOT: u32 = u32::MAX;
+
     /// Numbers `world`'s labelled things.
     pub fn new(world: &crate::model::world::World) -> Self {
         let mut ids = Self::default();

@@ -37,15 +37,17 @@ pub struct CameraRenderer {
     depth: Option<(Readback, Vec<f32>)>,
 }
 
-/// The id image and silhouettes read back each frame once ground truth is asked for.
+/// The id image read back each frame once asked for, and the silhouettes once ground truth
+/// is asked for.
 struct IdOutputs {
     readback: Readback,
-    silhouette: SilhouettePass,
+    silhouette: Option<SilhouettePass>,
     image: EntityImage,
 }
 
 /// Each pixel's labelled thing and each thing's unoccluded size, for one frame: what ground
-/// truth is measured from. Ids are [`EntityIds`] numbers (0: nothing labelled).
+/// truth is measured from. Ids are [`EntityIds`] numbers (0: nothing labelled;
+/// [`EntityIds::ROBOT`]: the robot's own links, as MoveIt's mesh filter renders them).
 #[derive(Debug, Clone, Default)]
 pub struct EntityImage {
     /// Image width (px).
@@ -109,14 +111,30 @@ impl CameraRenderer {
     /// From the next render on, also reads back the instance-id image and every labelled
     /// thing's silhouette ([`Self::entity_image`]). Allocates their buffers once.
     pub fn enable_entity_image(&mut self) -> Result<(), RenderError> {
-        if self.ids.is_some() {
+        self.enable_id_image();
+        let Some(ids) = self.ids.as_mut() else {
             return Ok(());
+        };
+        if ids.silhouette.is_none() {
+            let (w, h) = (self.info.width, self.info.height);
+            ids.silhouette = Some(SilhouettePass::new(&self.gpu.device, w, h, self.entities)?);
+            ids.image.silhouette_px = vec![0; self.entities as usize];
+        }
+        Ok(())
+    }
+
+    /// From the next render on, also reads back the instance-id image alone
+    /// ([`Self::entity_image`], its `silhouette_px` all zero): which pixels show which labelled
+    /// thing and which the robot itself. Allocates its buffers once.
+    pub fn enable_id_image(&mut self) {
+        if self.ids.is_some() {
+            return;
         }
         let (w, h) = (self.info.width, self.info.height);
         let pixels = (w * h) as usize;
         self.ids = Some(IdOutputs {
             readback: Readback::new(&self.gpu.device, "entity id readback", w, h),
-            silhouette: SilhouettePass::new(&self.gpu.device, w, h, self.entities)?,
+            silhouette: None,
             image: EntityImage {
                 width: w,
                 height: h,
@@ -130,7 +148,6 @@ impl CameraRenderer {
                 silhouette_px: vec![0; self.entities as usize],
             },
         });
-        Ok(())
     }
 
     /// From the next render on, also reads back the depth buffer as a depth image
@@ -291,15 +308,17 @@ impl CameraRenderer {
         };
         // Both passes first, then every copy: a transfer between passes would stall a
         // software rasterizer.
-        let silhouette = self.ids.as_ref().filter(|_| self.entities > 0);
-        if let Some(ids) = silhouette {
-            ids.silhouette.prepare(&self.gpu.queue, &view);
+        let silhouette = (self.ids.as_ref())
+            .and_then(|ids| ids.silhouette.as_ref())
+            .filter(|_| self.entities > 0);
+        if let Some(silhouette) = silhouette {
+            silhouette.prepare(&self.gpu.queue, &view);
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         self.colour
             .encode(&self.gpu.queue, &mut encoder, &self.scene, &view);
-        if let Some(ids) = silhouette {
-            ids.silhouette.encode(&mut encoder, &self.scene);
+        if let Some(silhouette) = silhouette {
+            silhouette.encode(&mut encoder, &self.scene);
         }
         self.readback.copy_from(&mut encoder, &self.colour.target);
         if let Some(ids) = &self.ids {
@@ -308,8 +327,8 @@ impl CameraRenderer {
         if let Some((readback, _)) = &self.depth {
             readback.copy_from(&mut encoder, &self.colour.depth);
         }
-        if let Some(ids) = silhouette {
-            ids.silhouette.copy_out(&mut encoder);
+        if let Some(silhouette) = silhouette {
+            silhouette.copy_out(&mut encoder);
         }
         self.gpu.queue.submit([encoder.finish()]);
         let w = self.info.width as usize;
@@ -337,9 +356,8 @@ impl CameraRenderer {
             if image.distorted {
                 self.post.remap_ids(&image.ideal_ids, &mut image.ids);
             }
-            if self.entities > 0 {
-                ids.silhouette
-                    .read_counts(&self.gpu.device, &mut image.silhouette_px)?;
+            if let Some(silhouette) = ids.silhouette.as_ref().filter(|_| self.entities > 0) {
+                silhouette.read_counts(&self.gpu.device, &mut image.silhouette_px)?;
             }
         }
         Ok(&self.post.rgb)

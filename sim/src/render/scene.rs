@@ -165,7 +165,7 @@ impl Builder<'_> {
             }),
         });
         self.instances.push(Instance::new(pose, color, entity));
-        if entity != 0 {
+        if entity != 0 && entity != EntityIds::ROBOT {
             self.labelled.push(self.meshes.len() as u32 - 1);
         }
         self.instances.len() - 1
@@ -266,7 +266,7 @@ impl Scene {
                 let mesh = visual_mesh(visual)?;
                 let color = visual.display_color(&mesh);
                 attached.push(Attached {
-                    instance: b.add(&mesh, visual.link_from_shape, color, 0),
+                    instance: b.add(&mesh, visual.link_from_shape, color, EntityIds::ROBOT),
                     frame: link_index,
                     frame_from_shape: visual.link_from_shape,
                 });

@@ -28,7 +28,8 @@ pub struct CameraFrame<'a> {
     pub rgb: &'a [u8],
     /// Every labelled thing in view (empty unless [`CameraSensor::enable_ground_truth`]).
     pub ground_truth: &'a [GroundTruthBox],
-    /// The instance-id image of the same frame (`None` unless ground truth is enabled).
+    /// The instance-id image of the same frame (`None` unless ground truth or the id image is
+    /// enabled); the robot's own pixels are [`crate::model::EntityIds::ROBOT`].
     pub entities: Option<&'a EntityImage>,
     /// The depth image of the same frame (`None` unless [`CameraSensor::enable_depth`]: a
     /// `<sensor type="depth">` has it on): per pixel, rows top to bottom, the distance along
@@ -95,6 +96,14 @@ impl CameraSensor {
             self.truth = Some((GroundTruth::new(sim.world(), &self.renderer)?, Vec::new()));
         }
         Ok(())
+    }
+
+    /// From the next image on, every frame carries its instance-id image
+    /// ([`CameraFrame::entities`]), in which the robot's own links are
+    /// [`crate::model::EntityIds::ROBOT`]: what a self filter needs. Cheaper than ground truth
+    /// (no silhouettes, no boxes).
+    pub fn enable_id_image(&mut self) {
+        self.renderer.enable_id_image();
     }
 
     /// From the next image on, every frame carries its depth image

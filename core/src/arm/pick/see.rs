@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Vector3};
 use rover_perception::BoundingBoxes;
 use rover_sim::{geometry::Shape, model::isometry_from_pose, physics::Simulation};
 
-use crate::arm::reach::{DepthView, object_estimate};
+use crate::arm::depth::{DepthView, hidden_by_robot, object_estimate};
 
 use super::state::{Pick, PickState, Target};
 use super::world::world_object;
@@ -38,9 +38,16 @@ impl Pick {
             .max_by(|a, b| a.probability.total_cmp(&b.probability))
             .and_then(|b| object_estimate(b, view, self.intrinsics, c.max_range_m));
         let Some(seen) = seen else {
-            self.sightings.clear();
+            // Behind the arm, the sightings so far stand; gone, they start again.
+            self.hidden =
+                (self.last_seen).is_some_and(|(p, r)| hidden_by_robot(view, self.intrinsics, p, r));
+            if !self.hidden {
+                self.sightings.clear();
+            }
             return;
         };
+        self.hidden = false;
+        self.last_seen = Some(seen);
         if self.fetch_towards(sim, seen.0, world_from_base) {
             return;
         }

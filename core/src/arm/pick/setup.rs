@@ -48,6 +48,8 @@ impl Pick {
             gripper: find_gripper(sim, tool),
             intrinsics,
             sightings: Vec::new(),
+            last_seen: None,
+            hidden: false,
             state: PickState::Seeking,
             steps: VecDeque::new(),
             running: None,
@@ -85,6 +87,12 @@ impl Pick {
         self.planning_s
     }
 
+    /// Whether the object it looks for is hidden by the robot's own links (not detected, the
+    /// robot covering where it was last seen): the sightings so far stand.
+    pub fn hidden(&self) -> bool {
+        self.hidden && matches!(self.state, PickState::Seeking | PickState::Fetching)
+    }
+
     /// Waypoints of the last plan's joint-space paths (to the pre-grasp, the carry, home; 0
     /// for a leg without one): 2 is a straight joint move, more goes round something.
     pub fn path_points(&self) -> Option<[usize; 3]> {
@@ -94,6 +102,8 @@ impl Pick {
     /// Starts afresh.
     pub fn reset(&mut self) {
         self.sightings.clear();
+        self.last_seen = None;
+        self.hidden = false;
         self.state = PickState::Seeking;
         self.steps.clear();
         self.running = None;

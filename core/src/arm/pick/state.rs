@@ -170,6 +170,10 @@ pub struct Pick {
     pub(super) gripper: Result<Gripper, String>,
     pub(super) intrinsics: [f64; 4],
     pub(super) sightings: Vec<(Vector3<f64>, f64)>,
+    /// The last sighting taken (centre, base frame, and radius, m).
+    pub(super) last_seen: Option<(Vector3<f64>, f64)>,
+    /// The object is not detected and the robot's own links cover where it was last seen.
+    pub(super) hidden: bool,
     pub(super) state: PickState,
     pub(super) steps: VecDeque<(Step, PickState)>,
     /// The step running and when it started (s of sim time).
