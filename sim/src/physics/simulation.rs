@@ -621,6 +621,12 @@ impl Simulation {
         &self.world
     }
 
+    /// Whether the robot's base can be driven (it has driven wheels: a diff drive or a skid
+    /// steer).
+    pub fn can_drive(&self) -> bool {
+        !self.wheels.is_empty()
+    }
+
     /// The diff drive controller (configuration, command in force).
     pub fn drive(&self) -> &DiffDriveController {
         &self.drive

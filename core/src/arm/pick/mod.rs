@@ -27,6 +27,7 @@
 mod config;
 mod fetch;
 mod plan;
+mod reachability;
 mod run;
 mod see;
 mod setup;

@@ -97,9 +97,10 @@ impl Pick {
             // No place: it stays in the hand, held up.
             return Ok(steps);
         };
-        if let Some(place) = place_under
-            && self.fetch_at(sim).is_some()
-        {
+        let Some(place) = place_under else {
+            return Ok(steps);
+        };
+        if self.fetch_given(sim).is_some() {
             // Fetching: it is held up while the base drives to the place ([`Self::deliver`]).
             self.held = Some(Held {
                 target,
@@ -109,8 +110,24 @@ impl Pick {
             });
             return Ok(steps);
         }
-        let held = (target, grasp.way);
-        steps.extend(self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m))?);
+        let held = (target, grasp.way.clone());
+        match self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m)) {
+            Ok(more) => steps.extend(more),
+            Err(why) if sim.can_drive() => {
+                // Held up while the base takes it to a stance the arm reaches the place from.
+                self.said.push((
+                    false,
+                    format!("pick: the place is out of the arm's reach from here ({why}): the base takes it there"),
+                ));
+                self.held = Some(Held {
+                    target,
+                    way: grasp.way,
+                    home_q: q0,
+                    place,
+                });
+            }
+            Err(why) => return Err(why),
+        }
         Ok(steps)
     }
 

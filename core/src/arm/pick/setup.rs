@@ -48,8 +48,10 @@ impl Pick {
             gripper: find_gripper(sim, tool),
             intrinsics,
             sightings: Vec::new(),
+            stance: None,
             last_seen: None,
             hidden: false,
+            unseen: 0,
             state: PickState::Seeking,
             steps: VecDeque::new(),
             running: None,
@@ -104,6 +106,7 @@ impl Pick {
         self.sightings.clear();
         self.last_seen = None;
         self.hidden = false;
+        self.unseen = 0;
         self.state = PickState::Seeking;
         self.steps.clear();
         self.running = None;
@@ -115,6 +118,7 @@ impl Pick {
         self.base_cmd = None;
         self.settle_until_s = 0.0;
         self.held = None;
+        self.stance = None;
     }
 
     /// What it has to say since the last call: (warning, text).

@@ -8,15 +8,66 @@ use rover_sim::{model::isometry_from_pose, physics::Simulation};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
 use super::plan::over_place;
-use super::state::{Held, Leg, Pick, PickState, Step};
+use super::state::{Held, Leg, Pick, PickState, Step, Target};
 
 impl Pick {
     /// Where the object should be when the base stops to pick it (arm base frame, m), when
-    /// the pick drives the base.
+    /// the pick drives the base: the `fetch` point given, else the stance chosen from the
+    /// arm's reachability for the leg under way.
     pub(super) fn fetch_at(&self, sim: &Simulation) -> Option<Vector2<f64>> {
+        self.fetch_given(sim).or(self.stance)
+    }
+
+    /// The `fetch` point given (here or in the world's `[robot] fetch`), if any.
+    pub(super) fn fetch_given(&self, sim: &Simulation) -> Option<Vector2<f64>> {
         (self.config.fetch_at)
             .or(sim.world().robot.fetch)
             .map(|[x, y]| Vector2::new(x, y))
+    }
+
+    /// With no `fetch` point and a base that drives: when the arm does not reach `target`
+    /// (called `what`) from here, the base drives to a stance chosen from the arm's
+    /// reachability. Returns whether it does (`false`: plan from here).
+    pub(super) fn stance_towards(
+        &mut self,
+        sim: &Simulation,
+        what: &str,
+        target: &Target,
+        world_from_base: &Isometry3<f64>,
+    ) -> bool {
+        if self.fetch_given(sim).is_some()
+            || !sim.can_drive()
+            || self.reaches(sim, target.centre, target.bound_m)
+        {
+            return false;
+        }
+        let world = world_from_base * Point3::from(target.centre);
+        let started = std::time::Instant::now();
+        let chosen = self.choose_stance(
+            sim,
+            (target.centre, target.bound_m),
+            world_from_base,
+            (world.coords, target.bound_m + 0.02),
+        );
+        match chosen {
+            Ok(at) => {
+                self.stance = Some(at);
+                self.said.push((
+                    false,
+                    format!(
+                        "pick: {what} is out of the arm's reach from here: the base stands with it at ({:.2}, {:.2}) m from the arm's base (surveyed in {:.3} s)",
+                        at.x,
+                        at.y,
+                        started.elapsed().as_secs_f64()
+                    ),
+                ));
+                self.fetch_towards(sim, target.centre, world_from_base)
+            }
+            Err(why) => {
+                self.fail(format!("{what} is out of the arm's reach: {why}"));
+                true
+            }
+        }
     }
 
     /// The object is at `centre` (base frame, the base at `world_from_base`): with fetch, when
@@ -96,6 +147,7 @@ impl Pick {
         }
         self.leg = None;
         self.settle_until_s = now + SETTLE_BASE_S;
+        self.unseen = 0;
         let (x, y) = (point.x, point.y);
         if leg.to_place {
             self.said.push((
@@ -122,6 +174,12 @@ impl Pick {
         };
         if self.state != PickState::Delivering {
             let [x, y, z] = held.place.0;
+            if self.fetch_given(sim).is_none()
+                && let Err(why) = self.place_stance(sim)
+            {
+                self.fail(format!("the place is out of the arm's reach: {why}"));
+                return true;
+            }
             let base = sim.world_from_link(self.base).translation;
             self.leg = Some(Leg {
                 goal: Vector3::new(x, y, z),
@@ -148,6 +206,37 @@ impl Pick {
             Err(why) => self.fail(format!("fetch: at the place: {why}")),
         }
         true
+    }
+
+    /// With no `fetch` point: the stance the arm reaches the place from with the object in the
+    /// hand (the object in the hand and round it left out of the obstacles).
+    fn place_stance(&mut self, sim: &Simulation) -> Result<(), String> {
+        let Some(held) = self.held.clone() else {
+            return Ok(());
+        };
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        let (over, _) = over_place(&world_from_base, held.place, held.target.half_height_m);
+        let tool = isometry_from_pose(&sim.world_from_link(self.tool))
+            .translation
+            .vector;
+        let started = std::time::Instant::now();
+        let at = self.choose_stance(
+            sim,
+            (over, held.target.bound_m),
+            &world_from_base,
+            (tool, held.target.bound_m + 0.05),
+        )?;
+        self.stance = Some(at);
+        self.said.push((
+            false,
+            format!(
+                "pick: the base stands with the place at ({:.2}, {:.2}) m from the arm's base (surveyed in {:.3} s)",
+                at.x,
+                at.y,
+                started.elapsed().as_secs_f64()
+            ),
+        ));
+        Ok(())
     }
 
     /// The place's plan from where the arm is now, the object held as it was taken.

@@ -170,10 +170,12 @@ pub struct Pick {
     pub(super) gripper: Result<Gripper, String>,
     pub(super) intrinsics: [f64; 4],
     pub(super) sightings: Vec<(Vector3<f64>, f64)>,
-    /// The last sighting taken (centre, base frame, and radius, m).
+    /// The last sighting taken (centre, world frame, and radius, m).
     pub(super) last_seen: Option<(Vector3<f64>, f64)>,
     /// The object is not detected and the robot's own links cover where it was last seen.
     pub(super) hidden: bool,
+    /// Detector messages in a row without the object (since the base last stopped).
+    pub(super) unseen: u32,
     pub(super) state: PickState,
     pub(super) steps: VecDeque<(Step, PickState)>,
     /// The step running and when it started (s of sim time).
@@ -199,6 +201,10 @@ pub struct Pick {
     pub(super) settle_until_s: f64,
     /// The object in the hand, to be placed once the base is at the place (`fetch`).
     pub(super) held: Option<Held>,
+    /// With no `fetch` point, where the base stands for the leg under way (arm base frame,
+    /// x and y, m): chosen from the arm's reachability when the object or the place is out of
+    /// reach.
+    pub(super) stance: Option<Vector2<f64>>,
 }
 
 /// Where the base is driving to.

@@ -166,7 +166,7 @@ impl Pick {
 }
 
 /// Whether an IK solution is close enough to use: 3 mm and about 2 degrees.
-fn ik_close(position_m: f64, orientation_rad: f64) -> bool {
+pub(super) fn ik_close(position_m: f64, orientation_rad: f64) -> bool {
     position_m <= 0.003 && orientation_rad <= 0.035
 }
 
