@@ -283,6 +283,10 @@ impl Session {
             _ => None,
         };
         if let Some(mode) = arm_mode {
+            if let Some(why) = self.arm.unknown_class(mode, &self.labels, &self.sim) {
+                emit(observer, self.sim.sim_time_s(), EventLevel::Warn, &why);
+                return;
+            }
             let (level, text) = match self.arm.set(mode, &mut self.sim) {
                 Ok(text) => (EventLevel::Info, text),
                 Err(why) => (EventLevel::Warn, why),

@@ -867,3 +867,95 @@ fn out_of_reach_the_base_moves_and_9_of_10_layouts_end_in_the_bin() -> Result<()
     }
     Ok(())
 }
+
+/// The arm car's arm and finger joints' positions now.
+fn joint_positions(session: &Session) -> Vec<f64> {
+    let sim = session.sim();
+    [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_pitch_joint",
+        "wrist_roll_joint",
+        "left_finger_joint",
+        "right_finger_joint",
+    ]
+    .iter()
+    .map(|name| {
+        (sim.robot().joint_id(name))
+            .and_then(|id| sim.joint_state(id))
+            .map_or(f64::NAN, |s| s.position)
+    })
+    .collect()
+}
+
+/// A bad-input case: the world, what is wrong, how the options are changed, the warning.
+type BadCase = (
+    &'static str,
+    &'static str,
+    Box<dyn Fn(&mut rover_core::SessionOptions)>,
+    &'static str,
+);
+
+/// Bad input for a pick, each one clear warning and an arm that holds (no joint moves more
+/// than 5 mrad over 3 s): a class the detector does not know (the nearest named), a place the
+/// world does not have (its objects listed), and a ball wider than the open gripper.
+#[test]
+fn bad_pick_input_says_one_thing_and_the_arm_holds() -> Result<()> {
+    let cases: [BadCase; 3] = [
+        (
+            "worlds/arm_car_pick.toml",
+            "an unknown class",
+            Box::new(|o| o.arm = rover_core::ArmConfig::default().with_class("tennis ball")),
+            "arm: pick stays off: \"tennis ball\" is not a class the detector knows (80 classes); the nearest: \"tennis racket\", \"sports ball\"",
+        ),
+        (
+            "worlds/arm_car_pick.toml",
+            "a missing place",
+            Box::new(|o| {
+                o.arm.pick.place = Some(rover_sim::model::Place::Object("shelf".into()));
+            }),
+            "no pick: no world object \"shelf\" to place on; the world's objects: table, bin, bin_wall_front, bin_wall_back, bin_wall_left, bin_wall_right, ball",
+        ),
+        (
+            "worlds/arm_car_reach.toml",
+            "a ball too wide",
+            Box::new(|_| {}),
+            "wider than the open gripper (0.090 m)",
+        ),
+    ];
+    for (world, what, change, expected) in cases {
+        let config = rover_core::RunConfig {
+            world: Some(rover_tests::repo(world)),
+            ..rover_core::RunConfig::default()
+        };
+        let (world, robot) = config.load_world_and_robot()?;
+        let mut options = rover_tests::lockstep_options(0);
+        change(&mut options);
+        let mut said = Said::default();
+        let mut session = Session::new(world, robot, &options, &mut said)?;
+        let end = session.sim().sim_time_s() + 1.0;
+        while session.sim().sim_time_s() < end {
+            session.step(&mut said)?;
+        }
+        let before = joint_positions(&session);
+        session.input(Action::TogglePick, &mut said);
+        let end = session.sim().sim_time_s() + 3.0;
+        while session.sim().sim_time_s() < end {
+            session.step(&mut said)?;
+        }
+        let moved = (joint_positions(&session).iter())
+            .zip(&before)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let warnings: Vec<&str> = (said.0.iter())
+            .filter(|(_, level, _)| *level == EventLevel::Warn)
+            .map(|(_, _, text)| text.as_str())
+            .collect();
+        println!("{what}: {warnings:?}; joints moved at most {moved:.5} rad");
+        assert_eq!(warnings.len(), 1, "{what}: {warnings:?}");
+        assert!(warnings[0].contains(expected), "{what}: {}", warnings[0]);
+        assert!(moved < 0.005, "{what}: a joint moved {moved} rad");
+    }
+    Ok(())
+}

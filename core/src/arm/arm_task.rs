@@ -193,6 +193,8 @@ pub(crate) struct ArmTask {
     base_link: LinkId,
     camera_link: LinkId,
     look: Result<Look, String>,
+    /// The classes look, reach and pick act on.
+    classes: (String, String, String),
     reach: Result<Reach, String>,
     pick: Result<Pick, String>,
     /// The end effector moved to points (scripts, Cartesian jogging).
@@ -281,6 +283,11 @@ impl ArmTask {
             tool,
             tool_scene: None,
             look_while_reaching,
+            classes: (
+                config.look.class.clone(),
+                config.reach.class.clone(),
+                config.pick.class.clone(),
+            ),
             frames: Vec::new(),
             q: Vec::with_capacity(robot.joints.len()),
             chain_q: Vec::with_capacity(robot.joints.len()),
@@ -396,7 +403,8 @@ impl ArmTask {
                 self.reach.as_ref().map_err(|e| format!("no reach: {e}"))?;
             }
             ArmMode::Pick => {
-                self.pick.as_ref().map_err(|e| format!("no pick: {e}"))?;
+                let pick = self.pick.as_ref().map_err(|e| format!("no pick: {e}"))?;
+                pick.check(sim).map_err(|e| format!("no pick: {e}"))?;
             }
             ArmMode::Off => {}
         }
@@ -430,6 +438,55 @@ impl ArmTask {
             ];
         }
         Ok(format!("arm: {}", next.as_str()))
+    }
+
+    /// Why `mode` cannot run with a detector that knows `labels` (empty: none runs, nothing
+    /// to check): its class is not one of them. The message names the nearest classes.
+    pub(crate) fn unknown_class(
+        &self,
+        mode: ArmMode,
+        labels: &[String],
+        sim: &Simulation,
+    ) -> Option<String> {
+        let class = match mode {
+            ArmMode::Off => return None,
+            ArmMode::Look => &self.classes.0,
+            ArmMode::Reach => &self.classes.1,
+            ArmMode::Pick => {
+                let named = self
+                    .pick
+                    .as_ref()
+                    .is_ok_and(|p| p.known_object(sim).is_some());
+                if named {
+                    return None;
+                }
+                &self.classes.2
+            }
+        };
+        if labels.is_empty() || labels.iter().any(|l| l == class) {
+            return None;
+        }
+        let mut near: Vec<(f64, &String)> = labels
+            .iter()
+            .map(|l| {
+                let shared = l.split(' ').any(|w| class.split(' ').any(|c| c == w));
+                let score = strsim::jaro_winkler(l, class) + if shared { 1.0 } else { 0.0 };
+                (score, l)
+            })
+            .collect();
+        near.sort_by(|a, b| b.0.total_cmp(&a.0));
+        // Those sharing a word with it, else the three most alike.
+        let sharing = near.iter().filter(|(score, _)| *score >= 1.0).count();
+        let shown = if sharing > 0 { sharing.min(3) } else { 3 };
+        let nearest: Vec<String> = (near.iter().take(shown))
+            .map(|(_, l)| format!("\"{l}\""))
+            .collect();
+        Some(format!(
+            "arm: {} stays off: \"{class}\" is not a class the detector knows ({} classes); the nearest: {}",
+            mode.as_str(),
+            labels.len(),
+            nearest.join(", ")
+        ))
     }
 
     /// Whether a task runs that needs the camera's id image (the robot's own pixels).

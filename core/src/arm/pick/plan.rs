@@ -16,6 +16,8 @@ use super::world::world_object;
 
 /// How far above a place point the object's bottom is let go (m): set down, not dropped.
 const SET_DOWN_M: f64 = 0.005;
+/// Each finger clears a round object by this much (m) when the hand comes down open.
+const SPAN_SPARE_M: f64 = 0.003;
 /// How far the tool backs up after letting go (m).
 const RETREAT_M: f64 = 0.05;
 /// Seconds to full speed on a timed path.
@@ -253,6 +255,7 @@ impl Pick {
         if let Some(t) = target {
             scene.ignore_object(t, true);
         }
+        spans(g, what, &object)?;
         let ways = match object.cuboid {
             Some((r, half)) => self.ways_across(
                 [(r * Vector3::x(), half[0]), (r * Vector3::y(), half[1])],
@@ -308,7 +311,10 @@ impl Pick {
     /// tray); at a point, [`PickConfig::approach_m`], then down to [`SET_DOWN_M`] above it (set
     /// down, as MoveIt's place approaches). From the configured place, else the world's
     /// `[robot] place`; none: the object is held up. An error for an object the world lacks.
-    fn place_under(&self, sim: &Simulation) -> Result<Option<([f64; 3], f64, f64)>, String> {
+    pub(super) fn place_under(
+        &self,
+        sim: &Simulation,
+    ) -> Result<Option<([f64; 3], f64, f64)>, String> {
         let world = sim.world();
         let name = match self
             .config
@@ -332,6 +338,19 @@ impl Pick {
             0.0,
         )))
     }
+}
+
+/// Whether the open gripper `g` spans `target` (called `what`): a round one with
+/// [`SPAN_SPARE_M`] to spare each side (a box is checked face by face); else why not.
+pub(super) fn spans(g: &Gripper, what: &str, target: &Target) -> Result<(), String> {
+    if target.cuboid.is_none() && target.bound_m + SPAN_SPARE_M > g.widest_m() {
+        return Err(format!(
+            "cannot grasp {what}: it is {:.3} m across, wider than the open gripper ({:.3} m)",
+            2.0 * target.bound_m,
+            2.0 * g.widest_m()
+        ));
+    }
+    Ok(())
 }
 
 /// Where the carry ends over a place ([`Pick::place_under`]: the point under the object, how

@@ -101,6 +101,11 @@ impl Pick {
         self.path_points
     }
 
+    /// Why the pick cannot start in `sim`, if it cannot: a place that is not in the world.
+    pub fn check(&self, sim: &Simulation) -> Result<(), String> {
+        self.place_under(sim).map(|_| ())
+    }
+
     /// Starts afresh.
     pub fn reset(&mut self) {
         self.sightings.clear();

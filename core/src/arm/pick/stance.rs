@@ -7,7 +7,7 @@ use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 use rover_sim::{model::isometry_from_pose, physics::Simulation};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
-use super::plan::over_place;
+use super::plan::{over_place, spans};
 use super::state::{Held, Leg, Pick, PickState, Step, Target};
 
 impl Pick {
@@ -35,6 +35,13 @@ impl Pick {
         target: &Target,
         world_from_base: &Isometry3<f64>,
     ) -> bool {
+        if let Ok(g) = &self.gripper
+            && let Err(why) = spans(g, what, target)
+        {
+            // No stance helps a hand too small.
+            self.fail(why);
+            return true;
+        }
         if self.fetch_given(sim).is_some()
             || !sim.can_drive()
             || self.reaches(sim, target.centre, target.bound_m)
