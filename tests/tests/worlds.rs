@@ -341,3 +341,41 @@ fn spherical_coordinates_come_from_sdf_and_toml_worlds() -> Result<()> {
     );
     Ok(())
 }
+
+/// COLLADA files saying `Y_UP` are drawn as Gazebo draws them, their z up: osrf's coke_can (a
+/// 12.4 cm can whose `<pose>` lowers its mesh 0.18 m onto the ground), plastic_cup, and
+/// turtlebot3_world's outer wall stand upright: each spans its height along z, where a turn by
+/// its up axis would have laid it down (the can 6.7 cm high, the wall 26 m).
+#[test]
+fn y_up_collada_meshes_stand_as_gazebo_draws_them() -> Result<()> {
+    let Some(models) = shared("corpus/gazebo_models") else {
+        return Ok(());
+    };
+    let Some(tb3) = shared("corpus/turtlebot3_gz/turtlebot3_gazebo/models/turtlebot3_world") else {
+        return Ok(());
+    };
+    // (file, height (m) the mesh spans along z, as Gazebo stands it)
+    let cases = [
+        (models.join("coke_can/meshes/coke_can.dae"), 0.1239),
+        (models.join("plastic_cup/meshes/plastic_cup.dae"), 0.1301),
+        (tb3.join("meshes/wall.dae"), 5.08),
+    ];
+    for (path, height_m) in cases {
+        let mesh = rover_sim::description::load_mesh(&path, glam::Vec3::ONE)?;
+        let (lo, hi) = mesh.positions.iter().fold(
+            (
+                glam::Vec3::splat(f32::INFINITY),
+                glam::Vec3::splat(f32::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let size = hi - lo;
+        println!("{}: {size:?}", path.display());
+        assert!(
+            (f64::from(size.z) - height_m).abs() < 0.002 * height_m.max(1.0),
+            "{}: spans {size:?}, want {height_m} m along z",
+            path.display()
+        );
+    }
+    Ok(())
+}

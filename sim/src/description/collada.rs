@@ -1,8 +1,11 @@
 //! COLLADA (`.dae`) scenes as Gazebo draws them: every `<instance_geometry>` of the visual
 //! scene placed by its node hierarchy (`<matrix>`, `<translate>`, `<rotate>`, `<scale>`,
-//! `<instance_node>` into `<library_nodes>`), in the file's `<unit>` and turned from its
-//! `<up_axis>` to z up; triangles, polylists and polygons; texture coordinates (set 0); each
-//! primitive's material with its diffuse colour or image.
+//! `<instance_node>` into `<library_nodes>`), in the file's `<unit>`; triangles, polylists and
+//! polygons; texture coordinates (set 0); each primitive's material with its diffuse colour or
+//! image. `<up_axis>` is not applied: Gazebo's COLLADA loader does not read it
+//! (gazebo-classic issue 1305, open) and models are drawn by it: osrf's coke_can and
+//! plastic_cup and turtlebot3_world's walls say `Y_UP` while their height runs along the
+//! file's z (the can's `<pose>` lowers it 0.18 m onto the ground on that reading).
 //!
 //! Written here rather than taken from mesh-loader (still used for STL and OBJ): mesh-loader
 //! 0.1.13 applies `<unit>` to the scene's root only and does not follow `<instance_node>`, so
@@ -66,29 +69,16 @@ pub(crate) fn load_collada(path: &Path, text: &str, scale: Vec3) -> Result<TriMe
     mesh.finish(path)
 }
 
-/// A COLLADA file's units and axes to rover's: its `<unit meter>` and its `<up_axis>` turned
-/// to z up (COLLADA's default is y up; rover and Gazebo draw z up).
+/// A COLLADA file's units to rover's metres (its `<unit meter>`). Its `<up_axis>` is left
+/// alone, as Gazebo (classic and gz-sim) leaves it: the file's z is up.
 pub(super) fn file_basis(root: Node<'_, '_>) -> Mat4 {
-    let asset = child(root, "asset");
-    let unit = asset
+    let unit = child(root, "asset")
         .and_then(|a| child(a, "unit"))
         .and_then(|u| u.attribute("meter"))
         .and_then(|m| m.trim().parse::<f32>().ok())
         .filter(|m| m.is_finite() && *m > 0.0)
         .unwrap_or(1.0);
-    let up = asset
-        .and_then(|a| child(a, "up_axis"))
-        .and_then(|u| u.text())
-        .map(str::trim)
-        .unwrap_or("Y_UP");
-    let to_z_up = match up {
-        "Z_UP" => Mat4::IDENTITY,
-        "X_UP" => Mat4::from_cols_array(&[
-            0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-        ]),
-        _ => Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
-    };
-    to_z_up * Mat4::from_scale(Vec3::splat(unit))
+    Mat4::from_scale(Vec3::splat(unit))
 }
 
 pub(super) type NodeError<'a> = (Node<'a, 'a>, String);
@@ -529,12 +519,12 @@ mod tests {
     }
 
     #[test]
-    fn y_up_files_are_turned_to_z_up_and_loops_are_refused() -> Result<()> {
+    fn y_up_files_keep_their_z_up_as_gazebo_draws_them_and_loops_are_refused() -> Result<()> {
         let y_up = NESTED.replace("Z_UP", "Y_UP");
         let m = load_collada(Path::new("y.dae"), &y_up, Vec3::ONE)?;
-        // The file's +y (0,1,0 at 100 cm) becomes +z.
+        // The file's +y (0,1,0 at 100 cm) stays +y.
         assert!(
-            (m.positions[2] - Vec3::new(0.1, -0.5, 1.0)).length() < 1e-5,
+            (m.positions[2] - Vec3::new(0.1, 1.0, 0.5)).length() < 1e-5,
             "{:?}",
             m.positions[2]
         );

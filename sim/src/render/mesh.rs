@@ -35,7 +35,10 @@ pub(crate) fn cuboid(size: Vec3) -> MeshData {
     m
 }
 
-/// A cylinder along z, centred.
+/// A cylinder along z, centred, with texture coordinates as Gazebo's cylinder has them: round
+/// the side u from 0 to 1 (from +x, counter-clockwise seen from above), v from 0 at the top to
+/// 1 at the bottom, so a label image wraps it once; the caps mapped flat (u along x, v against
+/// y).
 pub(crate) fn cylinder(radius: f32, length: f32, segments: u32) -> MeshData {
     let mut m = MeshData::default();
     let hz = length / 2.0;
@@ -43,26 +46,26 @@ pub(crate) fn cylinder(radius: f32, length: f32, segments: u32) -> MeshData {
         let a = i as f32 / segments as f32 * std::f32::consts::TAU;
         Vec3::new(a.cos(), a.sin(), 0.0)
     };
+    let push = |m: &mut MeshData, p: Vec3, n: Vec3, uv: [f32; 2]| {
+        m.uvs.push(uv);
+        m.push(p, n)
+    };
+    let cap_uv = |p: Vec3| [0.5 + 0.5 * p.x, 0.5 - 0.5 * p.y];
     for i in 0..segments {
         let (a, b) = (ring(i), ring(i + 1));
-        let p = [
-            a * radius - Vec3::Z * hz,
-            b * radius - Vec3::Z * hz,
-            b * radius + Vec3::Z * hz,
-            a * radius + Vec3::Z * hz,
-        ];
+        let (ua, ub) = (i as f32 / segments as f32, (i + 1) as f32 / segments as f32);
         let idx = [
-            m.push(p[0], a),
-            m.push(p[1], b),
-            m.push(p[2], b),
-            m.push(p[3], a),
+            push(&mut m, a * radius - Vec3::Z * hz, a, [ua, 1.0]),
+            push(&mut m, b * radius - Vec3::Z * hz, b, [ub, 1.0]),
+            push(&mut m, b * radius + Vec3::Z * hz, b, [ub, 0.0]),
+            push(&mut m, a * radius + Vec3::Z * hz, a, [ua, 0.0]),
         ];
         m.indices
             .extend_from_slice(&[idx[0], idx[1], idx[2], idx[0], idx[2], idx[3]]);
         for (z, n) in [(hz, Vec3::Z), (-hz, Vec3::NEG_Z)] {
-            let c = m.push(Vec3::Z * z, n);
-            let pa = m.push(a * radius + Vec3::Z * z, n);
-            let pb = m.push(b * radius + Vec3::Z * z, n);
+            let c = push(&mut m, Vec3::Z * z, n, [0.5, 0.5]);
+            let pa = push(&mut m, a * radius + Vec3::Z * z, n, cap_uv(a));
+            let pb = push(&mut m, b * radius + Vec3::Z * z, n, cap_uv(b));
             if z > 0.0 {
                 m.indices.extend_from_slice(&[c, pa, pb]);
             } else {
@@ -102,6 +105,8 @@ pub(crate) fn sphere(radius: f32) -> MeshData {
 /// A capsule along z: cylinder part `length`, caps of `radius`.
 pub(crate) fn capsule(radius: f32, length: f32) -> MeshData {
     let mut m = cylinder(radius, length, 20);
+    // No texture coordinates for the caps' spheres: none for the whole.
+    m.uvs.clear();
     let cap = sphere(radius);
     m.append(&cap, Pose::from_translation(Vec3::Z * length / 2.0));
     m.append(&cap, Pose::from_translation(Vec3::NEG_Z * length / 2.0));
@@ -658,6 +663,14 @@ mod tests {
             .iter()
             .fold(Vec3::ZERO, |m, v| m.max(Vec3::from_array(v.position)));
         assert!((max - Vec3::new(0.5, 0.5, 1.0)).length() < 1e-3);
+        // Texture coordinates for every vertex: the side's top at v 0, its bottom at v 1.
+        assert_eq!(c.uvs.len(), c.vertices.len());
+        for (v, uv) in c.vertices.iter().zip(&c.uvs) {
+            let side = v.normal[2] == 0.0;
+            if side {
+                assert_eq!(uv[1], if v.position[2] > 0.0 { 0.0 } else { 1.0 });
+            }
+        }
     }
 
     /// The lowest point and the furthest forward point of a person's feet on one side
