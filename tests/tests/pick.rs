@@ -959,3 +959,83 @@ fn bad_pick_input_says_one_thing_and_the_arm_holds() -> Result<()> {
     }
     Ok(())
 }
+
+/// The stance world with the car 1.5 m back from the table and a low brick (8 cm high, 40 cm
+/// wide) across the straight way: the pick routes the base round the brick (the planning
+/// scene's objects), picks the ball and puts it in the bin, and no part of the car touches the
+/// brick.
+#[test]
+fn the_base_drives_round_a_brick_in_the_way_to_its_stance() -> Result<()> {
+    let text = std::fs::read_to_string(rover_tests::repo("worlds/arm_car_stance.toml"))?;
+    let assets = rover_tests::repo("assets");
+    let text = text
+        .replace("\"../assets", &format!("\"{}", assets.display()))
+        .replace(
+            "position_m = [0.0, 0.0]\nyaw_deg = 0.0",
+            "position_m = [-0.8, 0.0]\nyaw_deg = 0.0",
+        )
+        + "\n[[box]]\nname = \"brick\"\nsize_m = [0.10, 0.40, 0.08]\nposition_m = [-0.2, 0.0, 0.04]\ncolor = \"#a04030\"\n";
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("stance_brick.toml");
+    std::fs::write(&path, text)?;
+    let config = rover_core::RunConfig {
+        world: Some(path),
+        ..rover_core::RunConfig::default()
+    };
+    let (world, robot) = config.load_world_and_robot()?;
+    let index = |name: &str| {
+        (world.objects.iter())
+            .position(|o| o.name == name)
+            .ok_or_else(|| anyhow::anyhow!("no {name}"))
+    };
+    let (brick, ball, bin) = (index("brick")?, index("ball")?, index("bin")?);
+    let mut said = Said::default();
+    let mut session = Session::new(world, robot, &rover_tests::lockstep_options(0), &mut said)?;
+    let mut touched: Vec<String> = Vec::new();
+    session.input(Action::TogglePick, &mut said);
+    let start = session.sim().sim_time_s();
+    while session.sim().sim_time_s() < start + 70.0 {
+        session.step(&mut said)?;
+        for link in session.sim().object_contacts(brick) {
+            if !touched.contains(&link) {
+                touched.push(link);
+            }
+        }
+        if matches!(
+            session.stats().arm.pick,
+            PickState::Done | PickState::Failed
+        ) {
+            break;
+        }
+    }
+    let end = session.sim().sim_time_s() + 1.0;
+    while session.sim().sim_time_s() < end {
+        session.step(&mut said)?;
+    }
+    let ball = object(&session, ball).translation;
+    let bin = object(&session, bin).translation;
+    println!("ball {ball:?}, bin {bin:?}, brick touched by {touched:?}");
+    assert_eq!(
+        session.stats().arm.pick,
+        PickState::Done,
+        "{:?}",
+        said.0.last()
+    );
+    assert!(
+        said.0
+            .iter()
+            .any(|(_, _, t)| t.starts_with("pick: fetch: round what stands between")),
+        "the base was not routed round the brick"
+    );
+    assert!(
+        (ball.x - bin.x).abs() < 0.055 && (ball.y - bin.y).abs() < 0.055,
+        "the ball is not in the bin"
+    );
+    assert!(
+        touched
+            .iter()
+            .all(|link| link == "ground" || link.is_empty()),
+        "the brick was touched by {touched:?}"
+    );
+    Ok(())
+}

@@ -26,8 +26,10 @@
 
 mod config;
 mod fetch;
+mod ground;
 mod plan;
 mod reachability;
+mod route;
 mod run;
 mod see;
 mod setup;

@@ -7,6 +7,11 @@ use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 use rover_sim::{model::isometry_from_pose, physics::Simulation};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
+use super::ground::{body_footprint, obstacles, stance_pose};
+use super::route::route;
+
+/// A corner of a route within this (m) of the arm's base is passed.
+const VIA_REACHED_M: f64 = 0.12;
 use super::plan::{over_place, spans};
 use super::state::{Held, Leg, Pick, PickState, Step, Target};
 
@@ -94,8 +99,8 @@ impl Pick {
             return false;
         }
         let goal = (world_from_base * Point3::from(centre)).coords;
-        let started_s = match self.leg {
-            Some(leg) if driving => leg.started_s,
+        let (started_s, via) = match self.leg.take() {
+            Some(leg) if driving => (leg.started_s, leg.via),
             _ => {
                 self.drive.reset();
                 self.said.push((
@@ -105,7 +110,9 @@ impl Pick {
                         goal.x, goal.y
                     ),
                 ));
-                sim.sim_time_s()
+                let from = world_from_base.translation.vector.xy();
+                let via = self.route_to(sim, (goal, at), from, (goal, 0.08));
+                (sim.sim_time_s(), via)
             }
         };
         self.sightings.clear();
@@ -115,14 +122,63 @@ impl Pick {
             to_place: false,
             started_s,
             back_from: None,
+            via,
         });
         true
+    }
+
+    /// The corners (world x, y) the base drives through from `from` until `goal` (world) is at
+    /// `at` in its frame, round the world's objects (leaving out any within `ignore_m` of
+    /// `ignore`, world): empty when the straight way is clear; said and empty when no way is
+    /// found (the base then drives straight, as before).
+    fn route_to(
+        &mut self,
+        sim: &Simulation,
+        (goal, at): (Vector3<f64>, Vector2<f64>),
+        from: Vector2<f64>,
+        (ignore, ignore_m): (Vector3<f64>, f64),
+    ) -> Vec<Vector2<f64>> {
+        let Some(body) = body_footprint(sim, self.base) else {
+            return Vec::new();
+        };
+        let radius_m = [-1.0, 1.0]
+            .iter()
+            .flat_map(|sx| {
+                [-1.0, 1.0].map(|sy| body.centre + body.half.component_mul(&Vector2::new(*sx, sy)))
+            })
+            .map(|corner| corner.norm())
+            .fold(0.0, f64::max);
+        let heading = (goal.y - from.y).atan2(goal.x - from.x);
+        let (stand, _) = stance_pose(goal.xy(), at, heading - at.y.atan2(at.x));
+        match route(from, stand, radius_m, &obstacles(sim, ignore, ignore_m)) {
+            Ok(via) => {
+                if !via.is_empty() {
+                    let corners: Vec<String> = via
+                        .iter()
+                        .map(|p| format!("({:.2}, {:.2})", p.x, p.y))
+                        .collect();
+                    self.said.push((
+                        false,
+                        format!(
+                            "pick: fetch: round what stands between, by {}",
+                            corners.join(", ")
+                        ),
+                    ));
+                }
+                via
+            }
+            Err(why) => {
+                self.said
+                    .push((true, format!("pick: fetch: {why}; driving straight")));
+                Vec::new()
+            }
+        }
     }
 
     /// One control update of a drive: the base's command, and what comes after it gets there
     /// (a fresh look at the object, or the place's plan once the base has settled).
     pub(super) fn drive_base(&mut self, sim: &Simulation, now: f64) {
-        let Some(leg) = self.leg else {
+        let Some(mut leg) = self.leg.clone() else {
             return;
         };
         let Some(at) = self.fetch_at(sim) else {
@@ -141,10 +197,19 @@ impl Pick {
                 self.base_cmd = Some(self.drive.back(now));
                 return;
             }
-            self.leg = Some(Leg {
-                back_from: None,
-                ..leg
-            });
+            leg.back_from = None;
+            self.leg = Some(leg.clone());
+        }
+        if let Some(corner) = leg.via.first().copied() {
+            let z = world_from_base.translation.z;
+            let p = world_from_base.inverse() * Point3::new(corner.x, corner.y, z);
+            if p.coords.xy().norm() > VIA_REACHED_M {
+                let (cmd, _) = self.drive.command(now, p.coords.xy(), Vector2::zeros());
+                self.base_cmd = Some(cmd);
+                return;
+            }
+            leg.via.remove(0);
+            self.leg = Some(leg.clone());
         }
         let point = world_from_base.inverse() * Point3::from(leg.goal);
         let (cmd, there) = self.drive.command(now, point.coords.xy(), at);
@@ -187,12 +252,22 @@ impl Pick {
                 self.fail(format!("the place is out of the arm's reach: {why}"));
                 return true;
             }
-            let base = sim.world_from_link(self.base).translation;
+            let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+            let base = world_from_base.translation.vector.xy();
+            // The route starts where backing off ends.
+            let backed = base - (world_from_base.rotation * Vector3::x()).xy() * BACK_OFF_M;
+            let tool = isometry_from_pose(&sim.world_from_link(self.tool))
+                .translation
+                .vector;
+            let at = self.fetch_at(sim).unwrap_or_default();
+            let goal = Vector3::new(x, y, z);
+            let via = self.route_to(sim, (goal, at), backed, (tool, 0.1));
             self.leg = Some(Leg {
-                goal: Vector3::new(x, y, z),
+                goal,
                 to_place: true,
                 started_s: now,
-                back_from: Some(Vector2::new(f64::from(base.x), f64::from(base.y))),
+                back_from: Some(base),
+                via,
             });
             self.drive.reset();
             self.state = PickState::Delivering;

@@ -208,7 +208,7 @@ pub struct Pick {
 }
 
 /// Where the base is driving to.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(super) struct Leg {
     /// The point brought to the fetch point (world frame, m): the object's centre, or the
     /// place's point under the object.
@@ -219,6 +219,8 @@ pub(super) struct Leg {
     pub(super) started_s: f64,
     /// Backing away first, from where the base was (world x, y, m).
     pub(super) back_from: Option<Vector2<f64>>,
+    /// Corners to drive through first, round what stands between (world x, y, m).
+    pub(super) via: Vec<Vector2<f64>>,
 }
 
 /// The object in the hand while the base drives to the place.
