@@ -121,8 +121,10 @@ impl Pick {
             if usable <= 0.0 || best.as_ref().is_some_and(|(n, _)| *n >= longest.len()) {
                 continue;
             }
-            let middle = (longest[0] + longest[longest.len() - 1]) / 2.0;
-            best = Some((longest.len(), Vector2::new(c * middle, s * middle)));
+            if let (Some(near), Some(far)) = (longest.first(), longest.last()) {
+                let middle = (near + far) / 2.0;
+                best = Some((longest.len(), Vector2::new(c * middle, s * middle)));
+            }
         }
         best.map(|(_, at)| at).ok_or_else(|| {
             format!(
