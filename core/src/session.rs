@@ -479,48 +479,24 @@ impl Session {
     fn arm_events(&mut self, now_s: f64, observer: &mut dyn Observer) {
         let before = self.stats.arm;
         self.stats.arm = self.arm.status();
-        if before.mode == ArmMode::Reach
-            && self.stats.arm.mode == ArmMode::Reach
-            && before.reach != self.stats.arm.reach
-        {
-            emit(
-                observer,
-                now_s,
-                EventLevel::Info,
-                &format!(
-                    "reach: {} -> {}",
-                    before.reach.as_str(),
-                    self.stats.arm.reach.as_str()
-                ),
-            );
+        let now = self.stats.arm;
+        if before.mode != now.mode {
+            return;
         }
-        if before.mode == self.stats.arm.mode && before.hidden != self.stats.arm.hidden {
-            let text = if self.stats.arm.hidden {
+        if let (Some(was), Some(is)) = (before.task_state(), now.task_state())
+            && was != is
+        {
+            let text = format!("{}: {was} -> {is}", now.mode.as_str());
+            emit(observer, now_s, EventLevel::Info, &text);
+        }
+        if before.hidden != now.hidden {
+            let text = if now.hidden {
                 "the object is hidden by the robot's own links: going on with its last estimate"
             } else {
                 "the object is in view again"
             };
-            emit(
-                observer,
-                now_s,
-                EventLevel::Info,
-                &format!("{}: {text}", self.stats.arm.mode.as_str()),
-            );
-        }
-        if before.mode == ArmMode::Pick
-            && self.stats.arm.mode == ArmMode::Pick
-            && before.pick != self.stats.arm.pick
-        {
-            emit(
-                observer,
-                now_s,
-                EventLevel::Info,
-                &format!(
-                    "pick: {} -> {}",
-                    before.pick.as_str(),
-                    self.stats.arm.pick.as_str()
-                ),
-            );
+            let text = format!("{}: {text}", now.mode.as_str());
+            emit(observer, now_s, EventLevel::Info, &text);
         }
     }
 

@@ -565,31 +565,28 @@ fn gz_ros2_control_runs_its_ros2_control_controllers() -> Result<()> {
         (a - 0.6).abs() < 0.02 && (t + 0.4).abs() < 0.02,
         "joints at {a} and {t} rad; the trajectory ends at 0.6 and -0.4"
     );
-    // A type rover does not run: refused at the line of its type.
-    let bad = yaml.replace(
-        "joint_trajectory_controller/JointTrajectoryController",
-        "diff_drive_controller/DiffDriveController",
-    );
-    std::fs::write(tmp.path().join("controllers.yaml"), &bad)?;
-    let err = match RobotModel::load(&tmp.path().join("bot.sdf")) {
-        Ok(_) => anyhow::bail!("loaded a controller type rover does not run"),
-        Err(e) => e.to_string(),
+    // The controllers file with its trajectory controller's type replaced by `kind`: the
+    // robot's load error.
+    let refused = |kind: &str| -> Result<String> {
+        let changed = yaml.replace(
+            "joint_trajectory_controller/JointTrajectoryController",
+            kind,
+        );
+        std::fs::write(tmp.path().join("controllers.yaml"), &changed)?;
+        match RobotModel::load(&tmp.path().join("bot.sdf")) {
+            Ok(_) => anyhow::bail!("loaded a {kind}"),
+            Err(e) => Ok(e.to_string()),
+        }
     };
+    // A type rover does not run: refused at the line of its type.
+    let err = refused("diff_drive_controller/DiffDriveController")?;
     assert!(err.contains("controllers.yaml:7"), "{err}");
     assert!(
         err.contains("'diff_drive_controller/DiffDriveController' is not one rover runs"),
         "{err}"
     );
     // A group controller over two joints: rover runs one joint per controller.
-    let group = yaml.replace(
-        "joint_trajectory_controller/JointTrajectoryController",
-        "position_controllers/JointGroupPositionController",
-    );
-    std::fs::write(tmp.path().join("controllers.yaml"), &group)?;
-    let err = match RobotModel::load(&tmp.path().join("bot.sdf")) {
-        Ok(_) => anyhow::bail!("loaded a two-joint group controller"),
-        Err(e) => e.to_string(),
-    };
+    let err = refused("position_controllers/JointGroupPositionController")?;
     assert!(err.contains("2 joints"), "{err}");
     Ok(())
 }

@@ -160,6 +160,16 @@ impl ArmConfig {
 }
 
 impl ArmStatus {
+    /// The running task's own state (`moving`, `carrying`, ...): reach's or pick's; `None`
+    /// for look or off.
+    pub fn task_state(&self) -> Option<&'static str> {
+        match self.mode {
+            ArmMode::Reach => Some(self.reach.as_str()),
+            ArmMode::Pick => Some(self.pick.as_str()),
+            ArmMode::Off | ArmMode::Look => None,
+        }
+    }
+
     /// How far the tool is from the pre-grasp goal (m), once there is one.
     pub fn tool_to_goal_m(&self) -> Option<f64> {
         let (t, g) = (self.tool_world_m?, self.goal_world_m?);
@@ -193,8 +203,6 @@ pub(crate) struct ArmTask {
     base_link: LinkId,
     camera_link: LinkId,
     look: Result<Look, String>,
-    /// The classes look, reach and pick act on.
-    classes: (String, String, String),
     reach: Result<Reach, String>,
     pick: Result<Pick, String>,
     /// The end effector moved to points (scripts, Cartesian jogging).
@@ -283,11 +291,6 @@ impl ArmTask {
             tool,
             tool_scene: None,
             look_while_reaching,
-            classes: (
-                config.look.class.clone(),
-                config.reach.class.clone(),
-                config.pick.class.clone(),
-            ),
             frames: Vec::new(),
             q: Vec::with_capacity(robot.joints.len()),
             chain_q: Vec::with_capacity(robot.joints.len()),
@@ -448,19 +451,17 @@ impl ArmTask {
         labels: &[String],
         sim: &Simulation,
     ) -> Option<String> {
+        // A task that cannot be built says so when switched on ([`Self::set`]).
         let class = match mode {
             ArmMode::Off => return None,
-            ArmMode::Look => &self.classes.0,
-            ArmMode::Reach => &self.classes.1,
+            ArmMode::Look => &self.look.as_ref().ok()?.config().class,
+            ArmMode::Reach => &self.reach.as_ref().ok()?.config().class,
             ArmMode::Pick => {
-                let named = self
-                    .pick
-                    .as_ref()
-                    .is_ok_and(|p| p.known_object(sim).is_some());
-                if named {
+                let pick = self.pick.as_ref().ok()?;
+                if pick.known_object(sim).is_some() {
                     return None;
                 }
-                &self.classes.2
+                &pick.config().class
             }
         };
         if labels.is_empty() || labels.iter().any(|l| l == class) {
@@ -511,7 +512,13 @@ impl ArmTask {
             .extend_from_slice(frame.depth_m.unwrap_or_default());
         slot.robot_px.clear();
         if let Some(image) = frame.entities {
-            (slot.robot_px).extend(image.ids.iter().map(|&id| id == EntityIds::ROBOT));
+            // The depth image is the ideal pinhole one: so are the robot's pixels.
+            let ids = if image.distorted {
+                &image.ideal_ids
+            } else {
+                &image.ids
+            };
+            (slot.robot_px).extend(ids.iter().map(|&id| id == EntityIds::ROBOT));
         }
         let base_from_camera =
             sim.world_from_link(self.base_link).inverse() * sim.world_from_link(self.camera_link);

@@ -87,6 +87,11 @@ impl Look {
         })
     }
 
+    /// The settings.
+    pub fn config(&self) -> &LookConfig {
+        &self.config
+    }
+
     /// The joints it moves, base to camera.
     pub fn joints(&self) -> &[ChainJoint] {
         self.chain.joints()

@@ -18,6 +18,17 @@ struct Slot<'a> {
     types: &'static [&'static str],
 }
 
+impl<'a> Slot<'a> {
+    /// A topic the simulation publishes as one of `types`.
+    fn out(topic: &'a mut String, types: &'static [&'static str]) -> Self {
+        Self {
+            topic,
+            inbound: false,
+            types,
+        }
+    }
+}
+
 /// What bridging a robot's topics did.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct Bridged {
@@ -113,77 +124,33 @@ impl RobotModel {
                 inbound: true,
                 types: &["geometry_msgs/Twist", "geometry_msgs/TwistStamped"],
             });
-            slots.push(Slot {
-                topic: &mut dd.odometry_topic,
-                inbound: false,
-                types: &["nav_msgs/Odometry"],
-            });
+            slots.push(Slot::out(&mut dd.odometry_topic, &["nav_msgs/Odometry"]));
             if let Some(tf) = &mut dd.tf_topic {
-                slots.push(Slot {
-                    topic: tf,
-                    inbound: false,
-                    types: &["tf2_msgs/TFMessage"],
-                });
+                slots.push(Slot::out(tf, &["tf2_msgs/TFMessage"]));
             }
         }
         if let Some(jsp) = &mut self.joint_state_publisher {
-            slots.push(Slot {
-                topic: &mut jsp.topic,
-                inbound: false,
-                types: &["sensor_msgs/JointState"],
-            });
+            slots.push(Slot::out(&mut jsp.topic, &["sensor_msgs/JointState"]));
         }
         for c in self.cameras.iter_mut().filter(|c| c.camera_name.is_empty()) {
-            slots.push(Slot {
-                topic: &mut c.image_topic,
-                inbound: false,
-                types: &["sensor_msgs/Image"],
-            });
-            slots.push(Slot {
-                topic: &mut c.info_topic,
-                inbound: false,
-                types: &["sensor_msgs/CameraInfo"],
-            });
+            slots.push(Slot::out(&mut c.image_topic, &["sensor_msgs/Image"]));
+            slots.push(Slot::out(&mut c.info_topic, &["sensor_msgs/CameraInfo"]));
             if let Some(d) = &mut c.depth {
-                slots.push(Slot {
-                    topic: &mut d.image_topic,
-                    inbound: false,
-                    types: &["sensor_msgs/Image"],
-                });
-                slots.push(Slot {
-                    topic: &mut d.cloud_topic,
-                    inbound: false,
-                    types: &["sensor_msgs/PointCloud2"],
-                });
+                slots.push(Slot::out(&mut d.image_topic, &["sensor_msgs/Image"]));
+                slots.push(Slot::out(&mut d.cloud_topic, &["sensor_msgs/PointCloud2"]));
             }
         }
         for l in &mut self.lasers {
-            slots.push(Slot {
-                topic: &mut l.topic,
-                inbound: false,
-                types: &["sensor_msgs/LaserScan"],
-            });
+            slots.push(Slot::out(&mut l.topic, &["sensor_msgs/LaserScan"]));
         }
         for l in &mut self.lidars {
-            slots.push(Slot {
-                topic: &mut l.rays.topic,
-                inbound: false,
-                types: &["sensor_msgs/PointCloud2"],
-            });
+            slots.push(Slot::out(&mut l.rays.topic, &["sensor_msgs/PointCloud2"]));
         }
         for i in &mut self.imus {
-            slots.push(Slot {
-                topic: &mut i.topic,
-                inbound: false,
-                types: &["sensor_msgs/Imu"],
-            });
+            slots.push(Slot::out(&mut i.topic, &["sensor_msgs/Imu"]));
         }
         for g in &mut self.gpss {
-            slots.push(Slot {
-                topic: &mut g.topic,
-                inbound: false,
-                types: &["sensor_msgs/NavSatFix"],
-            });
+            slots.push(Slot::out(&mut g.topic, &["sensor_msgs/NavSatFix"]));
         }
         for c in self
             .controllers

@@ -97,6 +97,12 @@ impl Footprint {
         }
     }
 
+    /// How far its furthest corner is from its frame's origin (m): the circle round the arm
+    /// base that holds the whole body.
+    pub(super) fn far_corner_m(&self) -> f64 {
+        (self.centre.abs() + self.half).norm()
+    }
+
     /// How far the point `p` is from it (m; 0 inside).
     pub(super) fn distance_to(&self, p: Vector2<f64>) -> f64 {
         let [a, b] = self.axes();

@@ -104,33 +104,36 @@ impl Pick {
         let Some(place) = place_under else {
             return Ok(steps);
         };
-        if self.fetch_given(sim).is_some() {
-            // Fetching: it is held up while the base drives to the place ([`Self::deliver`]).
+        // With a fetch point the base takes it to the place ([`Self::deliver`]); else the
+        // place is planned from here, and only out of reach does the base take it there.
+        let drive_there = match self.fetch_given(sim) {
+            Some(_) => true,
+            None => {
+                let held = (target, grasp.way.clone());
+                match self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m)) {
+                    Ok(more) => {
+                        steps.extend(more);
+                        false
+                    }
+                    Err(why) if sim.can_drive() => {
+                        self.said.push((
+                            false,
+                            format!("pick: the place is out of the arm's reach from here ({why}): the base takes it there"),
+                        ));
+                        true
+                    }
+                    Err(why) => return Err(why),
+                }
+            }
+        };
+        if drive_there {
+            // Held up while the base drives.
             self.held = Some(Held {
                 target,
                 way: grasp.way,
                 home_q: q0,
                 place,
             });
-            return Ok(steps);
-        }
-        let held = (target, grasp.way.clone());
-        match self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m)) {
-            Ok(more) => steps.extend(more),
-            Err(why) if sim.can_drive() => {
-                // Held up while the base takes it to a stance the arm reaches the place from.
-                self.said.push((
-                    false,
-                    format!("pick: the place is out of the arm's reach from here ({why}): the base takes it there"),
-                ));
-                self.held = Some(Held {
-                    target,
-                    way: grasp.way,
-                    home_q: q0,
-                    place,
-                });
-            }
-            Err(why) => return Err(why),
         }
         Ok(steps)
     }

@@ -7,6 +7,9 @@ use rover_sim::{geometry::Shape, model::isometry_from_pose, physics::Simulation}
 
 use crate::arm::depth::{DepthView, hidden_by_robot, object_estimate};
 
+use super::state::{Pick, PickState, Target};
+use super::world::world_object;
+
 /// A box of the class this share of [`super::PickConfig::min_probability`] or more counts when
 /// its estimate is within [`TRACK_GATE_M`] of where the object was seen last: YOLO's score for
 /// one object moves with the view (a tennis ball scores 0.2-0.6 from the arm car's mast as it
@@ -17,9 +20,6 @@ const TRACK_GATE_M: f64 = 0.05;
 /// Detector messages in a row without the object, once the base has driven to it and settled,
 /// before the pick plans from where it was seen on the way.
 const UNSEEN_AFTER_DRIVE: u32 = 5;
-
-use super::state::{Pick, PickState, Target};
-use super::world::world_object;
 
 impl Pick {
     /// A detector message with the depth image it came from, taken at `captured_s` (sim time)

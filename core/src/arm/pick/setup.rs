@@ -101,6 +101,11 @@ impl Pick {
         self.path_points
     }
 
+    /// The settings.
+    pub fn config(&self) -> &PickConfig {
+        &self.config
+    }
+
     /// Why the pick cannot start in `sim`, if it cannot: a place that is not in the world.
     pub fn check(&self, sim: &Simulation) -> Result<(), String> {
         self.place_under(sim).map(|_| ())

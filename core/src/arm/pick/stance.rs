@@ -8,12 +8,12 @@ use rover_sim::{model::isometry_from_pose, physics::Simulation};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
 use super::ground::{body_footprint, obstacles, stance_pose};
+use super::plan::{over_place, spans};
 use super::route::route;
+use super::state::{Held, Leg, Pick, PickState, Step, Target};
 
 /// A corner of a route within this (m) of the arm's base is passed.
 const VIA_REACHED_M: f64 = 0.12;
-use super::plan::{over_place, spans};
-use super::state::{Held, Leg, Pick, PickState, Step, Target};
 
 impl Pick {
     /// Where the object should be when the base stops to pick it (arm base frame, m), when
@@ -141,13 +141,7 @@ impl Pick {
         let Some(body) = body_footprint(sim, self.base) else {
             return Vec::new();
         };
-        let radius_m = [-1.0, 1.0]
-            .iter()
-            .flat_map(|sx| {
-                [-1.0, 1.0].map(|sy| body.centre + body.half.component_mul(&Vector2::new(*sx, sy)))
-            })
-            .map(|corner| corner.norm())
-            .fold(0.0, f64::max);
+        let radius_m = body.far_corner_m();
         let heading = (goal.y - from.y).atan2(goal.x - from.x);
         let (stand, _) = stance_pose(goal.xy(), at, heading - at.y.atan2(at.x));
         match route(from, stand, radius_m, &obstacles(sim, ignore, ignore_m)) {
@@ -178,15 +172,14 @@ impl Pick {
     /// One control update of a drive: the base's command, and what comes after it gets there
     /// (a fresh look at the object, or the place's plan once the base has settled).
     pub(super) fn drive_base(&mut self, sim: &Simulation, now: f64) {
-        let Some(mut leg) = self.leg.clone() else {
+        // Taken while it runs; put back unless it ends here.
+        let Some(mut leg) = self.leg.take() else {
             return;
         };
         let Some(at) = self.fetch_at(sim) else {
-            self.leg = None;
             return;
         };
         if now - leg.started_s > MAX_DRIVE_S {
-            self.leg = None;
             return self.fail(format!(
                 "fetch: the base did not get there in {MAX_DRIVE_S:.0} s"
             ));
@@ -195,10 +188,10 @@ impl Pick {
         if let Some(from) = leg.back_from {
             if (world_from_base.translation.vector.xy() - from).norm() < BACK_OFF_M {
                 self.base_cmd = Some(self.drive.back(now));
+                self.leg = Some(leg);
                 return;
             }
             leg.back_from = None;
-            self.leg = Some(leg.clone());
         }
         if let Some(corner) = leg.via.first().copied() {
             let z = world_from_base.translation.z;
@@ -206,22 +199,23 @@ impl Pick {
             if p.coords.xy().norm() > VIA_REACHED_M {
                 let (cmd, _) = self.drive.command(now, p.coords.xy(), Vector2::zeros());
                 self.base_cmd = Some(cmd);
+                self.leg = Some(leg);
                 return;
             }
             leg.via.remove(0);
-            self.leg = Some(leg.clone());
         }
         let point = world_from_base.inverse() * Point3::from(leg.goal);
         let (cmd, there) = self.drive.command(now, point.coords.xy(), at);
         self.base_cmd = Some(cmd);
+        let to_place = leg.to_place;
         if !there {
+            self.leg = Some(leg);
             return;
         }
-        self.leg = None;
         self.settle_until_s = now + SETTLE_BASE_S;
         self.unseen = 0;
         let (x, y) = (point.x, point.y);
-        if leg.to_place {
+        if to_place {
             self.said.push((
                 false,
                 format!("pick: fetch: at the place ({x:.3}, {y:.3}) m from the arm's base"),
