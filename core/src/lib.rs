@@ -35,8 +35,8 @@ mod trace;
 
 pub use arm::{
     ArmConfig, ArmMode, ArmStatus, DepthView, Look, LookConfig, Pick, PickConfig, PickState, Reach,
-    ReachConfig, ReachState, ReachStep, hidden_by_robot, object_estimate, object_point, pregrasp,
-    robot_share,
+    ReachConfig, ReachState, ReachStep, Upright, hidden_by_robot, object_estimate, object_point,
+    pregrasp, robot_share, upright_extent,
 };
 pub use dataset::{
     COCO_CATEGORY_IDS, DatasetFormat, DatasetProgress, DatasetSpec, DatasetSummary, DetectedBox,

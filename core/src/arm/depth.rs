@@ -40,13 +40,13 @@ pub struct DepthView<'a> {
 
 impl DepthView<'_> {
     /// Whether pixel `(x, y)` (inside the image) shows the robot.
-    fn is_robot(&self, x: i64, y: i64) -> bool {
+    pub(crate) fn is_robot(&self, x: i64, y: i64) -> bool {
         let i = (y * i64::from(self.width) + x) as usize;
         self.robot_px.get(i).copied().unwrap_or(false)
     }
 
     /// Pixel `(x, y)`'s depth (m), NaN where none or outside the image.
-    fn depth_at(&self, x: i64, y: i64) -> f32 {
+    pub(crate) fn depth_at(&self, x: i64, y: i64) -> f32 {
         let i = (y * i64::from(self.width) + x) as usize;
         self.depth_m.get(i).copied().unwrap_or(f32::NAN)
     }
@@ -201,7 +201,7 @@ pub fn hidden_by_robot(
 }
 
 /// The stride that samples a `width` x `height` region at about [`MAX_SAMPLES`] pixels.
-fn sample_step(width: i64, height: i64) -> usize {
+pub(crate) fn sample_step(width: i64, height: i64) -> usize {
     (((width.max(1) * height.max(1)) as f64 / MAX_SAMPLES)
         .sqrt()
         .ceil() as usize)

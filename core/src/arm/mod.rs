@@ -7,6 +7,7 @@ mod depth;
 mod look;
 mod pick;
 mod reach;
+mod shape;
 
 pub(crate) use arm_task::ArmTask;
 pub use arm_task::{ArmConfig, ArmMode, ArmStatus};
@@ -14,3 +15,4 @@ pub use depth::{DepthView, hidden_by_robot, object_estimate, object_point, robot
 pub use look::{Look, LookConfig};
 pub use pick::{Pick, PickConfig, PickState};
 pub use reach::{Reach, ReachConfig, ReachState, ReachStep, pregrasp};
+pub use shape::{Upright, upright_extent};

@@ -20,6 +20,7 @@ pub(crate) mod resource;
 pub(crate) mod robot;
 pub(crate) mod ros2_controllers;
 pub(crate) mod sdf;
+pub(crate) mod sdf_include;
 pub(crate) mod sdf_robot;
 pub(crate) mod srdf;
 pub(crate) mod toml;

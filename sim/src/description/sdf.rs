@@ -34,7 +34,7 @@ use crate::model::world::{
 const MAX_SDF_NUMBER: f64 = MAX_MAGNITUDE;
 
 /// Deepest `<include>` nesting followed (models including models).
-const MAX_INCLUDE_DEPTH: usize = 16;
+pub(crate) const MAX_INCLUDE_DEPTH: usize = 16;
 
 /// Loads an SDF world file; `resources` finds `model://` models and meshes.
 pub fn load_world(path: &Path, resources: &ResourcePaths) -> Result<World> {
@@ -365,21 +365,21 @@ impl Ctx<'_, '_> {
     }
 }
 
-struct Loader<'r> {
-    resources: &'r ResourcePaths,
-    skipped: BTreeSet<String>,
+pub(crate) struct Loader<'r> {
+    pub(crate) resources: &'r ResourcePaths,
+    pub(crate) skipped: BTreeSet<String>,
 }
 
 /// Overrides an `<include>` applies to the model it brings in.
-struct Overrides {
-    name: Option<String>,
-    is_static: Option<bool>,
+pub(crate) struct Overrides {
+    pub(crate) name: Option<String>,
+    pub(crate) is_static: Option<bool>,
     /// The `model://` name the `<include>` used (its class, if it is one).
-    uri_name: Option<String>,
+    pub(crate) uri_name: Option<String>,
 }
 
 impl Loader<'_> {
-    fn model(
+    pub(crate) fn model(
         &mut self,
         ctx: &Ctx<'_, '_>,
         node: Node<'_, '_>,
@@ -622,76 +622,6 @@ impl Loader<'_> {
             ));
         }
         found
-    }
-
-    fn include(
-        &mut self,
-        ctx: &Ctx<'_, '_>,
-        node: Node<'_, '_>,
-        parent: Pose,
-        out: &mut Vec<Model>,
-        depth: usize,
-    ) -> Result<()> {
-        if depth > MAX_INCLUDE_DEPTH {
-            return Err(ctx.err(
-                node,
-                format!(
-                    "<include> nested deeper than {MAX_INCLUDE_DEPTH}: does a model include itself?"
-                ),
-            ));
-        }
-        let uri_node =
-            child(node, "uri").ok_or_else(|| ctx.err(node, "<include> needs a <uri>"))?;
-        let uri = uri_node.text().unwrap_or("").trim();
-        let dir = if let Some(name) = uri.strip_prefix("model://") {
-            self.resources
-                .find_model(name.trim_end_matches('/'))
-                .map_err(|e| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {e}")))?
-        } else if let Some(fuel) = super::fuel::parse(uri) {
-            super::fuel::find_local(&fuel, self.resources)
-                .map_err(|e| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {e}")))?
-        } else {
-            let p = PathBuf::from(uri.strip_prefix("file://").unwrap_or(uri));
-            let base = ctx.path.parent().unwrap_or(Path::new("."));
-            let p = if p.is_absolute() { p } else { base.join(p) };
-            if !p.is_dir() {
-                return Err(ctx.err(
-                    uri_node,
-                    format!(
-                        "<include><uri>{uri}</uri>: no model folder at {}",
-                        p.display()
-                    ),
-                ));
-            }
-            p
-        };
-        let file = model_file(&dir)
-            .map_err(|m| ctx.err(uri_node, format!("<include><uri>{uri}</uri>: {m}")))?;
-        let text = crate::io::read_text(&file)?;
-        let doc = parse_xml(&text, &file)?;
-        let inner = Ctx {
-            path: &file,
-            doc: &doc,
-        };
-        let root = doc.root_element();
-        let model = if root.has_tag_name("model") {
-            Some(root)
-        } else {
-            child(root, "model")
-        };
-        let model = model.ok_or_else(|| inner.err(root, "expected an <sdf> with a <model>"))?;
-        // The include's <pose> places the model's frame (its own <pose> is relative to it).
-        let placed = parent * ctx.local_pose(node)?;
-        let overrides = Overrides {
-            name: child(node, "name")
-                .and_then(|n| n.text())
-                .map(|s| s.trim().to_owned()),
-            is_static: child(node, "static").map(|s| ctx.flag(s)),
-            uri_name: uri
-                .strip_prefix("model://")
-                .map(|n| n.trim_end_matches('/').to_owned()),
-        };
-        self.model(&inner, model, placed, Some(overrides), out, depth)
     }
 }
 

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::description::resource::ResourcePaths;
+use crate::description::sdf_include::RawModel;
 use crate::description::{sdf, toml as tomlfile};
 use crate::error::{Result, SimError};
 use crate::geometry::{MAX_COORDINATE_M, MAX_MAGNITUDE, MAX_MASS_KG, MAX_SIZE_M, Rgba, Shape};
@@ -36,13 +37,13 @@ impl World {
             return sdf::load_world(path, resources);
         }
         let raw: RawWorld = tomlfile::load_toml(path)?;
-        raw.into_world(path)
+        raw.into_world(path, resources)
     }
 
     /// Parses world TOML text; `path` is used in messages and to resolve the robot's URDF.
     pub fn from_str(text: &str, path: &Path) -> Result<Self> {
         let raw: RawWorld = tomlfile::parse_toml(text, path)?;
-        raw.into_world(path)
+        raw.into_world(path, &ResourcePaths::from_env())
     }
 
     /// An empty flat world (ground only, every setting at its default), for tests and calibration.
@@ -64,9 +65,10 @@ impl<'de> Deserialize<'de> for WorldFile {
 
 impl WorldFile {
     /// Validates it into a [`World`]; `path` is the file it came from (for messages and for
-    /// resolving the robot's URDF relative to it).
+    /// resolving the robot's URDF relative to it); `[[model]]`s are found through the
+    /// environment's model paths ([`ResourcePaths::from_env`]).
     pub fn into_world(self, path: &Path) -> Result<World> {
-        self.0.into_world(path)
+        self.0.into_world(path, &ResourcePaths::from_env())
     }
 }
 
@@ -94,6 +96,8 @@ struct RawWorld {
     walls: Vec<RawWall>,
     #[serde(default, rename = "person")]
     people: Vec<RawPerson>,
+    #[serde(default, rename = "model")]
+    models: Vec<RawModel>,
     #[serde(default)]
     spherical_coordinates: RawSpherical,
 }
@@ -453,7 +457,7 @@ impl RawWorld {
         Ok(objects)
     }
 
-    fn into_world(mut self, path: &Path) -> Result<World> {
+    fn into_world(mut self, path: &Path, resources: &ResourcePaths) -> Result<World> {
         let c = Checker { path };
         let base_dir = path.parent().unwrap_or(Path::new("."));
 
@@ -526,11 +530,15 @@ impl RawWorld {
             .map(|(i, p)| p.into_person(i, &c))
             .collect::<Result<Vec<_>>>()?;
 
+        let mut models = Vec::new();
+        for (i, m) in std::mem::take(&mut self.models).into_iter().enumerate() {
+            models.extend(m.into_models(i, path, resources)?);
+        }
+
         let mut seen = std::collections::BTreeSet::new();
-        for name in objects
-            .iter()
-            .map(|o| &o.name)
+        for name in (objects.iter().map(|o| &o.name))
             .chain(people.iter().map(|p| &p.name))
+            .chain(models.iter().map(|m| &m.name))
         {
             if !seen.insert(name.clone()) {
                 return Err(SimError::invalid(
@@ -554,7 +562,7 @@ impl RawWorld {
             ground,
             objects,
             people,
-            models: Vec::new(),
+            models,
             sun_direction: crate::model::world::DEFAULT_SUN_DIRECTION,
             spherical_coordinates: spherical(self.spherical_coordinates, path)?,
         })

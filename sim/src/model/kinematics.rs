@@ -291,6 +291,19 @@ impl KinematicChain {
         Ok(self.walk(q, |_, _, _| {}))
     }
 
+    /// The first moving joint's origin and unit axis in the base frame with every joint at
+    /// zero (a pan joint's axis is vertical: the arm turns about it); `None` for a chain with
+    /// no moving joint.
+    pub fn first_axis(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let mut first = None;
+        self.walk(&vec![0.0; self.joints.len()], |i, origin, axis| {
+            if i == 0 {
+                first = Some((origin, axis));
+            }
+        });
+        first
+    }
+
     /// Forward kinematics: calls `visit(i, origin, axis)` with each moving joint's origin and
     /// axis in the base frame, and returns base_from_tip.
     fn walk(

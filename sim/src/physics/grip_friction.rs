@@ -82,17 +82,18 @@ impl FrictionAnchors {
         self.pads.is_empty()
     }
 
-    /// After a step: measures each pad contact's slip with the bodies in `objects` since it
-    /// stuck, anchors new contacts, drops those that ended, and sets the next step's
-    /// corrections.
-    pub(crate) fn update(&mut self, physics: &PhysicsWorld, objects: &[RigidBodyHandle]) {
+    /// After a step: measures each pad contact's slip with the bodies in `objects` (the
+    /// world's objects, the SDF models' links) since it stuck, anchors new contacts, drops
+    /// those that ended, and sets the next step's corrections.
+    pub(crate) fn update(&mut self, physics: &PhysicsWorld, objects: [&[RigidBodyHandle]; 2]) {
         self.next.clear();
         for pad in &self.pads {
             for pair in physics.narrow_phase.contact_pairs_with(*pad) {
                 if !pair.has_any_active_contact() {
                     continue;
                 }
-                if !other_body(physics, pair, *pad).is_some_and(|b| objects.contains(&b)) {
+                let other = other_body(physics, pair, *pad);
+                if !other.is_some_and(|b| objects.iter().any(|o| o.contains(&b))) {
                     continue;
                 }
                 let key = (pair.collider1, pair.collider2);

@@ -310,7 +310,8 @@ impl Simulation {
             self.physics.step_with_events(&hooks, &());
         }
         if !self.anchors.is_empty() {
-            self.anchors.update(&self.physics, &self.objects);
+            self.anchors
+                .update(&self.physics, [&self.objects, &self.model_links]);
         }
         if let Some(grasp) = &mut self.grasp
             && let Some(event) = grasp.update(&mut self.physics, &self.objects, now)

@@ -120,7 +120,8 @@ impl PlanningScene {
     }
 
     /// The world object nearest `world_point_m` within `within_m` of its surface, by index
-    /// (the object a perceived point belongs to).
+    /// (the object a perceived point belongs to): the world's objects first, then the SDF
+    /// models' links (model, then link order) numbered on after them.
     pub fn object_near(&self, world_point_m: [f64; 3], within_m: f32) -> Option<usize> {
         let [x, y, z] = world_point_m.map(|v| v as f32);
         let point = Vec3::new(x, y, z);
@@ -518,6 +519,16 @@ impl Simulation {
         if let Some(i) = self.people.iter().position(|b| *b == body) {
             return format!("person {i}");
         }
+        if let Some(k) = self.model_links.iter().position(|b| *b == body) {
+            // Models' links in order: the k-th link is the model's whose links reach past it.
+            let mut first = 0;
+            for model in &self.world.models {
+                if k < first + model.links.len() {
+                    return format!("model \"{}\"", model.name);
+                }
+                first += model.links.len();
+            }
+        }
         "a model".to_owned()
     }
 
@@ -527,7 +538,10 @@ impl Simulation {
             let Some(body) = body else {
                 return ("ground".to_owned(), None);
             };
-            let object = self.objects.iter().position(|b| *b == body);
+            // World objects by their index, then the SDF models' links.
+            let object = (self.objects.iter().position(|b| *b == body)).or_else(|| {
+                (self.model_links.iter().position(|b| *b == body)).map(|k| self.objects.len() + k)
+            });
             (self.body_name(body), object)
         };
         self.physics

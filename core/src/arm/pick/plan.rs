@@ -20,6 +20,11 @@ const SET_DOWN_M: f64 = 0.005;
 /// before it is refused: the estimate from a box and a depth image is a centimetre or so off
 /// (an orange of 7.4 cm is seen as 8.6 cm), and the grasp's fingers close on what is there.
 const SPAN_SLACK_M: f64 = 0.005;
+/// Turns (deg) round the vertical from the arm's side the hand may take an upright object
+/// with, in order.
+const GRASP_YAWS_DEG: [f64; 5] = [0.0, -20.0, 20.0, -40.0, 40.0];
+/// ... and set it down with.
+const PLACE_YAWS_DEG: [f64; 7] = [0.0, -20.0, 20.0, -40.0, 40.0, -60.0, 60.0];
 /// How far the tool backs up after letting go (m).
 const RETREAT_M: f64 = 0.05;
 /// Seconds to full speed on a timed path.
@@ -59,18 +64,32 @@ impl Pick {
         let w = world_from_base * Point3::from(target.centre);
         let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
         // Over the place: where the carry ends, and how far it then goes straight down.
-        let place_under = self.place_under(sim)?;
+        let place_under = (self.place_under(sim)?)
+            .map(|p| set_down_upright(p, &target, self.config.approach_m));
         let place = place_under.map(|p| over_place(&world_from_base, p, target.half_height_m));
         let q0 = self.chain_q(sim);
-        let grasp = self.plan_grasp(&mut scene, what, target, object, &g, &q0)?;
+        // With a fetch point the base takes it to the place ([`Self::deliver`]); else the
+        // place is planned from here, and only out of reach does the base take it there.
+        let place_here = place.filter(|_| self.fetch_given(sim).is_none());
+        let (grasp, placed) = self.grasp_then_place(
+            &mut scene,
+            (what, target, object),
+            &g,
+            &q0,
+            place_here,
+        )?;
+        self.taken = Some(grasp.way.label.clone());
         let assist = sim.world().robot.grasp == GraspMode::Assist;
         let joints = self.joints().to_vec();
         let speed_scale = self.config.speed_scale;
         let timed = |w: Vec<Vec<f64>>, stop: bool| {
             Step::Move(TimedPath::new(w, &joints, speed_scale, RAMP_S, stop))
         };
-        let lift_q = grasp.lift.last().cloned().unwrap_or_default();
-        self.path_points = Some([grasp.to_pre.len(), 0, 0]);
+        let to_pre_points = grasp.to_pre.len();
+        self.path_points = Some(match (self.path_points, &placed) {
+            (Some([_, carry, home]), Some(Ok(_))) => [to_pre_points, carry, home],
+            _ => [to_pre_points, 0, 0],
+        });
         let mut steps = VecDeque::from([
             (
                 Step::Gripper {
@@ -97,45 +116,76 @@ impl Pick {
             ),
             (timed(grasp.lift, false), PickState::Lifting),
         ]);
-        let Some((over, lower_m)) = place else {
+        let Some(place) = place_under else {
             // No place: it stays in the hand, held up.
             return Ok(steps);
         };
-        let Some(place) = place_under else {
-            return Ok(steps);
-        };
-        // With a fetch point the base takes it to the place ([`Self::deliver`]); else the
-        // place is planned from here, and only out of reach does the base take it there.
-        let drive_there = match self.fetch_given(sim) {
-            Some(_) => true,
-            None => {
-                let held = (target, grasp.way.clone());
-                match self.plan_place(&mut scene, held, &g, (&lift_q, &q0), (over, lower_m)) {
-                    Ok(more) => {
-                        steps.extend(more);
-                        false
-                    }
-                    Err(why) if sim.can_drive() => {
-                        self.said.push((
-                            false,
-                            format!("pick: the place is out of the arm's reach from here ({why}): the base takes it there"),
-                        ));
-                        true
-                    }
-                    Err(why) => return Err(why),
-                }
+        match placed {
+            Some(Ok(more)) => {
+                steps.extend(more);
+                return Ok(steps);
             }
-        };
-        if drive_there {
-            // Held up while the base drives.
-            self.held = Some(Held {
-                target,
-                way: grasp.way,
-                home_q: q0,
-                place,
-            });
+            Some(Err(why)) if sim.can_drive() => self.said.push((
+                false,
+                format!("pick: the place is out of the arm's reach from here ({why}): the base takes it there"),
+            )),
+            Some(Err(why)) => return Err(why),
+            None => {}
         }
+        // Held up while the base drives.
+        self.held = Some(Held {
+            target,
+            way: grasp.way,
+            home_q: q0,
+            place,
+        });
         Ok(steps)
+    }
+
+    /// The grasp of `target` (called `what`; `object` its index in the scene) from `q0`, and
+    /// with `place` (over it and how far down) the place's plan from the grasp's lift, or why
+    /// the place cannot be reached. An upright object is set down as it was taken (the hand at
+    /// the same pitch), so each pitch is tried in turn until one both takes and places it.
+    fn grasp_then_place(
+        &mut self,
+        scene: &mut PlanningScene,
+        (what, target, object): (&str, Target, Option<usize>),
+        g: &Gripper,
+        q0: &[f64],
+        place: Option<(Vector3<f64>, f64)>,
+    ) -> Result<(Grasp, Option<Result<Vec<(Step, PickState)>, String>>), String> {
+        let all = self.config.approach_pitches_deg.clone();
+        let tries: Vec<Vec<f64>> = match (target.upright, place) {
+            (Some(_), Some(_)) => upright_pitches(&all).into_iter().map(|p| vec![p]).collect(),
+            (Some(_), None) => vec![upright_pitches(&all)],
+            (None, _) => vec![all],
+        };
+        let mut first: Option<(Grasp, String)> = None;
+        let mut grasp_why = Vec::new();
+        for pitches in &tries {
+            let grasp = match self.plan_grasp(scene, what, (target, object), g, q0, pitches) {
+                Ok(grasp) => grasp,
+                Err(why) => {
+                    grasp_why.push(why);
+                    continue;
+                }
+            };
+            let Some(over) = place else {
+                return Ok((grasp, None));
+            };
+            let lift_q = grasp.lift.last().cloned().unwrap_or_default();
+            let held = (target, grasp.way.clone());
+            match self.plan_place(scene, held, g, (&lift_q, q0), over) {
+                Ok(more) => return Ok((grasp, Some(Ok(more)))),
+                Err(why) if first.is_none() => first = Some((grasp, why)),
+                Err(_) => {}
+            }
+        }
+        match first {
+            Some((grasp, why)) => Ok((grasp, Some(Err(why)))),
+            None if grasp_why.len() == 1 => Err(grasp_why.remove(0)),
+            None => Err(grasp_why.join("; ")),
+        }
     }
 
     /// From the lift (`lift_q`) with the object `held` as the hand took it: the carry to over
@@ -156,6 +206,21 @@ impl Pick {
         };
         // Carrying: the object on the tool, as the hand holds it.
         match (target.cuboid, way_held.turn) {
+            (None, Some(turn)) if target.upright.is_some() => {
+                // Upright, its axes the base's: the tool `offset` from its centre.
+                let r = target.across_m();
+                let box_from_tool = turn.inverse();
+                let at = box_from_tool * -way_held.offset;
+                let q = box_from_tool.into_inner();
+                scene.attach_box(
+                    self.tool,
+                    Pose::from_parts(
+                        glam::Vec3::new(at.x as f32, at.y as f32, at.z as f32),
+                        glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32),
+                    ),
+                    [r, r, target.half_height_m].map(|h| h as f32),
+                );
+            }
             (Some((r, half)), Some(turn)) => {
                 let q = (turn.inverse() * r).into_inner();
                 let tool_from_box =
@@ -168,7 +233,19 @@ impl Pick {
             }
             _ => scene.attach_sphere(Some((self.tool, Pose::IDENTITY, target.bound_m as f32))),
         }
-        let ways = self.ways_round(over, g.open);
+        let ways = match target.upright {
+            // Upright as it was taken: the hand at the same pitch, turned round the vertical.
+            Some(radius_m) => {
+                let pitch_deg = (-way_held.along.z).clamp(-1.0, 1.0).asin().to_degrees();
+                self.ways_upright(
+                    over,
+                    (radius_m, target.half_height_m),
+                    g,
+                    (&[pitch_deg], &PLACE_YAWS_DEG),
+                )
+            }
+            None => self.ways_round(over, g.open),
+        };
         let (place_q, _, way) = self
             .reachable(scene, over, lift_q, "the place", None, &ways)
             .map_err(|why| format!("cannot reach over the place: {why}"))?;
@@ -179,10 +256,11 @@ impl Pick {
         // Set down: straight down onto the surface, the object (about to touch it) left out.
         scene.attach_sphere(None);
         let set_down = if lower_m > 0.0 {
+            let at = over + ways[way].offset;
             self.line_at_least(
                 scene,
                 &place_q,
-                (over, over - Vector3::z() * lower_m),
+                (at, at - Vector3::z() * lower_m),
                 Some(&ways[way]),
                 1.0,
             )
@@ -200,13 +278,13 @@ impl Pick {
             .map_err(|e| e.to_string())?
             .translation
             .vector;
-        let retreat = self.line_at_least(
-            scene,
-            &release_q,
-            (from, from + Vector3::z() * RETREAT_M.max(lower_m)),
-            None,
-            0.0,
-        )?;
+        // Back out the way it came in from an upright object (the fingers slide off it), else
+        // straight up.
+        let back = match target.upright {
+            Some(_) => -ways[way].along * self.config.approach_m,
+            None => Vector3::z() * RETREAT_M.max(lower_m),
+        };
+        let retreat = self.line_at_least(scene, &release_q, (from, from + back), None, 0.0)?;
         let retreat_q = retreat.last().cloned().unwrap_or_else(|| release_q.clone());
         let home = plan_path(&joints, &retreat_q, home_q, &self.config.planner, |q| {
             scene.collision(q).map(|h| h.to_string())
@@ -249,10 +327,10 @@ impl Pick {
         &mut self,
         scene: &mut PlanningScene,
         what: &str,
-        object: Target,
-        target: Option<usize>,
+        (object, target): (Target, Option<usize>),
         g: &Gripper,
         q0: &[f64],
+        pitches: &[f64],
     ) -> Result<Grasp, String> {
         let c = self.config.clone();
         let centre = object.centre;
@@ -261,12 +339,18 @@ impl Pick {
             scene.ignore_object(t, true);
         }
         spans(g, what, &object)?;
-        let ways = match object.cuboid {
-            Some((r, half)) => self.ways_across(
+        let ways = match (object.cuboid, object.upright) {
+            (Some((r, half)), _) => self.ways_across(
                 [(r * Vector3::x(), half[0]), (r * Vector3::y(), half[1])],
                 g,
             ),
-            None => self.ways_round(centre, object.bound_m),
+            (None, Some(radius_m)) => self.ways_upright(
+                centre,
+                (radius_m, object.half_height_m),
+                g,
+                (pitches, &GRASP_YAWS_DEG),
+            ),
+            (None, None) => self.ways_round(centre, object.bound_m),
         };
         if ways.is_empty() {
             return Err(format!(
@@ -295,10 +379,11 @@ impl Pick {
         // Straight up off what it rests on; the hand may turn on the way (the object turns
         // with it). The arm is checked, the object (touching its support, as far as the
         // estimate knows) only from the lift's top.
+        let at = centre + ways[way].offset;
         let lift = self.line_at_least(
             scene,
             &grasp_q,
-            (centre, centre + Vector3::z() * c.lift_m),
+            (at, at + Vector3::z() * c.lift_m),
             None,
             0.5,
         )?;
@@ -348,10 +433,10 @@ impl Pick {
 /// Whether the open gripper `g` spans `target` (called `what`): a round one within
 /// [`SPAN_SLACK_M`] (a box is checked face by face); else why not.
 pub(super) fn spans(g: &Gripper, what: &str, target: &Target) -> Result<(), String> {
-    if target.cuboid.is_none() && target.bound_m > g.widest_m() + SPAN_SLACK_M {
+    if target.cuboid.is_none() && target.across_m() > g.widest_m() + SPAN_SLACK_M {
         return Err(format!(
             "cannot grasp {what}: it is {:.3} m across, wider than the open gripper ({:.3} m)",
-            2.0 * target.bound_m,
+            2.0 * target.across_m(),
             2.0 * g.widest_m()
         ));
     }
@@ -368,4 +453,31 @@ pub(super) fn over_place(
 ) -> (Vector3<f64>, f64) {
     let over = world_from_base.inverse() * Point3::new(x, y, z + above_m + half_height_m);
     (over.coords, lower_m)
+}
+
+/// The place ([`Pick::place_under`]) for `target`: an upright object is set down on a world
+/// object rather than dropped (from half `approach_m` above its top, straight down to
+/// [`SET_DOWN_M`] above it), so it stays standing.
+fn set_down_upright(
+    (point, above_m, lower_m): ([f64; 3], f64, f64),
+    target: &Target,
+    approach_m: f64,
+) -> ([f64; 3], f64, f64) {
+    if target.upright.is_none() || lower_m > 0.0 {
+        return (point, above_m, lower_m);
+    }
+    let above = (approach_m / 2.0).max(SET_DOWN_M);
+    (point, above, above - SET_DOWN_M)
+}
+
+/// The pitches (deg below horizontal) an upright object is taken at: `pitches` and level,
+/// steepest first. The pads' length along its side holds it upright; a level hand's pads
+/// touch it only 2 cm high, and a 390 g can turns about the fingers' line as it is lifted.
+fn upright_pitches(pitches: &[f64]) -> Vec<f64> {
+    let mut all = pitches.to_vec();
+    if !all.contains(&0.0) {
+        all.push(0.0);
+    }
+    all.sort_by(|a, b| b.total_cmp(a));
+    all
 }

@@ -1,11 +1,12 @@
 //! Seeing the object: sightings from detector messages and depth, or a named world object
 //! by its pose, and the plan that follows once it is known.
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3};
 use rover_perception::BoundingBoxes;
 use rover_sim::{geometry::Shape, model::isometry_from_pose, physics::Simulation};
 
 use crate::arm::depth::{DepthView, hidden_by_robot, object_estimate};
+use crate::arm::shape::upright_extent;
 
 use super::state::{Pick, PickState, Target};
 use super::world::world_object;
@@ -50,9 +51,15 @@ impl Pick {
             .iter()
             .filter(|b| b.class == c.class && b.probability >= TRACK_SHARE * c.min_probability)
             .filter_map(|b| {
-                let seen = object_estimate(b, view, self.intrinsics, c.max_range_m)?;
+                let (centre, radius) = object_estimate(b, view, self.intrinsics, c.max_range_m)?;
+                // A tall object stands upright: its axis, radius and height from the depth.
+                let seen = match upright_extent(b, view, self.intrinsics, c.max_range_m) {
+                    Some(u) => Target::upright(u.centre, u.radius_m, u.half_height_m),
+                    None => Target::round(centre, radius),
+                };
                 // A weak box counts only where the object was seen last (a tracker's gate).
-                let gated = expected.is_some_and(|(p, _)| (p - seen.0).norm() <= TRACK_GATE_M);
+                let gated =
+                    expected.is_some_and(|(p, _)| (p - seen.centre).norm() <= TRACK_GATE_M);
                 (b.probability >= c.min_probability || gated).then_some((b.probability, seen))
             })
             .max_by(|a, b| a.0.total_cmp(&b.0))
@@ -86,15 +93,18 @@ impl Pick {
         };
         self.unseen = 0;
         self.hidden = false;
-        self.last_seen = Some(((world_from_base * Point3::from(seen.0)).coords, seen.1));
-        if self.fetch_towards(sim, seen.0, world_from_base) {
+        self.last_seen = Some((
+            (world_from_base * Point3::from(seen.centre)).coords,
+            seen.across_m(),
+        ));
+        if self.fetch_towards(sim, seen.centre, world_from_base) {
             return;
         }
         let c = &self.config;
         if self
             .sightings
             .first()
-            .is_some_and(|(p, _)| (p - seen.0).norm() > c.agree_m)
+            .is_some_and(|first| (first.centre - seen.centre).norm() > c.agree_m)
         {
             self.sightings.clear();
         }
@@ -102,11 +112,8 @@ impl Pick {
         if self.sightings.len() < c.sightings as usize {
             return;
         }
-        let n = self.sightings.len() as f64;
-        let centre = self.sightings.iter().map(|(p, _)| p).sum::<Vector3<f64>>() / n;
-        let radius = self.sightings.iter().map(|(_, r)| r).sum::<f64>() / n;
+        let target = Target::mean(&self.sightings);
         let what = format!("the {}", self.config.class);
-        let target = Target::round(centre, radius);
         if self.stance_towards(sim, &what, &target, world_from_base) {
             return;
         }
@@ -127,18 +134,22 @@ impl Pick {
                 self.said.push((
                     false,
                     format!(
-                        "pick: {what} at ({:.3}, {:.3}, {:.3}) m, {:.3} m across; planned in {:.3} s",
+                        "pick: {what} at ({:.3}, {:.3}, {:.3}) m, {}, taken {}; planned in {:.3} s",
                         centre.x,
                         centre.y,
                         centre.z,
-                        2.0 * target.bound_m,
+                        target.size_text(),
+                        self.taken.as_deref().unwrap_or("?"),
                         self.planning_s.unwrap_or_default()
                     ),
                 ));
             }
             Err(why) => self.fail(format!(
-                "{what} at ({:.3}, {:.3}, {:.3}) m: {why}",
-                centre.x, centre.y, centre.z
+                "{what} at ({:.3}, {:.3}, {:.3}) m, {}: {why}",
+                centre.x,
+                centre.y,
+                centre.z,
+                target.size_text()
             )),
         }
     }
@@ -175,6 +186,7 @@ impl Pick {
                     half_height_m,
                     bound_m: half.iter().map(|h| h * h).sum::<f64>().sqrt(),
                     cuboid: Some((base_from_object.rotation, half)),
+                    upright: None,
                 }
             }
             Shape::Sphere { radius_m }

@@ -48,6 +48,7 @@ impl Pick {
             gripper: find_gripper(sim, tool),
             intrinsics,
             sightings: Vec::new(),
+            taken: None,
             stance: None,
             last_seen: None,
             hidden: false,

@@ -121,6 +121,9 @@ pub(super) struct Target {
     /// A box: its orientation (base frame) and half sizes along its axes; the fingers close
     /// across its x or y faces. `None`: round (any turn of the hand will do).
     pub(super) cuboid: Option<(UnitQuaternion<f64>, [f64; 3])>,
+    /// An upright cylinder (a can, a bottle, a cup) of this radius (m): taken across its axis
+    /// with the fingers level, carried and set down upright.
+    pub(super) upright: Option<f64>,
 }
 
 impl Target {
@@ -131,7 +134,50 @@ impl Target {
             half_height_m: radius_m,
             bound_m: radius_m,
             cuboid: None,
+            upright: None,
         }
+    }
+
+    /// An upright cylinder of `radius_m`, `half_height_m` above and below `centre`.
+    pub(super) fn upright(centre: Vector3<f64>, radius_m: f64, half_height_m: f64) -> Self {
+        Self {
+            centre,
+            half_height_m,
+            bound_m: radius_m.hypot(half_height_m),
+            cuboid: None,
+            upright: Some(radius_m),
+        }
+    }
+
+    /// The mean of `seen` (not empty): upright when every one of them is.
+    pub(super) fn mean(seen: &[Target]) -> Self {
+        let n = seen.len().max(1) as f64;
+        let centre = seen.iter().map(|t| t.centre).sum::<Vector3<f64>>() / n;
+        let across = seen.iter().map(Target::across_m).sum::<f64>() / n;
+        if seen.iter().all(|t| t.upright.is_some()) {
+            let half_height_m = seen.iter().map(|t| t.half_height_m).sum::<f64>() / n;
+            Self::upright(centre, across, half_height_m)
+        } else {
+            Self::round(centre, across)
+        }
+    }
+
+    /// Its size as messages say it: "0.067 m across", or "upright, 0.066 m across, 0.124 m
+    /// tall".
+    pub(super) fn size_text(&self) -> String {
+        match self.upright {
+            Some(r) => format!(
+                "upright, {:.3} m across, {:.3} m tall",
+                2.0 * r,
+                2.0 * self.half_height_m
+            ),
+            None => format!("{:.3} m across", 2.0 * self.bound_m),
+        }
+    }
+
+    /// Its radius across the fingers for a round or upright object (a box: its bound).
+    pub(super) fn across_m(&self) -> f64 {
+        self.upright.unwrap_or(self.bound_m)
     }
 }
 
@@ -148,6 +194,9 @@ pub(super) struct Way {
     pub(super) turn: Option<UnitQuaternion<f64>>,
     /// Each finger's position closed on the object (m from the middle).
     pub(super) grip_m: f64,
+    /// Where the tool is from the object's centre (base frame, m): zero but for an upright
+    /// object taken from above (near its top, the hand clear of it).
+    pub(super) offset: Vector3<f64>,
 }
 
 impl Way {
@@ -169,7 +218,7 @@ pub struct Pick {
     pub(super) tool: LinkId,
     pub(super) gripper: Result<Gripper, String>,
     pub(super) intrinsics: [f64; 4],
-    pub(super) sightings: Vec<(Vector3<f64>, f64)>,
+    pub(super) sightings: Vec<Target>,
     /// The last sighting taken (centre, world frame, and radius, m).
     pub(super) last_seen: Option<(Vector3<f64>, f64)>,
     /// The object is not detected and the robot's own links cover where it was last seen.
@@ -184,6 +233,8 @@ pub struct Pick {
     pub(super) object: Option<(Vector3<f64>, f64)>,
     /// Wall-clock seconds the last plan took.
     pub(super) planning_s: Option<f64>,
+    /// How the last plan takes hold of the object ([`Way::label`]).
+    pub(super) taken: Option<String>,
     /// Waypoints of the last plan's joint-space paths: to the pre-grasp, the carry, home
     /// (2: a straight joint move; more: it goes round something).
     pub(super) path_points: Option<[usize; 3]>,

@@ -9,6 +9,12 @@ use super::state::{Gripper, Pick, Way};
 /// Joint-space waypoints (the chain's joints each).
 type Waypoints = Vec<Vec<f64>>;
 
+/// How far (m) below an upright object's top the tool takes it from above: the pads' lower
+/// part round it, the hand clear of its top.
+const TOP_GRIP_M: f64 = 0.025;
+/// How far above an upright object's middle the tool takes it from the side, as a share of
+/// its half height.
+const SIDE_GRIP_SHARE: f64 = 0.4;
 /// Spacing of a straight move's waypoints (m).
 const LINE_STEP_M: f64 = 0.01;
 /// The most one joint may change between a straight move's waypoints (rad): more is IK
@@ -31,6 +37,7 @@ impl Pick {
                     along: horizontal * pitch.cos() - Vector3::z() * pitch.sin(),
                     turn: None,
                     grip_m,
+                    offset: Vector3::zeros(),
                 }
             })
             .collect()
@@ -60,8 +67,61 @@ impl Pick {
                         along: down,
                         turn: Some(turn),
                         grip_m: *half,
+                        offset: Vector3::zeros(),
                     });
                 }
+            }
+        }
+        ways
+    }
+
+    /// The ways to take hold of an upright cylinder of `radius_m` and `half_height_m` whose
+    /// centre is at `point` (base frame), so that it stays upright: coming in along
+    /// [`PickConfig::approach_pitches_deg`] below horizontal (level first: from the side), from
+    /// the arm's side and `yaws_deg` round it, the fingers level, closing across its axis to
+    /// `grip_m`. From the side the tool is above its centre ([`SIDE_GRIP_SHARE`]); from above
+    /// (60 degrees down or more) near its top, the fingers round its upper part and the hand
+    /// clear of it.
+    pub(super) fn ways_upright(
+        &self,
+        point: Vector3<f64>,
+        (radius_m, half_height_m): (f64, f64),
+        g: &Gripper,
+        (pitches_deg, yaws_deg): (&[f64], &[f64]),
+    ) -> Vec<Way> {
+        // Away from the arm's pan axis when it has one (a 5-joint arm holds the hand level
+        // only in the plane through it), else from the base's origin.
+        let pan = (self.solver.chain().first_axis())
+            .filter(|(_, axis)| axis.z.abs() > 0.99)
+            .map_or_else(Vector3::zeros, |(origin, _)| origin);
+        let radial = Vector3::new(point.x - pan.x, point.y - pan.y, 0.0)
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::x);
+        let mut ways = Vec::new();
+        for pitch_deg in pitches_deg {
+            for yaw_deg in yaws_deg {
+                let (pitch, yaw) = (pitch_deg.to_radians(), yaw_deg.to_radians());
+                let horizontal = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw) * radial;
+                let along = horizontal * pitch.cos() - Vector3::z() * pitch.sin();
+                let level = Vector3::z().cross(&horizontal);
+                let Some(turn) = turn_taking(g.across_tool, level, along) else {
+                    continue;
+                };
+                // Above its middle, so it hangs from the fingers rather than turning about
+                // them; from above (60 degrees down or more), near its top.
+                let offset = Vector3::z()
+                    * if *pitch_deg >= 60.0 {
+                        (half_height_m - TOP_GRIP_M).max(0.0)
+                    } else {
+                        SIDE_GRIP_SHARE * half_height_m
+                    };
+                ways.push(Way {
+                    label: format!("{:.0} deg down, {:+.0} deg round", pitch_deg + 0.0, yaw_deg + 0.0),
+                    along,
+                    turn: Some(turn),
+                    grip_m: radius_m,
+                    offset,
+                });
             }
         }
         ways
@@ -82,6 +142,7 @@ impl Pick {
         let mut why: Vec<String> = Vec::new();
         for (k, way) in ways.iter().enumerate() {
             let label = &way.label;
+            let point = point + way.offset;
             let solution = self
                 .solver
                 .solve(&way.target(point), seed)

@@ -1,0 +1,145 @@
+//! An object's shape as the depth image shows it: a detection's pixels back in 3D, split into
+//! what it stands on and the object above that, tell a tall upright object (a can, a bottle, a
+//! cup: [`upright_extent`]) from a round one, and give its axis, radius and height. A sphere's
+//! centre and radius stay [`crate::object_estimate`]'s.
+
+use nalgebra::{Point3, Vector3};
+use rover_perception::BoundingBox;
+
+use super::depth::{DepthView, sample_step};
+
+/// An object is upright and tall when it stands at least this many times its width high.
+const TALL_RATIO: f64 = 1.3;
+/// Points this far (m) above the support are the object's.
+const ABOVE_SUPPORT_M: f64 = 0.012;
+/// Most points sampled in a box.
+const MAX_POINTS: usize = 512;
+/// Beyond the box's front surface, points further than this many object widths (plus
+/// [`DEPTH_SLACK_M`]) are background (the floor past the table's edge, a wall).
+const DEPTH_WINDOW_WIDTHS: f64 = 2.0;
+/// See [`DEPTH_WINDOW_WIDTHS`] (m).
+const DEPTH_SLACK_M: f64 = 0.05;
+
+/// An upright object (its axis vertical) in the arm's base frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Upright {
+    /// The middle of its axis (m).
+    pub centre: Vector3<f64>,
+    /// Its radius across the view (m).
+    pub radius_m: f64,
+    /// Half its height above what it stands on (m).
+    pub half_height_m: f64,
+}
+
+/// The upright object box `b` shows, when it is one: at least [`TALL_RATIO`] times as high as
+/// it is wide. From the box's pixels in the depth image (the robot's own left out, depth within
+/// `max_range_m`), in the arm's base frame (z up):
+/// - the support is the lowest of them (3rd percentile of height), the top the highest (97th);
+/// - the object is what stands more than [`ABOVE_SUPPORT_M`] above the support: its width
+///   across the line of sight (5th to 95th percentile) is the diameter;
+/// - the axis is one radius behind the front surface the camera sees in the middle of it.
+///
+/// `None` for a round or flat object, or a box with too few depth pixels.
+pub fn upright_extent(
+    b: &BoundingBox,
+    view: &DepthView<'_>,
+    [fx, fy, cx, cy]: [f64; 4],
+    max_range_m: f64,
+) -> Option<Upright> {
+    let (w, h) = (i64::from(view.width), i64::from(view.height));
+    let (x0, x1) = (b.xmin.clamp(0, w - 1), b.xmax.clamp(0, w - 1));
+    let (y0, y1) = (b.ymin.clamp(0, h - 1), b.ymax.clamp(0, h - 1));
+    let step = sample_step(x1 - x0 + 1, y1 - y0 + 1);
+    // The nearest depth in the box's middle column: the object's front.
+    let mut points = [(0.0f64, Vector3::zeros()); MAX_POINTS];
+    let mut n = 0;
+    for y in (y0..=y1).step_by(step) {
+        for x in (x0..=x1).step_by(step) {
+            let d = f64::from(view.depth_at(x, y));
+            if view.is_robot(x, y) || !(d.is_finite() && d > 0.0 && d <= max_range_m) {
+                continue;
+            }
+            if n < MAX_POINTS {
+                let optical = Point3::new((x as f64 - cx) / fx * d, (y as f64 - cy) / fy * d, d);
+                points[n] = (d, (view.base_from_optical * optical).coords);
+                n += 1;
+            }
+        }
+    }
+    if n < 16 {
+        return None;
+    }
+    let points = &mut points[..n];
+    // Background far behind the object is not its support.
+    points.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let front_m = points[n / 20].0;
+    let width_m = (x1 - x0) as f64 / fx * front_m;
+    let far_m = front_m + DEPTH_WINDOW_WIDTHS * width_m + DEPTH_SLACK_M;
+    let kept = points.partition_point(|p| p.0 <= far_m);
+    let points = &mut points[..kept];
+    let mut heights = [0.0f64; MAX_POINTS];
+    for (k, p) in points.iter().enumerate() {
+        heights[k] = p.1.z;
+    }
+    let heights = &mut heights[..kept];
+    heights.sort_unstable_by(f64::total_cmp);
+    let support_z = percentile(heights, 0.03);
+    let top_z = percentile(heights, 0.97);
+    // Across and along the line of sight, horizontally, from the camera.
+    let camera = view.base_from_optical.translation.vector;
+    let centre_px = Point3::new(
+        ((b.xmin + b.xmax) as f64 / 2.0 - cx) / fx,
+        ((b.ymin + b.ymax) as f64 / 2.0 - cy) / fy,
+        1.0,
+    );
+    let ray = (view.base_from_optical * centre_px).coords - camera;
+    let ahead = Vector3::new(ray.x, ray.y, 0.0).try_normalize(1e-9)?;
+    let across = Vector3::z().cross(&ahead);
+    let mut side = [0.0f64; MAX_POINTS];
+    let mut m = 0;
+    for (_, p) in points.iter().filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M) {
+        side[m] = (p - camera).dot(&across);
+        m += 1;
+    }
+    if m < 8 {
+        return None;
+    }
+    let side = &mut side[..m];
+    side.sort_unstable_by(f64::total_cmp);
+    let (left, right) = (percentile(side, 0.05), percentile(side, 0.95));
+    // The 5th to 95th percentile of a disc's width seen edge on is 0.975 of it.
+    let radius_m = (right - left) / 2.0 / 0.975;
+    let height_m = top_z - support_z;
+    if height_m < TALL_RATIO * 2.0 * radius_m || radius_m <= 0.0 {
+        return None;
+    }
+    // The front surface, in the middle half of the object's width.
+    let mid = (left + right) / 2.0;
+    let mut range = [0.0f64; MAX_POINTS];
+    let mut k = 0;
+    for (_, p) in points.iter().filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M) {
+        let r = p - camera;
+        if (r.dot(&across) - mid).abs() <= radius_m / 2.0 {
+            range[k] = r.dot(&ahead);
+            k += 1;
+        }
+    }
+    if k == 0 {
+        return None;
+    }
+    let range = &mut range[..k];
+    range.sort_unstable_by(f64::total_cmp);
+    let front = percentile(range, 0.2);
+    let axis = camera + ahead * (front + radius_m) + across * mid;
+    Some(Upright {
+        centre: Vector3::new(axis.x, axis.y, (support_z + top_z) / 2.0),
+        radius_m,
+        half_height_m: height_m / 2.0,
+    })
+}
+
+/// The `share` percentile of sorted `values` (not empty).
+fn percentile(values: &[f64], share: f64) -> f64 {
+    let i = ((values.len() - 1) as f64 * share).round() as usize;
+    values[i.min(values.len() - 1)]
+}
