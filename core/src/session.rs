@@ -233,6 +233,16 @@ impl Session {
         Ok(self.sim.place_object(index, position_m, yaw_rad)?)
     }
 
+    /// Moves SDF model `index` (world order) rigidly so its frame is at `world_from_model`, at
+    /// rest: as [`Session::place_object`], for a Gazebo model.
+    pub fn place_model(
+        &mut self,
+        index: usize,
+        world_from_model: rover_sim::geometry::Pose,
+    ) -> Result<()> {
+        Ok(self.sim.place_model(index, world_from_model)?)
+    }
+
     /// The pilot (mode, teleop limits).
     pub fn pilot(&self) -> &Pilot {
         &self.pilot

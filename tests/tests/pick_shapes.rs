@@ -11,10 +11,14 @@ use rover_sim::geometry::Pose;
 
 /// The world's objects (tests/worlds/arm_car_shapes.toml): the tray, the ball.
 const TRAY: usize = 1;
-const BALL: usize = 2;
-/// The world's model links: the can, the cup.
+const BALL: usize = 6;
+/// The world's models (one link each): the can, the cup.
 const CAN: usize = 0;
 const CUP: usize = 1;
+/// How many model links come before the objects in [`poses`].
+const MODEL_LINKS: usize = 2;
+/// The detector's and the pick's threshold.
+const DETECTION_THRESHOLD: f32 = 0.15;
 /// The tray's top (world z, m) and half its side.
 const TRAY_TOP_Z: f32 = 0.106;
 const TRAY_HALF_M: f32 = 0.06;
@@ -27,6 +31,17 @@ impl rover_core::Observer for Said {
     fn event(&mut self, t: f64, level: EventLevel, text: &str) {
         println!("  {t:7.3} {level:?} {text}");
         self.0.push((t, level, text.to_owned()));
+    }
+
+    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
+        if std::env::var_os("SHAPES_DEBUG").is_some() {
+            for b in &boxes.bounding_boxes {
+                println!(
+                    "  box {} {:.2} [{}, {}, {}, {}]",
+                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
+                );
+            }
+        }
     }
 }
 
@@ -44,9 +59,10 @@ fn session(seed: u64, class: &str) -> Result<Option<Session>> {
     let (world, robot) = config.load_world_and_robot()?;
     let mut options = rover_tests::lockstep_options(seed);
     options.arm.pick.class = class.to_owned();
-    if let Some(n) = std::env::var("SQ").ok().and_then(|v| v.parse().ok()) {
-        options.arm.pick.squeeze_n = n;
-    }
+    // YOLO scores the can "bottle" 0.16-0.47 across the layouts (darknet_ros's 0.3 misses
+    // it in most): the detector's threshold and the pick's at 0.15, as `--threshold 0.15`.
+    options.detector_config.threshold = DETECTION_THRESHOLD;
+    options.arm.pick.min_probability = f64::from(DETECTION_THRESHOLD);
     Ok(Some(Session::new(
         world,
         robot,
@@ -88,7 +104,9 @@ struct Outcome {
 /// Switches pick on after 1 s with `class`, runs until it is done or failed (then 1 s more)
 /// or 30 s have passed; `object` is the picked thing's index in [`poses`].
 fn pick(session: &mut Session, object: usize, said: &mut Said) -> Result<Outcome> {
-    let names = ["can", "cup", "table", "tray", "ball"];
+    let names = [
+        "can", "cup", "table", "tray", "rim", "rim", "rim", "rim", "ball",
+    ];
     while session.sim().sim_time_s() < 1.0 {
         session.step(said)?;
     }
@@ -155,7 +173,7 @@ fn the_arm_car_sets_the_can_upright_on_the_tray() -> Result<()> {
     let mut said = Said::default();
     let outcome = pick(&mut session, CAN, &mut said)?;
     let all = poses(&session);
-    let tray = all[2 + TRAY];
+    let tray = all[MODEL_LINKS + TRAY];
     println!("{outcome:?}");
     let planned = said.0.iter().find(|(_, _, t)| t.contains("planned in"));
     let planned = planned.ok_or_else(|| anyhow!("no plan was said"))?;
@@ -169,6 +187,103 @@ fn the_arm_car_sets_the_can_upright_on_the_tray() -> Result<()> {
         tray.translation
     );
     assert!(outcome.others_moved.0 <= 0.01, "{:?}", outcome.others_moved);
-    let _ = (CUP, BALL);
+    Ok(())
+}
+
+/// A seeded layout of the table: where the can, the cup (their frames, on the table) and the
+/// ball (its centre) are. Each in its own patch, so the hand has room round the one it takes.
+fn layout(seed: u64) -> [[f64; 3]; 3] {
+    let mut rng = rover_sim::SplitMix64(0x5ba9e5 ^ seed.wrapping_mul(0x9e37_79b9));
+    let mut at = |x: f64, y: f64, dx: f64, dy: f64, z: f64| {
+        [x + dx * (rng.unit() - 0.5), y + dy * (rng.unit() - 0.5), z]
+    };
+    [
+        at(0.30, 0.02, 0.06, 0.06, 0.10),
+        at(0.44, 0.04, 0.04, 0.06, 0.10),
+        at(0.36, -0.08, 0.04, 0.04, 0.1335),
+    ]
+}
+
+/// Ten seeded layouts of the table, `--arm-class` for the object YOLO calls `class` (its
+/// index `object` in [`poses`]): each ends with that object upright (within 15 degrees) on the
+/// tray and nothing else on the table moved more than 1 cm, in at least 9 of 10. Prints each
+/// layout, and the planning time's median and slowest.
+fn ten_layouts(class: &str, object: usize) -> Result<()> {
+    let mut results = Vec::new();
+    let only: Option<u64> = std::env::var("SHAPES_TRIAL")
+        .ok()
+        .and_then(|t| t.parse().ok());
+    for seed in (0..10).filter(|s| only.is_none_or(|o| o == *s)) {
+        let Some(mut session) = session(seed, class)? else {
+            return Ok(());
+        };
+        let [can, cup, ball] = layout(seed);
+        for (model, at) in [(CAN, can), (CUP, cup)] {
+            let at = at.map(|v| v as f32);
+            session.place_model(model, Pose::from_translation(Vec3::from(at)))?;
+        }
+        session.place_object(BALL, ball, 0.0)?;
+        let mut said = Said::default();
+        let outcome = pick(&mut session, object, &mut said)?;
+        let tray = poses(&session)[MODEL_LINKS + TRAY];
+        let ok = outcome.state == PickState::Done
+            && upright_on_tray(&outcome.end, &tray)
+            && outcome.others_moved.0 <= 0.01;
+        println!(
+            "layout {seed}: {ok}: ends at {:.3?} leaning {:.1} deg; carried leaning {:.1} deg at most; others moved {:?}; {:.1} s",
+            outcome.end.translation,
+            tilt_deg(&outcome.end),
+            outcome.carried_tilt_deg,
+            outcome.others_moved,
+            outcome.took_s
+        );
+        results.push((ok, outcome.planning_s));
+    }
+    let successes = results.iter().filter(|(ok, _)| *ok).count();
+    let mut planning: Vec<f64> = results.iter().filter_map(|(_, p)| *p).collect();
+    planning.sort_by(f64::total_cmp);
+    println!(
+        "{class}: {successes}/{} upright on the tray; planning median {:.4} s, slowest {:.4} s",
+        results.len(),
+        planning.get(planning.len() / 2).copied().unwrap_or(f64::NAN),
+        planning.last().copied().unwrap_or(f64::NAN)
+    );
+    assert!(
+        successes * 10 >= results.len() * 9,
+        "{successes}/{} layouts",
+        results.len()
+    );
+    Ok(())
+}
+
+/// The can ("bottle" to YOLO) in ten seeded layouts.
+#[test]
+fn ten_layouts_of_the_can_end_upright_on_the_tray() -> Result<()> {
+    ten_layouts("bottle", CAN)
+}
+
+#[test]
+fn zz_debug_settle() -> Result<()> {
+    let Some(mut session) = session(0, "bottle")? else {
+        return Ok(());
+    };
+    let mut said = Said::default();
+    for k in 0..30 {
+        for _ in 0..20 {
+            session.step(&mut said)?;
+        }
+        if k % 3 == 0 {
+            let p = poses(&session);
+            println!(
+                "t {:.2}: can {:.4?} {:.1}, cup {:.4?} {:.1}, ball {:.4?}",
+                session.sim().sim_time_s(),
+                p[0].translation,
+                tilt_deg(&p[0]),
+                p[1].translation,
+                tilt_deg(&p[1]),
+                p[MODEL_LINKS + BALL].translation
+            );
+        }
+    }
     Ok(())
 }

@@ -16,9 +16,9 @@ const ABOVE_SUPPORT_M: f64 = 0.012;
 const MAX_POINTS: usize = 512;
 /// Beyond the box's front surface, points further than this many object widths (plus
 /// [`DEPTH_SLACK_M`]) are background (the floor past the table's edge, a wall).
-const DEPTH_WINDOW_WIDTHS: f64 = 2.0;
+const DEPTH_WINDOW_WIDTHS: f64 = 1.2;
 /// See [`DEPTH_WINDOW_WIDTHS`] (m).
-const DEPTH_SLACK_M: f64 = 0.05;
+const DEPTH_SLACK_M: f64 = 0.02;
 
 /// An upright object (its axis vertical) in the arm's base frame.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -22,7 +22,7 @@ const SET_DOWN_M: f64 = 0.005;
 const SPAN_SLACK_M: f64 = 0.005;
 /// Turns (deg) round the vertical from the arm's side the hand may take an upright object
 /// with, in order.
-const GRASP_YAWS_DEG: [f64; 5] = [0.0, -20.0, 20.0, -40.0, 40.0];
+pub(super) const GRASP_YAWS_DEG: [f64; 5] = [0.0, -20.0, 20.0, -40.0, 40.0];
 /// ... and set it down with.
 const PLACE_YAWS_DEG: [f64; 7] = [0.0, -20.0, 20.0, -40.0, 40.0, -60.0, 60.0];
 /// How far the tool backs up after letting go (m).
@@ -79,6 +79,10 @@ impl Pick {
             place_here,
         )?;
         self.taken = Some(grasp.way.label.clone());
+        self.squeeze_n = match target.upright {
+            Some(_) => self.config.squeeze_upright_n,
+            None => self.config.squeeze_n,
+        };
         let assist = sim.world().robot.grasp == GraspMode::Assist;
         let joints = self.joints().to_vec();
         let speed_scale = self.config.speed_scale;
@@ -166,6 +170,7 @@ impl Pick {
             let grasp = match self.plan_grasp(scene, what, (target, object), g, q0, pitches) {
                 Ok(grasp) => grasp,
                 Err(why) => {
+                    if std::env::var_os("PICK_WHY").is_some() { eprintln!("grasp {pitches:?}: {why}"); }
                     grasp_why.push(why);
                     continue;
                 }
@@ -177,7 +182,7 @@ impl Pick {
             let held = (target, grasp.way.clone());
             match self.plan_place(scene, held, g, (&lift_q, q0), over) {
                 Ok(more) => return Ok((grasp, Some(Ok(more)))),
-                Err(why) if first.is_none() => first = Some((grasp, why)),
+                Err(why) if first.is_none() => { if std::env::var_os("PICK_WHY").is_some() { eprintln!("place {pitches:?}: {why}"); } first = Some((grasp, why)) },
                 Err(_) => {}
             }
         }
@@ -473,7 +478,7 @@ fn set_down_upright(
 /// The pitches (deg below horizontal) an upright object is taken at: `pitches` and level,
 /// steepest first. The pads' length along its side holds it upright; a level hand's pads
 /// touch it only 2 cm high, and a 390 g can turns about the fingers' line as it is lifted.
-fn upright_pitches(pitches: &[f64]) -> Vec<f64> {
+pub(super) fn upright_pitches(pitches: &[f64]) -> Vec<f64> {
     let mut all = pitches.to_vec();
     if !all.contains(&0.0) {
         all.push(0.0);

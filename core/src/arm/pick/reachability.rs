@@ -14,7 +14,8 @@ use rover_sim::{
 };
 
 use super::ground::{body_footprint, obstacles, overlap, stance_pose};
-use super::state::Pick;
+use super::plan::{GRASP_YAWS_DEG, upright_pitches};
+use super::state::{Pick, Target};
 use super::ways::ik_close;
 
 /// Bearings surveyed (deg from the arm base's x, left positive), in order of preference on a
@@ -29,19 +30,23 @@ const RANGE_STEP_M: f64 = 0.02;
 const RUN_MARGIN_M: f64 = 0.04;
 
 impl Pick {
-    /// Whether the arm reaches something round of `radius_m` at `centre` (base frame) from its
-    /// pose now, by IK alone, any way in.
-    pub(super) fn reaches(
-        &mut self,
-        sim: &Simulation,
-        centre: Vector3<f64>,
-        radius_m: f64,
-    ) -> bool {
+    /// Whether the arm reaches `target` from its pose now, by IK alone, any of the ways it
+    /// would be taken.
+    pub(super) fn reaches(&mut self, sim: &Simulation, target: &Target) -> bool {
         let q = self.chain_q(sim);
-        let ways = self.ways_round(centre, radius_m);
+        let pitches = self.config.approach_pitches_deg.clone();
+        let ways = match (target.upright, &self.gripper) {
+            (Some(radius_m), Ok(g)) => self.ways_upright(
+                target.centre,
+                (radius_m, target.half_height_m),
+                g,
+                (&upright_pitches(&pitches), &GRASP_YAWS_DEG),
+            ),
+            _ => self.ways_round(target.centre, target.bound_m),
+        };
         ways.iter().any(|way| {
             self.solver
-                .solve(&way.target(centre), &q)
+                .solve(&way.target(target.centre + way.offset), &q)
                 .is_ok_and(|s| ik_close(s.position_error_m, s.orientation_error_rad))
         })
     }

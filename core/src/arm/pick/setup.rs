@@ -49,6 +49,7 @@ impl Pick {
             intrinsics,
             sightings: Vec::new(),
             taken: None,
+            squeeze_n: 0.0,
             stance: None,
             last_seen: None,
             hidden: false,

@@ -49,7 +49,7 @@ impl Pick {
         }
         if self.fetch_given(sim).is_some()
             || !sim.can_drive()
-            || self.reaches(sim, target.centre, target.bound_m)
+            || self.reaches(sim, target)
         {
             return false;
         }

@@ -235,6 +235,9 @@ pub struct Pick {
     pub(super) planning_s: Option<f64>,
     /// How the last plan takes hold of the object ([`Way::label`]).
     pub(super) taken: Option<String>,
+    /// The gripper's effort closing on it (N or N m): [`PickConfig::squeeze_n`], or
+    /// [`PickConfig::squeeze_upright_n`] for an upright object; set by each plan.
+    pub(super) squeeze_n: f64,
     /// Waypoints of the last plan's joint-space paths: to the pre-grasp, the carry, home
     /// (2: a straight joint move; more: it goes round something).
     pub(super) path_points: Option<[usize; 3]>,
