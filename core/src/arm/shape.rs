@@ -17,6 +17,9 @@ const MAX_POINTS: usize = 512;
 /// Beyond the box's front surface, points further than this many object widths (plus
 /// [`DEPTH_SLACK_M`]) are background (the floor past the table's edge, a wall).
 const DEPTH_WINDOW_WIDTHS: f64 = 1.2;
+/// The object's width must be at least this share of the box's: else the points are not what
+/// the box shows.
+const MIN_BOX_SHARE: f64 = 0.6;
 /// See [`DEPTH_WINDOW_WIDTHS`] (m).
 const DEPTH_SLACK_M: f64 = 0.02;
 
@@ -70,13 +73,20 @@ pub fn upright_extent(
         return None;
     }
     let points = &mut points[..n];
-    // Background far behind the object is not its support.
+    // What is far in front of the object (an occluder) or far behind it (the floor past the
+    // table's edge) is neither it nor its support: depths round the box's middle, the
+    // object's, are kept.
+    let middle_m = object_depth(b, view)?;
+    let width_m = (x1 - x0) as f64 / fx * middle_m;
+    let reach_m = DEPTH_WINDOW_WIDTHS * width_m + DEPTH_SLACK_M;
     points.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-    let front_m = points[n / 20].0;
-    let width_m = (x1 - x0) as f64 / fx * front_m;
-    let far_m = front_m + DEPTH_WINDOW_WIDTHS * width_m + DEPTH_SLACK_M;
-    let kept = points.partition_point(|p| p.0 <= far_m);
-    let points = &mut points[..kept];
+    let first = points.partition_point(|p| p.0 < middle_m - reach_m);
+    let kept = points.partition_point(|p| p.0 <= middle_m + reach_m);
+    let points = &mut points[first..kept];
+    let kept = points.len();
+    if kept < 16 {
+        return None;
+    }
     let mut heights = [0.0f64; MAX_POINTS];
     for (k, p) in points.iter().enumerate() {
         heights[k] = p.1.z;
@@ -97,7 +107,10 @@ pub fn upright_extent(
     let across = Vector3::z().cross(&ahead);
     let mut side = [0.0f64; MAX_POINTS];
     let mut m = 0;
-    for (_, p) in points.iter().filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M) {
+    for (_, p) in points
+        .iter()
+        .filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M)
+    {
         side[m] = (p - camera).dot(&across);
         m += 1;
     }
@@ -110,14 +123,18 @@ pub fn upright_extent(
     // The 5th to 95th percentile of a disc's width seen edge on is 0.975 of it.
     let radius_m = (right - left) / 2.0 / 0.975;
     let height_m = top_z - support_z;
-    if height_m < TALL_RATIO * 2.0 * radius_m || radius_m <= 0.0 {
+    // Not tall, or not what fills the box (a rim or an edge in front of a round object).
+    if height_m < TALL_RATIO * 2.0 * radius_m || 2.0 * radius_m < MIN_BOX_SHARE * width_m {
         return None;
     }
     // The front surface, in the middle half of the object's width.
     let mid = (left + right) / 2.0;
     let mut range = [0.0f64; MAX_POINTS];
     let mut k = 0;
-    for (_, p) in points.iter().filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M) {
+    for (_, p) in points
+        .iter()
+        .filter(|(_, p)| p.z > support_z + ABOVE_SUPPORT_M)
+    {
         let r = p - camera;
         if (r.dot(&across) - mid).abs() <= radius_m / 2.0 {
             range[k] = r.dot(&ahead);
@@ -136,6 +153,30 @@ pub fn upright_extent(
         radius_m,
         half_height_m: height_m / 2.0,
     })
+}
+
+/// The median depth (m) of box `b`'s middle (half its width and height), the robot's own
+/// pixels left out; `None` with none there.
+fn object_depth(b: &BoundingBox, view: &DepthView<'_>) -> Option<f64> {
+    let (w, h) = (i64::from(view.width), i64::from(view.height));
+    let (qx, qy) = ((b.xmax - b.xmin) / 4, (b.ymax - b.ymin) / 4);
+    let (x0, x1) = ((b.xmin + qx).clamp(0, w - 1), (b.xmax - qx).clamp(0, w - 1));
+    let (y0, y1) = ((b.ymin + qy).clamp(0, h - 1), (b.ymax - qy).clamp(0, h - 1));
+    let step = sample_step(x1 - x0 + 1, y1 - y0 + 1);
+    let mut depths = [0.0f64; MAX_POINTS];
+    let mut n = 0;
+    for y in (y0..=y1).step_by(step) {
+        for x in (x0..=x1).step_by(step) {
+            let d = f64::from(view.depth_at(x, y));
+            if !view.is_robot(x, y) && d.is_finite() && d > 0.0 && n < MAX_POINTS {
+                depths[n] = d;
+                n += 1;
+            }
+        }
+    }
+    let depths = &mut depths[..n];
+    depths.sort_unstable_by(f64::total_cmp);
+    depths.get(n / 2).copied()
 }
 
 /// The `share` percentile of sorted `values` (not empty).

@@ -64,20 +64,15 @@ impl Pick {
         let w = world_from_base * Point3::from(target.centre);
         let object = scene.object_near([w.x, w.y, w.z], target.bound_m as f32 + 0.02);
         // Over the place: where the carry ends, and how far it then goes straight down.
-        let place_under = (self.place_under(sim)?)
-            .map(|p| set_down_upright(p, &target, self.config.approach_m));
+        let place_under =
+            (self.place_under(sim)?).map(|p| set_down_upright(p, &target, self.config.approach_m));
         let place = place_under.map(|p| over_place(&world_from_base, p, target.half_height_m));
         let q0 = self.chain_q(sim);
         // With a fetch point the base takes it to the place ([`Self::deliver`]); else the
         // place is planned from here, and only out of reach does the base take it there.
         let place_here = place.filter(|_| self.fetch_given(sim).is_none());
-        let (grasp, placed) = self.grasp_then_place(
-            &mut scene,
-            (what, target, object),
-            &g,
-            &q0,
-            place_here,
-        )?;
+        let (grasp, placed) =
+            self.grasp_then_place(&mut scene, (what, target, object), &g, &q0, place_here)?;
         self.taken = Some(grasp.way.label.clone());
         self.squeeze_n = match target.upright {
             Some(_) => self.config.squeeze_upright_n,
@@ -170,7 +165,6 @@ impl Pick {
             let grasp = match self.plan_grasp(scene, what, (target, object), g, q0, pitches) {
                 Ok(grasp) => grasp,
                 Err(why) => {
-                    if std::env::var_os("PICK_WHY").is_some() { eprintln!("grasp {pitches:?}: {why}"); }
                     grasp_why.push(why);
                     continue;
                 }
@@ -182,7 +176,7 @@ impl Pick {
             let held = (target, grasp.way.clone());
             match self.plan_place(scene, held, g, (&lift_q, q0), over) {
                 Ok(more) => return Ok((grasp, Some(Ok(more)))),
-                Err(why) if first.is_none() => { if std::env::var_os("PICK_WHY").is_some() { eprintln!("place {pitches:?}: {why}"); } first = Some((grasp, why)) },
+                Err(why) if first.is_none() => first = Some((grasp, why)),
                 Err(_) => {}
             }
         }

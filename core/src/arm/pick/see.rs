@@ -58,8 +58,7 @@ impl Pick {
                     None => Target::round(centre, radius),
                 };
                 // A weak box counts only where the object was seen last (a tracker's gate).
-                let gated =
-                    expected.is_some_and(|(p, _)| (p - seen.centre).norm() <= TRACK_GATE_M);
+                let gated = expected.is_some_and(|(p, _)| (p - seen.centre).norm() <= TRACK_GATE_M);
                 (b.probability >= c.min_probability || gated).then_some((b.probability, seen))
             })
             .max_by(|a, b| a.0.total_cmp(&b.0))

@@ -47,10 +47,7 @@ impl Pick {
             self.fail(why);
             return true;
         }
-        if self.fetch_given(sim).is_some()
-            || !sim.can_drive()
-            || self.reaches(sim, target)
-        {
+        if self.fetch_given(sim).is_some() || !sim.can_drive() || self.reaches(sim, target) {
             return false;
         }
         let world = world_from_base * Point3::from(target.centre);

@@ -116,7 +116,11 @@ impl Pick {
                         SIDE_GRIP_SHARE * half_height_m
                     };
                 ways.push(Way {
-                    label: format!("{:.0} deg down, {:+.0} deg round", pitch_deg + 0.0, yaw_deg + 0.0),
+                    label: format!(
+                        "{:.0} deg down, {:+.0} deg round",
+                        pitch_deg + 0.0,
+                        yaw_deg + 0.0
+                    ),
                     along,
                     turn: Some(turn),
                     grip_m: radius_m,
