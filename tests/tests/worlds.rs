@@ -379,3 +379,57 @@ fn y_up_collada_meshes_stand_as_gazebo_draws_them() -> Result<()> {
     }
     Ok(())
 }
+
+/// A TOML world's `[[model]]` brings in a Gazebo model folder, as an SDF `<include>` does:
+/// osrf's coke_can by `model://` through the model path, renamed, at its pose, free (it has a
+/// mass), its class from its model name. A model the path lacks is refused naming the world
+/// file, the entry and where it looked.
+#[test]
+fn toml_worlds_take_gazebo_models() -> Result<()> {
+    let Some(models) = shared("corpus/gazebo_models") else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("table.toml");
+    std::fs::write(
+        &path,
+        "[[box]]\nname = \"table\"\nsize_m = [0.4, 0.4, 0.1]\nposition_m = [0.3, 0.0, 0.05]\n\n\
+         [[model]]\nuri = \"model://coke_can\"\nname = \"can\"\nposition_m = [0.3, 0.02, 0.1]\nyaw_deg = 90.0\n",
+    )?;
+    let resources = ResourcePaths {
+        model_search: vec![models.clone()],
+        ..ResourcePaths::default()
+    };
+    let world = World::load_with(&path, &resources)?;
+    assert_eq!(world.models.len(), 1);
+    let can = &world.models[0];
+    assert_eq!(can.name, "can");
+    assert!(!can.is_static);
+    assert_eq!(can.class.as_deref(), Some("bottle"), "{:?}", can.class);
+    let t = can.world_from_model.translation;
+    assert!(
+        (t - glam::Vec3::new(0.3, 0.02, 0.1)).length() < 1e-6,
+        "{t:?}"
+    );
+    let yaw = rover_sim::geometry::yaw_of(can.world_from_model.rotation);
+    assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-6, "{yaw}");
+    // Its one link at the model's frame (only its inertial is 0.06 m up).
+    let link = can.links[0].world_from_link.translation;
+    assert!((link - t).length() < 1e-6, "{link:?}");
+
+    std::fs::write(
+        &path,
+        "[[model]]\nuri = \"model://no_such_model\"\nposition_m = [0.0, 0.0, 0.0]\n",
+    )?;
+    let err = World::load_with(&path, &resources)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains("table.toml")
+            && err.contains("model[0].uri = \"model://no_such_model\"")
+            && err.contains(&models.display().to_string()),
+        "{err}"
+    );
+    Ok(())
+}

@@ -21,6 +21,11 @@ pub const MODEL_CLASSES: &[(&str, &str)] = &[
     ("table", "dining table"),
     ("table_marble", "dining table"),
     ("bowl", "bowl"),
+    // COCO has no can: YOLO calls osrf's Coke can a "bottle" (0.16-0.47 from the arm car's
+    // mast), and its 11 cm beer can "cup" or "bottle".
+    ("coke_can", "bottle"),
+    ("beer", "bottle"),
+    ("plastic_cup", "cup"),
     ("person_standing", "person"),
     ("person_walking", "person"),
 ];
