@@ -14,6 +14,9 @@ use rover_sim::{
 use super::state::{Grasp, Gripper, Held, Pick, PickState, Step, Target, Way};
 use super::world::world_object;
 
+/// The place's steps from the lift, or why the arm does not reach it.
+type Placed = Result<Vec<(Step, PickState)>, String>;
+
 /// How far above a place point the object's bottom is let go (m): set down, not dropped.
 const SET_DOWN_M: f64 = 0.005;
 /// A round object's estimated radius may exceed the open hand's half-width by this much (m)
@@ -152,7 +155,7 @@ impl Pick {
         g: &Gripper,
         q0: &[f64],
         place: Option<(Vector3<f64>, f64)>,
-    ) -> Result<(Grasp, Option<Result<Vec<(Step, PickState)>, String>>), String> {
+    ) -> Result<(Grasp, Option<Placed>), String> {
         let all = self.config.approach_pitches_deg.clone();
         let tries: Vec<Vec<f64>> = match (target.upright, place) {
             (Some(_), Some(_)) => upright_pitches(&all).into_iter().map(|p| vec![p]).collect(),
