@@ -207,34 +207,7 @@ impl Pick {
             Step::Move(TimedPath::new(w, &joints, speed_scale, RAMP_S, stop))
         };
         // Carrying: the object on the tool, as the hand holds it.
-        match (target.cuboid, way_held.turn) {
-            (None, Some(turn)) if target.upright.is_some() => {
-                // Upright, its axes the base's: the tool `offset` from its centre.
-                let r = target.across_m();
-                let box_from_tool = turn.inverse();
-                let at = box_from_tool * -way_held.offset;
-                let q = box_from_tool.into_inner();
-                scene.attach_box(
-                    self.tool,
-                    Pose::from_parts(
-                        glam::Vec3::new(at.x as f32, at.y as f32, at.z as f32),
-                        glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32),
-                    ),
-                    [r, r, target.half_height_m].map(|h| h as f32),
-                );
-            }
-            (Some((r, half)), Some(turn)) => {
-                let q = (turn.inverse() * r).into_inner();
-                let tool_from_box =
-                    glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32);
-                scene.attach_box(
-                    self.tool,
-                    Pose::from_rotation(tool_from_box),
-                    half.map(|h| h as f32),
-                );
-            }
-            _ => scene.attach_sphere(Some((self.tool, Pose::IDENTITY, target.bound_m as f32))),
-        }
+        self.attach_held(scene, &target, &way_held);
         let ways = match target.upright {
             // Upright as it was taken: the hand at the same pitch, turned round the vertical.
             Some(radius_m) => {
@@ -320,6 +293,39 @@ impl Pick {
             (timed(home, true), PickState::Retreating),
         ]);
         Ok(steps)
+    }
+
+    /// Puts `target`, held as `way_held` takes it, on the tool in `scene` (for the carry's
+    /// checks): upright, a box across its faces, else the sphere round it.
+    fn attach_held(&self, scene: &mut PlanningScene, target: &Target, way_held: &Way) {
+        match (target.cuboid, way_held.turn) {
+            (None, Some(turn)) if target.upright.is_some() => {
+                // Upright, its axes the base's: the tool `offset` from its centre.
+                let r = target.across_m();
+                let box_from_tool = turn.inverse();
+                let at = box_from_tool * -way_held.offset;
+                let q = box_from_tool.into_inner();
+                scene.attach_box(
+                    self.tool,
+                    Pose::from_parts(
+                        glam::Vec3::new(at.x as f32, at.y as f32, at.z as f32),
+                        glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32),
+                    ),
+                    [r, r, target.half_height_m].map(|h| h as f32),
+                );
+            }
+            (Some((r, half)), Some(turn)) => {
+                let q = (turn.inverse() * r).into_inner();
+                let tool_from_box =
+                    glam::Quat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32);
+                scene.attach_box(
+                    self.tool,
+                    Pose::from_rotation(tool_from_box),
+                    half.map(|h| h as f32),
+                );
+            }
+            _ => scene.attach_sphere(Some((self.tool, Pose::IDENTITY, target.bound_m as f32))),
+        }
     }
 
     /// The way to the object and up with it, from `q0`: the path to the pre-grasp (the object
