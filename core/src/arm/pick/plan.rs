@@ -6,19 +6,18 @@ use std::collections::VecDeque;
 use nalgebra::{Isometry3, Point3, Vector3};
 use rover_sim::{
     geometry::Pose,
-    model::{GraspMode, Place, isometry_from_pose},
+    model::{GraspMode, isometry_from_pose},
     physics::Simulation,
     planning::{PlanningScene, TimedPath, plan_path},
 };
 
 use super::state::{Grasp, Gripper, Held, Pick, PickState, Step, Target, Way};
-use super::world::world_object;
 
 /// The place's steps from the lift, or why the arm does not reach it.
 type Placed = Result<Vec<(Step, PickState)>, String>;
 
 /// How far above a place point the object's bottom is let go (m): set down, not dropped.
-const SET_DOWN_M: f64 = 0.005;
+pub(super) const SET_DOWN_M: f64 = 0.005;
 /// A round object's estimated radius may exceed the open hand's half-width by this much (m)
 /// before it is refused: the estimate from a box and a depth image is a centimetre or so off
 /// (an orange of 7.4 cm is seen as 8.6 cm), and the grasp's fingers close on what is there.
@@ -401,40 +400,6 @@ impl Pick {
             lift,
             way: ways[way].clone(),
         })
-    }
-
-    /// Where the object's bottom goes (world frame), how high above that the carry ends, and
-    /// how far the hand then goes straight down before letting go (m): over a world object's
-    /// top centre, [`PickConfig::drop_height_m`] and no further (dropped into a bin, onto a
-    /// tray); at a point, [`PickConfig::approach_m`], then down to [`SET_DOWN_M`] above it (set
-    /// down, as MoveIt's place approaches). From the configured place, else the world's
-    /// `[robot] place`; none: the object is held up. An error for an object the world lacks.
-    pub(super) fn place_under(
-        &self,
-        sim: &Simulation,
-    ) -> Result<Option<([f64; 3], f64, f64)>, String> {
-        let world = sim.world();
-        let name = match self
-            .config
-            .place
-            .clone()
-            .or_else(|| world.robot.place.clone())
-        {
-            None => return Ok(None),
-            Some(Place::Point(p)) => {
-                let above = self.config.approach_m.max(SET_DOWN_M);
-                return Ok(Some((p, above, above - SET_DOWN_M)));
-            }
-            Some(Place::Object(name)) => name,
-        };
-        let (shape, pose) = world_object(sim, &name, "to place on")?;
-        let t = pose.translation;
-        let top = t.z + shape.half_height_m().unwrap_or(0.0);
-        Ok(Some((
-            [f64::from(t.x), f64::from(t.y), f64::from(top)],
-            self.config.drop_height_m,
-            0.0,
-        )))
     }
 }
 
