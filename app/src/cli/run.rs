@@ -42,7 +42,7 @@ pub(crate) fn run_until(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         detector: args.detector.config(super::args::spare_detect_threads())?,
         inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
-        arm: args.arm.arm()?,
+        arm: args.arm.arm(args.detector.threshold)?,
         ground_truth: args.follow.ground_truth,
         // ROS peers expect real time: --ros and --ros2 pace headless runs unless --rtf says
         // otherwise.
@@ -217,7 +217,7 @@ fn run_window(args: RunArgs, stop: Arc<AtomicBool>) -> Result<()> {
         detector_config: args.detector.config(super::args::spare_detect_threads())?,
         inject_fault: args.detector.inject_fault,
         follower: args.follow.follower()?,
-        arm: args.arm.arm()?,
+        arm: args.arm.arm(args.detector.threshold)?,
         ground_truth: args.follow.ground_truth,
     };
     let mut transports = Transports::start(&args.ros, &robot, args.follow.ground_truth)?;

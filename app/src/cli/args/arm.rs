@@ -89,7 +89,9 @@ fn parse_place(text: &str) -> anyhow::Result<rover_sim::model::Place> {
 }
 
 impl ArmArgs {
-    pub(crate) fn arm(&self) -> anyhow::Result<rover_core::ArmConfig> {
+    /// The arm's settings; the pick takes boxes down to the detector's `threshold` when that is
+    /// under its own (0.25): `--threshold 0.15` lets it pick a can YOLO scores 0.2.
+    pub(crate) fn arm(&self, threshold: f32) -> anyhow::Result<rover_core::ArmConfig> {
         anyhow::ensure!(
             self.reach_standoff.is_finite() && self.reach_standoff >= 0.0,
             "--reach-standoff must be a distance of 0 m or more, found {}",
@@ -114,6 +116,9 @@ impl ArmArgs {
                 place: self.place.as_deref().map(parse_place).transpose()?,
                 object: self.pick_object.clone(),
                 fetch_at: self.fetch.as_deref().map(parse_fetch).transpose()?,
+                min_probability: rover_core::PickConfig::default()
+                    .min_probability
+                    .min(f64::from(threshold)),
                 ..rover_core::PickConfig::default()
             },
         })
