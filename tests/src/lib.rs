@@ -17,6 +17,29 @@ use rover_sim::{
     physics::{ControlSample, SimOptions, Simulation, Twist},
 };
 
+/// An observer for the arm's end-to-end tests: events said, printed as they come and kept;
+/// with `ROVER_TEST_BOXES` set, every detection box printed too.
+#[derive(Debug, Default)]
+pub struct Said(pub Vec<(f64, rover_core::EventLevel, String)>);
+
+impl rover_core::Observer for Said {
+    fn event(&mut self, t: f64, level: rover_core::EventLevel, text: &str) {
+        println!("  {t:7.3} {level:?} {text}");
+        self.0.push((t, level, text.to_owned()));
+    }
+
+    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
+        if std::env::var_os("ROVER_TEST_BOXES").is_some() {
+            for b in &boxes.bounding_boxes {
+                println!(
+                    "  box {} {:.2} [{}, {}, {}, {}]",
+                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
+                );
+            }
+        }
+    }
+}
+
 /// Path of a file in the repository.
 pub fn repo(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

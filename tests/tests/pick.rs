@@ -5,6 +5,7 @@
 use anyhow::Result;
 use rover_core::{Action, EventLevel, PickState, Session};
 use rover_sim::geometry::Pose;
+use rover_tests::Said;
 
 /// The ball's index among the world's objects (worlds/arm_car_pick.toml).
 const BALL: usize = 6;
@@ -12,28 +13,6 @@ const BALL: usize = 6;
 const BIN_X: (f64, f64) = (0.195, 0.305);
 const BIN_Y: (f64, f64) = (-0.205, -0.095);
 const BIN_FLOOR_Z: f64 = 0.104;
-
-/// Events said, printed as they come.
-#[derive(Default)]
-struct Said(Vec<(f64, EventLevel, String)>);
-
-impl rover_core::Observer for Said {
-    fn event(&mut self, t: f64, level: EventLevel, text: &str) {
-        println!("  {t:7.3} {level:?} {text}");
-        self.0.push((t, level, text.to_owned()));
-    }
-
-    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
-        if std::env::var_os("PICK_DEBUG").is_some() {
-            for b in &boxes.bounding_boxes {
-                println!(
-                    "  box {} {:.2} [{}, {}, {}, {}]",
-                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
-                );
-            }
-        }
-    }
-}
 
 /// The pick world as shipped, detecting at 5 Hz of sim time in lockstep.
 fn session(seed: u64) -> Result<Session> {

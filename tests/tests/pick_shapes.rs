@@ -6,8 +6,9 @@
 
 use anyhow::{Result, anyhow};
 use glam::Vec3;
-use rover_core::{Action, EventLevel, PickState, Session};
+use rover_core::{Action, PickState, Session};
 use rover_sim::geometry::Pose;
+use rover_tests::Said;
 
 /// The world's objects (tests/worlds/arm_car_shapes.toml): the tray, the ball.
 const TRAY: usize = 1;
@@ -22,28 +23,6 @@ const DETECTION_THRESHOLD: f32 = 0.15;
 /// The tray's top (world z, m) and half its side.
 const TRAY_TOP_Z: f32 = 0.106;
 const TRAY_HALF_M: f32 = 0.075;
-
-/// Events said, printed as they come.
-#[derive(Default)]
-struct Said(Vec<(f64, EventLevel, String)>);
-
-impl rover_core::Observer for Said {
-    fn event(&mut self, t: f64, level: EventLevel, text: &str) {
-        println!("  {t:7.3} {level:?} {text}");
-        self.0.push((t, level, text.to_owned()));
-    }
-
-    fn detections(&mut self, boxes: &rover_perception::BoundingBoxes, _labels: &[String]) {
-        if std::env::var_os("SHAPES_DEBUG").is_some() {
-            for b in &boxes.bounding_boxes {
-                println!(
-                    "  box {} {:.2} [{}, {}, {}, {}]",
-                    b.class, b.probability, b.xmin, b.ymin, b.xmax, b.ymax
-                );
-            }
-        }
-    }
-}
 
 /// The shapes world, its models from the corpus, detecting at 5 Hz of sim time in lockstep,
 /// the arm after `class`; `None` (skipped, with the reason) where ../shared is absent.
