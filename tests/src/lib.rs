@@ -40,6 +40,14 @@ impl rover_core::Observer for Said {
     }
 }
 
+/// The median and the largest of `times` (NaN for none): how planning times are reported.
+pub fn median_and_slowest(times: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let mut sorted: Vec<f64> = times.into_iter().collect();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN);
+    (median, sorted.last().copied().unwrap_or(f64::NAN))
+}
+
 /// Path of a file in the repository.
 pub fn repo(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

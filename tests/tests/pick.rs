@@ -352,17 +352,12 @@ fn twenty_seeded_picks_put_the_ball_in_the_bin() -> Result<()> {
         results.push((ok, outcome));
     }
     let successes = results.iter().filter(|(ok, _)| *ok).count();
-    let mut planning: Vec<f64> = results.iter().filter_map(|(_, o)| o.planning_s).collect();
-    planning.sort_by(f64::total_cmp);
+    let planned = results.iter().filter_map(|(_, o)| o.planning_s);
+    let (median, slowest) = rover_tests::median_and_slowest(planned.clone());
     let took: Vec<f64> = results.iter().map(|(_, o)| o.took_s).collect();
     println!(
-        "{successes}/20 in the bin; planning median {:.4} s, slowest {:.4} s ({} planned); sim seconds per pick: {took:.1?}",
-        planning
-            .get(planning.len() / 2)
-            .copied()
-            .unwrap_or(f64::NAN),
-        planning.last().copied().unwrap_or(f64::NAN),
-        planning.len()
+        "{successes}/20 in the bin; planning median {median:.4} s, slowest {slowest:.4} s ({} planned); sim seconds per pick: {took:.1?}",
+        planned.count()
     );
     let trials = results.len();
     assert_eq!(successes, trials, "{successes}/{trials} picks");
@@ -830,16 +825,11 @@ fn out_of_reach_the_base_moves_and_9_of_10_layouts_end_in_the_bin() -> Result<()
         results.push((ok, outcome));
     }
     let successes = results.iter().filter(|(ok, _)| *ok).count();
-    let mut planning: Vec<f64> = results.iter().filter_map(|(_, o)| o.planning_s).collect();
-    planning.sort_by(f64::total_cmp);
+    let (median, slowest) =
+        rover_tests::median_and_slowest(results.iter().filter_map(|(_, o)| o.planning_s));
     println!(
-        "{successes}/{} in the bin; planning median {:.4} s, slowest {:.4} s",
-        results.len(),
-        planning
-            .get(planning.len() / 2)
-            .copied()
-            .unwrap_or(f64::NAN),
-        planning.last().copied().unwrap_or(f64::NAN)
+        "{successes}/{} in the bin; planning median {median:.4} s, slowest {slowest:.4} s",
+        results.len()
     );
     if only.is_none() {
         assert!(successes >= 9, "{successes}/10 in the bin");
