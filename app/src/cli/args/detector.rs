@@ -22,7 +22,8 @@ pub(crate) struct DetectorArgs {
     #[arg(long, value_name = "FILE")]
     pub(crate) labels: Option<PathBuf>,
 
-    /// Confidence threshold (darknet_ros's default)
+    /// Confidence threshold (darknet_ros's default); under 0.25 it is the pick's too
+    /// (`--threshold 0.15` lets pick take a can YOLO scores 0.2)
     #[arg(long, default_value_t = DEFAULT_THRESHOLD, value_name = "T")]
     pub(crate) threshold: f32,
 
