@@ -515,7 +515,10 @@ fn an_rclpy_gripper_command_closes_on_the_ball() -> Result<()> {
 /// Each topic of docs/ROS2.md's table for the tutorial car with a laser reaches an rclpy
 /// subscription of its real type and documented QoS (sensor data best effort; /tf_static,
 /// /robot_description and the detection image transient local, subscribed after rover
-/// started): a table of topic, type, QoS and messages received in 10 s.
+/// started): a table of topic, type, QoS and messages received in 10 s. A topic silent in those
+/// 10 s has 10 s more to show it arrives at all: the detection image (a reliable 900 kB sample,
+/// deserialized in Python beside 13 other subscriptions) comes at about 0.5 Hz, and on a loaded
+/// machine Kilted's peer once took none in the window.
 #[test]
 fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
     let Some(distros) = distros() else {
@@ -532,14 +535,16 @@ fn rclpy_subscriptions_receive_each_topic_of_the_table() -> Result<()> {
         )?;
         let found = session.peer(&["topics"], Duration::from_secs(90))?;
         let table = found["topics"]["table"].as_array().context("no table")?;
-        println!("{distro}: | topic | type | QoS | messages in 10 s |");
+        println!("{distro}: | topic | type | QoS | messages in 10 s | reached in 20 s |");
         let mut silent = Vec::new();
         for row in table {
             println!(
-                "{distro}: | {} | {} | {} | {} |",
-                row[0], row[1], row[2], row[3]
+                "{distro}: | {} | {} | {} | {} | {} |",
+                row[0], row[1], row[2], row[3], row[4]
             );
-            if row[3].as_u64().unwrap_or(0) == 0 {
+            // Each topic reaches the subscription: within the window, or (a slow, large
+            // reliable sample) within 10 s more.
+            if row[4] != serde_json::Value::Bool(true) {
                 silent.push(row[0].to_string());
             }
         }
