@@ -75,11 +75,35 @@ pub fn object_estimate(
     [fx, fy, cx, cy]: [f64; 4],
     max_range_m: f64,
 ) -> Option<(Vector3<f64>, f64)> {
-    let (w, h) = (i64::from(view.width), i64::from(view.height));
+    let z = central_depth(b, view, max_range_m)?;
     let (xmin, xmax, ymin, ymax) = (b.xmin, b.xmax, b.ymin, b.ymax);
-    let (qx, qy) = ((xmax - xmin) / 4, (ymax - ymin) / 4);
-    let (x0, x1) = ((xmin + qx).clamp(0, w - 1), (xmax - qx).clamp(0, w - 1));
-    let (y0, y1) = ((ymin + qy).clamp(0, h - 1), (ymax - qy).clamp(0, h - 1));
+    let u = (b.xmin + b.xmax) as f64 / 2.0;
+    let v = (b.ymin + b.ymax) as f64 / 2.0;
+    let surface = Vector3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
+    let radius = radius_seen(
+        (xmax - xmin) as f64 / fx,
+        (ymax - ymin) as f64 / fy,
+        surface.norm(),
+    );
+    let centre = surface + surface.normalize() * radius;
+    Some((
+        (view.base_from_optical * Point3::from(centre)).coords,
+        radius,
+    ))
+}
+
+/// The median depth (m) of box `b`'s central part (half its width and height round its
+/// centre): the surface the camera sees there. The robot's own pixels are left out, and depths
+/// beyond `max_range_m`; `None` when none is left.
+pub(crate) fn central_depth(
+    b: &BoundingBox,
+    view: &DepthView<'_>,
+    max_range_m: f64,
+) -> Option<f64> {
+    let (w, h) = (i64::from(view.width), i64::from(view.height));
+    let (qx, qy) = ((b.xmax - b.xmin) / 4, (b.ymax - b.ymin) / 4);
+    let (x0, x1) = ((b.xmin + qx).clamp(0, w - 1), (b.xmax - qx).clamp(0, w - 1));
+    let (y0, y1) = ((b.ymin + qy).clamp(0, h - 1), (b.ymax - qy).clamp(0, h - 1));
     // A box of a few pixels: at most 400 samples, so the median costs nothing.
     let step = sample_step(x1 - x0 + 1, y1 - y0 + 1);
     let mut samples = [0.0f32; 512];
@@ -102,20 +126,7 @@ pub fn object_estimate(
     }
     let samples = &mut samples[..n];
     samples.sort_unstable_by(f32::total_cmp);
-    let z = f64::from(samples[n / 2]);
-    let u = (b.xmin + b.xmax) as f64 / 2.0;
-    let v = (b.ymin + b.ymax) as f64 / 2.0;
-    let surface = Vector3::new((u - cx) / fx * z, (v - cy) / fy * z, z);
-    let radius = radius_seen(
-        (xmax - xmin) as f64 / fx,
-        (ymax - ymin) as f64 / fy,
-        surface.norm(),
-    );
-    let centre = surface + surface.normalize() * radius;
-    Some((
-        (view.base_from_optical * Point3::from(centre)).coords,
-        radius,
-    ))
+    Some(f64::from(samples[n / 2]))
 }
 
 /// The radius (m) of a sphere whose silhouette spans `width` by `height` (the box's sides over

@@ -6,7 +6,7 @@
 use nalgebra::{Point3, Vector3};
 use rover_perception::BoundingBox;
 
-use super::depth::{DepthView, sample_step};
+use super::depth::{DepthView, central_depth, sample_step};
 
 /// An object is upright and tall when it stands at least this many times its width high (as
 /// read: the width is read narrow, by 17 % on a can and up to 30 % on an orange the arm half
@@ -78,7 +78,7 @@ pub fn upright_extent(
     // What is far in front of the object (an occluder) or far behind it (the floor past the
     // table's edge) is neither it nor its support: depths round the box's middle, the
     // object's, are kept.
-    let middle_m = object_depth(b, view)?;
+    let middle_m = central_depth(b, view, max_range_m)?;
     let width_m = (x1 - x0) as f64 / fx * middle_m;
     let reach_m = DEPTH_WINDOW_WIDTHS * width_m + DEPTH_SLACK_M;
     points.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
@@ -157,30 +157,6 @@ pub fn upright_extent(
         radius_m,
         half_height_m: height_m / 2.0,
     })
-}
-
-/// The median depth (m) of box `b`'s middle (half its width and height), the robot's own
-/// pixels left out; `None` with none there.
-fn object_depth(b: &BoundingBox, view: &DepthView<'_>) -> Option<f64> {
-    let (w, h) = (i64::from(view.width), i64::from(view.height));
-    let (qx, qy) = ((b.xmax - b.xmin) / 4, (b.ymax - b.ymin) / 4);
-    let (x0, x1) = ((b.xmin + qx).clamp(0, w - 1), (b.xmax - qx).clamp(0, w - 1));
-    let (y0, y1) = ((b.ymin + qy).clamp(0, h - 1), (b.ymax - qy).clamp(0, h - 1));
-    let step = sample_step(x1 - x0 + 1, y1 - y0 + 1);
-    let mut depths = [0.0f64; MAX_POINTS];
-    let mut n = 0;
-    for y in (y0..=y1).step_by(step) {
-        for x in (x0..=x1).step_by(step) {
-            let d = f64::from(view.depth_at(x, y));
-            if !view.is_robot(x, y) && d.is_finite() && d > 0.0 && n < MAX_POINTS {
-                depths[n] = d;
-                n += 1;
-            }
-        }
-    }
-    let depths = &mut depths[..n];
-    depths.sort_unstable_by(f64::total_cmp);
-    depths.get(n / 2).copied()
 }
 
 /// The `share` percentile of sorted `values` (not empty).

@@ -346,19 +346,7 @@ impl Pick {
             scene.ignore_object(t, true);
         }
         spans(g, what, &object)?;
-        let ways = match (object.cuboid, object.upright) {
-            (Some((r, half)), _) => self.ways_across(
-                [(r * Vector3::x(), half[0]), (r * Vector3::y(), half[1])],
-                g,
-            ),
-            (None, Some(radius_m)) => self.ways_upright(
-                centre,
-                (radius_m, object.half_height_m),
-                g,
-                (pitches, &GRASP_YAWS_DEG),
-            ),
-            (None, None) => self.ways_round(centre, object.bound_m),
-        };
+        let ways = self.ways_taking(&object, g, pitches);
         if ways.is_empty() {
             return Err(format!(
                 "cannot grasp {what}: it is wider than the open gripper ({:.3} m) every way",

@@ -14,7 +14,7 @@ use rover_sim::{
 };
 
 use super::ground::{body_footprint, obstacles, overlap, stance_pose};
-use super::plan::{GRASP_YAWS_DEG, upright_pitches};
+use super::plan::upright_pitches;
 use super::state::{Pick, Target};
 use super::ways::ik_close;
 
@@ -34,15 +34,13 @@ impl Pick {
     /// would be taken.
     pub(super) fn reaches(&mut self, sim: &Simulation, target: &Target) -> bool {
         let q = self.chain_q(sim);
-        let pitches = self.config.approach_pitches_deg.clone();
-        let ways = match (target.upright, &self.gripper) {
-            (Some(radius_m), Ok(g)) => self.ways_upright(
-                target.centre,
-                (radius_m, target.half_height_m),
-                g,
-                (&upright_pitches(&pitches), &GRASP_YAWS_DEG),
-            ),
-            _ => self.ways_round(target.centre, target.bound_m),
+        let mut pitches = self.config.approach_pitches_deg.clone();
+        if target.upright.is_some() {
+            pitches = upright_pitches(&pitches);
+        }
+        let ways = match &self.gripper {
+            Ok(g) => self.ways_taking(target, g, &pitches),
+            Err(_) => self.ways_round(target.centre, target.bound_m),
         };
         ways.iter().any(|way| {
             self.solver

@@ -4,7 +4,8 @@
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rover_sim::{model::IkTarget, planning::PlanningScene};
 
-use super::state::{Gripper, Pick, Way};
+use super::plan::GRASP_YAWS_DEG;
+use super::state::{Gripper, Pick, Target, Way};
 
 /// Joint-space waypoints (the chain's joints each).
 type Waypoints = Vec<Vec<f64>>;
@@ -22,6 +23,25 @@ const LINE_STEP_M: f64 = 0.01;
 const MAX_LINE_JUMP_RAD: f64 = 0.3;
 
 impl Pick {
+    /// The ways to take hold of `target`: a box across its faces, an upright object level
+    /// across its axis at `pitches` (below horizontal, in order) and [`GRASP_YAWS_DEG`] round
+    /// it, anything else round.
+    pub(super) fn ways_taking(&self, target: &Target, g: &Gripper, pitches: &[f64]) -> Vec<Way> {
+        match (target.cuboid, target.upright) {
+            (Some((r, half)), _) => self.ways_across(
+                [(r * Vector3::x(), half[0]), (r * Vector3::y(), half[1])],
+                g,
+            ),
+            (None, Some(radius_m)) => self.ways_upright(
+                target.centre,
+                (radius_m, target.half_height_m),
+                g,
+                (pitches, &GRASP_YAWS_DEG),
+            ),
+            (None, None) => self.ways_round(target.centre, target.bound_m),
+        }
+    }
+
     /// The ways to take hold of something round at `point` (base frame): coming in along
     /// [`PickConfig::approach_pitches_deg`] below horizontal, away from the arm's base, the
     /// turn about the way in free; the fingers close to `grip_m`.
@@ -76,10 +96,9 @@ impl Pick {
     }
 
     /// The ways to take hold of an upright cylinder of `radius_m` and `half_height_m` whose
-    /// centre is at `point` (base frame), so that it stays upright: coming in along
-    /// [`PickConfig::approach_pitches_deg`] below horizontal (level first: from the side), from
-    /// the arm's side and `yaws_deg` round it, the fingers level, closing across its axis to
-    /// `grip_m`. From the side the tool is above its centre ([`SIDE_GRIP_SHARE`]); from above
+    /// centre is at `point` (base frame), so that it stays upright: coming in `pitches_deg`
+    /// below horizontal (in order), from the arm's side and `yaws_deg` round it, the fingers
+    /// level, closing across its axis to `radius_m`. From the side the tool is above its centre ([`SIDE_GRIP_SHARE`]); from above
     /// (60 degrees down or more) near its top, the fingers round its upper part and the hand
     /// clear of it.
     pub(super) fn ways_upright(
