@@ -91,6 +91,78 @@ fn a_mimic_finger_follows_its_leader_and_takes_no_commands() -> Result<()> {
     Ok(())
 }
 
+/// The same gripper with its `<mimic>` given instead by the mimic joint plugin Gazebo Classic
+/// users add (roboticsgroup_upatras_gazebo_plugins): the right finger follows the left the same
+/// way; a plugin naming a missing joint, a fixed one, or the leader itself is refused at its
+/// line.
+#[test]
+fn the_mimic_joint_plugin_stands_for_a_mimic() -> Result<()> {
+    let plugin = |joint: &str, mimic: &str| {
+        let without = GRIPPER.replace(
+            r#"<mimic joint="left_finger_joint" multiplier="-1" offset="0.01"/>"#,
+            "",
+        );
+        without.replace(
+            "</robot>",
+            &format!(
+                r#"  <gazebo>
+    <plugin name="mimic" filename="libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so">
+      <joint>{joint}</joint>
+      <mimicJoint>{mimic}</mimicJoint>
+      <multiplier>-1.0</multiplier>
+      <offset>0.01</offset>
+    </plugin>
+  </gazebo>
+</robot>"#
+            ),
+        )
+    };
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("gripper.urdf");
+    std::fs::write(&path, plugin("left_finger_joint", "right_finger_joint"))?;
+    let robot = RobotModel::load_with(&path, &LoadOptions::default())?;
+    let mut sim = rover_tests::flat_sim(robot)?;
+    run(&mut sim, 0.5);
+    sim.command_joint("left_finger_joint", JointCommand::Position(0.03))?;
+    run(&mut sim, 1.0);
+    let (left, right) = (
+        position(&sim, "left_finger_joint")?,
+        position(&sim, "right_finger_joint")?,
+    );
+    println!("plugin: left {left:.4} m, right {right:.4} m (want 0.03, -0.02)");
+    ensure!(
+        (left - 0.03).abs() < 1e-3 && (right + 0.02).abs() < 1e-3,
+        "closed: left {left}, right {right} (want 0.03 and -0.02)"
+    );
+    let plugin_line = plugin("a", "b")
+        .lines()
+        .position(|l| l.contains("<plugin name=\"mimic\""))
+        .map_or(0, |i| i + 1);
+    for (joint, mimic, expect) in [
+        (
+            "left_finger_joint",
+            "thumb",
+            "no joint \"thumb\"; joints in this robot:",
+        ),
+        (
+            "left_finger_joint",
+            "left_finger_joint",
+            "a joint cannot follow itself",
+        ),
+    ] {
+        std::fs::write(&path, plugin(joint, mimic))?;
+        let err = RobotModel::load_with(&path, &LoadOptions::default())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        ensure!(
+            err.contains(expect) && err.contains(&format!(":{plugin_line}")),
+            "{joint} -> {mimic}: {err:?} (want {expect:?} at line {plugin_line})"
+        );
+    }
+    Ok(())
+}
+
 #[test]
 fn pandas_second_finger_follows_the_first() -> Result<()> {
     let Some(urdf) = rover_tests::example_robot_data("panda_description/urdf/panda.urdf") else {

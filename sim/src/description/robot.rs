@@ -149,6 +149,7 @@ impl RobotModel {
         )?;
         let mut joints = read_joints(&urdf.joints, &link_index, links.len(), path, &lines)?;
         resolve_mimics(&urdf.joints, &mut joints, path, &lines)?;
+        apply_mimic_plugins(&extensions.mimics, &mut joints, path)?;
         let transmissions = read_transmissions(&urdf, &joints, path)?;
         let root = find_root(&links, &joints, path, &lines)?;
 
@@ -718,6 +719,60 @@ fn resolve_mimics(
             joint: JointId(index),
             multiplier: *multiplier as f32,
             offset: *offset as f32,
+        });
+    }
+    Ok(())
+}
+
+/// Mimic joint plugins (`<gazebo>`): each follower gets the `<mimic>` the plugin stands for.
+/// A joint the robot lacks, a fixed joint, a joint following itself or one already mimicking
+/// is refused at the plugin's line.
+fn apply_mimic_plugins(
+    plugins: &[gazebo::MimicPlugin],
+    joints: &mut [Joint],
+    path: &Path,
+) -> Result<()> {
+    for plugin in plugins {
+        let err = |message: String| {
+            SimError::invalid(
+                path,
+                Some(plugin.line),
+                format!("the mimic joint plugin: {message}"),
+            )
+        };
+        let find = |name: &str| -> Result<usize> {
+            joints.iter().position(|j| j.name == name).ok_or_else(|| {
+                err(format!(
+                    "no joint \"{name}\"; joints in this robot: {}",
+                    names(joints.iter().map(|j| &j.name))
+                ))
+            })
+        };
+        let (leader, follower) = (find(&plugin.joint)?, find(&plugin.mimic_joint)?);
+        if leader == follower {
+            return Err(err(format!(
+                "<mimicJoint> {}: a joint cannot follow itself",
+                plugin.mimic_joint
+            )));
+        }
+        for index in [leader, follower] {
+            if !joints[index].is_moving() {
+                return Err(err(format!(
+                    "joint \"{}\" is fixed: expected a revolute or prismatic joint",
+                    joints[index].name
+                )));
+            }
+        }
+        if joints[follower].mimic.is_some() {
+            return Err(err(format!(
+                "joint \"{}\" already mimics another joint",
+                plugin.mimic_joint
+            )));
+        }
+        joints[follower].mimic = Some(Mimic {
+            joint: JointId(leader),
+            multiplier: plugin.multiplier as f32,
+            offset: plugin.offset as f32,
         });
     }
     Ok(())

@@ -136,6 +136,7 @@ struct RawRobot {
     place: Option<RawPlace>,
     pick: Option<String>,
     fetch: Option<[f64; 2]>,
+    pose: Option<String>,
 }
 
 /// `place = "NAME"` or `place = [x, y, z]`.
@@ -494,6 +495,7 @@ impl RawWorld {
                 }
                 None => None,
             },
+            pose: raw_robot.pose,
         };
 
         c.positive("physics.step_hz", &[self.physics.step_hz], "Hz")?;

@@ -304,6 +304,20 @@ impl KinematicChain {
         first
     }
 
+    /// Whether every joint that turns has a vertical axis (base frame, within about 8
+    /// degrees): the tip then never tilts, whatever the joints do (a lift, a telescoping arm
+    /// and a wrist's yaw, as Hello Robot's Stretch): its orientation is not the planner's to
+    /// choose beyond a turn about the vertical.
+    pub fn holds_level(&self) -> bool {
+        let mut level = true;
+        self.walk(&vec![0.0; self.joints.len()], |i, _, axis| {
+            if !self.joints[i].prismatic && axis.z.abs() < 0.99 {
+                level = false;
+            }
+        });
+        level && !self.joints.is_empty()
+    }
+
     /// Forward kinematics: calls `visit(i, origin, axis)` with each moving joint's origin and
     /// axis in the base frame, and returns base_from_tip.
     fn walk(

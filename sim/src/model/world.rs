@@ -103,6 +103,9 @@ pub struct RobotSpawn {
     /// when the car stops to pick it; set, the pick drives the car: to within reach of what it
     /// sees, then to a world object place. `None`: the pick never moves the base.
     pub fetch: Option<[f64; 2]>,
+    /// `pose`: a named pose of the controllers file (`named_poses`) the joints move to as the
+    /// world starts, as a launch file's first command would (a head turned to the table).
+    pub pose: Option<String>,
 }
 
 /// Where pick puts what it picked (`[robot] place`, `--place`).

@@ -230,7 +230,7 @@ impl Simulation {
             world.robot.grasp,
             &mut physics,
         )?;
-        Ok(Self {
+        let mut sim = Self {
             physics,
             anchors,
             springs: robot_bodies.springs,
@@ -257,7 +257,12 @@ impl Simulation {
             srdf_disabled: crate::description::srdf::srdf_disabled_collisions(&world, &robot)?,
             robot,
             world,
-        })
+        };
+        if let Some(name) = sim.world.robot.pose.clone() {
+            sim.go_to_named_pose(&name)
+                .map_err(|e| SimError::Setup(format!("[robot] pose = \"{name}\": {e}")))?;
+        }
+        Ok(sim)
     }
 
     /// Sets cmd_vel (takes effect at the next control update). Non-finite values are rejected and
@@ -671,6 +676,13 @@ impl Simulation {
                 .get(*h)
                 .map_or(Pose::IDENTITY, |b| *b.position())
         }));
+    }
+
+    /// Where model link `index` (in [`Self::model_link_poses_into`]'s order) has its centre of
+    /// mass now (world frame, m); `None` for no such link.
+    pub fn model_link_centre(&self, index: usize) -> Option<glam::Vec3> {
+        let body = self.physics.bodies.get(*self.model_links.get(index)?)?;
+        Some(body.center_of_mass())
     }
 
     /// Ground-truth planar pose and velocity of the base link.

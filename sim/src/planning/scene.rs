@@ -425,6 +425,29 @@ impl Simulation {
         Ok(scene)
     }
 
+    /// The box round `link`'s collision shapes in the link's own frame (m: its lowest and
+    /// highest corners), meshes as the hulls the physics uses; `None` when it has none.
+    pub fn link_collision_box(&self, link: LinkId) -> Result<Option<([f32; 3], [f32; 3])>> {
+        let robot = &self.robot;
+        let Some(l) = robot.links.get(link.index()) else {
+            return Ok(None);
+        };
+        let mut bounds: Option<([f32; 3], [f32; 3])> = None;
+        for c in &l.collisions {
+            let (shape, fix) = collider_shape(&c.shape, &robot.source, &l.name, false)?;
+            let aabb = shape.compute_aabb(&(c.link_from_shape * fix));
+            let (lo, hi) = (aabb.mins, aabb.maxs);
+            bounds = Some(match bounds {
+                None => (lo.into(), hi.into()),
+                Some((a, b)) => (
+                    glam::Vec3::from(a).min(lo).into(),
+                    glam::Vec3::from(b).max(hi).into(),
+                ),
+            });
+        }
+        Ok(bounds)
+    }
+
     /// Brings `scene` (this robot's) up to now: the joints' positions, where the robot is,
     /// where the world's things are; nothing ignored or attached.
     pub fn refresh_planning_scene(&self, scene: &mut PlanningScene) {

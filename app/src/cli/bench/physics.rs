@@ -75,7 +75,7 @@ pub fn physics(
         }
         best = best.min(started.elapsed().as_secs_f64());
         if let Some((object, tool)) = held {
-            held_off_m = Some(object_to_link_m(&sim, object, tool));
+            held_off_m = Some(held_to_link_m(&sim, object, tool));
         }
     }
     Ok(PhysicsBench {
@@ -91,16 +91,31 @@ const EIGHT_SPEED_MPS: f64 = 0.5;
 /// The physics benchmark's turn rate (rad/s): circles of 0.83 m radius.
 const EIGHT_TURN_RADPS: f64 = 0.6;
 
-/// Puts world object `name` in the robot's gripper, untimed: the first gripper controller
-/// opens, the object goes to the end effector (the world's `[robot] ee_link`), the gripper
-/// closes on it with 5 N and settles. Returns the object's index and the end effector.
-fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::model::LinkId)> {
-    let object = sim
-        .world()
-        .objects
-        .iter()
-        .position(|o| o.name == name)
-        .ok_or_else(|| anyhow::anyhow!("--hold {name}: the world has no object \"{name}\""))?;
+/// What `--hold` holds: a world object, or the first link of a Gazebo model (`[[model]]`),
+/// by index.
+#[derive(Debug, Clone, Copy)]
+enum Held {
+    Object(usize),
+    ModelLink(usize),
+}
+
+/// Puts world object (or Gazebo model) `name` in the robot's gripper, untimed: the first
+/// gripper controller opens, the object's centre (a model's first link's centre of mass) goes
+/// to the end effector (the world's `[robot] ee_link`), the gripper closes on it with 5 N and
+/// settles. Returns what is held and the end effector.
+fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::LinkId)> {
+    let world = sim.world();
+    let held = match world.objects.iter().position(|o| o.name == name) {
+        Some(i) => Held::Object(i),
+        None => {
+            let model = world.models.iter().position(|m| m.name == name);
+            let model = model.ok_or_else(|| {
+                anyhow::anyhow!("--hold {name}: the world has no object or model \"{name}\"")
+            })?;
+            let first: usize = world.models[..model].iter().map(|m| m.links.len()).sum();
+            Held::ModelLink(first)
+        }
+    };
     let ee = sim.world().robot.ee_link.clone().ok_or_else(|| {
         anyhow::anyhow!("--hold needs the world's [robot] ee_link (where the object is held)")
     })?;
@@ -115,11 +130,12 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::model::L
         .and_then(|c| c.first_gripper())
         .map(|(name, g)| (name.to_owned(), g.joint.clone()))
         .ok_or_else(|| anyhow::anyhow!("--hold needs a gripper controller"))?;
-    let open = sim
+    // Open at the finger's upper limit, closed at its lower (sliding fingers close at 0).
+    let (closed, open) = sim
         .robot()
         .joint_id(&joint)
         .and_then(|j| sim.robot().joint(j).position_limits())
-        .map_or(0.0, |(_, hi)| f64::from(hi));
+        .map_or((0.0, 0.0), |(lo, hi)| (f64::from(lo), f64::from(hi)));
     sim.command_gripper(&controller, open, 0.0)?;
     let settle = |sim: &mut Simulation, s: f64| {
         let end = sim.sim_time_s() + s;
@@ -129,27 +145,52 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(usize, rover_sim::model::L
     };
     settle(sim, 1.0);
     let at = sim.world_from_link(tool).translation;
-    let at = [f64::from(at.x), f64::from(at.y), f64::from(at.z)];
-    sim.place_object(object, at, 0.0)?;
-    sim.command_gripper(&controller, 0.0, 5.0)?;
+    match held {
+        Held::Object(i) => {
+            sim.place_object(i, [f64::from(at.x), f64::from(at.y), f64::from(at.z)], 0.0)?
+        }
+        Held::ModelLink(link) => {
+            let mut poses = Vec::new();
+            sim.model_link_poses_into(&mut poses);
+            let centre = sim.model_link_centre(link).unwrap_or(at);
+            let model = (sim.world().models.iter())
+                .scan(0, |first, m| {
+                    let this = *first;
+                    *first += m.links.len();
+                    Some(this)
+                })
+                .position(|first| first == link)
+                .unwrap_or(0);
+            let world_from_model = sim.world().models[model].world_from_model;
+            let moved = rover_sim::geometry::Pose::from_translation(at - centre) * world_from_model;
+            sim.place_model(model, moved)?;
+        }
+    }
+    sim.command_gripper(&controller, closed, 5.0)?;
     settle(sim, 1.5);
-    let off = object_to_link_m(sim, object, tool);
+    let off = held_to_link_m(sim, held, tool);
     anyhow::ensure!(
         off < 0.02,
         "--hold {name}: the gripper did not take it ({off:.3} m from {ee} after closing)"
     );
-    Ok((object, tool))
+    Ok((held, tool))
 }
 
 /// An object this close to the end effector (m) is still in the hand.
 const HELD_WITHIN_M: f64 = 0.05;
 
-/// How far world object `object` is from link `link` (m).
-fn object_to_link_m(sim: &Simulation, object: usize, link: rover_sim::model::LinkId) -> f64 {
-    let mut poses = Vec::new();
-    sim.object_poses_into(&mut poses);
-    let o = poses.get(object).map(|p| p.translation).unwrap_or_default();
-    f64::from((o - sim.world_from_link(link).translation).length())
+/// How far what is held (a world object's centre, a model link's centre of mass) is from link
+/// `link` (m).
+fn held_to_link_m(sim: &Simulation, held: Held, link: rover_sim::model::LinkId) -> f64 {
+    let at = match held {
+        Held::Object(i) => {
+            let mut poses = Vec::new();
+            sim.object_poses_into(&mut poses);
+            poses.get(i).map(|p| p.translation).unwrap_or_default()
+        }
+        Held::ModelLink(i) => sim.model_link_centre(i).unwrap_or_default(),
+    };
+    f64::from((at - sim.world_from_link(link).translation).length())
 }
 
 pub(crate) fn bench_cmd(world: WorldArgs, args: PhysicsBenchArgs) -> Result<()> {

@@ -38,12 +38,19 @@ const BEARING_GAIN: f64 = 1.5;
 const TURN_IN_PLACE_RAD: f64 = 0.35;
 /// The point within this (m) of the goal is there.
 pub(crate) const ARRIVED_M: f64 = 0.02;
+/// A heading within this (rad) of a stance's is there.
+const ARRIVED_RAD: f64 = 0.02;
+/// A stance behind the base and closer than this (m) is backed into rather than turned to.
+const BACK_INTO_M: f64 = 0.5;
 
 /// The base's go-to-point controller; it remembers its last command to limit accelerations.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct DriveTo {
     last: Twist,
     last_s: Option<f64>,
+    /// A pose drive has reached its point and turns to its heading (it goes back to the point
+    /// only if it drifts three times the arrival distance off).
+    turning: bool,
 }
 
 impl DriveTo {
@@ -83,13 +90,63 @@ impl DriveTo {
         } else {
             (RANGE_GAIN * range_err).clamp(-MAX_BACK_MPS, MAX_SPEED_MPS) * bearing_err.cos()
         };
+        (self.limited(dt, speed, turn), false)
+    }
+
+    /// The command at `now_s` that brings the base to a pose: its origin to `stand` (base
+    /// frame, m) and then its heading `turn_rad` further round (left positive), and whether it
+    /// is there. For an arm that reaches to the side (Stretch's), whose goal cannot be met by
+    /// a point's range and bearing: driving towards a point beside it only circles it. A
+    /// stance a little behind is backed into.
+    pub(crate) fn to_pose(
+        &mut self,
+        now_s: f64,
+        stand: Vector2<f64>,
+        turn_rad: f64,
+    ) -> (Twist, bool) {
+        let dt = self.last_s.map_or(0.0, |t| (now_s - t).max(0.0));
+        self.last_s = Some(now_s);
+        let range = stand.norm();
+        self.turning = range <= ARRIVED_M * if self.turning { 3.0 } else { 1.0 };
+        let (speed, turn) = if !self.turning {
+            let bearing = stand.y.atan2(stand.x);
+            let backing = range < BACK_INTO_M && bearing.abs() > std::f64::consts::FRAC_PI_2;
+            let err = if backing {
+                wrap_angle(bearing - std::f64::consts::PI)
+            } else {
+                bearing
+            };
+            let turn = (BEARING_GAIN * err).clamp(-MAX_TURN_RADPS, MAX_TURN_RADPS);
+            let speed = if err.abs() > TURN_IN_PLACE_RAD {
+                0.0
+            } else if backing {
+                -(RANGE_GAIN * range).min(MAX_BACK_MPS) * err.cos()
+            } else {
+                (RANGE_GAIN * range).min(MAX_SPEED_MPS) * err.cos()
+            };
+            (speed, turn)
+        } else if turn_rad.abs() > ARRIVED_RAD {
+            (
+                0.0,
+                (BEARING_GAIN * turn_rad).clamp(-MAX_TURN_RADPS, MAX_TURN_RADPS),
+            )
+        } else {
+            self.last = Twist::ZERO;
+            return (Twist::ZERO, true);
+        };
+        (self.limited(dt, speed, turn), false)
+    }
+
+    /// `speed` and `turn` reached from the last command within the acceleration limits over
+    /// `dt`, remembered.
+    fn limited(&mut self, dt: f64, speed: f64, turn: f64) -> Twist {
         let limit = |from: f64, to: f64, rate: f64| from + (to - from).clamp(-rate * dt, rate * dt);
         let cmd = Twist::new(
             limit(self.last.linear_mps, speed, MAX_ACCEL_MPS2),
             limit(self.last.angular_radps, turn, MAX_TURN_ACCEL_RADPS2),
         );
         self.last = cmd;
-        (cmd, false)
+        cmd
     }
 }
 
@@ -126,6 +183,42 @@ mod tests {
                 yaw += cmd.angular_radps * dt;
             }
             assert!(arrived, "from {start:?}: never arrived");
+        }
+    }
+
+    /// Drives a unicycle to poses ahead, behind and beside it with the pose law: it ends
+    /// within the arrival distance and heading.
+    #[test]
+    fn the_base_ends_at_a_pose_from_any_side() {
+        for (goal, goal_yaw) in [
+            (Vector2::new(1.2, 0.0), 0.0),
+            (Vector2::new(-0.3, 0.02), 0.0),
+            (Vector2::new(0.1, -0.6), 1.0),
+        ] {
+            let mut drive = DriveTo::default();
+            let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
+            let dt = 0.01;
+            let mut arrived = false;
+            for i in 0..9000 {
+                let (dx, dy) = (goal.x - x, goal.y - y);
+                let (s, c) = yaw.sin_cos();
+                let stand = Vector2::new(c * dx + s * dy, -s * dx + c * dy);
+                let (cmd, there) =
+                    drive.to_pose(f64::from(i) * dt, stand, wrap_angle(goal_yaw - yaw));
+                if there {
+                    arrived = true;
+                    break;
+                }
+                x += cmd.linear_mps * yaw.cos() * dt;
+                y += cmd.linear_mps * yaw.sin() * dt;
+                yaw += cmd.angular_radps * dt;
+            }
+            assert!(
+                arrived,
+                "to {goal:?}: never arrived (at {x:.3}, {y:.3}, {yaw:.3})"
+            );
+            assert!((goal - Vector2::new(x, y)).norm() < 0.03, "{x} {y}");
+            assert!(wrap_angle(goal_yaw - yaw).abs() < 0.03, "{yaw}");
         }
     }
 

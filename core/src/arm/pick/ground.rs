@@ -33,24 +33,50 @@ pub(super) fn stance_pose(
     (target_xy - at_world, yaw_rad)
 }
 
+/// Whether a stance `at` (arm base frame) puts the object beside the base (its bearing beyond
+/// 45 degrees): an arm that reaches to the side (Stretch's), whose base brings the object
+/// beside it by driving along its own axis, keeping its heading.
+pub(super) fn beside(at: Vector2<f64>) -> bool {
+    at.y.atan2(at.x).abs() > std::f64::consts::FRAC_PI_4
+}
+
+/// The heading (world, rad) the base stands at for the stance `at`: `facing_rad` (the object
+/// ahead, less the stance's bearing), or beside, the heading it has now, `base_yaw_rad`.
+pub(super) fn stance_yaw(at: Vector2<f64>, facing_rad: f64, base_yaw_rad: f64) -> f64 {
+    if beside(at) { base_yaw_rad } else { facing_rad }
+}
+
 /// The robot's root link's collision shapes, as a rectangle in the arm base's frame (inflated
-/// by [`BODY_CLEARANCE_M`]); `None` when it has none.
+/// by [`BODY_CLEARANCE_M`]); a mesh (Stretch's base) as the box round its hull. `None` when
+/// it has none.
 pub(super) fn body_footprint(sim: &Simulation, base: LinkId) -> Option<Footprint> {
     let robot = sim.robot();
     let base_from_root = isometry_from_pose(&sim.world_from_link(base)).inverse()
         * isometry_from_pose(&sim.world_from_link(robot.root));
     let mut lo = Vector2::repeat(f64::INFINITY);
     let mut hi = Vector2::repeat(f64::NEG_INFINITY);
-    for collision in &robot.links[robot.root.index()].collisions {
-        let Some(half) = half_extents(&collision.shape) else {
-            continue;
-        };
-        let shape = base_from_root * isometry_from_pose(&collision.link_from_shape);
+    let mut add = |shape: &nalgebra::Isometry3<f64>, centre: Vector3<f64>, half: Vector3<f64>| {
         for (sx, sy, sz) in box_corners() {
-            let corner = shape * Point3::new(sx * half.x, sy * half.y, sz * half.z);
+            let corner =
+                shape * Point3::from(centre + Vector3::new(sx * half.x, sy * half.y, sz * half.z));
             lo = lo.inf(&corner.coords.xy());
             hi = hi.sup(&corner.coords.xy());
         }
+    };
+    let collisions = &robot.links[robot.root.index()].collisions;
+    for collision in collisions {
+        if let Some(half) = half_extents(&collision.shape) {
+            let shape = base_from_root * isometry_from_pose(&collision.link_from_shape);
+            add(&shape, Vector3::zeros(), half);
+        }
+    }
+    let meshes = collisions
+        .iter()
+        .any(|c| matches!(c.shape, Shape::Mesh { .. }));
+    if meshes && let Ok(Some((a, b))) = sim.link_collision_box(robot.root) {
+        let v = |p: [f32; 3]| Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        let (a, b) = (v(a), v(b));
+        add(&base_from_root, (a + b) / 2.0, (b - a) / 2.0);
     }
     (lo.x.is_finite()).then(|| Footprint {
         centre: (lo + hi) / 2.0,

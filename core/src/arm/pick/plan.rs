@@ -230,12 +230,12 @@ impl Pick {
         // Set down: straight down onto the surface, the object (about to touch it) left out.
         scene.attach_sphere(None);
         let set_down = if lower_m > 0.0 {
-            let at = over + ways[way].offset;
+            let at = over + way.offset;
             self.line_at_least(
                 scene,
                 &place_q,
                 (at, at - Vector3::z() * lower_m),
-                Some(&ways[way]),
+                Some(&way),
                 1.0,
             )
             .map_err(|e| format!("setting it down: {e}"))?
@@ -255,7 +255,7 @@ impl Pick {
         // Back out the way it came in from an upright object (the fingers slide off it), else
         // straight up.
         let back = match target.upright {
-            Some(_) => -ways[way].along * self.config.approach_m,
+            Some(_) => -way.along * self.config.approach_m,
             None => Vector3::z() * RETREAT_M.max(lower_m),
         };
         let retreat = self.line_at_least(scene, &release_q, (from, from + back), None, 0.0)?;
@@ -370,11 +370,11 @@ impl Pick {
             scene.ignore_object(t, true);
         }
         let (lo, hi) = (g.closed.min(g.open), g.closed.max(g.open));
-        scene.set_joint(g.joint, ways[way].grip_m.clamp(lo, hi));
+        scene.set_joint(g.joint, way.grip_m.clamp(lo, hi));
         // Straight up off what it rests on; the hand may turn on the way (the object turns
         // with it). The arm is checked, the object (touching its support, as far as the
         // estimate knows) only from the lift's top.
-        let at = centre + ways[way].offset;
+        let at = centre + way.offset;
         let lift = self.line_at_least(
             scene,
             &grasp_q,
@@ -386,7 +386,7 @@ impl Pick {
             to_pre,
             descent,
             lift,
-            way: ways[way].clone(),
+            way,
         })
     }
 }

@@ -13,13 +13,14 @@ use rover_sim::{
     physics::Simulation,
 };
 
-use super::ground::{body_footprint, obstacles, overlap, stance_pose};
+use super::ground::{body_footprint, obstacles, overlap, stance_pose, stance_yaw};
 use super::plan::upright_pitches;
 use super::state::{Pick, Target};
 use super::ways::ik_close;
 
-/// Bearings surveyed (deg from the arm base's x, left positive), in order of preference on a
-/// tie: straight ahead is where the base's go-to-point law ends most exactly.
+/// Bearings surveyed (deg from the side the arm reaches to, [`Pick::arm_side_rad`]; left
+/// positive), in order of preference on a tie: straight out is where the base's drive ends
+/// most exactly.
 const BEARINGS_DEG: [f64; 7] = [0.0, 10.0, -10.0, 20.0, -20.0, 30.0, -30.0];
 /// Ranges surveyed from the arm's base (m).
 const RANGES_M: (f64, f64) = (0.05, 1.2);
@@ -49,6 +50,16 @@ impl Pick {
         })
     }
 
+    /// The side of the base the arm works on (rad from the arm base's x, left positive): the
+    /// tool's bearing at `q`, to the nearest quarter turn. 0 for an arm that reaches ahead (the
+    /// arm car's), -pi/2 for one that reaches out to the right (Stretch's).
+    pub(super) fn arm_side_rad(&self, q: &[f64]) -> f64 {
+        let tip = (self.solver.chain().base_from_tip(q))
+            .map_or_else(|_| Vector3::x(), |t| t.translation.vector);
+        let quarter = std::f64::consts::FRAC_PI_2;
+        (tip.y.atan2(tip.x) / quarter).round() * quarter
+    }
+
     /// Where (arm base frame, x and y, m) the point `target` (base frame now, the base at
     /// `world_from_base`) should be when the base stops so the arm reaches it: on the bearing
     /// with the longest run of ranges the arm reaches round `radius_m` and the car's body stands
@@ -76,10 +87,12 @@ impl Pick {
         let obstacles = obstacles(sim, ignore, ignore_m);
         let heading_rad = (target_world.y - world_from_base.translation.y)
             .atan2(target_world.x - world_from_base.translation.x);
+        let base_yaw = world_from_base.rotation.euler_angles().2;
         let q0 = self.chain_q(sim);
+        let side = self.arm_side_rad(&q0);
         let mut best: Option<(usize, Vector2<f64>)> = None;
         for bearing_deg in BEARINGS_DEG {
-            let bearing = bearing_deg.to_radians();
+            let bearing = side + bearing_deg.to_radians();
             let (s, c) = bearing.sin_cos();
             let mut seed = q0.clone();
             let mut run: Vec<f64> = Vec::new();
@@ -94,8 +107,9 @@ impl Pick {
                     ik_close(solution.position_error_m, solution.orientation_error_rad)
                         .then_some(solution.q)
                 });
-                // The base facing the object less the bearing, the point brought to `at`.
-                let yaw = heading_rad - bearing;
+                // The base facing the object less the bearing (or, beside, as it is), the
+                // point brought to `at`.
+                let yaw = stance_yaw(at, heading_rad - bearing, base_yaw);
                 let clear = body.is_some_and(|body| {
                     let stand = stance_pose(target_world.coords.xy(), at, yaw);
                     let body = body.placed(&stand);
@@ -131,8 +145,8 @@ impl Pick {
         }
         best.map(|(_, at)| at).ok_or_else(|| {
             format!(
-                "no stance found: the arm reaches ({:.2}, {:.2}, {:.2}) m from nowhere the car's body stands clear (bearings {:?} deg, ranges {:.2}-{:.2} m)",
-                target_world.x, target_world.y, target_world.z, BEARINGS_DEG, RANGES_M.0, RANGES_M.1
+                "no stance found: the arm reaches ({:.2}, {:.2}, {:.2}) m from nowhere the car's body stands clear (bearings {:?} deg from {:.0} deg, ranges {:.2}-{:.2} m)",
+                target_world.x, target_world.y, target_world.z, BEARINGS_DEG, side.to_degrees(), RANGES_M.0, RANGES_M.1
             )
         })
     }

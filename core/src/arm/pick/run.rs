@@ -63,7 +63,11 @@ impl Pick {
             if let Step::Gripper { position, grip } = &step
                 && let Ok(g) = &self.gripper
             {
-                let effort = if *grip { self.squeeze_n } else { 0.0 };
+                let effort = if *grip {
+                    self.squeeze_n * g.lever_m
+                } else {
+                    0.0
+                };
                 if let Err(e) = sim.command_gripper(&g.controller, *position, effort) {
                     self.fail(e.to_string());
                     return;

@@ -3,11 +3,11 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
 use rover_sim::{
     model::{
-        CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, KinematicChain, LinkId,
-        isometry_from_pose,
+        CameraConfig, CameraInfo, ChainJoint, IkOptions, IkSolver, JointKind, KinematicChain,
+        LinkId, isometry_from_pose,
     },
     physics::Simulation,
 };
@@ -178,13 +178,38 @@ fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
     let finger = robot.joint(joint);
     let world_from = |link| isometry_from_pose(&sim.world_from_link(link));
     let axis = finger.parent_from_child.rotation * finger.axis;
-    let across_tool = (world_from(tool).rotation.inverse() * world_from(finger.parent).rotation)
-        * Vector3::new(f64::from(axis.x), f64::from(axis.y), f64::from(axis.z));
+    let axis = Vector3::new(f64::from(axis.x), f64::from(axis.y), f64::from(axis.z));
+    let parent = world_from(finger.parent);
+    let tool_from_parent = world_from(tool).inverse() * parent;
+    // A sliding finger moves along its axis; a turning one, at the tool point, across the
+    // line from its axis to the point.
+    let (across_tool, lever_m) = if matches!(finger.kind, JointKind::Prismatic { .. }) {
+        (tool_from_parent.rotation * axis, 1.0)
+    } else {
+        let origin = finger.parent_from_child.translation;
+        let origin = Point3::new(
+            f64::from(origin.x),
+            f64::from(origin.y),
+            f64::from(origin.z),
+        );
+        let to_tool = tool_from_parent.inverse() * Point3::origin() - origin;
+        let arm = to_tool - axis * axis.dot(&to_tool);
+        let motion = tool_from_parent.rotation * axis.cross(&arm);
+        let lever_m = arm.norm();
+        if lever_m < 1e-3 {
+            return Err(format!(
+                "finger joint \"{}\" turns about the tool point: no squeeze to give",
+                spec.1
+            ));
+        }
+        (motion / lever_m, lever_m)
+    };
     Ok(Gripper {
         controller: spec.0,
         joint,
         open,
         closed,
         across_tool,
+        lever_m,
     })
 }

@@ -4,10 +4,13 @@
 use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Point3, Vector2, Vector3};
-use rover_sim::{model::isometry_from_pose, physics::Simulation};
+use rover_sim::{
+    model::isometry_from_pose,
+    physics::{Simulation, wrap_angle},
+};
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
-use super::ground::{body_footprint, obstacles, stance_pose};
+use super::ground::{beside, body_footprint, obstacles, stance_pose, stance_yaw};
 use super::plan::{over_place, spans};
 use super::route::route;
 use super::state::{Held, Leg, Pick, PickState, Step, Target};
@@ -107,19 +110,28 @@ impl Pick {
                         goal.x, goal.y
                     ),
                 ));
-                let from = world_from_base.translation.vector.xy();
+                let from = (
+                    world_from_base.translation.vector.xy(),
+                    yaw_of(world_from_base),
+                );
                 let via = self.route_to(sim, (goal, at), from, (goal, 0.08));
                 (sim.sim_time_s(), via)
             }
         };
+        let yaw_rad = beside(at).then(|| yaw_of(world_from_base));
         self.sightings.clear();
         self.state = PickState::Fetching;
+        let yaw_rad = match &self.leg {
+            Some(leg) if driving => leg.yaw_rad,
+            _ => yaw_rad,
+        };
         self.leg = Some(Leg {
             goal,
             to_place: false,
             started_s,
             back_from: None,
             via,
+            yaw_rad,
         });
         true
     }
@@ -132,7 +144,7 @@ impl Pick {
         &mut self,
         sim: &Simulation,
         (goal, at): (Vector3<f64>, Vector2<f64>),
-        from: Vector2<f64>,
+        (from, from_yaw): (Vector2<f64>, f64),
         (ignore, ignore_m): (Vector3<f64>, f64),
     ) -> Vec<Vector2<f64>> {
         let Some(body) = body_footprint(sim, self.base) else {
@@ -140,7 +152,8 @@ impl Pick {
         };
         let radius_m = body.far_corner_m();
         let heading = (goal.y - from.y).atan2(goal.x - from.x);
-        let (stand, _) = stance_pose(goal.xy(), at, heading - at.y.atan2(at.x));
+        let yaw = stance_yaw(at, heading - at.y.atan2(at.x), from_yaw);
+        let (stand, _) = stance_pose(goal.xy(), at, yaw);
         match route(from, stand, radius_m, &obstacles(sim, ignore, ignore_m)) {
             Ok(via) => {
                 if !via.is_empty() {
@@ -202,7 +215,17 @@ impl Pick {
             leg.via.remove(0);
         }
         let point = world_from_base.inverse() * Point3::from(leg.goal);
-        let (cmd, there) = self.drive.command(now, point.coords.xy(), at);
+        let (cmd, there) = match leg.yaw_rad {
+            // Beside: to the pose that brings it there.
+            Some(yaw) => {
+                let (stand, _) = stance_pose(leg.goal.xy(), at, yaw);
+                let z = world_from_base.translation.z;
+                let stand = world_from_base.inverse() * Point3::new(stand.x, stand.y, z);
+                let turn = wrap_angle(yaw - yaw_of(&world_from_base));
+                self.drive.to_pose(now, stand.coords.xy(), turn)
+            }
+            None => self.drive.command(now, point.coords.xy(), at),
+        };
         self.base_cmd = Some(cmd);
         let to_place = leg.to_place;
         if !there {
@@ -245,20 +268,24 @@ impl Pick {
             }
             let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
             let base = world_from_base.translation.vector.xy();
-            // The route starts where backing off ends.
-            let backed = base - (world_from_base.rotation * Vector3::x()).xy() * BACK_OFF_M;
+            let at = self.fetch_at(sim).unwrap_or_default();
+            // The route starts where backing off ends; an arm that works beside the base
+            // (its stance beside it) has nothing ahead to back away from.
+            let back_m = if beside(at) { 0.0 } else { BACK_OFF_M };
+            let backed = base - (world_from_base.rotation * Vector3::x()).xy() * back_m;
             let tool = isometry_from_pose(&sim.world_from_link(self.tool))
                 .translation
                 .vector;
-            let at = self.fetch_at(sim).unwrap_or_default();
             let goal = Vector3::new(x, y, z);
-            let via = self.route_to(sim, (goal, at), backed, (tool, 0.1));
+            let yaw = yaw_of(&world_from_base);
+            let via = self.route_to(sim, (goal, at), (backed, yaw), (tool, 0.1));
             self.leg = Some(Leg {
                 goal,
                 to_place: true,
                 started_s: now,
-                back_from: Some(base),
+                back_from: (!beside(at)).then_some(base),
                 via,
+                yaw_rad: beside(at).then_some(yaw),
             });
             self.drive.reset();
             self.state = PickState::Delivering;
@@ -342,4 +369,9 @@ impl Pick {
             over,
         )
     }
+}
+
+/// The base's heading (world, rad) at `world_from_base`.
+fn yaw_of(world_from_base: &Isometry3<f64>) -> f64 {
+    world_from_base.rotation.euler_angles().2
 }

@@ -100,6 +100,10 @@ pub(super) struct Gripper {
     /// The direction the finger joint moves, in the tool's frame (unit): the fingers close
     /// across it.
     pub(super) across_tool: Vector3<f64>,
+    /// Effort per newton of squeeze: 1 for sliding fingers, the lever (m) from a turning
+    /// finger's axis to the tool point for fingers that turn (Stretch's), so a squeeze in
+    /// newtons is the joint's torque in N m.
+    pub(super) lever_m: f64,
 }
 
 impl Gripper {
@@ -197,12 +201,30 @@ pub(super) struct Way {
     /// Where the tool is from the object's centre (base frame, m): zero but for an upright
     /// object taken from above (near its top, the hand clear of it).
     pub(super) offset: Vector3<f64>,
+    /// The hand's turn is the arm's to give, not the plan's: an arm that holds it level
+    /// whatever it does (Stretch's lift, telescope and wrist yaw) is given only the point;
+    /// `along` and `turn` are what it reached there with ([`Pick::reachable`]).
+    pub(super) free: bool,
 }
 
 impl Way {
+    /// The way of an arm that holds the hand level (see [`Way::free`]): the tool `offset`
+    /// from the object's centre, the fingers closing to `grip_m`.
+    pub(super) fn level(grip_m: f64, offset: Vector3<f64>) -> Self {
+        Self {
+            label: "level, turned as the arm reaches".into(),
+            along: Vector3::zeros(),
+            turn: None,
+            grip_m,
+            offset,
+            free: true,
+        }
+    }
+
     /// The IK target for the tool at `point`.
     pub(super) fn target(&self, point: Vector3<f64>) -> IkTarget {
         match self.turn {
+            _ if self.free => IkTarget::point(point),
             Some(turn) => IkTarget::pose(&Isometry3::from_parts(Translation3::from(point), turn)),
             None => IkTarget::approach(point, self.along),
         }
@@ -275,6 +297,10 @@ pub(super) struct Leg {
     pub(super) back_from: Option<Vector2<f64>>,
     /// Corners to drive through first, round what stands between (world x, y, m).
     pub(super) via: Vec<Vector2<f64>>,
+    /// The heading (world, rad) the base ends at when the stance puts the object beside it
+    /// ([`super::ground::beside`]): the base drives to that pose. `None`: the point's range
+    /// and bearing from the base decide the drive.
+    pub(super) yaw_rad: Option<f64>,
 }
 
 /// The object in the hand while the base drives to the place.

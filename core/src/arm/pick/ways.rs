@@ -46,6 +46,9 @@ impl Pick {
     /// [`PickConfig::approach_pitches_deg`] below horizontal, away from the arm's base, the
     /// turn about the way in free; the fingers close to `grip_m`.
     pub(super) fn ways_round(&self, point: Vector3<f64>, grip_m: f64) -> Vec<Way> {
+        if self.solver.chain().holds_level() {
+            return vec![Way::level(grip_m, Vector3::zeros())];
+        }
         let horizontal = Vector3::new(point.x, point.y, 0.0)
             .try_normalize(1e-9)
             .unwrap_or_else(Vector3::x);
@@ -58,6 +61,7 @@ impl Pick {
                     turn: None,
                     grip_m,
                     offset: Vector3::zeros(),
+                    free: false,
                 }
             })
             .collect()
@@ -88,6 +92,7 @@ impl Pick {
                         turn: Some(turn),
                         grip_m: *half,
                         offset: Vector3::zeros(),
+                        free: false,
                     });
                 }
             }
@@ -108,6 +113,11 @@ impl Pick {
         g: &Gripper,
         (pitches_deg, yaws_deg): (&[f64], &[f64]),
     ) -> Vec<Way> {
+        if self.solver.chain().holds_level() {
+            // Its only way: level, above the middle, at whatever turn the arm reaches it.
+            let offset = Vector3::z() * SIDE_GRIP_SHARE * half_height_m;
+            return vec![Way::level(radius_m, offset)];
+        }
         // Away from the arm's pan axis when it has one (a 5-joint arm holds the hand level
         // only in the plane through it), else from the base's origin.
         let pan = (self.solver.chain().first_axis())
@@ -144,6 +154,7 @@ impl Pick {
                     turn: Some(turn),
                     grip_m: radius_m,
                     offset,
+                    free: false,
                 });
             }
         }
@@ -152,7 +163,8 @@ impl Pick {
 
     /// Joint positions putting the tool at `point` (base frame) the first of `ways` IK
     /// reaches there without a collision (with `back_m`, the straight way back out along it
-    /// free too, returned), and which way; else why not each way.
+    /// free too, returned), and that way (a free one with the turn the arm reached it with);
+    /// else why not each way.
     pub(super) fn reachable(
         &mut self,
         scene: &mut PlanningScene,
@@ -161,9 +173,9 @@ impl Pick {
         what: &str,
         back_m: Option<f64>,
         ways: &[Way],
-    ) -> Result<(Vec<f64>, Waypoints, usize), String> {
+    ) -> Result<(Vec<f64>, Waypoints, Way), String> {
         let mut why: Vec<String> = Vec::new();
-        for (k, way) in ways.iter().enumerate() {
+        for way in ways {
             let label = &way.label;
             let point = point + way.offset;
             let solution = self
@@ -181,11 +193,15 @@ impl Pick {
                 why.push(format!("{label}: {hit}"));
                 continue;
             }
+            let way = match way.free {
+                true => self.as_reached(way, &solution.q)?,
+                false => way.clone(),
+            };
             // The straight way in, `back_m` long, must be there too.
             let back = match back_m {
                 Some(back_m) => {
                     let to = point - way.along * back_m;
-                    match self.line_at_least(scene, &solution.q, (point, to), Some(way), 1.0) {
+                    match self.line_at_least(scene, &solution.q, (point, to), Some(&way), 1.0) {
                         Ok(line) => line,
                         Err(e) => {
                             why.push(format!("{label}: {e}"));
@@ -195,9 +211,23 @@ impl Pick {
                 }
                 None => Vec::new(),
             };
-            return Ok((solution.q, back, k));
+            return Ok((solution.q, back, way));
         }
         Err(format!("{what}, coming in {}", why.join("; ")))
+    }
+
+    /// A free way ([`Way::free`]) as the arm reached it at `q`: the tool's z and turn there.
+    fn as_reached(&self, way: &Way, q: &[f64]) -> Result<Way, String> {
+        let tool = self
+            .solver
+            .chain()
+            .base_from_tip(q)
+            .map_err(|e| e.to_string())?;
+        Ok(Way {
+            along: tool.rotation * Vector3::z(),
+            turn: Some(tool.rotation),
+            ..way.clone()
+        })
     }
 
     /// A straight line of the tool from `from` (at `from_q`) to `to` (base frame), held to

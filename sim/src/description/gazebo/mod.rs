@@ -1,7 +1,7 @@
 //! The `<gazebo>` URDF extensions rover honours: the `libgazebo_ros_diff_drive.so` plugin, camera
 //! `<sensor>` blocks (with `libgazebo_ros_camera.so`), ray sensors (`ray.rs`: 2D lasers and 3D
-//! lidars), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), bumpers (`bumper.rs`), and per-link
-//! friction (`mu1`/`mu2`).
+//! lidars), IMUs (`imu.rs`), ground-truth poses (`p3d.rs`), hector's GPS (`gps.rs`), bumpers (`bumper.rs`), mimic
+//! joint plugins (`mimic.rs`), and per-link friction (`mu1`/`mu2`).
 //!
 //! Parameters keep gazebo_ros's names and defaults; values that do not parse are errors with the
 //! file, line and element.
@@ -13,6 +13,8 @@ pub(crate) mod gz;
 pub(crate) mod gz_joints;
 mod gz_sensors;
 mod imu;
+mod mimic;
+pub(crate) use mimic::MimicPlugin;
 mod p3d;
 mod ray;
 mod values;
@@ -54,6 +56,8 @@ pub(crate) struct Extensions {
     pub gz_controllers: Vec<crate::model::ControllerSpec>,
     /// gz_ros2_control's `<parameters>` (a ros2_control controllers file) and the plugin's line.
     pub ros2_control: Option<(String, u32)>,
+    /// Mimic joint plugins: joints that follow another, as `<mimic>` would say.
+    pub mimics: Vec<MimicPlugin>,
 }
 
 /// Reads every `<gazebo>` element under `<robot>`.
@@ -122,6 +126,8 @@ pub(crate) fn parse_blocks<'a, 'input: 'a>(
                         ext.p3ds.push(p3d::parse(&ctx, child)?);
                     } else if gps::is_plugin(file) {
                         ext.gpss.push(gps::parse(&ctx, child)?);
+                    } else if mimic::is_plugin(file) {
+                        ext.mimics.push(mimic::parse(&ctx, child)?);
                     } else {
                         ext.ignored.push(format!(
                             "plugin {}",

@@ -102,7 +102,7 @@ pub fn expand_file(
     };
     let mut text = String::from("<?xml version=\"1.0\"?>");
     let mut lines = vec![(file, 1)];
-    write_element(&out, 0, &ex.namespaces, &mut text, &mut lines);
+    write_element(&out, 0, (&ex.namespaces, &ex.files), &mut text, &mut lines);
     text.push('\n');
     Ok(Expanded {
         text,

@@ -1,8 +1,28 @@
 //! Writing the expanded URDF: escaped XML text, recording the source of every line written.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 use super::expander::{OElem, ONode};
+
+/// A `<mesh filename>` as written in an included file, as the consumer should read it: a
+/// plain relative path that names no file beside the top file but one beside the file it was
+/// written in (a URDF with `./meshes/...` included unchanged from its own folder) becomes that
+/// file's path; anything else is left as it is.
+fn mesh_file<'v>(e: &OElem, name: &str, value: &'v str, files: &[PathBuf]) -> Cow<'v, str> {
+    let relative = !value.contains("://") && !value.is_empty() && Path::new(value).is_relative();
+    if e.file == 0 || name != "filename" || !e.name.ends_with("mesh") || !relative {
+        return Cow::Borrowed(value);
+    }
+    let dir = |file: usize| files.get(file).and_then(|f| f.parent());
+    match (dir(0), dir(e.file)) {
+        (Some(top), Some(own)) if !top.join(value).is_file() && own.join(value).is_file() => {
+            Cow::Owned(own.join(value).display().to_string())
+        }
+        _ => Cow::Borrowed(value),
+    }
+}
 
 fn escape(s: &str, attribute: bool, out: &mut String) {
     for c in s.chars() {
@@ -19,11 +39,12 @@ fn escape(s: &str, attribute: bool, out: &mut String) {
     }
 }
 
-/// Writes an element starting on a new line, recording the source of every line written.
+/// Writes an element starting on a new line, recording the source of every line written; an
+/// included file's relative mesh files as [`mesh_file`] reads them.
 pub(super) fn write_element(
     e: &OElem,
     depth: usize,
-    namespaces: &BTreeMap<String, String>,
+    (namespaces, files): (&BTreeMap<String, String>, &[PathBuf]),
     out: &mut String,
     lines: &mut Vec<(usize, u32)>,
 ) {
@@ -47,7 +68,7 @@ pub(super) fn write_element(
         out.push(' ');
         out.push_str(name);
         out.push_str("=\"");
-        escape(value, true, out);
+        escape(&mesh_file(e, name, value, files), true, out);
         out.push('"');
     }
     if e.children.is_empty() {
@@ -61,7 +82,7 @@ pub(super) fn write_element(
             ONode::Text(t) => escape(t, false, out),
             ONode::Elem(c) => {
                 has_elements = true;
-                write_element(c, depth + 1, namespaces, out, lines);
+                write_element(c, depth + 1, (namespaces, files), out, lines);
             }
         }
     }
