@@ -305,6 +305,26 @@ pub fn lockstep_options(seed: u64) -> rover_core::SessionOptions {
     }
 }
 
+/// [`lockstep_options`] for a pick of `class` with the detector's and the pick's threshold at
+/// `threshold`, as `--arm-class CLASS --threshold T` sets them, in a session of `world` and
+/// `robot`.
+pub fn pick_session(
+    (world, robot): (rover_sim::model::World, RobotModel),
+    seed: u64,
+    (class, threshold): (&str, f32),
+) -> anyhow::Result<rover_core::Session> {
+    let mut options = lockstep_options(seed);
+    options.arm.pick.class = class.to_owned();
+    options.detector_config.threshold = threshold;
+    options.arm.pick.min_probability = f64::from(threshold);
+    Ok(rover_core::Session::new(
+        world,
+        robot,
+        &options,
+        &mut Said::default(),
+    )?)
+}
+
 /// TIAGo's wheels, driven like gazebo_ros_diff_drive (sizes from the URDF).
 pub fn tiago_drive() -> rover_sim::model::DriveSpec {
     rover_sim::model::DriveSpec {

@@ -35,18 +35,13 @@ fn session(seed: u64, class: &str) -> Result<Option<Session>> {
         ..rover_core::RunConfig::default()
     };
     config.robot_options.resources.model_search.push(models);
-    let (world, robot) = config.load_world_and_robot()?;
-    let mut options = rover_tests::lockstep_options(seed);
-    options.arm.pick.class = class.to_owned();
+    let loaded = config.load_world_and_robot()?;
     // YOLO scores the can "bottle" 0.16-0.47 across the layouts (darknet_ros's 0.3 misses
     // it in most): the detector's threshold and the pick's at 0.15, as `--threshold 0.15`.
-    options.detector_config.threshold = DETECTION_THRESHOLD;
-    options.arm.pick.min_probability = f64::from(DETECTION_THRESHOLD);
-    Ok(Some(Session::new(
-        world,
-        robot,
-        &options,
-        &mut Said::default(),
+    Ok(Some(rover_tests::pick_session(
+        loaded,
+        seed,
+        (class, DETECTION_THRESHOLD),
     )?))
 }
 

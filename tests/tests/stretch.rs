@@ -31,16 +31,11 @@ fn session(seed: u64) -> Result<Option<Session>> {
     config.robot_options.resources.model_search.push(models);
     config.robot_options.resources =
         (config.robot_options.resources).with_package("stretch_urdf", wheel.join("stretch_urdf"));
-    let (world, robot) = config.load_world_and_robot()?;
-    let mut options = rover_tests::lockstep_options(seed);
-    options.arm.pick.class = "bottle".to_owned();
-    options.detector_config.threshold = DETECTION_THRESHOLD;
-    options.arm.pick.min_probability = f64::from(DETECTION_THRESHOLD);
-    Ok(Some(Session::new(
-        world,
-        robot,
-        &options,
-        &mut Said::default(),
+    let loaded = config.load_world_and_robot()?;
+    Ok(Some(rover_tests::pick_session(
+        loaded,
+        seed,
+        ("bottle", DETECTION_THRESHOLD),
     )?))
 }
 

@@ -8,6 +8,7 @@ use crate::error::{Result, SimError, quoted_list};
 use crate::geometry::{Pose, yaw_of};
 use crate::model::actuation::Pid;
 use crate::model::drive::{DiffDriveConfig, OdometrySource};
+use crate::model::person::Person;
 use crate::model::robot::{JointId, LinkId, RobotModel};
 use crate::model::world::{JointSolver, World, check_step_hz};
 use crate::physics::actuators::{Actuators, JointCommand, JointState};
@@ -140,12 +141,8 @@ fn actuate(
 impl Simulation {
     /// Builds the physics scene for `robot` in `world`.
     pub fn new(world: World, robot: RobotModel, options: &SimOptions) -> Result<Self> {
-        crate::model::human::check_available(
-            world
-                .people
-                .iter()
-                .any(crate::model::person::Person::needs_makehuman),
-        )?;
+        let people = &world.people;
+        crate::model::human::check_available(people.iter().any(Person::needs_makehuman))?;
         let drivable = robot.diff_drive.is_some();
         // A robot bolted to the world (a `world` root link: an arm on a table) is not meant to
         // drive; anything else without a drive is told why cmd_vel does nothing.
@@ -230,7 +227,7 @@ impl Simulation {
             world.robot.grasp,
             &mut physics,
         )?;
-        let mut sim = Self {
+        Self {
             physics,
             anchors,
             springs: robot_bodies.springs,
@@ -257,12 +254,8 @@ impl Simulation {
             srdf_disabled: crate::description::srdf::srdf_disabled_collisions(&world, &robot)?,
             robot,
             world,
-        };
-        if let Some(name) = sim.world.robot.pose.clone() {
-            sim.go_to_named_pose(&name)
-                .map_err(|e| SimError::Setup(format!("[robot] pose = \"{name}\": {e}")))?;
         }
-        Ok(sim)
+        .with_start_pose()
     }
 
     /// Sets cmd_vel (takes effect at the next control update). Non-finite values are rejected and
@@ -505,6 +498,15 @@ impl Simulation {
     /// The state of the gripper controller `name`.
     pub fn gripper_state(&self, name: &str) -> Option<&GripperState> {
         self.controllers.gripper_state(name)
+    }
+
+    /// This simulation with its joints moving to the world's `[robot] pose`, when it names one.
+    fn with_start_pose(mut self) -> Result<Self> {
+        if let Some(name) = self.world.robot.pose.clone() {
+            self.go_to_named_pose(&name)
+                .map_err(|e| SimError::Setup(format!("[robot] pose = \"{name}\": {e}")))?;
+        }
+        Ok(self)
     }
 
     /// Moves every joint of the controllers file's pose `name` there (each at its own pace,

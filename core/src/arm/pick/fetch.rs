@@ -98,7 +98,7 @@ impl DriveTo {
     /// is there. For an arm that reaches to the side (Stretch's), whose goal cannot be met by
     /// a point's range and bearing: driving towards a point beside it only circles it. A
     /// stance a little behind is backed into.
-    pub(crate) fn to_pose(
+    pub(crate) fn pose_command(
         &mut self,
         now_s: f64,
         stand: Vector2<f64>,
@@ -154,6 +154,31 @@ impl DriveTo {
 mod tests {
     use super::*;
 
+    /// Drives a unicycle from the origin (heading +x) in 10 ms steps with `control`, given the
+    /// time, the world point `target` in the unicycle's frame and its heading; where it is when
+    /// `control` says it is there, or `None` after `steps` steps.
+    fn drive_unicycle(
+        target: Vector2<f64>,
+        steps: u32,
+        mut control: impl FnMut(f64, Vector2<f64>, f64) -> (Twist, bool),
+    ) -> Option<(f64, f64, f64)> {
+        let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
+        let dt = 0.01;
+        for i in 0..steps {
+            let (dx, dy) = (target.x - x, target.y - y);
+            let (s, c) = yaw.sin_cos();
+            let local = Vector2::new(c * dx + s * dy, -s * dx + c * dy);
+            let (cmd, there) = control(f64::from(i) * dt, local, yaw);
+            if there {
+                return Some((x, y, yaw));
+            }
+            x += cmd.linear_mps * yaw.cos() * dt;
+            y += cmd.linear_mps * yaw.sin() * dt;
+            yaw += cmd.angular_radps * dt;
+        }
+        None
+    }
+
     /// Drives a unicycle with the controller's commands: it ends with the point at the goal,
     /// from ahead, behind and beside, within the arrival distance.
     #[test]
@@ -165,24 +190,8 @@ mod tests {
             Vector2::new(0.0, 1.2),
         ] {
             let mut drive = DriveTo::default();
-            // The point in the world; the base at (x, y, yaw).
-            let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
-            let dt = 0.01;
-            let mut arrived = false;
-            for i in 0..6000 {
-                let (dx, dy) = (start.x - x, start.y - y);
-                let (s, c) = yaw.sin_cos();
-                let point = Vector2::new(c * dx + s * dy, -s * dx + c * dy);
-                let (cmd, there) = drive.command(f64::from(i) * dt, point, goal);
-                if there {
-                    arrived = true;
-                    break;
-                }
-                x += cmd.linear_mps * yaw.cos() * dt;
-                y += cmd.linear_mps * yaw.sin() * dt;
-                yaw += cmd.angular_radps * dt;
-            }
-            assert!(arrived, "from {start:?}: never arrived");
+            let end = drive_unicycle(start, 6000, |t, point, _| drive.command(t, point, goal));
+            assert!(end.is_some(), "from {start:?}: never arrived");
         }
     }
 
@@ -196,27 +205,12 @@ mod tests {
             (Vector2::new(0.1, -0.6), 1.0),
         ] {
             let mut drive = DriveTo::default();
-            let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
-            let dt = 0.01;
-            let mut arrived = false;
-            for i in 0..9000 {
-                let (dx, dy) = (goal.x - x, goal.y - y);
-                let (s, c) = yaw.sin_cos();
-                let stand = Vector2::new(c * dx + s * dy, -s * dx + c * dy);
-                let (cmd, there) =
-                    drive.to_pose(f64::from(i) * dt, stand, wrap_angle(goal_yaw - yaw));
-                if there {
-                    arrived = true;
-                    break;
-                }
-                x += cmd.linear_mps * yaw.cos() * dt;
-                y += cmd.linear_mps * yaw.sin() * dt;
-                yaw += cmd.angular_radps * dt;
-            }
-            assert!(
-                arrived,
-                "to {goal:?}: never arrived (at {x:.3}, {y:.3}, {yaw:.3})"
-            );
+            let end = drive_unicycle(goal, 9000, |t, stand, yaw| {
+                drive.pose_command(t, stand, wrap_angle(goal_yaw - yaw))
+            });
+            let Some((x, y, yaw)) = end else {
+                panic!("to {goal:?}: never arrived");
+            };
             assert!((goal - Vector2::new(x, y)).norm() < 0.03, "{x} {y}");
             assert!(wrap_angle(goal_yaw - yaw).abs() < 0.03, "{yaw}");
         }

@@ -50,10 +50,15 @@ impl Pick {
         })
     }
 
-    /// The side of the base the arm works on (rad from the arm base's x, left positive): the
-    /// tool's bearing at `q`, to the nearest quarter turn. 0 for an arm that reaches ahead (the
-    /// arm car's), -pi/2 for one that reaches out to the right (Stretch's).
+    /// The side of the base the arm works on (rad from the arm base's x, left positive): ahead
+    /// (0) for an arm that turns its hand as it likes (the arm car's, whose tool may rest
+    /// anywhere round its base); for one that holds its hand level and reaches out to one
+    /// side (Stretch's telescope, -pi/2), the tool's bearing at `q` to the nearest quarter
+    /// turn.
     pub(super) fn arm_side_rad(&self, q: &[f64]) -> f64 {
+        if !self.solver.chain().holds_level() {
+            return 0.0;
+        }
         let tip = (self.solver.chain().base_from_tip(q))
             .map_or_else(|_| Vector3::x(), |t| t.translation.vector);
         let quarter = std::f64::consts::FRAC_PI_2;

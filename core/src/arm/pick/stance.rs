@@ -222,7 +222,7 @@ impl Pick {
                 let z = world_from_base.translation.z;
                 let stand = world_from_base.inverse() * Point3::new(stand.x, stand.y, z);
                 let turn = wrap_angle(yaw - yaw_of(&world_from_base));
-                self.drive.to_pose(now, stand.coords.xy(), turn)
+                self.drive.pose_command(now, stand.coords.xy(), turn)
             }
             None => self.drive.command(now, point.coords.xy(), at),
         };
