@@ -91,12 +91,12 @@ const EIGHT_SPEED_MPS: f64 = 0.5;
 /// The physics benchmark's turn rate (rad/s): circles of 0.83 m radius.
 const EIGHT_TURN_RADPS: f64 = 0.6;
 
-/// What `--hold` holds: a world object, or the first link of a Gazebo model (`[[model]]`),
-/// by index.
+/// What `--hold` holds: a world object, or a Gazebo model (`[[model]]`) by its first link,
+/// by index (the model's among the world's models, its first link's among all model links).
 #[derive(Debug, Clone, Copy)]
 enum Held {
     Object(usize),
-    ModelLink(usize),
+    Model { model: usize, link: usize },
 }
 
 /// Puts world object (or Gazebo model) `name` in the robot's gripper, untimed: the first
@@ -112,8 +112,8 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
             let model = model.ok_or_else(|| {
                 anyhow::anyhow!("--hold {name}: the world has no object or model \"{name}\"")
             })?;
-            let first: usize = world.models[..model].iter().map(|m| m.links.len()).sum();
-            Held::ModelLink(first)
+            let link = world.models[..model].iter().map(|m| m.links.len()).sum();
+            Held::Model { model, link }
         }
     };
     let ee = sim.world().robot.ee_link.clone().ok_or_else(|| {
@@ -149,18 +149,9 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
         Held::Object(i) => {
             sim.place_object(i, [f64::from(at.x), f64::from(at.y), f64::from(at.z)], 0.0)?
         }
-        Held::ModelLink(link) => {
-            let mut poses = Vec::new();
-            sim.model_link_poses_into(&mut poses);
+        Held::Model { model, link } => {
+            // The model moved rigidly, its first link's centre of mass to the end effector.
             let centre = sim.model_link_centre(link).unwrap_or(at);
-            let model = (sim.world().models.iter())
-                .scan(0, |first, m| {
-                    let this = *first;
-                    *first += m.links.len();
-                    Some(this)
-                })
-                .position(|first| first == link)
-                .unwrap_or(0);
             let world_from_model = sim.world().models[model].world_from_model;
             let moved = rover_sim::geometry::Pose::from_translation(at - centre) * world_from_model;
             sim.place_model(model, moved)?;
@@ -188,7 +179,7 @@ fn held_to_link_m(sim: &Simulation, held: Held, link: rover_sim::model::LinkId) 
             sim.object_poses_into(&mut poses);
             poses.get(i).map(|p| p.translation).unwrap_or_default()
         }
-        Held::ModelLink(i) => sim.model_link_centre(i).unwrap_or_default(),
+        Held::Model { link, .. } => sim.model_link_centre(link).unwrap_or_default(),
     };
     f64::from((at - sim.world_from_link(link).translation).length())
 }
