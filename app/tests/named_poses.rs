@@ -214,3 +214,29 @@ fn an_unknown_pose_is_one_warning_listing_the_known_poses() -> Result<()> {
     );
     Ok(())
 }
+
+/// A world whose `[robot] pose` names a pose the controllers file lacks is refused as it
+/// loads, naming the key, the pose and the poses the file has.
+#[test]
+fn a_world_start_pose_the_controllers_file_lacks_is_refused() -> Result<()> {
+    let dir = tempfile::tempdir()?;
+    let world = std::fs::read_to_string(repo("worlds/arm_car.toml"))?
+        .replace("\"../", &format!("\"{}/", repo("").display()))
+        .replace("[robot]\n", "[robot]\npose = \"nope\"\n");
+    let path = dir.path().join("arm_car_pose.toml");
+    std::fs::write(&path, world)?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rover"))
+        .args(["--headless", "--duration", "0.5", "--world"])
+        .arg(&path)
+        .env("ROVER_OFFLINE", "1")
+        .output()?;
+    let stderr = text(&out.stderr);
+    anyhow::ensure!(
+        !out.status.success()
+            && stderr.contains("[robot] pose = \"nope\"")
+            && stderr.contains("no named pose \"nope\"")
+            && stderr.contains("\"home\""),
+        "{stderr}"
+    );
+    Ok(())
+}
