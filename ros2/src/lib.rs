@@ -4,7 +4,8 @@
 //!
 //! - [`msgs`]: the ROS 2 messages rover publishes and reads, as serde structs in CDR layout, and
 //!   [`definitions`]: their ROS 2 definitions (for MCAP's schemas);
-//! - [`bulk`]: large best-effort samples (images) in 64 KB fragments, as Fast DDS sends them;
+//! - [`bulk`]: large best-effort samples (images) in 16 KB fragments, paced, and [`acked`]:
+//!   large reliable ones, one at a time, each after the last was acknowledged;
 //! - [`dds`]: ROS names as DDS topics, rclcpp's QoS profiles, typed writers;
 //! - [`discovery`]: `ros_discovery_info`, so `ros2 node list` finds the node (Gids of each
 //!   distribution's size);
@@ -16,6 +17,7 @@
 //! The bridge's topic families, its input half and the controllers' action servers live in the
 //! app (app/src/ros2), which this crate serves. Its sibling for ROS 1 is `rover-ros1`.
 
+pub mod acked;
 pub mod action_msgs;
 pub mod bulk;
 pub mod dds;

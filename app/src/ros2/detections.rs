@@ -62,7 +62,7 @@ impl Darknet {
         Ok(Self {
             boxes: Boxes::create(sinks, BOUNDING_BOXES_TOPIC, "detection")?,
             found: sinks.out(FOUND_OBJECT_TOPIC, &default_qos())?,
-            detection_image: sinks.out(DETECTION_IMAGE_TOPIC, &latched_qos())?,
+            detection_image: sinks.out_large(DETECTION_IMAGE_TOPIC, &latched_qos())?,
             found_msg: msgs::ObjectCount {
                 header: header("detection"),
                 count: 0,

@@ -8,6 +8,7 @@ use rustdds::policy::Reliability;
 use rustdds::{DomainParticipant, GUID, QosPolicies, RTPSEntity};
 
 use super::mcap::McapRecorder;
+use rover_ros2::acked::AckedWriter;
 use rover_ros2::bulk::BulkWriter;
 use rover_ros2::dds::{Writer, writer};
 pub(super) use rover_ros2::dds::{latched_qos, sensor_qos};
@@ -24,11 +25,13 @@ pub(super) fn header(frame_id: &str) -> Header {
     }
 }
 
-/// A topic's DDS writer: RustDDS's, or for best-effort topics (whose samples may be large)
-/// the one that sends 64 KB fragments (rover_ros2::bulk).
+/// A topic's DDS writer: RustDDS's; for best-effort topics (whose samples may be large) the
+/// one that sends paced 16 KB fragments (rover_ros2::bulk); for reliable topics of large
+/// samples, the one that writes each after the last was acknowledged (rover_ros2::acked).
 enum Dds<M: RosMessage> {
     Plain(Writer<M>),
     Bulk(BulkWriter<M>),
+    Acked(AckedWriter<M>),
 }
 
 /// One topic: where its messages go.
@@ -52,6 +55,10 @@ impl<M: RosMessage + Clone> Out<M> {
         let written = match &mut self.dds {
             Some(Dds::Plain(w)) => w.write(msg.clone(), None).map_err(|e| e.to_string()),
             Some(Dds::Bulk(w)) => w.write(msg).map_err(|e| e.to_string()),
+            Some(Dds::Acked(w)) => {
+                w.write(msg.clone());
+                Ok(())
+            }
             None => Ok(()),
         };
         if let Err(e) = written
@@ -105,16 +112,41 @@ pub(super) struct Sinks<'a> {
 
 impl Sinks<'_> {
     /// The topic `ros_name` of messages `M` on every sink, with `qos` on DDS.
-    pub fn out<M: RosMessage>(&mut self, ros_name: &str, qos: &QosPolicies) -> Result<Out<M>> {
+    pub fn out<M: RosMessage + Send + 'static>(
+        &mut self,
+        ros_name: &str,
+        qos: &QosPolicies,
+    ) -> Result<Out<M>> {
+        self.out_sized(ros_name, qos, false)
+    }
+
+    /// [`Self::out`] for a topic whose samples are large (images): a reliable one writes each
+    /// sample once the last was acknowledged (rover_ros2::acked).
+    pub fn out_large<M: RosMessage + Send + 'static>(
+        &mut self,
+        ros_name: &str,
+        qos: &QosPolicies,
+    ) -> Result<Out<M>> {
+        self.out_sized(ros_name, qos, true)
+    }
+
+    fn out_sized<M: RosMessage + Send + 'static>(
+        &mut self,
+        ros_name: &str,
+        qos: &QosPolicies,
+        large: bool,
+    ) -> Result<Out<M>> {
         let dds = match self.dds {
             Some((participant, publisher)) => {
                 let w = writer(participant, publisher, ros_name, qos)?;
                 self.writers.push(w.guid());
-                if qos.reliability() == Some(Reliability::BestEffort) {
-                    Some(Dds::Bulk(BulkWriter::new(participant, w, ros_name)?))
+                Some(if qos.reliability() == Some(Reliability::BestEffort) {
+                    Dds::Bulk(BulkWriter::new(participant, w, ros_name)?)
+                } else if large {
+                    Dds::Acked(AckedWriter::new(w, ros_name)?)
                 } else {
-                    Some(Dds::Plain(w))
-                }
+                    Dds::Plain(w)
+                })
             }
             None => None,
         };
@@ -137,7 +169,7 @@ impl Sinks<'_> {
     }
 
     /// The topic `ros_name`, or none (`None`).
-    pub fn maybe<M: RosMessage>(
+    pub fn maybe<M: RosMessage + Send + 'static>(
         &mut self,
         ros_name: Option<&str>,
         qos: &QosPolicies,
