@@ -719,10 +719,13 @@ fn the_rclpy_listener_yolo_drives_the_car_toward_the_person() -> Result<()> {
 /// `net.core.rmem_default`, 208 KiB here).
 ///
 /// rover's images must arrive at least as often as the rclpy publisher's (which reach the
-/// subscriber through Fast DDS's shared memory). Through RustDDS's own writer they did not
-/// (53 of 300 against 130 on Jazzy): it cuts an image into ~3,600 fragments in ~700
-/// MTU-sized datagrams sent in one burst; rover_ros2::bulk sends 58 paced datagrams of
-/// 15,900-byte fragments (docs/ROS2.md, "Large samples").
+/// subscriber through Fast DDS's shared memory), give or take 10 %: on a loaded machine both
+/// streams are held to what the subscriber's share of the CPU takes (127 against 132 once,
+/// two tests beside it), where the defect this guards against is a gap of more than twice.
+/// Through RustDDS's own writer they did not (53 of 300 against 130 on Jazzy): it cuts an
+/// image into ~3,600 fragments in ~700 MTU-sized datagrams sent in one burst;
+/// rover_ros2::bulk sends 58 paced datagrams of 15,900-byte fragments (docs/ROS2.md, "Large
+/// samples").
 #[test]
 fn rovers_images_reach_rclpy_at_least_as_often_as_an_rclpy_publishers() -> Result<()> {
     let Some(distros) = distros() else {
@@ -742,7 +745,7 @@ fn rovers_images_reach_rclpy_at_least_as_often_as_an_rclpy_publishers() -> Resul
                  rover {rover}, an rclpy publisher {peer} (30 Hz each)"
             );
             ensure!(
-                rover >= peer && rover > 0,
+                rover * 10 >= peer * 9 && rover > 0,
                 "{distro}, round {round}: rover's images arrived {rover} times, the rclpy \
                  publisher's {peer} times\n{}",
                 session.rover_log()

@@ -66,22 +66,27 @@ pub(crate) struct Reader {
     pub to: Option<SocketAddr>,
 }
 
-/// The readers RustDDS matched to a best-effort, volatile writer of `topic`, with their UDP
-/// addresses as discovery gives them.
+/// The readers RustDDS matched to a writer of `topic` (best effort and volatile, or reliable
+/// and transient local), with their UDP addresses as discovery gives them.
 #[derive(Debug)]
 pub(crate) struct Matched {
     pub readers: Vec<Reader>,
     /// The writer's DDS topic.
     topic: String,
+    /// The writer is reliable and transient local (it matches any reader of the topic), not
+    /// best effort and volatile.
+    reliable_writer: bool,
     last_lookup: Option<Instant>,
 }
 
 impl Matched {
-    /// None yet, for a writer of `topic`.
-    pub fn new(topic: &str) -> Self {
+    /// None yet, for a best-effort, volatile writer of `topic` (`reliable_writer`: a
+    /// reliable, transient-local one).
+    pub fn new(topic: &str, reliable_writer: bool) -> Self {
         Self {
             readers: Vec::new(),
             topic: topic.to_owned(),
+            reliable_writer,
             last_lookup: None,
         }
     }
@@ -106,8 +111,8 @@ impl Matched {
     }
 
     /// At most every [`LOOKUP_EVERY`] (at once after a new match): the readers discovery has
-    /// of the topic that a best-effort, volatile writer matches (what a lost match report
-    /// left out comes in; one gone from discovery goes), and each one's address.
+    /// of the topic that the writer matches (what a lost match report left out comes in; one
+    /// gone from discovery goes), and each one's address.
     pub fn look_up(&mut self, participant: &DomainParticipant) {
         if self.last_lookup.is_some_and(|t| t.elapsed() < LOOKUP_EVERY) {
             return;
@@ -121,9 +126,16 @@ impl Matched {
         });
         for d in &discovered {
             let qos = d.subscription_topic_data.qos();
-            let matches = d.subscription_topic_data.topic_name() == &self.topic
-                && !matches!(qos.reliability(), Some(Reliability::Reliable { .. }))
-                && matches!(qos.durability(), None | Some(Durability::Volatile));
+            let durability_fits = if self.reliable_writer {
+                matches!(
+                    qos.durability(),
+                    None | Some(Durability::Volatile | Durability::TransientLocal)
+                )
+            } else {
+                matches!(qos.durability(), None | Some(Durability::Volatile))
+                    && !matches!(qos.reliability(), Some(Reliability::Reliable { .. }))
+            };
+            let matches = d.subscription_topic_data.topic_name() == &self.topic && durability_fits;
             let guid = d.reader_proxy.remote_reader_guid;
             if matches && !self.readers.iter().any(|r| r.guid == guid) {
                 self.readers.push(Reader { guid, to: None });
@@ -213,7 +225,7 @@ impl<M: RosMessage> BulkWriter<M> {
                 .spawn(move || send_jobs(&shared, &socket))
                 .context("starting a sending thread")?
         };
-        let matched = Matched::new(&writer.topic().name());
+        let matched = Matched::new(&writer.topic().name(), false);
         Ok(Self {
             writer,
             participant: participant.clone(),
@@ -328,39 +340,68 @@ fn send_jobs(shared: &Shared, socket: &UdpSocket) {
                     .unwrap_or_else(PoisonError::into_inner);
             }
         };
-        if let Err(e) = send(&job, socket, &mut datagram, Some(PACE_BYTES_PER_S))
-            && !std::mem::replace(&mut warned, true)
+        if let Err(e) = send(
+            &job,
+            socket,
+            &mut datagram,
+            BULK_CUT,
+            Some(PACE_BYTES_PER_S),
+        ) && !std::mem::replace(&mut warned, true)
         {
             tracing::warn!("ROS 2: a sample could not be sent ({e}); the run goes on");
         }
         shared.lock().spare.push(job);
     }
 }
-/// Sends `job`'s sample to each of its readers: one DATA when it fits a fragment, else one
-/// DATA_FRAG per fragment, each in its own datagram, fragment by fragment to every reader,
-/// paced at `pace_bytes_per_s` to each (`None`: at once).
+/// How a sample is cut for the wire: the fragment size its DATA_FRAGs announce, and how many
+/// fragments go in one datagram (one DATA_FRAG submessage).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cut {
+    pub fragment_bytes: usize,
+    pub per_datagram: usize,
+}
+
+/// This module's cut: one [`FRAGMENT_BYTES`] fragment a datagram.
+pub(crate) const BULK_CUT: Cut = Cut {
+    fragment_bytes: FRAGMENT_BYTES,
+    per_datagram: 1,
+};
+
+/// Sends `job`'s sample to each of its readers: one DATA when it fits a datagram, else one
+/// DATA_FRAG per datagram of `cut`, datagram by datagram to every reader, paced at
+/// `pace_bytes_per_s` to each (`None`: at once).
 pub(crate) fn send(
     job: &Job,
     socket: &UdpSocket,
     d: &mut Vec<u8>,
+    cut: Cut,
     pace_bytes_per_s: Option<f64>,
 ) -> std::io::Result<()> {
     let sample_bytes = job.payload.len();
-    let fragments = sample_bytes.div_ceil(FRAGMENT_BYTES).max(1);
+    let datagram_bytes = cut.fragment_bytes * cut.per_datagram;
+    let fragments = sample_bytes.div_ceil(cut.fragment_bytes).max(1);
+    let datagrams = sample_bytes.div_ceil(datagram_bytes).max(1);
     let started = Instant::now();
     let mut sent_bytes = 0usize;
-    for fragment in 0..fragments {
-        let start = fragment * FRAGMENT_BYTES;
-        let end = (start + FRAGMENT_BYTES).min(sample_bytes);
+    for datagram in 0..datagrams {
+        let first = datagram * cut.per_datagram;
+        let start = first * cut.fragment_bytes;
+        let end = (start + datagram_bytes).min(sample_bytes);
+        let frags = Frags {
+            first,
+            count: (end - start).div_ceil(cut.fragment_bytes).max(1),
+            total: fragments,
+            size: cut.fragment_bytes,
+        };
         for (reader, to) in &job.readers {
-            message(d, job, *reader, (fragment, fragments), (start, end));
+            message(d, job, *reader, frags, (start, end));
             socket.send_to(d, to)?;
         }
         // Each reader's socket drains on its own: the pace is per reader.
         sent_bytes += d.len();
         // Ahead of the pace: wait until the bytes sent so far are due.
         if let Some(pace) = pace_bytes_per_s
-            && fragment + 1 < fragments
+            && datagram + 1 < datagrams
             && let Some(ahead) =
                 Duration::from_secs_f64(sent_bytes as f64 / pace).checked_sub(started.elapsed())
         {
@@ -370,13 +411,23 @@ pub(crate) fn send(
     Ok(())
 }
 
-/// Writes into `d` the RTPS message that carries bytes `start..end` of `job`'s payload, the
-/// fragment `fragment` of `fragments` (0-based), to `reader`.
+/// The fragments one datagram carries: from `first` (0-based), `count` of them, of `total`
+/// fragments of `size` bytes.
+#[derive(Clone, Copy)]
+struct Frags {
+    first: usize,
+    count: usize,
+    total: usize,
+    size: usize,
+}
+
+/// Writes into `d` the RTPS message that carries bytes `start..end` of `job`'s payload,
+/// the fragments `frags` (a whole sample, one DATA, when `frags.total` is 1), to `reader`.
 fn message(
     d: &mut Vec<u8>,
     job: &Job,
     reader: [u8; 16],
-    (fragment, fragments): (usize, usize),
+    frags: Frags,
     (start, end): (usize, usize),
 ) {
     let writer = &job.writer;
@@ -392,7 +443,7 @@ fn message(
     d.extend_from_slice(&job.stamp.1.to_le_bytes());
     let qos = &job.inline_qos;
     let q = if qos.is_empty() { 0 } else { FLAG_INLINE_QOS };
-    if fragments == 1 {
+    if frags.total == 1 {
         let length = 20 + qos.len() + (end - start);
         submessage_header(d, DATA, FLAG_LITTLE_ENDIAN | FLAG_DATA | q, length);
         d.extend_from_slice(&0u16.to_le_bytes()); // extra flags
@@ -407,10 +458,10 @@ fn message(
     d.extend_from_slice(&writer[12..]);
     d.extend_from_slice(&((job.sequence >> 32) as i32).to_le_bytes());
     d.extend_from_slice(&(job.sequence as u32).to_le_bytes());
-    if fragments > 1 {
-        d.extend_from_slice(&(fragment as u32 + 1).to_le_bytes()); // 1-based
-        d.extend_from_slice(&1u16.to_le_bytes()); // fragments in this submessage
-        d.extend_from_slice(&(FRAGMENT_BYTES as u16).to_le_bytes());
+    if frags.total > 1 {
+        d.extend_from_slice(&(frags.first as u32 + 1).to_le_bytes()); // 1-based
+        d.extend_from_slice(&(frags.count as u16).to_le_bytes()); // fragments in this submessage
+        d.extend_from_slice(&(frags.size as u16).to_le_bytes());
         d.extend_from_slice(&(job.payload.len() as u32).to_le_bytes());
     }
     d.extend_from_slice(qos);

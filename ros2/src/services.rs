@@ -421,7 +421,7 @@ impl LargeReplies {
         job.inline_qos
             .extend_from_slice(&PID_SENTINEL.to_le_bytes());
         job.inline_qos.extend_from_slice(&0u16.to_le_bytes());
-        bulk::send(job, &self.socket, &mut self.datagram, None)
+        bulk::send(job, &self.socket, &mut self.datagram, bulk::BULK_CUT, None)
             .map_err(|e| format!("a large reply could not be sent ({e})"))
     }
 }

@@ -1,12 +1,14 @@
-//! rover_ros2::bulk against a real RTPS reader: a RustDDS participant subscribing best effort
-//! reassembles what the bulk writer sends from its own socket — a 640x480 rgb8 image in
-//! fragments and a small image in one DATA — byte for byte, in order.
+//! rover_ros2::bulk and rover_ros2::acked against a real RTPS reader: a RustDDS participant
+//! subscribing best effort reassembles what the bulk writer sends from its own socket — a
+//! 640x480 rgb8 image in fragments and a small image in one DATA — byte for byte, in order;
+//! one subscribing reliable gets every image the acked writer writes, whole, in order.
 
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, ensure};
+use rover_ros2::acked::AckedWriter;
 use rover_ros2::bulk::{BulkWriter, FRAGMENT_BYTES};
-use rover_ros2::dds::{dds_topic, sensor_qos, writer};
+use rover_ros2::dds::{dds_topic, latched_qos, sensor_qos, writer};
 use rover_ros2::msgs::{Header, Image, Lent, RosMessage, Time};
 use rustdds::no_key::DataReader;
 use rustdds::{CDRDeserializerAdapter, DomainParticipant, TopicKind};
@@ -114,6 +116,51 @@ fn a_rustdds_reader_reassembles_the_bulk_writers_images() -> Result<()> {
                 );
             }
         }
+    }
+    Ok(())
+}
+
+#[test]
+fn a_reliable_rustdds_reader_gets_each_image_of_the_acked_writer_whole() -> Result<()> {
+    let domain = 100 + ((std::process::id() + 50) % 100) as u16;
+    let ros_name = "/darknet_ros/detection_image";
+    let qos = latched_qos();
+
+    let sending = DomainParticipant::new(domain)?;
+    let publisher = sending.create_publisher(&qos)?;
+    let w = writer::<Image>(&sending, &publisher, ros_name, &qos)?;
+    let acked = AckedWriter::new(&sending, w, ros_name)?;
+
+    let receiving = DomainParticipant::new(domain)?;
+    let topic = receiving.create_topic(
+        dds_topic(ros_name),
+        Image::DDS_TYPE.to_owned(),
+        &qos,
+        TopicKind::NoKey,
+    )?;
+    let subscriber = receiving.create_subscriber(&qos)?;
+    let mut reader: DataReader<ReadImage, CDRDeserializerAdapter<ReadImage>> =
+        subscriber.create_datareader_no_key(&topic, Some(qos.clone()))?;
+
+    // Each image is written once, after the last was read: reliable delivery, no retries.
+    for seconds in 1..=4 {
+        let sent = image(seconds, (640, 480));
+        acked.write(sent.clone());
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let sample = loop {
+            ensure!(Instant::now() < deadline, "image {seconds} never arrived");
+            std::thread::sleep(Duration::from_millis(50));
+            if let Ok(Some(sample)) = reader.take_next_sample() {
+                break sample;
+            }
+        };
+        let read = sample.value();
+        ensure!(
+            read.header.stamp.sec == seconds,
+            "image {} read while waiting for {seconds}",
+            read.header.stamp.sec
+        );
+        ensure!(same(read, &sent), "image {seconds} arrived changed");
     }
     Ok(())
 }

@@ -143,7 +143,7 @@ impl Sinks<'_> {
                 Some(if qos.reliability() == Some(Reliability::BestEffort) {
                     Dds::Bulk(BulkWriter::new(participant, w, ros_name)?)
                 } else if large {
-                    Dds::Acked(AckedWriter::new(w, ros_name)?)
+                    Dds::Acked(AckedWriter::new(participant, w, ros_name)?)
                 } else {
                     Dds::Plain(w)
                 })
