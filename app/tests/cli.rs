@@ -206,6 +206,37 @@ fn bench_prints_a_real_time_factor() -> Result<()> {
     Ok(())
 }
 
+/// `bench physics --hold`: the arm car drives its figure eight with the ball in its hand and
+/// says it is still there; an object the world lacks is refused by name.
+#[test]
+fn bench_physics_holds_the_ball_in_the_arm_cars_hand() -> Result<()> {
+    let args = [
+        "bench",
+        "physics",
+        "--world",
+        "worlds/arm_car_pick.toml",
+        "--spawn=-3,-3",
+        "--sim-seconds",
+        "2",
+        "--repeats",
+        "1",
+        "--hold",
+    ];
+    let out = rover(&[&args[..], &["ball"]].concat(), &repo(""))?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", text(&out.stderr));
+    let held = stdout
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("ball: "))
+        .ok_or_else(|| anyhow::anyhow!("no line on the ball in {stdout}"))?;
+    assert!(held.starts_with("still in the hand"), "{stdout}");
+    assert_refused(
+        &[&args[..], &["teapot"]].concat(),
+        &repo(""),
+        "--hold teapot: the world has no object or model \"teapot\"",
+    )
+}
+
 #[test]
 fn detect_prints_boxes_json_and_draws_them() -> Result<()> {
     let photo = Path::new("/usr/share/darknet/data/person.jpg");

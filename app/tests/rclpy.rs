@@ -718,16 +718,17 @@ fn the_rclpy_listener_yolo_drives_the_car_toward_the_person() -> Result<()> {
 /// the subscriber's UDP socket at the OS's default receive buffer (Fast DDS asks for none:
 /// `net.core.rmem_default`, 208 KiB here).
 ///
-/// rover's images must arrive at least as often as the rclpy publisher's (which reach the
-/// subscriber through Fast DDS's shared memory), give or take 10 %: on a loaded machine both
-/// streams are held to what the subscriber's share of the CPU takes (127 against 132 once,
-/// two tests beside it), where the defect this guards against is a gap of more than twice.
+/// Of the images each stream's stamps say were sent while the subscriber listened, rover's
+/// must arrive at least as often as the rclpy publisher's (which reach the subscriber through
+/// Fast DDS's shared memory), give or take 10 %. The share, not the count: on a loaded machine
+/// rover renders fewer than 30 images a wall second (its sim time slows), and the count then
+/// measured the machine (127 against 132 once, two tests beside it), not the transport.
 /// Through RustDDS's own writer they did not (53 of 300 against 130 on Jazzy): it cuts an
 /// image into ~3,600 fragments in ~700 MTU-sized datagrams sent in one burst;
 /// rover_ros2::bulk sends 58 paced datagrams of 15,900-byte fragments (docs/ROS2.md, "Large
 /// samples").
 #[test]
-fn rovers_images_reach_rclpy_at_least_as_often_as_an_rclpy_publishers() -> Result<()> {
+fn rovers_images_reach_rclpy_as_surely_as_an_rclpy_publishers() -> Result<()> {
     let Some(distros) = distros() else {
         return Ok(());
     };
@@ -737,17 +738,24 @@ fn rovers_images_reach_rclpy_at_least_as_often_as_an_rclpy_publishers() -> Resul
         session.background("publish_images")?;
         for round in 1..=2 {
             let found = session.peer(&["camera_rate"], Duration::from_secs(60))?;
-            let counts = &found["camera_rate"];
-            let rover = counts["/camera/image_raw"].as_u64().unwrap_or(0);
-            let peer = counts["/peer/image_raw"].as_u64().unwrap_or(0);
+            let counts = &found["camera_rate"]["counts"];
+            let shares = &found["camera_rate"]["delivered"];
+            let (rover, peer) = ("/camera/image_raw", "/peer/image_raw");
+            let share = |name: &str| shares[name].as_f64().unwrap_or(0.0);
             println!(
                 "{distro}, round {round}: images in 10 s at the OS's default receive buffer: \
-                 rover {rover}, an rclpy publisher {peer} (30 Hz each)"
+                 rover {} ({:.0} % of those sent), an rclpy publisher {} ({:.0} %)",
+                counts[rover],
+                100.0 * share(rover),
+                counts[peer],
+                100.0 * share(peer)
             );
             ensure!(
-                rover * 10 >= peer * 9 && rover > 0,
-                "{distro}, round {round}: rover's images arrived {rover} times, the rclpy \
-                 publisher's {peer} times\n{}",
+                share(rover) >= 0.9 * share(peer) && share(rover) > 0.0,
+                "{distro}, round {round}: {:.0} % of rover's images arrived, {:.0} % of the \
+                 rclpy publisher's: {found}\n{}",
+                100.0 * share(rover),
+                100.0 * share(peer),
                 session.rover_log()
             );
         }

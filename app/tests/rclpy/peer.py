@@ -312,23 +312,37 @@ def gripper(node):
 
 def camera_rate(node):
     """Best-effort images counted side by side for 10 s, raw (no Python deserialization):
-    rover's camera and an rclpy publisher's identical images (`publish_images`)."""
+    rover's camera and an rclpy publisher's identical images (`publish_images`), both 30 Hz
+    on their stamps. Besides the counts, each stream's share delivered: the images received
+    over those its stamps say were sent from its first received to its last (a publisher that
+    sends fewer, on a loaded machine, is not counted against its transport)."""
+    import struct
     from sensor_msgs.msg import Image
 
-    counts = {"/camera/image_raw": 0, "/peer/image_raw": 0}
+    stamps = {"/camera/image_raw": [], "/peer/image_raw": []}
 
     def keep(name):
-        def callback(_raw):
-            counts[name] += 1
+        def callback(raw):
+            # The CDR encapsulation (4 bytes), then the header's stamp: sec, nanosec.
+            sec, nanosec = struct.unpack_from("<iI", raw, 4)
+            stamps[name].append(sec + nanosec * 1e-9)
         return callback
 
-    for name in counts:
+    for name in stamps:
         node.create_subscription(Image, name, keep(name), qos_profile_sensor_data, raw=True)
     spin_for(node, 2.0)  # discovery
-    for name in counts:
-        counts[name] = 0
+    for name in stamps:
+        stamps[name].clear()
     spin_for(node, 10.0)
-    return counts
+
+    def delivered(ts, rate_hz=30.0):
+        ts = sorted(set(ts))
+        if len(ts) < 2:
+            return 0.0
+        return len(ts) / (round((ts[-1] - ts[0]) * rate_hz) + 1)
+
+    return {"counts": {name: len(ts) for name, ts in stamps.items()},
+            "delivered": {name: delivered(ts) for name, ts in stamps.items()}}
 
 
 def publish_images(node):
@@ -343,6 +357,8 @@ def publish_images(node):
     image.data = bytes(640 * 480 * 3)
     sent, start = 0, time.monotonic()
     while time.monotonic() - start < 40.0:
+        # Stamped by its number at 30 Hz, so the subscriber can tell what it missed.
+        image.header.stamp.sec, image.header.stamp.nanosec = sent // 30, (sent % 30) * 33333333
         publisher.publish(image)
         sent += 1
         next_at = start + sent / 30.0

@@ -13,6 +13,7 @@ use crate::model::robot::{JointKind, RobotModel};
 use crate::model::world::JointSolver;
 use crate::model::world::World;
 use crate::physics::contact_springs::ContactSprings;
+use crate::physics::hull::WideHull;
 use crate::physics::joints::{BuiltJoint, add_joints};
 
 /// Collision group of the robot's own colliders (the robot does not collide with itself,
@@ -165,7 +166,7 @@ pub(crate) fn other_body(
 
 /// Collision shape for the engine, with the pose correction for rapier's y-axis cylinders.
 /// Meshes of static bodies keep their triangles (a concave arch stays passable); moving ones
-/// become their convex hull. `source` and `link` name the owner in messages.
+/// become their convex hull ([`WideHull`]). `source` and `link` name the owner in messages.
 pub(crate) fn collider_shape(
     shape: &Shape,
     source: &std::path::Path,
@@ -199,7 +200,9 @@ pub(crate) fn collider_shape(
                 })?;
                 return Ok((tri, Pose::IDENTITY));
             }
-            let hull = SharedShape::convex_hull(&mesh.positions).ok_or_else(|| {
+            // Its wide faces (a round foot) rest on their whole extent (physics/hull.rs).
+            let hull = WideHull::from_points(&mesh.positions).map(SharedShape::new);
+            let hull = hull.ok_or_else(|| {
                 SimError::invalid(
                     source,
                     None,

@@ -12,6 +12,7 @@ pub(crate) mod controllers;
 pub(crate) mod diff_drive;
 pub(crate) mod grasp;
 pub(crate) mod grip_friction;
+pub(crate) mod hull;
 pub(crate) mod joints;
 pub(crate) mod placement;
 pub(crate) mod simulation;
