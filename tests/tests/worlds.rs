@@ -473,7 +473,7 @@ fn osrfs_cup_can_and_beer_stand_on_a_table() -> Result<()> {
             *w = w.max(tilt_deg(pose));
         }
     }
-    let end: Vec<f64> = poses.iter().map(|p| tilt_deg(p)).collect();
+    let end: Vec<f64> = poses.iter().map(tilt_deg).collect();
     println!("{names:?}: tilt at the end {end:.2?} deg, at most {worst:.2?} deg");
     for ((name, end), worst) in names.iter().zip(&end).zip(&worst) {
         assert!(
