@@ -55,6 +55,28 @@ fn same(read: &ReadImage, sent: &Image) -> bool {
         && read.data == *sent.data.as_slice()
 }
 
+/// A reader of images on `ros_name` with `qos`, on a participant of its own in `domain`
+/// (returned with it: the reader lives as long as its participant).
+fn image_reader(
+    domain: u16,
+    ros_name: &str,
+    qos: &rustdds::QosPolicies,
+) -> Result<(DomainParticipant, ImageReader)> {
+    let receiving = DomainParticipant::new(domain)?;
+    let topic = receiving.create_topic(
+        dds_topic(ros_name),
+        Image::DDS_TYPE.to_owned(),
+        qos,
+        TopicKind::NoKey,
+    )?;
+    let subscriber = receiving.create_subscriber(qos)?;
+    let reader = subscriber.create_datareader_no_key(&topic, Some(qos.clone()))?;
+    Ok((receiving, reader))
+}
+
+/// A RustDDS reader of [`ReadImage`]s.
+type ImageReader = DataReader<ReadImage, CDRDeserializerAdapter<ReadImage>>;
+
 #[test]
 fn a_rustdds_reader_reassembles_the_bulk_writers_images() -> Result<()> {
     let domain = 100 + (std::process::id() % 100) as u16;
@@ -66,16 +88,7 @@ fn a_rustdds_reader_reassembles_the_bulk_writers_images() -> Result<()> {
     let w = writer::<Image>(&sending, &publisher, ros_name, &qos)?;
     let mut bulk = BulkWriter::new(&sending, w, ros_name)?;
 
-    let receiving = DomainParticipant::new(domain)?;
-    let topic = receiving.create_topic(
-        dds_topic(ros_name),
-        Image::DDS_TYPE.to_owned(),
-        &qos,
-        TopicKind::NoKey,
-    )?;
-    let subscriber = receiving.create_subscriber(&qos)?;
-    let mut reader: DataReader<ReadImage, CDRDeserializerAdapter<ReadImage>> =
-        subscriber.create_datareader_no_key(&topic, Some(qos.clone()))?;
+    let (_receiving, mut reader) = image_reader(domain, ros_name, &qos)?;
 
     // Discovery: the writer must know the reader and its UDP address.
     let deadline = Instant::now() + Duration::from_secs(20);
@@ -131,16 +144,7 @@ fn a_reliable_rustdds_reader_gets_each_image_of_the_acked_writer_whole() -> Resu
     let w = writer::<Image>(&sending, &publisher, ros_name, &qos)?;
     let acked = AckedWriter::new(&sending, w, ros_name)?;
 
-    let receiving = DomainParticipant::new(domain)?;
-    let topic = receiving.create_topic(
-        dds_topic(ros_name),
-        Image::DDS_TYPE.to_owned(),
-        &qos,
-        TopicKind::NoKey,
-    )?;
-    let subscriber = receiving.create_subscriber(&qos)?;
-    let mut reader: DataReader<ReadImage, CDRDeserializerAdapter<ReadImage>> =
-        subscriber.create_datareader_no_key(&topic, Some(qos.clone()))?;
+    let (_receiving, mut reader) = image_reader(domain, ros_name, &qos)?;
 
     // Each image is written once, after the last was read: reliable delivery, no retries.
     for seconds in 1..=4 {

@@ -245,6 +245,7 @@ const PUBLIC_MODULES: &[(&str, &[&str])] = &[
     (
         "ros2",
         &[
+            "acked",
             "action_msgs",
             "bulk",
             "dds",
