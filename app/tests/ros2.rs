@@ -122,6 +122,12 @@ impl Graph {
 
     /// Waits for rover to finish; its exit must be clean.
     fn wait_rover(&mut self, timeout: Duration) -> Result<()> {
+        self.wait_exit(timeout, false)
+    }
+
+    /// Waits for rover to exit, at most `timeout` (then kills it): exit code 0, or 130 too
+    /// when `interrupted` (ended by SIGINT, its files finished).
+    fn wait_exit(&mut self, timeout: Duration, interrupted: bool) -> Result<()> {
         let Some(mut child) = self.rover.take() else {
             return Ok(());
         };
@@ -129,7 +135,10 @@ impl Graph {
         loop {
             if let Some(status) = child.try_wait()? {
                 let log = std::fs::read_to_string(self.dir.path().join("rover.log"))?;
-                ensure!(status.success(), "rover failed ({status}):\n{log}");
+                ensure!(
+                    status.success() || (interrupted && status.code() == Some(130)),
+                    "rover failed ({status}):\n{log}"
+                );
                 return Ok(());
             }
             if start.elapsed() > timeout {
@@ -139,37 +148,19 @@ impl Graph {
             std::thread::sleep(Duration::from_millis(100));
         }
     }
-}
 
-impl Graph {
     /// Ends rover's run early as Ctrl-C does (its files finished, exit code 130).
     fn stop_rover(&mut self, timeout: Duration) -> Result<()> {
-        let Some(mut child) = self.rover.take() else {
-            return Ok(());
-        };
-        if child.try_wait()?.is_none() {
+        if let Some(child) = &mut self.rover
+            && child.try_wait()?.is_none()
+        {
             let status = Command::new("kill")
                 .arg("-INT")
                 .arg(child.id().to_string())
                 .status()?;
             ensure!(status.success(), "kill -INT {} failed", child.id());
         }
-        let start = Instant::now();
-        loop {
-            if let Some(status) = child.try_wait()? {
-                let log = std::fs::read_to_string(self.dir.path().join("rover.log"))?;
-                ensure!(
-                    status.success() || status.code() == Some(130),
-                    "rover failed ({status}):\n{log}"
-                );
-                return Ok(());
-            }
-            if start.elapsed() > timeout {
-                let _ = child.kill();
-                anyhow::bail!("rover did not stop in {timeout:?} after SIGINT");
-            }
-            std::thread::sleep(Duration::from_millis(100));
-        }
+        self.wait_exit(timeout, true)
     }
 }
 

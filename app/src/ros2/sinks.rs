@@ -56,6 +56,8 @@ impl<M: RosMessage + Clone> Out<M> {
             Some(Dds::Plain(w)) => w.write(msg.clone(), None).map_err(|e| e.to_string()),
             Some(Dds::Bulk(w)) => w.write(msg).map_err(|e| e.to_string()),
             Some(Dds::Acked(w)) => {
+                // The writing thread holds the copy a while (an image's buffer then goes
+                // to it, and the image pool makes a new one: one per detection image).
                 w.write(msg.clone());
                 Ok(())
             }

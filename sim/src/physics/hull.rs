@@ -30,11 +30,11 @@ impl WideHull {
     }
 }
 
-/// Of a face's `loop_points` (its vertices in order round it), the positions in the loop of
-/// at most four that span it: all of them up to four; else one far from the middle, the one
-/// farthest from that, and the farthest from the line between them on either side, in loop
-/// order.
-pub(crate) fn spanning_four(loop_points: &[Vector]) -> ([usize; 4], usize) {
+/// Of a face's `loop_points` (its vertices in order round it; `normal`, the face's), the
+/// positions in the loop of at most four that span it: all of them up to four; else one far
+/// from the middle, the one farthest from that, and the farthest from the line between them on
+/// either side, in loop order.
+pub(crate) fn spanning_four(loop_points: &[Vector], normal: Vector) -> ([usize; 4], usize) {
     let n = loop_points.len();
     if n <= 4 {
         return ([0, 1.min(n), 2.min(n), 3.min(n)], n);
@@ -54,8 +54,7 @@ pub(crate) fn spanning_four(loop_points: &[Vector]) -> ([usize; 4], usize) {
     let a = farthest_from(middle);
     let c = farthest_from(loop_points[a]);
     let ac = loop_points[c] - loop_points[a];
-    // Signed distance from the line a-c, in the face's plane (by the face's own turn).
-    let normal = (loop_points[1] - loop_points[0]).cross(loop_points[2] - loop_points[0]);
+    // Signed distance from the line a-c, in the face's plane.
     let side = |i: usize| ac.cross(loop_points[i] - loop_points[a]).dot(normal);
     let b = (0..n)
         .max_by(|&i, &j| side(i).total_cmp(&side(j)))
@@ -97,7 +96,7 @@ impl PolygonalFeatureMap for WideHull {
             for (slot, &v) in loop_points.iter_mut().zip(vertex_ids) {
                 *slot = points[v as usize];
             }
-            spanning_four(&loop_points[..len])
+            spanning_four(&loop_points[..len], face.normal)
         } else {
             // A face of more vertices than that: evenly round its loop.
             let step = |k: usize| k * len / 4;
@@ -225,7 +224,7 @@ mod tests {
     #[test]
     fn a_round_face_is_spanned_by_four_vertices_round_it() {
         let foot = ring(32, 0.0275);
-        let (picked, count) = spanning_four(&foot);
+        let (picked, count) = spanning_four(&foot, Vector::Z);
         assert_eq!(count, 4);
         // A quadrilateral across the circle: its area is near the inscribed square's, 2 r².
         let p: Vec<Vector> = picked.iter().map(|&i| foot[i]).collect();
@@ -241,9 +240,9 @@ mod tests {
     #[test]
     fn a_small_face_keeps_its_vertices() {
         let quad = ring(4, 1.0);
-        assert_eq!(spanning_four(&quad), ([0, 1, 2, 3], 4));
+        assert_eq!(spanning_four(&quad, Vector::Z), ([0, 1, 2, 3], 4));
         let triangle = ring(3, 1.0);
-        assert_eq!(spanning_four(&triangle).1, 3);
+        assert_eq!(spanning_four(&triangle, Vector::Z).1, 3);
     }
 
     #[test]
