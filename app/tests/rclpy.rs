@@ -718,15 +718,17 @@ fn the_rclpy_listener_yolo_drives_the_car_toward_the_person() -> Result<()> {
 /// the subscriber's UDP socket at the OS's default receive buffer (Fast DDS asks for none:
 /// `net.core.rmem_default`, 208 KiB here).
 ///
-/// Of the images each stream's stamps say were sent while the subscriber listened, rover's
-/// must arrive at least as often as the rclpy publisher's (which reach the subscriber through
-/// Fast DDS's shared memory), give or take 10 %. The share, not the count: on a loaded machine
-/// rover renders fewer than 30 images a wall second (its sim time slows), and the count then
-/// measured the machine (127 against 132 once, two tests beside it), not the transport.
-/// Through RustDDS's own writer they did not (53 of 300 against 130 on Jazzy): it cuts an
-/// image into ~3,600 fragments in ~700 MTU-sized datagrams sent in one burst;
-/// rover_ros2::bulk sends 58 paced datagrams of 15,900-byte fragments (docs/ROS2.md, "Large
-/// samples").
+/// Of the images each stream's stamps say were sent while the subscriber listened (both
+/// rounds together), rover's must arrive at least as often as the rclpy publisher's (which
+/// reach the subscriber through Fast DDS's shared memory), give or take 10 %. The share, not
+/// the count: on a loaded machine rover renders fewer than 30 images a wall second (its sim
+/// time slows), and the count then measured the machine (127 against 132 once, two tests
+/// beside it), not the transport. Through RustDDS's own writer they did not (53 of 300
+/// against 130 on Jazzy): it cuts an image into ~3,600 fragments in ~700 MTU-sized datagrams
+/// sent in one burst; rover_ros2::bulk sends 58 datagrams of 15,900-byte fragments, paced over
+/// most of the time to the next image (docs/ROS2.md, "Large samples"). Paced twice as fast,
+/// 60 MB/s, rover's share fell below the publisher's on a busy machine (22 % against 38 % in
+/// CI; 17-29 % against 35-44 % beside three busy loops) where 30 MB/s kept 63-75 %.
 #[test]
 fn rovers_images_reach_rclpy_as_surely_as_an_rclpy_publishers() -> Result<()> {
     let Some(distros) = distros() else {
@@ -736,12 +738,16 @@ fn rovers_images_reach_rclpy_as_surely_as_an_rclpy_publishers() -> Result<()> {
         let distro = rclpy.distro.clone();
         let mut session = Session::start(rclpy, 51 + k as u16, 40.0, &["--no-detector"])?;
         session.background("publish_images")?;
+        // Per stream: images received and images its stamps say were sent, both rounds.
+        let (mut rover_got, mut rover_sent, mut peer_got, mut peer_sent) = (0.0, 0.0, 0.0, 0.0);
         for round in 1..=2 {
             let found = session.peer(&["camera_rate"], Duration::from_secs(60))?;
             let counts = &found["camera_rate"]["counts"];
             let shares = &found["camera_rate"]["delivered"];
             let (rover, peer) = ("/camera/image_raw", "/peer/image_raw");
             let share = |name: &str| shares[name].as_f64().unwrap_or(0.0);
+            let count = |name: &str| counts[name].as_f64().unwrap_or(0.0);
+            let sent = |name: &str| count(name) / share(name).max(1e-9);
             println!(
                 "{distro}, round {round}: images in 10 s at the OS's default receive buffer: \
                  rover {} ({:.0} % of those sent), an rclpy publisher {} ({:.0} %)",
@@ -750,15 +756,20 @@ fn rovers_images_reach_rclpy_as_surely_as_an_rclpy_publishers() -> Result<()> {
                 counts[peer],
                 100.0 * share(peer)
             );
-            ensure!(
-                share(rover) >= 0.9 * share(peer) && share(rover) > 0.0,
-                "{distro}, round {round}: {:.0} % of rover's images arrived, {:.0} % of the \
-                 rclpy publisher's: {found}\n{}",
-                100.0 * share(rover),
-                100.0 * share(peer),
-                session.rover_log()
-            );
+            rover_got += count(rover);
+            rover_sent += sent(rover);
+            peer_got += count(peer);
+            peer_sent += sent(peer);
         }
+        let rover_share = rover_got / rover_sent.max(1.0);
+        let peer_share = peer_got / peer_sent.max(1.0);
+        ensure!(
+            rover_share >= 0.9 * peer_share && rover_got > 0.0,
+            "{distro}: {:.0} % of rover's images arrived, {:.0} % of the rclpy publisher's\n{}",
+            100.0 * rover_share,
+            100.0 * peer_share,
+            session.rover_log()
+        );
         session.wait(Duration::from_secs(60))?;
     }
     Ok(())

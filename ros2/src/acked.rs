@@ -11,7 +11,7 @@
 //! - the sample goes first to each matched reader whose UDP address discovery gives, from this
 //!   module's socket, in datagrams of 62 of RustDDS's 256-byte fragments (the same fragment
 //!   size and numbering, so RustDDS's repairs fit what the reader holds), paced at
-//!   [`PACE_BYTES_PER_S`], with the sequence number RustDDS gives it next;
+//!   [`PACE_FLOOR_BYTES_PER_S`], with the sequence number RustDDS gives it next;
 //! - then RustDDS writes it: it numbers it, keeps it, sends its own copy (a reader that has
 //!   the sample already drops it), announces it with heartbeats and repairs what a reader
 //!   still lacks; a reader with no UDP address gets RustDDS's copy alone;
@@ -29,7 +29,7 @@ use rustdds::{
     DomainParticipant, GUID, RTPSEntity, StatusEvented, TopicDescription, WriteOptionsBuilder,
 };
 
-use crate::bulk::{self, CDR_LE, Cut, Job, Matched, PACE_BYTES_PER_S, rtps_time};
+use crate::bulk::{self, CDR_LE, Cut, Job, Matched, PACE_FLOOR_BYTES_PER_S, rtps_time};
 use crate::dds::Writer;
 use crate::error::{Context, Result};
 use crate::msgs::RosMessage;
@@ -233,7 +233,7 @@ impl<M: RosMessage> Sender<M> {
             &self.socket,
             &mut self.datagram,
             CUT,
-            Some(PACE_BYTES_PER_S),
+            Some(PACE_FLOOR_BYTES_PER_S),
         )
         .context("sending a sample")
     }
