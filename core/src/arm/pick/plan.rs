@@ -218,7 +218,7 @@ impl Pick {
                     (&[pitch_deg], &PLACE_YAWS_DEG),
                 )
             }
-            None => self.ways_round(over, g.open),
+            None => self.ways_round(over, g.finger.half_width_m(g.open)),
         };
         let (place_q, _, way) = self
             .reachable(scene, over, lift_q, "the place", None, &ways)
@@ -370,7 +370,7 @@ impl Pick {
             scene.ignore_object(t, true);
         }
         let (lo, hi) = (g.closed.min(g.open), g.closed.max(g.open));
-        scene.set_joint(g.joint, way.grip_m.clamp(lo, hi));
+        scene.set_joint(g.joint, g.joint_at(way.grip_m).clamp(lo, hi));
         // Straight up off what it rests on; the hand may turn on the way (the object turns
         // with it). The arm is checked, the object (touching its support, as far as the
         // estimate knows) only from the lift's top.

@@ -64,7 +64,7 @@ impl Pick {
                 && let Ok(g) = &self.gripper
             {
                 let effort = if *grip {
-                    self.squeeze_n * g.lever_m
+                    self.squeeze_n * g.finger.effort_per_n()
                 } else {
                     0.0
                 };

@@ -14,7 +14,7 @@ use rover_sim::{
 
 use super::config::PickConfig;
 use super::fetch::DriveTo;
-use super::state::{Gripper, Pick, PickState};
+use super::state::{Finger, Gripper, Pick, PickState};
 
 impl Pick {
     /// A pick for the chain from `base_link` to `tool_link` of `sim`'s robot, seeing through
@@ -183,8 +183,8 @@ fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
     let tool_from_parent = world_from(tool).inverse() * parent;
     // A sliding finger moves along its axis; a turning one, at the tool point, across the
     // line from its axis to the point.
-    let (across_tool, lever_m) = if matches!(finger.kind, JointKind::Prismatic { .. }) {
-        (tool_from_parent.rotation * axis, 1.0)
+    let (across_tool, finger) = if matches!(finger.kind, JointKind::Prismatic { .. }) {
+        (tool_from_parent.rotation * axis, Finger::Slides)
     } else {
         let origin = finger.parent_from_child.translation;
         let origin = Point3::new(
@@ -202,7 +202,7 @@ fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
                 spec.1
             ));
         }
-        (motion / lever_m, lever_m)
+        (motion / lever_m, Finger::Turns { lever_m })
     };
     Ok(Gripper {
         controller: spec.0,
@@ -210,6 +210,6 @@ fn find_gripper(sim: &Simulation, tool: LinkId) -> Result<Gripper, String> {
         open,
         closed,
         across_tool,
-        lever_m,
+        finger,
     })
 }

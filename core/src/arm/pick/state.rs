@@ -100,16 +100,66 @@ pub(super) struct Gripper {
     /// The direction the finger joint moves, in the tool's frame (unit): the fingers close
     /// across it.
     pub(super) across_tool: Vector3<f64>,
-    /// Effort per newton of squeeze: 1 for sliding fingers, the lever (m) from a turning
-    /// finger's axis to the tool point for fingers that turn (Stretch's), so a squeeze in
-    /// newtons is the joint's torque in N m.
-    pub(super) lever_m: f64,
+    /// How its fingers move.
+    pub(super) finger: Finger,
+}
+
+/// How a gripper's fingers move.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Finger {
+    /// Along the joint's axis: the joint's position is the finger's distance from the middle.
+    Slides,
+    /// About the joint's axis, `lever_m` from the tool point (Stretch's): the tool point sits
+    /// between the fingers at 0.
+    Turns { lever_m: f64 },
+}
+
+impl Finger {
+    /// How far the finger is from the middle (m) at joint position `q` (m or rad): a turning
+    /// one's lever times the sine of its angle.
+    pub(super) fn half_width_m(self, q: f64) -> f64 {
+        match self {
+            Self::Slides => q.abs(),
+            Self::Turns { lever_m } => lever_m * q.abs().min(std::f64::consts::FRAC_PI_2).sin(),
+        }
+    }
+
+    /// How far from 0 the joint is (m or rad) with the finger `half_m` from the middle (a
+    /// turning finger at most a right angle).
+    pub(super) fn travel(self, half_m: f64) -> f64 {
+        match self {
+            Self::Slides => half_m.max(0.0),
+            Self::Turns { lever_m } => (half_m / lever_m).clamp(0.0, 1.0).asin(),
+        }
+    }
+
+    /// Effort per newton of squeeze: 1 for a sliding finger, the lever (m) for a turning one
+    /// (a squeeze in newtons is then the joint's torque in N m).
+    pub(super) fn effort_per_n(self) -> f64 {
+        match self {
+            Self::Slides => 1.0,
+            Self::Turns { lever_m } => lever_m,
+        }
+    }
 }
 
 impl Gripper {
-    /// Each finger's furthest from the middle (m or rad): half the widest the hand opens.
+    /// The joint position (m or rad) at which each finger is `half_m` from the middle, on the
+    /// side the hand opens to.
+    pub(super) fn joint_at(&self, half_m: f64) -> f64 {
+        let wide = if self.open.abs() >= self.closed.abs() {
+            self.open
+        } else {
+            self.closed
+        };
+        self.finger.travel(half_m).copysign(wide)
+    }
+
+    /// Each finger's furthest from the middle (m): half the widest the hand opens.
     pub(super) fn widest_m(&self) -> f64 {
-        self.open.abs().max(self.closed.abs())
+        self.finger
+            .half_width_m(self.open)
+            .max(self.finger.half_width_m(self.closed))
     }
 }
 
@@ -315,4 +365,26 @@ pub(super) struct Held {
     /// The place ([`Pick::place_under`]): the point under the object (world, m), how high above
     /// it the carry ends, how far the hand then goes straight down.
     pub(super) place: ([f64; 3], f64, f64),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sliding_fingers_width_is_its_position_a_turning_ones_its_levers_sine() {
+        let sliding = Finger::Slides;
+        assert_eq!(sliding.half_width_m(-0.04), 0.04);
+        assert_eq!(sliding.travel(0.03), 0.03);
+        assert_eq!(sliding.effort_per_n(), 1.0);
+        // Stretch's fingers: 0.6 rad on a 0.1 m lever is 56 mm from the middle, not 0.6 m.
+        let turning = Finger::Turns { lever_m: 0.1 };
+        assert!((turning.half_width_m(-0.6) - 0.1 * 0.6f64.sin()).abs() < 1e-12);
+        let q = turning.travel(0.033);
+        assert!((turning.half_width_m(q) - 0.033).abs() < 1e-12, "{q}");
+        assert!(q > 0.0 && q < 0.6);
+        // Wider than the lever: as far as the finger turns across (a right angle).
+        assert!((turning.travel(0.5) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(turning.effort_per_n(), 0.1);
+    }
 }
