@@ -3,7 +3,11 @@
 //! and on Franka's panda (example-robot-data: `panda_finger_joint2` mimics joint1).
 
 use anyhow::{Context, Result, ensure};
-use rover_sim::{description::LoadOptions, model::RobotModel, physics::JointCommand};
+use rover_sim::{
+    description::LoadOptions,
+    model::RobotModel,
+    physics::{Grasped, JointCommand},
+};
 
 /// A box with two prismatic fingers; the right one mirrors the left (multiplier -1) with a
 /// 1 cm offset.
@@ -371,7 +375,7 @@ fn lifter_grasp(
 /// 1 rad and drops and raises it 10 cm twice at full speed (m); whether it fell when the
 /// fingers opened; what the grasp assist held, if anything. `grasp` is the world's `[robot]
 /// grasp` line.
-fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<usize>)> {
+fn lift_and_shake(grasp: &str) -> Result<(f32, bool, Option<Grasped>)> {
     let (mut sim, grasp_state) = lifter_grasp(grasp, 10.0)?;
     ensure!(
         grasp_state.stalled,
@@ -435,7 +439,7 @@ fn a_held_ball_stays_in_the_fingers_while_lifted_and_turned_by_friction_or_assis
     ensure!(friction_held.is_none(), "no assist was asked for");
     let (assist_slip, assist_fell, assist_held) = lift_and_shake("grasp = \"assist\"")?;
     ensure!(
-        assist_held == Some(0),
+        assist_held == Some(Grasped::Object(0)),
         "the assist did not hold the ball: {assist_held:?}"
     );
     for (mode, slip, fell) in [

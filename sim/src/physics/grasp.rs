@@ -1,6 +1,6 @@
 //! Grasp assist (`[robot] grasp = "assist"`): gazebo_grasp_fix's rule, the fix Gazebo users
-//! reach for when objects slip out of a gripper. At [`CHECK_HZ`], each world object the
-//! gripper's fingers touch is checked: two or more finger links pushing on it with forces whose
+//! reach for when objects slip out of a gripper. At [`CHECK_HZ`], each world object and each
+//! link of the world's Gazebo models (a Coke can) the gripper's fingers touch is checked: two or more finger links pushing on it with forces whose
 //! directions differ by more than [`FORCES_ANGLE_TOLERANCE_DEG`] count as a grip. The count
 //! goes up (to [`MAX_GRIP_COUNT`]) on a grip and down otherwise; past
 //! [`GRIP_COUNT_THRESHOLD`] the object is attached to the palm with a fixed joint where it is.
@@ -28,11 +28,48 @@ pub const MAX_GRIP_COUNT: u32 = 8;
 /// How much further (m) a finger may move from the held object before it is let go.
 pub const RELEASE_TOLERANCE_M: f32 = 0.005;
 
+/// What the assist holds: a world object (`[[object]]`) or a link of a world's model
+/// (`[[model]]`), by its index among them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Grasped {
+    /// The world object of this index.
+    Object(usize),
+    /// The model link of this index (as [`crate::physics::Simulation::model_link_poses_into`]
+    /// lists them).
+    ModelLink(usize),
+}
+
+impl std::fmt::Display for Grasped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Object(k) => write!(f, "object {k}"),
+            Self::ModelLink(k) => write!(f, "model link {k}"),
+        }
+    }
+}
+
+/// The bodies the assist may hold: the world's objects, then its models' links.
+pub(crate) type Graspables<'a> = [&'a [RigidBodyHandle]; 2];
+
+/// The `k`th of `bodies` (objects first) and what it is.
+fn graspable(bodies: Graspables<'_>, k: usize) -> Option<(RigidBodyHandle, Grasped)> {
+    let [objects, links] = bodies;
+    match objects.get(k) {
+        Some(body) => Some((*body, Grasped::Object(k))),
+        None => {
+            let link = k - objects.len();
+            Some((*links.get(link)?, Grasped::ModelLink(link)))
+        }
+    }
+}
+
 /// An object held by the assist.
 #[derive(Debug, Clone)]
 struct Held {
-    /// The object's index in the world.
-    object: usize,
+    /// Its index among the graspable bodies (objects, then model links).
+    index: usize,
+    /// What it is.
+    what: Grasped,
     joint: ImpulseJointHandle,
     /// Each finger's distance to the object's centre when attached (m).
     finger_distance_m: Vec<f32>,
@@ -43,7 +80,7 @@ struct Held {
 pub(crate) struct GraspAssist {
     palm: RigidBodyHandle,
     fingers: Vec<RigidBodyHandle>,
-    /// Grip count per world object.
+    /// Grip count per graspable body (objects, then model links).
     counts: Vec<u32>,
     held: Option<Held>,
     next_check_s: f64,
@@ -56,7 +93,7 @@ impl GraspAssist {
     pub(crate) fn new(
         robot: &RobotModel,
         link_body: &[RigidBodyHandle],
-        objects: usize,
+        graspables: usize,
     ) -> Result<Self> {
         let (palm, fingers) = gripper_bodies(robot, link_body)?.ok_or_else(|| {
             SimError::Setup(format!(
@@ -67,15 +104,15 @@ impl GraspAssist {
         Ok(Self {
             palm,
             fingers,
-            counts: vec![0; objects],
+            counts: vec![0; graspables],
             held: None,
             next_check_s: 0.0,
         })
     }
 
-    /// The world object held, if one is.
-    pub(crate) fn held(&self) -> Option<usize> {
-        self.held.as_ref().map(|h| h.object)
+    /// What is held, if anything.
+    pub(crate) fn held(&self) -> Option<Grasped> {
+        self.held.as_ref().map(|h| h.what)
     }
 
     /// Checks grips at [`CHECK_HZ`] of sim time: attaches a gripped object, lets a held one go
@@ -83,7 +120,7 @@ impl GraspAssist {
     pub(crate) fn update(
         &mut self,
         physics: &mut PhysicsWorld,
-        objects: &[RigidBodyHandle],
+        bodies: Graspables<'_>,
         now_s: f64,
     ) -> Option<String> {
         if now_s + 1e-9 < self.next_check_s {
@@ -91,7 +128,8 @@ impl GraspAssist {
         }
         self.next_check_s = now_s + 1.0 / CHECK_HZ;
         if let Some(held) = &self.held {
-            let centre = physics.bodies.get(objects[held.object])?.translation();
+            let (body, _) = graspable(bodies, held.index)?;
+            let centre = physics.bodies.get(body)?.translation();
             let opened = self
                 .fingers
                 .iter()
@@ -104,22 +142,27 @@ impl GraspAssist {
             if !opened {
                 return None;
             }
-            let (object, joint) = (held.object, held.joint);
+            let (index, what, joint) = (held.index, held.what, held.joint);
             physics.remove_impulse_joint(joint);
             self.held = None;
-            self.counts[object] = 0;
-            return Some(format!("grasp assist: let go of object {object}"));
+            if let Some(count) = self.counts.get_mut(index) {
+                *count = 0;
+            }
+            return Some(format!("grasp assist: let go of {what}"));
         }
-        for (k, object) in objects.iter().enumerate() {
-            let gripped = self.gripped(physics, *object);
-            let count = &mut self.counts[k];
+        let [objects, links] = bodies;
+        for (k, body) in objects.iter().chain(links).enumerate() {
+            let gripped = self.gripped(physics, *body);
+            let Some(count) = self.counts.get_mut(k) else {
+                break;
+            };
             *count = if gripped {
                 (*count + 1).min(MAX_GRIP_COUNT)
             } else {
                 count.saturating_sub(1)
             };
             if *count > GRIP_COUNT_THRESHOLD {
-                return self.attach(physics, objects, k);
+                return self.attach(physics, bodies, k);
             }
         }
         None
@@ -162,14 +205,14 @@ impl GraspAssist {
         })
     }
 
-    /// Fixes object `k` to the palm where it is now.
+    /// Fixes graspable body `k` to the palm where it is now.
     fn attach(
         &mut self,
         physics: &mut PhysicsWorld,
-        objects: &[RigidBodyHandle],
+        bodies: Graspables<'_>,
         k: usize,
     ) -> Option<String> {
-        let object = objects[k];
+        let (object, what) = graspable(bodies, k)?;
         let palm_pose: Pose = *physics.bodies.get(self.palm)?.position();
         let object_pose: Pose = *physics.bodies.get(object)?.position();
         let centre = object_pose.translation;
@@ -186,11 +229,12 @@ impl GraspAssist {
             .build();
         let handle = physics.insert_impulse_joint(self.palm, object, joint);
         self.held = Some(Held {
-            object: k,
+            index: k,
+            what,
             joint: handle,
             finger_distance_m,
         });
-        Some(format!("grasp assist: holding object {k}"))
+        Some(format!("grasp assist: holding {what}"))
     }
 }
 

@@ -116,17 +116,17 @@ impl FrictionAnchors {
 }
 
 /// How the robot's first gripper holds: the grasp assist (with `grasp = "assist"`) and the
-/// friction anchors of its finger pads (none without a gripper controller). `objects`: how
-/// many world objects there are.
+/// friction anchors of its finger pads (none without a gripper controller). `graspables`: how
+/// many world objects and model links there are.
 pub(crate) fn grip(
     robot: &RobotModel,
-    (link_body, objects): (&[RigidBodyHandle], usize),
+    (link_body, graspables): (&[RigidBodyHandle], usize),
     mode: GraspMode,
     physics: &mut PhysicsWorld,
 ) -> Result<(Option<GraspAssist>, FrictionAnchors)> {
     let assist = match mode {
         GraspMode::Friction => None,
-        GraspMode::Assist => Some(GraspAssist::new(robot, link_body, objects)?),
+        GraspMode::Assist => Some(GraspAssist::new(robot, link_body, graspables)?),
     };
     let fingers = gripper_bodies(robot, link_body)?
         .map(|(_, fingers)| fingers)

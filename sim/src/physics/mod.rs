@@ -28,6 +28,7 @@ pub use diff_drive::{
     DiffDriveController, EncoderOdometry, ODOM_POSE_COVARIANCE_DIAGONAL, Odometry, Twist,
     WheelSpeeds, wrap_angle,
 };
+pub use grasp::Grasped;
 pub use placement::PersonLook;
 pub use simulation::{ControlSample, SimOptions, Simulation};
 pub use states::ModelState;

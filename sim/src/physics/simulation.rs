@@ -22,6 +22,7 @@ use crate::physics::controllers::{
 use crate::physics::diff_drive::{
     DiffDriveController, EncoderOdometry, LEFT, Odometry, RIGHT, Twist, WheelSpeeds, wrap_angle,
 };
+use crate::physics::grasp::Grasped;
 use crate::physics::grip_friction::{ContactHooks, FrictionAnchors};
 use crate::physics::joints::{BuiltJoint, joint_data_mut};
 use crate::physics::trajectory::JointTrajectory;
@@ -223,7 +224,7 @@ impl Simulation {
         let encoder = EncoderOdometry::new(start, &drive_config);
         let (grasp, anchors) = crate::physics::grip_friction::grip(
             &robot,
-            (&robot_bodies.link_body, objects.len()),
+            (&robot_bodies.link_body, objects.len() + model_links.len()),
             world.robot.grasp,
             &mut physics,
         )?;
@@ -312,7 +313,8 @@ impl Simulation {
                 .update(&self.physics, [&self.objects, &self.model_links]);
         }
         if let Some(grasp) = &mut self.grasp
-            && let Some(event) = grasp.update(&mut self.physics, &self.objects, now)
+            && let Some(event) =
+                grasp.update(&mut self.physics, [&self.objects, &self.model_links], now)
         {
             tracing::info!("{event}");
             self.controllers.note(event);
@@ -490,8 +492,9 @@ impl Simulation {
         )
     }
 
-    /// The world object the grasp assist holds (`[robot] grasp = "assist"`), by its index.
-    pub fn grasp_assist_holds(&self) -> Option<usize> {
+    /// What the grasp assist holds (`[robot] grasp = "assist"`): a world object or a model's
+    /// link, by its index.
+    pub fn grasp_assist_holds(&self) -> Option<Grasped> {
         self.grasp.as_ref().and_then(|g| g.held())
     }
 
