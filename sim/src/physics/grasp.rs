@@ -1,7 +1,8 @@
 //! Grasp assist (`[robot] grasp = "assist"`): gazebo_grasp_fix's rule, the fix Gazebo users
 //! reach for when objects slip out of a gripper. At [`CHECK_HZ`], each world object and each
-//! link of the world's Gazebo models (a Coke can) the gripper's fingers touch is checked: two or more finger links pushing on it with forces whose
-//! directions differ by more than [`FORCES_ANGLE_TOLERANCE_DEG`] count as a grip. The count
+//! link of the world's Gazebo models (a Coke can) the gripper's fingers touch is checked: two
+//! or more finger links pushing on it with forces whose directions differ by more than
+//! [`FORCES_ANGLE_TOLERANCE_DEG`] count as a grip. The count
 //! goes up (to [`MAX_GRIP_COUNT`]) on a grip and down otherwise; past
 //! [`GRIP_COUNT_THRESHOLD`] the object is attached to the palm with a fixed joint where it is.
 //! It is let go when a finger moves more than [`RELEASE_TOLERANCE_M`] further from it than it
