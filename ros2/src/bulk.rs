@@ -54,6 +54,10 @@ pub const PACE_FLOOR_BYTES_PER_S: f64 = 30e6;
 /// over (the rest is slack for a late sending thread).
 const PACE_SPREAD: f64 = 0.9;
 
+/// How much of each new interval between samples enters the smoothed one (an exponential
+/// moving average: a camera's jitter does not swing the pace).
+const PACE_SMOOTHING: f64 = 0.2;
+
 /// A writer's pace: each sample spread over [`PACE_SPREAD`] of the time between its samples
 /// (smoothed), at no less than [`PACE_FLOOR_BYTES_PER_S`].
 #[derive(Debug, Default)]
@@ -68,7 +72,7 @@ impl Pace {
         if let Some(last) = self.last.replace(now) {
             let dt_s = now.saturating_duration_since(last).as_secs_f64();
             self.interval_s = Some(match self.interval_s {
-                Some(interval_s) => interval_s + 0.2 * (dt_s - interval_s),
+                Some(interval_s) => interval_s + PACE_SMOOTHING * (dt_s - interval_s),
                 None => dt_s,
             });
         }

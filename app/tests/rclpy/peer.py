@@ -313,8 +313,8 @@ def gripper(node):
 def camera_rate(node):
     """Best-effort images counted side by side for 10 s, raw (no Python deserialization):
     rover's camera and an rclpy publisher's identical images (`publish_images`), both 30 Hz
-    on their stamps. Besides the counts, each stream's share delivered: the images received
-    over those its stamps say were sent from its first received to its last (a publisher that
+    on their stamps. Besides the counts, what each stream's stamps say was sent from its first
+    received to its last, and the share delivered: the images received over those (a publisher that
     sends fewer, on a loaded machine, is not counted against its transport)."""
     import struct
     from sensor_msgs.msg import Image
@@ -335,13 +335,15 @@ def camera_rate(node):
         stamps[name].clear()
     spin_for(node, 10.0)
 
-    def delivered(ts, rate_hz=30.0):
+    def sent(ts, rate_hz=30.0):
         ts = sorted(set(ts))
-        if len(ts) < 2:
-            return 0.0
-        return len(ts) / (round((ts[-1] - ts[0]) * rate_hz) + 1)
+        return round((ts[-1] - ts[0]) * rate_hz) + 1 if ts else 0
+
+    def delivered(ts):
+        return len(set(ts)) / sent(ts) if len(set(ts)) >= 2 else 0.0
 
     return {"counts": {name: len(ts) for name, ts in stamps.items()},
+            "sent": {name: sent(ts) for name, ts in stamps.items()},
             "delivered": {name: delivered(ts) for name, ts in stamps.items()}}
 
 

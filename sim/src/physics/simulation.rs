@@ -316,7 +316,7 @@ impl Simulation {
             && let Some(event) =
                 grasp.update(&mut self.physics, [&self.objects, &self.model_links], now)
         {
-            tracing::info!("{event}");
+            // Logged with the controllers' events (Simulation::drain_controller_events).
             self.controllers.note(event);
         }
         self.placement.clear();
