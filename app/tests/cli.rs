@@ -237,6 +237,50 @@ fn bench_physics_holds_the_ball_in_the_arm_cars_hand() -> Result<()> {
     )
 }
 
+/// `bench physics --hold` on a model's link and a turning gripper: Stretch (PyPI
+/// hello-robot-stretch-urdf) drives its figure eight with osrf's Coke can in its hand, the
+/// grasp assist holding it (its world sets `grasp = "assist"`), and says it is still there.
+/// The bench waits for the lift to reach its start pose and holds the can at the tool until
+/// the fingers stop on it and the assist takes it.
+#[test]
+fn bench_physics_holds_the_can_in_stretchs_hand() -> Result<()> {
+    let Some(models) = rover_tests::shared("corpus/gazebo_models") else {
+        return Ok(());
+    };
+    let Some(wheel) = rover_tests::pypi("hello-robot-stretch-urdf", "0.1.2") else {
+        return Ok(());
+    };
+    let (models, package) = (
+        models.display().to_string(),
+        format!("stretch_urdf={}", wheel.join("stretch_urdf").display()),
+    );
+    let args = [
+        "bench",
+        "physics",
+        "--world",
+        "tests/worlds/stretch_pick.toml",
+        "--model-path",
+        &models,
+        "--package-path",
+        &package,
+        "--sim-seconds",
+        "3",
+        "--repeats",
+        "1",
+        "--hold",
+        "can",
+    ];
+    let out = rover(&args, &repo(""))?;
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", text(&out.stderr));
+    let held = stdout
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("can: "))
+        .ok_or_else(|| anyhow::anyhow!("no line on the can in {stdout}"))?;
+    assert!(held.starts_with("still in the hand"), "{stdout}");
+    Ok(())
+}
+
 #[test]
 fn detect_prints_boxes_json_and_draws_them() -> Result<()> {
     let photo = Path::new("/usr/share/darknet/data/person.jpg");

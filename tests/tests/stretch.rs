@@ -3,8 +3,9 @@
 //! assets/robots/stretch_gripper.urdf.xacro), osrf's Coke can on a table beside it and a second
 //! table 1.2 m further on (tests/worlds/stretch_pick.toml). The head camera sees the can
 //! ("bottle" to YOLO) and the lift and the telescoping arm bring the gripper round it from
-//! the side; the grasp assist (gazebo_grasp_fix's rule, on the can's model link) holds it, and
-//! the base carries it off towards the other table, judged from the world's model states.
+//! the side; the grasp assist (gazebo_grasp_fix's rule, on the can's model link) holds it, the
+//! base carries it to the other table and the arm sets it down there, upright, judged from the
+//! world's model states.
 
 use anyhow::Result;
 use glam::Vec3;
@@ -64,10 +65,12 @@ fn poses(session: &Session) -> (Pose, Vec<Pose>) {
 /// within 10 s of sim time of the toggle. Then the grasp assist holds the can's model link, the
 /// arm lifts it and the base drives off with it: 12 s of sim time after the fingers started to
 /// close, the can is at least 0.5 m further along towards the other table, at least 3 cm above
-/// the counter, leaning no more than 15 degrees. (Setting it down there is not asserted: the
-/// base stalls turning at its stance; docs/ARM.md "Stretch".)
+/// the counter, leaning no more than 15 degrees. The pick then sets it down on the other
+/// table: done within 60 s of the toggle, and 2 s later the can stands on table_b's top
+/// (within its edges, its bottom within 1 cm of the top), leaning no more than 15 degrees,
+/// let go.
 #[test]
-fn stretch_sees_the_can_closes_its_gripper_round_it_and_carries_it_off() -> Result<()> {
+fn stretch_sees_the_can_takes_it_and_sets_it_down_on_the_other_table() -> Result<()> {
     let Some(mut session) = session(1)? else {
         return Ok(());
     };
@@ -166,5 +169,57 @@ fn stretch_sees_the_can_closes_its_gripper_round_it_and_carries_it_off() -> Resu
         before.translation,
         tilt_deg(&carried)
     );
+    // Set down on the other table: the pick done, then 2 s for anything to settle.
+    while session.stats().arm.pick != PickState::Done {
+        session.step(&mut said)?;
+        let state = session.stats().arm.pick;
+        anyhow::ensure!(
+            state != PickState::Failed && session.sim().sim_time_s() - start < 60.0,
+            "not set down within 60 s of the toggle: {state:?}, {:?}",
+            said.0.last()
+        );
+    }
+    let done_s = session.sim().sim_time_s();
+    while session.sim().sim_time_s() - done_s < 2.0 {
+        session.step(&mut said)?;
+    }
+    let (placed, objects) = poses(&session);
+    let world_objects = &session.sim().world().objects;
+    let (table, half_height_m) = (world_objects.iter())
+        .position(|o| o.name == "table_b")
+        .and_then(|i| Some((objects.get(i)?, world_objects[i].shape.half_height_m()?)))
+        .ok_or_else(|| anyhow::anyhow!("no table_b"))?;
+    // From the middle of table_b's top (0.5 m square).
+    let on_top = placed.translation - (table.translation + Vec3::Z * half_height_m);
+    let stopped: Vec<&str> = (said.0.iter())
+        .filter(|(_, _, t)| {
+            t.contains("reaches the place from here") || t.contains("setting it down at")
+        })
+        .map(|(_, _, t)| t.as_str())
+        .collect();
+    println!(
+        "stretch: done {:.1} s after the toggle; the can is ({:.3}, {:.3}) m from table_b's middle, its bottom {:.4} m off its top, leaning {:.1} deg; the assist holds {:?}; {stopped:?}",
+        done_s - start,
+        on_top.x,
+        on_top.y,
+        on_top.z,
+        tilt_deg(&placed),
+        session.sim().grasp_assist_holds()
+    );
+    let half_m = 0.25;
+    assert!(
+        on_top.x.abs() <= half_m && on_top.y.abs() <= half_m,
+        "the can is not over table_b: {on_top:?} from its middle"
+    );
+    assert!(
+        on_top.z.abs() <= 0.01,
+        "the can's bottom is not on table_b's top: {on_top:?}"
+    );
+    assert!(
+        tilt_deg(&placed) <= 15.0,
+        "the can leans {} deg",
+        tilt_deg(&placed)
+    );
+    assert_eq!(session.sim().grasp_assist_holds(), None, "still held");
     Ok(())
 }

@@ -483,3 +483,52 @@ fn osrfs_cup_can_and_beer_stand_on_a_table() -> Result<()> {
     }
     Ok(())
 }
+
+/// A model placed after physics has moved it goes where it is put: osrf's can dropped onto the
+/// ground on its side (tipped 80 degrees, 0.3 m up) and left to fall for 1 s is then placed
+/// upright at a new spot 0.5 m up, twice within one step (as a layout does), and its link is
+/// there, upright, both times: the model's frame follows its links, not the pose it was last
+/// placed at.
+#[test]
+fn a_model_that_has_fallen_is_placed_where_it_is_put() -> Result<()> {
+    use rover_sim::geometry::Pose;
+    use rover_sim::physics::{SimOptions, Simulation};
+    let Some(models) = shared("corpus/gazebo_models") else {
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("drop.toml");
+    std::fs::write(
+        &path,
+        "[[model]]\nuri = \"model://coke_can\"\nname = \"can\"\nposition_m = [1.0, 0.0, 0.3]\n",
+    )?;
+    let resources = ResourcePaths::default().with_model_path(models);
+    let world = World::load_with(&path, &resources)?;
+    let mut sim = Simulation::new(world, rover_tests::my_robot()?, &SimOptions::default())?;
+    let tipped = glam::Quat::from_rotation_x(80f32.to_radians());
+    sim.place_model(0, Pose::from_parts(glam::Vec3::new(1.0, 0.0, 0.3), tipped))?;
+    let steps = (1.0 / sim.dt_s()).round() as u64;
+    for _ in 0..steps {
+        sim.step();
+    }
+    let mut poses = Vec::new();
+    sim.model_link_poses_into(&mut poses);
+    let fallen = poses[0];
+    println!("fallen to {:?}", fallen.translation);
+    assert!(fallen.translation.z < 0.1, "it did not fall: {fallen:?}");
+    for at in [
+        glam::Vec3::new(2.0, 1.0, 0.5),
+        glam::Vec3::new(2.0, 1.2, 0.5),
+    ] {
+        sim.place_model(0, Pose::from_translation(at))?;
+        sim.model_link_poses_into(&mut poses);
+        let tilt_deg = (poses[0].rotation * glam::Vec3::Z).angle_between(glam::Vec3::Z);
+        assert!(
+            (poses[0].translation - at).length() < 1e-4 && tilt_deg.to_degrees() < 0.1,
+            "placed at {at:?}, its link is at {:?}, tilted {} deg",
+            poses[0].translation,
+            tilt_deg.to_degrees()
+        );
+    }
+    Ok(())
+}

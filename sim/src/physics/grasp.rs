@@ -5,8 +5,9 @@
 //! [`FORCES_ANGLE_TOLERANCE_DEG`] count as a grip. The count
 //! goes up (to [`MAX_GRIP_COUNT`]) on a grip and down otherwise; past
 //! [`GRIP_COUNT_THRESHOLD`] the object is attached to the palm with a fixed joint where it is.
-//! It is let go when a finger moves more than [`RELEASE_TOLERANCE_M`] further from it than it
-//! was when attached (the gripper opening). The constants stand for gazebo_grasp_fix's
+//! It is let go when a finger (its centre of mass: a turning finger's link origin is its pivot,
+//! which stays put as it opens) moves more than [`RELEASE_TOLERANCE_M`] further from it than
+//! it was when attached (the gripper opening). The constants stand for gazebo_grasp_fix's
 //! parameters of the same names (`forces_angle_tolerance`, `update_rate`,
 //! `grip_count_threshold`, `max_grip_count`, `release_tolerance`): a grip held for about a
 //! second attaches.
@@ -137,7 +138,7 @@ impl GraspAssist {
                 .zip(&held.finger_distance_m)
                 .any(|(f, d0)| {
                     physics.bodies.get(*f).is_some_and(|b| {
-                        (b.translation() - centre).length() > d0 + RELEASE_TOLERANCE_M
+                        (b.center_of_mass() - centre).length() > d0 + RELEASE_TOLERANCE_M
                     })
                 });
             if !opened {
@@ -221,7 +222,7 @@ impl GraspAssist {
             .fingers
             .iter()
             .filter_map(|f| physics.bodies.get(*f))
-            .map(|b| (b.translation() - centre).length())
+            .map(|b| (b.center_of_mass() - centre).length())
             .collect();
         let joint = FixedJointBuilder::new()
             .local_frame1(palm_pose.inverse() * object_pose)

@@ -165,7 +165,8 @@ impl Simulation {
     }
 
     /// Moves SDF model `index` (world order) rigidly so that its frame is at
-    /// `world_from_model`, its links at rest.
+    /// `world_from_model`, its links at rest. The frame is where the model's links have taken
+    /// it: a can that has fallen over is set upright at `world_from_model`.
     pub fn place_model(&mut self, index: usize, world_from_model: Pose) -> Result<()> {
         check_pose(&world_from_model, "model pose")?;
         let first: usize = self
@@ -184,18 +185,26 @@ impl Simulation {
         let model_from_links = match cached {
             Some((_, links)) => links.clone(),
             None => {
-                // Relative to the model as it was at its first placement since the last step.
-                let model_from_world = model.world_from_model.inverse();
-                let links: Vec<Pose> = (0..model.links.len())
+                // Its links as they are now (their joints' positions kept), relative to the
+                // model's frame as it is now: carried along by its first link since the model
+                // was last placed (physics moves the links, not `world_from_model`).
+                let now: Vec<Pose> = (0..model.links.len())
                     .map(|k| {
-                        let now = self
-                            .model_links
+                        self.model_links
                             .get(first + k)
                             .and_then(|h| self.physics.bodies.get(*h))
-                            .map_or(model.links[k].world_from_link, |b| *b.position());
-                        model_from_world * now
+                            .map_or(model.links[k].world_from_link, |b| *b.position())
                     })
                     .collect();
+                let model_from_world = match (model.links.first(), now.first()) {
+                    (Some(link), Some(first_now)) => {
+                        let link_from_model =
+                            link.world_from_link.inverse() * model.world_from_model;
+                        (*first_now * link_from_model).inverse()
+                    }
+                    _ => model.world_from_model.inverse(),
+                };
+                let links: Vec<Pose> = now.iter().map(|p| model_from_world * *p).collect();
                 self.placement.models.push((index, links.clone()));
                 links
             }

@@ -210,10 +210,11 @@ pub(crate) struct PhysicsBenchArgs {
     pub(crate) rates: Vec<f64>,
 
     /// Hold this world object or Gazebo model (`[[model]]` name) in the gripper while driving
-    /// (before the clock starts: the gripper opens, the object is put at the end effector, the
-    /// gripper closes on it);
-    /// needs a gripper controller and the world's [robot] ee_link. Says whether it was still
-    /// held at the end. E.g. `--world worlds/arm_car_pick.toml --spawn -3,-3 --hold ball`
+    /// (before the clock starts: the arm reaches its start pose, the gripper opens, the object
+    /// is held at the end effector while the gripper closes on it and, with the world's grasp
+    /// assist, until the assist takes it); needs a gripper controller and the world's [robot]
+    /// ee_link. Says whether it was still held at the end. E.g. `--world
+    /// worlds/arm_car_pick.toml --spawn -3,-3 --hold ball`
     #[arg(long, value_name = "NAME")]
     pub(crate) hold: Option<String>,
 }

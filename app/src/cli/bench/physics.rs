@@ -101,8 +101,8 @@ enum Held {
 
 /// Puts world object (or Gazebo model) `name` in the robot's gripper, untimed: the first
 /// gripper controller opens, the object's centre (a model's first link's centre of mass) goes
-/// to the end effector (the world's `[robot] ee_link`), the gripper closes on it with 5 N and
-/// settles. Returns what is held and the end effector.
+/// to the end effector (the world's `[robot] ee_link`) and is held there while the gripper
+/// closes on it with 5 N until two of the robot's links touch it, then it settles. Returns what is held and the end effector.
 fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::LinkId)> {
     let world = sim.world();
     let held = match world.objects.iter().position(|o| o.name == name) {
@@ -143,21 +143,67 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
             sim.step();
         }
     };
-    settle(sim, 1.0);
-    let at = sim.world_from_link(tool).translation;
-    match held {
-        Held::Object(i) => {
-            sim.place_object(i, [f64::from(at.x), f64::from(at.y), f64::from(at.z)], 0.0)?
-        }
-        Held::Model { model, link } => {
-            // The model moved rigidly, its first link's centre of mass to the end effector.
-            let centre = sim.model_link_centre(link).unwrap_or(at);
-            let world_from_model = sim.world().models[model].world_from_model;
-            let moved = rover_sim::geometry::Pose::from_translation(at - centre) * world_from_model;
-            sim.place_model(model, moved)?;
+    // Until the arm has reached its start pose (the world's `[robot] pose`): the tool still.
+    let still_by_s = sim.sim_time_s() + ARM_SETTLE_S;
+    loop {
+        let before = sim.world_from_link(tool).translation;
+        settle(sim, 0.1);
+        let moved = (sim.world_from_link(tool).translation - before).length();
+        if f64::from(moved) < TOOL_STILL_M || sim.sim_time_s() >= still_by_s {
+            break;
         }
     }
+    let at = sim.world_from_link(tool).translation;
+    // The model moved rigidly, its first link's centre of mass to the end effector.
+    let world_from_model = match held {
+        Held::Object(_) => None,
+        Held::Model { model, link } => {
+            let centre = sim.model_link_centre(link).unwrap_or(at);
+            let world_from_model = sim.world().models[model].world_from_model;
+            Some(rover_sim::geometry::Pose::from_translation(at - centre) * world_from_model)
+        }
+    };
+    let put = |sim: &mut Simulation| -> Result<()> {
+        match (held, world_from_model) {
+            (Held::Model { model, .. }, Some(pose)) => sim.place_model(model, pose)?,
+            (Held::Object(i), _) => {
+                sim.place_object(i, [f64::from(at.x), f64::from(at.y), f64::from(at.z)], 0.0)?
+            }
+            (Held::Model { .. }, None) => {}
+        }
+        Ok(())
+    };
+    // Held at the tool while the fingers close on it (a wide-open hand takes longer to close
+    // than the object takes to fall out of it), until they stop on it.
+    let finger = sim.robot().joint_id(&joint);
+    let finger_q = |sim: &Simulation| {
+        finger
+            .and_then(|j| sim.joint_state(j))
+            .map_or(0.0, |s| s.position)
+    };
     sim.command_gripper(&controller, closed, 5.0)?;
+    let closing_until_s = sim.sim_time_s() + CLOSING_S;
+    let mut still_steps = 0;
+    while sim.sim_time_s() < closing_until_s && still_steps < STOPPED_STEPS {
+        put(sim)?;
+        let q = finger_q(sim);
+        sim.step();
+        let moved = (finger_q(sim) - q).abs();
+        still_steps = if moved < STOPPED_RAD_PER_STEP {
+            still_steps + 1
+        } else {
+            0
+        };
+    }
+    // With the grasp assist (gazebo_grasp_fix's rule), held there until it takes it: a grip
+    // held for about a second attaches, and the object may slip out of the squeeze before.
+    if sim.world().robot.grasp == rover_sim::model::GraspMode::Assist {
+        let until_s = sim.sim_time_s() + CLOSING_S;
+        while sim.grasp_assist_holds().is_none() && sim.sim_time_s() < until_s {
+            put(sim)?;
+            sim.step();
+        }
+    }
     settle(sim, 1.5);
     let off = held_to_link_m(sim, held, tool);
     anyhow::ensure!(
@@ -166,6 +212,19 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
     );
     Ok((held, tool))
 }
+
+/// The longest the arm takes to reach its start pose before the object is put in the hand (s
+/// of sim time).
+const ARM_SETTLE_S: f64 = 10.0;
+/// A tool that moves less than this in 0.1 s (m) is still.
+const TOOL_STILL_M: f64 = 1e-3;
+/// The longest the fingers take to close on what `--hold` holds (s of sim time).
+const CLOSING_S: f64 = 3.0;
+
+/// A finger that moves less than this in a step (m or rad) ...
+const STOPPED_RAD_PER_STEP: f64 = 1e-4;
+/// ... for this many steps in a row has stopped on what it closes on.
+const STOPPED_STEPS: u32 = 10;
 
 /// An object this close to the end effector (m) is still in the hand.
 const HELD_WITHIN_M: f64 = 0.05;

@@ -59,6 +59,11 @@ impl DriveTo {
         *self = Self::default();
     }
 
+    /// Whether a pose drive has reached its point and turns to its heading.
+    pub(crate) fn at_point(&self) -> bool {
+        self.turning
+    }
+
     /// The command at `now_s` that backs straight up.
     pub(crate) fn back(&mut self, now_s: f64) -> Twist {
         let dt = self.last_s.map_or(0.0, |t| (now_s - t).max(0.0));

@@ -27,6 +27,9 @@ const SPAN_SLACK_M: f64 = 0.005;
 pub(super) const GRASP_YAWS_DEG: [f64; 5] = [0.0, -20.0, 20.0, -40.0, 40.0];
 /// ... and set it down with.
 const PLACE_YAWS_DEG: [f64; 7] = [0.0, -20.0, 20.0, -40.0, 40.0, -60.0, 60.0];
+/// How much farther than its bounding radius (m) an object is set down inside a place's edges
+/// when it goes elsewhere than the place's middle.
+const SPOT_MARGIN_M: f64 = 0.03;
 /// How far the tool backs up after letting go (m).
 const RETREAT_M: f64 = 0.05;
 /// Seconds to full speed on a timed path.
@@ -134,11 +137,13 @@ impl Pick {
             None => {}
         }
         // Held up while the base drives.
+        let spots = self.place_spots(sim, place.0, target.bound_m + SPOT_MARGIN_M);
         self.held = Some(Held {
             target,
             way: grasp.way,
             home_q: q0,
             place,
+            spots,
         });
         Ok(steps)
     }
@@ -189,6 +194,29 @@ impl Pick {
         }
     }
 
+    /// The ways the hand may come over the place at `over` (base frame) holding `target` as
+    /// way `way_held` took it: an upright object at the same pitch, turned round the vertical;
+    /// anything else any way round the point.
+    pub(super) fn place_ways(
+        &self,
+        (target, way_held): (&Target, &Way),
+        g: &Gripper,
+        over: Vector3<f64>,
+    ) -> Vec<Way> {
+        match target.upright {
+            Some(radius_m) => {
+                let pitch_deg = (-way_held.along.z).clamp(-1.0, 1.0).asin().to_degrees();
+                self.ways_upright(
+                    over,
+                    (radius_m, target.half_height_m),
+                    g,
+                    (&[pitch_deg], &PLACE_YAWS_DEG),
+                )
+            }
+            None => self.ways_round(over, g.finger.half_width_m(g.open)),
+        }
+    }
+
     /// From the lift (`lift_q`) with the object `held` as the hand took it: the carry to over
     /// the place (`over`, base frame), the straight way down `lower_m` (none for a drop), the
     /// release, the retreat and the way home (`home_q`).
@@ -207,19 +235,7 @@ impl Pick {
         };
         // Carrying: the object on the tool, as the hand holds it.
         self.attach_held(scene, &target, &way_held);
-        let ways = match target.upright {
-            // Upright as it was taken: the hand at the same pitch, turned round the vertical.
-            Some(radius_m) => {
-                let pitch_deg = (-way_held.along.z).clamp(-1.0, 1.0).asin().to_degrees();
-                self.ways_upright(
-                    over,
-                    (radius_m, target.half_height_m),
-                    g,
-                    (&[pitch_deg], &PLACE_YAWS_DEG),
-                )
-            }
-            None => self.ways_round(over, g.finger.half_width_m(g.open)),
-        };
+        let ways = self.place_ways((&target, &way_held), g, over);
         let (place_q, _, way) = self
             .reachable(scene, over, lift_q, "the place", None, &ways)
             .map_err(|why| format!("cannot reach over the place: {why}"))?;

@@ -31,6 +31,21 @@ const RANGE_STEP_M: f64 = 0.02;
 const RUN_MARGIN_M: f64 = 0.04;
 
 impl Pick {
+    /// An IK solver for the arm's chain that tries once, without random restarts: for surveys
+    /// of many points, each seeded from a solution near it.
+    pub(super) fn quick_solver(&self) -> Result<IkSolver, String> {
+        IkSolver::new(
+            self.solver.chain().clone(),
+            IkOptions {
+                restarts: 0,
+                tolerance_m: 5e-4,
+                tolerance_rad: 5e-3,
+                ..IkOptions::default()
+            },
+        )
+        .map_err(|e| e.to_string())
+    }
+
     /// Whether the arm reaches `target` from its pose now, by IK alone, any of the ways it
     /// would be taken.
     pub(super) fn reaches(&mut self, sim: &Simulation, target: &Target) -> bool {
@@ -77,16 +92,7 @@ impl Pick {
         world_from_base: &Isometry3<f64>,
         (ignore, ignore_m): (Vector3<f64>, f64),
     ) -> Result<Vector2<f64>, String> {
-        let mut survey = IkSolver::new(
-            self.solver.chain().clone(),
-            IkOptions {
-                restarts: 0,
-                tolerance_m: 5e-4,
-                tolerance_rad: 5e-3,
-                ..IkOptions::default()
-            },
-        )
-        .map_err(|e| e.to_string())?;
+        let mut survey = self.quick_solver()?;
         let target_world = world_from_base * Point3::from(target);
         let body = body_footprint(sim, self.base);
         let obstacles = obstacles(sim, ignore, ignore_m);

@@ -5,18 +5,25 @@ use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 use rover_sim::{
-    model::isometry_from_pose,
-    physics::{Simulation, wrap_angle},
+    model::{IkSolver, isometry_from_pose},
+    physics::{Simulation, Twist, wrap_angle},
 };
 
 use super::fetch::{BACK_OFF_M, FETCH_FROM_M, MAX_DRIVE_S, SETTLE_BASE_S};
 use super::ground::{beside, body_footprint, obstacles, stance_pose, stance_yaw};
 use super::plan::{over_place, spans};
 use super::route::route;
-use super::state::{Held, Leg, Pick, PickState, Step, Target};
+use super::state::{Gripper, Held, Leg, Pick, PickState, Step, Target};
+use super::ways::ik_close;
 
 /// A corner of a route within this (m) of the arm's base is passed.
 const VIA_REACHED_M: f64 = 0.12;
+/// How often (s of sim time) a pose drive to the place, at its point, asks whether the arm
+/// already reaches the place.
+const REACH_CHECK_S: f64 = 0.5;
+/// At most this many of a place's spots are planned (each one the arm reaches by IK) before
+/// the place's plan gives up.
+const SPOTS_PLANNED: usize = 4;
 
 impl Pick {
     /// Where the object should be when the base stops to pick it (arm base frame, m), when
@@ -132,6 +139,7 @@ impl Pick {
             back_from: None,
             via,
             yaw_rad,
+            reach_checked_s: started_s,
         });
         true
     }
@@ -226,6 +234,12 @@ impl Pick {
             }
             None => self.drive.command(now, point.coords.xy(), at),
         };
+        let (cmd, there) = if !there && self.near_enough(sim, &mut leg, now) {
+            self.drive.reset();
+            (Twist::ZERO, true)
+        } else {
+            (cmd, there)
+        };
         self.base_cmd = Some(cmd);
         let to_place = leg.to_place;
         if !there {
@@ -286,6 +300,7 @@ impl Pick {
                 back_from: (!beside(at)).then_some(base),
                 via,
                 yaw_rad: beside(at).then_some(yaw),
+                reach_checked_s: now,
             });
             self.drive.reset();
             self.state = PickState::Delivering;
@@ -339,7 +354,71 @@ impl Pick {
         Ok(())
     }
 
-    /// The place's plan from where the arm is now, the object held as it was taken.
+    /// Whether a pose drive to the place (`leg`), at its point and turning to its heading,
+    /// may stop where it is: the arm reaches one of the place's spots from here (checked
+    /// every [`REACH_CHECK_S`]). A base that reaches its point a little off its heading
+    /// (Stretch's, on its box-shaped wheels) need not turn in place the last few degrees,
+    /// which drags it off the point again.
+    fn near_enough(&mut self, sim: &Simulation, leg: &mut Leg, now: f64) -> bool {
+        if !leg.to_place || leg.yaw_rad.is_none() || !self.drive.at_point() {
+            return false;
+        }
+        if now - leg.reach_checked_s < REACH_CHECK_S {
+            return false;
+        }
+        leg.reach_checked_s = now;
+        let (Some(held), Ok(g)) = (self.held.clone(), self.gripper.clone()) else {
+            return false;
+        };
+        let Ok(mut quick) = self.quick_solver() else {
+            return false;
+        };
+        let world_from_base = isometry_from_pose(&sim.world_from_link(self.base));
+        let q = self.chain_q(sim);
+        let reached = held.spots.iter().position(|spot| {
+            let (over, _) = over_place(
+                &world_from_base,
+                (*spot, held.place.1, held.place.2),
+                held.target.half_height_m,
+            );
+            self.reaches_over(&mut quick, (&held, &g), over, &q)
+        });
+        if let Some(k) = reached {
+            let heading = leg
+                .yaw_rad
+                .map_or(0.0, |yaw| wrap_angle(yaw - yaw_of(&world_from_base)));
+            self.said.push((
+                false,
+                format!(
+                    "pick: fetch: the arm reaches the place from here ({:.1} deg off the stance's heading; spot {k} of {})",
+                    heading.to_degrees(),
+                    held.spots.len()
+                ),
+            ));
+        }
+        reached.is_some()
+    }
+
+    /// Whether the arm, at `q`, reaches over the place at `over` (base frame) with the object
+    /// `held` as it was taken, any of the place's ways, by IK alone (`quick`).
+    fn reaches_over(
+        &self,
+        quick: &mut IkSolver,
+        (held, g): (&Held, &Gripper),
+        over: Vector3<f64>,
+        q: &[f64],
+    ) -> bool {
+        let ways = self.place_ways((&held.target, &held.way), g, over);
+        ways.iter().any(|way| {
+            quick
+                .solve(&way.target(over + way.offset), q)
+                .is_ok_and(|s| ik_close(s.position_error_m, s.orientation_error_rad))
+        })
+    }
+
+    /// The place's plan from where the arm is now, the object held as it was taken: over the
+    /// place's point, else over the first of its other spots the arm reaches (at most
+    /// [`SPOTS_PLANNED`] of them planned).
     fn plan_delivery(
         &mut self,
         sim: &Simulation,
@@ -360,14 +439,45 @@ impl Pick {
         ) {
             scene.ignore_object(i, true);
         }
-        let over = over_place(&world_from_base, held.place, held.target.half_height_m);
-        self.plan_place(
-            &mut scene,
-            (held.target, held.way),
-            &g,
-            (&q, &held.home_q),
-            over,
-        )
+        let mut quick = self.quick_solver()?;
+        let mut first_why: Option<String> = None;
+        let mut planned = 0;
+        for (k, spot) in held.spots.iter().enumerate() {
+            let over = over_place(
+                &world_from_base,
+                (*spot, held.place.1, held.place.2),
+                held.target.half_height_m,
+            );
+            if k > 0 && !self.reaches_over(&mut quick, (&held, &g), over.0, &q) {
+                continue;
+            }
+            let mut tried = scene.clone();
+            let way = (held.target, held.way.clone());
+            match self.plan_place(&mut tried, way, &g, (&q, &held.home_q), over) {
+                Ok(steps) => {
+                    if k > 0 {
+                        self.said.push((
+                            false,
+                            format!(
+                                "pick: fetch: the place's middle is out of reach from where the base stopped ({}): setting it down at ({:.2}, {:.2}) m",
+                                first_why.as_deref().unwrap_or("?"),
+                                spot[0],
+                                spot[1]
+                            ),
+                        ));
+                    }
+                    return Ok(steps);
+                }
+                Err(why) => {
+                    first_why.get_or_insert(why);
+                    planned += 1;
+                    if planned >= SPOTS_PLANNED {
+                        break;
+                    }
+                }
+            }
+        }
+        Err(first_why.unwrap_or_else(|| "no spot on the place is in the arm's reach".to_owned()))
     }
 }
 

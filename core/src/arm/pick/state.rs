@@ -351,6 +351,9 @@ pub(super) struct Leg {
     /// ([`super::ground::beside`]): the base drives to that pose. `None`: the point's range
     /// and bearing from the base decide the drive.
     pub(super) yaw_rad: Option<f64>,
+    /// When the drive last asked whether the arm reaches the place from where the base is
+    /// (s of sim time): a pose drive to the place stops as soon as it does.
+    pub(super) reach_checked_s: f64,
 }
 
 /// The object in the hand while the base drives to the place.
@@ -365,6 +368,10 @@ pub(super) struct Held {
     /// The place ([`Pick::place_under`]): the point under the object (world, m), how high above
     /// it the carry ends, how far the hand then goes straight down.
     pub(super) place: ([f64; 3], f64, f64),
+    /// Where on the place it may go (world, m; [`Pick::place_spots`]): the place's point
+    /// first. The base need not stop exactly where it was sent: the place's plan takes the
+    /// first spot the arm reaches from where it stopped.
+    pub(super) spots: Vec<[f64; 3]>,
 }
 
 #[cfg(test)]
