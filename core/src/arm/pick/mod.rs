@@ -25,6 +25,7 @@
 //!    place, and the arm retreats and goes back to where it started.
 
 mod config;
+mod deliver;
 mod fetch;
 mod ground;
 mod plan;
