@@ -67,8 +67,8 @@ fn poses(session: &Session) -> (Pose, Vec<Pose>) {
 /// close, the can is at least 0.5 m further along towards the other table, at least 3 cm above
 /// the counter, leaning no more than 15 degrees. The pick then sets it down on the other
 /// table: done within 60 s of the toggle, and 2 s later the can stands on table_b's top
-/// (within its edges, its bottom within 1 cm of the top), leaning no more than 15 degrees,
-/// let go.
+/// (its axis at least its radius inside the edges, its bottom within 1 cm of the top),
+/// leaning no more than 15 degrees, let go.
 #[test]
 fn stretch_sees_the_can_takes_it_and_sets_it_down_on_the_other_table() -> Result<()> {
     let Some(mut session) = session(1)? else {
@@ -206,7 +206,8 @@ fn stretch_sees_the_can_takes_it_and_sets_it_down_on_the_other_table() -> Result
         tilt_deg(&placed),
         session.sim().grasp_assist_holds()
     );
-    let half_m = 0.25;
+    // Standing on it whole: its axis the can's radius (3.3 cm) inside table_b's edges.
+    let half_m = 0.25 - 0.033;
     assert!(
         on_top.x.abs() <= half_m && on_top.y.abs() <= half_m,
         "the can is not over table_b: {on_top:?} from its middle"

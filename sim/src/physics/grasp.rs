@@ -221,8 +221,13 @@ impl GraspAssist {
         let finger_distance_m = self
             .fingers
             .iter()
-            .filter_map(|f| physics.bodies.get(*f))
-            .map(|b| (b.center_of_mass() - centre).length())
+            // One per finger, in order (a finger without a body never counts as opened).
+            .map(|f| {
+                physics
+                    .bodies
+                    .get(*f)
+                    .map_or(f32::INFINITY, |b| (b.center_of_mass() - centre).length())
+            })
             .collect();
         let joint = FixedJointBuilder::new()
             .local_frame1(palm_pose.inverse() * object_pose)

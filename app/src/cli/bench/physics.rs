@@ -100,9 +100,11 @@ enum Held {
 }
 
 /// Puts world object (or Gazebo model) `name` in the robot's gripper, untimed: the first
-/// gripper controller opens, the object's centre (a model's first link's centre of mass) goes
-/// to the end effector (the world's `[robot] ee_link`) and is held there while the gripper
-/// closes on it with 5 N until two of the robot's links touch it, then it settles. Returns what is held and the end effector.
+/// gripper controller opens once the arm is still in its start pose, the object's centre (a
+/// model's first link's centre of mass) goes to the end effector (the world's `[robot]
+/// ee_link`) and is held there while the gripper closes on it with 5 N until the finger stops
+/// on it (and, with the world's grasp assist, until the assist takes it), then it settles.
+/// Returns what is held and the end effector.
 fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::LinkId)> {
     let world = sim.world();
     let held = match world.objects.iter().position(|o| o.name == name) {
@@ -143,7 +145,9 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
             sim.step();
         }
     };
-    // Until the arm has reached its start pose (the world's `[robot] pose`): the tool still.
+    // Until the arm has reached its start pose (the world's `[robot] pose`): the tool still,
+    // after a second at least (a slow lift may not have started yet).
+    settle(sim, 1.0);
     let still_by_s = sim.sim_time_s() + ARM_SETTLE_S;
     loop {
         let before = sim.world_from_link(tool).translation;
@@ -155,14 +159,7 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
     }
     let at = sim.world_from_link(tool).translation;
     // The model moved rigidly, its first link's centre of mass to the end effector.
-    let world_from_model = match held {
-        Held::Object(_) => None,
-        Held::Model { model, link } => {
-            let centre = sim.model_link_centre(link).unwrap_or(at);
-            let world_from_model = sim.world().models[model].world_from_model;
-            Some(rover_sim::geometry::Pose::from_translation(at - centre) * world_from_model)
-        }
-    };
+    let world_from_model = model_at_tool(sim, held, at);
     let put = |sim: &mut Simulation| -> Result<()> {
         match (held, world_from_model) {
             (Held::Model { model, .. }, Some(pose)) => sim.place_model(model, pose)?,
@@ -183,16 +180,18 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
     };
     sim.command_gripper(&controller, closed, 5.0)?;
     let closing_until_s = sim.sim_time_s() + CLOSING_S;
-    let mut still_steps = 0;
+    let (mut still_steps, mut started) = (0, false);
     while sim.sim_time_s() < closing_until_s && still_steps < STOPPED_STEPS {
         put(sim)?;
         let q = finger_q(sim);
         sim.step();
-        let moved = (finger_q(sim) - q).abs();
-        still_steps = if moved < STOPPED_RAD_PER_STEP {
-            still_steps + 1
-        } else {
+        let moved = (finger_q(sim) - q).abs() >= STOPPED_RAD_PER_STEP;
+        started |= moved;
+        // Counted once the finger has started to close.
+        still_steps = if moved || !started {
             0
+        } else {
+            still_steps + 1
         };
     }
     // With the grasp assist (gazebo_grasp_fix's rule), held there until it takes it: a grip
@@ -211,6 +210,26 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
         "--hold {name}: the gripper did not take it ({off:.3} m from {ee} after closing)"
     );
     Ok((held, tool))
+}
+
+/// For a model held: the pose of its frame that brings its first link's centre of mass to
+/// `at`, from its frame as that link carries it now (the frame it was last placed at does not
+/// follow physics). `None` for a world object.
+fn model_at_tool(
+    sim: &Simulation,
+    held: Held,
+    at: glam::Vec3,
+) -> Option<rover_sim::geometry::Pose> {
+    let Held::Model { model, link } = held else {
+        return None;
+    };
+    let centre = sim.model_link_centre(link).unwrap_or(at);
+    let mut links = Vec::new();
+    sim.model_link_poses_into(&mut links);
+    let m = sim.world().models.get(model)?;
+    let (now, stored) = links.get(link).copied().zip(m.links.first())?;
+    let link_from_model = stored.world_from_link.inverse() * m.world_from_model;
+    Some(rover_sim::geometry::Pose::from_translation(at - centre) * now * link_from_model)
 }
 
 /// The longest the arm takes to reach its start pose before the object is put in the hand (s

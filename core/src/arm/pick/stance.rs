@@ -1,5 +1,5 @@
-//! Where the base stands for a pick (`fetch`): driving it to within reach of the object, and
-//! with the object in the hand to the place, then the place's plan from there.
+//! Where the base stands for a pick (`fetch`): driving it to within reach of the object or
+//! the place (the drive to the place starts in `deliver.rs`), round what stands between.
 
 use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 use rover_sim::{
