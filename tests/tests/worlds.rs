@@ -516,6 +516,16 @@ fn a_model_that_has_fallen_is_placed_where_it_is_put() -> Result<()> {
     let fallen = poses[0];
     println!("fallen to {:?}", fallen.translation);
     assert!(fallen.translation.z < 0.1, "it did not fall: {fallen:?}");
+    // Its frame went with it (the can's link is at its frame).
+    let frame = sim
+        .world_from_model_now(0)
+        .ok_or_else(|| anyhow::anyhow!("no model 0"))?;
+    assert!(
+        (frame.translation - fallen.translation).length() < 1e-4
+            && frame.rotation.angle_between(fallen.rotation) < 1e-3,
+        "the frame is at {frame:?}, the link at {fallen:?}"
+    );
+    assert!(sim.world_from_model_now(1).is_none());
     for at in [
         glam::Vec3::new(2.0, 1.0, 0.5),
         glam::Vec3::new(2.0, 1.2, 0.5),

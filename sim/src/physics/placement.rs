@@ -164,9 +164,27 @@ impl Simulation {
         Ok(())
     }
 
+    /// Where SDF model `index`'s (world order) frame is now: carried along by its first link
+    /// since it was loaded or last placed (physics moves the links, not the model's stored
+    /// `world_from_model`). `None` for no such model.
+    pub fn world_from_model_now(&self, index: usize) -> Option<Pose> {
+        let model = self.world.models.get(index)?;
+        let Some(link) = model.links.first() else {
+            return Some(model.world_from_model);
+        };
+        let first: usize = (self.world.models.iter().take(index))
+            .map(|m| m.links.len())
+            .sum();
+        let now = (self.model_links.get(first))
+            .and_then(|h| self.physics.bodies.get(*h))
+            .map_or(link.world_from_link, |b| *b.position());
+        Some(now * link.world_from_link.inverse() * model.world_from_model)
+    }
+
     /// Moves SDF model `index` (world order) rigidly so that its frame is at
     /// `world_from_model`, its links at rest. The frame is where the model's links have taken
-    /// it: a can that has fallen over is set upright at `world_from_model`.
+    /// it ([`Self::world_from_model_now`]): a can that has fallen over is set upright at
+    /// `world_from_model`.
     pub fn place_model(&mut self, index: usize, world_from_model: Pose) -> Result<()> {
         check_pose(&world_from_model, "model pose")?;
         let first: usize = self
@@ -176,6 +194,10 @@ impl Simulation {
             .take(index)
             .map(|m| m.links.len())
             .sum();
+        let model_from_world = self
+            .world_from_model_now(index)
+            .ok_or_else(|| no_such("model", index))?
+            .inverse();
         let model = self
             .world
             .models
@@ -186,25 +208,17 @@ impl Simulation {
             Some((_, links)) => links.clone(),
             None => {
                 // Its links as they are now (their joints' positions kept), relative to the
-                // model's frame as it is now: carried along by its first link since the model
-                // was last placed (physics moves the links, not `world_from_model`).
-                let now: Vec<Pose> = (0..model.links.len())
+                // model's frame as it is now.
+                let links: Vec<Pose> = (0..model.links.len())
                     .map(|k| {
-                        self.model_links
+                        let now = self
+                            .model_links
                             .get(first + k)
                             .and_then(|h| self.physics.bodies.get(*h))
-                            .map_or(model.links[k].world_from_link, |b| *b.position())
+                            .map_or(model.links[k].world_from_link, |b| *b.position());
+                        model_from_world * now
                     })
                     .collect();
-                let model_from_world = match (model.links.first(), now.first()) {
-                    (Some(link), Some(first_now)) => {
-                        let link_from_model =
-                            link.world_from_link.inverse() * model.world_from_model;
-                        (*first_now * link_from_model).inverse()
-                    }
-                    _ => model.world_from_model.inverse(),
-                };
-                let links: Vec<Pose> = now.iter().map(|p| model_from_world * *p).collect();
                 self.placement.models.push((index, links.clone()));
                 links
             }

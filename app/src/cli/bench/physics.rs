@@ -158,8 +158,15 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
         }
     }
     let at = sim.world_from_link(tool).translation;
-    // The model moved rigidly, its first link's centre of mass to the end effector.
-    let world_from_model = model_at_tool(sim, held, at);
+    // A model moved rigidly from where it is now, its first link's centre of mass to the end
+    // effector.
+    let world_from_model = match held {
+        Held::Object(_) => None,
+        Held::Model { model, link } => sim.world_from_model_now(model).map(|now| {
+            let centre = sim.model_link_centre(link).unwrap_or(at);
+            rover_sim::geometry::Pose::from_translation(at - centre) * now
+        }),
+    };
     let put = |sim: &mut Simulation| -> Result<()> {
         match (held, world_from_model) {
             (Held::Model { model, .. }, Some(pose)) => sim.place_model(model, pose)?,
@@ -210,26 +217,6 @@ fn grasp(sim: &mut Simulation, name: &str) -> Result<(Held, rover_sim::model::Li
         "--hold {name}: the gripper did not take it ({off:.3} m from {ee} after closing)"
     );
     Ok((held, tool))
-}
-
-/// For a model held: the pose of its frame that brings its first link's centre of mass to
-/// `at`, from its frame as that link carries it now (the frame it was last placed at does not
-/// follow physics). `None` for a world object.
-fn model_at_tool(
-    sim: &Simulation,
-    held: Held,
-    at: glam::Vec3,
-) -> Option<rover_sim::geometry::Pose> {
-    let Held::Model { model, link } = held else {
-        return None;
-    };
-    let centre = sim.model_link_centre(link).unwrap_or(at);
-    let mut links = Vec::new();
-    sim.model_link_poses_into(&mut links);
-    let m = sim.world().models.get(model)?;
-    let (now, stored) = links.get(link).copied().zip(m.links.first())?;
-    let link_from_model = stored.world_from_link.inverse() * m.world_from_model;
-    Some(rover_sim::geometry::Pose::from_translation(at - centre) * now * link_from_model)
 }
 
 /// The longest the arm takes to reach its start pose before the object is put in the hand (s

@@ -126,7 +126,7 @@ impl Pick {
             return false;
         }
         leg.reach_checked_s = now;
-        let (Some(held), Ok(g)) = (self.held.clone(), self.gripper.clone()) else {
+        let (Some(held), Ok(g)) = (&self.held, &self.gripper) else {
             return false;
         };
         let Ok(mut quick) = self.quick_solver() else {
@@ -140,8 +140,9 @@ impl Pick {
                 (*spot, held.place.1, held.place.2),
                 held.target.half_height_m,
             );
-            self.reaches_over(&mut quick, (&held, &g), over, &q)
+            self.reaches_over(&mut quick, (held, g), over, &q)
         });
+        let spots = held.spots.len();
         if let Some(k) = reached {
             let heading = leg
                 .yaw_rad
@@ -149,9 +150,8 @@ impl Pick {
             self.said.push((
                 false,
                 format!(
-                    "pick: fetch: the arm reaches the place from here ({:.1} deg off the stance's heading; spot {k} of {})",
+                    "pick: fetch: the arm reaches the place from here ({:.1} deg off the stance's heading; spot {k} of {spots})",
                     heading.to_degrees(),
-                    held.spots.len()
                 ),
             ));
         }

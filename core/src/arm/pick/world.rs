@@ -11,6 +11,11 @@ use super::plan::SET_DOWN_M;
 use super::state::Pick;
 
 impl Pick {
+    /// The place: the configured one, else the world's `[robot] place`.
+    fn place(&self, sim: &Simulation) -> Option<Place> {
+        (self.config.place.clone()).or_else(|| sim.world().robot.place.clone())
+    }
+
     /// Where the object's bottom goes (world frame), how high above that the carry ends, and
     /// how far the hand then goes straight down before letting go (m): over a world object's
     /// top centre, [`PickConfig::drop_height_m`] and no further (dropped into a bin, onto a
@@ -21,13 +26,7 @@ impl Pick {
         &self,
         sim: &Simulation,
     ) -> Result<Option<([f64; 3], f64, f64)>, String> {
-        let world = sim.world();
-        let name = match self
-            .config
-            .place
-            .clone()
-            .or_else(|| world.robot.place.clone())
-        {
+        let name = match self.place(sim) {
             None => return Ok(None),
             Some(Place::Point(p)) => {
                 let above = self.config.approach_m.max(SET_DOWN_M);
@@ -56,14 +55,8 @@ impl Pick {
         inset_m: f64,
     ) -> Vec<[f64; 3]> {
         let mut spots = vec![point];
-        let name = match self
-            .config
-            .place
-            .clone()
-            .or_else(|| sim.world().robot.place.clone())
-        {
-            Some(Place::Object(name)) => name,
-            _ => return spots,
+        let Some(Place::Object(name)) = self.place(sim) else {
+            return spots;
         };
         if let Ok((shape, pose)) = world_object(sim, &name, "to place on") {
             spots.extend(
